@@ -1,0 +1,145 @@
+"""Screw-theory mobility of a platform connected to the base by serial chains (as paper 5 does by hand).
+
+For chain i with unit joint screws ``S_i (n_i, 6)`` expressed in one frame at one configuration:
+
+* its twist system is ``span(S_i)``;
+* its constraint system is every wrench reciprocal to all of them: ``W`` with
+  ``reciprocal_product(W, S) = W^T Delta S = 0``, ``Delta = [[0, I], [I, 0]]``;
+* the platform's constraint system is the union (span of all chains' constraints), and its twist
+  system is the reciprocal of that union; ``dof = 6 - rank(union)``.
+
+Numerical ranks use the SVD with a relative tolerance :data:`RANK_RTOL`; screws mix angular (1) and
+length units, so express them in a length unit in which the mechanism's size is of order one, or
+pass ``length_scale``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array
+
+__all__ = ["RANK_RTOL", "ChainScrews", "MobilityResult", "analyze", "reciprocal_basis"]
+
+# Singular values below RANK_RTOL * max(1, sigma_max) count as zero.  Unit screws of a mechanism of
+# size ~1 have entries of order one; rounding in their construction leaves ~1e-15, while a
+# genuinely independent direction of a non-degenerate mechanism is far above 1e-9.
+RANK_RTOL = 1e-9
+
+_DELTA = np.block([[np.zeros((3, 3)), np.eye(3)], [np.eye(3), np.zeros((3, 3))]])
+
+
+def _row_basis(X: np.ndarray, tol: float) -> np.ndarray:
+    """Orthonormal basis (k, 6) of the row space of X."""
+    if X.size == 0:
+        return np.zeros((0, 6))
+    _, s, Vt = np.linalg.svd(X)
+    cutoff = tol * max(1.0, s[0] if s.size else 0.0)
+    return Vt[: int(np.sum(s > cutoff))]
+
+
+def _null_basis(X: np.ndarray, tol: float) -> np.ndarray:
+    """Orthonormal basis (k, 6) of ``{y : X y = 0}``."""
+    if X.size == 0:
+        return np.eye(6)
+    _, s, Vt = np.linalg.svd(X)
+    cutoff = tol * max(1.0, s[0] if s.size else 0.0)
+    r = int(np.sum(s > cutoff))
+    return Vt[r:]
+
+
+def reciprocal_basis(screws: object, *, tol: float = RANK_RTOL) -> np.ndarray:
+    """Basis (k, 6) of the screws reciprocal to every row of ``screws (m, 6)``."""
+    S = as_array(screws, "screws", (None, 6))
+    if S.ndim != 2:
+        raise ValueError(f"Expected screws to have shape (m, 6), got {S.shape}.")
+    return _null_basis(S @ _DELTA, tol) if S.shape[0] else np.eye(6)
+
+
+@dataclass(frozen=True)
+class ChainScrews:
+    twists: np.ndarray  # (r_i, 6) basis of the chain's twist system
+    constraints: np.ndarray  # (c_i, 6) basis of its constraint (wrench) system
+
+
+@dataclass(frozen=True)
+class MobilityResult:
+    """Mobility of the platform and the counts that explain it."""
+
+    dof: int
+    platform_twists: np.ndarray  # (dof, 6) orthonormal basis of the platform twist system
+    constraint_wrenches: np.ndarray  # (6 - dof, 6) basis of the union of the chains' constraints
+    chains: tuple[ChainScrews, ...]
+    rotational_dof: int  # rank of the angular parts of the platform twists
+    translational_dof: int  # dimension of the pure translations the platform can make
+    common_constraints: int  # lambda: dimension of the constraints shared by every chain
+    redundant_constraints: int  # nu: constraints beyond the common ones that repeat others
+    gruebler_kutzbach: int  # 6(n - g - 1) + sum f, the spatial count
+    modified_gruebler_kutzbach: int  # (6 - lambda)(n - g - 1) + sum f + nu
+
+    def summary(self) -> str:
+        return (
+            f"DOF {self.dof} ({self.rotational_dof}R{self.translational_dof}T); "
+            f"constraints {self.constraint_wrenches.shape[0]} independent, "
+            f"common {self.common_constraints}, redundant {self.redundant_constraints}; "
+            f"Gruebler-Kutzbach {self.gruebler_kutzbach}, modified {self.modified_gruebler_kutzbach}"
+        )
+
+
+def _intersection_dim(bases: Sequence[np.ndarray], tol: float) -> int:
+    """Dimension of the intersection of subspaces given by row bases."""
+    # The intersection is the reciprocal-free complement: orthogonal complement of the sum of complements.
+    complements = [_null_basis(B, tol) if B.shape[0] else np.eye(6) for B in bases]
+    stacked = np.vstack(complements) if complements else np.zeros((0, 6))
+    return 6 - _row_basis(stacked, tol).shape[0]
+
+
+def analyze(chains: Sequence[object], *, length_scale: float = 1.0, tol: float = RANK_RTOL) -> MobilityResult:
+    """Platform mobility from each chain's unit joint screws (``[w; v]``; ``[0; d]`` for prismatic).
+
+    ``length_scale`` divides the moment parts so that the screws are of order one (e.g. the
+    mechanism's radius in the units used).  The Grübler–Kutzbach counts assume each chain is a serial
+    chain of one-DOF joints from base to platform (a universal joint is two screws, a spherical three).
+    """
+    if len(chains) == 0:
+        raise ValueError("Expected chains to hold at least one (n_i, 6) array of joint screws, got none.")
+    if not (np.isfinite(length_scale) and length_scale > 0):
+        raise ValueError(f"Expected length_scale > 0, got {length_scale!r}.")
+    scale = np.array([1, 1, 1, 1 / length_scale, 1 / length_scale, 1 / length_scale])
+    per_chain = []
+    for i, c in enumerate(chains):
+        S = as_array(c, f"chains[{i}]", (None, 6))
+        if S.ndim != 2 or S.shape[0] == 0:
+            raise ValueError(f"Expected chains[{i}] to have shape (n_i, 6) with n_i >= 1, got {S.shape}.")
+        S = S * scale
+        twists = _row_basis(S, tol)
+        constraints = _null_basis(S @ _DELTA, tol)
+        per_chain.append(ChainScrews(twists=twists, constraints=constraints))
+
+    all_constraints = np.vstack([c.constraints for c in per_chain])
+    union = _row_basis(all_constraints, tol)
+    platform = _null_basis(union @ _DELTA, tol) if union.shape[0] else np.eye(6)
+    dof = platform.shape[0]
+
+    rot = _row_basis(platform[:, :3], tol).shape[0] if dof else 0
+    lam = _intersection_dim([c.constraints for c in per_chain], tol)
+    nu = sum(c.constraints.shape[0] - lam for c in per_chain) - (union.shape[0] - lam)
+
+    n_joints = sum(np.asarray(c).shape[0] for c in chains)
+    n_links = 2 + sum(np.asarray(c).shape[0] - 1 for c in chains)
+    loops = n_links - n_joints - 1
+    return MobilityResult(
+        dof=dof,
+        platform_twists=platform / scale,
+        constraint_wrenches=union / scale[[3, 4, 5, 0, 1, 2]],  # wrench [m; f]: m carries length
+        chains=tuple(per_chain),
+        rotational_dof=rot,
+        translational_dof=dof - rot,
+        common_constraints=lam,
+        redundant_constraints=nu,
+        gruebler_kutzbach=6 * loops + n_joints,
+        modified_gruebler_kutzbach=(6 - lam) * loops + n_joints + nu,
+    )

@@ -1,0 +1,136 @@
+"""Rigid-body dynamics from body Jacobians (Lagrange's equations in matrix form) and virtual-work statics.
+
+For a mechanism whose bodies b = 1..B have body twists ``V_b = J_b(q) qd`` (``J_b (..., B, 6, n)``,
+body frames, ``[w; v]``), Lagrange's equations give
+
+    tau = sum_b J_b^T ( G_b (J_b qdd + Jdot_b qd - g_b) - ad(V_b)^T G_b V_b )
+
+with ``G_b`` the 6x6 spatial inertia in the body frame and ``g_b = [0; R_b^T g]`` gravity expressed
+in the body frame.  This is exact for any holonomic mechanism once the closure is solved, i.e. once
+``J_b`` maps the independent coordinates q (a parallel mechanism's platform angles, say) to each
+body's twist: the constraint forces do no virtual work and drop out.  Actuator forces then follow by
+virtual work from the actuator Jacobian (:func:`actuator_forces`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array
+from robomech.spatial import ad, hat
+
+__all__ = [
+    "DynamicsTerms",
+    "actuator_forces",
+    "inverse_dynamics",
+    "kinetic_energy",
+    "mass_matrix",
+    "spatial_inertia",
+    "static_torques",
+]
+
+
+def spatial_inertia(mass: object, com: object, inertia_com: object) -> np.ndarray:
+    """6x6 spatial inertia about a body frame's origin for twists ``[w; v]``.
+
+    ``com (..., 3)`` is the centre of mass in the body frame and ``inertia_com (..., 3, 3)`` the
+    rotational inertia about it, in body axes:
+    ``G = [[I_c - m hat(c)^2, m hat(c)], [-m hat(c), m I]]``.
+    """
+    m = np.asarray(mass, dtype=float)
+    c = as_array(com, "com", (3,))
+    Ic = as_array(inertia_com, "inertia_com", (3, 3))
+    if np.any(m < 0):
+        raise ValueError(f"Expected mass >= 0, got {mass!r}.")
+    C = hat(c)
+    mm = m[..., None, None]
+    batch = np.broadcast_shapes(m.shape, c.shape[:-1], Ic.shape[:-2])
+    G = np.zeros((*batch, 6, 6))
+    G[..., :3, :3] = Ic - mm * (C @ C)
+    G[..., :3, 3:] = mm * C
+    G[..., 3:, :3] = -mm * C
+    G[..., 3:, 3:] = mm * np.eye(3)
+    return G
+
+
+def mass_matrix(G: np.ndarray, J: np.ndarray) -> np.ndarray:
+    """``M = sum_b J_b^T G_b J_b`` for ``G (..., B, 6, 6)`` and ``J (..., B, 6, n)``."""
+    return np.einsum("...bia,...bij,...bjc->...ac", J, G, J)
+
+
+def kinetic_energy(G: np.ndarray, J: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """``0.5 qd^T M qd`` (...)."""
+    V = np.einsum("...bij,...j->...bi", J, qd)
+    return 0.5 * np.einsum("...bi,...bij,...bj->...", V, G, V)
+
+
+@dataclass(frozen=True)
+class DynamicsTerms:
+    """``tau = M qdd + c + g_terms`` split into its parts (each (..., n); M (..., n, n))."""
+
+    tau: np.ndarray
+    M: np.ndarray
+    velocity_terms: np.ndarray
+    gravity_terms: np.ndarray
+
+
+def inverse_dynamics(
+    G: np.ndarray,
+    J: np.ndarray,
+    Jdot: np.ndarray,
+    qd: np.ndarray,
+    qdd: np.ndarray,
+    gravity_body: np.ndarray | None = None,
+    external_wrench_body: np.ndarray | None = None,
+) -> DynamicsTerms:
+    """Generalized forces for the motion (q, qd, qdd) of bodies with body Jacobians ``J``.
+
+    ``Jdot (..., B, 6, n)`` is the time derivative of ``J`` along ``qd`` (see
+    :func:`robomech.kinematics.jacobian_derivative`), ``gravity_body (..., B, 3)`` the gravity
+    acceleration vector expressed in each body frame, and ``external_wrench_body (..., B, 6)`` a wrench
+    ``[m; f]`` applied to each body about its frame origin (body axes).  The external wrench enters
+    with a minus sign: tau is what the joints must supply.
+    """
+    V = np.einsum("...bij,...j->...bi", J, qd)
+    Jd_qd = np.einsum("...bij,...j->...bi", Jdot, qd)
+    GV = np.einsum("...bij,...bj->...bi", G, V)
+    bias_w = np.einsum("...bji,...bj->...bi", ad(V), GV)  # ad(V)^T G V
+    M = mass_matrix(G, J)
+    vel = np.einsum("...bia,...bi->...a", J, np.einsum("...bij,...bj->...bi", G, Jd_qd) - bias_w)
+    grav = np.zeros_like(vel)
+    if gravity_body is not None:
+        g6 = np.concatenate([np.zeros_like(gravity_body), gravity_body], axis=-1)
+        grav = -np.einsum("...bia,...bi->...a", J, np.einsum("...bij,...bj->...bi", G, g6))
+    if external_wrench_body is not None:
+        grav = grav - np.einsum("...bia,...bi->...a", J, external_wrench_body)
+    tau = np.einsum("...ij,...j->...i", M, qdd) + vel + grav
+    return DynamicsTerms(tau=tau, M=M, velocity_terms=vel, gravity_terms=grav)
+
+
+def static_torques(J: object, wrench: object) -> np.ndarray:
+    """Virtual work: generalized forces balancing ``wrench`` applied where ``J`` maps q-rates to the twist.
+
+    ``tau = J^T w`` for ``J (..., 6, n)``, ``w (..., 6)`` (or any matching m-vector, e.g. a force with a
+    3xn translational Jacobian).
+    """
+    J = as_array(J, "J", (None, None), finite=False)
+    w = as_array(wrench, "wrench", (J.shape[-2],), finite=False)
+    return np.einsum("...ij,...i->...j", J, w)
+
+
+def actuator_forces(J_act: object, tau_q: object, *, rcond: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Actuator forces ``f`` with ``J_act^T f = tau_q`` of minimum norm, and the residual per sample.
+
+    ``J_act (..., k, n)`` maps generalized rates to the k actuator rates (k >= n; k > n is redundant
+    actuation, resolved here by the minimum-norm rule).  Returns ``(f (..., k), residual (...))``; a
+    residual well above rounding flags a configuration where the actuators cannot balance ``tau_q``
+    (an actuation singularity).
+    """
+    J_act = as_array(J_act, "J_act", (None, None), finite=False)
+    tau_q = as_array(tau_q, "tau_q", (J_act.shape[-1],), finite=False)
+    JT = np.swapaxes(J_act, -1, -2)
+    f = np.einsum("...ij,...j->...i", np.linalg.pinv(JT, rcond=1e-12 if rcond is None else rcond), tau_q)
+    resid = np.linalg.norm(np.einsum("...ij,...j->...i", JT, f) - tau_q, axis=-1)
+    return f, resid

@@ -1,0 +1,46 @@
+"""Paper reproductions: one module per study, discovered by name.
+
+``robomech/studies/<module>.py`` defines ``STUDY = Study(name=..., ...)``; modules whose name starts
+with an underscore are infrastructure.  This is the only layer (with ``cli``) that imports matplotlib.
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+
+from ._core import Figure, Progress, Study, StudyResult, Table, comparison_table
+from ._report import write_index, write_study_report
+
+__all__ = [
+    "Figure",
+    "Progress",
+    "Study",
+    "StudyResult",
+    "Table",
+    "available_studies",
+    "comparison_table",
+    "get_study",
+    "write_index",
+    "write_study_report",
+]
+
+
+def available_studies() -> dict[str, Study]:
+    """All registered studies by name, in a stable order."""
+    found: dict[str, Study] = {}
+    for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
+        if info.name.startswith("_"):
+            continue
+        module = importlib.import_module(f"{__name__}.{info.name}")
+        study = getattr(module, "STUDY", None)
+        if isinstance(study, Study):
+            found[study.name] = study
+    return found
+
+
+def get_study(name: str) -> Study:
+    studies = available_studies()
+    if name not in studies:
+        raise ValueError(f"Unknown study {name!r}; valid studies are: {', '.join(studies)}.")
+    return studies[name]

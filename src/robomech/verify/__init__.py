@@ -1,0 +1,49 @@
+"""Independent verification of every mechanism model (the role ADAMS plays in the papers).
+
+Modules ``robomech/verify/<module>.py`` define ``VERIFICATION``; they are discovered by name so that a
+mechanism's verification needs no edit elsewhere.  Engines are imported inside those modules only.
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from collections.abc import Iterable
+
+from ._core import Check, Tolerance, Verification, VerificationReport
+
+__all__ = [
+    "Check",
+    "Tolerance",
+    "Verification",
+    "VerificationReport",
+    "available_verifications",
+    "run_verifications",
+]
+
+
+def available_verifications() -> dict[str, Verification]:
+    found: dict[str, Verification] = {}
+    for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
+        if info.name.startswith("_"):
+            continue
+        module = importlib.import_module(f"{__name__}.{info.name}")
+        v = getattr(module, "VERIFICATION", None)
+        if isinstance(v, Verification):
+            found[v.name] = v
+    return found
+
+
+def run_verifications(names: Iterable[str] | None = None) -> VerificationReport:
+    """Run the named verifications (all when ``names`` is empty or None)."""
+    available = available_verifications()
+    names = list(names or available)
+    unknown = [n for n in names if n not in available]
+    if unknown:
+        raise ValueError(
+            f"Unknown mechanism(s) {', '.join(map(repr, unknown))}; valid ones are: {', '.join(available)}."
+        )
+    report = VerificationReport()
+    for n in names:
+        report.checks.extend(available[n].run())
+    return report

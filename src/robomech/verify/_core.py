@@ -1,0 +1,80 @@
+"""What a verification is: analytic model vs an independent engine or higher-fidelity model.
+
+A module ``robomech/verify/<module>.py`` defines ``VERIFICATION = Verification(name=..., run=...)``;
+``run()`` returns a list of :class:`Check`.  Each check names the quantity, the maximum error found,
+the tolerance and *why* that tolerance (engine constraint stiffness, step size, model fidelity).
+This layer is the only one that imports a multibody engine.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+__all__ = ["Check", "Tolerance", "Verification", "VerificationReport"]
+
+
+@dataclass(frozen=True)
+class Tolerance:
+    """A named tolerance with its reason; ``relative`` says how the error was normalised."""
+
+    value: float
+    reason: str
+    relative: bool = False
+
+
+@dataclass(frozen=True)
+class Check:
+    mechanism: str
+    quantity: str
+    max_error: float
+    tolerance: Tolerance
+    detail: str = ""
+
+    @property
+    def passed(self) -> bool:
+        return math.isfinite(self.max_error) and self.max_error <= self.tolerance.value
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "mechanism": self.mechanism,
+            "quantity": self.quantity,
+            "max_error": self.max_error,
+            "tolerance": self.tolerance.value,
+            "relative": self.tolerance.relative,
+            "reason": self.tolerance.reason,
+            "passed": self.passed,
+            "detail": self.detail,
+        }
+
+
+@dataclass(frozen=True)
+class Verification:
+    name: str
+    title: str
+    engine: str
+    run: Callable[[], Sequence[Check]]
+
+
+@dataclass
+class VerificationReport:
+    checks: list[Check] = field(default_factory=list)
+
+    @property
+    def passed(self) -> bool:
+        return all(c.passed for c in self.checks)
+
+    def table(self) -> str:
+        header = f"{'mechanism':<16} {'quantity':<44} {'max error':>11} {'tolerance':>11}  result"
+        lines = [header, "-" * len(header)]
+        for c in self.checks:
+            kind = " rel" if c.tolerance.relative else ""
+            lines.append(
+                f"{c.mechanism:<16} {c.quantity:<44} {c.max_error:>11.3e} {c.tolerance.value:>11.1e}{kind:4}"
+                f"  {'pass' if c.passed else 'FAIL'}"
+            )
+        n_fail = sum(not c.passed for c in self.checks)
+        lines.append(f"{len(self.checks) - n_fail} passed, {n_fail} failed")
+        return "\n".join(lines)
