@@ -3,8 +3,8 @@
 For chain i with unit joint screws ``S_i (n_i, 6)`` expressed in one frame at one configuration:
 
 * its twist system is ``span(S_i)``;
-* its constraint system is every wrench reciprocal to all of them: ``W`` with
-  ``reciprocal_product(W, S) = W^T Delta S = 0``, ``Delta = [[0, I], [I, 0]]``;
+* its constraint system is every wrench ``W = [m; f]`` that does no work on any of them:
+  ``W . S = m . w + f . v = 0`` (the reciprocal product of the wrench's screw ``[f; m]`` with ``S``);
 * the platform's constraint system is the union (span of all chains' constraints), and its twist
   system is the reciprocal of that union; ``dof = 6 - rank(union)``.
 
@@ -22,7 +22,7 @@ import numpy as np
 
 from robomech._validation import as_array
 
-__all__ = ["RANK_RTOL", "ChainScrews", "MobilityResult", "analyze", "reciprocal_basis"]
+__all__ = ["RANK_RTOL", "ChainScrews", "MobilityResult", "analyze", "constraint_wrenches", "reciprocal_basis"]
 
 # Singular values below RANK_RTOL * max(1, sigma_max) count as zero.  Unit screws of a mechanism of
 # size ~1 have entries of order one; rounding in their construction leaves ~1e-15, while a
@@ -43,7 +43,7 @@ def _row_basis(X: np.ndarray, tol: float) -> np.ndarray:
 
 def _null_basis(X: np.ndarray, tol: float) -> np.ndarray:
     """Orthonormal basis (k, 6) of ``{y : X y = 0}``."""
-    if X.size == 0:
+    if X.shape[0] == 0:
         return np.eye(6)
     _, s, Vt = np.linalg.svd(X)
     cutoff = tol * max(1.0, s[0] if s.size else 0.0)
@@ -52,17 +52,25 @@ def _null_basis(X: np.ndarray, tol: float) -> np.ndarray:
 
 
 def reciprocal_basis(screws: object, *, tol: float = RANK_RTOL) -> np.ndarray:
-    """Basis (k, 6) of the screws reciprocal to every row of ``screws (m, 6)``."""
+    """Basis (k, 6) of the screws (axis-moment order) reciprocal to every row of ``screws (m, 6)``."""
     S = as_array(screws, "screws", (None, 6))
     if S.ndim != 2:
         raise ValueError(f"Expected screws to have shape (m, 6), got {S.shape}.")
     return _null_basis(S @ _DELTA, tol) if S.shape[0] else np.eye(6)
 
 
+def constraint_wrenches(twists: object, *, tol: float = RANK_RTOL) -> np.ndarray:
+    """Basis (k, 6) of the wrenches ``[m; f]`` that do no work on any row of ``twists (m, 6)``."""
+    S = as_array(twists, "twists", (None, 6))
+    if S.ndim != 2:
+        raise ValueError(f"Expected twists to have shape (m, 6), got {S.shape}.")
+    return _null_basis(S, tol) if S.shape[0] else np.eye(6)
+
+
 @dataclass(frozen=True)
 class ChainScrews:
     twists: np.ndarray  # (r_i, 6) basis of the chain's twist system
-    constraints: np.ndarray  # (c_i, 6) basis of its constraint (wrench) system
+    constraints: np.ndarray  # (c_i, 6) basis of its constraint wrenches [m; f] (scaled coordinates)
 
 
 @dataclass(frozen=True)
@@ -71,7 +79,7 @@ class MobilityResult:
 
     dof: int
     platform_twists: np.ndarray  # (dof, 6) orthonormal basis of the platform twist system
-    constraint_wrenches: np.ndarray  # (6 - dof, 6) basis of the union of the chains' constraints
+    constraint_wrenches: np.ndarray  # (6 - dof, 6) wrenches [m; f] spanning the union of the constraints
     chains: tuple[ChainScrews, ...]
     rotational_dof: int  # rank of the angular parts of the platform twists
     translational_dof: int  # dimension of the pure translations the platform can make
@@ -92,7 +100,7 @@ class MobilityResult:
 def _intersection_dim(bases: Sequence[np.ndarray], tol: float) -> int:
     """Dimension of the intersection of subspaces given by row bases."""
     # The intersection is the reciprocal-free complement: orthogonal complement of the sum of complements.
-    complements = [_null_basis(B, tol) if B.shape[0] else np.eye(6) for B in bases]
+    complements = [_null_basis(B, tol) for B in bases]
     stacked = np.vstack(complements) if complements else np.zeros((0, 6))
     return 6 - _row_basis(stacked, tol).shape[0]
 
@@ -116,12 +124,12 @@ def analyze(chains: Sequence[object], *, length_scale: float = 1.0, tol: float =
             raise ValueError(f"Expected chains[{i}] to have shape (n_i, 6) with n_i >= 1, got {S.shape}.")
         S = S * scale
         twists = _row_basis(S, tol)
-        constraints = _null_basis(S @ _DELTA, tol)
+        constraints = _null_basis(S, tol)
         per_chain.append(ChainScrews(twists=twists, constraints=constraints))
 
     all_constraints = np.vstack([c.constraints for c in per_chain])
     union = _row_basis(all_constraints, tol)
-    platform = _null_basis(union @ _DELTA, tol) if union.shape[0] else np.eye(6)
+    platform = _null_basis(union, tol) if union.shape[0] else np.eye(6)
     dof = platform.shape[0]
 
     rot = _row_basis(platform[:, :3], tol).shape[0] if dof else 0

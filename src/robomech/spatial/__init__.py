@@ -17,6 +17,7 @@ from ._se3 import (
     screw_to_axis,
     transform,
     vee_se3,
+    virtual_power,
     wrench_at,
 )
 from ._so3 import SMALL_ANGLE, exp_so3, hat, log_so3, rot_x, rot_y, rot_z, vee
@@ -42,5 +43,6 @@ __all__ = [
     "transform",
     "vee",
     "vee_se3",
+    "virtual_power",
     "wrench_at",
 ]

@@ -19,6 +19,7 @@ __all__ = [
     "screw_to_axis",
     "transform",
     "vee_se3",
+    "virtual_power",
     "wrench_at",
 ]
 
@@ -123,10 +124,22 @@ def lie_bracket(V1: np.ndarray, V2: np.ndarray) -> np.ndarray:
 
 
 def reciprocal_product(S1: np.ndarray, S2: np.ndarray) -> np.ndarray:
-    """Reciprocal (virtual-power) product ``w1 . v2 + w2 . v1``; zero when a wrench does no work on a twist."""
+    """Reciprocal product ``w1 . v2 + w2 . v1`` of two screws in axis-moment order ``[s; s0]``.
+
+    A force ``f`` along a line through ``r`` is the screw ``[f; r x f]``; it is reciprocal to a twist
+    (product zero) when it does no work on it.  For wrenches in robomech's ``[m; f]`` order use
+    :func:`virtual_power`, which is the same product with the wrench's halves swapped.
+    """
     S1 = np.asarray(S1, dtype=float)
     S2 = np.asarray(S2, dtype=float)
     return np.sum(S1[..., :3] * S2[..., 3:], axis=-1) + np.sum(S2[..., :3] * S1[..., 3:], axis=-1)
+
+
+def virtual_power(W: np.ndarray, V: np.ndarray) -> np.ndarray:
+    """Power ``m . w + f . v`` of the wrench ``W = [m; f]`` on the twist ``V = [w; v]`` (same frame)."""
+    W = np.asarray(W, dtype=float)
+    V = np.asarray(V, dtype=float)
+    return np.sum(W * V, axis=-1)
 
 
 def screw_from_axis(axis: np.ndarray, point: np.ndarray, pitch: np.ndarray | float = 0.0) -> np.ndarray:
