@@ -36,11 +36,18 @@ def main() -> int:
     p.add_argument("--json", default=None)
     args = p.parse_args()
     floors = measure_floors()
-    print(f"machine: {platform.processor() or platform.machine()}, numpy {np.__version__}, python {platform.python_version()}")
-    print(f"floors: memory bandwidth {floors.bandwidth / 1e9:.1f} GB/s (copy, read+write), "
-          f"matmul {floors.matmul_flops / 1e9:.1f} GFLOP/s (float64)")
-    header = (f"{'#':<2} {'workload':<52} {'n':>9} {'time':>9} {'per sample':>11} {'alternative':<28} "
-              f"{'speedup':>8} {'target':>7} {'x floor':>8} {'target':>7}")
+    print(
+        f"machine: {platform.processor() or platform.machine()}, numpy {np.__version__}, "
+        f"python {platform.python_version()}"
+    )
+    print(
+        f"floors: memory bandwidth {floors.bandwidth / 1e9:.1f} GB/s (copy, read+write), "
+        f"matmul {floors.matmul_flops / 1e9:.1f} GFLOP/s (float64)"
+    )
+    header = (
+        f"{'#':<2} {'workload':<52} {'n':>9} {'time':>9} {'per sample':>11} {'alternative':<28} "
+        f"{'speedup':>8} {'target':>7} {'x floor':>8} {'target':>7}"
+    )
     print(header)
     print("-" * len(header))
     rows = []
@@ -52,13 +59,27 @@ def main() -> int:
             speedup = t_alt / t
         floor = w.bytes_moved / floors.bandwidth if w.bytes_moved else None
         x_floor = t / floor if floor else None
-        rows.append({"group": w.group, "name": w.name, "n": w.n, "seconds": t, "per_sample_s": t / w.n,
-                     "alternative": w.alternative_name, "speedup": speedup, "target_speedup": w.target_speedup,
-                     "x_floor": x_floor, "target_floor_ratio": w.target_floor_ratio})
+        rows.append(
+            {
+                "group": w.group,
+                "name": w.name,
+                "n": w.n,
+                "seconds": t,
+                "per_sample_s": t / w.n,
+                "alternative": w.alternative_name,
+                "speedup": speedup,
+                "target_speedup": w.target_speedup,
+                "x_floor": x_floor,
+                "target_floor_ratio": w.target_floor_ratio,
+            }
+        )
         fmt = lambda v, f: "—" if v is None else format(v, f)  # noqa: E731
-        print(f"{w.group:<2} {w.name:<52} {w.n:>9} {t:>8.3f}s {t / w.n * 1e6:>9.3f}µs {w.alternative_name:<28} "
-              f"{fmt(speedup, '>7.1f')}x {fmt(w.target_speedup, '>6.0f')}x {fmt(x_floor, '>7.1f')}x "
-              f"{fmt(w.target_floor_ratio, '>6.0f')}x", flush=True)
+        print(
+            f"{w.group:<2} {w.name:<52} {w.n:>9} {t:>8.3f}s {t / w.n * 1e6:>9.3f}µs {w.alternative_name:<28} "
+            f"{fmt(speedup, '>7.1f')}x {fmt(w.target_speedup, '>6.0f')}x {fmt(x_floor, '>7.1f')}x "
+            f"{fmt(w.target_floor_ratio, '>6.0f')}x",
+            flush=True,
+        )
     if args.json:
         Path(args.json).write_text(json.dumps({"floors": floors.__dict__, "rows": rows}, indent=2))
     return 0

@@ -15,7 +15,17 @@ from typing import Any
 
 __version__ = "0.1.0"
 
-_SUBPACKAGES = ("spatial", "kinematics", "trajectory", "dynamics", "analysis", "mechanisms", "verify", "studies", "testing")
+_SUBPACKAGES = (
+    "spatial",
+    "kinematics",
+    "trajectory",
+    "dynamics",
+    "analysis",
+    "mechanisms",
+    "verify",
+    "studies",
+    "testing",
+)
 
 __all__ = ["__version__", *_SUBPACKAGES]
 

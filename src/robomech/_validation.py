@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["as_array", "broadcast_batch", "check_positive", "check_finite"]
+__all__ = ["as_array", "broadcast_batch", "check_finite", "check_positive"]
 
 
 def _shape_text(tail: Sequence[int | None]) -> str:
@@ -38,7 +38,9 @@ def as_array(
     except (TypeError, ValueError) as exc:
         raise ValueError(f"Expected {name} to be an array of real numbers, got {type(x).__name__}.") from exc
     need = len(tail) if min_ndim is None else max(min_ndim, len(tail))
-    if a.ndim < need or any(d is not None and a.shape[a.ndim - len(tail) + i] != d for i, d in enumerate(tail)):
+    if a.ndim < need or any(
+        d is not None and a.shape[a.ndim - len(tail) + i] != d for i, d in enumerate(tail)
+    ):
         raise ValueError(f"Expected {name} to have shape {_shape_text(tail)}, got {a.shape}.")
     if finite and not np.all(np.isfinite(a)):
         bad = int(np.size(a) - np.count_nonzero(np.isfinite(a)))

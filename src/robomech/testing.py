@@ -19,7 +19,9 @@ FD_STEP = 6e-6
 # The Hessian differences the analytic Jacobian once, so the same optimal step applies.
 
 
-def numerical_jacobian(f: Callable[[np.ndarray], np.ndarray], x: np.ndarray, h: float = FD_STEP) -> np.ndarray:
+def numerical_jacobian(
+    f: Callable[[np.ndarray], np.ndarray], x: np.ndarray, h: float = FD_STEP
+) -> np.ndarray:
     """Central-difference derivative of ``f`` at ``x (..., n)``: returns ``(..., *out, n)``.
 
     ``f`` must be batched: ``f(x (..., n)) -> (..., *out)``.
@@ -34,7 +36,9 @@ def numerical_jacobian(f: Callable[[np.ndarray], np.ndarray], x: np.ndarray, h: 
     return np.stack(cols, axis=-1)
 
 
-def numerical_hessian(jac: Callable[[np.ndarray], np.ndarray], x: np.ndarray, h: float = FD_STEP) -> np.ndarray:
+def numerical_hessian(
+    jac: Callable[[np.ndarray], np.ndarray], x: np.ndarray, h: float = FD_STEP
+) -> np.ndarray:
     """Central differences of an analytic Jacobian ``jac(x) -> (..., m, n)``: ``(..., m, n, n)``."""
     return numerical_jacobian(jac, x, h)
 

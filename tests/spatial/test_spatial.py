@@ -58,7 +58,9 @@ def test_lie_bracket_is_the_matrix_commutator():
     assert np.allclose(sp.hat_se3(sp.lie_bracket(V1, V2)), X1 @ X2 - X2 @ X1, atol=1e-12)
 
 
-@pytest.mark.parametrize("angle", [0.0, 1e-12, 1e-8, 1e-5, 1e-4, 2e-4, 0.5, np.pi / 2, np.pi - 1e-4, np.pi - 1e-9, np.pi])
+@pytest.mark.parametrize(
+    "angle", [0.0, 1e-12, 1e-8, 1e-5, 1e-4, 2e-4, 0.5, np.pi / 2, np.pi - 1e-4, np.pi - 1e-9, np.pi]
+)
 def test_so3_round_trip_near_singular_angles(angle):
     axes = rng.normal(size=(20, 3))
     axes /= np.linalg.norm(axes, axis=1, keepdims=True)
@@ -81,8 +83,13 @@ def test_se3_round_trip_near_singular_angles(angle):
     assert np.abs(sp.log_se3(T) - V).max() < 1e-9  # near pi, v scales with 1/(pi - angle) rounding
 
 
-@given(arrays(np.float64, array_shapes(min_dims=1, max_dims=3, max_side=4).map(lambda s: (*s, 6)),
-              elements=st.floats(-3, 3)))
+@given(
+    arrays(
+        np.float64,
+        array_shapes(min_dims=1, max_dims=3, max_side=4).map(lambda s: (*s, 6)),
+        elements=st.floats(-3, 3),
+    )
+)
 def test_exp_se3_batch_shapes_and_group_properties(V):
     T = sp.exp_se3(V)
     assert T.shape == (*V.shape[:-1], 4, 4)

@@ -125,7 +125,9 @@ def solve_normal_equations(A: object, b: object) -> LstsqResult:
     if not np.all(full):
         x[~full] = np.einsum("...ij,...j->...i", np.linalg.pinv(AtA[~full]), Atb[~full])
     resid = np.linalg.norm(np.einsum("...ij,...j->...i", safe_A, x) - safe_b, axis=-1)
-    cond = np.sqrt(np.where(sv[..., -1] > 0, sv[..., 0] / np.where(sv[..., -1] > 0, sv[..., -1], 1.0), np.inf))
+    cond = np.sqrt(
+        np.where(sv[..., -1] > 0, sv[..., 0] / np.where(sv[..., -1] > 0, sv[..., -1], 1.0), np.inf)
+    )
     return LstsqResult(
         x=np.where(finite[..., None], x, np.nan),
         residual_norm=np.where(finite, resid, np.nan),

@@ -56,4 +56,6 @@ def singularity_map(J: object, *, rtol: float = SINGULAR_RTOL) -> SingularityMap
     ratio = np.where(smax > 0, smin / np.where(smax > 0, smax, 1.0), 0.0)
     ratio = np.where(finite, ratio, 0.0)
     cond = np.where(ratio > 0, 1.0 / np.where(ratio > 0, ratio, 1.0), np.inf)
-    return SingularityMap(cond=cond, dexterity=ratio, singular=ratio < rtol, sigma_min=np.where(finite, smin, np.nan))
+    return SingularityMap(
+        cond=cond, dexterity=ratio, singular=ratio < rtol, sigma_min=np.where(finite, smin, np.nan)
+    )

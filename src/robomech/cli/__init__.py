@@ -33,7 +33,8 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
     unknown = [n for n in names if n not in studies]
     if unknown:
         print(
-            f"robomech: unknown study {', '.join(map(repr, unknown))}; valid studies are: {', '.join(studies)}",
+            f"robomech: unknown study {', '.join(map(repr, unknown))}; "
+            f"valid studies are: {', '.join(studies)}",
             file=sys.stderr,
         )
         return 2
@@ -51,7 +52,9 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
         paths = write_study_report(result, out_root / name)
         progress.step(f"done in {seconds:.1f} s → {paths['md']}")
         entries.append((result, seconds))
-        summary.append({"study": name, "seconds": seconds, "report": str(paths["md"]), "json": str(paths["json"])})
+        summary.append(
+            {"study": name, "seconds": seconds, "report": str(paths["md"]), "json": str(paths["json"])}
+        )
     index = write_index(out_root, entries)
     if args.json:
         print(json.dumps({"index": str(index), "studies": summary}, indent=2))
@@ -81,7 +84,9 @@ def _cmd_verify(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="robomech", description="Kinematics, dynamics and verification of robot mechanisms.")
+    p = argparse.ArgumentParser(
+        prog="robomech", description="Kinematics, dynamics and verification of robot mechanisms."
+    )
     sub = p.add_subparsers(dest="command", required=True)
 
     sp = sub.add_parser("list", help="list the registered studies and verifications")

@@ -120,7 +120,9 @@ def static_torques(J: object, wrench: object) -> np.ndarray:
     return np.einsum("...ij,...i->...j", J, w)
 
 
-def actuator_forces(J_act: object, tau_q: object, *, rcond: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+def actuator_forces(
+    J_act: object, tau_q: object, *, rcond: float | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Actuator forces ``f`` with ``J_act^T f = tau_q`` of minimum norm, and the residual per sample.
 
     ``J_act (..., k, n)`` maps generalized rates to the k actuator rates (k >= n; k > n is redundant

@@ -89,7 +89,9 @@ def hessian_space(screws: object, q: object) -> np.ndarray:
     adJ = ad(Jc)  # (..., n, 6, 6)
     for k in range(n):
         # columns j > k
-        H[..., :, k + 1 :, k] = np.swapaxes(np.einsum("...ab,...jb->...ja", adJ[..., k, :, :], Jc[..., k + 1 :, :]), -1, -2)
+        H[..., :, k + 1 :, k] = np.swapaxes(
+            np.einsum("...ab,...jb->...ja", adJ[..., k, :, :], Jc[..., k + 1 :, :]), -1, -2
+        )
     return H
 
 
@@ -110,5 +112,9 @@ def hessian_body(body_screws: object, q: object) -> np.ndarray:
 
 
 def jacobian_derivative(H: np.ndarray, qd: np.ndarray) -> np.ndarray:
-    """Time derivative of a Jacobian along ``qd``: ``dJ/dt = sum_k H[..., k] qd_k``."""
+    """Time derivative of a Jacobian along ``qd``: ``dJ/dt = sum_k H[..., k] qd_k``.
+
+    ``H (..., m, n, n)`` and ``qd (..., n)`` broadcast over their batch dimensions; for a stack of
+    bodies ``H (..., B, 6, n, n)`` pass ``qd[..., None, :]``.
+    """
     return np.einsum("...ijk,...k->...ij", H, qd)

@@ -7,9 +7,9 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
-from ._core import Figure  # noqa: E402
+from ._core import Figure
 
 __all__ = ["plt", "save_figure"]
 

@@ -86,7 +86,9 @@ def write_study_report(result: StudyResult, out_dir: Path) -> dict[str, Path]:
         for f in result.figures
     ]
     if result.notes:
-        parts.append("<h2>Notes</h2><ul>" + "".join(f"<li>{html.escape(n)}</li>" for n in result.notes) + "</ul>")
+        parts.append(
+            "<h2>Notes</h2><ul>" + "".join(f"<li>{html.escape(n)}</li>" for n in result.notes) + "</ul>"
+        )
     (out_dir / "report.html").write_text(
         f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(result.title)}</title>"
         f"<style>{_CSS}</style></head><body>{''.join(parts)}</body></html>"
@@ -97,7 +99,10 @@ def write_study_report(result: StudyResult, out_dir: Path) -> dict[str, Path]:
         "title": result.title,
         "source": result.source,
         "summary": result.summary,
-        "tables": [{"title": t.title, "columns": list(t.columns), "rows": t.rows, "note": t.note} for t in result.tables],
+        "tables": [
+            {"title": t.title, "columns": list(t.columns), "rows": t.rows, "note": t.note}
+            for t in result.tables
+        ],
         "figures": [{"file": f.path.name, "caption": f.caption} for f in result.figures],
         "notes": result.notes,
         "data": result.data,
@@ -108,7 +113,12 @@ def write_study_report(result: StudyResult, out_dir: Path) -> dict[str, Path]:
 
 def write_index(out_root: Path, entries: Sequence[tuple[StudyResult, float]]) -> Path:
     """``index.md`` and ``index.html`` linking every study report, with run times."""
-    md = ["# robomech — paper reproductions", "", "| study | title | figures | tables | time (s) |", "|---|---|---|---|---|"]
+    md = [
+        "# robomech — paper reproductions",
+        "",
+        "| study | title | figures | tables | time (s) |",
+        "|---|---|---|---|---|",
+    ]
     rows_html = []
     for res, seconds in entries:
         md.append(

@@ -106,13 +106,36 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     expected = {"planar four-bar (RR-RR)": 1, "3-RRR spherical": 3, "3-UPU translational": 3, "3-RPS": 3}
     for name, chains in textbook_chains().items():
         m = mobility.analyze(chains)
-        rows.append([name, expected[name], m.dof, f"{m.rotational_dof}R{m.translational_dof}T", m.common_constraints,
-                     m.redundant_constraints, m.gruebler_kutzbach, m.modified_gruebler_kutzbach])
-        res.data[name] = {"dof": m.dof, "gk": m.gruebler_kutzbach, "modified_gk": m.modified_gruebler_kutzbach}
+        rows.append(
+            [
+                name,
+                expected[name],
+                m.dof,
+                f"{m.rotational_dof}R{m.translational_dof}T",
+                m.common_constraints,
+                m.redundant_constraints,
+                m.gruebler_kutzbach,
+                m.modified_gruebler_kutzbach,
+            ]
+        )
+        res.data[name] = {
+            "dof": m.dof,
+            "gk": m.gruebler_kutzbach,
+            "modified_gk": m.modified_gruebler_kutzbach,
+        }
     res.tables.append(
         Table(
             "Mobility by screw theory vs Grübler–Kutzbach",
-            ["mechanism", "textbook DOF", "screw DOF", "type", "common λ", "redundant ν", "G–K", "modified G–K"],
+            [
+                "mechanism",
+                "textbook DOF",
+                "screw DOF",
+                "type",
+                "common λ",
+                "redundant ν",
+                "G–K",
+                "modified G–K",
+            ],
             rows,
         )
     )
@@ -125,7 +148,10 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         Table(
             "UR5 space Jacobian at q0: analytic vs central differences",
             ["quantity", "value"],
-            [["max |J - J_fd|", float(np.abs(J - J_fd).max())], ["condition number", float(workspace.condition_number(J))]],
+            [
+                ["max |J - J_fd|", float(np.abs(J - J_fd).max())],
+                ["condition number", float(workspace.condition_number(J))],
+            ],
         )
     )
     q3 = np.linspace(-np.pi, np.pi, 721)
@@ -138,7 +164,9 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     ax.set_ylabel("dexterity 1/cond(J)")
     ax.set_title("UR5 dexterity along an elbow sweep (zero at the elbow singularity q3 = 0)")
     ax.grid(True, alpha=0.3)
-    res.figures.append(save_figure(fig, out_dir, "ur5_dexterity", "Dexterity of a UR5-like arm vs elbow angle"))
+    res.figures.append(
+        save_figure(fig, out_dir, "ur5_dexterity", "Dexterity of a UR5-like arm vs elbow angle")
+    )
     res.data["ur5_min_dexterity_deg"] = float(np.degrees(q3[np.argmin(smap.dexterity)]))
     return res
 

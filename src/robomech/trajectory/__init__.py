@@ -66,14 +66,18 @@ def quintic(t: object, duration: float, start: object = 0.0, end: object = 1.0) 
 
 
 def swing_sextic(t: object, duration: float, height: object = 1.0) -> Profile:
-    """Swing-height sextic 0 -> ``height`` -> 0 over ``duration`` (paper 2, eq. (53) Z), zero velocity at both ends."""
+    """Swing sextic 0 -> ``height`` -> 0 over ``duration`` (paper 2, eq. (53) Z), at rest at both ends."""
     return _normalised(t, duration, _SWING, height)
 
 
-def sinusoid(t: object, amplitude: object, frequency: object, phase: object = 0.0, offset: object = 0.0) -> Profile:
+def sinusoid(
+    t: object, amplitude: object, frequency: object, phase: object = 0.0, offset: object = 0.0
+) -> Profile:
     """``offset + amplitude sin(2 pi f t + phase)`` (frequency in Hz)."""
     t = as_array(t, "t")
     w = 2.0 * np.pi * np.asarray(frequency, dtype=float)
     arg = w * t + np.asarray(phase, dtype=float)
     a = np.asarray(amplitude, dtype=float)
-    return Profile(np.asarray(offset, dtype=float) + a * np.sin(arg), a * w * np.cos(arg), -a * w * w * np.sin(arg))
+    return Profile(
+        np.asarray(offset, dtype=float) + a * np.sin(arg), a * w * np.cos(arg), -a * w * w * np.sin(arg)
+    )

@@ -1,0 +1,55 @@
+"""The command line and the report writer, end to end on the demonstration study."""
+
+import json
+
+import pytest
+
+from robomech.cli import main
+from robomech.studies import Table, available_studies, comparison_table, get_study
+
+
+def test_reproduce_demo_writes_report_json_and_figure(tmp_path, capsys):
+    assert main(["reproduce", "demo", "--out", str(tmp_path), "--quiet"]) == 0
+    d = tmp_path / "demo"
+    report = (d / "report.md").read_text()
+    assert "Mobility by screw theory" in report and "![" in report
+    assert (d / "report.html").exists() and (tmp_path / "index.html").exists()
+    data = json.loads((d / "results.json").read_text())
+    assert data["name"] == "demo" and data["figures"]
+    png = d / data["figures"][0]["file"]
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 10_000
+    assert "demo/report.md" in (tmp_path / "index.md").read_text()
+
+
+def test_reproduce_json_summary(tmp_path, capsys):
+    assert main(["reproduce", "demo", "--out", str(tmp_path), "--json", "--quiet"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["studies"][0]["study"] == "demo"
+
+
+def test_unknown_study_is_a_clear_error_with_nonzero_exit(tmp_path, capsys):
+    assert main(["reproduce", "no-such-study", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "no-such-study" in err and "demo" in err
+    with pytest.raises(ValueError, match="valid studies"):
+        get_study("no-such-study")
+
+
+def test_unknown_mechanism_for_verify_is_a_clear_error(capsys):
+    assert main(["verify", "no-such-mechanism"]) == 2
+    assert "no-such-mechanism" in capsys.readouterr().err
+
+
+def test_list_names_every_study(capsys):
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    for name in available_studies():
+        assert name in out
+
+
+def test_comparison_table_computes_differences():
+    t = comparison_table("t", [("l1", 100.0, 100.5, "mm"), ("l2", None, 3.0, "mm")])
+    assert t.rows[0][4] == pytest.approx(0.5) and t.rows[0][5] == pytest.approx(0.005)
+    assert t.rows[1][2] == "—"
+    with pytest.raises(ValueError, match="cells"):
+        Table("bad", ["a", "b"], [[1]])
