@@ -22,11 +22,15 @@ def test_matches_numpy_lstsq_on_well_conditioned_stacks():
     rng = np.random.default_rng(0)
     A = random_stack(rng, 500, 30, 11, cond=10.0)
     b = rng.normal(size=(500, 30))
-    r = lstsq.solve(A, b)
+    r = lstsq.solve(A, b, exact_cond=True)
     ref = np.stack([np.linalg.lstsq(a, y, rcond=None)[0] for a, y in zip(A, b, strict=True)])
     assert np.abs(r.x - ref).max() < AGREE_TOL
     assert np.all(r.full_rank) and np.all(r.ok) and np.all(r.rank == 11)
     assert np.allclose(r.cond, 10.0, rtol=1e-8)
+    # the default 1-norm condition of R is within a factor n of the 2-norm one (Higham, Table 6.2)
+    c1 = lstsq.solve(A, b).cond
+    assert np.all((c1 >= 10.0 / 11 * (1 - 1e-9)) & (c1 <= 10.0 * 11))
+    assert np.abs(lstsq.solve(A, b).x - r.x).max() == 0.0
     ref_res = np.linalg.norm(np.einsum("kmn,kn->km", A, ref) - b, axis=1)
     assert np.allclose(r.residual_norm, ref_res, rtol=1e-12)
     # On a well-conditioned system the normal equations give the same residual (paper 4's comparison).

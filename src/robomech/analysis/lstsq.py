@@ -12,11 +12,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
 from robomech._validation import as_array
 
-__all__ = ["RANK_RTOL_FACTOR", "LstsqResult", "solve", "solve_normal_equations"]
+__all__ = ["RANK_RTOL_FACTOR", "LstsqResult", "rank_cond_limit", "solve", "solve_normal_equations"]
 
 # A system is rank deficient when a singular value of R is below RANK_RTOL_FACTOR * max(m, n) * eps
 # times the largest: max(m, n) * eps is numpy's matrix_rank default, the bound on the rounding that
@@ -49,54 +48,57 @@ def _validate(A: object, b: object) -> tuple[np.ndarray, np.ndarray]:
     return A, b
 
 
-def solve(A: object, b: object, *, diagnostics: bool = True) -> LstsqResult:
+def solve(A: object, b: object, *, exact_cond: bool = False) -> LstsqResult:
     """Least-squares solution of every system in the stack by Householder QR.
 
-    With ``diagnostics=False`` the singular values of R are not computed (``cond`` and ``rank`` come
-    from the diagonal of R, a cheaper but only indicative estimate).
+    Each system is factorised as ``[A | b] = Q [R, c; 0, r]`` (unblocked Householder, the algorithm
+    of LAPACK's ``dgeqr2``, compiled and run in parallel over the batch: see ``_householder.py``), so
+    ``x = R^-1 c`` and the residual norm is ``|r|``.
+
+    ``cond`` is the exact 1-norm condition number of R (within a factor n of the 2-norm condition
+    number of A) unless ``exact_cond=True``, which computes the 2-norm one from the singular values
+    of R.  A system whose condition exceeds :func:`rank_cond_limit` is rank deficient: its rank comes
+    from the SVD and ``x`` is the minimum-norm solution.
     """
+    from ._householder import householder_lstsq
+
     A, b = _validate(A, b)
     m, n = A.shape[-2:]
     batch = np.broadcast_shapes(A.shape[:-2], b.shape[:-1])
-    A = np.broadcast_to(A, (*batch, m, n))
-    b = np.broadcast_to(b, (*batch, m))
-    finite = np.all(np.isfinite(A), axis=(-1, -2)) & np.all(np.isfinite(b), axis=-1)
-    # Non-finite systems are replaced by a harmless identity-like system and reported as not ok.
-    safe_A = np.where(finite[..., None, None], A, np.eye(m, n))
-    safe_b = np.where(finite[..., None], b, 0.0)
+    Af = np.broadcast_to(A, (*batch, m, n)).reshape(-1, m, n)
+    bf = np.broadcast_to(b, (*batch, m)).reshape(-1, m)
+    finite = np.all(np.isfinite(Af), axis=(-1, -2)) & np.all(np.isfinite(bf), axis=-1)
 
-    Q, R = np.linalg.qr(safe_A, mode="reduced")  # Householder (LAPACK dgeqrf + dorgqr), batched
-    Qtb = np.einsum("...mi,...m->...i", Q, safe_b)
-    if diagnostics:
+    x, resid, cond, R = householder_lstsq(Af, bf, ~finite, exact_cond)
+    if exact_cond:
         sv = np.linalg.svd(R, compute_uv=False)
-        smax, smin = sv[..., 0], sv[..., -1]
-        tol = RANK_RTOL_FACTOR * max(m, n) * np.finfo(float).eps * smax
-        rank = np.sum(sv > tol[..., None], axis=-1)
-    else:
-        d = np.abs(np.diagonal(R, axis1=-2, axis2=-1))
-        smax, smin = d.max(axis=-1), d.min(axis=-1)
-        tol = RANK_RTOL_FACTOR * max(m, n) * np.finfo(float).eps * smax
-        rank = np.sum(d > tol[..., None], axis=-1)
-    full = rank == n
-    cond = np.where(smin > 0, smax / np.where(smin > 0, smin, 1.0), np.inf)
-
-    # Full-rank systems: back substitution on R (LAPACK dtrtrs, batched by SciPy).
-    R_safe = np.where(full[..., None, None], R, np.eye(n))
-    x = scipy.linalg.solve_triangular(R_safe, Qtb[..., None], lower=False)[..., 0]
-    if not np.all(full):
-        # Rank-deficient systems only: minimum-norm solution by SVD (LAPACK dgelsd via pinv).
-        idx = ~full
-        x[idx] = np.einsum("...ij,...j->...i", np.linalg.pinv(safe_A[idx]), safe_b[idx])
-    resid = np.linalg.norm(np.einsum("...ij,...j->...i", safe_A, x) - safe_b, axis=-1)
+        cond = np.where(sv[:, -1] > 0, sv[:, 0] / np.where(sv[:, -1] > 0, sv[:, -1], 1.0), np.inf)
+    full = finite & (cond <= rank_cond_limit(m, n))
+    rank = np.where(full, n, 0)
+    deficient = finite & ~full
+    if np.any(deficient):
+        # Rank-deficient systems only: numerical rank and minimum-norm solution by SVD (LAPACK).
+        Ad, bd = Af[deficient], bf[deficient]
+        sv = np.linalg.svd(Ad, compute_uv=False)
+        tol = RANK_RTOL_FACTOR * max(m, n) * np.finfo(float).eps * sv[:, :1]
+        rank[deficient] = np.sum(sv > tol, axis=-1)
+        xd = np.einsum("kij,kj->ki", np.linalg.pinv(Ad, rcond=tol[:, 0] / sv[:, 0]), bd)
+        x[deficient] = xd
+        resid[deficient] = np.linalg.norm(np.einsum("kij,kj->ki", Ad, xd) - bd, axis=-1)
     nan = np.nan
     return LstsqResult(
-        x=np.where(finite[..., None], x, nan),
-        residual_norm=np.where(finite, resid, nan),
-        rank=np.where(finite, rank, 0),
-        cond=np.where(finite, cond, nan),
-        full_rank=full & finite,
-        ok=finite,
+        x=np.where(finite[:, None], x, nan).reshape(*batch, n),
+        residual_norm=np.where(finite, resid, nan).reshape(batch),
+        rank=rank.reshape(batch),
+        cond=np.where(finite, cond, nan).reshape(batch),
+        full_rank=full.reshape(batch),
+        ok=finite.reshape(batch),
     )
+
+
+def rank_cond_limit(m: int, n: int) -> float:
+    """Condition number above which a system counts as rank deficient: ``1 / (10 max(m, n) eps)``."""
+    return 1.0 / (RANK_RTOL_FACTOR * max(m, n) * np.finfo(float).eps)
 
 
 def solve_normal_equations(A: object, b: object) -> LstsqResult:
