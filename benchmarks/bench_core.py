@@ -6,9 +6,10 @@ import subprocess
 import sys
 
 import numpy as np
-from _harness import Workload
 
 from robomech.analysis import lstsq
+
+from _harness import Workload
 
 N_SYSTEMS = 250_000  # paper 4's "computationally heavy" count
 M, N = 30, 11  # paper 4's overdetermined system
@@ -27,23 +28,18 @@ def _numpy_batched_qr(A: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _compile_seconds() -> float:
-    """Time of the first call in a fresh process with the numba cache removed (the compile cost)."""
-    import shutil
+    """First-call time in a fresh process with an empty numba cache: the kernel's compile cost."""
+    import os
     import tempfile
-    import time
 
     code = (
         "import time, numpy as np; t=time.perf_counter(); from robomech.analysis import lstsq; "
         "lstsq.solve(np.ones((1, 3, 2)) + np.eye(3, 2), np.ones((1, 3))); print(time.perf_counter() - t)"
     )
     with tempfile.TemporaryDirectory() as d:
-        env = {**__import__("os").environ, "NUMBA_CACHE_DIR": d}
-        t0 = time.perf_counter()
-        out = subprocess.run(
-            [sys.executable, "-c", code], check=True, capture_output=True, text=True, env=env
-        )
-        del t0
-        shutil.rmtree(d, ignore_errors=True)
+        env = {**os.environ, "NUMBA_CACHE_DIR": d}
+        cmd = [sys.executable, "-c", code]
+        out = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env)
     return float(out.stdout.strip())
 
 

@@ -125,7 +125,7 @@ def householder_lstsq(
     Returns ``x (B, n)``, ``residual (B,)``, ``cond1 (B,)`` (1-norm condition number of R, inf when R
     has an exact zero pivot) and ``R (B, n, n)`` when requested.
     """
-    batch, m, n = A.shape
+    batch, _, n = A.shape
     x = np.zeros((batch, n))
     resid = np.zeros(batch)
     cond1 = np.zeros(batch)
