@@ -19,6 +19,7 @@ run: install
 	$(BIN)/robomech reproduce --out $(OUT)
 
 test: install
+	$(BIN)/ruff check src tests benchmarks
 	$(BIN)/python -m pytest -q
 
 verify: install
