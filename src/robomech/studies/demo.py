@@ -162,10 +162,10 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     ax.plot(np.degrees(q3), smap.dexterity)
     ax.set_xlabel("elbow angle q3 (deg)")
     ax.set_ylabel("dexterity 1/cond(J)")
-    ax.set_title("UR5 dexterity along an elbow sweep (zero at the elbow singularity q3 = 0)")
+    ax.set_title("UR5 dexterity along an elbow sweep (zeros: singular configurations)")
     ax.grid(True, alpha=0.3)
     res.figures.append(
-        save_figure(fig, out_dir, "ur5_dexterity", "Dexterity of a UR5-like arm vs elbow angle")
+        save_figure(fig, out_dir, "ur5_dexterity", "Dexterity 1/cond(J_s) of a UR5-like arm vs elbow angle (other joints fixed); it vanishes at the elbow singularities q3 = 0, ±180° and where the wrist aligns")
     )
     res.data["ur5_min_dexterity_deg"] = float(np.degrees(q3[np.argmin(smap.dexterity)]))
     return res
