@@ -164,9 +164,11 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     ax.set_ylabel("dexterity 1/cond(J)")
     ax.set_title("UR5 dexterity along an elbow sweep (zeros: singular configurations)")
     ax.grid(True, alpha=0.3)
-    res.figures.append(
-        save_figure(fig, out_dir, "ur5_dexterity", "Dexterity 1/cond(J_s) of a UR5-like arm vs elbow angle (other joints fixed); it vanishes at the elbow singularities q3 = 0, ±180° and where the wrist aligns")
+    caption = (
+        "Dexterity 1/cond(J_s) of a UR5-like arm vs elbow angle (other joints fixed); it vanishes at the "
+        "elbow singularities q3 = 0, ±180° and where the wrist aligns"
     )
+    res.figures.append(save_figure(fig, out_dir, "ur5_dexterity", caption))
     res.data["ur5_min_dexterity_deg"] = float(np.degrees(q3[np.argmin(smap.dexterity)]))
     return res
 
