@@ -15,6 +15,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from robomech.verify import _cosserat as cz
 from robomech.verify._cosserat import (
@@ -186,6 +188,19 @@ def test_elastica_small_load_is_linear_beam() -> None:
     assert abs(y_l - lin) / lin > 0.0
 
 
+@pytest.mark.parametrize("force", [(0.5, 0.0, 0.0), (-0.3, 0.0, -0.6)])
+def test_planar_cable_tension_equals_tip_moment(rigid: TendonRod, force) -> None:
+    """Independent of the cable code path: in a planar bend an inextensible rod's cable at r e_x acts as a
+    moment τ r e_y at every section, i.e. exactly as a tip moment τ r e_y (in-plane moments do not turn),
+    so (cable τ, tip force F) and (tip moment τ r e_y, tip force F) must give the same shape."""
+    tau = _tension_for(rigid, math.radians(70.0))
+    a = solve_static(rigid, (tau, 0.0, 0.0), force)
+    b = solve_static(rigid, (0.0, 0.0, 0.0), force, (0.0, tau * rigid.tendon_radius[0], 0.0))
+    assert a.converged and b.converged
+    np.testing.assert_allclose(a.position, b.position, atol=TIP_ACCURACY_REL * rigid.length)
+    np.testing.assert_allclose(a.rotation, b.rotation, atol=TIP_ACCURACY_REL)
+
+
 def test_tip_force_departs_from_arc(rod: TendonRod) -> None:
     tau = _tension_for(rod, math.radians(45.0))
     sol = solve_static(rod, (tau, 0.0, 0.0), (0.5, 0.0, 0.0))
@@ -212,6 +227,26 @@ def test_global_static_balance_at_base(rod: TendonRod) -> None:
     bad_f = base_balance_error(rod, dataclasses.replace(sol, tip_force=-sol.tip_force))
     bad_t = base_balance_error(rod, dataclasses.replace(sol, tensions=sol.tensions * [1.0, 0.0, 1.0]))
     assert np.min(bad_f) > 1e3 * BALANCE_TOL and np.min(bad_t) > 1e3 * BALANCE_TOL
+
+
+ORTHO_TOL = 1e-7
+"""R(s) from the collocation spline is orthonormal to about the BVP tolerance (not projected)."""
+
+
+@settings(max_examples=20, deadline=None)
+@given(
+    tau=st.lists(st.floats(0.0, 12.0), min_size=3, max_size=3),
+    force=st.lists(st.floats(-0.4, 0.4), min_size=3, max_size=3),
+    moment=st.lists(st.floats(-0.01, 0.01), min_size=3, max_size=3),
+)
+def test_property_random_spatial_loads_balance(rod: TendonRod, tau, force, moment) -> None:
+    """Over random cable tensions and spatial tip wrenches (bends up to ~70°, torsion from out-of-plane
+    loads): converged, globally balanced, and the frames stay rotations."""
+    sol = solve_static(rod, tau, force, moment)
+    assert sol.converged
+    assert base_balance_error(rod, sol) <= BALANCE_TOL
+    RtR = np.einsum("sji,sjk->sik", sol.rotation, sol.rotation)
+    assert np.max(np.abs(RtR - np.eye(3))) <= ORTHO_TOL
 
 
 def test_unloaded_rod_moment_equals_tendon_moment(rod: TendonRod) -> None:
