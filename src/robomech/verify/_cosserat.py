@@ -749,6 +749,8 @@ def constant_curvature_statics(
     """
     n_t = rod.n_tendons
     tau = as_array(tensions, "tensions", (n_t,))
+    if np.any(tau < 0.0):
+        raise ValueError(f"Expected tensions >= 0 (a tendon cannot push), got min {tau.min()!r}.")
     F = as_array(np.zeros(3) if tip_force is None else tip_force, "tip_force", (3,))
     Lm = as_array(np.zeros(3) if tip_moment is None else tip_moment, "tip_moment", (3,))
     batch = np.broadcast_shapes(tau.shape[:-1], F.shape[:-1], Lm.shape[:-1])
