@@ -19,8 +19,9 @@ __all__ = ["WorkspaceMap", "workspace_map"]
 # A pose counts as singular when sigma_min/sigma_max of J falls below this (as
 # robomech.analysis.workspace.SINGULAR_RTOL: a 1e8 amplification has no physical meaning here).
 SINGULAR_RTOL = 1e-8
-# Poses whose J condition number exceeds this are reported as ill-conditioned: a 1 mm leg error then
-# moves the platform by more than 100 mrad per metre of lever... i.e. 100x the best-case sensitivity.
+# Poses whose J condition number exceeds this are reported as ill-conditioned: the platform's
+# sensitivity to leg-length errors then differs by more than 100x between its two directions (both
+# columns of J are in m/rad, so the ratio is unit-free).
 ILL_CONDITIONED = 100.0
 
 
