@@ -29,6 +29,7 @@ from ._kinematics import (
     leg_rates,
     platform_rotation,
 )
+from ._motions import fig5_motion, sway
 from ._params import LegBody, SphericalLeg
 from ._workspace import WorkspaceMap, workspace_map
 
@@ -43,6 +44,7 @@ __all__ = [
     "WorkspaceMap",
     "angular_velocity_jacobian",
     "distribute_forces",
+    "fig5_motion",
     "forward_kinematics",
     "generalized_forces",
     "hessian",
@@ -54,5 +56,6 @@ __all__ = [
     "mass_matrix",
     "mechanical_energy",
     "platform_rotation",
+    "sway",
     "workspace_map",
 ]
