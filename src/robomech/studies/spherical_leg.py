@@ -240,7 +240,7 @@ def _force_figures(leg: sl.SphericalLeg, out_dir: Path, res: StudyResult, engine
 
 
 def _mechanism_figure(leg: sl.SphericalLeg, out_dir: Path, res: StudyResult) -> None:
-    poses = [(0.0, 0.0), (PI / 6, PI / 6), (-PI / 4, PI / 6), (PI / 3, -PI / 4)]
+    poses = [(0.0, 0.0), (PI / 6, PI / 6), (-PI / 4, PI / 6), (PI / 4, -PI / 6)]
     fig = plt.figure(figsize=(13, 3.8))
     for k, (a, b) in enumerate(poses):
         ax = fig.add_subplot(1, 4, k + 1, projection="3d")

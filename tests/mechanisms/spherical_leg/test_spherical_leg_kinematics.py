@@ -207,3 +207,24 @@ def test_batched_equals_per_sample():
         assert np.max(np.abs(sl.hessian(LEG, q[k, 0], q[k, 1]) - H[k])) <= 1e-12
     # leading batch dimensions broadcast
     assert sl.inverse_kinematics(LEG, np.zeros((2, 1)), np.zeros((1, 5))).lengths.shape == (2, 5, 3)
+
+
+def test_chunked_batches_equal_per_sample_across_chunk_boundaries():
+    from robomech.mechanisms.spherical_leg._kinematics import CHUNK
+
+    rng = np.random.default_rng(8)
+    n = CHUNK + 7
+    q = rng.uniform(-1, 1, (n, 2))
+    ik = sl.inverse_kinematics(LEG, q[:, 0], q[:, 1])
+    L = ik.lengths + rng.normal(scale=1e-5, size=(n, 3))
+    fk = sl.forward_kinematics(LEG, L)
+    J = sl.jacobian(LEG, q[:, 0], q[:, 1])
+    wm = sl.workspace_map(LEG, q[:, 0], q[:, 1])
+    for k in (0, CHUNK - 1, CHUNK, n - 1):
+        one_ik = sl.inverse_kinematics(LEG, q[k, 0], q[k, 1])
+        assert np.max(np.abs(one_ik.unit_vectors - ik.unit_vectors[k])) <= 1e-12
+        assert np.max(np.abs(one_ik.platform_points - ik.platform_points[k])) <= 1e-12
+        one = sl.forward_kinematics(LEG, L[k])
+        assert abs(one.alpha - fk.alpha[k]) <= 1e-12 and abs(one.residual - fk.residual[k]) <= 1e-12
+        assert np.max(np.abs(sl.jacobian(LEG, q[k, 0], q[k, 1]) - J[k])) <= 1e-12
+        assert abs(sl.workspace_map(LEG, q[k, 0], q[k, 1]).cond - wm.cond[k]) <= 1e-12 * wm.cond[k]

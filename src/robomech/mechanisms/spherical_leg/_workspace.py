@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._kinematics import LENGTH_FLOOR, _angles, _squared_lengths
+from ._kinematics import LENGTH_FLOOR, _angles, _chunked, _squared_lengths
 from ._params import SphericalLeg
 
 __all__ = ["WorkspaceMap", "workspace_map"]
@@ -47,14 +47,24 @@ def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMa
     The singular values of the 3x2 J come from the eigenvalues of the 2x2 Gram matrix J^T J.
     """
     a, b = _angles(alpha, beta)
+    n = a.size
+    outs = (np.empty((n, 3)), np.empty(n, dtype=bool), np.empty(n), np.empty(n), np.empty(n), np.empty(n))
+    _chunked(lambda *x: _kernel(leg, *x), (a.reshape(-1), b.reshape(-1)), outs)
+    L, reach, smin, smax, cond, j3a = (o.reshape((*a.shape, *o.shape[1:])) for o in outs)
+    ratio = smin / smax
+    return WorkspaceMap(L, reach, smin, smax, cond, ratio < SINGULAR_RTOL, cond > ILL_CONDITIONED, j3a)
+
+
+def _kernel(leg: SphericalLeg, a, b, L_out, reach_out, smin_out, smax_out, cond_out, j3a_out) -> None:
     sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
     R, r, h = leg.R, leg.r, leg.h
     q = _squared_lengths(leg, sa, ca, sb, cb)
-    l = np.sqrt(np.maximum(q, LENGTH_FLOOR**2))
-    j1b = R * (r * sb - h * cb) / l[..., 0]
-    j2b = R * (r * sb + h * cb) / l[..., 1]
-    j3a = R * (r * sa + h * cb * ca) / l[..., 2]
-    j3b = -R * h * sb * sa / l[..., 2]
+    np.sqrt(np.maximum(q, 0.0), out=L_out)
+    l = np.maximum(L_out, LENGTH_FLOOR)
+    j1b = R * (r * sb - h * cb) / l[:, 0]
+    j2b = R * (r * sb + h * cb) / l[:, 1]
+    j3a = R * (r * sa + h * cb * ca) / l[:, 2]
+    j3b = -R * h * sb * sa / l[:, 2]
     g11 = j3a * j3a
     g22 = j1b * j1b + j2b * j2b + j3b * j3b
     g12 = j3a * j3b
@@ -65,7 +75,8 @@ def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMa
     lam_min = np.maximum(g11 * g22 - g12 * g12, 0.0) / lam_max
     smax, smin = np.sqrt(lam_max), np.sqrt(lam_min)
     ratio = smin / smax
-    cond = np.where(ratio > 0, 1.0 / np.where(ratio > 0, ratio, 1.0), np.inf)
-    lengths = np.sqrt(np.maximum(q, 0.0))
-    reach = np.all((lengths >= leg.length_min) & (lengths <= leg.length_max), -1)
-    return WorkspaceMap(lengths, reach, smin, smax, cond, ratio < SINGULAR_RTOL, cond > ILL_CONDITIONED, j3a)
+    cond_out[:] = np.where(ratio > 0, 1.0 / np.where(ratio > 0, ratio, 1.0), np.inf)
+    reach_out[:] = np.all((L_out >= leg.length_min) & (L_out <= leg.length_max), -1)
+    smin_out[:] = smin
+    smax_out[:] = smax
+    j3a_out[:] = j3a
