@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from robomech.mechanisms import spherical_leg as sl
@@ -56,8 +56,12 @@ def test_table1_forward_kinematics_error_is_rounding_not_0_0127():
 )
 def test_fk_of_ik_round_trip(alpha, beta):
     ik = sl.inverse_kinematics(LEG, alpha, beta)
+    dl3 = sl.jacobian(LEG, alpha, beta)[2, 0]
+    # On the singular curve dl3/dalpha = 0 alpha is ill-posed (error ~ eps / sqrt(1 - s^2)); 1e-4 R/rad
+    # away from it the conditioning costs at most ~1e4 eps, still far below the 1e-10 rad target.
+    assume(abs(dl3) > 1e-4 * LEG.R)
     # the assembly branch containing alpha = 0 is the one where dl3/dalpha > 0
-    branch = 0 if sl.jacobian(LEG, alpha, beta)[2, 0] > 0 else 1
+    branch = 0 if dl3 > 0 else 1
     fk = sl.forward_kinematics(LEG, ik.lengths, branch=branch)
     assert fk.valid and fk.converged
     assert abs(fk.alpha - alpha) < ROUND_TRIP_TOL

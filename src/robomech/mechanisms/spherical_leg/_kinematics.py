@@ -383,6 +383,12 @@ def leg_rates(
     qa = as_array(q, "q", (2,))
     qda = as_array(qd, "qd", (2,))
     qdda = as_array(qdd, "qdd", (2,))
+    try:
+        qa, qda, qdda = np.broadcast_arrays(qa, qda, qdda)
+    except ValueError as exc:
+        raise ValueError(
+            f"Expected q, qd, qdd to broadcast, got shapes {qa.shape}, {qda.shape}, {qdda.shape}."
+        ) from exc
     a, b = qa[..., 0], qa[..., 1]
     sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
     qq, dq, d2q = _derivatives(leg, sa, ca, sb, cb)
