@@ -104,7 +104,10 @@ def _kinematics_figures(leg: sl.SphericalLeg, out_dir: Path, res: StudyResult, e
     tp = np.arange(0.0, 40.0 + 1e-9, PAPER_STEP)
     fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
     for ax, about, title in zip(
-        axes, ("x", "y"), ("(a) α varies (sway about X; l̇1 = l̇2 = 0)", "(b) β varies (sway about Y; l̇3 = 0)"), strict=True
+        axes,
+        ("x", "y"),
+        ("(a) α varies (sway about X; l̇1 = l̇2 = 0)", "(b) β varies (sway about Y; l̇3 = 0)"),
+        strict=True,
     ):
         _, ld, _ = sl.leg_rates(leg, *sl.sway(t, about))
         _, ldp, _ = sl.leg_rates(leg, *sl.sway(tp, about))
