@@ -21,7 +21,7 @@ axisymmetric leg), except the lead screws of legs 1 and 3, which spin at ``2 pi 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -81,6 +81,7 @@ def _motion(leg: SphericalLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -
     # d/dt of E qd: the second column (0, cos a, sin a) turns with alpha
     Ed_qd = np.stack([np.zeros_like(a), -sa, ca], -1) * (qd[..., 0] * qd[..., 1])[..., None]
     dw = np.einsum("...ij,...j->...i", E, qdd) + Ed_qd
+    # paper 1, eq. (21): printed lever arm h_p (the platform thickness); the centre P is at OP = h
     p = leg.h * Rp[..., :, 2]
     B = np.einsum("...ij,kj->...ki", Rp, leg.platform_points_home)  # (..., 3 legs, 3)
     u = B - leg.base_points
@@ -190,8 +191,6 @@ def mass_matrix(leg: SphericalLeg, q: object) -> np.ndarray:
 
 
 def _replace_gravity(leg: SphericalLeg) -> SphericalLeg:
-    from dataclasses import replace
-
     return replace(leg, gravity=(0.0, 0.0, 0.0))
 
 
@@ -258,11 +257,12 @@ def distribute_forces(
         x = np.einsum("...ij,...j->...i", inv, t) / dsafe[..., None]
         f = np.einsum("...ij,...j->...i", J, x)
     else:
-        i, j = (int(x) for x in driven_legs)
-        if len(driven_legs) != 2 or i == j or not {i, j} <= {0, 1, 2}:
+        pair = tuple(driven_legs)
+        if len(pair) != 2 or pair[0] == pair[1] or not set(pair) <= {0, 1, 2}:
             raise ValueError(
                 f"Expected driven_legs to be two different leg indices in 0..2, got {driven_legs!r}."
             )
+        i, j = (int(x) for x in pair)
         Js = J[..., [i, j], :]  # (..., 2, 2)
         det = Js[..., 0, 0] * Js[..., 1, 1] - Js[..., 0, 1] * Js[..., 1, 0]
         scale = np.sum(Js * Js, axis=(-1, -2))

@@ -398,5 +398,8 @@ def leg_rates(
         4 * l[..., None, None] ** 3
     )
     ld = np.einsum("...ij,...j->...i", J, qda)
+    # paper 1, eqs. (13)-(17): printed l*lddot = L.V (for l*ldot) and a scalar (1 - S^2)/l; correct is
+    # lddot = s.a_B + v_B^T (I - s s^T) v_B / l = s.a_B + (|v_B|^2 - ldot^2)/l, which J qdd + qd^T H qd
+    # equals (tested against the engine and against this form).
     ldd = np.einsum("...ij,...j->...i", J, qdda) + np.einsum("...ijk,...j,...k->...i", H, qda, qda)
     return l, ld, ldd
