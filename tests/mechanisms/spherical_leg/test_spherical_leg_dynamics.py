@@ -141,3 +141,24 @@ def test_batched_equals_per_sample_and_bad_input():
         sl.inverse_dynamics(LEG, np.zeros((20, 3)), qd, qdd)
     with pytest.raises(ValueError, match="platform_wrench"):
         sl.inverse_dynamics(LEG, q, qd, qdd, platform_wrench=np.zeros(3))
+
+
+@pytest.mark.parametrize(
+    ("kind", "arg"), [("sway", "x"), ("sway", "y"), ("fig5", "a"), ("fig5", "b"), ("fig5", "c")]
+)
+def test_paper_motions_are_consistent(kind, arg):
+    t = np.linspace(0.0, 24.0, 24001)
+    dt = t[1] - t[0]
+    q, qd, qdd = sl.sway(t, arg) if kind == "sway" else sl.fig5_motion(arg, t)
+    # Fig. 5(b) as printed starts the sine sway from rest at t = 5 s: alpha_dot steps by A*2*pi*f there
+    keep = np.abs(t - 5.0) > 2 * dt if (kind, arg) == ("fig5", "b") else np.ones(t.size, dtype=bool)
+    keep[[0, -1]] = False
+    assert np.max(np.abs(np.gradient(q, dt, axis=0) - qd)[keep]) < 1e-6
+    assert np.max(np.abs(np.gradient(qd, dt, axis=0) - qdd)[keep]) < 1e-3  # the quintic's jerk step at 5 s
+    assert np.max(np.abs(q)) <= np.pi / 3 + 1e-12
+    if kind == "fig5" and arg == "b":
+        assert q[0, 1] == pytest.approx(np.pi / 3) and q[-1, 1] == pytest.approx(np.pi / 6)
+        jump = qd[t >= 5.0][0, 0] - qd[t < 5.0][-1, 0]
+        assert jump == pytest.approx(np.pi / 3 * 2 * np.pi * 0.05)
+    with pytest.raises(ValueError, match=r"about|case"):
+        sl.sway(t, "z") if kind == "sway" else sl.fig5_motion("d", t)

@@ -17,7 +17,7 @@ FIG5B_TRANSITION = 5.0
 
 
 def sway(t: object, about: str, beta0: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Section 6.1 sway ``A sin(2 pi f t)`` about X (alpha; beta held at ``beta0``) or Y (beta).
+    """Section 6.1 sway ``A sin(2 pi f t)`` about X (alpha; beta held at ``beta0``) or Y (beta; alpha = 0).
 
     Returns q, qd, qdd, each (..., 2) with q = (alpha, beta).
     """
@@ -32,9 +32,13 @@ def sway(t: object, about: str, beta0: float = 0.0) -> tuple[np.ndarray, np.ndar
 
 
 def fig5_motion(case: str, t: object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The motions of Fig. 5: ``"a"`` sway about X at beta = pi/3; ``"b"`` beta pi/3 -> pi/6 in 5 s then
-    sway about X (from alpha = 0, one period = 20 s); ``"c"`` sway about X at beta = 0 (the print does
-    not state beta for case (c): an assumption). Returns q, qd, qdd (..., 2)."""
+    """The motions of Fig. 5, each returned as q, qd, qdd (..., 2).
+
+    ``"a"``: sway about X at beta = pi/3. ``"b"``: beta pi/3 -> pi/6 in 5 s, then sway about X from
+    alpha = 0 (one period = 20 s); as printed the sine starts from rest, so alpha_dot steps by
+    A 2 pi f = 0.33 rad/s at t = 5 s (an impulse the forces cannot show). ``"c"``: sway about X at
+    beta = 0 (the print does not state beta for case (c): an assumption).
+    """
     t = as_array(t, "t")
     if case == "a":
         return sway(t, "x", np.pi / 3)
