@@ -62,13 +62,22 @@ SIM_PD_BANDWIDTH = 30.0  # rad/s, well below 1/SIM_TIMESTEP, above the 0.05 Hz m
 SIM_PD_MASS = 5.0  # kg, the order of the platform's effective mass at the legs (screw spin off)
 
 
+# Stiff equality constraints for the forward simulation (time constant 10 x the step, as MuJoCo advises).
+_SOLVER = 'solref="0.002 1" solimp="0.9999 0.9999 0.001 0.5 2"'
+
+
+def _rot_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Minimal rotation taking unit vector a to unit vector b (never called with b = -a here: a leg
+    cannot turn half a revolution from its home direction)."""
+    axis = np.cross(a, b)
+    n = np.linalg.norm(axis)
+    ang = np.arctan2(n, float(a @ b))
+    return exp_so3(axis / n * ang) if n > 0 else np.eye(3)
+
+
 def _rot_z_to(s: np.ndarray) -> np.ndarray:
     """A rotation matrix whose z axis is the unit vector ``s`` (minimal rotation from z)."""
-    z = np.array([0.0, 0.0, 1.0])
-    axis = np.cross(z, s)
-    n = np.linalg.norm(axis)
-    ang = np.arctan2(n, float(z @ s))
-    return exp_so3(axis / n * ang) if n > 0 else np.eye(3)
+    return _rot_between(np.array([0.0, 0.0, 1.0]), s)
 
 
 def _quat(R: np.ndarray) -> np.ndarray:
@@ -135,10 +144,6 @@ def build_model(leg: sl.SphericalLeg, timestep: float = SIM_TIMESTEP) -> mujoco.
     return mujoco.MjModel.from_xml_string(xml)
 
 
-# Stiff equality constraints for the forward simulation (time constant 10 x the step, as MuJoCo advises).
-_SOLVER = 'solref="0.002 1" solimp="0.9999 0.9999 0.001 0.5 2"'
-
-
 class _Layout:
     """Indices of the model's joints in qpos / qvel."""
 
@@ -199,14 +204,6 @@ def _set_state(m, d, lay: _Layout, leg: sl.SphericalLeg, q, qd, qdd) -> None:
             d.qvel[va] = -sig
             qacc[va] = -sigd
     d.qacc[:] = qacc
-
-
-def _rot_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Minimal rotation taking unit vector a to unit vector b."""
-    axis = np.cross(a, b)
-    n = np.linalg.norm(axis)
-    ang = np.arctan2(n, float(a @ b))
-    return exp_so3(axis / n * ang) if n > 0 else np.eye(3)
 
 
 def _equality_rows(d) -> np.ndarray:
