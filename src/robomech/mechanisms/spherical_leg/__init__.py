@@ -1,0 +1,61 @@
+"""Paper 1: the 2RUHU-RUPR-RUR spherical parallel leg of a wheel-leg robot.
+
+Chen, He, Jiang, Sang, Ning, "Dynamic model of spherical parallel mechanism for wheel-leg hybrid mobile
+robot", Optics and Precision Engineering 27(8), 2019.  Exact closed-form inverse and forward position,
+first- and second-order influence coefficients, rigid-body inverse dynamics with a selectable
+redundant-actuation force distribution, and workspace/singularity maps.  See
+``docs/mechanisms/spherical_leg.md`` for every assumption and departure from the print.
+"""
+
+from ._dynamics import (
+    PAPER_DRIVEN_LEGS,
+    ForceDistribution,
+    InverseDynamicsResult,
+    distribute_forces,
+    generalized_forces,
+    inverse_dynamics,
+    mass_matrix,
+    mechanical_energy,
+)
+from ._kinematics import (
+    ForwardKinematicsResult,
+    InverseKinematicsResult,
+    angular_velocity_jacobian,
+    forward_kinematics,
+    hessian,
+    influence_coefficients,
+    inverse_kinematics,
+    jacobian,
+    leg_rates,
+    platform_rotation,
+)
+from ._motions import fig5_motion, sway
+from ._params import LegBody, SphericalLeg
+from ._workspace import WorkspaceMap, workspace_map
+
+__all__ = [
+    "PAPER_DRIVEN_LEGS",
+    "ForceDistribution",
+    "ForwardKinematicsResult",
+    "InverseDynamicsResult",
+    "InverseKinematicsResult",
+    "LegBody",
+    "SphericalLeg",
+    "WorkspaceMap",
+    "angular_velocity_jacobian",
+    "distribute_forces",
+    "fig5_motion",
+    "forward_kinematics",
+    "generalized_forces",
+    "hessian",
+    "influence_coefficients",
+    "inverse_dynamics",
+    "inverse_kinematics",
+    "jacobian",
+    "leg_rates",
+    "mass_matrix",
+    "mechanical_energy",
+    "platform_rotation",
+    "sway",
+    "workspace_map",
+]

@@ -1,0 +1,316 @@
+"""Rigid-body inverse dynamics of the spherical parallel leg and its redundant force distribution.
+
+Replaces paper 1, eqs. (19)-(28), which cannot be reproduced as printed (errata): the generalized
+coordinates here are the platform angles q = (alpha, beta) (the printed model uses the three leg
+lengths as coordinates of a 2-DOF platform), the platform lever arm is OP = h (the print uses the
+thickness h_p), and every body's kinetic energy is complete (eq. (25)'s dE/dqdot lost its squares).
+
+Method (Kane's equations = d'Alembert's principle, exact for this holonomic mechanism once the loop
+closure is solved): with each body's centre-of-mass velocity ``v_b = Pv_b qd`` and angular velocity
+``w_b = Pw_b qd``,
+
+    tau = sum_b Pv_b^T m_b (a_b - g) + Pw_b^T (I_b dw_b + w_b x I_b w_b) - E^T m_ext.
+
+Bodies: the platform (rotating about O), and per leg a lower body (centre of mass fixed on the leg
+axis at half its length from A_i) and an upper body (centre of mass at half its length from B_i). The
+leg bodies are inertially axisymmetric and do not spin about the leg axis (the S-P-S motion of an
+axisymmetric leg), except the lead screws of legs 1 and 3, which spin at ``2 pi ldot / lead``
+(helical joint) when ``leg.screw_spin`` is set.  Leg forces f (positive = extending the leg) satisfy
+``J^T f = tau`` (virtual work, power f . ldot): three legs drive two coordinates, so a rule picks f.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from robomech._validation import as_array
+
+from ._kinematics import LENGTH_FLOOR, _rotation
+from ._params import SphericalLeg
+
+__all__ = [
+    "PAPER_DRIVEN_LEGS",
+    "ForceDistribution",
+    "InverseDynamicsResult",
+    "distribute_forces",
+    "generalized_forces",
+    "inverse_dynamics",
+    "mass_matrix",
+    "mechanical_energy",
+]
+
+# Paper 1, Section 2.1: the sway (alpha, beta) is driven by motors 7 and 9 through the two RUHU
+# chains, legs 1 and 3 (indices 0 and 2); leg 2 (RUPR) carries the wheel lift.
+PAPER_DRIVEN_LEGS = (0, 2)
+# The actuation is singular where the leg Jacobian (or the driven legs' 2x2 block) loses rank: below
+# this ratio sigma_min/sigma_max the forces exceed 1e8 times the generalized force scale and are
+# reported invalid (same threshold as robomech.analysis.workspace.SINGULAR_RTOL).
+ACTUATION_SINGULAR_RTOL = 1e-8
+
+
+@dataclass(frozen=True)
+class _Motion:
+    """Per-body kinematic quantities (legs stacked on axis -2 of the (..., 3, 3) arrays)."""
+
+    E: np.ndarray  # (..., 3, 2)
+    w: np.ndarray  # platform angular velocity (..., 3)
+    dw: np.ndarray
+    p: np.ndarray  # platform centre (..., 3)
+    Rp: np.ndarray  # platform rotation (..., 3, 3)
+    s: np.ndarray  # (..., 3, 3) leg unit vectors
+    sd: np.ndarray
+    sdd: np.ndarray
+    l: np.ndarray  # (..., 3)
+    ld: np.ndarray
+    ldd: np.ndarray
+    Jl: np.ndarray  # (..., 3, 2) dl/dq
+    Ps: np.ndarray  # (..., 3, 3, 2) d(sdot)/d(qd)
+
+
+def _motion(leg: SphericalLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> _Motion:
+    a, b = q[..., 0], q[..., 1]
+    sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
+    Rp = _rotation(sa, ca, sb, cb)
+    E = np.zeros((*a.shape, 3, 2))
+    E[..., 0, 0] = 1.0
+    E[..., 1, 1] = ca
+    E[..., 2, 1] = sa
+    w = np.einsum("...ij,...j->...i", E, qd)
+    # d/dt of E qd: the second column (0, cos a, sin a) turns with alpha
+    Ed_qd = np.stack([np.zeros_like(a), -sa, ca], -1) * (qd[..., 0] * qd[..., 1])[..., None]
+    dw = np.einsum("...ij,...j->...i", E, qdd) + Ed_qd
+    # paper 1, eq. (21): printed lever arm h_p (the platform thickness); the centre P is at OP = h
+    p = leg.h * Rp[..., :, 2]
+    B = np.einsum("...ij,kj->...ki", Rp, leg.platform_points_home)  # (..., 3 legs, 3)
+    u = B - leg.base_points
+    wl = w[..., None, :]
+    ud = np.cross(wl, B)
+    udd = np.cross(dw[..., None, :], B) + np.cross(wl, ud)
+    l = np.maximum(np.linalg.norm(u, axis=-1), LENGTH_FLOOR)
+    s = u / l[..., None]
+    ld = np.sum(s * ud, -1)
+    sd = (ud - s * ld[..., None]) / l[..., None]
+    ldd = np.sum(s * udd, -1) + l * np.sum(sd * sd, -1)
+    sdd = (udd - s * ldd[..., None] - 2 * sd * ld[..., None]) / l[..., None]
+    # partial velocities: d(udot)/d(qd_k) = E_k x B_i
+    U = np.cross(np.swapaxes(E, -1, -2)[..., None, :, :], B[..., :, None, :])  # (..., legs, k, 3)
+    U = np.swapaxes(U, -1, -2)  # (..., legs, 3, k)
+    Jl = np.einsum("...li,...lik->...lk", s, U)
+    Ps = (U - s[..., :, None] * Jl[..., None, :]) / l[..., None, None]
+    return _Motion(E, w, dw, p, Rp, s, sd, sdd, l, ld, ldd, Jl, Ps)
+
+
+def _check_state(q: object, qd: object, qdd: object | None = None):
+    qa = as_array(q, "q", (2,))
+    qda = as_array(qd, "qd", (2,))
+    qdda = None if qdd is None else as_array(qdd, "qdd", (2,))
+    shapes = [x.shape for x in (qa, qda, qdda) if x is not None]
+    try:
+        shape = np.broadcast_shapes(*shapes)
+    except ValueError as exc:
+        raise ValueError(f"Expected q, qd, qdd to broadcast, got shapes {shapes}.") from exc
+    out = [np.broadcast_to(qa, shape), np.broadcast_to(qda, shape)]
+    if qdda is not None:
+        out.append(np.broadcast_to(qdda, shape))
+    return out
+
+
+def _cross_cols(s: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """s (..., 3) x each column of P (..., 3, k) -> (..., 3, k)."""
+    return np.swapaxes(np.cross(s[..., None, :], np.swapaxes(P, -1, -2)), -1, -2)
+
+
+def _generalized(leg: SphericalLeg, m: _Motion, wrench: np.ndarray | None) -> np.ndarray:
+    g = np.asarray(leg.gravity)
+    # platform: partial velocity of p is -hat(p) E, so Pv^T F = E^T (p x F)
+    mp = leg.platform_mass
+    ap = np.cross(m.dw, m.p) + np.cross(m.w, np.cross(m.w, m.p))
+    Fp = mp * (ap - g)
+    Iw = m.Rp @ leg.platform_inertia @ np.swapaxes(m.Rp, -1, -2)
+    Iww = np.einsum("...ij,...j->...i", Iw, m.w)
+    n_p = np.einsum("...ij,...j->...i", Iw, m.dw) + np.cross(m.w, Iww)
+    moment = n_p + np.cross(m.p, Fp)
+    if wrench is not None:
+        moment = moment - wrench[..., :3]  # the platform's twist about O is [w; 0]: only m_O works
+    tau = np.einsum("...ik,...i->...k", m.E, moment)
+    # legs (loop over the two bodies of every leg; legs are vectorised on axis -2)
+    dwL = np.cross(m.s, m.sdd)
+    PwL = _cross_cols(m.s, m.Ps)  # (..., legs, 3, 2)
+    sJ = m.s[..., :, None] * m.Jl[..., None, :]  # (..., legs, 3, 2): s (dl/dq)
+    k = leg.spin_ratio
+    for pos, bodies in (("lower", leg.lower), ("upper", leg.upper)):
+        mass = np.array([bd.mass for bd in bodies])
+        It = np.array([bd.transverse_inertia for bd in bodies])
+        if pos == "lower":
+            d = np.array([0.5 * bd.length for bd in bodies])
+            acc = d[:, None] * m.sdd
+            Pv = d[:, None, None] * m.Ps
+            Ia = np.array([bd.axial_inertia for bd in bodies])
+            sig, sigd = k * m.ld, k * m.ldd
+            # screw spin sigma s: n = It dwL + Ia (dsigma s + sigma sdot) (axisymmetric body)
+            n = It[:, None] * dwL + Ia[:, None] * (sigd[..., None] * m.s + sig[..., None] * m.sd)
+            Pw = PwL + k[:, None, None] * sJ
+        else:
+            d = m.l - np.array([0.5 * bd.length for bd in bodies])
+            acc = m.ldd[..., None] * m.s + 2 * m.ld[..., None] * m.sd + d[..., None] * m.sdd
+            Pv = sJ + d[..., None, None] * m.Ps
+            n = It[:, None] * dwL  # w x (I w) = 0: w is perpendicular to the symmetry axis
+            Pw = PwL
+        F = mass[:, None] * (acc - g)
+        tau = tau + np.einsum("...lik,...li->...k", Pv, F) + np.einsum("...lik,...li->...k", Pw, n)
+    return tau
+
+
+def generalized_forces(
+    leg: SphericalLeg, q: object, qd: object, qdd: object, *, platform_wrench: object | None = None
+) -> np.ndarray:
+    """Generalized forces on q = (alpha, beta) (N m) for the motion (q, qd, qdd), each (..., 2).
+
+    ``platform_wrench (..., 6)``: external wrench ``[m_O; f]`` on the platform, base frame, moment
+    about O (conventions); tau is what the actuators must supply.
+    """
+    qa, qda, qdda = _check_state(q, qd, qdd)
+    w = None if platform_wrench is None else as_array(platform_wrench, "platform_wrench", (6,))
+    return _generalized(leg, _motion(leg, qa, qda, qdda), w)
+
+
+def mass_matrix(leg: SphericalLeg, q: object) -> np.ndarray:
+    """Mass matrix M(q) (..., 2, 2) of the coordinates (alpha, beta): tau = M qdd + c(q, qd) + g(q)."""
+    qa = as_array(q, "q", (2,))
+    zero_g = _replace_gravity(leg)
+    cols = []
+    for j in range(2):
+        e = np.zeros(2)
+        e[j] = 1.0
+        cols.append(
+            _generalized(zero_g, _motion(zero_g, qa, np.zeros_like(qa), np.broadcast_to(e, qa.shape)), None)
+        )
+    return np.stack(cols, -1)
+
+
+def _replace_gravity(leg: SphericalLeg) -> SphericalLeg:
+    return replace(leg, gravity=(0.0, 0.0, 0.0))
+
+
+def mechanical_energy(leg: SphericalLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
+    """Kinetic and potential energy (J) of platform and legs, each (...); potential zero at O."""
+    qa, qda = _check_state(q, qd)
+    m = _motion(leg, qa, qda, np.zeros_like(qa))
+    g = np.asarray(leg.gravity)
+    vp = np.cross(m.w, m.p)
+    Iw = m.Rp @ leg.platform_inertia @ np.swapaxes(m.Rp, -1, -2)
+    T = 0.5 * leg.platform_mass * np.sum(vp * vp, -1) + 0.5 * np.einsum("...i,...ij,...j->...", m.w, Iw, m.w)
+    V = -leg.platform_mass * (m.p @ g)
+    wL2 = np.sum(np.cross(m.s, m.sd) ** 2, -1)  # (..., legs)
+    A = leg.base_points
+    sig = leg.spin_ratio * m.ld
+    for pos, bodies in (("lower", leg.lower), ("upper", leg.upper)):
+        mass = np.array([bd.mass for bd in bodies])
+        It = np.array([bd.transverse_inertia for bd in bodies])
+        if pos == "lower":
+            d = np.array([0.5 * bd.length for bd in bodies])
+            v = d[:, None] * m.sd
+            Ia = np.array([bd.axial_inertia for bd in bodies])
+            T = T + 0.5 * np.sum(Ia * sig * sig, -1)
+        else:
+            d = m.l - np.array([0.5 * bd.length for bd in bodies])
+            v = m.ld[..., None] * m.s + d[..., None] * m.sd
+        c = A + d[..., None] * m.s
+        T = T + 0.5 * np.sum(mass * np.sum(v * v, -1) + It * wL2, -1)
+        V = V - np.sum(mass * (c @ g), -1)
+    return T, V
+
+
+@dataclass(frozen=True)
+class ForceDistribution:
+    """Leg forces f (..., 3) (N, positive extends the leg) with J^T f = tau; residual (...) N m is
+    |J^T f - tau| (rounding level where valid); valid (...) False at an actuation singularity (f NaN)."""
+
+    forces: np.ndarray
+    residual: np.ndarray
+    valid: np.ndarray
+
+
+def distribute_forces(
+    J: object, tau: object, driven_legs: tuple[int, int] | None = None
+) -> ForceDistribution:
+    """Leg forces balancing the generalized forces ``tau (..., 2)`` through ``J (..., 3, 2)``.
+
+    ``driven_legs=None``: minimum-norm forces ``f = J (J^T J)^-1 tau`` (all three legs share the load,
+    no internal preload). ``driven_legs=(i, j)``: only those two legs act (paper 1's choice is
+    :data:`PAPER_DRIVEN_LEGS`, legs 1 and 3), the third carries no force.
+    """
+    J = as_array(J, "J", (3, 2), finite=False)
+    t = as_array(tau, "tau", (2,), finite=False)
+    if driven_legs is None:
+        A = np.einsum("...ki,...kj->...ij", J, J)
+        det = A[..., 0, 0] * A[..., 1, 1] - A[..., 0, 1] * A[..., 1, 0]
+        tr = A[..., 0, 0] + A[..., 1, 1]
+        # sigma_min^2 / sigma_max^2 of J from the 2x2 Gram matrix; cond ratio test on sigma
+        ok = np.isfinite(det) & (det > (ACTUATION_SINGULAR_RTOL**2) * tr * tr)
+        dsafe = np.where(ok, det, 1.0)
+        inv = np.stack(
+            [np.stack([A[..., 1, 1], -A[..., 0, 1]], -1), np.stack([-A[..., 1, 0], A[..., 0, 0]], -1)], -2
+        )
+        x = np.einsum("...ij,...j->...i", inv, t) / dsafe[..., None]
+        f = np.einsum("...ij,...j->...i", J, x)
+    else:
+        pair = tuple(driven_legs)
+        if len(pair) != 2 or pair[0] == pair[1] or not set(pair) <= {0, 1, 2}:
+            raise ValueError(
+                f"Expected driven_legs to be two different leg indices in 0..2, got {driven_legs!r}."
+            )
+        i, j = (int(x) for x in pair)
+        Js = J[..., [i, j], :]  # (..., 2, 2)
+        det = Js[..., 0, 0] * Js[..., 1, 1] - Js[..., 0, 1] * Js[..., 1, 0]
+        scale = np.sum(Js * Js, axis=(-1, -2))
+        ok = np.isfinite(det) & (np.abs(det) > ACTUATION_SINGULAR_RTOL * scale)
+        dsafe = np.where(ok, det, 1.0)
+        # solve Js^T fs = tau
+        f0 = (Js[..., 1, 1] * t[..., 0] - Js[..., 1, 0] * t[..., 1]) / dsafe
+        f1 = (-Js[..., 0, 1] * t[..., 0] + Js[..., 0, 0] * t[..., 1]) / dsafe
+        f = np.zeros((*det.shape, 3))
+        f[..., i] = f0
+        f[..., j] = f1
+    ok = ok & np.all(np.isfinite(t), -1)
+    f = np.where(ok[..., None], f, np.nan)
+    resid = np.linalg.norm(
+        np.einsum("...ki,...k->...i", J, np.where(ok[..., None], f, 0.0)) - np.where(ok[..., None], t, 0.0),
+        axis=-1,
+    )
+    return ForceDistribution(forces=f, residual=np.where(ok, resid, np.nan), valid=ok)
+
+
+@dataclass(frozen=True)
+class InverseDynamicsResult:
+    """generalized_forces (..., 2) N m on (alpha, beta); leg_forces (..., 3) N (positive extends);
+    residual (...) N m of J^T f = tau; valid (...) False at an actuation singularity (forces NaN)."""
+
+    generalized_forces: np.ndarray
+    leg_forces: np.ndarray
+    residual: np.ndarray
+    valid: np.ndarray
+
+
+def inverse_dynamics(
+    leg: SphericalLeg,
+    q: object,
+    qd: object,
+    qdd: object,
+    *,
+    platform_wrench: object | None = None,
+    driven_legs: tuple[int, int] | None = None,
+) -> InverseDynamicsResult:
+    """Generalized forces and leg actuator forces for the platform motion (q, qd, qdd), each (..., 2).
+
+    q = (alpha, beta) rad; ``platform_wrench (..., 6)`` ``[m_O; f]`` on the platform (base frame, moment
+    about O); ``driven_legs`` selects the force distribution (see :func:`distribute_forces`).
+    """
+    qa, qda, qdda = _check_state(q, qd, qdd)
+    w = None if platform_wrench is None else as_array(platform_wrench, "platform_wrench", (6,))
+    m = _motion(leg, qa, qda, qdda)
+    tau = _generalized(leg, m, w)
+    dist = distribute_forces(m.Jl, tau, driven_legs)
+    return InverseDynamicsResult(tau, dist.forces, dist.residual, dist.valid)

@@ -1,0 +1,405 @@
+"""Position, velocity and acceleration kinematics of the spherical parallel leg (paper 1, Sections 3-4).
+
+The platform rotates about O by ``T = Rx(alpha) Ry(beta)`` (paper 1, eq. (1)); leg i joins
+``A_i`` (base) to ``B_i = T b_i`` (``b_i`` = B_i at the home pose). Squared leg lengths in closed form,
+with ``K = R^2 + r^2 + h^2``:
+
+    l1^2 = K - 2R (r cos b + h sin b)
+    l2^2 = K - 2R (r cos b - h sin b)
+    l3^2 = K - 2R (r cos a - h cos b sin a)
+
+so l1, l2 fix beta alone and l3 then fixes alpha: the three lengths over-determine the two angles.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array
+
+from ._params import SphericalLeg
+
+__all__ = [
+    "ForwardKinematicsResult",
+    "InverseKinematicsResult",
+    "angular_velocity_jacobian",
+    "forward_kinematics",
+    "hessian",
+    "influence_coefficients",
+    "inverse_kinematics",
+    "jacobian",
+    "leg_rates",
+    "platform_rotation",
+]
+
+# Forward kinematics fits beta to (l1, l2) by Newton's method started at the exact closed form.  For
+# consistent lengths the start is already the answer; for noisy lengths the 1-D least-squares problem
+# is smooth and convex near the start, and Newton converges quadratically in about 3-5 steps.  40 is a
+# generous cap that only sub-millimetre-inconsistent inputs far from any pose could approach.
+FK_MAX_ITER = 40
+# Newton stops when the beta step falls below this (rad): 100x the rounding of an O(1) angle, far
+# below the 1e-10 rad accuracy the tests require (used where the Gauss-Newton fallback is active).
+FK_STEP_TOL = 1e-14
+# With Newton's own curvature the convergence is quadratic (f'' is bounded away from zero since
+# dl1/db and dl2/db never vanish together), so after a step below 1e-8 rad the remaining error is
+# of order step^2 ~ 1e-16 rad: the step is applied and the iteration stops, saving one iteration.
+FK_NEWTON_STEP_TOL = 1e-8
+# |sin(alpha - phi)| may exceed 1 by rounding when l3 sits exactly on the branch boundary (the
+# l3-singularity); up to this excess the value is clipped, beyond it the lengths have no assembly.
+ASSEMBLY_TOL = 1e-12
+# Derivatives divide by the leg length; B_i can only reach A_i in a collided pose far outside any
+# stroke (length_min > 0). The length is floored here so such a pose gives a huge finite derivative
+# (flagged by within_limits) rather than a division-by-zero warning.
+LENGTH_FLOOR = 1e-12
+# Large batches are evaluated in chunks of this many samples so that a kernel's temporaries (about
+# twenty arrays of 16384 float64 = 128 KiB each) stay in the L2 cache instead of streaming through
+# memory; on 10^6 poses this roughly halves the time (benchmarks/bench_spherical_leg.py). Every
+# operation is elementwise per sample, so chunking does not change any result bit.
+CHUNK = 16384
+
+
+def _chunked(kernel, inputs: tuple[np.ndarray, ...], outputs: tuple[np.ndarray, ...]) -> None:
+    """Run ``kernel(*inputs[c], *outputs[c])`` over chunks c of the leading (flat) batch axis."""
+    n = inputs[0].shape[0]
+    for start in range(0, n, CHUNK):
+        c = slice(start, start + CHUNK)
+        kernel(*(x[c] for x in inputs), *(o[c] for o in outputs))
+
+
+def _angles(alpha: object, beta: object) -> tuple[np.ndarray, np.ndarray]:
+    a = as_array(alpha, "alpha")
+    b = as_array(beta, "beta")
+    try:
+        a, b = np.broadcast_arrays(a, b)
+    except ValueError as exc:
+        raise ValueError(
+            f"Expected alpha and beta to broadcast, got shapes {a.shape} and {b.shape}."
+        ) from exc
+    return a, b
+
+
+def platform_rotation(alpha: object, beta: object) -> np.ndarray:
+    """``T = Rx(alpha) Ry(beta)`` (paper 1, eq. (1)) -> (..., 3, 3)."""
+    a, b = _angles(alpha, beta)
+    return _rotation(np.sin(a), np.cos(a), np.sin(b), np.cos(b))
+
+
+def _rotation(sa: np.ndarray, ca: np.ndarray, sb: np.ndarray, cb: np.ndarray) -> np.ndarray:
+    z = np.zeros_like(sa)
+    return np.stack(
+        [
+            np.stack([cb, z, sb], -1),
+            np.stack([sa * sb, ca, -sa * cb], -1),
+            np.stack([-ca * sb, sa, ca * cb], -1),
+        ],
+        -2,
+    )
+
+
+def _squared_lengths(leg: SphericalLeg, sa, ca, sb, cb) -> np.ndarray:
+    R, r, h = leg.R, leg.r, leg.h
+    K = R * R + r * r + h * h
+    q1 = K - 2 * R * (r * cb + h * sb)
+    q2 = K - 2 * R * (r * cb - h * sb)
+    q3 = K - 2 * R * (r * ca - h * cb * sa)
+    return np.stack([q1, q2, q3], -1)
+
+
+@dataclass(frozen=True)
+class InverseKinematicsResult:
+    """Leg lengths and geometry for platform angles (alpha, beta).
+
+    lengths (..., 3) m; unit_vectors (..., 3, 3) rows s_i = (B_i - A_i)/l_i; platform_points
+    (..., 3, 3) rows B_i in the base frame; base_points (3, 3) rows A_i; within_limits (..., 3) bool:
+    length_min <= l_i <= length_max.
+    """
+
+    lengths: np.ndarray
+    unit_vectors: np.ndarray
+    platform_points: np.ndarray
+    base_points: np.ndarray
+    within_limits: np.ndarray
+
+
+def inverse_kinematics(leg: SphericalLeg, alpha: object, beta: object) -> InverseKinematicsResult:
+    """Leg lengths (paper 1, eq. (4)) for platform angles ``alpha``, ``beta`` (rad, broadcast).
+
+    Every finite (alpha, beta) has a solution; non-finite angles raise ``ValueError``.
+    """
+    a, b = _angles(alpha, beta)
+    shape = a.shape
+    n = a.size
+    L = np.empty((n, 3))
+    S = np.empty((n, 3, 3))
+    B = np.empty((n, 3, 3))
+    _chunked(lambda *x: _ik_kernel(leg, *x), (a.reshape(-1), b.reshape(-1)), (L, S, B))
+    within = (L >= leg.length_min) & (L <= leg.length_max)
+    return InverseKinematicsResult(
+        L.reshape(*shape, 3),
+        S.reshape(*shape, 3, 3),
+        B.reshape(*shape, 3, 3),
+        leg.base_points,
+        within.reshape(*shape, 3),
+    )
+
+
+def _ik_kernel(leg: SphericalLeg, a, b, L, S, B) -> None:
+    """B_i = T b_i written out (paper 1, eq. (3) and its analogues), lengths from the closed form."""
+    R, r, h = leg.R, leg.r, leg.h
+    sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
+    rsb_m_hcb = r * sb - h * cb
+    rsb_p_hcb = r * sb + h * cb
+    B[:, 0, 0] = r * cb + h * sb
+    B[:, 0, 1] = sa * rsb_m_hcb
+    B[:, 0, 2] = -ca * rsb_m_hcb
+    B[:, 1, 0] = h * sb - r * cb
+    B[:, 1, 1] = -sa * rsb_p_hcb
+    B[:, 1, 2] = ca * rsb_p_hcb
+    hcb = h * cb
+    B[:, 2, 0] = h * sb
+    B[:, 2, 1] = r * ca - sa * hcb
+    B[:, 2, 2] = r * sa + ca * hcb
+    # the closed form keeps full relative accuracy where |B - A| is small
+    K = R * R + r * r + h * h
+    L[:, 0] = K - 2 * R * (r * cb + h * sb)
+    L[:, 1] = K - 2 * R * (r * cb - h * sb)
+    L[:, 2] = K - 2 * R * (r * ca - hcb * sa)
+    np.sqrt(np.maximum(L, 0.0, out=L), out=L)
+    np.subtract(B, leg.base_points, out=S)
+    S /= np.where(L > 0, L, 1.0)[:, :, None]
+
+
+@dataclass(frozen=True)
+class ForwardKinematicsResult:
+    """Platform angles from leg lengths.
+
+    alpha, beta (...) rad; residual (...) m: norm of (l(alpha, beta) - lengths), i.e. how inconsistent
+    the three lengths are (rounding level for exact lengths); valid (...) bool: finite positive lengths
+    that assemble (NaN angles only where valid is false); converged (...) bool: the beta fit converged.
+    """
+
+    alpha: np.ndarray
+    beta: np.ndarray
+    residual: np.ndarray
+    valid: np.ndarray
+    converged: np.ndarray
+
+
+def forward_kinematics(leg: SphericalLeg, lengths: object, branch: int = 0) -> ForwardKinematicsResult:
+    """Platform angles from leg lengths ``(..., 3)`` (m): exact closed form, least squares if noisy.
+
+    beta is the least-squares fit of (l1, l2) (which depend on beta only), started from the exact
+    ``atan2`` form built from l2^2 - l1^2 and l1^2 + l2^2; alpha then matches l3 exactly:
+    ``h cos b sin a - r cos a = (l3^2 - K) / (2R)``, i.e. ``sin(a - phi) = s`` with
+    ``phi = atan2(r, h cos b)``. ``branch=0`` is the assembly ``a = phi + asin(s)`` that contains
+    alpha = 0; ``branch=1`` is ``a = phi + pi - asin(s)``. Bad samples (non-finite, non-positive, no
+    assembly) are flagged in ``.valid``; a wrong shape raises ``ValueError``.
+    """
+    if branch not in (0, 1):
+        raise ValueError(f"Expected branch to be 0 or 1, got {branch!r}.")
+    L = as_array(lengths, "lengths", (3,), finite=False)
+    shape = L.shape[:-1]
+    n = int(np.prod(shape, dtype=int))
+    outs = (np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=bool), np.empty(n, dtype=bool))
+    _chunked(lambda *x: _fk_kernel(leg, branch, *x), (L.reshape(n, 3),), outs)
+    alpha, beta, residual, valid, converged = (o.reshape(shape) for o in outs)
+    return ForwardKinematicsResult(
+        alpha=alpha, beta=beta, residual=residual, valid=valid, converged=converged
+    )
+
+
+def _fk_kernel(
+    leg: SphericalLeg, branch: int, L, alpha_out, beta_out, resid_out, valid_out, conv_out
+) -> None:
+    ok_in = np.all(np.isfinite(L) & (L > 0), axis=-1)
+    Lw = np.where(ok_in[:, None], L, 1.0)
+    R, r, h = leg.R, leg.r, leg.h
+    K = R * R + r * r + h * h
+    q = Lw * Lw
+    # paper 1, eq. (6) uses arcsin((l2^2 - l1^2)/(4Rh)); atan2 with the cosine from l1^2 + l2^2 is exact
+    # for consistent lengths, covers |beta| > pi/2 and never leaves the domain for noisy ones.
+    beta = np.arctan2((q[:, 1] - q[:, 0]) / (4 * R * h), (2 * K - q[:, 0] - q[:, 1]) / (4 * R * r))
+    beta, converged = _fit_beta(leg, beta, Lw[:, 0], Lw[:, 1])
+    sb, cb = np.sin(beta), np.cos(beta)
+    hcb = h * cb
+    rho = np.hypot(hcb, r)
+    phi = np.arctan2(r, hcb)
+    # paper 1, eqs. (7): the printed Ferrari quartic (with a dropped square in k2, 9k2k3k4 for 9k1k2k3
+    # and arctan(2a) for 2 arctan(a)) is replaced by this exact closed form of the l3 equation.
+    s = (q[:, 2] - K) / (2 * R * rho)
+    assembles = np.abs(s) <= 1.0 + ASSEMBLY_TOL
+    asn = np.arcsin(np.clip(s, -1.0, 1.0))
+    alpha = phi + asn if branch == 0 else phi + np.pi - asn
+    alpha = np.mod(alpha + np.pi, 2 * np.pi) - np.pi
+    valid = ok_in & assembles
+    sa, ca = np.sin(alpha), np.cos(alpha)
+    fitted = np.sqrt(np.maximum(_squared_lengths(leg, sa, ca, sb, cb), 0.0))
+    residual = np.linalg.norm(fitted - Lw, axis=-1)
+    alpha_out[:] = np.where(valid, alpha, np.nan)
+    beta_out[:] = np.where(valid, beta, np.nan)
+    resid_out[:] = np.where(valid, residual, np.nan)
+    valid_out[:] = valid
+    conv_out[:] = converged & valid
+
+
+def _fit_beta(
+    leg: SphericalLeg, beta: np.ndarray, m1: np.ndarray, m2: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Newton's method on f(b) = 1/2 sum_{i=1,2} (l_i(b) - m_i)^2, batched; returns (beta, converged).
+
+    Only the samples not yet converged are iterated (active set); each sample's iterates are those it
+    would have alone.
+    """
+    R, r, h = leg.R, leg.r, leg.h
+    K = R * R + r * r + h * h
+    beta = np.array(beta, dtype=float, copy=True)
+    done = np.zeros(beta.shape, dtype=bool)
+    idx = np.arange(beta.size)
+    for _ in range(FK_MAX_ITER):
+        b = beta[idx]
+        sb, cb = np.sin(b), np.cos(b)
+        rcb, hsb, rsb, hcb = r * cb, h * sb, r * sb, h * cb
+        # q_i = l_i^2 and its beta-derivatives (closed forms of the module docstring)
+        l1 = np.sqrt(np.maximum(K - 2 * R * (rcb + hsb), LENGTH_FLOOR**2))
+        l2 = np.sqrt(np.maximum(K - 2 * R * (rcb - hsb), LENGTH_FLOOR**2))
+        d1 = R * (rsb - hcb) / l1  # dl/db = (dq/db) / (2 l)
+        d2 = R * (rsb + hcb) / l2
+        dd1 = (R * (rcb + hsb) - d1 * d1) / l1  # d2l/db2 = (q''/2 - l'^2) / l
+        dd2 = (R * (rcb - hsb) - d2 * d2) / l2
+        e1 = l1 - m1[idx]
+        e2 = l2 - m2[idx]
+        hgn = d1 * d1 + d2 * d2  # > 0: dl1/db and dl2/db never vanish together (R, r, h > 0)
+        hn = hgn + e1 * dd1 + e2 * dd2
+        newton = hn > 0.5 * hgn  # Gauss-Newton curvature where Newton's is unsafe (large residuals)
+        step = (e1 * d1 + e2 * d2) / np.where(newton, hn, hgn)
+        beta[idx] = b - step
+        fin = np.abs(step) <= np.where(newton, FK_NEWTON_STEP_TOL, FK_STEP_TOL)
+        done[idx[fin]] = True
+        idx = idx[~fin]
+        if idx.size == 0:
+            break
+    return beta, done
+
+
+def jacobian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
+    """``J[..., i, j] = d l_i / d (alpha, beta)_j`` -> (..., 3, 2) in m/rad."""
+    a, b = _angles(alpha, beta)
+    J = np.empty((a.size, 3, 2))
+    _chunked(lambda *x: _jacobian_kernel(leg, *x), (a.reshape(-1), b.reshape(-1)), (J,))
+    return J.reshape(*a.shape, 3, 2)
+
+
+def _jacobian_kernel(leg: SphericalLeg, a, b, J) -> None:
+    R, r, h = leg.R, leg.r, leg.h
+    K = R * R + r * r + h * h
+    sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
+    rcb, hsb, rsb, hcb = r * cb, h * sb, r * sb, h * cb
+    # dl/dq = (dq/dq) / (2 l) with q = l^2 (module docstring); R/l below is 2R / (2l)
+    J[:, 0, 0] = 0.0
+    J[:, 1, 0] = 0.0
+    J[:, 0, 1] = (rsb - hcb) * R / np.sqrt(np.maximum(K - 2 * R * (rcb + hsb), LENGTH_FLOOR**2))
+    J[:, 1, 1] = (rsb + hcb) * R / np.sqrt(np.maximum(K - 2 * R * (rcb - hsb), LENGTH_FLOOR**2))
+    k3 = R / np.sqrt(np.maximum(K - 2 * R * (r * ca - hcb * sa), LENGTH_FLOOR**2))
+    J[:, 2, 0] = (r * sa + hcb * ca) * k3
+    J[:, 2, 1] = -(hsb * sa) * k3
+
+
+def _derivatives(leg: SphericalLeg, sa, ca, sb, cb):
+    """Squared lengths q (..., 3), dq (..., 3, 2) and d2q (..., 3, 2, 2) w.r.t. (alpha, beta)."""
+    R, r, h = leg.R, leg.r, leg.h
+    z = np.zeros_like(sa)
+    q = _squared_lengths(leg, sa, ca, sb, cb)
+    dq = np.stack(
+        [
+            np.stack([z, 2 * R * (r * sb - h * cb)], -1),
+            np.stack([z, 2 * R * (r * sb + h * cb)], -1),
+            np.stack([2 * R * (r * sa + h * cb * ca), -2 * R * h * sb * sa], -1),
+        ],
+        -2,
+    )
+    d2q = np.stack(
+        [
+            np.stack([np.stack([z, z], -1), np.stack([z, 2 * R * (r * cb + h * sb)], -1)], -2),
+            np.stack([np.stack([z, z], -1), np.stack([z, 2 * R * (r * cb - h * sb)], -1)], -2),
+            np.stack(
+                [
+                    np.stack([2 * R * (r * ca - h * cb * sa), -2 * R * h * sb * ca], -1),
+                    np.stack([-2 * R * h * sb * ca, -2 * R * h * cb * sa], -1),
+                ],
+                -2,
+            ),
+        ],
+        -3,
+    )
+    return q, dq, d2q
+
+
+def hessian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
+    """``H[..., i, j, k] = d^2 l_i / dq_j dq_k`` with q = (alpha, beta) -> (..., 3, 2, 2) in m/rad^2."""
+    a, b = _angles(alpha, beta)
+    q, dq, d2q = _derivatives(leg, np.sin(a), np.cos(a), np.sin(b), np.cos(b))
+    l = np.sqrt(np.maximum(q, LENGTH_FLOOR**2))[..., None, None]
+    # l = sqrt(q): l'' = q''/(2l) - q' q'^T / (4 l^3)
+    return d2q / (2 * l) - np.einsum("...ij,...ik->...ijk", dq, dq) / (4 * l**3)
+
+
+def angular_velocity_jacobian(alpha: object) -> np.ndarray:
+    """``E`` with platform angular velocity ``omega = E (alpha_dot, beta_dot)`` (base frame), (..., 3, 2).
+
+    For T = Rx(alpha) Ry(beta): omega = alpha_dot x + beta_dot Rx(alpha) y.
+    """
+    a = as_array(alpha, "alpha")
+    E = np.zeros((*a.shape, 3, 2))
+    E[..., 0, 0] = 1.0
+    E[..., 1, 1] = np.cos(a)
+    E[..., 2, 1] = np.sin(a)
+    return E
+
+
+def influence_coefficients(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
+    """First-order influence coefficients: ``ldot = G [omega; v_O]`` -> G (..., 3, 6).
+
+    Row i is the Pluecker line of leg i, ``[(B_i - O) x s_i; s_i]``, acting on the platform twist
+    ``[omega; v_O]`` (base frame, reference point O; for this leg v_O = 0 since O is fixed). This is
+    paper 1, eqs. (8)-(12) with the reference point moved from P to O; eq. (12)'s first row lacks a
+    factor sin(alpha) on its ``R r`` term (errata). ``jacobian = G[..., :3] @ angular_velocity_jacobian``.
+    """
+    ik = inverse_kinematics(leg, alpha, beta)
+    G = np.empty((*ik.lengths.shape[:-1], 3, 6))
+    G[..., :3] = np.cross(ik.platform_points, ik.unit_vectors)
+    G[..., 3:] = ik.unit_vectors
+    return G
+
+
+def leg_rates(
+    leg: SphericalLeg, q: object, qd: object, qdd: object
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Leg lengths, rates and accelerations ``(l, ldot, lddot)`` (each (..., 3)) along q = (alpha, beta).
+
+    ``ldot = J qd``, ``lddot = J qdd + qd^T H qd`` (conventions: H[..., i, j, k] = dJ_ij/dq_k).
+    """
+    qa = as_array(q, "q", (2,))
+    qda = as_array(qd, "qd", (2,))
+    qdda = as_array(qdd, "qdd", (2,))
+    try:
+        qa, qda, qdda = np.broadcast_arrays(qa, qda, qdda)
+    except ValueError as exc:
+        raise ValueError(
+            f"Expected q, qd, qdd to broadcast, got shapes {qa.shape}, {qda.shape}, {qdda.shape}."
+        ) from exc
+    a, b = qa[..., 0], qa[..., 1]
+    sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
+    qq, dq, d2q = _derivatives(leg, sa, ca, sb, cb)
+    l = np.sqrt(np.maximum(qq, LENGTH_FLOOR**2))
+    J = dq / (2 * l[..., None])
+    H = d2q / (2 * l[..., None, None]) - np.einsum("...ij,...ik->...ijk", dq, dq) / (
+        4 * l[..., None, None] ** 3
+    )
+    ld = np.einsum("...ij,...j->...i", J, qda)
+    # paper 1, eqs. (13)-(17): printed l*lddot = L.V (for l*ldot) and a scalar (1 - S^2)/l; correct is
+    # lddot = s.a_B + v_B^T (I - s s^T) v_B / l = s.a_B + (|v_B|^2 - ldot^2)/l, which J qdd + qd^T H qd
+    # equals (tested against the engine and against this form).
+    ldd = np.einsum("...ij,...j->...i", J, qdda) + np.einsum("...ijk,...j,...k->...i", H, qda, qda)
+    return l, ld, ldd

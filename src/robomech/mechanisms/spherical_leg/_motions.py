@@ -1,0 +1,56 @@
+"""The motions of paper 1, Section 6 (shared by the study, the verification and the benchmarks)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robomech._validation import as_array
+from robomech.trajectory import quintic, sinusoid
+
+__all__ = ["AMPLITUDE", "FREQUENCY", "fig5_motion", "sway"]
+
+# Section 6.1: "amplitude pi/3 and frequency 0.05 Hz" about the X or the Y axis.
+AMPLITUDE = np.pi / 3
+FREQUENCY = 0.05
+# Fig. 5(b): "from beta = pi/3 to pi/6 in 5 s"; the profile is not printed: a rest-to-rest quintic.
+FIG5B_TRANSITION = 5.0
+
+
+def sway(t: object, about: str, beta0: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Section 6.1 sway ``A sin(2 pi f t)`` about X (alpha; beta held at ``beta0``) or Y (beta; alpha = 0).
+
+    Returns q, qd, qdd, each (..., 2) with q = (alpha, beta).
+    """
+    if about not in ("x", "y"):
+        raise ValueError(f"Expected about to be 'x' or 'y', got {about!r}.")
+    t = as_array(t, "t")
+    p = sinusoid(t, AMPLITUDE, FREQUENCY)
+    z = np.zeros_like(t)
+    if about == "x":
+        return np.stack([p.q, z + beta0], -1), np.stack([p.qd, z], -1), np.stack([p.qdd, z], -1)
+    return np.stack([z, p.q], -1), np.stack([z, p.qd], -1), np.stack([z, p.qdd], -1)
+
+
+def fig5_motion(case: str, t: object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The motions of Fig. 5, each returned as q, qd, qdd (..., 2).
+
+    ``"a"``: sway about X at beta = pi/3. ``"b"``: beta pi/3 -> pi/6 in 5 s, then sway about X from
+    alpha = 0 (one period = 20 s); as printed the sine starts from rest, so alpha_dot steps by
+    A 2 pi f = 0.33 rad/s at t = 5 s (an impulse the forces cannot show). ``"c"``: sway about X at
+    beta = 0 (the print does not state beta for case (c): an assumption).
+    """
+    t = as_array(t, "t")
+    if case == "a":
+        return sway(t, "x", np.pi / 3)
+    if case == "c":
+        return sway(t, "x", 0.0)
+    if case != "b":
+        raise ValueError(f"Expected case to be 'a', 'b' or 'c', got {case!r}.")
+    tr = quintic(t, FIG5B_TRANSITION, np.pi / 3, np.pi / 6)
+    sw = sinusoid(np.clip(t - FIG5B_TRANSITION, 0.0, None), AMPLITUDE, FREQUENCY)
+    on = t >= FIG5B_TRANSITION
+    return (
+        np.stack([np.where(on, sw.q, 0.0), tr.q], -1),
+        np.stack([np.where(on, sw.qd, 0.0), tr.qd], -1),
+        np.stack([np.where(on, sw.qdd, 0.0), tr.qdd], -1),
+    )

@@ -1,0 +1,165 @@
+"""Parameters of the 2RUHU-RUPR-RUR spherical parallel leg (paper 1), in SI units.
+
+Geometry (paper 1, Section 3.1): base joints A1 = (R, 0, 0), A2 = (-R, 0, 0), A3 = (0, R, 0); platform
+joints at the home pose B1 = (r, 0, h), B2 = (-r, 0, h), B3 = (0, r, h); platform centre P = (0, 0, h).
+Table 1 is reproduced exactly by R = 75 mm, r = 30 mm, h = 100 mm (errata; h is Table 2's H).
+
+Inertial model (assumptions, see ``docs/mechanisms/spherical_leg.md``): each leg is two bodies of
+Table 2. The *lower* body is joined to the base at A_i, its near end at A_i (centre of mass at half its
+length from A_i); the *upper* body is joined to the platform at B_i, its far end at B_i. Legs 1 and 3
+(RUHU): lower = lead screw (solid cylinder 110 x 30 mm, 2 kg, 10 mm lead), upper = sleeve (70 mm,
+20 mm outer diameter, 10 mm wall, 1.5 kg). Leg 2 (RUPR): lower = cylinder (square tube 70 x 40 mm,
+10 mm wall, 1 kg), upper = piston (solid bar 110 x 30 x 30 mm, 1 kg). Platform: uniform box
+60 x 60 x 20 mm, 5 kg, centred at P. The central passive chain 0 (RUR) is massless (no data given).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["LegBody", "SphericalLeg"]
+
+_MM = 1e-3
+
+
+def _positive(value: float, name: str, *, allow_zero: bool = False) -> float:
+    v = float(value)
+    ok = math.isfinite(v) and (v >= 0.0 if allow_zero else v > 0.0)
+    if not ok:
+        raise ValueError(f"Expected {name} {'>= 0' if allow_zero else '> 0'} and finite, got {value!r}.")
+    return v
+
+
+@dataclass(frozen=True)
+class LegBody:
+    """One rigid body of a leg, modelled as a uniform prism along the leg axis.
+
+    ``shape`` is ``"round"`` (cylinder of outer diameter ``width``) or ``"square"`` (square section of
+    side ``width``); ``wall`` is the wall thickness of a hollow section (``wall >= width / 2`` means
+    solid). Lengths in metres, mass in kg.
+    """
+
+    name: str
+    length: float
+    width: float
+    wall: float
+    mass: float
+    shape: str = "round"
+
+    def __post_init__(self) -> None:
+        _positive(self.length, f"{self.name}.length")
+        _positive(self.width, f"{self.name}.width")
+        _positive(self.wall, f"{self.name}.wall")
+        _positive(self.mass, f"{self.name}.mass", allow_zero=True)
+        if self.shape not in ("round", "square"):
+            raise ValueError(f"Expected {self.name}.shape to be 'round' or 'square', got {self.shape!r}.")
+
+    @property
+    def axial_inertia(self) -> float:
+        """Moment of inertia about the body's own axis through its centre of mass (kg m^2)."""
+        o = 0.5 * self.width
+        i = max(0.0, o - self.wall)
+        if self.shape == "round":
+            return 0.5 * self.mass * (o * o + i * i)
+        # square tube of outer side 2o, inner side 2i: polar moment per area (a^4 - b^4)/6 / (a^2 - b^2)
+        a, b = 2 * o, 2 * i
+        return self.mass * (a * a + b * b) / 6.0
+
+    @property
+    def transverse_inertia(self) -> float:
+        """Moment of inertia about a transverse axis through the centre of mass (kg m^2).
+
+        Both section shapes have equal second moments about every transverse axis (a square's
+        section is isotropic), so the body is inertially axisymmetric.
+        """
+        return 0.5 * self.axial_inertia + self.mass * self.length**2 / 12.0
+
+
+@dataclass(frozen=True)
+class SphericalLeg:
+    """Frozen parameters of the spherical parallel leg (SI units, radians).
+
+    ``R``, ``r``: radii of the base and platform joint circles (OA_i, PB_i); ``h``: distance OP at the
+    home pose. ``lower``/``upper``: the two bodies of each leg (index 0, 1, 2 = legs 1, 2, 3).
+    ``screw_lead``: lead of the helical joints of legs 1 and 3; the lower body of those legs (the
+    screw) spins about the leg axis at ``2 pi ldot / screw_lead`` relative to the upper body when
+    ``screw_spin`` is true. ``length_min``/``length_max``: leg stroke limits (the paper gives none).
+    ``gravity``: acceleration vector in the base frame (paper: (0, 0, -10) m/s^2).
+    """
+
+    R: float = 75 * _MM
+    r: float = 30 * _MM
+    h: float = 100 * _MM
+    platform_side: float = 60 * _MM
+    platform_thickness: float = 20 * _MM
+    platform_mass: float = 5.0
+    lower: tuple[LegBody, LegBody, LegBody] = field(
+        default_factory=lambda: (
+            LegBody("screw", 110 * _MM, 30 * _MM, 15 * _MM, 2.0),
+            LegBody("cylinder", 70 * _MM, 40 * _MM, 10 * _MM, 1.0, "square"),
+            LegBody("screw", 110 * _MM, 30 * _MM, 15 * _MM, 2.0),
+        )
+    )
+    upper: tuple[LegBody, LegBody, LegBody] = field(
+        default_factory=lambda: (
+            LegBody("sleeve", 70 * _MM, 20 * _MM, 10 * _MM, 1.5),
+            LegBody("piston", 110 * _MM, 30 * _MM, 15 * _MM, 1.0, "square"),
+            LegBody("sleeve", 70 * _MM, 20 * _MM, 10 * _MM, 1.5),
+        )
+    )
+    screw_lead: float = 10 * _MM
+    screw_spin: bool = True
+    length_min: float = 30 * _MM
+    length_max: float = 170 * _MM
+    gravity: tuple[float, float, float] = (0.0, 0.0, -10.0)
+
+    def __post_init__(self) -> None:
+        for name in ("R", "r", "h", "platform_side", "platform_thickness", "screw_lead"):
+            _positive(getattr(self, name), name)
+        _positive(self.platform_mass, "platform_mass", allow_zero=True)
+        _positive(self.length_min, "length_min", allow_zero=True)
+        _positive(self.length_max, "length_max")
+        if self.length_max <= self.length_min:
+            raise ValueError(
+                f"Expected length_max > length_min, got length_max={self.length_max!r}, "
+                f"length_min={self.length_min!r}."
+            )
+        for name in ("lower", "upper"):
+            bodies = getattr(self, name)
+            if len(bodies) != 3 or not all(isinstance(b, LegBody) for b in bodies):
+                raise ValueError(f"Expected {name} to be a tuple of 3 LegBody, got {bodies!r}.")
+        g = tuple(float(x) for x in self.gravity)
+        if len(g) != 3 or not all(math.isfinite(x) for x in g):
+            raise ValueError(f"Expected gravity to be 3 finite numbers, got {self.gravity!r}.")
+        object.__setattr__(self, "gravity", g)
+
+    @classmethod
+    def paper(cls) -> SphericalLeg:
+        """The paper's values (Tables 1-2, Section 6.1) converted to SI; see the module docstring."""
+        return cls()
+
+    # --- derived geometry (cheap properties, no state) -------------------------------------------------
+    @property
+    def base_points(self) -> np.ndarray:
+        """A_i in the base frame, (3, 3) rows = legs 1..3 (paper 1, Section 3.1)."""
+        return np.array([[self.R, 0.0, 0.0], [-self.R, 0.0, 0.0], [0.0, self.R, 0.0]])
+
+    @property
+    def platform_points_home(self) -> np.ndarray:
+        """B_i at the home pose (alpha = beta = 0), relative to O, (3, 3) rows = legs 1..3."""
+        return np.array([[self.r, 0.0, self.h], [-self.r, 0.0, self.h], [0.0, self.r, self.h]])
+
+    @property
+    def platform_inertia(self) -> np.ndarray:
+        """Platform rotational inertia about P in platform axes (uniform box), (3, 3) kg m^2."""
+        a, t, m = self.platform_side, self.platform_thickness, self.platform_mass
+        return np.diag([m * (a * a + t * t) / 12.0, m * (a * a + t * t) / 12.0, m * (2 * a * a) / 12.0])
+
+    @property
+    def spin_ratio(self) -> np.ndarray:
+        """Screw spin rate per unit leg rate (rad/m) per leg: 2 pi / lead for legs 1, 3; 0 for leg 2."""
+        k = 2.0 * math.pi / self.screw_lead if self.screw_spin else 0.0
+        return np.array([k, 0.0, k])

@@ -1,0 +1,82 @@
+"""Reachable workspace and singularity map of the spherical parallel leg over (alpha, beta).
+
+J = dl/d(alpha, beta) has rows (0, dl1/db), (0, dl2/db), (dl3/da, dl3/db): dl1/db and dl2/db never
+vanish together, so J loses rank exactly where dl3/da = 0, i.e. ``h cos b cos a + r sin a = 0``: the
+boundary between the two assembly branches of the l3 equation, where alpha is no longer controlled.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._kinematics import LENGTH_FLOOR, _angles, _chunked, _squared_lengths
+from ._params import SphericalLeg
+
+__all__ = ["WorkspaceMap", "workspace_map"]
+
+# A pose counts as singular when sigma_min/sigma_max of J falls below this (as
+# robomech.analysis.workspace.SINGULAR_RTOL: a 1e8 amplification has no physical meaning here).
+SINGULAR_RTOL = 1e-8
+# Poses whose J condition number exceeds this are reported as ill-conditioned: the platform's
+# sensitivity to leg-length errors then differs by more than 100x between its two directions (both
+# columns of J are in m/rad, so the ratio is unit-free).
+ILL_CONDITIONED = 100.0
+
+
+@dataclass(frozen=True)
+class WorkspaceMap:
+    """Per pose (...): lengths (..., 3) m; reachable: every leg within [length_min, length_max];
+    sigma_min, sigma_max (m/rad) and cond of J; singular (sigma_min/sigma_max < SINGULAR_RTOL);
+    ill_conditioned (cond > ILL_CONDITIONED); dl3_dalpha (m/rad), whose sign marks the assembly branch."""
+
+    lengths: np.ndarray
+    reachable: np.ndarray
+    sigma_min: np.ndarray
+    sigma_max: np.ndarray
+    cond: np.ndarray
+    singular: np.ndarray
+    ill_conditioned: np.ndarray
+    dl3_dalpha: np.ndarray
+
+
+def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMap:
+    """Workspace and singularity map at poses ``alpha``, ``beta`` (rad, broadcast) in closed form.
+
+    The singular values of the 3x2 J come from the eigenvalues of the 2x2 Gram matrix J^T J.
+    """
+    a, b = _angles(alpha, beta)
+    n = a.size
+    outs = (np.empty((n, 3)), np.empty(n, dtype=bool), np.empty(n), np.empty(n), np.empty(n), np.empty(n))
+    _chunked(lambda *x: _kernel(leg, *x), (a.reshape(-1), b.reshape(-1)), outs)
+    L, reach, smin, smax, cond, j3a = (o.reshape((*a.shape, *o.shape[1:])) for o in outs)
+    ratio = smin / smax
+    return WorkspaceMap(L, reach, smin, smax, cond, ratio < SINGULAR_RTOL, cond > ILL_CONDITIONED, j3a)
+
+
+def _kernel(leg: SphericalLeg, a, b, L_out, reach_out, smin_out, smax_out, cond_out, j3a_out) -> None:
+    sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
+    R, r, h = leg.R, leg.r, leg.h
+    q = _squared_lengths(leg, sa, ca, sb, cb)
+    np.sqrt(np.maximum(q, 0.0), out=L_out)
+    l = np.maximum(L_out, LENGTH_FLOOR)
+    j1b = R * (r * sb - h * cb) / l[:, 0]
+    j2b = R * (r * sb + h * cb) / l[:, 1]
+    j3a = R * (r * sa + h * cb * ca) / l[:, 2]
+    j3b = -R * h * sb * sa / l[:, 2]
+    g11 = j3a * j3a
+    g22 = j1b * j1b + j2b * j2b + j3b * j3b
+    g12 = j3a * j3b
+    half_tr = 0.5 * (g11 + g22)
+    disc = np.sqrt(0.25 * (g11 - g22) ** 2 + g12 * g12)
+    lam_max = half_tr + disc
+    # det / lam_max avoids the cancellation of half_tr - disc
+    lam_min = np.maximum(g11 * g22 - g12 * g12, 0.0) / lam_max
+    smax, smin = np.sqrt(lam_max), np.sqrt(lam_min)
+    ratio = smin / smax
+    cond_out[:] = np.where(ratio > 0, 1.0 / np.where(ratio > 0, ratio, 1.0), np.inf)
+    reach_out[:] = np.all((L_out >= leg.length_min) & (L_out <= leg.length_max), -1)
+    smin_out[:] = smin
+    smax_out[:] = smax
+    j3a_out[:] = j3a
