@@ -6,8 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from _harness import Workload
 from robomech.mechanisms import spherical_leg as sl
+
+from _harness import Workload
 
 N_KIN = 1_000_000
 N_DYN = 100_000

@@ -30,6 +30,11 @@ def _load_workloads(only: str | None) -> list[Workload]:
     return out
 
 
+def _ratio(value: float | None, width: int, digits: int) -> str:
+    """A ratio as ``12.3x``, or a dash where there is none, right-aligned in ``width``."""
+    return ("—" if value is None else f"{value:.{digits}f}x").rjust(width)
+
+
 def main() -> int:
     p = argparse.ArgumentParser()
     p.add_argument("--only", default=None)
@@ -73,11 +78,10 @@ def main() -> int:
                 "target_floor_ratio": w.target_floor_ratio,
             }
         )
-        fmt = lambda v, f: "—" if v is None else format(v, f)  # noqa: E731
         print(
             f"{w.group:<2} {w.name:<52} {w.n:>9} {t:>8.3f}s {t / w.n * 1e6:>9.3f}µs {w.alternative_name:<28} "
-            f"{fmt(speedup, '>7.1f')}x {fmt(w.target_speedup, '>6.0f')}x {fmt(x_floor, '>7.1f')}x "
-            f"{fmt(w.target_floor_ratio, '>6.0f')}x",
+            f"{_ratio(speedup, 8, 1)} {_ratio(w.target_speedup, 7, 0)} {_ratio(x_floor, 8, 1)} "
+            f"{_ratio(w.target_floor_ratio, 7, 0)}",
             flush=True,
         )
     if args.json:
