@@ -48,8 +48,18 @@ def test_list_names_every_study(capsys):
 
 
 def test_comparison_table_computes_differences():
-    t = comparison_table("t", [("l1", 100.0, 100.5, "mm"), ("l2", None, 3.0, "mm")])
+    t = comparison_table("t", [("l1", 100.0, 100.5, "mm"), ("l2", None, 3.0, "mm"), ("a", 0.0, 1e-9, "rad")])
     assert t.rows[0][4] == pytest.approx(0.5) and t.rows[0][5] == pytest.approx(0.005)
     assert t.rows[1][2] == "—"
+    assert t.rows[2][4] == pytest.approx(1e-9) and t.rows[2][5] == "—"
+
+
+def test_markdown_table_escapes_pipes_in_headers_and_cells(tmp_path):
+    from robomech.studies import StudyResult, write_study_report
+
+    res = StudyResult("x", "X", "src", tables=[Table("T", ["max |f|", "b"], [["|a|", 1.0]])])
+    md = write_study_report(res, tmp_path)["md"].read_text()
+    header = next(line for line in md.splitlines() if line.startswith("| max"))
+    assert header == "| max \\|f\\| | b |"
     with pytest.raises(ValueError, match="cells"):
         Table("bad", ["a", "b"], [[1]])

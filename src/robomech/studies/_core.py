@@ -96,7 +96,8 @@ def comparison_table(
             out.append([quantity, unit, "—", ours, "—", "—"])
             continue
         diff = float(ours) - float(printed)
-        rel = abs(diff) / abs(float(printed)) if float(printed) != 0 else math.inf
+        # relative difference is undefined against a printed zero: shown as a dash, not inf
+        rel = abs(diff) / abs(float(printed)) if float(printed) != 0 else "—"
         out.append([quantity, unit, float(printed), float(ours), diff, rel])
     return Table(
         title=title,

@@ -33,7 +33,7 @@ def format_cell(value: Any) -> str:
 
 def _md_table(t: Table) -> str:
     lines = [f"### {t.title}", ""]
-    lines.append("| " + " | ".join(t.columns) + " |")
+    lines.append("| " + " | ".join(str(c).replace("|", "\\|") for c in t.columns) + " |")
     lines.append("|" + "|".join("---" for _ in t.columns) + "|")
     for row in t.rows:
         lines.append("| " + " | ".join(format_cell(c).replace("|", "\\|") for c in row) + " |")
