@@ -8,6 +8,7 @@ from ._kinematics import (
     JacobianResult,
     JointAxes,
     PassiveResult,
+    RotationResult,
     angular_acceleration,
     angular_velocity,
     arc_clearance,
@@ -18,11 +19,22 @@ from ._kinematics import (
     link_clearance,
     passive_angles,
     passive_rates,
+    platform_rotation,
 )
 from ._mobility import MechanismMobility, chain_screws, mechanism_mobility, platform_mobility
 from ._params import VectoredThruster
+from ._workspace import (
+    DEXTERITY_TOL,
+    WorkspaceMap,
+    dexterity,
+    idle_input_curve,
+    input_grid,
+    singular_points,
+    workspace_map,
+)
 
 __all__ = [
+    "DEXTERITY_TOL",
     "SINGULAR_TOL",
     "AccelerationResult",
     "FKResult",
@@ -31,12 +43,17 @@ __all__ = [
     "JointAxes",
     "MechanismMobility",
     "PassiveResult",
+    "RotationResult",
     "VectoredThruster",
+    "WorkspaceMap",
     "angular_acceleration",
     "angular_velocity",
     "arc_clearance",
     "chain_screws",
+    "dexterity",
     "forward_kinematics",
+    "idle_input_curve",
+    "input_grid",
     "inverse_kinematics",
     "jacobian",
     "joint_axes",
@@ -45,4 +62,7 @@ __all__ = [
     "passive_angles",
     "passive_rates",
     "platform_mobility",
+    "platform_rotation",
+    "singular_points",
+    "workspace_map",
 ]

@@ -33,6 +33,7 @@ __all__ = [
     "JacobianResult",
     "JointAxes",
     "PassiveResult",
+    "RotationResult",
     "angular_acceleration",
     "angular_velocity",
     "arc_clearance",
@@ -43,6 +44,7 @@ __all__ = [
     "link_clearance",
     "passive_angles",
     "passive_rates",
+    "platform_rotation",
 ]
 
 # |s22 x s12| (the sine of the angle between the two passive axes, in [0, 1]) below which a
@@ -72,25 +74,28 @@ class JointAxes:
 
 @dataclass(frozen=True)
 class FKResult:
-    axis: np.ndarray  # (..., 3) unit propeller axis s0
+    axis: np.ndarray  # (..., 3) unit propeller axis s0; NaN where not valid
     tip: np.ndarray  # (..., 3) propeller tip propeller_arm * s0, metres
-    rotation: np.ndarray  # (..., 3, 3) platform rotation R_OP (columns -s22, -s13, s0)
     tilt: np.ndarray  # (...,) angle between s0 and Z (universal-joint deflection), rad
-    valid: np.ndarray  # (...,) assembled and not singular; NaN elsewhere
+    valid: np.ndarray  # (...,) assembled and not singular
     in_range: np.ndarray  # (...,) inputs within q1_limits and q2_limits
-    tilt_ok: np.ndarray  # (...,) tilt <= tilt_limit
-    clear: np.ndarray  # (...,) 45 deg arc and fixing device keep interference_clearance
-    within_limits: np.ndarray  # (...,) valid & in_range & tilt_ok & clear
+    tilt_ok: np.ndarray  # (...,) valid and tilt <= tilt_limit
+    within_limits: np.ndarray  # (...,) valid & in_range & tilt_ok (interference: see workspace_map)
 
 
 @dataclass(frozen=True)
 class IKResult:
     q: np.ndarray  # (..., 2) inputs (q1, q2), rad; NaN where not solved
     solved: np.ndarray  # (...,) an assembly with this propeller direction exists (ignoring limits)
-    in_range: np.ndarray
-    tilt_ok: np.ndarray
-    clear: np.ndarray
-    valid: np.ndarray  # solved & in_range & tilt_ok & clear
+    in_range: np.ndarray  # (...,) solved and q within q1_limits, q2_limits
+    tilt_ok: np.ndarray  # (...,) solved and the direction within tilt_limit of Z
+    valid: np.ndarray  # solved & in_range & tilt_ok
+
+
+@dataclass(frozen=True)
+class RotationResult:
+    R: np.ndarray  # (..., 3, 3) platform rotation R_OP, columns (-s22, -s13, s0); NaN where not valid
+    valid: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -219,25 +224,37 @@ def link_clearance(th: VectoredThruster, q: object) -> np.ndarray:
     return _interference(th, _axes(th, _q(q)))
 
 
+def _theta_cs(th: VectoredThruster, q: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Kernel: cos q2, sin q2, cos theta, sin theta (NaN where singular), |s22 x s12|, valid."""
+    ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
+    c1, s1 = np.cos(q[..., 0]), np.sin(q[..., 0])
+    c2, s2 = np.cos(q[..., 1]), np.sin(q[..., 1])
+    x = sa * c1 * c2 - ca * s2
+    y = -sa * s1
+    d = np.hypot(x, y)
+    valid = d > SINGULAR_TOL
+    inv = np.where(valid, 1.0 / np.where(valid, d, 1.0), np.nan)
+    return c2, s2, x * inv, y * inv, d, valid
+
+
 def _fk(th: VectoredThruster, q: np.ndarray) -> FKResult:
-    ax = _axes(th, q)
-    s0 = ax.s0
-    R = np.stack([-ax.s22, -ax.s13, s0], axis=-1)
-    tilt = np.arccos(np.clip(s0[..., 2], -1.0, 1.0))
-    with np.errstate(invalid="ignore"):
-        tilt_ok = ax.valid & (tilt <= th.tilt_limit)
-        clear = ax.valid & (_interference(th, ax) >= th.interference_clearance)
+    c2, s2, ct, st, _, valid = _theta_cs(th, q)
+    axis = np.empty((*q.shape[:-1], 3))
+    # s0 = s22 x s13 = Ry(q2) (0, sin th, cos th): paper 5, eq. (12) with sin(phi1) -> sin(phi2)
+    axis[..., 0] = s2 * ct
+    axis[..., 1] = st
+    axis[..., 2] = c2 * ct
+    tilt = np.arccos(np.clip(axis[..., 2], -1.0, 1.0))
+    tilt_ok = valid & (tilt <= th.tilt_limit)
     in_range = _in_range(th, q)
     return FKResult(
-        axis=s0,
-        tip=th.propeller_arm * s0,
-        rotation=R,
+        axis=axis,
+        tip=th.propeller_arm * axis,
         tilt=tilt,
-        valid=ax.valid,
+        valid=valid,
         in_range=in_range,
         tilt_ok=tilt_ok,
-        clear=clear,
-        within_limits=ax.valid & in_range & tilt_ok & clear,
+        within_limits=in_range & tilt_ok,
     )
 
 
@@ -245,23 +262,31 @@ def forward_kinematics(th: VectoredThruster, q: object) -> FKResult:
     """Propeller axis and tip from the inputs ``q (..., 2)`` = (q1, q2) in rad.
 
     Paper 5, eqs. (11)-(12), with eq. (12)'s sin(phi1) corrected to sin(phi2).  Singular inputs
-    (``|s22 x s12| <= SINGULAR_TOL``) give NaN outputs with ``valid`` False.
+    (``|s22 x s12| <= SINGULAR_TOL``) give NaN outputs with ``valid`` False.  The link-interference
+    limit (Section 4.1 (2)) is evaluated by :func:`link_clearance` and ``workspace_map``.
     """
     return _fk(th, _q(q))
+
+
+def platform_rotation(th: VectoredThruster, q: object) -> RotationResult:
+    """Platform rotation ``R_OP (..., 3, 3)`` = Ry(q2) Rx(-theta), columns (-s22, -s13, s0)."""
+    ax = _axes(th, _q(q))
+    return RotationResult(R=np.stack([-ax.s22, -ax.s13, ax.s0], axis=-1), valid=ax.valid)
 
 
 def _ik(th: VectoredThruster, s: np.ndarray) -> IKResult:
     norm = np.linalg.norm(s, axis=-1)
     has_dir = norm > MIN_DIRECTION_NORM
-    u = s / np.where(has_dir, norm, 1.0)[..., None]
-    ux, uy, uz = u[..., 0], u[..., 1], u[..., 2]
+    inv = 1.0 / np.where(has_dir, norm, 1.0)
+    ux, uy, uz = s[..., 0] * inv, s[..., 1] * inv, s[..., 2] * inv
     # s0 = (sin q2 cos th, sin th, cos q2 cos th): the branch cos(theta) > 0 is the one through q = 0
     # (|q2| < pi/2 is enforced by the parameters).  paper 5, eq. (13): phi2 = arctan(L*/N*) is right.
     ct = np.hypot(ux, uz)
     st = uy
     q2 = np.arctan2(ux, uz)
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    c2, s2 = np.cos(q2), np.sin(q2)
+    c2 = np.where(ct > 0, uz / np.where(ct > 0, ct, 1.0), 1.0)
+    s2 = np.where(ct > 0, ux / np.where(ct > 0, ct, 1.0), 0.0)
     # paper 5, eq. (13): printed phi1 = -arctan(M* N* / L*^2) does not invert eq. (12).  Correct: find
     # t > 0 with t (cos th, sin th) = (sa c1 c2 - ca s2, -sa s1) (the FK closure and its branch), i.e.
     # A t^2 + B t + C = 0 from s1^2 + c1^2 = 1; take the larger root (the only positive one for |q2| < a).
@@ -271,29 +296,27 @@ def _ik(th: VectoredThruster, s: np.ndarray) -> IKResult:
     disc = B * B - 4.0 * A * C
     ok = has_dir & (A > 0) & (disc >= 0)
     sq = np.sqrt(np.where(ok, disc, 0.0))
-    Aok = np.where(ok, A, 1.0)
     qq = -0.5 * (B + np.where(B >= 0, sq, -sq))  # stable pair of roots qq / A and C / qq
-    r1 = qq / Aok
+    r1 = qq / np.where(ok, A, 1.0)
     r2 = np.where(qq != 0, C / np.where(qq != 0, qq, 1.0), r1)
     t = np.maximum(r1, r2)
     ok &= t > SINGULAR_TOL
     # (sin q1, cos q1) = (-t st / sa, (t ct + ca s2) / (sa c2)); sa, c2 > 0
     q1 = np.arctan2(-t * st * c2, t * ct + ca * s2)
-    q = np.where(ok[..., None], np.stack([q1, q2], axis=-1), np.nan)
+    q = np.empty((*s.shape[:-1], 2))
+    q[..., 0] = np.where(ok, q1, np.nan)
+    q[..., 1] = np.where(ok, q2, np.nan)
     in_range = ok & _in_range(th, q)
     tilt_ok = ok & (np.arccos(np.clip(uz, -1.0, 1.0)) <= th.tilt_limit)
-    ax = _axes(th, np.where(ok[..., None], q, 0.0))
-    with np.errstate(invalid="ignore"):
-        clear = ok & (_interference(th, ax) >= th.interference_clearance)
-    valid = in_range & tilt_ok & clear
-    return IKResult(q=q, solved=ok, in_range=in_range, tilt_ok=tilt_ok, clear=clear, valid=valid)
+    return IKResult(q=q, solved=ok, in_range=in_range, tilt_ok=tilt_ok, valid=in_range & tilt_ok)
 
 
 def inverse_kinematics(th: VectoredThruster, s: object) -> IKResult:
     """Inputs ``q (..., 2)`` pointing the propeller along ``s (..., 3)`` (any positive multiple: axis or tip).
 
     Per-sample masks: ``solved`` (an assembly exists: |s| > 0, the closure has a root), ``in_range``,
-    ``tilt_ok`` (universal joint), ``clear`` (link interference); ``valid`` is all of them.
+    ``tilt_ok`` (universal joint); ``valid`` is all of them.  The link-interference limit is checked
+    on the inputs by :func:`link_clearance` / ``workspace_map``.
     """
     return _ik(th, as_array(s, "s", (3,)))
 
