@@ -21,6 +21,9 @@ from ._params import VectoredThruster
 
 __all__ = ["MechanismMobility", "chain_screws", "mechanism_mobility", "platform_mobility"]
 
+# Screws are passed in metres (see platform_mobility).
+CORE_LENGTH_SCALE = 1.0
+
 _JOINTS = ("s11", "s12", "s13", "s21", "s22")
 
 
@@ -53,10 +56,13 @@ def platform_mobility(
 ) -> mobility.MobilityResult:
     """Mobility of the RRR-RR platform (the fixing device) at ``q``: paper 5, eqs. (4)-(10).
 
-    Screws are scaled by the platform radius so moment and direction parts are of the same order.
+    Screws are in metres with ``length_scale = 1``: offsets of millimetres give moment parts ~1e-3,
+    far above the SVD rank tolerance (1e-9).  (With ``length_scale != 1`` the core's returned
+    ``constraint_wrenches`` are mis-scaled; see docs/mechanisms/vectored_thrust.md.)  The returned
+    ``constraint_wrenches`` satisfy ``reciprocal_product(W, S) = 0`` with every joint screw S.
     """
     rrr, rr = chain_screws(th, q, offsets)
-    return mobility.analyze([rrr, rr], length_scale=th.platform_radius)
+    return mobility.analyze([rrr, rr], length_scale=CORE_LENGTH_SCALE)
 
 
 @dataclass(frozen=True)
@@ -95,5 +101,5 @@ def mechanism_mobility(
         ]
     )
     via_platform = np.vstack([plat.platform_twists, screw_from_axis(s0, np.zeros(3))])
-    prop = mobility.analyze([central, via_platform], length_scale=th.platform_radius)
+    prop = mobility.analyze([central, via_platform], length_scale=CORE_LENGTH_SCALE)
     return MechanismMobility(platform=plat, propeller=prop)
