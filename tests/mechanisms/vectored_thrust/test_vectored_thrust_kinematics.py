@@ -227,3 +227,12 @@ def test_out_of_range_inputs_are_flagged() -> None:
 def test_bad_input_names_the_argument(fn, args, name) -> None:  # type: ignore[no-untyped-def]
     with pytest.raises(ValueError, match=rf"\b{name}\b"):
         fn(TH, *args)
+
+
+def test_passive_angles_cover_the_full_circle() -> None:
+    # Table 1's trajectory reaches q = (-pi/4, pi/4), where the propeller tilts beyond the horizontal
+    q = np.array([-math.pi / 4, math.pi / 4])
+    p = vt.passive_angles(TH, q).values
+    assert p[0] > math.pi / 2
+    R = rot_y(q[1]) @ exp_so3(np.array([-1.0, 0, 0]) * p[0])
+    np.testing.assert_allclose(R, vt.platform_rotation(TH, q).R, atol=1e-14)

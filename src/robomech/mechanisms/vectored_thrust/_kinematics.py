@@ -356,7 +356,8 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
     q = _q(q)
     ax = _axes(th, q)
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    theta = np.arctan2(np.sum(ax.s0 * _Y, -1), np.hypot(ax.s0[..., 0], ax.s0[..., 2]))
+    _, _, ct, st, _, _ = _theta_cs(th, q)
+    theta = np.arctan2(st, ct)  # full circle: the propeller may pass beyond the horizontal
     R = np.stack([-ax.s22, -ax.s13, ax.s0], axis=-1)
     c1, s1 = np.cos(q[..., 0]), np.sin(q[..., 0])
     # R_rel = Rx(-q1) R, expressed in the basis P = [s12(0), s13(0), s12(0) x s13(0)] = Rx'(rho2) Ry'(rho3).
