@@ -16,7 +16,10 @@ Equivalently the platform rotation is ``R = Ry(q2) Rx(-theta)``, ``theta`` the R
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 
@@ -53,6 +56,46 @@ __all__ = [
 SINGULAR_TOL = 1e-6
 # A propeller direction shorter than this (in the caller's units) has no direction to invert.
 MIN_DIRECTION_NORM = 1e-12
+# Inputs within this of a range limit count as in range: an IK solution on the boundary carries a few
+# ulps of rounding (1e-16 rad), and a limit is never meaningful to better than a micro-radian.
+RANGE_TOL = 1e-12
+# Samples per block in the batched kernels: ~20 float64 temporaries of 16384 samples (~2.6 MB) stay
+# in cache; measured 1.3-2x faster than whole-array evaluation at 10^6 samples (benchmarks/).
+CHUNK = 1 << 14
+
+_R = TypeVar("_R")
+
+
+def _chunked(kernel: Callable[..., _R], th: VectoredThruster, x: np.ndarray) -> _R:
+    """Run ``kernel(th, x_block)`` over blocks of CHUNK samples of ``x (..., k)`` into preallocated outputs.
+
+    ``kernel`` returns a frozen dataclass of arrays whose leading dimension is the sample axis.
+    """
+    batch = x.shape[:-1]
+    flat = x.reshape(-1, x.shape[-1])
+    n = flat.shape[0]
+    if n <= CHUNK:
+        first = kernel(th, flat)
+        return dataclasses.replace(
+            first,
+            **{
+                f.name: getattr(first, f.name).reshape(batch + getattr(first, f.name).shape[1:])
+                for f in dataclasses.fields(first)
+            },
+        )
+    first = kernel(th, flat[:CHUNK])
+    names = [f.name for f in dataclasses.fields(first)]
+    outs = {}
+    for k in names:
+        a = getattr(first, k)
+        outs[k] = np.empty((n, *a.shape[1:]), dtype=a.dtype)
+        outs[k][:CHUNK] = a
+    for i in range(CHUNK, n, CHUNK):  # a fixed number of cache-sized blocks, not a loop over samples
+        r = kernel(th, flat[i : i + CHUNK])
+        for k in names:
+            outs[k][i : i + CHUNK] = getattr(r, k)
+    return dataclasses.replace(first, **{k: v.reshape(batch + v.shape[1:]) for k, v in outs.items()})
+
 
 _X = np.array([1.0, 0.0, 0.0])
 _Y = np.array([0.0, 1.0, 0.0])
@@ -165,6 +208,7 @@ def joint_axes(th: VectoredThruster, q: object) -> JointAxes:
 
 def _in_range(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
     (a1, b1), (a2, b2) = th.q1_limits, th.q2_limits
+    a1, a2, b1, b2 = a1 - RANGE_TOL, a2 - RANGE_TOL, b1 + RANGE_TOL, b2 + RANGE_TOL
     with np.errstate(invalid="ignore"):
         return (q[..., 0] >= a1) & (q[..., 0] <= b1) & (q[..., 1] >= a2) & (q[..., 1] <= b2)
 
@@ -227,14 +271,22 @@ def link_clearance(th: VectoredThruster, q: object) -> np.ndarray:
 def _theta_cs(th: VectoredThruster, q: np.ndarray) -> tuple[np.ndarray, ...]:
     """Kernel: cos q2, sin q2, cos theta, sin theta (NaN where singular), |s22 x s12|, valid."""
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    c1, s1 = np.cos(q[..., 0]), np.sin(q[..., 0])
-    c2, s2 = np.cos(q[..., 1]), np.sin(q[..., 1])
-    x = sa * c1 * c2 - ca * s2
-    y = -sa * s1
-    d = np.hypot(x, y)
+    q1, q2 = q[..., 0], q[..., 1]
+    c1, s1 = np.cos(q1), np.sin(q1)
+    c2, s2 = np.cos(q2), np.sin(q2)
+    x = c1 * c2
+    x *= sa
+    x -= ca * s2  # sa c1 c2 - ca s2
+    y = s1
+    y *= -sa  # -sa s1
+    d = x * x
+    d += y * y
+    d = np.sqrt(d)  # x, y are O(1): no overflow, so no need for hypot
     valid = d > SINGULAR_TOL
-    inv = np.where(valid, 1.0 / np.where(valid, d, 1.0), np.nan)
-    return c2, s2, x * inv, y * inv, d, valid
+    inv = np.divide(1.0, d, out=np.full_like(d, np.nan), where=valid)
+    x *= inv
+    y *= inv
+    return c2, s2, x, y, d, valid
 
 
 def _fk(th: VectoredThruster, q: np.ndarray) -> FKResult:
@@ -265,7 +317,7 @@ def forward_kinematics(th: VectoredThruster, q: object) -> FKResult:
     (``|s22 x s12| <= SINGULAR_TOL``) give NaN outputs with ``valid`` False.  The link-interference
     limit (Section 4.1 (2)) is evaluated by :func:`link_clearance` and ``workspace_map``.
     """
-    return _fk(th, _q(q))
+    return _chunked(_fk, th, _q(q))
 
 
 def platform_rotation(th: VectoredThruster, q: object) -> RotationResult:
@@ -275,13 +327,13 @@ def platform_rotation(th: VectoredThruster, q: object) -> RotationResult:
 
 
 def _ik(th: VectoredThruster, s: np.ndarray) -> IKResult:
-    norm = np.linalg.norm(s, axis=-1)
+    norm = np.sqrt(s[..., 0] ** 2 + s[..., 1] ** 2 + s[..., 2] ** 2)
     has_dir = norm > MIN_DIRECTION_NORM
     inv = 1.0 / np.where(has_dir, norm, 1.0)
     ux, uy, uz = s[..., 0] * inv, s[..., 1] * inv, s[..., 2] * inv
     # s0 = (sin q2 cos th, sin th, cos q2 cos th): the branch cos(theta) > 0 is the one through q = 0
     # (|q2| < pi/2 is enforced by the parameters).  paper 5, eq. (13): phi2 = arctan(L*/N*) is right.
-    ct = np.hypot(ux, uz)
+    ct = np.sqrt(ux * ux + uz * uz)  # unit components: no overflow
     st = uy
     q2 = np.arctan2(ux, uz)
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
@@ -307,7 +359,7 @@ def _ik(th: VectoredThruster, s: np.ndarray) -> IKResult:
     q[..., 0] = np.where(ok, q1, np.nan)
     q[..., 1] = np.where(ok, q2, np.nan)
     in_range = ok & _in_range(th, q)
-    tilt_ok = ok & (np.arccos(np.clip(uz, -1.0, 1.0)) <= th.tilt_limit)
+    tilt_ok = ok & (uz >= np.cos(th.tilt_limit))  # arccos(uz) <= limit, without the arccos
     return IKResult(q=q, solved=ok, in_range=in_range, tilt_ok=tilt_ok, valid=in_range & tilt_ok)
 
 
@@ -318,7 +370,7 @@ def inverse_kinematics(th: VectoredThruster, s: object) -> IKResult:
     ``tilt_ok`` (universal joint); ``valid`` is all of them.  The link-interference limit is checked
     on the inputs by :func:`link_clearance` / ``workspace_map``.
     """
-    return _ik(th, as_array(s, "s", (3,)))
+    return _chunked(_ik, th, as_array(s, "s", (3,)))
 
 
 def _solve3(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -395,8 +447,12 @@ def _jacobian(th: VectoredThruster, q: np.ndarray) -> JacobianResult:
     th1 = sa * (ca * c1 * s2 - sa * c2) * inv
     th2 = -sa * s1 * (sa * c1 * s2 + ca * c2) * inv
     J = np.empty((*q.shape[:-1], 3, 2))
-    J[..., 0, 0], J[..., 1, 0], J[..., 2, 0] = -c2 * th1, 0.0 * th1, s2 * th1
-    J[..., 0, 1], J[..., 1, 1], J[..., 2, 1] = -c2 * th2, 1.0 + 0.0 * th2, s2 * th2
+    np.multiply(-c2, th1, out=J[..., 0, 0])
+    np.multiply(0.0, th1, out=J[..., 1, 0])  # 0, or NaN where singular
+    np.multiply(s2, th1, out=J[..., 2, 0])
+    np.multiply(-c2, th2, out=J[..., 0, 1])
+    np.add(1.0, J[..., 1, 0], out=J[..., 1, 1])
+    np.multiply(s2, th2, out=J[..., 2, 1])
     return JacobianResult(J=J, valid=valid, distance=np.sqrt(d2))
 
 
@@ -406,7 +462,7 @@ def jacobian(th: VectoredThruster, q: object) -> JacobianResult:
     ``omega`` is the angular velocity of the platform carrying the propeller shaft (the propeller's
     own spin about s0 excluded).  NaN with ``valid`` False at singular inputs.
     """
-    return _jacobian(th, _q(q))
+    return _chunked(_jacobian, th, _q(q))
 
 
 def angular_velocity(th: VectoredThruster, q: object, qd: object) -> np.ndarray:
