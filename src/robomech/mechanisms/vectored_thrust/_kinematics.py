@@ -213,50 +213,75 @@ def _in_range(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
         return (q[..., 0] >= a1) & (q[..., 0] <= b1) & (q[..., 1] >= a2) & (q[..., 1] <= b2)
 
 
-def _angle(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Angle between vectors (..., 3), accurate at 0 and pi."""
-    return np.arctan2(np.linalg.norm(np.cross(u, v), axis=-1), np.sum(u * v, axis=-1))
+# Component-wise 3-vector helpers (tuples of arrays): np.cross / np.linalg.norm on (..., 3) arrays cost
+# several times more than these fused element-wise expressions.
+_V = tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
-def _point_arc_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Angular distance from unit ``p`` to the minor great-circle arc from unit ``a`` to unit ``b``."""
-    n = np.cross(a, b)
-    n = n / np.linalg.norm(n, axis=-1, keepdims=True)
-    pn = np.sum(p * n, axis=-1)
-    foot = p - pn[..., None] * n
-    inside = (np.sum(np.cross(a, foot) * n, axis=-1) >= 0) & (np.sum(np.cross(foot, b) * n, axis=-1) >= 0)
-    perp = np.arcsin(np.clip(np.abs(pn), 0.0, 1.0))
+def _cross(u: _V, v: _V) -> _V:
+    return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+
+
+def _dot(u: _V, v: _V) -> np.ndarray:
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+
+
+def _unit(u: _V) -> _V:
+    n = np.sqrt(_dot(u, u))
+    inv = np.divide(1.0, n, out=np.zeros_like(n), where=n > 0)
+    return (u[0] * inv, u[1] * inv, u[2] * inv)
+
+
+def _angle(u: _V, v: _V) -> np.ndarray:
+    """Angle between vectors, accurate at 0 and pi."""
+    c = _cross(u, v)
+    return np.arctan2(np.sqrt(_dot(c, c)), _dot(u, v))
+
+
+def _point_arc_distance(p: _V, a: _V, b: _V, n: _V) -> np.ndarray:
+    """Angular distance from unit ``p`` to the minor arc a -> b of the great circle with unit normal ``n``."""
+    pn = _dot(p, n)
+    # the foot of p on the circle lies within the arc: (a x p).n >= 0 and (p x b).n >= 0
+    inside = (_dot(p, _cross(n, a)) >= 0) & (_dot(p, _cross(b, n)) >= 0)
+    perp = np.arcsin(np.minimum(np.abs(pn), 1.0))
     return np.where(inside, perp, np.minimum(_angle(p, a), _angle(p, b)))
 
 
-def arc_clearance(a1: np.ndarray, b1: np.ndarray, a2: np.ndarray, b2: np.ndarray) -> np.ndarray:
+def _arc_clearance(a1: _V, b1: _V, a2: _V, b2: _V) -> np.ndarray:
+    n1, n2 = _unit(_cross(a1, b1)), _unit(_cross(a2, b2))
+    m = _cross(n1, n2)
+    has_m = _dot(m, m) > 0
+    m = _unit(m)
+    # the great circles meet at +-m; the arcs cross if one of those lies within both arcs
+    on1 = (_dot(m, _cross(n1, a1)), _dot(m, _cross(b1, n1)))
+    on2 = (_dot(m, _cross(n2, a2)), _dot(m, _cross(b2, n2)))
+    plus = (on1[0] >= 0) & (on1[1] >= 0) & (on2[0] >= 0) & (on2[1] >= 0)
+    minus = (on1[0] <= 0) & (on1[1] <= 0) & (on2[0] <= 0) & (on2[1] <= 0)
+    crosses = has_m & (plus | minus)
+    ends = np.minimum(
+        np.minimum(_point_arc_distance(a1, a2, b2, n2), _point_arc_distance(b1, a2, b2, n2)),
+        np.minimum(_point_arc_distance(a2, a1, b1, n1), _point_arc_distance(b2, a1, b1, n1)),
+    )
+    return np.where(crosses, 0.0, ends)
+
+
+def _split(v: np.ndarray) -> _V:
+    return (v[..., 0], v[..., 1], v[..., 2])
+
+
+def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
     """Angular distance (rad) between the minor great-circle arcs (a1 -> b1) and (a2 -> b2) (unit, (..., 3)).
 
     Zero where they cross; otherwise the closest point is an end of one of them.
     """
-    n1, n2 = np.cross(a1, b1), np.cross(a2, b2)
-    m = np.cross(n1, n2)
-    mn = np.linalg.norm(m, axis=-1, keepdims=True)
-    m = m / np.where(mn > 0, mn, 1.0)
-
-    def on(arc_n: np.ndarray, a: np.ndarray, b: np.ndarray, p: np.ndarray) -> np.ndarray:
-        return (np.sum(np.cross(a, p) * arc_n, axis=-1) >= 0) & (np.sum(np.cross(p, b) * arc_n, axis=-1) >= 0)
-
-    crosses = np.zeros(m.shape[:-1], dtype=bool)
-    for sgn in (1.0, -1.0):
-        crosses |= on(n1, a1, b1, sgn * m) & on(n2, a2, b2, sgn * m)
-    crosses &= mn[..., 0] > 0
-    ends = np.minimum(
-        np.minimum(_point_arc_distance(a1, a2, b2), _point_arc_distance(b1, a2, b2)),
-        np.minimum(_point_arc_distance(a2, a1, b1), _point_arc_distance(b2, a1, b1)),
-    )
-    return np.where(crosses, 0.0, ends)
+    arrs = [as_array(v, name, (3,)) for v, name in ((a1, "a1"), (b1, "b1"), (a2, "a2"), (b2, "b2"))]
+    return _arc_clearance(*(_split(v) for v in arrs))
 
 
 def _interference(th: VectoredThruster, ax: JointAxes) -> np.ndarray:
     """Clearance (rad) of the 45 deg arc (s11 -> s12) from the fixing device (s22 -> s13); NaN if singular."""
     s13 = np.where(ax.valid[..., None], ax.s13, -_Y)  # placeholder where singular, masked below
-    c = arc_clearance(ax.s11, ax.s12, ax.s22, s13)
+    c = _arc_clearance(_split(ax.s11), _split(ax.s12), _split(ax.s22), _split(s13))
     return np.where(ax.valid, c, np.nan)
 
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from robomech._validation import as_array
 
-from ._kinematics import _axes, _fk, _interference, _jacobian, _q
+from ._kinematics import _axes, _chunked, _fk, _interference, _jacobian, _q
 from ._params import VectoredThruster
 
 __all__ = [
@@ -74,7 +74,10 @@ def dexterity(th: VectoredThruster, q: object) -> np.ndarray:
 
 def workspace_map(th: VectoredThruster, q: object) -> WorkspaceMap:
     """Section 4 at each input sample ``q (..., 2)`` (rad): tip, limits, singularity, dexterity."""
-    q = _q(q)
+    return _chunked(_workspace_map, th, _q(q))
+
+
+def _workspace_map(th: VectoredThruster, q: np.ndarray) -> WorkspaceMap:
     fk = _fk(th, q)
     jr = _jacobian(th, q)
     dex = _dexterity(jr.J, jr.valid)
