@@ -236,3 +236,25 @@ def test_passive_angles_cover_the_full_circle() -> None:
     assert p[0] > math.pi / 2
     R = rot_y(q[1]) @ exp_so3(np.array([-1.0, 0, 0]) * p[0])
     np.testing.assert_allclose(R, vt.platform_rotation(TH, q).R, atol=1e-14)
+
+
+def test_chunked_evaluation_equals_whole_array_kernels() -> None:
+    from robomech.mechanisms.vectored_thrust import _kinematics as K
+
+    rng = np.random.default_rng(8)
+    n = 2 * K.CHUNK + 123  # several blocks and a ragged tail
+    q = rng.uniform([-1.0, -0.7], [1.0, 0.7], size=(n, 2))
+    q[5] = [0.0, math.pi / 4]  # a singular sample inside the first block
+    fk, fk_ref = vt.forward_kinematics(TH, q.reshape(3, -1, 2) if n % 3 == 0 else q), K._fk(TH, q)
+    np.testing.assert_array_equal(fk.axis.reshape(-1, 3), fk_ref.axis)
+    np.testing.assert_array_equal(fk.valid.reshape(-1), fk_ref.valid)
+    tips = np.where(fk_ref.valid[:, None], fk_ref.tip, [0.0, 0.0, 1.0])
+    ik, ik_ref = vt.inverse_kinematics(TH, tips), K._ik(TH, tips)
+    np.testing.assert_array_equal(ik.q, ik_ref.q)
+    np.testing.assert_array_equal(ik.valid, ik_ref.valid)
+    jr, jr_ref = vt.jacobian(TH, q), K._jacobian(TH, q)
+    np.testing.assert_array_equal(jr.J, jr_ref.J)
+    np.testing.assert_array_equal(jr.valid, jr_ref.valid)
+    assert not jr.valid[5] and not fk.valid.reshape(-1)[5]
+    m = vt.workspace_map(TH, q.reshape(-1, 1, 2))
+    assert m.tip.shape == (n, 1, 3) and m.singular[5, 0]
