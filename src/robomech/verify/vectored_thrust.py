@@ -204,7 +204,7 @@ def engine_trace(
         R_analytic=vt.platform_rotation(th, q).R,
         omega_engine=out["w"],
         omega_engine_rrr=out["w3"],
-        omega_analytic=vt.angular_velocity(th, q, qd),
+        omega_analytic=vt.angular_velocity(th, q, qd).omega,
         omega_dot_engine=out["wd"],
         omega_dot_engine_rrr=out["wd3"],
         omega_dot_analytic=wd_model,

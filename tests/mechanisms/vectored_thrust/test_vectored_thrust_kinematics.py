@@ -141,7 +141,7 @@ def test_passive_rates_close_both_chains_and_differentiate_the_angles() -> None:
     qd = rng.normal(size=(100, 2))
     r = vt.passive_rates(TH, q, qd).values
     ax = vt.joint_axes(TH, q)
-    w = vt.angular_velocity(TH, q, qd)
+    w = vt.angular_velocity(TH, q, qd).omega
     np.testing.assert_allclose(qd[:, :1] * ax.s11 + r[:, 1:2] * ax.s12 + r[:, 2:3] * ax.s13, w, atol=1e-13)
     np.testing.assert_allclose(qd[:, 1:2] * ax.s21 + r[:, 0:1] * ax.s22, w, atol=1e-13)
     dp = numerical_jacobian(lambda qq: vt.passive_angles(TH, qq).values, q)
@@ -161,12 +161,12 @@ def test_angular_acceleration_is_the_time_derivative_of_j_qd() -> None:
     h = 1e-5
     q, qd, qdd = _trajectory(t)
     acc = vt.angular_acceleration(TH, q, qd, qdd)
-    w_plus = vt.angular_velocity(TH, *_trajectory(t + h)[:2])
-    w_minus = vt.angular_velocity(TH, *_trajectory(t - h)[:2])
+    w_plus = vt.angular_velocity(TH, *_trajectory(t + h)[:2]).omega
+    w_minus = vt.angular_velocity(TH, *_trajectory(t - h)[:2]).omega
     wd_fd = (w_plus - w_minus) / (2 * h)
     assert acc.valid.all()
     np.testing.assert_allclose(acc.omega_dot, wd_fd, atol=ACC_FD_TOL)
-    np.testing.assert_allclose(acc.omega, vt.angular_velocity(TH, q, qd), atol=1e-14)
+    np.testing.assert_allclose(acc.omega, vt.angular_velocity(TH, q, qd).omega, atol=1e-14)
     # omega_dot = J qdd + (Lie-bracket velocity products); those products are not negligible:
     J = vt.jacobian(TH, q).J
     J_qdd = np.einsum("...ij,...j->...i", J, qdd)
@@ -184,6 +184,8 @@ def test_singularity_is_flagged_not_raised() -> None:
     assert jr.valid.tolist() == [False, True] and np.all(np.isnan(jr.J[0]))
     acc = vt.angular_acceleration(TH, q, np.ones((2, 2)), np.ones((2, 2)))
     assert acc.valid.tolist() == [False, True] and np.all(np.isfinite(acc.omega_dot[1]))
+    vel = vt.angular_velocity(TH, q, np.ones((2, 2)))
+    assert vel.valid.tolist() == [False, True] and np.all(np.isnan(vel.omega[0]))
     pr = vt.passive_rates(TH, q, np.ones((2, 2)))
     assert not pr.valid[0] and np.all(np.isnan(pr.values[0]))
 
@@ -258,3 +260,17 @@ def test_chunked_evaluation_equals_whole_array_kernels() -> None:
     assert not jr.valid[5] and not fk.valid.reshape(-1)[5]
     m = vt.workspace_map(TH, q.reshape(-1, 1, 2))
     assert m.tip.shape == (n, 1, 3) and m.singular[5, 0]
+
+
+@given(st.floats(0.3, 1.3), st.floats(-0.6, 0.6), st.floats(-0.25, 0.25))
+@settings(max_examples=60, deadline=None)
+def test_other_arc_angles_round_trip_and_jacobian(arc: float, q1: float, q2_frac: float) -> None:
+    import dataclasses
+
+    th = dataclasses.replace(TH, arc_angle=arc)
+    q = np.array([q1, q2_frac * arc * 2])  # |q2| < a/2: away from the singular point (0, a)
+    fk = vt.forward_kinematics(th, q)
+    assert fk.valid and abs(np.linalg.norm(fk.axis) - 1) < 1e-14
+    np.testing.assert_allclose(vt.inverse_kinematics(th, fk.axis).q, q, atol=ROUND_TRIP_TOL)
+    pose = lambda qq: transform(vt.platform_rotation(th, qq).R, np.zeros((*qq.shape[:-1], 3)))  # noqa: E731
+    np.testing.assert_allclose(vt.jacobian(th, q).J, numerical_space_jacobian(pose, q)[:3], atol=FD_TOL)

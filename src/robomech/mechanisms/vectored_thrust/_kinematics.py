@@ -37,6 +37,7 @@ __all__ = [
     "JointAxes",
     "PassiveResult",
     "RotationResult",
+    "VelocityResult",
     "angular_acceleration",
     "angular_velocity",
     "arc_clearance",
@@ -490,11 +491,17 @@ def jacobian(th: VectoredThruster, q: object) -> JacobianResult:
     return _chunked(_jacobian, th, _q(q))
 
 
-def angular_velocity(th: VectoredThruster, q: object, qd: object) -> np.ndarray:
-    """Platform angular velocity ``omega (..., 3)``, rad/s; NaN where ``jacobian().valid`` is False."""
+@dataclass(frozen=True)
+class VelocityResult:
+    omega: np.ndarray  # (..., 3) platform angular velocity, rad/s; NaN where not valid
+    valid: np.ndarray  # (...,) not singular
+
+
+def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityResult:
+    """Platform angular velocity ``omega = J qd`` (..., 3), rad/s, from ``q, qd (..., 2)``."""
     q, qd = _q(q), as_array(qd, "qd", (2,))
     jr = _jacobian(th, q)
-    return np.einsum("...ij,...j->...i", jr.J, qd)
+    return VelocityResult(omega=np.einsum("...ij,...j->...i", jr.J, qd), valid=jr.valid)
 
 
 def _screw(s: np.ndarray) -> np.ndarray:
