@@ -86,3 +86,7 @@ def test_input_grid_and_bad_inputs() -> None:
         vt.input_grid(TH, 5, [[1.0, 0.0], [0.0, 1.0]])
     with pytest.raises(ValueError, match="q"):
         vt.workspace_map(TH, np.zeros((4, 3)))
+    with pytest.raises(ValueError, match="b2"):
+        vt.arc_clearance([1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0], [0, 1.0])
+    with pytest.raises(ValueError, match="a1"):
+        vt.arc_clearance([float("nan"), 0, 0], [0, 1.0, 0], [0, 0, 1.0], [0, 1.0, 0])
