@@ -1,0 +1,105 @@
+"""Screw-theory mobility of the vectored thruster (paper 5, Section 2), from the joint screws.
+
+Nothing is hard-coded: each chain's joint screws are built from the joint axes at a configuration
+(optionally with an axis moved off the common centre) and passed to
+:func:`robomech.analysis.mobility.analyze`, which forms the chains' constraint systems, their union and
+the platform's reciprocal twist system.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array
+from robomech.analysis import mobility
+from robomech.spatial import screw_from_axis
+
+from ._kinematics import _axes
+from ._params import VectoredThruster
+
+__all__ = ["MechanismMobility", "chain_screws", "mechanism_mobility", "platform_mobility"]
+
+# Screws are passed in metres (see platform_mobility).
+CORE_LENGTH_SCALE = 1.0
+
+_JOINTS = ("s11", "s12", "s13", "s21", "s22")
+
+
+def chain_screws(
+    th: VectoredThruster, q: object, offsets: dict[str, object] | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Unit joint screws ``[s; r x s]`` of the RRR chain (3, 6) and the RR chain (2, 6) at ``q (2,)``.
+
+    ``offsets`` moves named axes (``"s11"``, ``"s12"``, ``"s13"``, ``"s21"``, ``"s22"``) to pass through
+    the given point (3,) in metres instead of through O (a design perturbation; the paper's axes all
+    pass through O, eqs. (5) and (7)).
+    """
+    qa = as_array(q, "q", (2,))
+    if qa.ndim != 1:
+        raise ValueError(f"Expected q to have shape (2,), got {qa.shape}.")
+    ax = _axes(th, qa)
+    if not ax.valid:
+        raise ValueError(f"Expected q away from the singularity (|s22 x s12| > 0), got q = {qa.tolist()}.")
+    offsets = dict(offsets or {})
+    for k in offsets:
+        if k not in _JOINTS:
+            raise ValueError(f"Expected offsets keys among {_JOINTS}, got {k!r}.")
+    pts = {k: as_array(offsets.get(k, np.zeros(3)), f"offsets[{k!r}]", (3,)) for k in _JOINTS}
+    S = {k: screw_from_axis(getattr(ax, k), pts[k]) for k in _JOINTS}
+    return np.stack([S["s11"], S["s12"], S["s13"]]), np.stack([S["s21"], S["s22"]])
+
+
+def platform_mobility(
+    th: VectoredThruster, q: object = (0.0, 0.0), offsets: dict[str, object] | None = None
+) -> mobility.MobilityResult:
+    """Mobility of the RRR-RR platform (the fixing device) at ``q``: paper 5, eqs. (4)-(10).
+
+    Screws are in metres with ``length_scale = 1``: offsets of millimetres give moment parts ~1e-3,
+    far above the SVD rank tolerance (1e-9).  (With ``length_scale != 1`` the core's returned
+    ``constraint_wrenches`` are mis-scaled; see docs/mechanisms/vectored_thrust.md.)  The returned
+    ``constraint_wrenches`` satisfy ``reciprocal_product(W, S) = 0`` with every joint screw S.
+    """
+    rrr, rr = chain_screws(th, q, offsets)
+    return mobility.analyze([rrr, rr], length_scale=CORE_LENGTH_SCALE)
+
+
+@dataclass(frozen=True)
+class MechanismMobility:
+    platform: mobility.MobilityResult  # RRR-RR platform (2R expected)
+    propeller: mobility.MobilityResult  # propeller body: RU central chain + (platform twists, s0)
+
+
+def mechanism_mobility(
+    th: VectoredThruster,
+    q: object = (0.0, 0.0),
+    offsets: dict[str, object] | None = None,
+    ujoint_centre: object = (0.0, 0.0, 0.0),
+) -> MechanismMobility:
+    """Mobility of the whole vectored thruster with the central universal-joint chain (Section 2, Fig. 2).
+
+    The propeller body is reached by two paths: the central chain (motor R about Z, universal joint with
+    axes X and Y at ``ujoint_centre``) and the platform (its twist system from :func:`platform_mobility`,
+    taken as an equivalent chain) followed by the shaft bearing R about s0 through O.  The propeller has
+    3 rotational DOF (platform 2R + spin) when the universal-joint centre coincides with O.
+    """
+    plat = platform_mobility(th, q, offsets)
+    qa = as_array(q, "q", (2,))
+    c = as_array(ujoint_centre, "ujoint_centre", (3,))
+    s0 = _axes(th, qa).s0
+    # The universal-joint cross: first axis fixed to the motor shaft (X at the current motor angle 0),
+    # second axis perpendicular to it and to the propeller shaft.
+    u1 = np.array([1.0, 0.0, 0.0])
+    u2 = np.cross(s0, u1)
+    u2 = u2 / np.linalg.norm(u2)
+    central = np.stack(
+        [
+            screw_from_axis(np.array([0.0, 0.0, 1.0]), np.zeros(3)),  # motor shaft, fixed along Z through O
+            screw_from_axis(u1, c),
+            screw_from_axis(u2, c),
+        ]
+    )
+    via_platform = np.vstack([plat.platform_twists, screw_from_axis(s0, np.zeros(3))])
+    prop = mobility.analyze([central, via_platform], length_scale=CORE_LENGTH_SCALE)
+    return MechanismMobility(platform=plat, propeller=prop)

@@ -1,0 +1,86 @@
+"""Parameters of the RRR-RR vectored-thrust spherical mechanism (paper 5, Table 1)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+__all__ = ["VectoredThruster"]
+
+
+def _check_range(name: str, lim: tuple[float, float], bound: float) -> tuple[float, float]:
+    try:
+        lo, hi = (float(v) for v in lim)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"Expected {name} to be a (lo, hi) pair of radians, got {lim!r}.") from exc
+    if not (math.isfinite(lo) and math.isfinite(hi) and -bound <= lo < hi <= bound):
+        raise ValueError(f"Expected {name} to satisfy -{bound:.4g} <= lo < hi <= {bound:.4g}, got {lim!r}.")
+    return lo, hi
+
+
+def _check_pos(name: str, value: float, upper: float = math.inf) -> float:
+    v = float(value)
+    if not (math.isfinite(v) and 0.0 < v < upper):
+        raise ValueError(f"Expected {name} in (0, {upper:.4g}), got {value!r}.")
+    return v
+
+
+@dataclass(frozen=True)
+class VectoredThruster:
+    """Geometry of the vectored thruster, SI units (metres, radians).
+
+    All joint axes pass through the universal-joint centre O (Section 2), so the kinematics depend
+    only on ``arc_angle``; the radii and the propeller arm give points (tip, drawings, engine model),
+    and the limits define the workspace.
+
+    Chains, as in eqs. (5) and (7) (the paper's subscript 1 is the RRR chain, 2 the RR chain):
+
+    * RRR chain: input ``q1`` about X; a ``arc_angle`` (45 deg) arc of radius ``rrr_arc1_radius`` to the
+      passive axis ``s12 = Rx(q1) (cos a, 0, -sin a)``; a 90 deg arc of radius ``rrr_arc2_radius`` to the
+      passive axis ``s13`` fixed in the platform.
+    * RR chain: input ``q2`` about Y; a 90 deg arc of radius ``rr_arc_radius`` to the passive axis
+      ``s22 = Ry(q2) (-1, 0, 0)`` fixed in the platform.
+    * Platform (the "arc-link fixing device", radius ``platform_radius``) carries ``s22``, ``s13`` (at
+      90 deg to each other) and the propeller shaft ``s0 = s22 x s13`` (eq. 11), along +Z at q = 0.
+    """
+
+    arc_angle: float = math.pi / 4  # paper 5, eq. (7): angle between X and s12 (the 45 deg arc)
+    platform_radius: float = 0.020  # Table 1: arc-link fixing device, 20 mm
+    rr_arc_radius: float = 0.0225  # Table 1: "chain 1" (the RR chain) 90 deg arc, 22.5 mm
+    rrr_arc1_radius: float = 0.025  # Table 1: "chain 2" (the RRR chain) 45 deg arc, 25 mm
+    rrr_arc2_radius: float = 0.0225  # Table 1: "chain 2" (the RRR chain) 90 deg arc, 22.5 mm
+    propeller_arm: float = 0.080  # Table 1: propeller shaft, 80 mm from the rotation centre
+    q1_limits: tuple[float, float] = (-math.pi / 4, math.pi / 4)  # Table 1: q1 range +-pi/4
+    q2_limits: tuple[float, float] = (-math.pi / 6, math.pi / 6)  # Table 1: q2 range +-pi/6
+    tilt_limit: float = math.pi / 4  # Table 1 / Section 4.1: universal joint delta_max = pi/4
+    # Section 4.1 (2): the 45 deg arc and the fixing device must not touch.  The paper gives no
+    # clearance; assumed: both members 6 mm wide, so their centre lines must stay one width
+    # (6 mm) apart measured on the 20 mm platform sphere: 0.006 / 0.020 = 0.3 rad (17.2 deg).
+    interference_clearance: float = 0.3
+
+    def __post_init__(self) -> None:
+        _check_pos("arc_angle", self.arc_angle, math.pi / 2)
+        radius_names = (
+            "platform_radius", "rr_arc_radius", "rrr_arc1_radius", "rrr_arc2_radius", "propeller_arm"
+        )
+        for name in radius_names:
+            _check_pos(name, getattr(self, name))
+        object.__setattr__(self, "q1_limits", _check_range("q1_limits", self.q1_limits, math.pi))
+        object.__setattr__(self, "q2_limits", _check_range("q2_limits", self.q2_limits, math.pi / 2))
+        _check_pos("tilt_limit", self.tilt_limit, math.pi / 2)
+        v = float(self.interference_clearance)
+        if not (math.isfinite(v) and 0.0 <= v < math.pi / 2):
+            raise ValueError(
+                f"Expected interference_clearance in [0, pi/2) rad, got {self.interference_clearance!r}."
+            )
+        radii = (self.platform_radius, self.rr_arc_radius, self.rrr_arc2_radius, self.rrr_arc1_radius)
+        if self.propeller_arm <= max(radii):
+            raise ValueError(
+                f"Expected propeller_arm > every arc radius ({max(radii):.4g} m) so the tip clears the "
+                f"links, got {self.propeller_arm!r}."
+            )
+
+    @classmethod
+    def paper(cls) -> VectoredThruster:
+        """Table 1 of paper 5 (radii in mm converted to metres; ranges in radians)."""
+        return cls()

@@ -1,0 +1,124 @@
+"""Workspace, singularity and dexterity maps of the vectored thruster over its inputs (paper 5, Section 4).
+
+Two kinds of singularity, both from the closed-form Jacobian ``J = [theta_1 s22, Y + theta_2 s22]``:
+
+* passive axes parallel (``s22 || s12``, ``|s22 x s12| = 0``): the platform's rotation about s22 is
+  undetermined and J is unbounded.  Isolated points q = (0, a) and (pi, -a), a the 45 deg arc angle.
+* input 1 idle (``theta_1 = 0``: X, s12, s13 coplanar, the RRR chain at a serial singularity): J
+  loses rank, q1 no longer moves the platform.  The curve ``tan q2 = tan a / cos q1`` (|q2| >= a).
+
+paper 5, eq. (35): the printed "no singularity" tests det of the 3x3 passive-rate map (21), which is
+the wrong matrix; both sets above exist, and (0, pi/4) lies on the edge of the +-pi/4 trajectory box.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array
+
+from ._kinematics import _axes, _chunked, _fk, _interference, _jacobian, _q
+from ._params import VectoredThruster
+
+__all__ = [
+    "DEXTERITY_TOL",
+    "WorkspaceMap",
+    "dexterity",
+    "idle_input_curve",
+    "input_grid",
+    "singular_points",
+    "workspace_map",
+]
+
+# sigma_min / sigma_max of J below which an input configuration counts as singular in the maps: the
+# same threshold as robomech.analysis.workspace.SINGULAR_RTOL (1e-8), applied to the closed form.
+DEXTERITY_TOL = 1e-8
+
+
+@dataclass(frozen=True)
+class WorkspaceMap:
+    q: np.ndarray  # (..., 2) inputs, rad
+    tip: np.ndarray  # (..., 3) propeller tip, m (NaN where singular)
+    tilt: np.ndarray  # (...,) universal-joint deflection, rad
+    clearance: np.ndarray  # (...,) 45 deg arc to fixing device, rad
+    distance: np.ndarray  # (...,) |s22 x s12| (0 at the passive-axes-parallel singularity)
+    dexterity: np.ndarray  # (...,) 1 / cond(J) in [0, 1]; 0 where singular
+    singular: np.ndarray  # (...,) dexterity < DEXTERITY_TOL or passive axes parallel
+    in_range: np.ndarray
+    tilt_ok: np.ndarray
+    clear: np.ndarray  # (...,) clearance >= interference_clearance
+    reachable: np.ndarray  # in_range & tilt_ok & clear & not singular
+
+
+def _dexterity(J: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """1/cond of each (..., 3, 2) J from the eigenvalues of the 2x2 J^T J (closed form, no SVD)."""
+    Jz = np.where(ok[..., None, None], J, 0.0)
+    a = np.sum(Jz[..., :, 0] ** 2, -1)
+    b = np.sum(Jz[..., :, 0] * Jz[..., :, 1], -1)
+    c = np.sum(Jz[..., :, 1] ** 2, -1)
+    half_tr = 0.5 * (a + c)
+    root = np.sqrt(np.maximum(0.25 * (a - c) ** 2 + b * b, 0.0))
+    lmax = half_tr + root
+    lmin = np.maximum((a * c - b * b) / np.where(lmax > 0, lmax, 1.0), 0.0)  # det / lmax: no cancellation
+    ratio = np.sqrt(lmin / np.where(lmax > 0, lmax, 1.0))
+    return np.where(ok & (lmax > 0), ratio, 0.0)
+
+
+def dexterity(th: VectoredThruster, q: object) -> np.ndarray:
+    """Dexterity 1/cond(J) (...,) in [0, 1] at inputs ``q (..., 2)``; 0 at singular inputs."""
+    jr = _jacobian(th, _q(q))
+    return _dexterity(jr.J, jr.valid)
+
+
+def workspace_map(th: VectoredThruster, q: object) -> WorkspaceMap:
+    """Section 4 at each input sample ``q (..., 2)`` (rad): tip, limits, singularity, dexterity."""
+    return _chunked(_workspace_map, th, _q(q))
+
+
+def _workspace_map(th: VectoredThruster, q: np.ndarray) -> WorkspaceMap:
+    fk = _fk(th, q)
+    jr = _jacobian(th, q)
+    dex = _dexterity(jr.J, jr.valid)
+    clearance = _interference(th, _axes(th, q))
+    singular = ~jr.valid | (dex < DEXTERITY_TOL)
+    with np.errstate(invalid="ignore"):
+        clear = jr.valid & (clearance >= th.interference_clearance)
+    return WorkspaceMap(
+        q=q,
+        tip=fk.tip,
+        tilt=fk.tilt,
+        clearance=clearance,
+        distance=jr.distance,
+        dexterity=dex,
+        singular=singular,
+        in_range=fk.in_range,
+        tilt_ok=fk.tilt_ok,
+        clear=clear,
+        reachable=fk.in_range & fk.tilt_ok & clear & ~singular,
+    )
+
+
+def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = None) -> np.ndarray:
+    """Regular grid (n1, n2, 2) over ``limits`` ((lo, hi) per input, rad; default the input ranges)."""
+    lim = np.array([th.q1_limits, th.q2_limits]) if limits is None else as_array(limits, "limits", (2, 2))
+    if lim.shape != (2, 2) or np.any(lim[:, 1] <= lim[:, 0]):
+        raise ValueError(f"Expected limits of shape (2, 2) with lo < hi per input, got {lim.tolist()}.")
+    n1, n2 = (n, n) if isinstance(n, int) else n
+    if n1 < 2 or n2 < 2:
+        raise ValueError(f"Expected n >= 2 per input, got {n!r}.")
+    g1, g2 = np.linspace(*lim[0], n1), np.linspace(*lim[1], n2)
+    return np.stack(np.meshgrid(g1, g2, indexing="ij"), axis=-1)
+
+
+def singular_points(th: VectoredThruster) -> np.ndarray:
+    """Passive-axes-parallel singular inputs (2, 2), q1 in (-pi, pi], |q2| < pi/2: (0, a), (pi, -a)."""
+    a = th.arc_angle
+    return np.array([[0.0, a], [np.pi, -a]])
+
+
+def idle_input_curve(th: VectoredThruster, q1: object) -> np.ndarray:
+    """q2 (...,) on the rank-deficient curve ``tan q2 = tan a / cos q1`` for |q1| < pi/2 (rad)."""
+    q1 = as_array(q1, "q1")
+    return np.arctan2(np.tan(th.arc_angle), np.cos(q1))
