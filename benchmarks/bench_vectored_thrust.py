@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from _harness import Workload
 from robomech.mechanisms import vectored_thrust as vt
+
+from _harness import Workload
 
 N = 1_000_000
 N_ALT = 2000  # per-sample Python loop timed on this many samples and scaled

@@ -70,6 +70,15 @@ def test_length_scale_does_not_change_the_result():
     chains = [c * np.array([1, 1, 1, 1000, 1000, 1000]) for c in CHAINS["3-RPS"]]  # same mechanism in mm
     m = mobility.analyze(chains, length_scale=1000.0)
     assert m.dof == 3 and m.rotational_dof == 2
+    # the returned screws are in the caller's units: the wrenches still do no work on the mm twists
+    W = m.constraint_wrenches / np.linalg.norm(m.constraint_wrenches, axis=1, keepdims=True)
+    P = m.platform_twists / np.linalg.norm(m.platform_twists, axis=1, keepdims=True)
+    assert np.abs(virtual_power(W[:, None, :], P[None, :, :])).max() < 1e-9
+    m1 = mobility.analyze(CHAINS["3-RPS"])
+    # same constraint system as in metres, with moments scaled by 1000 (N·mm)
+    Wm = m1.constraint_wrenches * np.array([1000, 1000, 1000, 1, 1, 1])
+    both = np.vstack([Wm, m.constraint_wrenches])
+    assert np.linalg.matrix_rank(both / np.linalg.norm(both, axis=1, keepdims=True), tol=1e-8) == 3
 
 
 def test_bad_input_names_the_argument():

@@ -88,9 +88,7 @@ def test_ik_of_fk_round_trip(q: tuple[float, float]) -> None:
     assert bool(ik.tilt_ok) == bool(fk.tilt_ok)
 
 
-@given(
-    st.floats(0.0, math.pi / 4 * 0.999, allow_nan=False), st.floats(-math.pi, math.pi, allow_nan=False)
-)
+@given(st.floats(0.0, math.pi / 4 * 0.999, allow_nan=False), st.floats(-math.pi, math.pi, allow_nan=False))
 @settings(max_examples=100, deadline=None)
 def test_fk_of_ik_round_trip_over_the_tilt_cone(tilt: float, azimuth: float) -> None:
     s = np.array([math.sin(tilt) * math.cos(azimuth), math.sin(tilt) * math.sin(azimuth), math.cos(tilt)])

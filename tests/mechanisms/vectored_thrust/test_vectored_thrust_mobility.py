@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from robomech.mechanisms import vectored_thrust as vt
-from robomech.spatial import reciprocal_product
+from robomech.spatial import virtual_power
 
 TH = vt.VectoredThruster.paper()
 
@@ -37,9 +37,9 @@ def test_platform_has_two_rotations_everywhere(q1: float, q2: float) -> None:
         assert _in_span(tw, basis)
     # each chain's constraints are reciprocal to its joint screws; the union to the platform twists
     for chain, S in zip(m.chains, vt.chain_screws(TH, (q1, q2)), strict=True):
-        np.testing.assert_allclose(reciprocal_product(chain.constraints[:, None], S[None]), 0.0, atol=1e-12)
+        np.testing.assert_allclose(virtual_power(chain.constraints[:, None], S[None]), 0.0, atol=1e-12)
     P = m.platform_twists
-    np.testing.assert_allclose(reciprocal_product(m.constraint_wrenches[:, None], P[None]), 0.0, atol=1e-12)
+    np.testing.assert_allclose(virtual_power(m.constraint_wrenches[:, None], P[None]), 0.0, atol=1e-12)
 
 
 def test_paper_eq10_basis_holds_at_home() -> None:
@@ -65,7 +65,7 @@ def test_moving_an_axis_off_the_centre_changes_the_mobility() -> None:
     assert off_rrr.dof < 2
     for m in (off, off_rrr):
         W, P = m.constraint_wrenches, m.platform_twists
-        np.testing.assert_allclose(reciprocal_product(W[:, None], P[None]), 0.0, atol=1e-12)
+        np.testing.assert_allclose(virtual_power(W[:, None], P[None]), 0.0, atol=1e-12)
 
 
 def test_whole_mechanism_with_central_universal_joint() -> None:

@@ -57,9 +57,8 @@ def platform_mobility(
     """Mobility of the RRR-RR platform (the fixing device) at ``q``: paper 5, eqs. (4)-(10).
 
     Screws are in metres with ``length_scale = 1``: offsets of millimetres give moment parts ~1e-3,
-    far above the SVD rank tolerance (1e-9).  (With ``length_scale != 1`` the core's returned
-    ``constraint_wrenches`` are mis-scaled; see docs/mechanisms/vectored_thrust.md.)  The returned
-    ``constraint_wrenches`` satisfy ``reciprocal_product(W, S) = 0`` with every joint screw S.
+    far above the SVD rank tolerance (1e-9).  The returned ``constraint_wrenches`` are wrenches
+    ``[m; f]`` that do no work on any joint screw S: ``virtual_power(W, S) = 0``.
     """
     rrr, rr = chain_screws(th, q, offsets)
     return mobility.analyze([rrr, rr], length_scale=CORE_LENGTH_SCALE)

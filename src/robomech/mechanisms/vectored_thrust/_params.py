@@ -61,7 +61,11 @@ class VectoredThruster:
     def __post_init__(self) -> None:
         _check_pos("arc_angle", self.arc_angle, math.pi / 2)
         radius_names = (
-            "platform_radius", "rr_arc_radius", "rrr_arc1_radius", "rrr_arc2_radius", "propeller_arm"
+            "platform_radius",
+            "rr_arc_radius",
+            "rrr_arc1_radius",
+            "rrr_arc2_radius",
+            "propeller_arm",
         )
         for name in radius_names:
             _check_pos(name, getattr(self, name))
