@@ -19,6 +19,7 @@ from ._params import ContinuumRobot
 from ._statics import TensionResult, cable_tensions
 
 __all__ = [
+    "SIM_BACKTRACKS",
     "SIM_FD_STEP",
     "SIM_MAX_ITERATIONS",
     "SIM_TOLERANCE",
@@ -36,6 +37,8 @@ SIM_TOLERANCE = 1e-10
 # ... within 40 iterations (quadratic convergence needs ~5 from a nearby start; the margin covers starts
 # far from the solution and the Coulomb kink of the wrap angles at theta = 0).
 SIM_MAX_ITERATIONS = 40
+# Step halvings of the backtracking line search (2^-12 ~ 2e-4 of a Newton step is the smallest tried).
+SIM_BACKTRACKS = 12
 # Central-difference step (rad) for the 2n x 2n Newton matrix: eps^(1/3) for O(1) curvature.
 SIM_FD_STEP = 6e-6
 
@@ -212,7 +215,18 @@ def simulate(
                          - _sim_residual(robot, k - e, qa, d, model)[0]) / (2 * SIM_FD_STEP))
         Jm = np.stack(cols, -1)
         step = np.linalg.solve(Jm, F[..., None])[..., 0]
-        k = np.where(converged[..., None], k, k - step)
+        # Backtracking: halve the step where it does not reduce |F| (the slack clip and the Coulomb
+        # kink at theta = 0 make F only piecewise smooth).
+        f0 = np.linalg.norm(F, axis=-1)
+        scale = np.ones(batch)
+        for _ in range(SIM_BACKTRACKS):
+            F_try, _ = _sim_residual(robot, k - scale[..., None] * step, qa, d, model)
+            trial = np.linalg.norm(F_try, axis=-1)
+            worse = (trial >= f0) & ~converged
+            if not np.any(worse):
+                break
+            scale = np.where(worse, 0.5 * scale, scale)
+        k = np.where(converged[..., None], k, k - scale[..., None] * step)
         iterations = iterations + ~converged
     F, t_raw = _sim_residual(robot, k, qa, d, model)
     res = np.linalg.norm(F, axis=-1)
