@@ -17,6 +17,7 @@ __all__ = [
     "CAPSTAN_FIRST_STEP",
     "CAPSTAN_H_ACCURACY",
     "CAPSTAN_LAYER_STEPS",
+    "CAPSTAN_MAX_STEPS",
     "CAPSTAN_STABILITY",
     "FrictionEstimate",
     "capstan_coefficient",
@@ -104,6 +105,9 @@ CAPSTAN_LAYER_STEPS = 60
 CAPSTAN_FIRST_STEP = 0.1
 CAPSTAN_STABILITY = 1.5
 CAPSTAN_H_ACCURACY = 0.02
+# Largest phase-2 step count accepted (~1 s per point group): beyond it the stiffness (rho large with
+# n < 1) calls for the rho = inf limit, which is solved in closed form.
+CAPSTAN_MAX_STEPS = 2**20
 # Slack on the a-priori bound of T along the wrap used for the stiffness estimate.
 _GROWTH_MARGIN = 1.5
 
@@ -226,6 +230,12 @@ def capstan_tension_ratio(
         layer = np.where(g > 1.0, h0 * (g**CAPSTAN_LAYER_STEPS - 1.0) / np.where(g > 1.0, g - 1.0, 1.0),
                          h0 * CAPSTAN_LAYER_STEPS)
         need = np.maximum(ph - layer, 0.0) / h_cap
+        if np.any(need > CAPSTAN_MAX_STEPS):
+            raise ValueError(
+                f"Expected rho small enough for an explicit integration (at most {CAPSTAN_MAX_STEPS} steps), "
+                f"got rho up to {r[need > CAPSTAN_MAX_STEPS].max():g} with n < 1; pass rho=np.inf for the "
+                "limit of vanishing bending stiffness."
+            )
         bucket = np.ceil(2.0 * np.log2(np.maximum(need, 1.0))).astype(int)
         for b in np.unique(bucket):  # a handful of step-count buckets, not samples
             sel = bucket == b

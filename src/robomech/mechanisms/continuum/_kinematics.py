@@ -47,32 +47,36 @@ IK_DAMPING = 1e-14
 
 
 # ---- scalar functions of the bend angle, exact and finite at theta = 0 --------------------------
+def _small_fix(t: np.ndarray, closed, series) -> np.ndarray:
+    """``closed(t)`` with the entries below SMALL_ANGLE replaced by ``series(t)`` (no 0/0 evaluated)."""
+    t = np.asarray(t, dtype=float)
+    small = np.abs(t) < SMALL_ANGLE
+    if not np.any(small):
+        return closed(t)
+    out = np.array(closed(np.where(small, 1.0, t)), dtype=float)
+    out[small] = series(t[small])
+    return out
+
+
 def _f_cos(t: np.ndarray) -> np.ndarray:
     """(1 - cos t) / t."""
-    small = np.abs(t) < SMALL_ANGLE
-    ts = np.where(small, 1.0, t)
-    return np.where(small, t / 2.0 - t**3 / 24.0 + t**5 / 720.0, (1.0 - np.cos(ts)) / ts)
+    return _small_fix(t, lambda x: (1.0 - np.cos(x)) / x, lambda x: x / 2.0 - x**3 / 24.0 + x**5 / 720.0)
 
 
 def _f_sin(t: np.ndarray) -> np.ndarray:
     """sin t / t."""
-    small = np.abs(t) < SMALL_ANGLE
-    ts = np.where(small, 1.0, t)
-    return np.where(small, 1.0 - t**2 / 6.0 + t**4 / 120.0, np.sin(ts) / ts)
+    return _small_fix(t, lambda x: np.sin(x) / x, lambda x: 1.0 - x**2 / 6.0 + x**4 / 120.0)
 
 
 def _df_cos(t: np.ndarray) -> np.ndarray:
     """d/dt (1 - cos t)/t = (t sin t + cos t - 1) / t^2 (paper 3, eq. (6))."""
-    small = np.abs(t) < SMALL_ANGLE
-    ts = np.where(small, 1.0, t)
-    return np.where(small, 0.5 - t**2 / 8.0 + t**4 / 144.0, (ts * np.sin(ts) + np.cos(ts) - 1.0) / ts**2)
+    return _small_fix(t, lambda x: (x * np.sin(x) + np.cos(x) - 1.0) / (x * x),
+                      lambda x: 0.5 - x**2 / 8.0 + x**4 / 144.0)
 
 
 def _df_sin(t: np.ndarray) -> np.ndarray:
     """d/dt sin t / t = (t cos t - sin t) / t^2 (paper 3, eq. (6))."""
-    small = np.abs(t) < SMALL_ANGLE
-    ts = np.where(small, 1.0, t)
-    return np.where(small, -t / 3.0 + t**3 / 30.0, (ts * np.cos(ts) - np.sin(ts)) / ts**2)
+    return _small_fix(t, lambda x: (x * np.cos(x) - np.sin(x)) / (x * x), lambda x: -x / 3.0 + x**3 / 30.0)
 
 
 def _split(robot: ContinuumRobot, psi: object, name: str = "psi") -> tuple[np.ndarray, np.ndarray]:
@@ -82,27 +86,37 @@ def _split(robot: ContinuumRobot, psi: object, name: str = "psi") -> tuple[np.nd
 
 # ---- one segment --------------------------------------------------------------------------------
 def _segment_T(theta: np.ndarray, beta: np.ndarray, length: np.ndarray | float) -> np.ndarray:
+    """Segment poses (..., 4, 4), computed as 16 contiguous planes (4, 4, ...) and returned as a view
+    with the matrix axes last: writing planes is several times faster than 16 strided writes."""
     ct, st, cb, sb = np.cos(theta), np.sin(theta), np.cos(beta), np.sin(beta)
     shape = np.broadcast_shapes(np.shape(theta), np.shape(beta), np.shape(length))
-    T = np.zeros((*shape, 4, 4))
+    P = np.empty((4, 4, *shape))
+    cb2, sb2 = cb * cb, sb * sb
     # R = Rz(beta) Ry(theta) Rz(-beta).  paper 3, eq. (1): printed element (2,1) c(beta)s(beta)c(theta);
     # the product gives c(beta)s(beta)(c(theta) - 1) (symmetric with element (1,2)).
-    T[..., 0, 0] = ct * cb**2 + sb**2
-    T[..., 0, 1] = cb * sb * (ct - 1.0)
-    T[..., 0, 2] = cb * st
-    T[..., 1, 0] = cb * sb * (ct - 1.0)
-    T[..., 1, 1] = sb**2 * ct + cb**2
-    T[..., 1, 2] = sb * st
-    T[..., 2, 0] = -cb * st
-    T[..., 2, 1] = -sb * st
-    T[..., 2, 2] = ct
-    # paper 3, eq. (2), written with (1 - cos t)/t and sin t / t so that it is finite at theta = 0.
-    fc = length * _f_cos(theta)
-    T[..., 0, 3] = fc * cb
-    T[..., 1, 3] = fc * sb
-    T[..., 2, 3] = length * _f_sin(theta)
-    T[..., 3, 3] = 1.0
-    return T
+    P[0, 0] = ct * cb2 + sb2
+    np.multiply(cb * sb, ct - 1.0, out=P[0, 1, ...])
+    P[1, 0] = P[0, 1]
+    np.multiply(cb, st, out=P[0, 2, ...])
+    P[1, 1] = sb2 * ct + cb2
+    np.multiply(sb, st, out=P[1, 2, ...])
+    np.negative(P[0, 2], out=P[2, 0, ...])
+    np.negative(P[1, 2], out=P[2, 1, ...])
+    P[2, 2] = ct
+    # paper 3, eq. (2), written with (1 - cos t)/t and sin t / t so that it is finite at theta = 0
+    # (closed forms from the cosines above; Taylor series on the rare entries below SMALL_ANGLE).
+    if np.any(np.abs(theta) < SMALL_ANGLE):
+        fc, fs = _f_cos(theta), _f_sin(theta)
+    else:
+        inv = 1.0 / theta
+        fc, fs = (1.0 - ct) * inv, st * inv
+    fc = length * fc
+    np.multiply(fc, cb, out=P[0, 3, ...])
+    np.multiply(fc, sb, out=P[1, 3, ...])
+    np.multiply(length, fs, out=P[2, 3, ...])
+    P[3, :3] = 0.0
+    P[3, 3] = 1.0
+    return np.moveaxis(P, (0, 1), (-2, -1))
 
 
 def segment_transform(theta: object, beta: object, length: object) -> np.ndarray:
@@ -121,12 +135,10 @@ def segment_transform(theta: object, beta: object, length: object) -> np.ndarray
 
 # ---- the whole robot ----------------------------------------------------------------------------
 def _fk(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray) -> np.ndarray:
-    T_loc = _segment_T(theta, beta, robot.segment_length)  # (..., n, 4, 4)
-    out = np.empty_like(T_loc)
-    out[..., 0, :, :] = T_loc[..., 0, :, :]
+    T = _segment_T(theta, beta, robot.segment_length)  # (..., n, 4, 4), composed in place
     for i in range(1, robot.n_segments):  # loop over the fixed, small number of segments
-        out[..., i, :, :] = out[..., i - 1, :, :] @ T_loc[..., i, :, :]
-    return out
+        T[..., i, :, :] = T[..., i - 1, :, :] @ T[..., i, :, :]
+    return T
 
 
 def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
@@ -142,28 +154,45 @@ def tip_position(robot: ContinuumRobot, psi: object) -> np.ndarray:
 
 def _tip_jacobian(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray) -> np.ndarray:
     n, L = robot.n_segments, robot.segment_length
-    T = _fk(robot, theta, beta)
     ct, st, cb, sb = np.cos(theta), np.sin(theta), np.cos(beta), np.sin(beta)
-    z = np.zeros_like(theta)
+    # Columns as contiguous planes (6, 2, ..., n), returned as a (..., 6, 2n) view (see _segment_T).
+    P = np.empty((6, 2, *theta.shape))
     # paper 3, eq. (6): local angular and linear velocity columns of one segment (verified correct).
-    w_th = np.stack([-sb, cb, z], -1)
-    w_be = np.stack([-cb * st, -sb * st, 1.0 - ct], -1)
-    g1, g2, fc = _df_cos(theta), _df_sin(theta), _f_cos(theta)
-    v_th = L * np.stack([cb * g1, sb * g1, g2], -1)
-    v_be = L * fc[..., None] * np.stack([-sb, cb, z], -1)
+    if np.any(np.abs(theta) < SMALL_ANGLE):
+        g1, g2, fc = L * _df_cos(theta), L * _df_sin(theta), L * _f_cos(theta)
+    else:  # the same closed forms, reusing the cosines
+        inv = 1.0 / theta
+        fc = L * (1.0 - ct) * inv
+        g1 = (L * st - fc) * inv
+        g2 = L * (ct - st * inv) * inv
+    np.negative(sb, out=P[0, 0, ...])
+    P[1, 0] = cb
+    P[2, 0] = 0.0
+    np.multiply(-cb, st, out=P[0, 1, ...])
+    np.multiply(-sb, st, out=P[1, 1, ...])
+    np.subtract(1.0, ct, out=P[2, 1, ...])
+    np.multiply(cb, g1, out=P[3, 0, ...])
+    np.multiply(sb, g1, out=P[4, 0, ...])
+    P[5, 0] = g2
+    np.multiply(-sb, fc, out=P[3, 1, ...])
+    np.multiply(cb, fc, out=P[4, 1, ...])
+    P[5, 1] = 0.0
+    # (6, 2, ..., n) -> (..., 6, n, 2) -> (..., 6, 2n) with columns [theta_1, beta_1, theta_2, ...]
+    J = np.moveaxis(P, (0, 1), (-3, -1))
+    J = J.reshape(*theta.shape[:-1], 6, 2 * n)
+    if n == 1:  # the local columns are the tip Jacobian: base frame = segment base, tip = segment end
+        return J
+    T = _fk(robot, theta, beta)
     p_tip = T[..., -1, :3, 3]
-    J = np.zeros((*theta.shape[:-1], 6, 2 * n))
-    for i in range(n):
-        if i == 0:
-            R_prev = np.broadcast_to(np.eye(3), (*theta.shape[:-1], 3, 3))
-        else:
+    for i in range(n):  # loop over the fixed, small number of segments
+        cols = slice(2 * i, 2 * i + 2)
+        if i > 0:  # rotate the local columns into the base frame
             R_prev = T[..., i - 1, :3, :3]
-        r = p_tip - T[..., i, :3, 3]  # from segment i's end to the tip
-        for k, (w, v) in enumerate(((w_th, v_th), (w_be, v_be))):
-            wb = np.einsum("...ab,...b->...a", R_prev, w[..., i, :])
-            vb = np.einsum("...ab,...b->...a", R_prev, v[..., i, :]) + np.cross(wb, r)
-            J[..., :3, 2 * i + k] = wb
-            J[..., 3:, 2 * i + k] = vb
+            J[..., :3, cols] = R_prev @ J[..., :3, cols]
+            J[..., 3:, cols] = R_prev @ J[..., 3:, cols]
+        if i < n - 1:  # the distal segments ride on segment i's end frame: v_tip += omega x r
+            r = p_tip - T[..., i, :3, 3]
+            J[..., 3:, cols] += np.cross(J[..., :3, cols], r[..., :, None], axis=-2)
     return J
 
 
@@ -203,9 +232,7 @@ def _sinc(x: np.ndarray) -> np.ndarray:
 
 def _dsinc_over_x(x: np.ndarray) -> np.ndarray:
     """(d/dx sin x / x) / x = (x cos x - sin x) / x^3, finite at 0."""
-    small = np.abs(x) < SMALL_ANGLE
-    xs = np.where(small, 1.0, x)
-    return np.where(small, -1.0 / 3.0 + x**2 / 30.0, (xs * np.cos(xs) - np.sin(xs)) / xs**3)
+    return _small_fix(x, lambda v: (v * np.cos(v) - np.sin(v)) / v**3, lambda v: -1.0 / 3.0 + v**2 / 30.0)
 
 
 def _segment_spans(
@@ -323,29 +350,32 @@ def inverse_kinematics(robot: ContinuumRobot, p_tip: object) -> IKResult:
     p = as_array(p_tip, "p_tip", (3,))
     n, L = robot.n_segments, robot.segment_length
     batch = p.shape[:-1]
-    rh = np.hypot(p[..., 0], p[..., 1])
-    beta0 = np.arctan2(p[..., 1], p[..., 0])
-    theta_tot = 2.0 * np.arctan2(rh, p[..., 2])
-    theta = np.repeat((theta_tot / n)[..., None], n, axis=-1)
-    beta = np.repeat(beta0[..., None], n, axis=-1)
-    converged = np.zeros(batch, dtype=bool)
-    iterations = np.zeros(batch, dtype=int)
+    pf = p.reshape(-1, 3)
+    rh = np.hypot(pf[:, 0], pf[:, 1])
+    theta = np.repeat((2.0 * np.arctan2(rh, pf[:, 2]) / n)[:, None], n, axis=-1)
+    beta = np.repeat(np.arctan2(pf[:, 1], pf[:, 0])[:, None], n, axis=-1)
+    res = np.linalg.norm(pf - _fk(robot, theta, beta)[:, -1, :3, 3], axis=-1)
+    converged = res < IK_TOLERANCE  # the single-arc start is exact for every reachable one-segment tip
+    iterations = np.zeros(pf.shape[0], dtype=int)
+    idx = np.flatnonzero(~converged)
     eye = np.eye(2 * n)
-    for _ in range(IK_MAX_ITERATIONS):  # iterations, not samples: every step acts on the whole batch
-        e = p - _fk(robot, theta, beta)[..., -1, :3, 3]
-        Jv = _tip_jacobian(robot, theta, beta)[..., 3:, :]
+    for _ in range(IK_MAX_ITERATIONS):  # iterations, not samples: every step acts on the unconverged set
+        if idx.size == 0:
+            break
+        th, be, pp = theta[idx], beta[idx], pf[idx]
+        e = pp - _fk(robot, th, be)[:, -1, :3, 3]
+        Jv = _tip_jacobian(robot, th, be)[:, 3:, :]
         JtJ = np.swapaxes(Jv, -1, -2) @ Jv + IK_DAMPING * eye
         step = np.linalg.solve(JtJ, np.einsum("...ji,...j->...i", Jv, e)[..., None])[..., 0]
-        active = ~converged
-        theta = np.where(active[..., None], theta + step[..., 0::2], theta)
-        beta = np.where(active[..., None], beta + step[..., 1::2], beta)
-        iterations = iterations + active
-        small = np.linalg.norm(step, axis=-1) * L < IK_TOLERANCE
-        converged = converged | small
-        if np.all(converged):
-            break
+        theta[idx] = th + step[:, 0::2]
+        beta[idx] = be + step[:, 1::2]
+        iterations[idx] += 1
+        done = np.linalg.norm(step, axis=-1) * L < IK_TOLERANCE
+        converged[idx[done]] = True
+        res[idx] = np.linalg.norm(pp - _fk(robot, theta[idx], beta[idx])[:, -1, :3, 3], axis=-1)
+        idx = idx[~done]
     theta, beta = _normalise(theta, beta)
-    res = np.linalg.norm(p - _fk(robot, theta, beta)[..., -1, :3, 3], axis=-1)
     psi = np.stack([theta, beta], -1).reshape(*batch, 2 * n)
+    res, converged, iterations = res.reshape(batch), converged.reshape(batch), iterations.reshape(batch)
     return IKResult(psi=psi, residual=res, reachable=res < IK_TOLERANCE, converged=converged,
                     iterations=iterations)
