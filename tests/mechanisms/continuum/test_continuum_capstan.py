@@ -38,6 +38,12 @@ def test_agrees_with_tight_reference_over_paper_box():
     alpha[:6] = [0.15, 0.15, 0.15, 0.6, 0.6, 0.6]
     n[:6] = 0.67
     t[:6] = [0.1, 1.0, 10.0, 0.1, 1.0, 10.0]
+    # fastest slow-mode growth (rho 10, alpha 0.6) and weakest damping (rho 1, alpha 0.15), n near 1
+    phi[6:12] = np.pi
+    rho[6:12] = [10, 10, 10, 1, 1, 1]
+    alpha[6:12] = [0.6, 0.6, 0.6, 0.15, 0.15, 0.15]
+    n[6:12] = [0.8, 0.95, 0.999, 0.8, 0.95, 0.999]
+    t[6:12] = 1.0
     k = C.capstan_tension_ratio(phi, rho=rho, alpha=alpha, n=n, t_out=t)
     ref = np.array([reference(*a) for a in zip(phi, rho, alpha, n, t, strict=True)])
     assert np.abs(k - ref).max() < CAPSTAN_TARGET
@@ -104,3 +110,8 @@ def test_bad_input(kwargs, name):
     phi = args.pop("phi")
     with pytest.raises(ValueError, match=name):
         C.capstan_tension_ratio(phi, **args)
+
+
+def test_extreme_stiffness_is_refused_with_advice():
+    with pytest.raises(ValueError, match="rho"):
+        C.capstan_tension_ratio(3.0, rho=1e9, alpha=0.15, n=0.7)

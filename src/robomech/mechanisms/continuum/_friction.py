@@ -14,8 +14,9 @@ from ._kinematics import _disk_T, _split
 from ._params import ContinuumRobot
 
 __all__ = [
+    "CAPSTAN_ACCURACY",
     "CAPSTAN_FIRST_STEP",
-    "CAPSTAN_H_ACCURACY",
+    "CAPSTAN_H_MAX",
     "CAPSTAN_LAYER_STEPS",
     "CAPSTAN_MAX_STEPS",
     "CAPSTAN_STABILITY",
@@ -97,19 +98,21 @@ def friction_factors(robot: ContinuumRobot, psi: object, direction: object | Non
 #      growing to the phase-2 step (the transient e^(-lambda phi) decays faster than the steps grow, so
 #      its local error stays ~ (lambda h0)^5 / 120 ~ 1e-7 of a transient that is itself ~ rho/c^2 small);
 #   2. uniform steps with |lambda h| <= CAPSTAN_STABILITY (inside RK4's real stability interval
-#      [-2.78, 0]) and h <= CAPSTAN_H_ACCURACY (RK4 error of the slow mode, growth rate <= alpha).
+#      [-2.78, 0]) and h <= CAPSTAN_ACCURACY / (rho / c) (RK4's slow-mode error scales with
+#      (h * growth rate)^4 and the growth rate of T is at most rho / c), capped at CAPSTAN_H_MAX.
 # Points are grouped into buckets of equal phase-2 step count (factors of sqrt 2) so that a stiff point
-# does not set the step count of the whole grid.  The accuracy, 1e-8 against a tight reference
-# integration over the paper's parameter box, is proven by test_continuum_capstan.py.
+# does not set the step count of the whole grid.  Measured error ~1e-9; the accuracy, 1e-8 against a
+# tight reference integration over the paper's parameter box, is proven by test_continuum_capstan.py.
 CAPSTAN_LAYER_STEPS = 60
 CAPSTAN_FIRST_STEP = 0.1
-CAPSTAN_STABILITY = 1.5
-CAPSTAN_H_ACCURACY = 0.02
+CAPSTAN_STABILITY = 2.0
+CAPSTAN_ACCURACY = 0.005
+CAPSTAN_H_MAX = 0.1
 # Largest phase-2 step count accepted (~1 s per point group): beyond it the stiffness (rho large with
 # n < 1) calls for the rho = inf limit, which is solved in closed form.
 CAPSTAN_MAX_STEPS = 2**20
-# Slack on the a-priori bound of T along the wrap used for the stiffness estimate.
-_GROWTH_MARGIN = 1.5
+# Slack on the a-priori bound T <= t_out exp(phi rho / c) used for the stiffness estimate.
+_GROWTH_MARGIN = 1.1
 
 
 def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np.ndarray:
@@ -120,6 +123,12 @@ def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np
 def classical_capstan_ratio(phi: object, mu: object) -> np.ndarray:
     """Euler-Eytelwein capstan law T_in / T_out = exp(mu phi)."""
     return np.exp(as_array(mu, "mu") * as_array(phi, "phi"))
+
+
+def _accuracy_step(rho: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Largest step for the slow mode: RK4's error scales with (h * growth rate)^4, the growth rate of
+    T is at most rho / c (slow manifold), so h = CAPSTAN_ACCURACY / rate, capped at CAPSTAN_H_MAX."""
+    return np.minimum(CAPSTAN_ACCURACY * c / rho, CAPSTAN_H_MAX)
 
 
 def _rk4(phi, rho, c, p, lam, M2):
@@ -142,7 +151,7 @@ def _rk4(phi, rho, c, p, lam, M2):
 
     M1 = CAPSTAN_LAYER_STEPS
     h0 = CAPSTAN_FIRST_STEP / lam
-    h_cap = np.minimum(CAPSTAN_STABILITY / lam, CAPSTAN_H_ACCURACY)
+    h_cap = np.minimum(CAPSTAN_STABILITY / lam, _accuracy_step(rho, c))
     g = np.maximum((h_cap / h0) ** (1.0 / M1), 1.0)
     layer = np.where(g > 1.0, h0 * (g**M1 - 1.0) / np.where(g > 1.0, g - 1.0, 1.0), h0 * M1)
     h = h0 * np.minimum(1.0, phi / layer)  # a short wrap is covered by the layer alone
@@ -225,7 +234,7 @@ def capstan_tension_ratio(
         # A-priori bound of y: on the slow manifold y'/y = rho / (c y^p) <= rho / c.
         lam = c * (_GROWTH_MARGIN * np.exp(ph * r / c)) ** p
         h0 = CAPSTAN_FIRST_STEP / lam
-        h_cap = np.minimum(CAPSTAN_STABILITY / lam, CAPSTAN_H_ACCURACY)
+        h_cap = np.minimum(CAPSTAN_STABILITY / lam, _accuracy_step(r, c))
         g = np.maximum((h_cap / h0) ** (1.0 / CAPSTAN_LAYER_STEPS), 1.0)
         layer = np.where(g > 1.0, h0 * (g**CAPSTAN_LAYER_STEPS - 1.0) / np.where(g > 1.0, g - 1.0, 1.0),
                          h0 * CAPSTAN_LAYER_STEPS)
