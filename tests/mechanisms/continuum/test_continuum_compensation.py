@@ -124,3 +124,30 @@ def test_simulate_bad_input():
         C.simulate(PAPER, [0.0, 0.0])
     with pytest.raises(ValueError, match="direction"):
         C.simulate(PAPER, [0.0, 0.0, 0.0], [1.0, 0.0])
+
+
+def test_identification_end_to_end_on_simulated_robot():
+    """Paper 3, Section 5: beta = 0, 120, 240 deg, theta 40 -> 90 deg; tensions at both cable ends with
+    0.05 N noise, pose from a noisy tracked tip (0.022 mm) through IK; Table 1's mu recovered within 3 std."""
+    rng = np.random.default_rng(11)
+    sigma = 0.05
+    theta = np.radians(np.arange(40.0, 90.1, 5.0))
+    wraps, t_in, t_out, dirs = [], [], [], []
+    for k, beta in enumerate(np.radians([0.0, 120.0, 240.0])):
+        psi = np.stack([theta, np.full_like(theta, beta)], -1)
+        direction = np.where(np.arange(3) == k, 1.0, -1.0) * np.ones((theta.size, 1))
+        sim = C.simulate(PAPER, C.theoretical_drive(PAPER, psi, "arc"), direction, initial=psi)
+        assert sim.converged.all()
+        P = C.friction_factors(PAPER, sim.psi, direction)
+        tracked = C.tip_position(PAPER, sim.psi) + rng.normal(0, 0.022e-3, (theta.size, 3))
+        ik = C.inverse_kinematics(PAPER, tracked)  # least-squares pose of an off-surface tip
+        wraps.append(C.wrap_angles(PAPER, ik.psi).sum(-1))
+        t_in.append(sim.tension + rng.normal(0, sigma, sim.tension.shape))
+        t_out.append(sim.tension * P[..., -1] + rng.normal(0, sigma, sim.tension.shape))
+        dirs.append(direction)
+    cat = lambda xs: np.concatenate(xs, 0).T  # noqa: E731
+    taut = cat(t_out) > 10 * sigma
+    est = C.identify_friction(np.where(taut, cat(wraps), 0.0), np.where(taut, cat(t_in), 1.0),
+                              np.where(taut, cat(t_out), 1.0), np.where(taut, cat(dirs), 0.0), sigma_t=sigma)
+    assert np.all(np.abs(est.mu - PAPER.friction_array) < 3 * est.std)
+    assert np.all(est.std < 0.01)

@@ -214,7 +214,8 @@ def simulate(
             cols.append((_sim_residual(robot, k + e, qa, d, model)[0]
                          - _sim_residual(robot, k - e, qa, d, model)[0]) / (2 * SIM_FD_STEP))
         Jm = np.stack(cols, -1)
-        step = np.linalg.solve(Jm, F[..., None])[..., 0]
+        # pinv, not solve: a singular Newton matrix in one sample must not abort the batch
+        step = np.einsum("...ij,...j->...i", np.linalg.pinv(Jm), F)
         # Backtracking: halve the step where it does not reduce |F| (the slack clip and the Coulomb
         # kink at theta = 0 make F only piecewise smooth).
         f0 = np.linalg.norm(F, axis=-1)

@@ -142,7 +142,10 @@ def _fk(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray) -> np.ndarra
 
 
 def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """Poses ``T_0i (..., n, 4, 4)`` of every segment's end frame in the base frame (paper 3, eq. (3))."""
+    """Poses ``T_0i (..., n, 4, 4)`` of every segment's end frame in the base frame (paper 3, eq. (3)).
+
+    The array may be a non-contiguous view (the matrix entries are computed as contiguous planes).
+    """
     theta, beta = _split(robot, psi)
     return _fk(robot, theta, beta)
 
