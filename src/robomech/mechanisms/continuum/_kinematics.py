@@ -81,7 +81,8 @@ def _df_sin(t: np.ndarray) -> np.ndarray:
 
 def _split(robot: ContinuumRobot, psi: object, name: str = "psi") -> tuple[np.ndarray, np.ndarray]:
     p = as_array(psi, name, (2 * robot.n_segments,))
-    return p[..., 0::2], p[..., 1::2]
+    # contiguous copies: numpy's vectorised trigonometry is ~2x faster on contiguous input
+    return np.ascontiguousarray(p[..., 0::2]), np.ascontiguousarray(p[..., 1::2])
 
 
 # ---- one segment --------------------------------------------------------------------------------
