@@ -1,0 +1,80 @@
+"""Paper 3: the cable-driven continuum robot — kinematics, statics, cable friction, compensation,
+identification.
+
+Constant-curvature segments ``psi = [theta_1, beta_1, ...]``; cables indexed ``3 i + j``; SI units.
+See ``docs/mechanisms/continuum.md`` for every assumption and every departure from the print.
+"""
+
+from ._compensation import (
+    DriveResult,
+    SimulationResult,
+    cable_elongation,
+    compensated_drive,
+    simulate,
+    theoretical_drive,
+)
+from ._friction import (
+    FrictionEstimate,
+    capstan_coefficient,
+    capstan_tension_ratio,
+    classical_capstan_ratio,
+    friction_factors,
+    identify_friction,
+    wrap_angles,
+)
+from ._kinematics import (
+    IK_TOLERANCE,
+    IKResult,
+    cable_jacobian,
+    cable_lengths,
+    disk_transforms,
+    forward_kinematics,
+    inverse_kinematics,
+    segment_transform,
+    span_jacobian,
+    span_lengths,
+    tip_jacobian,
+    tip_position,
+)
+from ._params import ContinuumRobot
+from ._statics import (
+    TensionResult,
+    cable_tensions,
+    coupling_moments,
+    elastic_energy,
+    elastic_gradient,
+)
+
+__all__ = [
+    "IK_TOLERANCE",
+    "ContinuumRobot",
+    "DriveResult",
+    "FrictionEstimate",
+    "IKResult",
+    "SimulationResult",
+    "TensionResult",
+    "cable_elongation",
+    "cable_jacobian",
+    "cable_lengths",
+    "cable_tensions",
+    "capstan_coefficient",
+    "capstan_tension_ratio",
+    "classical_capstan_ratio",
+    "compensated_drive",
+    "coupling_moments",
+    "disk_transforms",
+    "elastic_energy",
+    "elastic_gradient",
+    "forward_kinematics",
+    "friction_factors",
+    "identify_friction",
+    "inverse_kinematics",
+    "segment_transform",
+    "simulate",
+    "span_jacobian",
+    "span_lengths",
+    "theoretical_drive",
+    "tip_jacobian",
+    "tip_position",
+    "wrap_angles",
+]

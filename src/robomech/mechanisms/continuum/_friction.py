@@ -1,0 +1,305 @@
+"""Cable friction: wrap angles from the geometry, capstan transfer along the disks, the improved
+capstan equation of a cable-pulley system (paper 3, eqs. (29)-(32)), and friction identification.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array
+
+from ._kinematics import _disk_T, _split
+from ._params import ContinuumRobot
+
+__all__ = [
+    "CAPSTAN_ACCURACY",
+    "CAPSTAN_FIRST_STEP",
+    "CAPSTAN_H_MAX",
+    "CAPSTAN_LAYER_STEPS",
+    "CAPSTAN_MAX_STEPS",
+    "CAPSTAN_STABILITY",
+    "FrictionEstimate",
+    "capstan_coefficient",
+    "capstan_tension_ratio",
+    "classical_capstan_ratio",
+    "friction_factors",
+    "identify_friction",
+    "wrap_angles",
+]
+
+
+# ---- wrap angles and the capstan transfer along the disks -----------------------------------------
+def _wrap(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray) -> np.ndarray:
+    T = _disk_T(robot, theta, beta)  # (..., 1 + nN, 4, 4)
+    r, sig = robot.hole_radius, robot.hole_angles
+    holes_local = np.stack([r * np.cos(sig), r * np.sin(sig), np.zeros_like(sig)], -1)  # (3n, 3)
+    holes = np.einsum("...kab,cb->...cka", T[..., :3, :3], holes_local) + T[..., None, :, :3, 3]
+    chords = np.diff(holes, axis=-2)  # (..., 3n, nN, 3)
+    # paper 3, eq. (21): printed h = h / |h| with the chord undefined; the unit chord between
+    # consecutive holes is meant.
+    b = chords / np.linalg.norm(chords, axis=-1, keepdims=True)
+    incoming = np.concatenate([np.broadcast_to([0.0, 0.0, 1.0], (*b.shape[:-2], 1, 3)), b[..., :-1, :]], -2)
+    # paper 3, eq. (22): eta = arccos(b_k . b_k+1); 2 atan2(|a - b|, |a + b|) is the same angle without
+    # arccos's loss of accuracy near 0.
+    eta = 2.0 * np.arctan2(np.linalg.norm(b - incoming, axis=-1), np.linalg.norm(b + incoming, axis=-1))
+    n_spans = robot.disks_per_segment * (robot.cable_segment + 1)
+    active = np.arange(robot.n_segments * robot.disks_per_segment)[None, :] < n_spans[:, None]
+    return np.where(active, eta, 0.0)
+
+
+def wrap_angles(robot: ContinuumRobot, psi: object) -> np.ndarray:
+    """Wrap angle of every cable at the hole where each span starts, ``(..., 3 n, n N)`` (rad).
+
+    Span 0 starts at the base plate, where the cable arrives along the base z axis; span k at disk k.
+    Zero beyond the cable's termination disk.  Under constant curvature every cable of a segment wraps
+    theta / (2 N) at the segment's base and theta / N at each interior disk.
+    """
+    theta, beta = _split(robot, psi)
+    return _wrap(robot, theta, beta)
+
+
+def _as_direction(robot: ContinuumRobot, direction: object | None, batch: tuple[int, ...]) -> np.ndarray:
+    if direction is None:
+        return np.zeros((*batch, robot.n_cables))
+    d = as_array(direction, "direction", (robot.n_cables,))
+    if np.any(np.abs(d) > 1.0):
+        raise ValueError(
+            "Expected direction in [-1, 1] (+1: cable pulled in, -1: paid out), got larger values."
+        )
+    return d
+
+
+def _factors(robot: ContinuumRobot, eta: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    mu = robot.friction_array
+    # paper 3, eqs. (17)-(19) and (23): friction opposes sliding, so a cable pulled in by the actuator
+    # (direction +1) loses tension distally: T_k+1 = T_k exp(-mu eta).  The printed
+    # exp(+sgn(q_dot) mu eta) makes the pulled cable gain tension along the disks.
+    return np.exp(-np.cumsum(direction[..., :, None] * mu[:, None] * eta, axis=-1))
+
+
+def friction_factors(robot: ContinuumRobot, psi: object, direction: object | None = None) -> np.ndarray:
+    """Tension of every span relative to the cable's tension at the base plate, ``(..., 3 n, n N)``.
+
+    ``direction (..., 3 n)``: +1 where the cable slides toward the actuator (pulled in), -1 where it is
+    paid out, 0 where it sticks (no friction is transmitted; the tension is then undetermined within
+    the friction band and the frictionless value is returned).
+    """
+    theta, beta = _split(robot, psi)
+    d = _as_direction(robot, direction, theta.shape[:-1])
+    return _factors(robot, _wrap(robot, theta, beta), d)
+
+
+# ---- the improved capstan equation ----------------------------------------------------------------
+# Fixed-step classical Runge-Kutta 4, vectorised over the whole grid, every point with its own steps:
+#   1. a geometrically graded boundary layer next to the output side: CAPSTAN_LAYER_STEPS steps, the
+#      first with |lambda h| = CAPSTAN_FIRST_STEP (lambda = c T^p, the stiff eigenvalue of eq. (31)),
+#      growing to the phase-2 step (the transient e^(-lambda phi) decays faster than the steps grow, so
+#      its local error stays ~ (lambda h0)^5 / 120 ~ 1e-7 of a transient that is itself ~ rho/c^2 small);
+#   2. uniform steps with |lambda h| <= CAPSTAN_STABILITY (inside RK4's real stability interval
+#      [-2.78, 0]) and h <= CAPSTAN_ACCURACY / (rho / c) (RK4's slow-mode error scales with
+#      (h * growth rate)^4 and the growth rate of T is at most rho / c), capped at CAPSTAN_H_MAX.
+# Points are grouped into buckets of equal phase-2 step count (factors of sqrt 2) so that a stiff point
+# does not set the step count of the whole grid.  Measured error ~1e-9; the accuracy, 1e-8 against a
+# tight reference integration over the paper's parameter box, is proven by test_continuum_capstan.py.
+CAPSTAN_LAYER_STEPS = 60
+CAPSTAN_FIRST_STEP = 0.1
+CAPSTAN_STABILITY = 2.0
+CAPSTAN_ACCURACY = 0.005
+CAPSTAN_H_MAX = 0.1
+# Largest phase-2 step count accepted (~1 s per point group): beyond it the stiffness (rho large with
+# n < 1) calls for the rho = inf limit, which is solved in closed form.
+CAPSTAN_MAX_STEPS = 2**20
+# Slack on the a-priori bound T <= t_out exp(phi rho / c) used for the stiffness estimate.
+_GROWTH_MARGIN = 1.1
+
+
+def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """c = (rho / n) ((1 + rho) / (alpha rho))^(1/n) of paper 3, eq. (29)."""
+    return (rho / n) * ((1.0 + rho) / (alpha * rho)) ** (1.0 / n)
+
+
+def classical_capstan_ratio(phi: object, mu: object) -> np.ndarray:
+    """Euler-Eytelwein capstan law T_in / T_out = exp(mu phi)."""
+    return np.exp(as_array(mu, "mu") * as_array(phi, "phi"))
+
+
+def _accuracy_step(rho: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Largest step for the slow mode: RK4's error scales with (h * growth rate)^4, the growth rate of
+    T is at most rho / c (slow manifold), so h = CAPSTAN_ACCURACY / rate, capped at CAPSTAN_H_MAX."""
+    return np.minimum(CAPSTAN_ACCURACY * c / rho, CAPSTAN_H_MAX)
+
+
+def _rk4(phi, rho, c, p, lam, M2):
+    """Integrate y'' + c y^p y' - rho y = 0, y(0) = 1, y'(0) = 0 over [0, phi] (1-D arrays)."""
+    y = np.ones_like(phi)
+    z = np.zeros_like(phi)
+    w = np.ones_like(phi)  # w = y^p carried as a state (cheaper than a power per stage)
+
+    def f(y, z, w):
+        return z, rho * y - c * w * z, p * w * z / y
+
+    def step(y, z, w, h):
+        h2, h6 = 0.5 * h, h / 6.0
+        a1, b1, c1 = f(y, z, w)
+        a2, b2, c2 = f(y + h2 * a1, z + h2 * b1, w + h2 * c1)
+        a3, b3, c3 = f(y + h2 * a2, z + h2 * b2, w + h2 * c2)
+        a4, b4, c4 = f(y + h * a3, z + h * b3, w + h * c3)
+        return (y + h6 * (a1 + 2.0 * (a2 + a3) + a4), z + h6 * (b1 + 2.0 * (b2 + b3) + b4),
+                w + h6 * (c1 + 2.0 * (c2 + c3) + c4))
+
+    M1 = CAPSTAN_LAYER_STEPS
+    h0 = CAPSTAN_FIRST_STEP / lam
+    h_cap = np.minimum(CAPSTAN_STABILITY / lam, _accuracy_step(rho, c))
+    g = np.maximum((h_cap / h0) ** (1.0 / M1), 1.0)
+    layer = np.where(g > 1.0, h0 * (g**M1 - 1.0) / np.where(g > 1.0, g - 1.0, 1.0), h0 * M1)
+    h = h0 * np.minimum(1.0, phi / layer)  # a short wrap is covered by the layer alone
+    for _ in range(M1):  # time steps; every step acts on the whole bucket
+        y, z, w = step(y, z, w, h)
+        h = h * g
+    h = np.maximum(phi - np.minimum(layer, phi), 0.0) / M2
+    for _ in range(M2):
+        y, z, w = step(y, z, w, h)
+    return y, z
+
+
+def capstan_tension_ratio(
+    phi: object, *, rho: object, alpha: object, n: object, t_out: object = 1.0
+) -> np.ndarray:
+    """Input/output tension ratio kappa of a cable over a pulley, paper 3, eqs. (29)-(32).
+
+    Solves T'' + c T^((1-n)/n) T' - rho T = 0, c = (rho/n)((1 + rho)/(alpha rho))^(1/n), from the output
+    side: T(0) = t_out, T'(0) = 0 (eq. (31) with theta_1 = 0), and returns
+    kappa = sqrt(rho^2 T(phi)^2 + T'(phi)^2) / (rho T(0)).
+
+    All arguments broadcast: ``phi`` wrap angle (rad, >= 0), ``rho`` = pulley radius / cable radius
+    (> 0; ``np.inf`` is the limit of vanishing cable bending stiffness), ``alpha`` > 0 and ``n`` in
+    (0, 1] of the friction law f = alpha N^n (eq. (25)), ``t_out`` output tension (N, > 0; the ratio
+    depends on it when n != 1).  n = 1 and rho = inf are solved in closed form; otherwise the ODE is
+    integrated (see the CAPSTAN_* constants).
+    """
+    phi_a = as_array(phi, "phi")
+    rho_a = as_array(rho, "rho", finite=False)
+    alpha_a = as_array(alpha, "alpha")
+    n_a = as_array(n, "n")
+    t_a = as_array(t_out, "t_out")
+    if np.any(phi_a < 0.0):
+        raise ValueError("Expected phi >= 0, got a negative wrap angle.")
+    if np.any(np.isnan(rho_a)) or np.any(rho_a <= 0.0):
+        raise ValueError("Expected rho > 0 (np.inf allowed), got a non-positive or NaN value.")
+    if np.any(alpha_a <= 0.0):
+        raise ValueError("Expected alpha > 0, got a non-positive value.")
+    if np.any(n_a <= 0.0) or np.any(n_a > 1.0):
+        raise ValueError("Expected n in (0, 1], got a value outside.")
+    if np.any(t_a <= 0.0):
+        raise ValueError("Expected t_out > 0, got a non-positive value.")
+    phi_b, rho_b, alpha_b, n_b, t_b = (
+        np.ravel(a) for a in np.broadcast_arrays(phi_a, rho_a, alpha_a, n_a, t_a)
+    )
+    shape = np.broadcast_shapes(phi_a.shape, rho_a.shape, alpha_a.shape, n_a.shape, t_a.shape)
+    out = np.ones(phi_b.shape)
+    inf = np.isinf(rho_b)
+    one = n_b == 1.0
+
+    # rho -> inf: eq. (29) / rho -> (1/n) alpha^(-1/n) T^p T' = T, p = (1 - n)/n, whose solution is
+    # T^p = t_out^p + (1 - n) alpha^(1/n) phi (exp(alpha phi) for n = 1: the classical law).
+    m = inf & one
+    out[m] = np.exp(alpha_b[m] * phi_b[m])
+    m = inf & ~one
+    p = (1.0 - n_b[m]) / n_b[m]
+    out[m] = (1.0 + (1.0 - n_b[m]) * alpha_b[m] ** (1.0 / n_b[m]) * phi_b[m] / t_b[m] ** p) ** (1.0 / p)
+
+    # n = 1, finite rho: linear ODE y'' + a y' - rho y = 0, a = (1 + rho)/alpha, y(0) = 1, y'(0) = 0.
+    m = ~inf & one
+    if np.any(m):
+        r, ph = rho_b[m], phi_b[m]
+        a = (1.0 + r) / alpha_b[m]
+        disc = np.sqrt(a * a + 4.0 * r)
+        lp = 2.0 * r / (a + disc)  # (-a + disc)/2 without cancellation
+        lm = -0.5 * (a + disc)
+        cp, cm = -lm / disc, lp / disc
+        ep, em = np.exp(lp * ph), np.exp(lm * ph)
+        y = cp * ep + cm * em
+        z = cp * lp * ep + cm * lm * em
+        out[m] = np.sqrt(y * y + (z / r) ** 2)
+
+    # n < 1, finite rho: integrate (normalised y = T / t_out, so c_eff = c t_out^p).
+    m = ~inf & ~one & (phi_b > 0.0)
+    if np.any(m):
+        idx = np.flatnonzero(m)
+        r, ph, nn = rho_b[m], phi_b[m], n_b[m]
+        p = (1.0 - nn) / nn
+        c = capstan_coefficient(r, alpha_b[m], nn) * t_b[m] ** p
+        # A-priori bound of y: on the slow manifold y'/y = rho / (c y^p) <= rho / c.
+        lam = c * (_GROWTH_MARGIN * np.exp(ph * r / c)) ** p
+        h0 = CAPSTAN_FIRST_STEP / lam
+        h_cap = np.minimum(CAPSTAN_STABILITY / lam, _accuracy_step(r, c))
+        g = np.maximum((h_cap / h0) ** (1.0 / CAPSTAN_LAYER_STEPS), 1.0)
+        layer = np.where(g > 1.0, h0 * (g**CAPSTAN_LAYER_STEPS - 1.0) / np.where(g > 1.0, g - 1.0, 1.0),
+                         h0 * CAPSTAN_LAYER_STEPS)
+        need = np.maximum(ph - layer, 0.0) / h_cap
+        if np.any(need > CAPSTAN_MAX_STEPS):
+            raise ValueError(
+                f"Expected rho small enough for an explicit integration (at most {CAPSTAN_MAX_STEPS} steps), "
+                f"got rho up to {r[need > CAPSTAN_MAX_STEPS].max():g} with n < 1; pass rho=np.inf for the "
+                "limit of vanishing bending stiffness."
+            )
+        bucket = np.ceil(2.0 * np.log2(np.maximum(need, 1.0))).astype(int)
+        for b in np.unique(bucket):  # a handful of step-count buckets, not samples
+            sel = bucket == b
+            y, z = _rk4(ph[sel], r[sel], c[sel], p[sel], lam[sel], int(np.ceil(2.0 ** (b / 2.0))))
+            out[idx[sel]] = np.sqrt(y * y + (z / r[sel]) ** 2)
+    return out.reshape(shape)
+
+
+# ---- identification -------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class FrictionEstimate:
+    """Least-squares friction coefficients with their standard uncertainty (batch shape ``...``).
+
+    ``mu`` estimate, ``std`` its standard deviation (from the stated tension noise if given, else from
+    the residual scatter), ``chi2_per_dof`` the weighted residual per degree of freedom (about 1 when the
+    noise model holds), ``n_used`` measurements used (those with nonzero direction).
+    """
+
+    mu: np.ndarray
+    std: np.ndarray
+    chi2_per_dof: np.ndarray
+    n_used: np.ndarray
+
+
+def identify_friction(
+    wrap: object, t_in: object, t_out: object, direction: object, *, sigma_t: float | None = None
+) -> FrictionEstimate:
+    """Friction coefficient per cable from measured input and output tensions, by weighted least squares.
+
+    The capstan law along the disks gives ln(t_in / t_out) = s mu eta (eq. (18) with the physical sign:
+    s = +1 for a cable pulled in, whose input tension exceeds its output tension), linear in mu.  Arrays
+    ``(..., m)``: ``wrap`` total wrap angle eta (rad) of each measurement, ``t_in`` actuator-side and
+    ``t_out`` distal tension (N, > 0), ``direction`` s in {-1, 0, +1} (0 rows are ignored: no sliding).
+    ``sigma_t`` (N): standard deviation of each tension reading; the log-ratio's variance is then
+    sigma_t^2 (1/t_in^2 + 1/t_out^2) (first order) and weights the fit.  Solves over the last axis.
+    """
+    eta = as_array(wrap, "wrap", (None,))
+    ti = as_array(t_in, "t_in", (None,))
+    to = as_array(t_out, "t_out", (None,))
+    s = as_array(direction, "direction", (None,))
+    if np.any(ti <= 0.0) or np.any(to <= 0.0):
+        raise ValueError("Expected t_in and t_out > 0 (a slack cable carries no friction information).")
+    if sigma_t is not None and not (np.isfinite(sigma_t) and sigma_t > 0.0):
+        raise ValueError(f"Expected sigma_t > 0 and finite, got {sigma_t!r}.")
+    eta, ti, to, s = np.broadcast_arrays(eta, ti, to, s)
+    y = np.log(ti / to)
+    x = s * eta
+    var = (sigma_t**2) * (1.0 / ti**2 + 1.0 / to**2) if sigma_t is not None else np.ones_like(y)
+    w = np.where(s != 0.0, 1.0 / var, 0.0)
+    sxx = np.sum(w * x * x, axis=-1)
+    if np.any(sxx <= 0.0):
+        raise ValueError("Expected at least one measurement with nonzero wrap and direction per cable.")
+    mu = np.sum(w * x * y, axis=-1) / sxx
+    n_used = np.count_nonzero(w, axis=-1)
+    dof = np.maximum(n_used - 1, 1)
+    chi2 = np.sum(w * (y - mu[..., None] * x) ** 2, axis=-1) / dof
+    std = np.sqrt(1.0 / sxx) if sigma_t is not None else np.sqrt(chi2 / sxx)
+    return FrictionEstimate(mu=mu, std=std, chi2_per_dof=chi2, n_used=n_used)

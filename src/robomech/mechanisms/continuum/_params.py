@@ -1,0 +1,114 @@
+"""Frozen parameters of an n-segment cable-driven continuum robot (paper 3), SI units."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import check_positive
+
+__all__ = ["ContinuumRobot"]
+
+CABLES_PER_SEGMENT = 3  # paper 3, Fig. 3: three cables 120 degrees apart drive every segment
+
+
+@dataclass(frozen=True)
+class ContinuumRobot:
+    """Parameters of a cable-driven constant-curvature continuum robot.
+
+    Every segment is a NiTi core rod of length ``segment_length`` carrying ``disks_per_segment`` disks
+    evenly spaced along it (the last one at the segment's end, the segment's base disk being the
+    previous segment's end disk or the robot's base plate), and three cables in holes at radius
+    ``hole_radius``, 120 degrees apart.  The cables of segment ``i`` (0-based) terminate at its end disk
+    and run through the holes of all proximal segments; their hole angles are
+    ``(0, 2 pi/3, 4 pi/3) + i * cable_offset``.
+
+    Attributes (SI):
+        n_segments: number of segments n.
+        segment_length: arc length of every segment (m); paper: 90 mm.
+        disks_per_segment: disks N per segment (chord spans per segment); paper: 5 disks.
+        hole_radius: distance r of the cable holes from the core axis (m); not printed, default 4 mm.
+        core_modulus, core_diameter: Young's modulus (Pa) and diameter (m) of the NiTi core; not printed.
+        cable_modulus, cable_diameter: Dyneema cable, paper: E = 4.96 GPa, 0.8 mm.
+        friction: Coulomb friction coefficient per cable (3 n), paper Table 1 (0.26, 0.31, 0.28).
+        pretension: cable pretension T0 (N); not printed, default 5 N (inside Fig. 6's 3-11 N range).
+        free_length: cable length between the actuator and the base plate (m); not printed, default 0.1 m.
+        cable_offset: angular offset of the holes of successive segments (rad).
+    """
+
+    n_segments: int = 1
+    segment_length: float = 0.090
+    disks_per_segment: int = 5
+    hole_radius: float = 0.004
+    core_modulus: float = 60e9
+    core_diameter: float = 0.8e-3
+    cable_modulus: float = 4.96e9
+    cable_diameter: float = 0.8e-3
+    friction: tuple[float, ...] = (0.26, 0.31, 0.28)
+    pretension: float = 5.0
+    free_length: float = 0.1
+    cable_offset: float = math.pi / 3.0
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.n_segments, int | np.integer) or self.n_segments < 1:
+            raise ValueError(f"Expected n_segments to be an integer >= 1, got {self.n_segments!r}.")
+        if not isinstance(self.disks_per_segment, int | np.integer) or self.disks_per_segment < 1:
+            raise ValueError(
+                f"Expected disks_per_segment to be an integer >= 1, got {self.disks_per_segment!r}."
+            )
+        for name in ("segment_length", "hole_radius", "core_modulus", "core_diameter", "cable_modulus",
+                     "cable_diameter"):
+            check_positive(getattr(self, name), name)
+        check_positive(self.pretension, "pretension", allow_zero=True)
+        check_positive(self.free_length, "free_length", allow_zero=True)
+        if not math.isfinite(float(self.cable_offset)):
+            raise ValueError(f"Expected cable_offset to be finite, got {self.cable_offset!r}.")
+        if self.hole_radius * self.n_segments >= self.segment_length:
+            raise ValueError(
+                f"Expected hole_radius well below segment_length, got {self.hole_radius!r} m vs "
+                f"{self.segment_length!r} m."
+            )
+        mu = tuple(float(m) for m in self.friction)
+        n_cables = CABLES_PER_SEGMENT * self.n_segments
+        if len(mu) != n_cables:
+            raise ValueError(f"Expected friction to have {n_cables} entries (3 per segment), got {len(mu)}.")
+        if not all(math.isfinite(m) and m >= 0.0 for m in mu):
+            raise ValueError(f"Expected friction coefficients >= 0 and finite, got {mu!r}.")
+        object.__setattr__(self, "friction", mu)
+
+    @classmethod
+    def paper(cls) -> ContinuumRobot:
+        """The prototype of paper 3, Section 5: one 90 mm segment, 5 disks, 0.8 mm Dyneema, Table 1 mu."""
+        return cls()
+
+    # ---- derived quantities -------------------------------------------------------------------
+    @property
+    def n_cables(self) -> int:
+        return CABLES_PER_SEGMENT * self.n_segments
+
+    @property
+    def bending_stiffness(self) -> float:
+        """Core bending stiffness E I (N m^2) of a solid round rod, I = pi d^4 / 64."""
+        return self.core_modulus * math.pi * self.core_diameter**4 / 64.0
+
+    @property
+    def cable_axial_stiffness(self) -> float:
+        """E A of one cable (N)."""
+        return self.cable_modulus * math.pi * self.cable_diameter**2 / 4.0
+
+    @property
+    def hole_angles(self) -> np.ndarray:
+        """Hole angle sigma of every cable (3 n,), cable index 3 i + j for segment i, cable j."""
+        base = np.array([0.0, 2.0 * math.pi / 3.0, 4.0 * math.pi / 3.0])  # paper 3, eqs. (4) and (20)
+        return np.concatenate([base + i * self.cable_offset for i in range(self.n_segments)])
+
+    @property
+    def cable_segment(self) -> np.ndarray:
+        """Index of the segment where every cable terminates (3 n,)."""
+        return np.repeat(np.arange(self.n_segments), CABLES_PER_SEGMENT)
+
+    @property
+    def friction_array(self) -> np.ndarray:
+        return np.asarray(self.friction, dtype=float)

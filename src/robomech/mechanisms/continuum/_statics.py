@@ -1,0 +1,123 @@
+"""Statics by virtual work: core elastic energy, cable tensions with pretension, coupling moments."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array
+
+from ._friction import _as_direction, _factors, _wrap
+from ._kinematics import CableModel, _span_jac, _split, _tip_jacobian
+from ._params import ContinuumRobot
+
+__all__ = [
+    "TENSION_FLOOR",
+    "TensionResult",
+    "cable_tensions",
+    "coupling_moments",
+    "elastic_energy",
+    "elastic_gradient",
+]
+
+# A cable counts as taut when its tension is at least 0 N: a cable cannot push; any positive
+# tension keeps it straight between the holes in this (massless, inextensible-path) model.
+TENSION_FLOOR = 0.0
+
+
+def elastic_energy(robot: ContinuumRobot, psi: object) -> np.ndarray:
+    """Bending energy of the cores, U = sum EI theta_i^2 / (2 l) (paper 3, eq. (8)), ``(...)`` in J."""
+    theta, _ = _split(robot, psi)
+    return 0.5 * robot.bending_stiffness / robot.segment_length * np.sum(theta**2, axis=-1)
+
+
+def _grad_u(robot: ContinuumRobot, theta: np.ndarray) -> np.ndarray:
+    g = np.zeros((*theta.shape[:-1], 2 * robot.n_segments))
+    g[..., 0::2] = robot.bending_stiffness / robot.segment_length * theta
+    return g
+
+
+def elastic_gradient(robot: ContinuumRobot, psi: object) -> np.ndarray:
+    """dU/dpsi ``(..., 2 n)``: (EI theta_i / l, 0) per segment."""
+    theta, _ = _split(robot, psi)
+    return _grad_u(robot, theta)
+
+
+def coupling_moments(robot: ContinuumRobot, psi: object) -> np.ndarray:
+    """Paper 3, eq. (12): moment of segment i+1 on segment i, ``(..., n, 2)`` = (-EI theta_i+1 / l, 0).
+
+    The last segment has none.  The full virtual-work model of :func:`cable_tensions` contains this
+    coupling exactly (distal cables run through proximal segments); this function is the paper's
+    one-neighbour form, for comparison.
+    """
+    theta, _ = _split(robot, psi)
+    M = np.zeros((*theta.shape, 2))
+    M[..., :-1, 0] = -robot.bending_stiffness / robot.segment_length * theta[..., 1:]
+    return M
+
+
+@dataclass(frozen=True)
+class TensionResult:
+    """Cable tensions in equilibrium (batch shape ``...``).
+
+    ``tension (..., 3 n)``: tension of every cable where it enters the base plate (N, positive = pull);
+    ``minimum_norm``: the part that balances the core and the load; ``taut``: all cables at or above
+    ``TENSION_FLOOR``; ``min_tension``: the smallest tension; ``residual``: norm of the virtual-work
+    balance (N m), ~1e-15 when the balance holds.
+    """
+
+    tension: np.ndarray
+    minimum_norm: np.ndarray
+    taut: np.ndarray
+    min_tension: np.ndarray
+    residual: np.ndarray
+
+
+def _effective_jacobian(robot, theta, beta, direction, model):
+    """G = sum_k P_k d span_k / d psi ``(..., 3 n, 2 n)``: virtual work of unit base tensions."""
+    J = _span_jac(robot, theta, beta, model)  # (..., 3n, nN, 2n)
+    P = _factors(robot, _wrap(robot, theta, beta), direction)
+    return np.einsum("...ck,...ckj->...cj", P, J)
+
+
+def cable_tensions(
+    robot: ContinuumRobot,
+    psi: object,
+    *,
+    wrench: object | None = None,
+    direction: object | None = None,
+    pretension: float | None = None,
+    model: CableModel = "chord",
+) -> TensionResult:
+    """Cable tensions holding the robot at ``psi (..., 2 n)`` (paper 3, eqs. (7)-(10), (23)-(24)).
+
+    Virtual work with tension positive: the actuators pull the cables in by -dL, so
+    ``-G^T tau + J_x^T W = grad U`` with ``G = dL/dpsi`` weighted by the friction factors of each span
+    (``direction``, see :func:`friction_factors`), and ``W = [m; f] (..., 6)`` an external wrench at the
+    tip, in the base frame.  Solution: ``tau = -(G^T)^+ (grad U - J_x^T W) + (I - (G^T)^+ G^T) eta`` with
+    ``eta = pretension * 1`` (default ``robot.pretension``).
+    """
+    theta, beta = _split(robot, psi)
+    batch = theta.shape[:-1]
+    d = _as_direction(robot, direction, batch)
+    T0 = robot.pretension if pretension is None else float(pretension)
+    if not np.isfinite(T0) or T0 < 0.0:
+        raise ValueError(f"Expected pretension >= 0 and finite, got {pretension!r}.")
+    G = _effective_jacobian(robot, theta, beta, d, model)
+    rhs = _grad_u(robot, theta)
+    if wrench is not None:
+        W = as_array(wrench, "wrench", (6,))
+        Jx = _tip_jacobian(robot, theta, beta)
+        rhs = rhs - np.einsum("...ij,...i->...j", Jx, W)
+    Gt = np.swapaxes(G, -1, -2)  # (..., 2n, 3n)
+    Gt_pinv = np.linalg.pinv(Gt)  # (..., 3n, 2n)
+    t_min = -np.einsum("...ij,...j->...i", Gt_pinv, rhs)
+    # paper 3, eq. (10): printed projector I - (J_qpsi^T)^+ J_x^T; the null-space projector of J_qpsi^T is
+    # I - (J_qpsi^T)^+ J_qpsi^T.  Printed eta = (1, 1, 1) N; here eta = pretension * (1, ..., 1).
+    proj = np.eye(robot.n_cables) - Gt_pinv @ Gt
+    tau = t_min + T0 * proj.sum(axis=-1)
+    residual = np.linalg.norm(-np.einsum("...ij,...j->...i", Gt, tau) - rhs, axis=-1)
+    tmin = tau.min(axis=-1)
+    return TensionResult(tension=tau, minimum_norm=t_min, taut=tmin >= TENSION_FLOOR, min_tension=tmin,
+                         residual=residual)

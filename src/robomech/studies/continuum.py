@@ -1,0 +1,296 @@
+"""Paper 3 study: the cable-driven continuum robot (Qi et al., 2023).
+
+* Fig. 9: the improved capstan tension ratio (eqs. (29)-(32)) against the classical law.
+* Fig. 6 trends: tension loss of a cable-pulley system vs pretension and wrap angle (model, not data).
+* Section 5 on a SIMULATED robot: friction identified from noisy simulated tensions, then planar bending
+  0 -> 90 deg at beta = 0 and a spatial circle, tip error before and after the compensation q~ = q + delta.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from robomech.mechanisms import continuum as C
+
+from ._core import Progress, Study, StudyResult, Table, comparison_table
+from ._plot import plt, save_figure
+
+# Simulated sensors (paper 3, Section 5): JLBS-MD 10 kg load cells, 0.05 % of full scale ~ 0.05 N;
+# CTrac-380 laser tracker, 0.022 mm accuracy.
+TENSION_NOISE = 0.05
+TRACKER_NOISE = 0.022e-3
+SEED = 3
+# Fig. 6 assumptions (the paper gives no pulley or friction data for its test rig): 0.4 mm Dyneema on
+# a 10 mm guide pulley (rho = 10 / 0.2 = 50), nonlinear friction alpha = 0.2, n = 0.8.
+FIG6_RHO, FIG6_ALPHA, FIG6_N = 50.0, 0.2, 0.8
+# Spatial circle: the paper gives no radius; bend 60 deg, full turn of beta.
+CIRCLE_THETA_DEG = 60.0
+
+
+def _fig9(out_dir: Path, res: StudyResult) -> None:
+    phi = np.linspace(0.0, np.pi, 121)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
+    rows = []
+    for ax, alpha in zip(axes, (0.15, 0.6), strict=True):
+        classical = C.classical_capstan_ratio(phi, alpha)
+        ax.plot(np.degrees(phi), classical, "k-", lw=2, label="classical exp(α φ)")
+        for rho, ls in ((1.0, "--"), (10.0, "-")):
+            for n, color in ((0.67, "tab:red"), (1.0, "tab:blue")):
+                k = C.capstan_tension_ratio(phi, rho=rho, alpha=alpha, n=n, t_out=1.0)
+                ax.plot(np.degrees(phi), k, ls=ls, color=color, label=f"improved ρ={rho:g}, n={n:g}")
+                rows.append([alpha, rho, n, float(k[-1]), float(np.exp(alpha * np.pi))])
+        ax.set_xlabel("wrap angle φ (deg)")
+        ax.set_title(f"Fig. 9: tension ratio, friction α = {alpha}")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    axes[0].set_ylabel("T_in / T_out (output tension 1 N)")
+    res.figures.append(save_figure(fig, out_dir, "fig9_capstan",
+                                   "Fig. 9: improved capstan ratio (eqs. 29-32) vs the classical law"))
+    res.tables.append(Table("Fig. 9 at φ = 180° (output tension 1 N)",
+                            ["α", "ρ", "n", "improved κ", "classical exp(απ)"], rows,
+                            note="The paper prints only curves; the improved model loses less tension than "
+                                 "the classical law everywhere, as the paper states."))
+
+
+def _fig6(out_dir: Path, res: StudyResult) -> None:
+    pre = np.array([3.0, 5.0, 7.0, 9.0, 11.0])
+    wrap_deg = np.array([30.0, 60.0, 90.0, 120.0, 150.0])
+    P, Wd = np.meshgrid(pre, wrap_deg, indexing="ij")
+    k = C.capstan_tension_ratio(np.radians(Wd), rho=FIG6_RHO, alpha=FIG6_ALPHA, n=FIG6_N, t_out=P)
+    loss = P * (k - 1.0)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    for j, w in enumerate(wrap_deg):
+        axes[0].plot(pre, loss[:, j], "o-", label=f"wrap {w:g}°")
+    axes[0].set_xlabel("pretension (output tension) T_out (N)")
+    axes[0].set_ylabel("tension loss T_in − T_out (N)")
+    axes[0].set_title("Fig. 6c trend: loss vs pretension")
+    for i, t in enumerate(pre):
+        axes[1].plot(wrap_deg, loss[i, :], "s-", label=f"T_out {t:g} N")
+    axes[1].set_xlabel("wrap angle (deg)")
+    axes[1].set_ylabel("tension loss T_in − T_out (N)")
+    axes[1].set_title("Fig. 6d trend: loss vs wrap angle")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    res.figures.append(save_figure(
+        fig, out_dir, "fig6_trends",
+        f"Fig. 6 trends from the improved capstan model (assumed ρ = {FIG6_RHO:g}, α = {FIG6_ALPHA}, "
+        f"n = {FIG6_N}); the paper's measured curves are not reproduced (no data given)"))
+    res.data["fig6_loss_N"] = loss
+
+
+def _identify(truth: C.ContinuumRobot, rng, res: StudyResult) -> C.FrictionEstimate:
+    """Paper 3, Section 5 / Table 1: beta = 0, 120, 240 deg, theta 40 -> 90 deg in 5 deg steps."""
+    theta = np.radians(np.arange(40.0, 90.1, 5.0))
+    wraps, t_in, t_out, dirs = [], [], [], []
+    for k, beta in enumerate(np.radians([0.0, 120.0, 240.0])):
+        psi = np.stack([theta, np.full_like(theta, beta)], -1)
+        direction = np.where(np.arange(3) == k, 1.0, -1.0) * np.ones((theta.size, 1))
+        sim = C.simulate(truth, C.theoretical_drive(truth, psi, "arc"), direction, initial=psi)
+        P = C.friction_factors(truth, sim.psi, direction)
+        # measured: tensions at both cable ends (noisy load cells) and the pose from the tracked tip
+        p_meas = C.tip_position(truth, sim.psi) + rng.normal(0.0, TRACKER_NOISE, (theta.size, 3))
+        ik = C.inverse_kinematics(truth, p_meas)
+        wraps.append(C.wrap_angles(truth, ik.psi).sum(-1))
+        t_in.append(sim.tension + rng.normal(0.0, TENSION_NOISE, sim.tension.shape))
+        t_out.append(sim.tension * P[..., -1] + rng.normal(0.0, TENSION_NOISE, sim.tension.shape))
+        dirs.append(direction)
+    cat = lambda xs: np.concatenate(xs, 0).T  # noqa: E731  (cables, measurements)
+    taut = cat(t_out) > 10 * TENSION_NOISE  # a nearly slack cable carries no friction information
+    est = C.identify_friction(np.where(taut, cat(wraps), 0.0), np.where(taut, cat(t_in), 1.0),
+                              np.where(taut, cat(t_out), 1.0), np.where(taut, cat(dirs), 0.0),
+                              sigma_t=TENSION_NOISE)
+    rows = [[f"cable {j + 1} (β = {120 * j}°)", truth.friction[j], float(est.mu[j]), float(est.std[j]),
+             float((est.mu[j] - truth.friction[j]) / est.std[j]), int(est.n_used[j])] for j in range(3)]
+    res.tables.append(Table(
+        "Friction identification from simulated, noisy tensions (Table 1 μ as ground truth)",
+        ["cable", "true μ (paper Table 1)", "identified μ", "std", "error / std", "measurements"], rows,
+        note=f"Load-cell noise {TENSION_NOISE} N on both ends, tracker noise {TRACKER_NOISE * 1e3} mm; "
+             "linear least squares on ln(T_in/T_out) = s μ η. Table 1's λ column is undefined in the "
+             "paper and not reproduced."))
+    res.data["identified_mu"] = est.mu
+    res.data["identified_mu_std"] = est.std
+    return est
+
+
+def _run_trajectory(truth, model, psi, direction):
+    p_d = C.tip_position(truth, psi)
+    q = C.theoretical_drive(truth, psi, "arc")  # the rigid, frictionless drive of eq. (4)
+    sim0 = C.simulate(truth, q, direction, initial=psi)
+    drive = C.compensated_drive(model, psi, direction, model="arc")  # paper's method, identified mu
+    sim1 = C.simulate(truth, drive.q_compensated, direction, initial=psi)
+    ideal = C.compensated_drive(truth, psi, direction, model="chord")  # same model as the simulation
+    sim2 = C.simulate(truth, ideal.q_compensated, direction, initial=psi)
+    errs = [np.linalg.norm(C.tip_position(truth, s.psi) - p_d, axis=-1) for s in (sim0, sim1, sim2)]
+    ok = all(bool(s.converged.all()) for s in (sim0, sim1, sim2))
+    tips = [C.tip_position(truth, s.psi) for s in (sim0, sim1)]
+    return p_d, tips, errs, ok, (sim0, sim1)
+
+
+def run(out_dir: Path, progress: Progress) -> StudyResult:
+    res = StudyResult(
+        name="continuum",
+        title="Paper 3: cable-driven continuum robot — capstan friction, statics and drive compensation",
+        source="Qi, Zhang, Pei, Chen, Wu: Drive error compensation of continuum manipulator based on force "
+               "transfer model, Trans. CSAM 54(1), 2023 (doi:10.6041/j.issn.1000-1298.2023.01.041)",
+        summary=(
+            "Exact: the constant-curvature kinematics (eqs. (1)-(6), with eq. (1)'s misprinted element "
+            'corrected), cable lengths (arc model of eq. (4) and straight chords between disks), '
+            'Jacobians and IK; virtual-work statics with the physical sign (tension positive) and the '
+            'corrected null-space projector; the improved capstan equation (eqs. (29)-(32)) integrated to'
+            " 1e-8 against a tight reference. SIMULATED, not measured: Section 5's 'experiments' run on a"
+            " simulated robot whose ground truth is robomech's quasi-static model with straight cable "
+            "chords, Coulomb friction at every disk hole with Table 1's μ, elastic Dyneema cables (E = "
+            '4.96 GPa, 0.8 mm) over the body and a 0.1 m free length, and a 0.8 mm NiTi core (E = 60 '
+            'GPa); those stiffnesses and lengths are not printed, so the error magnitudes depend on these'
+            " assumed values. The compensation applied is the paper's: arc cable lengths (eq. (4)), "
+            'virtual-work tensions with pretension and disk friction with the identified μ, cable stretch'
+            " by Hooke's law, q~ = q + δ (eq. (37)). Fig. 6 is shown only as model trends (no data are "
+            'given).'
+        ),
+    )
+    rng = np.random.default_rng(SEED)
+    progress.step("Fig. 9: improved capstan equation")
+    _fig9(out_dir, res)
+    progress.step("Fig. 6 trends")
+    _fig6(out_dir, res)
+
+    truth = C.ContinuumRobot.paper()
+    progress.step("identification of friction from simulated tensions")
+    est = _identify(truth, rng, res)
+    model = C.ContinuumRobot(friction=tuple(float(m) for m in est.mu))
+
+    progress.step("planar bending 0 -> 90 deg (simulated robot)")
+    th = np.radians(np.linspace(0.0, 90.0, 91))
+    psi_p = np.stack([th, np.zeros_like(th)], -1)
+    dir_p = np.broadcast_to([1.0, -1.0, -1.0], (th.size, 3))  # cable 1 pulled, 2 and 3 paid out
+    _, _, errs_p, ok_p, (sim_p, sim_p1) = _run_trajectory(truth, model, psi_p, dir_p)
+
+    progress.step("spatial circle (simulated robot)")
+    be = np.linspace(0.0, 2.0 * np.pi, 181)
+    psi_c = np.stack([np.full_like(be, np.radians(CIRCLE_THETA_DEG)), be], -1)
+    dq = np.gradient(C.theoretical_drive(truth, psi_c, "arc"), axis=0)
+    dir_c = np.sign(dq)  # each cable slides in the direction its actuator moves
+    pd_c, tips_c, errs_c, ok_c, (sim_c, _) = _run_trajectory(truth, model, psi_c, dir_c)
+
+    mm = 1e3
+    e_p = [float(np.mean(e[1:]) * mm) for e in errs_p]  # theta = 0 excluded: no motion, no error
+    e_c = [float(np.mean(e) * mm) for e in errs_c]
+    rate = lambda before, after: 100.0 * (before - after) / before  # noqa: E731
+    res.tables.append(comparison_table(
+        "Section 5: mean tip error before and after compensation (simulated robot vs the paper's experiment)",
+        [
+            ("planar bending: before compensation", 3.03, e_p[0], "mm"),
+            ("planar bending: after compensation", 1.48, e_p[1], "mm"),
+            ("planar bending: compensation rate", 50.99, rate(e_p[0], e_p[1]), "%"),
+            ("spatial circle: before compensation", 5.94, e_c[0], "mm"),
+            ("spatial circle: after compensation", 3.15, e_c[1], "mm"),
+            ("spatial circle: compensation rate", 46.97, rate(e_c[0], e_c[1]), "%"),
+            ("planar: compensation with the simulation's own model", None, e_p[2], "mm"),
+            ("circle: compensation with the simulation's own model", None, e_c[2], "mm"),
+        ],
+        note="The paper's values are measured on its prototype; robomech's come from a simulated robot "
+             "(see summary). The remaining error after the paper's compensation comes from its arc cable "
+             "model (real cables run in straight chords), its pretension rule, and the identified μ; "
+             "compensating with the simulation's own model removes it (last rows: a consistency check).",
+    ))
+    res.data.update({"planar_mean_error_mm": e_p, "circle_mean_error_mm": e_c,
+                     "all_converged": bool(ok_p and ok_c),
+                     "planar_slack_fraction_uncompensated": float(1.0 - np.mean(sim_p.taut)),
+                     "circle_slack_fraction_uncompensated": float(1.0 - np.mean(sim_c.taut))})
+
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    ax = axes[0]
+    ax.plot(np.degrees(th), np.degrees(sim_p.psi[:, 0] - th), "r--", label="before compensation")
+    ax.plot(np.degrees(th), np.degrees(sim_p1.psi[:, 0] - th), "b-.", label="after compensation")
+    ax.axhline(0.0, color="k", lw=0.8)
+    ax.set_xlabel("commanded bend angle θ (deg)")
+    ax.set_ylabel("achieved − commanded bend angle (deg)")
+    ax.set_title("Planar bending 0→90° at β = 0: bend-angle error")
+    ax.legend()
+    ax.grid(True, alpha=0.3)
+    ax = axes[1]
+    ax.plot(np.degrees(th), errs_p[0] * mm, "r--", label="before compensation")
+    ax.plot(np.degrees(th), errs_p[1] * mm, "b-.", label="after compensation (paper's method)")
+    ax.plot(np.degrees(th), errs_p[2] * mm, "g:", label="after compensation (simulation's own model)")
+    ax.set_xlabel("commanded bend angle θ (deg)")
+    ax.set_ylabel("tip position error (mm)")
+    ax.set_title("Fig. 12c analogue: tip error (SIMULATED robot)")
+    ax.legend()
+    ax.grid(True, alpha=0.3)
+    res.figures.append(save_figure(fig, out_dir, "planar_compensation",
+                                   "Planar bending on the simulated robot: tip path and error before/after "
+                                   "compensation (Fig. 12 analogue)"))
+
+    fig = plt.figure(figsize=(11, 4.2))
+    ax = fig.add_subplot(1, 2, 1)
+    ax.plot(pd_c[:, 0] * mm, pd_c[:, 1] * mm, "k-", lw=2, label="desired")
+    ax.plot(tips_c[0][:, 0] * mm, tips_c[0][:, 1] * mm, "r--", label="before compensation")
+    ax.plot(tips_c[1][:, 0] * mm, tips_c[1][:, 1] * mm, "b-.", label="after compensation")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_aspect("equal")
+    ax.set_title(f"Spatial circle θ = {CIRCLE_THETA_DEG:g}°, β 0→360° (top view)")
+    ax.legend(fontsize=8)
+    ax.grid(True, alpha=0.3)
+    ax = fig.add_subplot(1, 2, 2)
+    ax.plot(np.degrees(be), errs_c[0] * mm, "r--", label="before compensation")
+    ax.plot(np.degrees(be), errs_c[1] * mm, "b-.", label="after compensation (paper's method)")
+    ax.plot(np.degrees(be), errs_c[2] * mm, "g:", label="after compensation (simulation's own model)")
+    ax.set_xlabel("bending-plane angle β (deg)")
+    ax.set_ylabel("tip position error (mm)")
+    ax.set_title("Fig. 13c analogue: tip error (SIMULATED robot)")
+    ax.legend(fontsize=8)
+    ax.grid(True, alpha=0.3)
+    res.figures.append(save_figure(fig, out_dir, "circle_compensation",
+                                   "Spatial circle on the simulated robot: tip path and error before/after "
+                                   "compensation (Fig. 13 analogue)"))
+
+    progress.step("statics: tensions along the planar bend")
+    tr = C.cable_tensions(truth, psi_p, direction=dir_p)
+    tr_printed = C.cable_tensions(truth, psi_p, direction=dir_p, pretension=1.0)
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for j in range(3):
+        ax.plot(np.degrees(th), tr.tension[:, j], label=f"cable {j + 1}, pretension {truth.pretension:g} N")
+        ax.plot(np.degrees(th), tr_printed.tension[:, j], ls=":", label=f"cable {j + 1}, printed η = 1 N")
+    ax.axhline(0.0, color="k", lw=0.8)
+    ax.set_xlabel("bend angle θ (deg), β = 0")
+    ax.set_ylabel("cable tension at the base (N)")
+    ax.set_title("Virtual-work tensions with disk friction (pulling cable 1)")
+    ax.legend(fontsize=7)
+    ax.grid(True, alpha=0.3)
+    res.figures.append(save_figure(fig, out_dir, "tensions",
+                                   "Cable tensions from virtual work (tension positive), default pretension "
+                                   "vs the paper's η = (1, 1, 1) N, which lets cables 2 and 3 go slack"))
+    slack_deg = np.degrees(th[~tr_printed.taut])
+    res.notes.append(
+        f"With the printed η = (1, 1, 1) N, cables 2 and 3 would have to push beyond θ = "
+        f"{slack_deg.min() if slack_deg.size else float('nan'):.0f}°; robomech flags these poses "
+        "(taut = False)."
+    )
+    res.notes.append(
+        f"Uncompensated drive: cables 2 and 3 go slack in "
+        f"{100 * res.data['planar_slack_fraction_uncompensated']:.0f} % of the planar poses (the arc model "
+        "pays out more cable than the chord geometry needs); the simulated "
+        "robot handles slack cables (zero tension) and flags them."
+    )
+    slack_after = np.degrees(th[~sim_p1.taut])
+    if slack_after.size:
+        res.notes.append(
+            f"After the paper's compensation, cables 2 and 3 go slack from θ = {slack_after.min():.0f}° on "
+            "(its arc-model payout exceeds what the chord geometry needs); there cable 1 alone bends the "
+            "core, the bend-angle error changes sign and the tip error grows again (kinks in the curves)."
+        )
+    if not res.data["all_converged"]:
+        res.notes.append("WARNING: some simulated equilibria did not converge.")
+    return res
+
+
+STUDY = Study(
+    name="continuum",
+    title="Paper 3: cable-driven continuum robot (capstan friction, statics, compensation)",
+    source="Qi et al., Trans. CSAM 54(1), 2023",
+    run=run,
+)
