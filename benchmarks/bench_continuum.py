@@ -13,8 +13,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from _harness import Workload
 from robomech.mechanisms import continuum as C
+
+from _harness import Workload
 
 N_KIN = 1_000_000
 N_ALT_KIN = 1000
@@ -25,16 +26,22 @@ IVP_RTOL = 1e-7  # loosest RK45 rtol that reaches 1e-8 on the grid (measured max
 
 
 def _capstan_grid() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    rho, alpha, n = np.meshgrid(np.linspace(1.0, 10.0, 25), np.linspace(0.15, 0.6, 20),
-                                np.linspace(0.67, 1.0, 20), indexing="ij")
+    rho, alpha, n = np.meshgrid(
+        np.linspace(1.0, 10.0, 25), np.linspace(0.15, 0.6, 20), np.linspace(0.67, 1.0, 20), indexing="ij"
+    )
     return rho.ravel(), alpha.ravel(), n.ravel()
 
 
 def _ivp_ratio(phi: float, rho: float, alpha: float, n: float) -> float:
     c = float(C.capstan_coefficient(rho, alpha, n))
     p = (1.0 - n) / n
-    sol = solve_ivp(lambda _, u: [u[1], -c * u[0] ** p * u[1] + rho * u[0]], (0.0, phi), [1.0, 0.0],
-                    rtol=IVP_RTOL, atol=IVP_RTOL * 1e-3)
+    sol = solve_ivp(
+        lambda _, u: [u[1], -c * u[0] ** p * u[1] + rho * u[0]],
+        (0.0, phi),
+        [1.0, 0.0],
+        rtol=IVP_RTOL,
+        atol=IVP_RTOL * 1e-3,
+    )
     T, dT = sol.y[:, -1]
     return float(np.sqrt(rho**2 * T**2 + dT**2) / rho)
 
@@ -53,57 +60,65 @@ def workloads() -> list[Workload]:
             raise RuntimeError(f"alternative not at matched accuracy: {err:.2e}")
         return k
 
-    out.append(Workload(
-        name="continuum: capstan ratio, 10^4 (rho, alpha, n) grid",
-        group="4",
-        run=lambda: C.capstan_tension_ratio(phi, rho=rho, alpha=alpha, n=n),
-        n=rho.size,
-        bytes_moved=4 * rho.nbytes,
-        alternative=capstan_alt,
-        n_alt=N_ALT_CAPSTAN,
-        alternative_name="solve_ivp RK45 per point",
-        target_speedup=250.0,
-    ))
+    out.append(
+        Workload(
+            name="continuum: capstan ratio, 10^4 (rho, alpha, n) grid",
+            group="4",
+            run=lambda: C.capstan_tension_ratio(phi, rho=rho, alpha=alpha, n=n),
+            n=rho.size,
+            bytes_moved=4 * rho.nbytes,
+            alternative=capstan_alt,
+            n_alt=N_ALT_CAPSTAN,
+            alternative_name="solve_ivp RK45 per point",
+            target_speedup=250.0,
+        )
+    )
 
     robot = C.ContinuumRobot.paper()
     rng = np.random.default_rng(1)
     psi = np.stack([rng.uniform(0.0, 2.0, N_KIN), rng.uniform(-np.pi, np.pi, N_KIN)], -1)
     p_tip = C.tip_position(robot, psi)
     psi_alt, p_alt = psi[:N_ALT_KIN], p_tip[:N_ALT_KIN]
-    out.append(Workload(
-        name="continuum: forward kinematics (tip pose), 1 segment",
-        group="2",
-        run=lambda: C.forward_kinematics(robot, psi),
-        n=N_KIN,
-        bytes_moved=psi.nbytes + N_KIN * 16 * 8,
-        alternative=lambda: [C.forward_kinematics(robot, q) for q in psi_alt],
-        n_alt=N_ALT_KIN,
-        alternative_name="per-sample loop, same function",
-        target_speedup=100.0,
-        target_floor_ratio=20.0,
-    ))
-    out.append(Workload(
-        name="continuum: tip Jacobian (6x2), 1 segment",
-        group="2",
-        run=lambda: C.tip_jacobian(robot, psi),
-        n=N_KIN,
-        bytes_moved=psi.nbytes + N_KIN * 12 * 8,
-        alternative=lambda: [C.tip_jacobian(robot, q) for q in psi_alt],
-        n_alt=N_ALT_KIN,
-        alternative_name="per-sample loop, same function",
-        target_speedup=100.0,
-        target_floor_ratio=20.0,
-    ))
-    out.append(Workload(
-        name="continuum: inverse kinematics from tip, 1 segment",
-        group="2",
-        run=lambda: C.inverse_kinematics(robot, p_tip),
-        n=N_KIN,
-        bytes_moved=p_tip.nbytes + psi.nbytes + N_KIN * 8 * 2 + N_KIN * 2,
-        alternative=lambda: [C.inverse_kinematics(robot, p) for p in p_alt],
-        n_alt=N_ALT_KIN,
-        alternative_name="per-sample loop, same function",
-        target_speedup=100.0,
-        target_floor_ratio=20.0,
-    ))
+    out.append(
+        Workload(
+            name="continuum: forward kinematics (tip pose), 1 segment",
+            group="2",
+            run=lambda: C.forward_kinematics(robot, psi),
+            n=N_KIN,
+            bytes_moved=psi.nbytes + N_KIN * 16 * 8,
+            alternative=lambda: [C.forward_kinematics(robot, q) for q in psi_alt],
+            n_alt=N_ALT_KIN,
+            alternative_name="per-sample loop, same function",
+            target_speedup=100.0,
+            target_floor_ratio=20.0,
+        )
+    )
+    out.append(
+        Workload(
+            name="continuum: tip Jacobian (6x2), 1 segment",
+            group="2",
+            run=lambda: C.tip_jacobian(robot, psi),
+            n=N_KIN,
+            bytes_moved=psi.nbytes + N_KIN * 12 * 8,
+            alternative=lambda: [C.tip_jacobian(robot, q) for q in psi_alt],
+            n_alt=N_ALT_KIN,
+            alternative_name="per-sample loop, same function",
+            target_speedup=100.0,
+            target_floor_ratio=20.0,
+        )
+    )
+    out.append(
+        Workload(
+            name="continuum: inverse kinematics from tip, 1 segment",
+            group="2",
+            run=lambda: C.inverse_kinematics(robot, p_tip),
+            n=N_KIN,
+            bytes_moved=p_tip.nbytes + psi.nbytes + N_KIN * 8 * 2 + N_KIN * 2,
+            alternative=lambda: [C.inverse_kinematics(robot, p) for p in p_alt],
+            n_alt=N_ALT_KIN,
+            alternative_name="per-sample loop, same function",
+            target_speedup=100.0,
+            target_floor_ratio=20.0,
+        )
+    )
     return out

@@ -46,12 +46,20 @@ def _fig9(out_dir: Path, res: StudyResult) -> None:
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
     axes[0].set_ylabel("T_in / T_out (output tension 1 N)")
-    res.figures.append(save_figure(fig, out_dir, "fig9_capstan",
-                                   "Fig. 9: improved capstan ratio (eqs. 29-32) vs the classical law"))
-    res.tables.append(Table("Fig. 9 at φ = 180° (output tension 1 N)",
-                            ["α", "ρ", "n", "improved κ", "classical exp(απ)"], rows,
-                            note="The paper prints only curves; the improved model loses less tension than "
-                                 "the classical law everywhere, as the paper states."))
+    res.figures.append(
+        save_figure(
+            fig, out_dir, "fig9_capstan", "Fig. 9: improved capstan ratio (eqs. 29-32) vs the classical law"
+        )
+    )
+    res.tables.append(
+        Table(
+            "Fig. 9 at φ = 180° (output tension 1 N)",
+            ["α", "ρ", "n", "improved κ", "classical exp(απ)"],
+            rows,
+            note="The paper prints only curves; the improved model loses less tension than "
+            "the classical law everywhere, as the paper states.",
+        )
+    )
 
 
 def _fig6(out_dir: Path, res: StudyResult) -> None:
@@ -74,10 +82,15 @@ def _fig6(out_dir: Path, res: StudyResult) -> None:
     for ax in axes:
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
-    res.figures.append(save_figure(
-        fig, out_dir, "fig6_trends",
-        f"Fig. 6 trends from the improved capstan model (assumed ρ = {FIG6_RHO:g}, α = {FIG6_ALPHA}, "
-        f"n = {FIG6_N}); the paper's measured curves are not reproduced (no data given)"))
+    res.figures.append(
+        save_figure(
+            fig,
+            out_dir,
+            "fig6_trends",
+            f"Fig. 6 trends from the improved capstan model (assumed ρ = {FIG6_RHO:g}, α = {FIG6_ALPHA}, "
+            f"n = {FIG6_N}); the paper's measured curves are not reproduced (no data given)",
+        )
+    )
     res.data["fig6_loss_N"] = loss
 
 
@@ -99,17 +112,34 @@ def _identify(truth: C.ContinuumRobot, rng, res: StudyResult) -> C.FrictionEstim
         dirs.append(direction)
     cat = lambda xs: np.concatenate(xs, 0).T  # noqa: E731  (cables, measurements)
     taut = cat(t_out) > 10 * TENSION_NOISE  # a nearly slack cable carries no friction information
-    est = C.identify_friction(np.where(taut, cat(wraps), 0.0), np.where(taut, cat(t_in), 1.0),
-                              np.where(taut, cat(t_out), 1.0), np.where(taut, cat(dirs), 0.0),
-                              sigma_t=TENSION_NOISE)
-    rows = [[f"cable {j + 1} (β = {120 * j}°)", truth.friction[j], float(est.mu[j]), float(est.std[j]),
-             float((est.mu[j] - truth.friction[j]) / est.std[j]), int(est.n_used[j])] for j in range(3)]
-    res.tables.append(Table(
-        "Friction identification from simulated, noisy tensions (Table 1 μ as ground truth)",
-        ["cable", "true μ (paper Table 1)", "identified μ", "std", "error / std", "measurements"], rows,
-        note=f"Load-cell noise {TENSION_NOISE} N on both ends, tracker noise {TRACKER_NOISE * 1e3} mm; "
-             "linear least squares on ln(T_in/T_out) = s μ η. Table 1's λ column is undefined in the "
-             "paper and not reproduced."))
+    est = C.identify_friction(
+        np.where(taut, cat(wraps), 0.0),
+        np.where(taut, cat(t_in), 1.0),
+        np.where(taut, cat(t_out), 1.0),
+        np.where(taut, cat(dirs), 0.0),
+        sigma_t=TENSION_NOISE,
+    )
+    rows = [
+        [
+            f"cable {j + 1} (β = {120 * j}°)",
+            truth.friction[j],
+            float(est.mu[j]),
+            float(est.std[j]),
+            float((est.mu[j] - truth.friction[j]) / est.std[j]),
+            int(est.n_used[j]),
+        ]
+        for j in range(3)
+    ]
+    res.tables.append(
+        Table(
+            "Friction identification from simulated, noisy tensions (Table 1 μ as ground truth)",
+            ["cable", "true μ (paper Table 1)", "identified μ", "std", "error / std", "measurements"],
+            rows,
+            note=f"Load-cell noise {TENSION_NOISE} N on both ends, tracker noise {TRACKER_NOISE * 1e3} mm; "
+            "linear least squares on ln(T_in/T_out) = s μ η. Table 1's λ column is undefined in the "
+            "paper and not reproduced.",
+        )
+    )
     res.data["identified_mu"] = est.mu
     res.data["identified_mu_std"] = est.std
     return est
@@ -134,21 +164,21 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         name="continuum",
         title="Paper 3: cable-driven continuum robot — capstan friction, statics and drive compensation",
         source="Qi, Zhang, Pei, Chen, Wu: Drive error compensation of continuum manipulator based on force "
-               "transfer model, Trans. CSAM 54(1), 2023 (doi:10.6041/j.issn.1000-1298.2023.01.041)",
+        "transfer model, Trans. CSAM 54(1), 2023 (doi:10.6041/j.issn.1000-1298.2023.01.041)",
         summary=(
             "Exact: the constant-curvature kinematics (eqs. (1)-(6), with eq. (1)'s misprinted element "
-            'corrected), cable lengths (arc model of eq. (4) and straight chords between disks), '
-            'Jacobians and IK; virtual-work statics with the physical sign (tension positive) and the '
-            'corrected null-space projector; the improved capstan equation (eqs. (29)-(32)) integrated to'
+            "corrected), cable lengths (arc model of eq. (4) and straight chords between disks), "
+            "Jacobians and IK; virtual-work statics with the physical sign (tension positive) and the "
+            "corrected null-space projector; the improved capstan equation (eqs. (29)-(32)) integrated to"
             " 1e-8 against a tight reference. SIMULATED, not measured: Section 5's 'experiments' run on a"
             " simulated robot whose ground truth is robomech's quasi-static model with straight cable "
             "chords, Coulomb friction at every disk hole with Table 1's μ, elastic Dyneema cables (E = "
-            '4.96 GPa, 0.8 mm) over the body and a 0.1 m free length, and a 0.8 mm NiTi core (E = 60 '
-            'GPa); those stiffnesses and lengths are not printed, so the error magnitudes depend on these'
+            "4.96 GPa, 0.8 mm) over the body and a 0.1 m free length, and a 0.8 mm NiTi core (E = 60 "
+            "GPa); those stiffnesses and lengths are not printed, so the error magnitudes depend on these"
             " assumed values. The compensation applied is the paper's: arc cable lengths (eq. (4)), "
-            'virtual-work tensions with pretension and disk friction with the identified μ, cable stretch'
+            "virtual-work tensions with pretension and disk friction with the identified μ, cable stretch"
             " by Hooke's law, q~ = q + δ (eq. (37)). Fig. 6 is shown only as model trends (no data are "
-            'given).'
+            "given)."
         ),
     )
     rng = np.random.default_rng(SEED)
@@ -179,27 +209,34 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     e_p = [float(np.mean(e[1:]) * mm) for e in errs_p]  # theta = 0 excluded: no motion, no error
     e_c = [float(np.mean(e) * mm) for e in errs_c]
     rate = lambda before, after: 100.0 * (before - after) / before  # noqa: E731
-    res.tables.append(comparison_table(
-        "Section 5: mean tip error before and after compensation (simulated robot vs the paper's experiment)",
-        [
-            ("planar bending: before compensation", 3.03, e_p[0], "mm"),
-            ("planar bending: after compensation", 1.48, e_p[1], "mm"),
-            ("planar bending: compensation rate", 50.99, rate(e_p[0], e_p[1]), "%"),
-            ("spatial circle: before compensation", 5.94, e_c[0], "mm"),
-            ("spatial circle: after compensation", 3.15, e_c[1], "mm"),
-            ("spatial circle: compensation rate", 46.97, rate(e_c[0], e_c[1]), "%"),
-            ("planar: compensation with the simulation's own model", None, e_p[2], "mm"),
-            ("circle: compensation with the simulation's own model", None, e_c[2], "mm"),
-        ],
-        note="The paper's values are measured on its prototype; robomech's come from a simulated robot "
-             "(see summary). The remaining error after the paper's compensation comes from its arc cable "
-             "model (real cables run in straight chords), its pretension rule, and the identified μ; "
-             "compensating with the simulation's own model removes it (last rows: a consistency check).",
-    ))
-    res.data.update({"planar_mean_error_mm": e_p, "circle_mean_error_mm": e_c,
-                     "all_converged": bool(ok_p and ok_c),
-                     "planar_slack_fraction_uncompensated": float(1.0 - np.mean(sim_p.taut)),
-                     "circle_slack_fraction_uncompensated": float(1.0 - np.mean(sim_c.taut))})
+    res.tables.append(
+        comparison_table(
+            "Section 5: mean tip error before and after compensation (simulated robot vs the paper's experiment)",
+            [
+                ("planar bending: before compensation", 3.03, e_p[0], "mm"),
+                ("planar bending: after compensation", 1.48, e_p[1], "mm"),
+                ("planar bending: compensation rate", 50.99, rate(e_p[0], e_p[1]), "%"),
+                ("spatial circle: before compensation", 5.94, e_c[0], "mm"),
+                ("spatial circle: after compensation", 3.15, e_c[1], "mm"),
+                ("spatial circle: compensation rate", 46.97, rate(e_c[0], e_c[1]), "%"),
+                ("planar: compensation with the simulation's own model", None, e_p[2], "mm"),
+                ("circle: compensation with the simulation's own model", None, e_c[2], "mm"),
+            ],
+            note="The paper's values are measured on its prototype; robomech's come from a simulated robot "
+            "(see summary). The remaining error after the paper's compensation comes from its arc cable "
+            "model (real cables run in straight chords), its pretension rule, and the identified μ; "
+            "compensating with the simulation's own model removes it (last rows: a consistency check).",
+        )
+    )
+    res.data.update(
+        {
+            "planar_mean_error_mm": e_p,
+            "circle_mean_error_mm": e_c,
+            "all_converged": bool(ok_p and ok_c),
+            "planar_slack_fraction_uncompensated": float(1.0 - np.mean(sim_p.taut)),
+            "circle_slack_fraction_uncompensated": float(1.0 - np.mean(sim_c.taut)),
+        }
+    )
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     ax = axes[0]
@@ -220,9 +257,15 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     ax.set_title("Fig. 12c analogue: tip error (SIMULATED robot)")
     ax.legend()
     ax.grid(True, alpha=0.3)
-    res.figures.append(save_figure(fig, out_dir, "planar_compensation",
-                                   "Planar bending on the simulated robot: tip path and error before/after "
-                                   "compensation (Fig. 12 analogue)"))
+    res.figures.append(
+        save_figure(
+            fig,
+            out_dir,
+            "planar_compensation",
+            "Planar bending on the simulated robot: tip path and error before/after "
+            "compensation (Fig. 12 analogue)",
+        )
+    )
 
     fig = plt.figure(figsize=(11, 4.2))
     ax = fig.add_subplot(1, 2, 1)
@@ -244,9 +287,15 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     ax.set_title("Fig. 13c analogue: tip error (SIMULATED robot)")
     ax.legend(fontsize=8)
     ax.grid(True, alpha=0.3)
-    res.figures.append(save_figure(fig, out_dir, "circle_compensation",
-                                   "Spatial circle on the simulated robot: tip path and error before/after "
-                                   "compensation (Fig. 13 analogue)"))
+    res.figures.append(
+        save_figure(
+            fig,
+            out_dir,
+            "circle_compensation",
+            "Spatial circle on the simulated robot: tip path and error before/after "
+            "compensation (Fig. 13 analogue)",
+        )
+    )
 
     progress.step("statics: tensions along the planar bend")
     tr = C.cable_tensions(truth, psi_p, direction=dir_p)
@@ -261,9 +310,15 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     ax.set_title("Virtual-work tensions with disk friction (pulling cable 1)")
     ax.legend(fontsize=7)
     ax.grid(True, alpha=0.3)
-    res.figures.append(save_figure(fig, out_dir, "tensions",
-                                   "Cable tensions from virtual work (tension positive), default pretension "
-                                   "vs the paper's η = (1, 1, 1) N, which lets cables 2 and 3 go slack"))
+    res.figures.append(
+        save_figure(
+            fig,
+            out_dir,
+            "tensions",
+            "Cable tensions from virtual work (tension positive), default pretension "
+            "vs the paper's η = (1, 1, 1) N, which lets cables 2 and 3 go slack",
+        )
+    )
     slack_deg = np.degrees(th[~tr_printed.taut])
     res.notes.append(
         f"With the printed η = (1, 1, 1) N, cables 2 and 3 would have to push beyond θ = "

@@ -18,8 +18,14 @@ def reference(phi, rho, alpha, n, t_out):
     """Tight per-point integration of eq. (29) in the original variables (T, T')."""
     c = C.capstan_coefficient(rho, alpha, n)
     p = (1 - n) / n
-    sol = solve_ivp(lambda _, u: [u[1], -c * u[0] ** p * u[1] + rho * u[0]], (0.0, phi), [t_out, 0.0],
-                    method="DOP853", rtol=REF_RTOL, atol=REF_RTOL * t_out)
+    sol = solve_ivp(
+        lambda _, u: [u[1], -c * u[0] ** p * u[1] + rho * u[0]],
+        (0.0, phi),
+        [t_out, 0.0],
+        method="DOP853",
+        rtol=REF_RTOL,
+        atol=REF_RTOL * t_out,
+    )
     T, dT = sol.y[:, -1]
     return np.sqrt(rho**2 * T**2 + dT**2) / (rho * t_out)
 
@@ -95,15 +101,24 @@ def test_batched_broadcasting_equals_per_point():
     rho = np.array([1.0, 4.0, 10.0])[None, :]
     k = C.capstan_tension_ratio(phi, rho=rho, alpha=0.3, n=0.75, t_out=2.0)
     assert k.shape == (6, 3)
-    single = np.array([[C.capstan_tension_ratio(f, rho=r, alpha=0.3, n=0.75, t_out=2.0) for r in rho[0]]
-                       for f in phi[:, 0]])
+    single = np.array(
+        [[C.capstan_tension_ratio(f, rho=r, alpha=0.3, n=0.75, t_out=2.0) for r in rho[0]] for f in phi[:, 0]]
+    )
     assert np.abs(k - single).max() < 1e-12
 
 
 @pytest.mark.parametrize(
     ("kwargs", "name"),
-    [({"phi": -0.1}, "phi"), ({"rho": 0.0}, "rho"), ({"rho": np.nan}, "rho"), ({"alpha": -1.0}, "alpha"),
-     ({"n": 1.5}, "n"), ({"n": 0.0}, "n"), ({"t_out": 0.0}, "t_out"), ({"phi": np.nan}, "phi")],
+    [
+        ({"phi": -0.1}, "phi"),
+        ({"rho": 0.0}, "rho"),
+        ({"rho": np.nan}, "rho"),
+        ({"alpha": -1.0}, "alpha"),
+        ({"n": 1.5}, "n"),
+        ({"n": 0.0}, "n"),
+        ({"t_out": 0.0}, "t_out"),
+        ({"phi": np.nan}, "phi"),
+    ],
 )
 def test_bad_input(kwargs, name):
     args = {"phi": 1.0, "rho": 2.0, "alpha": 0.3, "n": 0.8, "t_out": 1.0, **kwargs}

@@ -147,7 +147,12 @@ def test_identification_end_to_end_on_simulated_robot():
         dirs.append(direction)
     cat = lambda xs: np.concatenate(xs, 0).T  # noqa: E731
     taut = cat(t_out) > 10 * sigma
-    est = C.identify_friction(np.where(taut, cat(wraps), 0.0), np.where(taut, cat(t_in), 1.0),
-                              np.where(taut, cat(t_out), 1.0), np.where(taut, cat(dirs), 0.0), sigma_t=sigma)
+    est = C.identify_friction(
+        np.where(taut, cat(wraps), 0.0),
+        np.where(taut, cat(t_in), 1.0),
+        np.where(taut, cat(t_out), 1.0),
+        np.where(taut, cat(dirs), 0.0),
+        sigma_t=sigma,
+    )
     assert np.all(np.abs(est.mu - PAPER.friction_array) < 3 * est.std)
     assert np.all(est.std < 0.01)

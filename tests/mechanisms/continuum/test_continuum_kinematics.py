@@ -36,11 +36,13 @@ def test_segment_rotation_is_rz_ry_rz():
 def test_paper_eq1_except_misprinted_element_and_eq2():
     th, be = 0.7, 0.4
     ct, st_, cb, sb = np.cos(th), np.sin(th), np.cos(be), np.sin(be)
-    printed = np.array([  # paper 3, eq. (1) as printed
-        [ct * cb**2 + sb**2, cb * sb * (ct - 1), cb * st_],
-        [cb * sb * ct, sb**2 * ct + cb**2, sb * st_],
-        [-cb * st_, -sb * st_, ct],
-    ])
+    printed = np.array(
+        [  # paper 3, eq. (1) as printed
+            [ct * cb**2 + sb**2, cb * sb * (ct - 1), cb * st_],
+            [cb * sb * ct, sb**2 * ct + cb**2, sb * st_],
+            [-cb * st_, -sb * st_, ct],
+        ]
+    )
     T = C.segment_transform(th, be, 0.09)
     mask = np.ones((3, 3), bool)
     mask[1, 0] = False
@@ -118,11 +120,13 @@ def test_tip_jacobian_vs_central_differences(robot):
 def test_tip_jacobian_equals_paper_eq6():
     th, be, l = 0.9, -0.6, PAPER.segment_length
     ct, st_, cb, sb = np.cos(th), np.sin(th), np.cos(be), np.sin(be)
-    Jv = np.array([
-        [l * cb * (th * st_ + ct - 1) / th**2, l * (ct - 1) / th * sb],
-        [l * sb * (th * st_ + ct - 1) / th**2, -l * (ct - 1) / th * cb],
-        [l * (th * ct - st_) / th**2, 0.0],
-    ])
+    Jv = np.array(
+        [
+            [l * cb * (th * st_ + ct - 1) / th**2, l * (ct - 1) / th * sb],
+            [l * sb * (th * st_ + ct - 1) / th**2, -l * (ct - 1) / th * cb],
+            [l * (th * ct - st_) / th**2, 0.0],
+        ]
+    )
     Jw = np.array([[-sb, -cb * st_], [cb, -sb * st_], [0.0, 1 - ct]])
     J = C.tip_jacobian(PAPER, [th, be])
     assert np.abs(J[:3] - Jw).max() < EXACT_TOL
@@ -151,8 +155,10 @@ def test_ik_fk_round_trip_one_segment(theta, beta):
 
 
 @settings(max_examples=40, deadline=None)
-@given(th=st.lists(st.floats(0.0, 1.5), min_size=2, max_size=2),
-       be=st.lists(st.floats(-np.pi, np.pi), min_size=2, max_size=2))
+@given(
+    th=st.lists(st.floats(0.0, 1.5), min_size=2, max_size=2),
+    be=st.lists(st.floats(-np.pi, np.pi), min_size=2, max_size=2),
+)
 def test_ik_round_trip_two_segments(th, be):
     psi = np.array([th[0], be[0], th[1], be[1]])
     p = C.tip_position(TWO, psi)
@@ -204,10 +210,15 @@ def test_bad_input():
 
 @pytest.mark.parametrize(
     ("kwargs", "field"),
-    [({"segment_length": -0.09}, "segment_length"), ({"n_segments": 0}, "n_segments"),
-     ({"friction": (0.2, 0.3)}, "friction"), ({"hole_radius": 0.2}, "hole_radius"),
-     ({"pretension": np.nan}, "pretension"), ({"disks_per_segment": 0}, "disks_per_segment"),
-     ({"friction": (0.2, -0.1, 0.3)}, "friction")],
+    [
+        ({"segment_length": -0.09}, "segment_length"),
+        ({"n_segments": 0}, "n_segments"),
+        ({"friction": (0.2, 0.3)}, "friction"),
+        ({"hole_radius": 0.2}, "hole_radius"),
+        ({"pretension": np.nan}, "pretension"),
+        ({"disks_per_segment": 0}, "disks_per_segment"),
+        ({"friction": (0.2, -0.1, 0.3)}, "friction"),
+    ],
 )
 def test_impossible_parameters(kwargs, field):
     with pytest.raises(ValueError, match=field):

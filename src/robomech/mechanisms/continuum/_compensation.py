@@ -211,8 +211,10 @@ def simulate(
         cols = []
         for j in range(2 * n):
             e = SIM_FD_STEP * eye[j]
-            cols.append((_sim_residual(robot, k + e, qa, d, model)[0]
-                         - _sim_residual(robot, k - e, qa, d, model)[0]) / (2 * SIM_FD_STEP))
+            cols.append(
+                (_sim_residual(robot, k + e, qa, d, model)[0] - _sim_residual(robot, k - e, qa, d, model)[0])
+                / (2 * SIM_FD_STEP)
+            )
         Jm = np.stack(cols, -1)
         # pinv, not solve: a singular Newton matrix in one sample must not abort the batch
         step = np.einsum("...ij,...j->...i", np.linalg.pinv(Jm), F)
@@ -233,5 +235,11 @@ def simulate(
     res = np.linalg.norm(F, axis=-1)
     theta, beta = _k_to_psi(k)
     psi = np.stack([theta, beta], -1).reshape(*batch, 2 * n)
-    return SimulationResult(psi=psi, tension=np.maximum(t_raw, 0.0), taut=np.all(t_raw >= 0.0, axis=-1),
-                            converged=res < SIM_TOLERANCE, residual=res, iterations=iterations)
+    return SimulationResult(
+        psi=psi,
+        tension=np.maximum(t_raw, 0.0),
+        taut=np.all(t_raw >= 0.0, axis=-1),
+        converged=res < SIM_TOLERANCE,
+        residual=res,
+        iterations=iterations,
+    )

@@ -146,8 +146,11 @@ def _rk4(phi, rho, c, p, lam, M2):
         a2, b2, c2 = f(y + h2 * a1, z + h2 * b1, w + h2 * c1)
         a3, b3, c3 = f(y + h2 * a2, z + h2 * b2, w + h2 * c2)
         a4, b4, c4 = f(y + h * a3, z + h * b3, w + h * c3)
-        return (y + h6 * (a1 + 2.0 * (a2 + a3) + a4), z + h6 * (b1 + 2.0 * (b2 + b3) + b4),
-                w + h6 * (c1 + 2.0 * (c2 + c3) + c4))
+        return (
+            y + h6 * (a1 + 2.0 * (a2 + a3) + a4),
+            z + h6 * (b1 + 2.0 * (b2 + b3) + b4),
+            w + h6 * (c1 + 2.0 * (c2 + c3) + c4),
+        )
 
     M1 = CAPSTAN_LAYER_STEPS
     h0 = CAPSTAN_FIRST_STEP / lam
@@ -236,8 +239,11 @@ def capstan_tension_ratio(
         h0 = CAPSTAN_FIRST_STEP / lam
         h_cap = np.minimum(CAPSTAN_STABILITY / lam, _accuracy_step(r, c))
         g = np.maximum((h_cap / h0) ** (1.0 / CAPSTAN_LAYER_STEPS), 1.0)
-        layer = np.where(g > 1.0, h0 * (g**CAPSTAN_LAYER_STEPS - 1.0) / np.where(g > 1.0, g - 1.0, 1.0),
-                         h0 * CAPSTAN_LAYER_STEPS)
+        layer = np.where(
+            g > 1.0,
+            h0 * (g**CAPSTAN_LAYER_STEPS - 1.0) / np.where(g > 1.0, g - 1.0, 1.0),
+            h0 * CAPSTAN_LAYER_STEPS,
+        )
         need = np.maximum(ph - layer, 0.0) / h_cap
         if np.any(need > CAPSTAN_MAX_STEPS):
             raise ValueError(

@@ -70,8 +70,9 @@ def _f_sin(t: np.ndarray) -> np.ndarray:
 
 def _df_cos(t: np.ndarray) -> np.ndarray:
     """d/dt (1 - cos t)/t = (t sin t + cos t - 1) / t^2 (paper 3, eq. (6))."""
-    return _small_fix(t, lambda x: (x * np.sin(x) + np.cos(x) - 1.0) / (x * x),
-                      lambda x: 0.5 - x**2 / 8.0 + x**4 / 144.0)
+    return _small_fix(
+        t, lambda x: (x * np.sin(x) + np.cos(x) - 1.0) / (x * x), lambda x: 0.5 - x**2 / 8.0 + x**4 / 144.0
+    )
 
 
 def _df_sin(t: np.ndarray) -> np.ndarray:
@@ -381,5 +382,6 @@ def inverse_kinematics(robot: ContinuumRobot, p_tip: object) -> IKResult:
     theta, beta = _normalise(theta, beta)
     psi = np.stack([theta, beta], -1).reshape(*batch, 2 * n)
     res, converged, iterations = res.reshape(batch), converged.reshape(batch), iterations.reshape(batch)
-    return IKResult(psi=psi, residual=res, reachable=res < IK_TOLERANCE, converged=converged,
-                    iterations=iterations)
+    return IKResult(
+        psi=psi, residual=res, reachable=res < IK_TOLERANCE, converged=converged, iterations=iterations
+    )

@@ -58,8 +58,14 @@ class ContinuumRobot:
             raise ValueError(
                 f"Expected disks_per_segment to be an integer >= 1, got {self.disks_per_segment!r}."
             )
-        for name in ("segment_length", "hole_radius", "core_modulus", "core_diameter", "cable_modulus",
-                     "cable_diameter"):
+        for name in (
+            "segment_length",
+            "hole_radius",
+            "core_modulus",
+            "core_diameter",
+            "cable_modulus",
+            "cable_diameter",
+        ):
             check_positive(getattr(self, name), name)
         check_positive(self.pretension, "pretension", allow_zero=True)
         check_positive(self.free_length, "free_length", allow_zero=True)

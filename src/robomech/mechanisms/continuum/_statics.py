@@ -119,5 +119,6 @@ def cable_tensions(
     tau = t_min + T0 * proj.sum(axis=-1)
     residual = np.linalg.norm(-np.einsum("...ij,...j->...i", Gt, tau) - rhs, axis=-1)
     tmin = tau.min(axis=-1)
-    return TensionResult(tension=tau, minimum_norm=t_min, taut=tmin >= TENSION_FLOOR, min_tension=tmin,
-                         residual=residual)
+    return TensionResult(
+        tension=tau, minimum_norm=t_min, taut=tmin >= TENSION_FLOOR, min_tension=tmin, residual=residual
+    )
