@@ -281,7 +281,9 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
                  t_np_loop / N_THROUGHPUT * 1e6, t_loop / t_np_loop],
             ],
             note=f"All {int(np.sum(big.valid))} of {N_THROUGHPUT} systems full rank; median cond "
-            f"{float(np.median(big.cond)):.1f}. Same machine, same run; 2 shared cores.",
+            f"{float(np.median(big.cond)):.1f}. Same machine, same run; 2 shared cores. The batched solve "
+            "is limited by the core's lstsq.solve (a Python loop inside scipy.linalg.solve_triangular over "
+            "the stack, and an SVD per system for cond); see docs/mechanisms/skid_steer.md.",
         )
     )
     res.summary = (
