@@ -46,7 +46,9 @@ def skid_steer_turn(v_right: object, v_left: object, track_width: float) -> Skid
     diff = v1 - v2
     total = v1 + v2
     turning = np.abs(diff) > STRAIGHT_RTOL * (np.abs(v1) + np.abs(v2))
+    # paper 4, Sec. 1.2: printed R_s (same formula) is called the inner wheel's radius; it is the centre's.
     radius = np.where(turning, 0.5 * S * total / np.where(turning, diff, 1.0), np.inf)
+    # paper 4, Sec. 1.2: printed ω = 2 v_X / L; the yaw rate consistent with the geometry is (v1 - v2)/S.
     return SkidSteerTurn(yaw_rate=diff / S, forward_speed=0.5 * total, radius=radius, turning=turning)
 
 

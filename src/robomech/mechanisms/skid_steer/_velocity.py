@@ -91,7 +91,9 @@ def _assemble(robot: ExplorationRobot, q: np.ndarray) -> tuple[np.ndarray, np.nd
         for j, col in zip((1, 2, 3), _PASSIVE[side], strict=True):
             A0[..., r, col] = G[..., w, 0, j]
             A0[..., r + 2, col] = G[..., w, 1, j]
-        # angular rows
+        # angular rows.  paper 4, eqs. (1)-(2): printed ω_BX = sin(α) ω, ω_BZ = cos(α) ω (contact frames
+        # not rolling relative to the ground); that cannot hold for all wheels once their α differ, so the
+        # rows are ω_BX = measured roll rate, ω_BZ = measured yaw rate (22 measurements, not 21).
         A0[..., r + 3, 3] = 1.0
         A0[..., r + 4, 4] = 1.0
         # right-hand side: R_BP v_P with R_BP = rot_y(α)
@@ -104,6 +106,9 @@ def _assemble(robot: ExplorationRobot, q: np.ndarray) -> tuple[np.ndarray, np.nd
         # rocker terms: -(ω_BY y × p + θ̇_i G_θ) with ω_BY = (ω1+ω2)/2, θ̇_i = ω_i - ω_BY.  Since the
         # rocker pivot lies on the body y axis, G_θ = y × p and the sum is -ω_i (y × p): each wheel
         # sees only its own rocker's absolute pitch rate.
+        # paper 4, eq. (1): printed zero columns for the rocker rate ω1 in the linear rows; the rocker
+        # carries the wheel, so its rate enters.  Printed ω_BY = -(ω1+ω2)/2: here ω_i are right-handed about
+        # +y, so ω_BY = +(ω1+ω2)/2.
         own = I_ROCKER1 if side == 0 else I_ROCKER2
         J[..., r, own] = -G[..., w, 0, 0]
         J[..., r + 2, own] = -G[..., w, 1, 0]
