@@ -123,8 +123,9 @@ def wheel_measurements(
     """Exact measurements ``q̇ (..., 22)`` of a known motion (the forward velocity map).
 
     ``twist (..., 6)`` = ``[ω_B; v_B]`` of the body relative to the ground in body axes (``v_B`` the
-    velocity of the body centre); ``config_rate (..., 8)`` the joint rates.  Consistent with
-    :func:`body_velocity` only when the differential holds (``θ̇2 = -θ̇1``).
+    velocity of the body centre); ``config_rate (..., 8)`` the joint rates.  :func:`body_velocity`
+    recovers everything from these except that it reports ``ω_BY = (ω1 + ω2)/2``, which is the true
+    pitch rate only when the differential holds (``θ̇2 = -θ̇1``).
     """
     q = as_array(config, "config", (CONFIG_SIZE,))
     V = as_array(twist, "twist", (6,))
