@@ -1,0 +1,110 @@
+"""Skid-steer robot (paper 4) workloads for issue 9.
+
+1. The estimator end to end: ``body_velocity`` (assembly of the 30×11 / 30×22 systems + batched
+   Householder QR through ``lstsq.solve``) over 250,000 samples, each system different, against the
+   per-sample Python loop of the same function.  (The generic ``lstsq.solve`` vs a loop of
+   ``numpy.linalg.lstsq`` is the lead's workload.)
+2. Forward kinematics (the six contact frames) and the wheel Jacobians over 10^6 configurations, and
+   the assembly alone over 250,000, against per-sample loops.
+Also the dead reckoning of 250,000 twists (prefix scan) against the sequential product.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+
+import numpy as np
+
+import robomech.mechanisms.skid_steer as ss
+from _harness import Workload
+from robomech.spatial import exp_se3
+
+N_EST = 250_000  # paper 4, Sec. 2.2
+N_KIN = 1_000_000
+N_ALT = 1000
+ROBOT = ss.ExplorationRobot.paper()
+F8 = 8
+
+
+@cache
+def _data(n: int) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(0)
+    q = rng.uniform(-0.25, 0.25, size=(n, 8))
+    q[:, [3, 7]] += ROBOT.rear_wheel_drop
+    V = rng.uniform(-0.3, 0.3, size=(n, 6))
+    qd = rng.uniform(-0.3, 0.3, size=(n, 8))
+    qd[:, 4] = -qd[:, 0]
+    m = ss.wheel_measurements(ROBOT, q, V, qd) + rng.normal(scale=0.005, size=(n, 22))
+    return q, m
+
+
+def _loop(fn, *arrays, n=N_ALT, **kw):
+    return [fn(ROBOT, *(a[i] for a in arrays), **kw) for i in range(n)]
+
+
+def _sequential_dead_reckoning(V: np.ndarray, dt: float) -> np.ndarray:
+    T = np.eye(4)
+    out = [T]
+    for k in range(V.shape[0] - 1):
+        T = T @ exp_se3(0.5 * dt * (V[k] + V[k + 1]))
+        out.append(T)
+    return np.stack(out)
+
+
+def workloads() -> list[Workload]:
+    # body_velocity: inputs config (8) + measured (22); outputs twist (6), config_rate (8), unknowns (11),
+    # residual, cond (float64) and valid (bool).
+    est_bytes = N_EST * ((8 + 22 + 6 + 8 + 11 + 2) * F8 + 1)
+    q_est = lambda: _data(N_EST)[0]  # noqa: E731
+    m_est = lambda: _data(N_EST)[1]  # noqa: E731
+    q_kin = lambda: _data(N_KIN)[0]  # noqa: E731
+    V = np.random.default_rng(1).normal(size=(N_EST, 6)) * 0.2
+    return [
+        Workload(
+            name="skid_steer: body_velocity 30x11 QR (250k)", group="1",
+            run=lambda: ss.body_velocity(ROBOT, q_est(), m_est()), n=N_EST, bytes_moved=est_bytes,
+            alternative=lambda: _loop(ss.body_velocity, q_est(), m_est()), n_alt=N_ALT,
+            alternative_name="per-sample loop, same fn", target_speedup=20.0,
+        ),
+        Workload(
+            name="skid_steer: body_velocity QR, cheap diag (250k)", group="1",
+            run=lambda: ss.body_velocity(ROBOT, q_est(), m_est(), diagnostics=False), n=N_EST,
+            bytes_moved=est_bytes,
+            alternative=lambda: _loop(ss.body_velocity, q_est(), m_est(), diagnostics=False), n_alt=N_ALT,
+            alternative_name="per-sample loop, same fn", target_speedup=20.0,
+        ),
+        Workload(
+            name="skid_steer: body_velocity normal eqs (250k)", group="1",
+            run=lambda: ss.body_velocity(ROBOT, q_est(), m_est(), solver="normal_equations"), n=N_EST,
+            bytes_moved=est_bytes,
+            alternative=lambda: _loop(ss.body_velocity, q_est(), m_est(), solver="normal_equations"),
+            n_alt=N_ALT, alternative_name="per-sample loop, same fn",
+        ),
+        Workload(
+            name="skid_steer: assemble A0, J (250k)", group="2",
+            run=lambda: ss.assemble(ROBOT, q_est()), n=N_EST,
+            bytes_moved=N_EST * (8 + 30 * 11 + 30 * 22) * F8,
+            alternative=lambda: _loop(ss.assemble, q_est()), n_alt=N_ALT,
+            alternative_name="per-sample Python loop", target_speedup=100.0, target_floor_ratio=20.0,
+        ),
+        Workload(
+            name="skid_steer: contact frames FK (1e6)", group="2",
+            run=lambda: ss.contact_frames(ROBOT, q_kin()), n=N_KIN, bytes_moved=N_KIN * (8 + 6 * 16) * F8,
+            alternative=lambda: _loop(ss.contact_frames, q_kin()), n_alt=N_ALT,
+            alternative_name="per-sample Python loop", target_speedup=100.0, target_floor_ratio=20.0,
+            repeats=2,
+        ),
+        Workload(
+            name="skid_steer: wheel Jacobians (1e6)", group="2",
+            run=lambda: ss.wheel_jacobians(ROBOT, q_kin()), n=N_KIN, bytes_moved=N_KIN * (8 + 6 * 24) * F8,
+            alternative=lambda: _loop(ss.wheel_jacobians, q_kin()), n_alt=N_ALT,
+            alternative_name="per-sample Python loop", target_speedup=100.0, target_floor_ratio=20.0,
+            repeats=2,
+        ),
+        Workload(
+            name="skid_steer: dead reckoning (250k)", group="-",
+            run=lambda: ss.dead_reckoning(V, 2e-4), n=N_EST, bytes_moved=N_EST * (6 + 16) * F8,
+            alternative=lambda: _sequential_dead_reckoning(V[:N_ALT], 2e-4), n_alt=N_ALT,
+            alternative_name="sequential product loop",
+        ),
+    ]  # fmt: skip

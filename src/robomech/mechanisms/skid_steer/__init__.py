@@ -1,0 +1,59 @@
+"""Paper 4: the six-wheel skid-steer wheel-track exploration robot.
+
+Velocity kinematics from the wheel chains (rear wheels on rockers, road wheels on a parallelogram bogie)
+with instantaneously coincident contact frames, stacked into the 30×11 system ``A0 ṗ = J q̇`` and
+solved per sample by batched Householder QR; skid-steer turning; dead reckoning.
+See ``docs/mechanisms/skid_steer.md``.
+"""
+
+from ._chains import CONFIG_SIZE, N_WHEELS, SIDE_JOINTS, WHEEL_SIDE, WHEELS, contact_frames, wheel_jacobians
+from ._params import ExplorationRobot
+from ._skid import (
+    STRAIGHT_RTOL,
+    SkidSteerTurn,
+    dead_reckoning,
+    paper_lateral_slip,
+    skid_steer_turn,
+    wheel_lateral_velocity,
+)
+from ._velocity import (
+    I_ROCKER1,
+    I_ROCKER2,
+    I_ROLL,
+    I_YAW,
+    MEASURED_SIZE,
+    N_ROWS,
+    UNKNOWN_SIZE,
+    BodyVelocity,
+    assemble,
+    body_velocity,
+    wheel_measurements,
+)
+
+__all__ = [
+    "CONFIG_SIZE",
+    "I_ROCKER1",
+    "I_ROCKER2",
+    "I_ROLL",
+    "I_YAW",
+    "MEASURED_SIZE",
+    "N_ROWS",
+    "N_WHEELS",
+    "SIDE_JOINTS",
+    "STRAIGHT_RTOL",
+    "UNKNOWN_SIZE",
+    "WHEELS",
+    "WHEEL_SIDE",
+    "BodyVelocity",
+    "ExplorationRobot",
+    "SkidSteerTurn",
+    "assemble",
+    "body_velocity",
+    "contact_frames",
+    "dead_reckoning",
+    "paper_lateral_slip",
+    "skid_steer_turn",
+    "wheel_jacobians",
+    "wheel_lateral_velocity",
+    "wheel_measurements",
+]

@@ -1,0 +1,99 @@
+"""Skid steering (turning from the two track speeds, lateral slip) and dead reckoning of the body pose."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array, check_positive
+from robomech.spatial import exp_se3
+
+__all__ = ["STRAIGHT_RTOL", "SkidSteerTurn", "dead_reckoning", "paper_lateral_slip", "skid_steer_turn",
+           "wheel_lateral_velocity"]
+
+# Track speeds whose difference is below this fraction of their magnitude are "straight": the radius
+# (S/2)(v1+v2)/(v1-v2) would then be dominated by the rounding of v1 - v2 (relative 1e-13 ~ 500 eps).
+STRAIGHT_RTOL = 1e-13
+
+
+@dataclass(frozen=True)
+class SkidSteerTurn:
+    """Turning of a skid-steered body from its right/left track speeds (batch shape ``...``).
+
+    ``yaw_rate = (v1 - v2)/S`` (rad/s, positive counter-clockwise about body z, i.e. turning left);
+    ``forward_speed = (v1 + v2)/2`` of the body centre; ``radius`` of the body centre's path, signed
+    (positive: centre of rotation on the left), ``inf`` where ``turning`` is false (straight or at rest).
+    """
+
+    yaw_rate: np.ndarray
+    forward_speed: np.ndarray
+    radius: np.ndarray
+    turning: np.ndarray
+
+
+def skid_steer_turn(v_right: object, v_left: object, track_width: float) -> SkidSteerTurn:
+    """Yaw rate, speed and turning radius of the body centre from the right (``v1``) and left (``v2``)
+    track speeds (m/s), for tracks ``track_width`` (m) apart, assuming no longitudinal slip.
+
+    paper 4, Sec. 1.2: printed ``R_s = (S/2)(v1+v2)/(v1-v2)`` is called the inner wheel's radius; it is
+    the radius of the body centre (the inner track runs at ``R_s - S/2``).  Printed ``ω = 2 v_X / L``;
+    the yaw rate consistent with the geometry is ``(v1 - v2)/S``.
+    """
+    v1 = as_array(v_right, "v_right")
+    v2 = as_array(v_left, "v_left")
+    S = check_positive(track_width, "track_width")
+    diff = v1 - v2
+    total = v1 + v2
+    turning = np.abs(diff) > STRAIGHT_RTOL * (np.abs(v1) + np.abs(v2))
+    # paper 4, Sec. 1.2: printed R_s (same formula) is called the inner wheel's radius; it is the centre's.
+    radius = np.where(turning, 0.5 * S * total / np.where(turning, diff, 1.0), np.inf)
+    # paper 4, Sec. 1.2: printed ω = 2 v_X / L; the yaw rate consistent with the geometry is (v1 - v2)/S.
+    return SkidSteerTurn(yaw_rate=diff / S, forward_speed=0.5 * total, radius=radius, turning=turning)
+
+
+def wheel_lateral_velocity(yaw_rate: object, wheel_x: object, icr_x: object = 0.0) -> np.ndarray:
+    """Lateral (body y) sliding velocity of a contact at body ``x = wheel_x`` (m) of a body turning at
+    ``yaw_rate`` about a centre of rotation at longitudinal position ``icr_x`` (m): ``r (x_w - x_icr)``.
+
+    Planar rigid motion: the velocity of point ``p`` is ``r z × (p - p_icr)``, whose y part is this.
+    """
+    r = as_array(yaw_rate, "yaw_rate")
+    x = as_array(wheel_x, "wheel_x")
+    xi = as_array(icr_x, "icr_x")
+    return r * (x - xi)
+
+
+def paper_lateral_slip(v_outer: object, wheelbase: float, radius: object, track_width: float) -> np.ndarray:
+    """paper 4, Sec. 1.2: ``v_Y = v_X L / (2 R_s + S)``, magnitude of the lateral slip of an outer
+    wheel a distance ``L/2`` ahead of or behind the centre of rotation, with ``R_s`` the radius of the
+    body centre (not of the inner wheel, as printed)."""
+    v = as_array(v_outer, "v_outer")
+    R = as_array(radius, "radius")
+    L = check_positive(wheelbase, "wheelbase")
+    S = check_positive(track_width, "track_width")
+    return v * L / (2.0 * R + S)
+
+
+def dead_reckoning(twists: object, dt: float, T0: object | None = None) -> np.ndarray:
+    """Body poses ``T_GB (..., N, 4, 4)`` from body twists ``[ω; v]`` ``(..., N, 6)`` sampled every ``dt`` s.
+
+    Between samples the twist is taken as the mean of its end values (second order in ``dt``):
+    ``T_{k+1} = T_k exp(dt (V_k + V_{k+1})/2)``.  The running product is evaluated as a parallel prefix
+    scan (``log2 N`` batched matrix products), so there is no Python loop over samples.
+    """
+    V = as_array(twists, "twists", (None, 6), min_ndim=2)
+    h = check_positive(dt, "dt")
+    n = V.shape[-2]
+    T0a = np.eye(4) if T0 is None else as_array(T0, "T0", (4, 4))
+    out = np.empty((*np.broadcast_shapes(V.shape[:-2], T0a.shape[:-2]), n, 4, 4))
+    out[..., 0, :, :] = T0a
+    if n == 1:
+        return out
+    P = exp_se3(0.5 * h * (V[..., :-1, :] + V[..., 1:, :]))  # increments D_k, (..., n-1, 4, 4)
+    shift = 1
+    while shift < n - 1:
+        P[..., shift:, :, :] = P[..., :-shift, :, :] @ P[..., shift:, :, :]
+        shift *= 2
+    out[..., 1:, :, :] = T0a[..., None, :, :] @ P
+    return out

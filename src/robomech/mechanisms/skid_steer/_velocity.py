@@ -1,0 +1,234 @@
+"""Composite velocity system ``A0 ṗ = J q̇`` of the six wheels and its batched least-squares solution.
+
+Unknowns ``ṗ (..., 11)`` (paper 4, eq. (5) order):
+``[v_BX, v_BY, v_BZ, ω_BX, ω_BZ, θ̇01_1, θ̇02_1, θ̇01_2, θ̇02_2, ṡ_1, ṡ_2]``.
+
+Measurements ``q̇ (..., 22)``: the contact-frame velocity of each wheel (3 per wheel, in its contact
+frame, wheel order ``WHEELS``), then ``ω1, ω2`` (pitch rate of each rocker relative to the ground),
+``ω`` (body yaw rate ω_BZ) and the body roll rate ω_BX (added to the paper's 21, see the docs).
+
+Rows (5 per wheel, paper order ``[v_X, v_Y, v_Z, ω_X, ω_Z]`` in body axes), for contact ``p`` of wheel w:
+``v_B + ω_B × p + Σ_chain G q̇_chain = R_BP v_P`` and ``ω_BX = roll``, ``ω_BZ = yaw``.  The differential
+makes the rockers turn oppositely relative to the body, so ``ω_BY = (ω1 + ω2)/2`` and
+``θ̇_i = ω_i - ω_BY`` are known; their terms go to the right-hand side.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from robomech._validation import as_array
+from robomech.analysis import lstsq
+
+from ._chains import CONFIG_SIZE, N_WHEELS, _linear_columns
+from ._params import ExplorationRobot
+
+__all__ = [
+    "I_ROCKER1",
+    "I_ROCKER2",
+    "I_ROLL",
+    "I_YAW",
+    "MEASURED_SIZE",
+    "N_ROWS",
+    "UNKNOWN_SIZE",
+    "BodyVelocity",
+    "assemble",
+    "body_velocity",
+    "wheel_measurements",
+]
+
+N_ROWS = 5 * N_WHEELS  # 30
+UNKNOWN_SIZE = 11
+MEASURED_SIZE = 3 * N_WHEELS + 4  # 22
+# Column indices in the measured vector.
+I_ROCKER1, I_ROCKER2, I_YAW, I_ROLL = 18, 19, 20, 21
+# Samples per block in body_velocity: the (block, 30, 11) and (block, 30, 22) systems (6 MB) stay in
+# cache while they are assembled and solved; one 250,000-sample block ran ~2x slower (strided writes).
+CHUNK = 8192
+# Samples per block of a bare assembly (8 kB of output per sample stays in the 2 MB L2 cache).
+ASSEMBLY_CHUNK = 256
+# Unknown indices of each side's passive rates (θ̇01, θ̇02, ṡ).
+_PASSIVE = ((5, 6, 9), (7, 8, 10))
+
+
+def assemble(robot: ExplorationRobot, config: object) -> tuple[np.ndarray, np.ndarray]:
+    """``A0 (..., 30, 11)`` and ``J (..., 30, 22)`` of the composite system at ``config (..., 8)``."""
+    q = as_array(config, "config", (CONFIG_SIZE,))
+    batch = q.shape[:-1]
+    n = int(np.prod(batch))
+    qf = q.reshape(n, CONFIG_SIZE)
+    A0 = np.empty((n, N_ROWS, UNKNOWN_SIZE))
+    J = np.empty((n, N_ROWS, MEASURED_SIZE))
+    for start in range(0, n, ASSEMBLY_CHUNK):
+        sl = slice(start, start + ASSEMBLY_CHUNK)
+        A0[sl], J[sl] = _assemble(robot, qf[sl])
+    return A0.reshape(*batch, N_ROWS, UNKNOWN_SIZE), J.reshape(*batch, N_ROWS, MEASURED_SIZE)
+
+
+def _assemble(robot: ExplorationRobot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    batch = q.shape[:-1]
+    p, alpha, G = _linear_columns(robot, q)
+    A0 = np.zeros((*batch, N_ROWS, UNKNOWN_SIZE))
+    J = np.zeros((*batch, N_ROWS, MEASURED_SIZE))
+    c, s = np.cos(alpha), np.sin(alpha)
+    px, py, pz = p[..., 0], p[..., 1], p[..., 2]
+    for w in range(N_WHEELS):
+        side = w // 3
+        r = 5 * w
+        # v_B
+        A0[..., r, 0] = 1.0
+        A0[..., r + 1, 1] = 1.0
+        A0[..., r + 2, 2] = 1.0
+        # ω_BX x × p = (0, -p_z, p_y); ω_BZ z × p = (-p_y, p_x, 0)
+        A0[..., r + 1, 3] = -pz[..., w]
+        A0[..., r + 2, 3] = py[..., w]
+        A0[..., r, 4] = -py[..., w]
+        A0[..., r + 1, 4] = px[..., w]
+        # passive chain rates: (θ̇01, θ̇02, ṡ) are side joints 1, 2, 3
+        for j, col in zip((1, 2, 3), _PASSIVE[side], strict=True):
+            A0[..., r, col] = G[..., w, 0, j]
+            A0[..., r + 2, col] = G[..., w, 1, j]
+        # angular rows.  paper 4, eqs. (1)-(2): printed ω_BX = sin(α) ω, ω_BZ = cos(α) ω (contact frames
+        # not rolling relative to the ground); that cannot hold for all wheels once their α differ, so the
+        # rows are ω_BX = measured roll rate, ω_BZ = measured yaw rate (22 measurements, not 21).
+        A0[..., r + 3, 3] = 1.0
+        A0[..., r + 4, 4] = 1.0
+        # right-hand side: R_BP v_P with R_BP = rot_y(α)
+        k = 3 * w
+        J[..., r, k] = c[..., w]
+        J[..., r, k + 2] = s[..., w]
+        J[..., r + 1, k + 1] = 1.0
+        J[..., r + 2, k] = -s[..., w]
+        J[..., r + 2, k + 2] = c[..., w]
+        # rocker terms: -(ω_BY y × p + θ̇_i G_θ) with ω_BY = (ω1+ω2)/2, θ̇_i = ω_i - ω_BY.  Since the
+        # rocker pivot lies on the body y axis, G_θ = y × p and the sum is -ω_i (y × p): each wheel
+        # sees only its own rocker's absolute pitch rate.
+        # paper 4, eq. (1): printed zero columns for the rocker rate ω1 in the linear rows; the rocker
+        # carries the wheel, so its rate enters.  Printed ω_BY = -(ω1+ω2)/2: here ω_i are right-handed about
+        # +y, so ω_BY = +(ω1+ω2)/2.
+        own = I_ROCKER1 if side == 0 else I_ROCKER2
+        J[..., r, own] = -G[..., w, 0, 0]
+        J[..., r + 2, own] = -G[..., w, 1, 0]
+        J[..., r + 3, I_ROLL] = 1.0
+        J[..., r + 4, I_YAW] = 1.0
+    return A0, J
+
+
+def wheel_measurements(
+    robot: ExplorationRobot, config: object, twist: object, config_rate: object
+) -> np.ndarray:
+    """Exact measurements ``q̇ (..., 22)`` of a known motion (the forward velocity map).
+
+    ``twist (..., 6)`` = ``[ω_B; v_B]`` of the body relative to the ground in body axes (``v_B`` the
+    velocity of the body centre); ``config_rate (..., 8)`` the joint rates.  :func:`body_velocity`
+    recovers everything from these except that it reports ``ω_BY = (ω1 + ω2)/2``, which is the true
+    pitch rate only when the differential holds (``θ̇2 = -θ̇1``).
+    """
+    q = as_array(config, "config", (CONFIG_SIZE,))
+    V = as_array(twist, "twist", (6,))
+    qd = as_array(config_rate, "config_rate", (CONFIG_SIZE,))
+    p, alpha, G = _linear_columns(robot, q)
+    w_B, v_B = V[..., None, :3], V[..., None, 3:]
+    v = v_B + np.cross(w_B, p)  # (..., 6, 3)
+    side_rates = np.stack([qd[..., 4 * (w // 3) : 4 * (w // 3) + 4] for w in range(N_WHEELS)], -2)
+    vx = v[..., 0] + np.einsum("...wj,...wj->...w", G[..., 0, :], side_rates)
+    vz = v[..., 2] + np.einsum("...wj,...wj->...w", G[..., 1, :], side_rates)
+    c, s = np.cos(alpha), np.sin(alpha)
+    # v_P = R_PB v with R_PB = rot_y(α)^T
+    vp = np.stack([c * vx - s * vz, v[..., 1], s * vx + c * vz], axis=-1)
+    out = np.empty((*np.broadcast_shapes(vp.shape[:-2], V.shape[:-1]), MEASURED_SIZE))
+    out[..., :18] = vp.reshape(*vp.shape[:-2], 18)
+    out[..., I_ROCKER1] = V[..., 1] + qd[..., 0]
+    out[..., I_ROCKER2] = V[..., 1] + qd[..., 4]
+    out[..., I_YAW] = V[..., 2]
+    out[..., I_ROLL] = V[..., 0]
+    return out
+
+
+@dataclass(frozen=True)
+class BodyVelocity:
+    """Estimated body motion per sample (batch shape ``...``).
+
+    ``twist (..., 6)``: ``[ω_B; v_B]`` in body axes (ω_BY from the rockers, the rest estimated);
+    ``config_rate (..., 8)``: all joint rates (rockers from ω1, ω2; the rest estimated);
+    ``unknowns (..., 11)``: the least-squares solution in paper order; ``residual_norm`` ``‖A0 ṗ - J q̇‖``
+    (m/s and rad/s mixed, as in the paper); ``cond``: condition number of ``A0``; ``valid``: finite
+    inputs and full-rank ``A0`` (NaN entries appear only where ``valid`` is false; ``cond`` is NaN only
+    for non-finite inputs).
+    """
+
+    twist: np.ndarray
+    config_rate: np.ndarray
+    unknowns: np.ndarray
+    residual_norm: np.ndarray
+    cond: np.ndarray
+    valid: np.ndarray
+
+
+def body_velocity(
+    robot: ExplorationRobot,
+    state: object,
+    measured: object,
+    *,
+    solver: Literal["qr", "normal_equations"] = "qr",
+    diagnostics: bool = True,
+) -> BodyVelocity:
+    """Body twist and passive joint rates from wheel and rocker measurements, per sample.
+
+    ``state (..., 8)`` is the joint configuration, ``measured (..., 22)`` the measured vector (module
+    docstring).  ``solver="qr"`` uses Householder QR (``robomech.analysis.lstsq.solve``, paper 4,
+    Sec. 2.1); ``"normal_equations"`` the textbook ``(A0ᵀA0)⁻¹A0ᵀ`` for comparison.  Non-finite
+    samples (sensor drop-outs) are flagged by ``valid`` instead of raising.  ``diagnostics=False``
+    estimates ``cond`` from the diagonal of R (QR only; cheaper).
+    """
+    q = as_array(state, "state", (CONFIG_SIZE,), finite=False)
+    m = as_array(measured, "measured", (MEASURED_SIZE,), finite=False)
+    if solver not in ("qr", "normal_equations"):
+        raise ValueError(f"Expected solver 'qr' or 'normal_equations', got {solver!r}.")
+    batch = np.broadcast_shapes(q.shape[:-1], m.shape[:-1])
+    n = int(np.prod(batch))
+    qf = np.broadcast_to(q, (*batch, CONFIG_SIZE)).reshape(n, CONFIG_SIZE)
+    mf = np.broadcast_to(m, (*batch, MEASURED_SIZE)).reshape(n, MEASURED_SIZE)
+    x = np.empty((n, UNKNOWN_SIZE))
+    resid = np.empty(n)
+    cond = np.empty(n)
+    valid = np.empty(n, dtype=bool)
+    for start in range(0, n, CHUNK):
+        sl = slice(start, start + CHUNK)
+        qc, mc = qf[sl], mf[sl]
+        finite_q = np.all(np.isfinite(qc), axis=-1)
+        A0, J = _assemble(robot, np.where(finite_q[:, None], qc, 0.0))
+        A0[~finite_q] = np.nan  # flagged by lstsq as not ok
+        b = np.einsum("nij,nj->ni", J, mc)
+        if solver == "qr":
+            res = lstsq.solve(A0, b, diagnostics=diagnostics)
+        else:
+            res = lstsq.solve_normal_equations(A0, b)
+        x[sl] = res.x
+        resid[sl] = res.residual_norm
+        # the condition number stays reported for finite rank-deficient samples (huge or inf)
+        cond[sl] = np.where(res.ok, res.cond, np.nan)
+        valid[sl] = res.ok & res.full_rank
+    x = x.reshape(*batch, UNKNOWN_SIZE)
+    valid = valid.reshape(batch)
+    w_by = 0.5 * (m[..., I_ROCKER1] + m[..., I_ROCKER2])
+    w_by = np.broadcast_to(w_by, batch)
+    twist = np.stack([x[..., 3], w_by, x[..., 4], x[..., 0], x[..., 1], x[..., 2]], axis=-1)
+    rate = np.empty((*batch, CONFIG_SIZE))
+    rate[..., 0] = m[..., I_ROCKER1] - w_by
+    rate[..., 4] = m[..., I_ROCKER2] - w_by
+    for side in range(2):
+        for j, col in zip((1, 2, 3), _PASSIVE[side], strict=True):
+            rate[..., 4 * side + j] = x[..., col]
+    nan = np.nan
+    return BodyVelocity(
+        twist=np.where(valid[..., None], twist, nan),
+        config_rate=np.where(valid[..., None], rate, nan),
+        unknowns=np.where(valid[..., None], x, nan),
+        residual_norm=np.where(valid, resid.reshape(batch), nan),
+        cond=cond.reshape(batch),
+        valid=valid,
+    )
