@@ -206,7 +206,7 @@ def simulate(
     stencil = (-2, -1, 1, 2)
     weights = np.array([1.0, -8.0, 8.0, -1.0]) / (12.0 * h)
     T_GB, q, res, conv = _pose_and_config(robot, terrain, t, u, v, r)
-    P = (T_GB[..., None, :, :] @ _contacts_in_body(robot, q))
+    P = T_GB[..., None, :, :] @ _contacts_in_body(robot, q)
     dT = np.zeros_like(T_GB)
     dq = np.zeros_like(q)
     dP = np.zeros((n, 6, 3))
@@ -269,12 +269,26 @@ def run_checks(
     gt = simulate(robot, duration=10.0, rate=200.0)
     name = "skid-steer"
     contact = float(np.max(np.abs(gt.contact_residual)))
-    checks = [Check(name, "ground truth: contact height residual (m)", contact, TOL_CONTACT,
-                    f"{gt.t.size} samples, converged {bool(np.all(gt.converged))}")]
+    checks = [
+        Check(
+            name,
+            "ground truth: contact height residual (m)",
+            contact,
+            TOL_CONTACT,
+            f"{gt.t.size} samples, converged {bool(np.all(gt.converged))}",
+        )
+    ]
     bv = body_velocity(est, gt.config, gt.measured)
     err = np.where(bv.valid[:, None], np.abs(bv.twist - gt.twist), np.inf)
-    checks.append(Check(name, "noise-free body twist vs truth (m/s, rad/s)", float(np.max(err)), TOL_ESTIMATE,
-                        f"max cond(A0) {np.nanmax(bv.cond):.1f}"))
+    checks.append(
+        Check(
+            name,
+            "noise-free body twist vs truth (m/s, rad/s)",
+            float(np.max(err)),
+            TOL_ESTIMATE,
+            f"max cond(A0) {np.nanmax(bv.cond):.1f}",
+        )
+    )
     err = np.where(bv.valid[:, None], np.abs(bv.config_rate - gt.config_rate), np.inf)
     checks.append(Check(name, "noise-free joint rates vs truth (rad/s, m/s)", float(np.max(err)), TOL_RATES))
     T = dead_reckoning(gt.twist, gt.t[1] - gt.t[0], gt.T_GB[0])
@@ -283,8 +297,14 @@ def run_checks(
     flat = simulate(robot, duration=2.0, rate=100.0, terrain=Terrain.flat())
     vx = flat.measured[:, :18].reshape(-1, 6, 3)[..., 0]
     turn = skid_steer_turn(vx[:, :3].mean(axis=1), vx[:, 3:].mean(axis=1), est.track_width)
-    checks.append(Check(name, "flat ground: yaw rate (v1-v2)/S vs truth (rad/s)",
-                        float(np.max(np.abs(turn.yaw_rate - flat.twist[:, 2]))), TOL_SKID))
+    checks.append(
+        Check(
+            name,
+            "flat ground: yaw rate (v1-v2)/S vs truth (rad/s)",
+            float(np.max(np.abs(turn.yaw_rate - flat.twist[:, 2]))),
+            TOL_SKID,
+        )
+    )
     return checks
 
 

@@ -34,7 +34,12 @@ N_WHEELS = 6
 # Wheel order of the paper's measured vector (eq. (5)): right front road wheel A_F1, right rear road
 # wheel A_H1, right rear wheel P1, then the same on the left side.
 WHEELS = (
-    "front_road_right", "rear_road_right", "rear_right", "front_road_left", "rear_road_left", "rear_left"
+    "front_road_right",
+    "rear_road_right",
+    "rear_right",
+    "front_road_left",
+    "rear_road_left",
+    "rear_left",
 )
 WHEEL_SIDE = (0, 0, 0, 1, 1, 1)
 SIDE_JOINTS = ("rocker", "bogie", "side_link", "rear_slide")

@@ -9,8 +9,14 @@ import numpy as np
 from robomech._validation import as_array, check_positive
 from robomech.spatial import exp_se3
 
-__all__ = ["STRAIGHT_RTOL", "SkidSteerTurn", "dead_reckoning", "paper_lateral_slip", "skid_steer_turn",
-           "wheel_lateral_velocity"]
+__all__ = [
+    "STRAIGHT_RTOL",
+    "SkidSteerTurn",
+    "dead_reckoning",
+    "paper_lateral_slip",
+    "skid_steer_turn",
+    "wheel_lateral_velocity",
+]
 
 # Track speeds whose difference is below this fraction of their magnitude are "straight": the radius
 # (S/2)(v1+v2)/(v1-v2) would then be dominated by the rounding of v1 - v2 (relative 1e-13 ~ 500 eps).
