@@ -18,6 +18,7 @@ from ._dynamics import (
     mass_matrix,
     static_torques,
 )
+from ._joints import TREE_JOINTS, JointMotion, joint_motion
 from ._kinematics import (
     IKResult,
     foot_acceleration,
@@ -41,10 +42,12 @@ from ._trajectories import (
 
 __all__ = [
     "BODY_NAMES",
+    "TREE_JOINTS",
     "DynamicsResult",
     "FootForceResult",
     "GaitProfile",
     "IKResult",
+    "JointMotion",
     "OmniLeg",
     "RigidBody",
     "ShankResult",
@@ -64,6 +67,7 @@ __all__ = [
     "inverse_dynamics",
     "inverse_kinematics",
     "jacobian",
+    "joint_motion",
     "joint_trajectory_eq52",
     "mass_matrix",
     "passive_angles",

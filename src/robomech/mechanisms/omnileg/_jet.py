@@ -166,3 +166,13 @@ def dot(a: Jet, b: Jet | Array) -> Jet:
 def columns(*cols: Jet) -> Jet:
     """A 3x3 matrix jet with the given column vectors (each value (..., 3))."""
     return Jet(*(np.stack([getattr(c, k) for c in cols], axis=-1) for k in ("v", "vd", "vdd", "g")))
+
+
+def atan2(y: Jet, x: Jet) -> Jet:
+    """``atan2(y, x)`` of two scalar jets (x² + y² > 0)."""
+    r2 = x.v * x.v + y.v * y.v
+    num_d = x.v * y.vd - y.v * x.vd
+    vd = num_d / r2
+    vdd = (x.v * y.vdd - y.v * x.vdd) / r2 - num_d * 2.0 * (x.v * x.vd + y.v * y.vd) / (r2 * r2)
+    g = (x.v * y.g - y.v * x.g) / r2
+    return Jet(np.arctan2(y.v, x.v), vd, vdd, g)
