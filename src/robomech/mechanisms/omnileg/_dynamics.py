@@ -50,6 +50,11 @@ SINGULAR_RCOND = 1e-3
 DAMPING_RELATIVE = SINGULAR_RCOND
 
 
+# Samples per chunk of the dynamics kernel: its temporaries are (3, N, 3, 3) arrays per body; measured
+# 45 us/sample at 4k-16k samples against 140 us/sample for one 1e5-sample block (cache misses).
+DYN_CHUNK = 8192
+
+
 def _body_list() -> list[tuple[str, str]]:
     """(instance name, parameter key) of the 22 bodies, in a fixed order."""
     out = []
@@ -183,18 +188,31 @@ def _terms(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> _Ter
         Rt = np.swapaxes(R.v, -1, -2)
         w = _vee(R.vd @ Rt)  # space angular velocity (N, 3)
         wd = _vee(R.vdd @ Rt)  # its time derivative (Ṙ Ṙᵀ is symmetric and drops out)
-        Jw = _vee(R.g @ Rt)  # (3, N, 3): ∂ω/∂q̇_k
+        JwT = np.moveaxis(_vee(R.g @ Rt), 0, 1)  # (N, 3 q, 3 xyz): row k = ∂ω/∂q̇_k
+        JvT = np.moveaxis(p.g, 0, 1)  # (N, 3 q, 3 xyz): row k = ∂p/∂q_k
         I_s = R.v @ body.inertia_matrix @ Rt
-        Iw = np.einsum("nij,nj->ni", I_s, w)
-        h = np.einsum("nij,nj->ni", I_s, wd) + np.cross(w, Iw)
-        tau_m += np.einsum("kni,ni->nk", p.g, m * p.vdd) + np.einsum("kni,ni->nk", Jw, h)
-        tau_g -= m * np.einsum("kni,i->nk", p.g, grav)
-        M += m * np.einsum("kni,lni->nkl", p.g, p.g) + np.einsum("kni,nij,lnj->nkl", Jw, I_s, Jw)
-        kin += 0.5 * (m * np.einsum("ni,ni->n", p.vd, p.vd) + np.einsum("ni,ni->n", w, Iw))
+        Iw = (I_s @ w[..., None])[..., 0]
+        h = (I_s @ wd[..., None])[..., 0] + jt._cross3(w, Iw)
+        tau_m += (JvT @ (m * p.vdd)[..., None] + JwT @ h[..., None])[..., 0]
+        tau_g -= m * (JvT @ grav)
+        M += m * (JvT @ np.swapaxes(JvT, -1, -2)) + JwT @ I_s @ np.swapaxes(JwT, -1, -2)
+        kin += 0.5 * (m * np.sum(p.vd * p.vd, axis=-1) + np.sum(w * Iw, axis=-1))
         pot -= m * (p.v @ grav)
         Rs.append(R.v)
         ps.append(p.v)
     return _Terms(tau_m, tau_g, M, kin, pot, np.stack(Rs, axis=1), np.stack(ps, axis=1))
+
+
+def _terms_chunked(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> _Terms:
+    """:func:`_terms` over cache-sized chunks of samples (identical results, far fewer cache misses)."""
+    N = q.shape[0]
+    if N <= DYN_CHUNK:
+        return _terms(leg, q, qd, qdd)
+    parts = [
+        _terms(leg, q[s : s + DYN_CHUNK], qd[s : s + DYN_CHUNK], qdd[s : s + DYN_CHUNK])
+        for s in range(0, N, DYN_CHUNK)
+    ]  # loop over chunks of DYN_CHUNK samples, not over samples
+    return _Terms(*(np.concatenate([getattr(t, f) for t in parts]) for f in _Terms.__dataclass_fields__))
 
 
 def _flat(*arrays: np.ndarray) -> tuple[tuple[int, ...], list[np.ndarray]]:
@@ -206,7 +224,7 @@ def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
     """Body rotations ``R_b (..., 22, 3, 3)`` (in the hip frame) and mass centres ``p_b (..., 22, 3)`` (m)."""
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
-    t = _terms(leg, qf, np.zeros_like(qf), np.zeros_like(qf))
+    t = _terms_chunked(leg, qf, np.zeros_like(qf), np.zeros_like(qf))
     B = len(BODY_NAMES)
     return t.R.reshape(*batch, B, 3, 3), t.p.reshape(*batch, B, 3)
 
@@ -236,7 +254,7 @@ def inverse_dynamics(
     qd = as_array(qd, "qd", (3,))
     qdd = as_array(qdd, "qdd", (3,))
     batch, (qf, qdf, qddf) = _flat(q, qd, qdd)
-    t = _terms(leg, qf, qdf, qddf)
+    t = _terms_chunked(leg, qf, qdf, qddf)
     vel = t.tau_motion - np.einsum("nij,nj->ni", t.M, qddf)
     foot = np.zeros_like(t.tau_motion)
     if foot_force is not None:
@@ -259,7 +277,7 @@ def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
     z = np.zeros_like(qf)
-    return _terms(leg, qf, z, z).M.reshape(*batch, 3, 3)
+    return _terms_chunked(leg, qf, z, z).M.reshape(*batch, 3, 3)
 
 
 def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
@@ -267,7 +285,7 @@ def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
     z = np.zeros_like(qf)
-    return _terms(leg, qf, z, z).tau_gravity.reshape(*batch, 3)
+    return _terms_chunked(leg, qf, z, z).tau_gravity.reshape(*batch, 3)
 
 
 def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
@@ -275,7 +293,7 @@ def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]
     q = as_array(q, "q", (3,))
     qd = as_array(qd, "qd", (3,))
     batch, (qf, qdf) = _flat(q, qd)
-    t = _terms(leg, qf, qdf, np.zeros_like(qf))
+    t = _terms_chunked(leg, qf, qdf, np.zeros_like(qf))
     return t.kinetic.reshape(batch), t.potential.reshape(batch)
 
 

@@ -151,12 +151,23 @@ def matmul(a: Jet | Array, b: Jet | Array) -> Jet:
     return bilinear(a, b, np.matmul)
 
 
+def _matvec(x: Array, y: Array) -> Array:
+    return (x @ y[..., None])[..., 0]
+
+
 def matvec(a: Jet | Array, b: Jet | Array) -> Jet:
-    return bilinear(a, b, lambda x, y: np.einsum("...ij,...j->...i", x, y))
+    return bilinear(a, b, _matvec)
+
+
+def _cross3(x: Array, y: Array) -> Array:
+    """Cross product over the last axis (broadcasting), without np.cross's axis shuffling."""
+    x0, x1, x2 = x[..., 0], x[..., 1], x[..., 2]
+    y0, y1, y2 = y[..., 0], y[..., 1], y[..., 2]
+    return np.stack([x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0], axis=-1)
 
 
 def cross(a: Jet | Array, b: Jet | Array) -> Jet:
-    return bilinear(a, b, lambda x, y: np.cross(x, y))
+    return bilinear(a, b, _cross3)
 
 
 def dot(a: Jet, b: Jet | Array) -> Jet:
