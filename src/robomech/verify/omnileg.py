@@ -12,8 +12,9 @@ Checks (each a :class:`Check` with a named tolerance):
 * kinematics: analytic joint angles in ``qpos`` -> equality-constraint violation ``efc_pos`` and the foot
   site against eq. (11); analytic joint rates in ``qvel`` -> ``efc_J qvel`` and the foot site velocity
   against ``J q̇``;
-* inverse dynamics: the engine's tree inverse dynamics (``mj_inverse`` with constraints disabled) along
-  eq. (52) with Fig. 11's foot force, projected through the constraint Jacobian
+* inverse dynamics: the engine's tree inverse dynamics (``M q̈ + c`` from ``mj_inverse``/``mj_mulM``,
+  constraint forces left out) along eq. (52) with Fig. 11's foot force, projected through the
+  constraint Jacobian
   (``τ_tree = Sᵀ τ + J_cᵀ λ``, least squares) -> motor torques, against the analytic model;
 * forward simulation: the engine driven only by the analytic torques follows eq. (52).
 """
@@ -200,8 +201,10 @@ def engine_inverse_dynamics(
 ) -> np.ndarray:
     """Motor torques (N, 3) from the engine, one sample at a time (the per-sample alternative).
 
-    Per sample: ``mj_forward`` for the constraint Jacobian, ``mj_inverse`` with constraints disabled for
-    the tree forces, then least squares on ``[Sᵀ J_cᵀ] [τ; λ] = τ_tree - J_footᵀ F``.
+    Per sample: ``mj_inverse`` (which also builds the constraint Jacobian ``efc_J``), the tree forces
+    ``τ_tree = M q̈ + c(q, q̇) - J_footᵀ F`` (``mj_mulM`` + ``qfrc_bias``: the constraint forces are left
+    out), then least squares on ``[Sᵀ J_cᵀ] [τ; λ] = τ_tree`` (minimum norm: the thigh's redundant
+    closure rows leave λ, not τ, undetermined).
     """
     m, d = em.model, em.data
     N = jm.q.shape[0]
@@ -210,24 +213,19 @@ def engine_inverse_dynamics(
     S = np.zeros((3, nv))
     S[[0, 1, 2], em.actuated] = 1.0
     jacp = np.zeros((3, nv))
+    Mqacc = np.zeros(nv)
     for n in range(N):  # the per-sample engine loop (this is what the analytic model is compared with)
         _set_state(em, jm.q[n], jm.qd[n], jm.qdd[n])
-        m.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
-        mujoco.mj_forward(m, d)
+        mujoco.mj_inverse(m, d)
         rows = _eq_rows(em)
-        Jc = d.efc_J.reshape(-1, nv)[rows] if d.nefc else np.zeros((0, nv))
-        tree_f = 0.0
+        Jc = d.efc_J.reshape(-1, nv)[rows]
+        mujoco.mj_mulM(m, d, Mqacc, d.qacc)
+        tau_tree = Mqacc + d.qfrc_bias
         if foot_force is not None:
             mujoco.mj_jacSite(m, d, jacp, None, em.foot_site)
-            tree_f = jacp.T @ foot_force[n]
-        m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
-        _set_state(em, jm.q[n], jm.qd[n], jm.qdd[n])
-        mujoco.mj_inverse(m, d)
-        tau_tree = d.qfrc_inverse.copy() - tree_f
-        A = np.vstack([S, Jc]).T
-        sol = np.linalg.lstsq(A, tau_tree, rcond=None)[0]
+            tau_tree = tau_tree - jacp.T @ foot_force[n]
+        sol = np.linalg.lstsq(np.vstack([S, Jc]).T, tau_tree, rcond=None)[0]
         out[n] = sol[:3]
-    m.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
     return out
 
 
@@ -331,7 +329,7 @@ def run() -> list[Check]:
             "motor torques vs engine ID, eq. (52)+Fig.11",
             err,
             TOL_TORQUE,
-            "mj_inverse (constraints off) + least squares through the equality Jacobian",
+            "engine M q̈ + c, least squares through the equality-constraint Jacobian",
         )
     )
     sim = forward_simulation(leg, em)

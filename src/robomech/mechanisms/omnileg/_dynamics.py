@@ -81,10 +81,13 @@ def _body_list() -> list[tuple[str, str]]:
 BODY_NAMES = tuple(name for name, _ in _body_list())
 
 
+Cols = tuple[jt.Jet, jt.Jet, jt.Jet] | None  # the three columns of R_b (None: R_b = I, translation only)
+
+
 def _poses(
     leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray
-) -> list[tuple[jt.Jet, jt.Jet | np.ndarray]]:
-    """(R_b, o_b) jets of every body, in the order of BODY_NAMES; ``q, qd, qdd (N, 3)``."""
+) -> list[tuple[Cols, jt.Jet | np.ndarray]]:
+    """(columns of R_b, o_b) of every body as jets, in the order of BODY_NAMES; ``q, qd, qdd (N, 3)``."""
     alpha, beta, gamma = jt.Jet.variables(q, qd, qdd)
     ta, tb = jt.tan(alpha), jt.tan(beta)
     inv_n = jt.reciprocal(jt.sqrt(ta * ta + tb * tb + 1.0))
@@ -110,50 +113,36 @@ def _poses(
         np.array([leg.L3, 0.0, 0.0]),
         np.array([0.0, -leg.L3, 0.0]),
     ]  # eq. (7)
-    out: list[tuple[jt.Jet, jt.Jet | np.ndarray]] = []
+    out: list[tuple[Cols, jt.Jet | np.ndarray]] = []
     for k in range(3):
         xk = x_axes[k]
         # cross frame columns (x, y, z): x the carried axis, y the fixed axis, z = x × y
-        R_cross = jt.columns(xk, xk * 0.0 + y_axes[k], jt.cross(xk, y_axes[k]))
-        R_rod = jt.columns(xk, jt.cross(u, xk), u)
+        R_cross = (xk, xk * 0.0 + y_axes[k], jt.cross(xk, y_axes[k]))
+        R_rod = (xk, jt.cross(u, xk), u)
         out.append((R_cross, A_pts[k]))
         out.append((R_rod, A_pts[k]))
         out.append((R_cross, knee + A_pts[k]))
-    eye = np.eye(3)
-    out.append((_const_rot(eye, one), knee))
+    out.append((None, knee))
     a1 = jt.stack([-sg, cg, zero])  # Rz(γ) e_y: input yoke arm of the drive cross
-    Rz = jt.columns(jt.stack([cg, sg, zero]), a1, jt.stack([zero, zero, one]))
+    Rz = (jt.stack([cg, sg, zero]), a1, jt.stack([zero, zero, one]))
     n_vec = jt.cross(a1, u)
     a2 = n_vec * jt.reciprocal(jt.sqrt(jt.dot(n_vec, n_vec))).expand()  # rod-side arm, ⟂ a1 and the rod
-    R_dcross = jt.columns(a2, a1, jt.cross(a2, a1))
-    R_drod = jt.columns(a2, jt.cross(u, a2), u)
+    R_dcross = (a2, a1, jt.cross(a2, a1))
+    R_drod = (a2, jt.cross(u, a2), u)
     origin = np.zeros(3)
     out += [(Rz, origin), (R_dcross, origin), (R_drod, origin), (R_dcross, knee), (Rz, knee)]
     S = shank_frames(leg)
     crank_dir = jt.stack([zero, -sg, cg])  # Rx(γ) e_z
-    Rx_p = jt.columns(jt.stack([one, zero, zero]), jt.stack([zero, cg, sg]), jt.stack([zero, -sg, cg]))
-    Rx_m = jt.columns(jt.stack([one, zero, zero]), jt.stack([zero, cg, -sg]), jt.stack([zero, sg, cg]))
+    Rx_p = (jt.stack([one, zero, zero]), jt.stack([zero, cg, sg]), jt.stack([zero, -sg, cg]))
+    Rx_m = (jt.stack([one, zero, zero]), jt.stack([zero, cg, -sg]), jt.stack([zero, sg, cg]))
     for i in range(3):
         C = knee + S[i] @ np.array([leg.shank_radius, 0.0, leg.knee_to_crank])
-        D = C + jt.matvec(S[i], crank_dir) * leg.L4
-        out.append((jt.matmul(S[i], Rx_p), C))
-        out.append((jt.matmul(S[i], Rx_m), D))
+        D = C + jt.rotate_const(S[i], crank_dir) * leg.L4
+        out.append((tuple(jt.rotate_const(S[i], c) for c in Rx_p), C))
+        out.append((tuple(jt.rotate_const(S[i], c) for c in Rx_m), D))
     foot_origin = knee + jt.stack([zero, zero, cg * (2.0 * leg.L4) + leg.knee_to_crank])
-    out.append((_const_rot(eye, one), foot_origin))
+    out.append((None, foot_origin))
     return out
-
-
-def _const_rot(R: np.ndarray, like: jt.Jet) -> jt.Jet:
-    N, n = like.v.shape[0], like.g.shape[0]
-    z = np.zeros((N, 3, 3))
-    return jt.Jet(np.broadcast_to(R, (N, 3, 3)), z, z, np.zeros((n, N, 3, 3)))
-
-
-def _vee(W: np.ndarray) -> np.ndarray:
-    """Axial vector of the antisymmetric part of W (..., 3, 3)."""
-    return 0.5 * np.stack(
-        [W[..., 2, 1] - W[..., 1, 2], W[..., 0, 2] - W[..., 2, 0], W[..., 1, 0] - W[..., 0, 1]], -1
-    )
 
 
 @dataclass(frozen=True)
@@ -163,11 +152,11 @@ class _Terms:
     M: np.ndarray  # (N, 3, 3)
     kinetic: np.ndarray  # (N,)
     potential: np.ndarray  # (N,)
-    R: np.ndarray  # (N, B, 3, 3)
-    p: np.ndarray  # (N, B, 3) centres of mass
+    R: np.ndarray  # (N, B, 3, 3) body rotations (B = 0 unless requested)
+    p: np.ndarray  # (N, B, 3) centres of mass (B = 0 unless requested)
 
 
-def _terms(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> _Terms:
+def _terms(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: bool = False) -> _Terms:
     """Newton-Euler sums over the bodies projected on q (Lagrange's equations), ``q, qd, qdd (N, 3)``.
 
     For body b with centre of mass p_b, rotation R_b and inertia I_b (body axes):
@@ -175,41 +164,75 @@ def _terms(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> _Ter
     """
     grav = np.asarray(leg.gravity)
     N = q.shape[0]
-    tau_m = np.zeros((N, 3))
-    tau_g = np.zeros((N, 3))
-    M = np.zeros((N, 3, 3))
+    tau_m = np.zeros((3, N))
+    tau_g = np.zeros((3, N))
+    M = np.zeros((3, 3, N))
     kin = np.zeros(N)
     pot = np.zeros(N)
+    eye = np.broadcast_to(np.eye(3), (N, 3, 3))
     Rs, ps = [], []
-    for (R, o), (_, key) in zip(_poses(leg, q, qd, qdd), _body_list(), strict=True):
+    groups: dict[int, tuple[Cols, np.ndarray]] = {}
+    for (cols, o), (_, key) in zip(_poses(leg, q, qd, qdd), _body_list(), strict=True):
         body: RigidBody = leg.bodies[key]
         m = body.mass
-        p = jt.matvec(R, body.com_vector) + o
-        Rt = np.swapaxes(R.v, -1, -2)
-        w = _vee(R.vd @ Rt)  # space angular velocity (N, 3)
-        wd = _vee(R.vdd @ Rt)  # its time derivative (Ṙ Ṙᵀ is symmetric and drops out)
-        JwT = np.moveaxis(_vee(R.g @ Rt), 0, 1)  # (N, 3 q, 3 xyz): row k = ∂ω/∂q̇_k
-        JvT = np.moveaxis(p.g, 0, 1)  # (N, 3 q, 3 xyz): row k = ∂p/∂q_k
-        I_s = R.v @ body.inertia_matrix @ Rt
-        Iw = (I_s @ w[..., None])[..., 0]
-        h = (I_s @ wd[..., None])[..., 0] + jt._cross3(w, Iw)
-        tau_m += (JvT @ (m * p.vdd)[..., None] + JwT @ h[..., None])[..., 0]
-        tau_g -= m * (JvT @ grav)
-        M += m * (JvT @ np.swapaxes(JvT, -1, -2)) + JwT @ I_s @ np.swapaxes(JwT, -1, -2)
-        kin += 0.5 * (m * np.sum(p.vd * p.vd, axis=-1) + np.sum(w * Iw, axis=-1))
-        pot -= m * (p.v @ grav)
-        Rs.append(R.v)
-        ps.append(p.v)
-    return _Terms(tau_m, tau_g, M, kin, pot, np.stack(Rs, axis=1), np.stack(ps, axis=1))
+        c = body.com_vector
+        # mass centre p = o + R c = o + Σ_j c_j r_j
+        p = (
+            o + c
+            if cols is None
+            else o + sum((cols[j] * c[j] for j in range(3) if c[j] != 0.0), start=0.0 * c)
+        )
+        if isinstance(p, jt.Jet):
+            tau_m += np.sum(p.g * (m * p.vdd), axis=-1)
+            tau_g -= m * (p.g @ grav)
+            M += m * np.sum(p.g[:, None] * p.g[None, :], axis=-1)
+            kin += 0.5 * m * np.sum(p.vd * p.vd, axis=-1)
+            pot -= m * (p.v @ grav)
+            if poses:
+                ps.append(p.v)
+        else:  # a mass centre fixed in the hip frame (the hip crosses): potential only
+            pot -= m * float(np.asarray(p) @ grav)
+            if poses:
+                ps.append(np.broadcast_to(np.asarray(p, dtype=float), (N, 3)))
+        if poses:
+            Rs.append(eye if cols is None else np.stack([r.v for r in cols], axis=-1))
+        if cols is None:
+            continue
+        # bodies turning together (a U-joint's two crosses, the drive's two crosses and two shafts) share
+        # one set of columns: their rotational terms are linear in the inertia, so sum the inertias
+        key_cols = id(cols)
+        if key_cols in groups:
+            groups[key_cols] = (cols, groups[key_cols][1] + body.inertia_matrix)
+        else:
+            groups[key_cols] = (cols, body.inertia_matrix)
+    for cols, Iner in groups.values():
+        # ω = ½ Σ_j r_j × ṙ_j, ω̇ = ½ Σ_j r_j × r̈_j, ∂ω/∂q̇_k = ½ Σ_j r_j × ∂r_j/∂q_k  (columns r_j of R)
+        w = 0.5 * sum(jt._cross3(r.v, r.vd) for r in cols)
+        wd = 0.5 * sum(jt._cross3(r.v, r.vdd) for r in cols)
+        Jw = 0.5 * sum(jt._cross3(r.v, r.g) for r in cols)  # (3 q, N, 3 xyz)
+        # body-frame components x_b = Rᵀ x; the inertia then acts as a constant 3x3 matrix (BLAS)
+        wb = np.stack([np.sum(r.v * w, axis=-1) for r in cols], axis=-1)
+        wdb = np.stack([np.sum(r.v * wd, axis=-1) for r in cols], axis=-1)
+        Jwb = np.stack([np.sum(r.v * Jw, axis=-1) for r in cols], axis=-1)  # (3 q, N, 3 body)
+        Iwb = wb @ Iner.T
+        hb = wdb @ Iner.T + jt._cross3(wb, Iwb)  # I ω̇ + ω × I ω in body axes
+        tau_m += np.sum(Jwb * hb, axis=-1)
+        M += np.sum((Jwb @ Iner.T)[:, None] * Jwb[None, :], axis=-1)
+        kin += 0.5 * np.sum(wb * Iwb, axis=-1)
+    R_all = np.stack(Rs, axis=1) if poses else np.zeros((N, 0, 3, 3))
+    p_all = np.stack(ps, axis=1) if poses else np.zeros((N, 0, 3))
+    return _Terms(tau_m.T, tau_g.T, np.moveaxis(M, -1, 0), kin, pot, R_all, p_all)
 
 
-def _terms_chunked(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> _Terms:
+def _terms_chunked(
+    leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: bool = False
+) -> _Terms:
     """:func:`_terms` over cache-sized chunks of samples (identical results, far fewer cache misses)."""
     N = q.shape[0]
     if N <= DYN_CHUNK:
-        return _terms(leg, q, qd, qdd)
+        return _terms(leg, q, qd, qdd, poses)
     parts = [
-        _terms(leg, q[s : s + DYN_CHUNK], qd[s : s + DYN_CHUNK], qdd[s : s + DYN_CHUNK])
+        _terms(leg, q[s : s + DYN_CHUNK], qd[s : s + DYN_CHUNK], qdd[s : s + DYN_CHUNK], poses)
         for s in range(0, N, DYN_CHUNK)
     ]  # loop over chunks of DYN_CHUNK samples, not over samples
     return _Terms(*(np.concatenate([getattr(t, f) for t in parts]) for f in _Terms.__dataclass_fields__))
@@ -224,7 +247,7 @@ def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
     """Body rotations ``R_b (..., 22, 3, 3)`` (in the hip frame) and mass centres ``p_b (..., 22, 3)`` (m)."""
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
-    t = _terms_chunked(leg, qf, np.zeros_like(qf), np.zeros_like(qf))
+    t = _terms_chunked(leg, qf, np.zeros_like(qf), np.zeros_like(qf), poses=True)
     B = len(BODY_NAMES)
     return t.R.reshape(*batch, B, 3, 3), t.p.reshape(*batch, B, 3)
 

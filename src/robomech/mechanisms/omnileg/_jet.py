@@ -25,6 +25,9 @@ class Jet:
     vdd: Array
     g: Array
 
+    # ndarray (+, *) Jet must call Jet's reflected operators, not broadcast the Jet as an object
+    __array_ufunc__ = None
+
     @staticmethod
     def variables(q: Array, qd: Array, qdd: Array) -> list[Jet]:
         """The coordinates themselves: one jet per column of ``q (N, n)`` (flattened batch)."""
@@ -187,3 +190,9 @@ def atan2(y: Jet, x: Jet) -> Jet:
     vdd = (x.v * y.vdd - y.v * x.vdd) / r2 - num_d * 2.0 * (x.v * x.vd + y.v * y.vd) / (r2 * r2)
     g = (x.v * y.g - y.v * x.g) / r2
     return Jet(np.arctan2(y.v, x.v), vd, vdd, g)
+
+
+def rotate_const(S: Array, x: Jet) -> Jet:
+    """``S x`` for a constant matrix ``S (3, 3)`` and a vector jet (as one BLAS product per part)."""
+    St = np.asarray(S, dtype=float).T
+    return Jet(x.v @ St, x.vd @ St, x.vdd @ St, x.g @ St)
