@@ -90,7 +90,8 @@ def workloads() -> list[Workload]:
 
     out.append(Workload(name="omnileg: inverse dynamics, eq. (52)", group="3", run=dyn, n=N_DYN,
                         bytes_moved=dyn_bytes, alternative=_engine_loop, n_alt=N_ALT_ENGINE,
-                        alternative_name="MuJoCo ID per-sample loop", target_speedup=5.0, repeats=2))  # fmt: skip
+                        alternative_name="MuJoCo ID per-sample loop", target_speedup=5.0,
+                        repeats=2))  # fmt: skip
     out.append(Workload(name="omnileg: inverse dynamics (vs own loop)", group="3", run=dyn, n=N_DYN,
                         bytes_moved=dyn_bytes, alternative=dyn_loop, n_alt=N_ALT_DYN,
                         alternative_name="per-sample Python loop", repeats=2))  # fmt: skip
