@@ -93,3 +93,20 @@ def test_shank_crank_slider_equals_eq10_and_foot_equals_eq11():
 def test_shank_rejects_flat_crank():
     with pytest.raises(ValueError, match="gamma"):
         ol.shank_crank_slider(LEG, np.pi / 2)
+
+
+def test_joint_motion_rates_are_time_derivatives_and_match_the_closure():
+    t = np.linspace(0.0, 1.0, 2001)
+    dt = t[1] - t[0]
+    q = np.stack([0.6 * np.sin(2 * t), 0.5 * np.cos(3 * t), 0.7 + 0.3 * np.sin(t)], -1)
+    qd = np.stack([1.2 * np.cos(2 * t), -1.5 * np.sin(3 * t), 0.3 * np.cos(t)], -1)
+    qdd = np.stack([-2.4 * np.sin(2 * t), -4.5 * np.cos(3 * t), -0.3 * np.sin(t)], -1)
+    jm = ol.joint_motion(LEG, q, qd, qdd)
+    assert jm.q.shape == (t.size, len(ol.TREE_JOINTS))
+    # central differences in time: error ~dt² q''' / 6 ~ 1e-6
+    np.testing.assert_allclose(jm.qd[1:-1], (jm.q[2:] - jm.q[:-2]) / (2 * dt), atol=1e-5)
+    np.testing.assert_allclose(jm.qdd[1:-1], (jm.qd[2:] - jm.qd[:-2]) / (2 * dt), atol=1e-4)
+    c = ol.thigh_closure(LEG, q[::400, 0], q[::400, 1])
+    # the tree keeps θ11..θ14, θ21..θ23, θ31..θ33 (the closure's theta is (chain, joint) = 3 x 4)
+    np.testing.assert_allclose(jm.q[::400, :10], c.theta.reshape(-1, 12)[:, [0, 1, 2, 3, 4, 5, 6, 8, 9, 10]],
+                               atol=CLOSURE_AGREEMENT)  # fmt: skip

@@ -207,3 +207,17 @@ def test_bad_foot_input_names_p_foot():
         ol.inverse_kinematics(LEG, np.zeros((3, 4)))
     with pytest.raises(ValueError, match="qd"):
         ol.foot_velocity(LEG, np.zeros(3), np.zeros(2))
+
+
+def test_fast_kernels_equal_the_printed_formulas():
+    # the kernels evaluate cos/sin through half-angle tangents (speed); they must equal eq. (11) as printed
+    q = np.concatenate([_rand_q(2000, seed=8), [[0.0, 0.0, 0.0], [1.1, -1.1, 1.4], [-1.5, 1.5, -1.5]]])
+    a, b, g = q[:, 0], q[:, 1], q[:, 2]
+    den = np.sqrt(1 + np.cos(b) ** 2 * np.tan(a) ** 2)
+    printed = np.stack([LEG.L1 * np.sin(b) / den, -LEG.L1 * np.cos(b) * np.tan(a) / den,
+                        LEG.L1 * np.cos(b) / den + 2 * LEG.L4 * np.cos(g) + LEG.L5], -1)  # fmt: skip
+    np.testing.assert_allclose(ol.forward_kinematics(LEG, q), printed, rtol=0, atol=4e-16)
+    np.testing.assert_allclose(ol.jacobian(LEG, q)[:, 2, 2], -2 * LEG.L4 * np.sin(g), rtol=0, atol=1e-16)
+    # chunked evaluation: a batch longer than one chunk gives the same values as small batches
+    big = _rand_q(70000, seed=9)
+    np.testing.assert_array_equal(ol.forward_kinematics(LEG, big)[-5:], ol.forward_kinematics(LEG, big[-5:]))
