@@ -90,9 +90,13 @@ def test_shank_crank_slider_equals_eq10_and_foot_equals_eq11():
     np.testing.assert_allclose(foot, ol.forward_kinematics(LEG, q), atol=CLOSURE_AGREEMENT)
 
 
-def test_shank_rejects_flat_crank():
+def test_shank_flags_flat_crank_per_sample():
+    s = ol.shank_crank_slider(LEG, [0.3, np.pi / 2, -2.0, -0.3])
+    assert s.valid.tolist() == [True, False, False, True]
+    assert np.all(np.isnan(s.slider[~s.valid])) and np.all(np.isfinite(s.slider[s.valid]))
+    assert np.all(np.isnan(s.E[~s.valid]))
     with pytest.raises(ValueError, match="gamma"):
-        ol.shank_crank_slider(LEG, np.pi / 2)
+        ol.shank_crank_slider(LEG, [np.nan])
 
 
 def test_joint_motion_rates_are_time_derivatives_and_match_the_closure():

@@ -161,7 +161,8 @@ class ShankResult:
 
     ``C, D, E (..., 3, 3)`` joint points of chains i = 1..3 (m); ``slider (...)`` the depth of the E
     plane below the C plane (m); ``coupler_angle (...)`` the coupler's angle from Z0' (rad, sign opposite
-    to the crank); ``delta_L2 (...)`` the shank shortening 2 L4 - slider (eq. (10)).
+    to the crank); ``delta_L2 (...)`` the shank shortening 2 L4 - slider (eq. (10)); ``valid (...)``
+    false (and D, E, slider NaN) where |γ| >= π/2, where the chain folds flat.
     """
 
     C: np.ndarray
@@ -170,6 +171,7 @@ class ShankResult:
     slider: np.ndarray
     coupler_angle: np.ndarray
     delta_L2: np.ndarray
+    valid: np.ndarray
 
 
 def shank_frames(leg: OmniLeg) -> np.ndarray:
@@ -184,21 +186,24 @@ def shank_frames(leg: OmniLeg) -> np.ndarray:
 
 
 def shank_crank_slider(leg: OmniLeg, gamma: object) -> ShankResult:
-    """Centred crank-slider of each shank chain for crank angle ``gamma`` (...), rad, |γ| < π/2.
+    """Centred crank-slider of each shank chain for crank angle ``gamma`` (...), rad (valid for |γ| < π/2).
 
     Crank C_iD_i turns by γ about the radial axis X_Ci; the slider position below C_i is the crank-slider
     law ``s = r cos γ + sqrt(l² - (r sin γ)²)`` with r = l = L4, i.e. 2 L4 cos γ (eq. (10)).
     """
-    g = as_array(gamma, "gamma")
-    if np.any(np.abs(g) >= 0.5 * np.pi):
-        raise ValueError("Expected |gamma| < pi/2 (the shank folds flat at 90°), got values outside.")
+    g_in = as_array(gamma, "gamma")
+    valid = np.abs(g_in) < 0.5 * np.pi  # the chain folds flat at |γ| = 90°: outside, flagged and NaN
+    g = np.where(valid, g_in, 0.0)
     r = l = leg.L4
-    slider = r * np.cos(g) + np.sqrt(l * l - (r * np.sin(g)) ** 2)
-    coupler = -np.arcsin(r * np.sin(g) / l)
+    slider = np.where(valid, r * np.cos(g) + np.sqrt(l * l - (r * np.sin(g)) ** 2), np.nan)
+    coupler = np.where(valid, -np.arcsin(r * np.sin(g) / l), np.nan)
     S = shank_frames(leg)
     c0 = np.array([leg.shank_radius, 0.0, leg.knee_to_crank])
     C = np.broadcast_to(np.einsum("kij,j->ki", S, c0), (*g.shape, 3, 3))
     crank_dir = np.stack([np.zeros_like(g), -np.sin(g), np.cos(g)], axis=-1)  # Rx(γ) e_z in the chain frame
     D = C + leg.L4 * np.einsum("kij,...j->...ki", S, crank_dir)
+    D = np.where(valid[..., None, None], D, np.nan)
     E = C + slider[..., None, None] * np.array([0.0, 0.0, 1.0])
-    return ShankResult(C=C, D=D, E=E, slider=slider, coupler_angle=coupler, delta_L2=2.0 * leg.L4 - slider)
+    return ShankResult(
+        C=C, D=D, E=E, slider=slider, coupler_angle=coupler, delta_L2=2.0 * leg.L4 - slider, valid=valid
+    )

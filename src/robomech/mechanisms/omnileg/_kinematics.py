@@ -63,8 +63,8 @@ def _q(q: object) -> np.ndarray:
 
 
 def thigh_direction(alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
-    """Unit vector from O0 to the knee O0' (..., 3), paper 2, eq. (9) divided by L1."""
-    a, b = np.tan(alpha), np.tan(beta)
+    """Unit vector from O0 to the knee O0' (..., 3), paper 2, eq. (9) divided by L1 (x corrected)."""
+    a, b = np.tan(as_array(alpha, "alpha")), np.tan(as_array(beta, "beta"))
     inv = 1.0 / np.sqrt(1.0 + a * a + b * b)
     return np.stack([b * inv, -a * inv, inv], axis=-1)
 
