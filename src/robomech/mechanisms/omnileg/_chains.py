@@ -18,7 +18,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomech._validation import as_array
-from robomech.analysis import lstsq
 from robomech.kinematics import jacobian_space, poe_fk
 from robomech.spatial import inverse_transform, log_se3, screw_from_axis
 
@@ -137,6 +136,8 @@ def _newton(
     S: np.ndarray, M: np.ndarray, theta: np.ndarray, passive: list[tuple[int, int]], batch: tuple[int, ...]
 ) -> int:
     """Gauss-Newton on the passive joints of ``theta`` (in place); returns the iterations used."""
+    from robomech.analysis import lstsq  # deferred: it loads scipy.linalg (0.25 s), keep the import cheap
+
     for it in range(CLOSURE_MAX_ITER):  # fixed small iteration count, batched over samples
         r, _ = _closure_residual(S, M, theta)
         if np.all(np.abs(r) <= CLOSURE_TOL):
