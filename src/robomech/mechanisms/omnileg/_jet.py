@@ -162,7 +162,7 @@ def matvec(a: Jet | Array, b: Jet | Array) -> Jet:
     return bilinear(a, b, _matvec)
 
 
-def _cross3(x: Array, y: Array) -> Array:
+def cross3(x: Array, y: Array) -> Array:
     """Cross product over the last axis (broadcasting), without np.cross's axis shuffling."""
     x0, x1, x2 = x[..., 0], x[..., 1], x[..., 2]
     y0, y1, y2 = y[..., 0], y[..., 1], y[..., 2]
@@ -170,7 +170,7 @@ def _cross3(x: Array, y: Array) -> Array:
 
 
 def cross(a: Jet | Array, b: Jet | Array) -> Jet:
-    return bilinear(a, b, _cross3)
+    return bilinear(a, b, cross3)
 
 
 def dot(a: Jet, b: Jet | Array) -> Jet:
