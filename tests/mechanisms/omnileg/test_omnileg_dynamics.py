@@ -156,3 +156,14 @@ def test_bad_dynamics_input_names_argument(name):
     args[name] = np.array([0.0, np.nan, 0.0])
     with pytest.raises(ValueError, match=name):
         ol.inverse_dynamics(LEG, **args)
+
+
+def test_chunked_dynamics_equals_one_block(monkeypatch):
+    from robomech.mechanisms.omnileg import _dynamics
+
+    _, q, qd, qdd = _trajectory(23)
+    whole = ol.inverse_dynamics(LEG, q, qd, qdd)
+    monkeypatch.setattr(_dynamics, "DYN_CHUNK", 5)  # 5 chunks, the last one partial
+    chunked = ol.inverse_dynamics(LEG, q, qd, qdd)
+    np.testing.assert_allclose(chunked.tau, whole.tau, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(chunked.M, whole.M, rtol=0, atol=1e-15)
