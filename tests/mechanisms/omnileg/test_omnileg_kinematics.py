@@ -43,17 +43,11 @@ def test_home_pose_and_table2_shank_lengths():
     # Fully extended, vertical leg: depth L1 + 2 L4 + L5 (eq. (11) at q = 0).
     p = ol.forward_kinematics(LEG, [0.0, 0.0, 0.0])
     np.testing.assert_allclose(p, [0.0, 0.0, 0.15 + 0.19 + 0.16], atol=1e-15)
-    # Table 2 prints the shank length range L2 = 0.017 ~ 0.19 m: 2 L4 cos γ over γ in [0°, 85°].
-    d0 = (
-        ol.forward_kinematics(LEG, [0.0, 0.0, 0.0])[2]
-        - ol.forward_kinematics(LEG, [0.0, 0.0, np.pi / 2 - 1e-300])[2]
-    )
-    d85 = (
-        ol.forward_kinematics(LEG, [0.0, 0.0, LEG.gamma_max])[2]
-        - ol.forward_kinematics(LEG, [0.0, 0.0, np.pi / 2 - 1e-300])[2]
-    )
-    assert round(d0, 3) == 0.19
-    assert round(d85, 3) == 0.017
+    # Table 2 prints the shank length range L2 = 0.017 ~ 0.19 m: 2 L4 cos γ over γ in [0°, 85°]
+    # (at α = β = 0 the thigh contributes L1 to the depth, the knee height L5)
+    shank = lambda g: ol.forward_kinematics(LEG, [0.0, 0.0, g])[2] - LEG.L1 - LEG.L5  # noqa: E731
+    assert round(shank(0.0), 3) == 0.19
+    assert round(shank(LEG.gamma_max), 3) == 0.017
 
 
 def test_eq11_equals_thigh_direction_form():
