@@ -33,6 +33,8 @@ from ._core import Check, Tolerance, Verification
 __all__ = ["VERIFICATION", "EngineModel", "build_mjcf", "build_model", "engine_inverse_dynamics", "run"]
 
 MECHANISM = "omnileg"
+# Tree joints driven by the motors, in q = (α, β, γ) order.
+ACTUATED_JOINTS = ("theta21", "theta11", "drive_in")
 # Distance between the two connect anchors that replace a cut hinge (m): any non-zero length on the
 # axis works; 20 mm keeps the rows well conditioned against the 0.1 m link scale.
 CONNECT_SPAN = 0.02
@@ -170,26 +172,28 @@ def build_mjcf(leg: ol.OmniLeg) -> str:
 class EngineModel:
     model: mujoco.MjModel
     data: mujoco.MjData
-    qpos_index: np.ndarray  # tree joint i (TREE_JOINTS order) -> qpos/dof address
+    qpos_index: np.ndarray  # tree joint i (TREE_JOINTS order) -> qpos address
+    dof_index: np.ndarray  # tree joint i -> dof address (qvel, qacc, forces)
     actuated: np.ndarray  # dof addresses of (α, β, γ) = (theta21, theta11, drive_in)
     foot_site: int
-    n_eq_rows: int
 
 
 def build_model(leg: ol.OmniLeg) -> EngineModel:
     m = mujoco.MjModel.from_xml_string(build_mjcf(leg))
     d = mujoco.MjData(m)
-    idx = np.array([m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n)] for n in ol.TREE_JOINTS])
-    act = idx[[ol.TREE_JOINTS.index(n) for n in ("theta21", "theta11", "drive_in")]]
+    jid = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n) for n in ol.TREE_JOINTS]
+    qadr = np.array([m.jnt_qposadr[j] for j in jid])
+    dadr = np.array([m.jnt_dofadr[j] for j in jid])
+    act = dadr[[ol.TREE_JOINTS.index(n) for n in ACTUATED_JOINTS]]
     site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "foot_point")
-    return EngineModel(m, d, idx, act, site, 0)
+    return EngineModel(m, d, qadr, dadr, act, site)
 
 
 def _set_state(em: EngineModel, qpos: np.ndarray, qvel: np.ndarray, qacc: np.ndarray | None = None) -> None:
-    em.data.qpos[em.qpos_index] = qpos  # hinges: qpos address = dof address here (no free joints)
-    em.data.qvel[em.qpos_index] = qvel
+    em.data.qpos[em.qpos_index] = qpos
+    em.data.qvel[em.dof_index] = qvel
     if qacc is not None:
-        em.data.qacc[em.qpos_index] = qacc
+        em.data.qacc[em.dof_index] = qacc
 
 
 def _eq_rows(em: EngineModel) -> np.ndarray:
@@ -306,8 +310,9 @@ def forward_simulation(
     q_sim = np.empty((n_steps + 1, 3))
     closure = 0.0
     rows = _eq_rows(em)  # no contacts or limits: the equality rows are fixed
+    act_q = em.qpos_index[[ol.TREE_JOINTS.index(n) for n in ACTUATED_JOINTS]]
     for k in range(n_steps + 1):  # time stepping (inherently sequential)
-        q_sim[k] = d.qpos[em.actuated]
+        q_sim[k] = d.qpos[act_q]
         closure = max(closure, float(np.abs(d.efc_pos[rows]).max()))
         if k == n_steps:
             break
