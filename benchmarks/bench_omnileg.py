@@ -69,7 +69,7 @@ def workloads() -> list[Workload]:
         ("omnileg: forward kinematics (eq. 11)", lambda: ol.forward_kinematics(LEG, _kin_data()[0]),
          lambda: _loop(ol.forward_kinematics, _kin_data()[0], n=N_ALT_KIN), 6 * f8),
         ("omnileg: inverse kinematics (eq. 13 corr.)", lambda: ol.inverse_kinematics(LEG, _kin_data()[1]),
-         lambda: _loop(ol.inverse_kinematics, _kin_data()[1], n=N_ALT_KIN), 7 * f8 + 3),
+         lambda: _loop(ol.inverse_kinematics, _kin_data()[1], n=N_ALT_KIN), 6 * f8 + 3),
         ("omnileg: foot Jacobian (eq. 14)", lambda: ol.jacobian(LEG, _kin_data()[0]),
          lambda: _loop(ol.jacobian, _kin_data()[0], n=N_ALT_KIN), 12 * f8),
     ]  # fmt: skip

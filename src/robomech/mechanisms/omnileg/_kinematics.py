@@ -7,7 +7,8 @@ The thigh's knee point O0' lies on a sphere of radius L1 about O0: ``p_knee = L1
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -200,14 +201,23 @@ class IKResult:
 
     ``q (..., 3)`` is NaN exactly where ``exists`` is false (no real solution: the foot is farther than
     L1 from Z0 horizontally, or deeper/shallower than the shank can reach).  ``within_limits`` checks the
-    joint ranges; ``reachable = exists & within_limits``.  ``residual`` is ``|FK(q) - p|`` (m).
+    joint ranges; ``reachable = exists & within_limits``.  ``residual`` is ``|FK(q) - p|`` (m, NaN where
+    no solution exists), a diagnostic computed on first access (it costs a forward kinematics).
     """
 
     q: np.ndarray
     exists: np.ndarray
     within_limits: np.ndarray
     reachable: np.ndarray
-    residual: np.ndarray
+    leg: OmniLeg = field(repr=False, compare=False)
+    p_foot: np.ndarray = field(repr=False, compare=False)
+
+    @cached_property
+    def residual(self) -> np.ndarray:
+        q_safe = np.where(self.exists[..., None], self.q, 0.0)
+        p_safe = np.where(self.exists[..., None], self.p_foot, 0.0)
+        r = np.linalg.norm(forward_kinematics(self.leg, q_safe) - p_safe, axis=-1)
+        return np.where(self.exists, r, np.nan)
 
 
 def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
@@ -224,7 +234,6 @@ def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
     q = np.empty((n, 3))
     exists = np.empty(n, dtype=bool)
     lim = np.empty(n, dtype=bool)
-    resid = np.empty(n)
     L1, L4, L5 = leg.L1, leg.L4, leg.L5
     for s in _chunks(n):
         finite = np.isfinite(pf[s]).all(axis=-1)
@@ -239,16 +248,11 @@ def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
         alpha = np.arctan(a)  # paper 2, eq. (13): printed arctan(P_y / s); eq. (11) needs the minus
         beta = np.arctan(b)
         gamma = np.arccos(np.clip(c, -1.0, 1.0))
-        # forward kinematics of the solution (eq. (11) in the form of thigh_direction) for the residual
-        inv = L1 / np.sqrt(1.0 + a * a + b * b)
-        r2 = (b * inv - px) ** 2 + (a * inv + py) ** 2 + (inv + 2.0 * L4 * _cos_sin(gamma)[0] + L5 - pz) ** 2
         exists[s] = ok
-        resid[s] = np.sqrt(r2)
         q[s, 0] = alpha
         q[s, 1] = beta
         q[s, 2] = gamma
         if not ok.all():  # NaN exactly where no solution exists
-            resid[s][~ok] = np.nan
             q[s][~ok] = np.nan
         lim[s] = (
             ok
@@ -263,5 +267,6 @@ def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
         exists=exists.reshape(batch),
         within_limits=lim.reshape(batch),
         reachable=(exists & lim).reshape(batch),
-        residual=resid.reshape(batch),
+        leg=leg,
+        p_foot=p,
     )
