@@ -127,6 +127,8 @@ def default_bodies(L1: float, L3: float, L4: float, L5: float, knee_to_crank: fl
     m_tube = RHO_ALUMINIUM * math.pi * (r_o**2 - r_i**2) * L1
     tube = _cylinder(m_tube, r_o, L1, inner_radius=r_i).inertia_matrix
     m_fit = 0.020
+    # two 20 g fittings at ±L1/2 (point masses) plus their own inertia (~20 g rings of radius ~3 mm:
+    # m r² ≈ 2e-7 kg m² about the rod axis, half that across)
     ends = np.diag([2 * m_fit * (L1 / 2) ** 2, 2 * m_fit * (L1 / 2) ** 2, 0.0]) + np.diag([1e-7, 1e-7, 2e-7])
     thigh_rod = RigidBody(m_tube + 2 * m_fit, (0.0, 0.0, L1 / 2), tuple(map(tuple, tube + ends)))
     r_s = 0.003
@@ -157,7 +159,7 @@ def default_bodies(L1: float, L3: float, L4: float, L5: float, knee_to_crank: fl
     I_cr = (
         bar
         + np.diag([1.0, 1.0, 0.0]) * (m_bar * (L4 / 2 - z_cr) ** 2 + m_cg * z_cr**2)
-        + np.diag([2e-6, 1e-6, 1e-6])
+        + np.diag([2e-6, 1e-6, 1e-6])  # the 25 g bevel gear (r ≈ 12 mm) about its own axis x: ½ m r²
     )
     crank = RigidBody(m_bar + m_cg, (0.0, 0.0, z_cr), tuple(map(tuple, I_cr)))
     foot_drop = L5 - knee_to_crank
