@@ -1,0 +1,81 @@
+"""Paper 2: the OmniLeg serial-parallel leg (3-UU double-parallel thigh + 3-RRR crank-slider shank).
+
+Joint coordinates ``q = (α, β, γ)`` (rad): α turns chain 2 about X0, β turns chain 1 about Y0, γ is the
+crank angle of the shank (motor M3).  The hip frame's Z0 points down, toward the foot.  See
+``docs/mechanisms/omnileg.md`` for frames, assumptions and every departure from the printed paper.
+"""
+
+from ._chains import ShankResult, ThighClosure, chain_screws, shank_crank_slider, shank_frames, thigh_closure
+from ._dynamics import (
+    BODY_NAMES,
+    DynamicsResult,
+    FootForceResult,
+    body_poses,
+    energy,
+    foot_force_from_torques,
+    gravity_torques,
+    inverse_dynamics,
+    mass_matrix,
+    static_torques,
+)
+from ._joints import TREE_JOINTS, JointMotion, joint_motion
+from ._kinematics import (
+    IKResult,
+    foot_acceleration,
+    foot_velocity,
+    forward_kinematics,
+    hessian,
+    inverse_kinematics,
+    jacobian,
+    passive_angles,
+    thigh_direction,
+    within_limits,
+)
+from ._params import OmniLeg, RigidBody, default_bodies
+from ._trajectories import (
+    GaitProfile,
+    foot_trajectory_eq51,
+    gait_eq53,
+    joint_trajectory_eq52,
+    start_point,
+)
+
+__all__ = [
+    "BODY_NAMES",
+    "TREE_JOINTS",
+    "DynamicsResult",
+    "FootForceResult",
+    "GaitProfile",
+    "IKResult",
+    "JointMotion",
+    "OmniLeg",
+    "RigidBody",
+    "ShankResult",
+    "ThighClosure",
+    "body_poses",
+    "chain_screws",
+    "default_bodies",
+    "energy",
+    "foot_acceleration",
+    "foot_force_from_torques",
+    "foot_trajectory_eq51",
+    "foot_velocity",
+    "forward_kinematics",
+    "gait_eq53",
+    "gravity_torques",
+    "hessian",
+    "inverse_dynamics",
+    "inverse_kinematics",
+    "jacobian",
+    "joint_motion",
+    "joint_trajectory_eq52",
+    "mass_matrix",
+    "passive_angles",
+    "shank_crank_slider",
+    "shank_frames",
+    "start_point",
+    "static_torques",
+    "thigh_closure",
+    "thigh_direction",
+    "within_limits",
+]

@@ -1,0 +1,210 @@
+"""The thigh as three UU chains closed by the product of exponentials, and the shank crank-slider.
+
+Thigh (paper 2, eqs. (1)-(8)): chain k's joint screws are those of chain 1 rotated by
+``kR = [[cos δ, sin δ, 0], [-sin δ, cos δ, 0], [0, 0, 1]]`` with δ = (k - 1) π/2 (eq. (5); this is
+Rz(-δ), and taken literally it yields the signs of eqs. (9) and (11)).  Chain 1's actuated joint θ11 = β
+(about Y0 through A1), chain 2's θ21 = α (about X0 through A2); the other ten joint angles are passive
+and are found here by solving the closure ``T1 = T2 = T3`` (eq. (8)) with Gauss-Newton on the
+12 closure equations, independently of the closed form.
+
+Shank (paper 2, eq. (10), Fig. 4e): each chain C_iD_iE_i is a centred crank-slider with crank C_iD_i
+and coupler D_iE_i of equal length L4 and the slider E_i moving along Z0 directly below C_i.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array
+from robomech.kinematics import jacobian_space, poe_fk
+from robomech.spatial import inverse_transform, log_se3, screw_from_axis
+
+from ._params import OmniLeg
+
+__all__ = [
+    "ShankResult",
+    "ThighClosure",
+    "chain_screws",
+    "shank_crank_slider",
+    "shank_frames",
+    "thigh_closure",
+]
+
+# Gauss-Newton on the closure converges quadratically; 1e-14 (m or rad) is a few ulps of the O(0.1)
+# pose entries, below which the residual is rounding noise.
+CLOSURE_TOL = 1e-14
+# Newton from the home pose straight to (α, β) can jump to another assembly branch near the range
+# limits (seen at |β| > 60° with α ≈ 0); a continuation through CLOSURE_STAGES equally spaced
+# intermediate poses keeps every step inside the translational branch's basin.
+CLOSURE_STAGES = 3
+# Per stage the closure converges in 4-6 iterations over the whole joint range (measured by the
+# tests); 20 leaves ample margin before a sample is flagged as not converged.
+CLOSURE_MAX_ITER = 20
+# The knee plate "only translates" when its rotation differs from I by less than this (rad): a
+# rounding-level bound for a converged closure.
+TRANSLATION_ONLY_TOL = 1e-12
+
+
+def _kR(k: int) -> np.ndarray:
+    d = 0.5 * np.pi * k
+    c, s = np.cos(d), np.sin(d)
+    return np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # paper 2, eq. (5): Rz(-δ), as printed
+
+
+def chain_screws(leg: OmniLeg) -> tuple[np.ndarray, np.ndarray]:
+    """Space screws of the three UU chains at the home pose, (3, 4, 6), and their home pose M (4, 4)."""
+    w1 = np.array([[0.0, 1, 0], [1, 0, 0], [1, 0, 0], [0, 1, 0]])  # paper 2, eq. (1)
+    p1 = np.array([[0.0, leg.L3, 0], [0, leg.L3, 0], [0, leg.L3, leg.L1], [0, leg.L3, leg.L1]])  # eq. (2)
+    S = np.stack([screw_from_axis(w1 @ _kR(k).T, p1 @ _kR(k).T) for k in range(3)])  # eqs. (6), (7)
+    M = np.eye(4)
+    M[2, 3] = leg.L1  # eq. (3)
+    return S, M
+
+
+@dataclass(frozen=True)
+class ThighClosure:
+    """Closure of the thigh per sample.
+
+    ``theta (..., 3, 4)`` all joint angles (chain k, joint i as θ_{k+1, i+1}); ``T_knee (..., 4, 4)`` the
+    knee-plate pose O0' in O0 (chain 1's PoE); ``residual`` the largest closure twist |log(T_k T_1^-1)|;
+    ``converged`` the Gauss-Newton flag; ``rotation_error`` the angle of the knee plate's rotation (rad);
+    ``translation_only`` = converged and rotation_error <= TRANSLATION_ONLY_TOL.
+    """
+
+    theta: np.ndarray
+    T_knee: np.ndarray
+    residual: np.ndarray
+    converged: np.ndarray
+    rotation_error: np.ndarray
+    translation_only: np.ndarray
+    iterations: int
+
+    @property
+    def knee(self) -> np.ndarray:
+        return self.T_knee[..., :3, 3]
+
+
+def _closure_residual(S: np.ndarray, M: np.ndarray, theta: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
+    T = [poe_fk(M, S[k], theta[..., k, :]) for k in range(3)]
+    T1_inv = inverse_transform(T[0])
+    r = np.concatenate([log_se3(T[1] @ T1_inv), log_se3(T[2] @ T1_inv)], axis=-1)
+    return r, T
+
+
+def thigh_closure(leg: OmniLeg, alpha: object, beta: object) -> ThighClosure:
+    """Solve the closure T1 = T2 = T3 (eq. (8)) for the passive joints, given α = θ21 and β = θ11.
+
+    Gauss-Newton from the home pose: with ``J_k`` the space Jacobian of chain k, a passive step
+    ``dθ`` must satisfy ``J_1 dθ_1 - J_k dθ_k = log(T_k T_1^-1)`` (k = 2, 3), a 12 x 10 least-squares
+    system solved per sample by batched Householder QR.
+    """
+    a = as_array(alpha, "alpha")
+    b = as_array(beta, "beta")
+    batch = np.broadcast_shapes(a.shape, b.shape)
+    S, M = chain_screws(leg)
+    theta = np.zeros((*batch, 3, 4))
+    passive = [(0, 1), (0, 2), (0, 3), (1, 1), (1, 2), (1, 3), (2, 0), (2, 1), (2, 2), (2, 3)]
+    total = 0
+    for stage in range(1, CLOSURE_STAGES + 1):
+        theta[..., 0, 0] = b * stage / CLOSURE_STAGES
+        theta[..., 1, 0] = a * stage / CLOSURE_STAGES
+        total += _newton(S, M, theta, passive, batch)
+    r, T = _closure_residual(S, M, theta)
+    res = np.max(np.abs(r), axis=-1)
+    R = T[0][..., :3, :3]
+    cos_rot = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
+    # angle from the skew part is accurate for small rotations (arccos is not)
+    skew = 0.5 * np.stack(
+        [R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]], -1
+    )
+    rot_err = np.arctan2(np.linalg.norm(skew, axis=-1), cos_rot)
+    converged = res <= 10 * CLOSURE_TOL
+    return ThighClosure(
+        theta=theta,
+        T_knee=T[0],
+        residual=res,
+        converged=converged,
+        rotation_error=rot_err,
+        translation_only=converged & (rot_err <= TRANSLATION_ONLY_TOL),
+        iterations=total,
+    )
+
+
+def _newton(
+    S: np.ndarray, M: np.ndarray, theta: np.ndarray, passive: list[tuple[int, int]], batch: tuple[int, ...]
+) -> int:
+    """Gauss-Newton on the passive joints of ``theta`` (in place); returns the iterations used."""
+    from robomech.analysis import lstsq  # deferred: it loads scipy.linalg (0.25 s), keep the import cheap
+
+    for it in range(CLOSURE_MAX_ITER):  # fixed small iteration count, batched over samples
+        r, _ = _closure_residual(S, M, theta)
+        if np.all(np.abs(r) <= CLOSURE_TOL):
+            return it
+        Js = [jacobian_space(S[k], theta[..., k, :]) for k in range(3)]
+        A = np.zeros((*batch, 12, 10))
+        for col, (k, i) in enumerate(passive):
+            if k == 0:
+                A[..., 0:6, col] = Js[0][..., :, i]
+                A[..., 6:12, col] = Js[0][..., :, i]
+            else:
+                A[..., 6 * (k - 1) : 6 * k, col] = -Js[k][..., :, i]
+        step = lstsq.solve(A, r, diagnostics=False).x
+        for col, (k, i) in enumerate(passive):
+            theta[..., k, i] += step[..., col]
+    return CLOSURE_MAX_ITER
+
+
+@dataclass(frozen=True)
+class ShankResult:
+    """Shank chains in the knee-plate frame O0' (axes parallel to O0), per sample.
+
+    ``C, D, E (..., 3, 3)`` joint points of chains i = 1..3 (m); ``slider (...)`` the depth of the E
+    plane below the C plane (m); ``coupler_angle (...)`` the coupler's angle from Z0' (rad, sign opposite
+    to the crank); ``delta_L2 (...)`` the shank shortening 2 L4 - slider (eq. (10)); ``valid (...)``
+    false (and D, E, slider NaN) where |γ| >= π/2, where the chain folds flat.
+    """
+
+    C: np.ndarray
+    D: np.ndarray
+    E: np.ndarray
+    slider: np.ndarray
+    coupler_angle: np.ndarray
+    delta_L2: np.ndarray
+    valid: np.ndarray
+
+
+def shank_frames(leg: OmniLeg) -> np.ndarray:
+    """Rotations S_i (3, 3, 3) of the shank chain frames: x radial outward along the C_i axis, z = Z0'."""
+    psi = leg.shank_azimuth + 2.0 * np.pi * np.arange(3) / 3.0
+    c, s = np.cos(psi), np.sin(psi)
+    S = np.zeros((3, 3, 3))
+    S[:, 0, 0], S[:, 1, 0] = c, s
+    S[:, 0, 1], S[:, 1, 1] = -s, c
+    S[:, 2, 2] = 1.0
+    return S
+
+
+def shank_crank_slider(leg: OmniLeg, gamma: object) -> ShankResult:
+    """Centred crank-slider of each shank chain for crank angle ``gamma`` (...), rad (valid for |γ| < π/2).
+
+    Crank C_iD_i turns by γ about the radial axis X_Ci; the slider position below C_i is the crank-slider
+    law ``s = r cos γ + sqrt(l² - (r sin γ)²)`` with r = l = L4, i.e. 2 L4 cos γ (eq. (10)).
+    """
+    g_in = as_array(gamma, "gamma")
+    valid = np.abs(g_in) < 0.5 * np.pi  # the chain folds flat at |γ| = 90°: outside, flagged and NaN
+    g = np.where(valid, g_in, 0.0)
+    r = l = leg.L4
+    slider = np.where(valid, r * np.cos(g) + np.sqrt(l * l - (r * np.sin(g)) ** 2), np.nan)
+    coupler = np.where(valid, -np.arcsin(r * np.sin(g) / l), np.nan)
+    S = shank_frames(leg)
+    c0 = np.array([leg.shank_radius, 0.0, leg.knee_to_crank])
+    C = np.broadcast_to(np.einsum("kij,j->ki", S, c0), (*g.shape, 3, 3))
+    crank_dir = np.stack([np.zeros_like(g), -np.sin(g), np.cos(g)], axis=-1)  # Rx(γ) e_z in the chain frame
+    D = C + leg.L4 * np.einsum("kij,...j->...ki", S, crank_dir)
+    D = np.where(valid[..., None, None], D, np.nan)
+    E = C + slider[..., None, None] * np.array([0.0, 0.0, 1.0])
+    return ShankResult(
+        C=C, D=D, E=E, slider=slider, coupler_angle=coupler, delta_L2=2.0 * leg.L4 - slider, valid=valid
+    )

@@ -1,0 +1,366 @@
+"""Rigid-body dynamics of the OmniLeg: M(q) q̈ + V(q, q̇) + G(q) = τ + Jᵀ F, and the static force maps.
+
+Every moving body (22 of them, ``docs/mechanisms/omnileg.md``) is placed by closed-form kinematics of
+the solved closure: U-joint crosses and thigh rods of the three UU chains, the translating knee plate,
+the double-Cardan drive of the shank (input shaft, two crosses, central rod, output shaft with bevel
+gear), the three cranks and three couplers of the crank-slider shank, and the foot.  Each body's
+rotation ``R_b(q)`` and origin ``o_b(q)`` are evaluated as jets (value, first and second time derivative
+along the motion, gradient in q; ``_jet.py``), which yields exact body velocities, accelerations and
+Jacobians; the Newton-Euler equations of every body projected on q (Lagrange's equations in
+matrix form, ``τ = Σ_b J_bᵀ (G_b V̇_b - ad(V_b)ᵀ G_b V_b - gravity)``) then give the motor torques: the
+closure's constraint forces do no work on q = (α, β, γ) and drop out.
+
+Departures from the print (paper 2, Section 3): the central drive rod A4B4 is modelled with its exact
+double-Cardan kinematics instead of neglecting its non-uniform spin (the paper's simplification); the
+cross CS_B1 turns with +β̇ about Y0 (eq. (16) prints -β̇, eq. (27) uses +); potential energy is the
+scalar -m gᵀ p with g along +Z0 (eq. (44) prints m g P).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array
+
+from . import _jet as jt
+from ._chains import shank_frames
+from ._kinematics import jacobian
+from ._params import OmniLeg, RigidBody
+
+__all__ = [
+    "BODY_NAMES",
+    "DynamicsResult",
+    "FootForceResult",
+    "body_poses",
+    "energy",
+    "foot_force_from_torques",
+    "gravity_torques",
+    "inverse_dynamics",
+    "mass_matrix",
+    "static_torques",
+]
+
+# A foot Jacobian with sigma_min / sigma_max below this is treated as singular (γ ≈ 0, the fully
+# extended shank): 1e-3 bounds the force amplification by 1e3 relative to the best-conditioned direction.
+SINGULAR_RCOND = 1e-3
+# Damping of the weak directions of the foot force at flagged samples, relative to sigma_max: equal to
+# the singularity threshold, so that no direction is amplified by more than 1 / (2 SINGULAR_RCOND).
+DAMPING_RELATIVE = SINGULAR_RCOND
+
+
+# Samples per chunk of the dynamics kernel: bounds the memory of its temporaries (dozens of (3, N, 3)
+# arrays, 2.4 MB each at this size) for huge batches; measured at no cost in speed (27 us/sample in
+# chunks of 8k-32k samples vs 24 us/sample for one 1e5-sample block; 40 us/sample at 2k).
+DYN_CHUNK = 32768
+
+
+def _body_list() -> list[tuple[str, str]]:
+    """(instance name, parameter key) of the 22 bodies, in a fixed order."""
+    out = []
+    for k in range(3):
+        out += [
+            (f"hip_cross_{k + 1}", "hip_cross"),
+            (f"thigh_rod_{k + 1}", "thigh_rod"),
+            (f"knee_cross_{k + 1}", "knee_cross"),
+        ]
+    out += [
+        ("knee_plate", "knee_plate"),
+        ("drive_shaft_in", "drive_shaft_in"),
+        ("drive_cross_a", "drive_cross"),
+        ("drive_rod", "drive_rod"),
+        ("drive_cross_b", "drive_cross"),
+        ("drive_shaft_out", "drive_shaft_out"),
+    ]
+    for i in range(3):
+        out += [(f"crank_{i + 1}", "crank"), (f"coupler_{i + 1}", "coupler")]
+    out.append(("foot", "foot"))
+    return out
+
+
+BODY_NAMES = tuple(name for name, _ in _body_list())
+
+
+Cols = tuple[jt.Jet, jt.Jet, jt.Jet] | None  # the three columns of R_b (None: R_b = I, translation only)
+
+
+def _poses(
+    leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray
+) -> list[tuple[Cols, jt.Jet | np.ndarray]]:
+    """(columns of R_b, o_b) of every body as jets, in the order of BODY_NAMES; ``q, qd, qdd (N, 3)``."""
+    alpha, beta, gamma = jt.Jet.variables(q, qd, qdd)
+    ta, tb = jt.tan(alpha), jt.tan(beta)
+    inv_n = jt.reciprocal(jt.sqrt(ta * ta + tb * tb + 1.0))
+    u = jt.stack([tb * inv_n, -ta * inv_n, inv_n])  # thigh direction, eq. (9) / L1
+    knee = u * leg.L1
+    ca, sa, cb, sb, cg, sg = (
+        jt.cos(alpha),
+        jt.sin(alpha),
+        jt.cos(beta),
+        jt.sin(beta),
+        jt.cos(gamma),
+        jt.sin(gamma),
+    )
+    zero = np.zeros(q.shape[0])
+    one = cg * 0.0 + 1.0  # constant 1 as a jet (jt.stack needs one jet per stacked vector)
+    # Second-joint axis x_k of chain k (carried by the crosses and the rod); fixed axis y_k of chain k.
+    x1 = jt.stack([cb, zero, -sb])  # Ry(β) e_x
+    x2 = jt.stack([zero, -ca, -sa])  # Rx(α) (-e_y)
+    x_axes = [x1, x2, -x1]
+    y_axes = [np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 0.0]), np.array([0.0, -1.0, 0.0])]
+    A_pts = [
+        np.array([0.0, leg.L3, 0.0]),
+        np.array([leg.L3, 0.0, 0.0]),
+        np.array([0.0, -leg.L3, 0.0]),
+    ]  # eq. (7)
+    out: list[tuple[Cols, jt.Jet | np.ndarray]] = []
+    for k in range(3):
+        xk = x_axes[k]
+        # cross frame columns (x, y, z): x the carried axis, y the fixed axis, z = x × y
+        R_cross = (xk, xk * 0.0 + y_axes[k], jt.cross(xk, y_axes[k]))
+        R_rod = (xk, jt.cross(u, xk), u)
+        out.append((R_cross, A_pts[k]))
+        out.append((R_rod, A_pts[k]))
+        out.append((R_cross, knee + A_pts[k]))
+    out.append((None, knee))
+    a1 = jt.stack([-sg, cg, zero])  # Rz(γ) e_y: input yoke arm of the drive cross
+    Rz = (jt.stack([cg, sg, zero]), a1, jt.stack([zero, zero, one]))
+    n_vec = jt.cross(a1, u)
+    a2 = n_vec * jt.reciprocal(jt.sqrt(jt.dot(n_vec, n_vec))).expand()  # rod-side arm, ⟂ a1 and the rod
+    R_dcross = (a2, a1, jt.cross(a2, a1))
+    R_drod = (a2, jt.cross(u, a2), u)
+    origin = np.zeros(3)
+    out += [(Rz, origin), (R_dcross, origin), (R_drod, origin), (R_dcross, knee), (Rz, knee)]
+    S = shank_frames(leg)
+    crank_dir = jt.stack([zero, -sg, cg])  # Rx(γ) e_z
+    Rx_p = (jt.stack([one, zero, zero]), jt.stack([zero, cg, sg]), jt.stack([zero, -sg, cg]))
+    Rx_m = (jt.stack([one, zero, zero]), jt.stack([zero, cg, -sg]), jt.stack([zero, sg, cg]))
+    for i in range(3):
+        C = knee + S[i] @ np.array([leg.shank_radius, 0.0, leg.knee_to_crank])
+        D = C + jt.rotate_const(S[i], crank_dir) * leg.L4
+        out.append((tuple(jt.rotate_const(S[i], c) for c in Rx_p), C))
+        out.append((tuple(jt.rotate_const(S[i], c) for c in Rx_m), D))
+    foot_origin = knee + jt.stack([zero, zero, cg * (2.0 * leg.L4) + leg.knee_to_crank])
+    out.append((None, foot_origin))
+    return out
+
+
+@dataclass(frozen=True)
+class _Terms:
+    tau_motion: np.ndarray  # Σ J_vᵀ m a_c + J_ωᵀ (I ω̇ + ω × I ω)   (N, 3)
+    tau_gravity: np.ndarray  # -Σ m J_vᵀ g                            (N, 3)
+    M: np.ndarray  # (N, 3, 3)
+    kinetic: np.ndarray  # (N,)
+    potential: np.ndarray  # (N,)
+    R: np.ndarray  # (N, B, 3, 3) body rotations (B = 0 unless requested)
+    p: np.ndarray  # (N, B, 3) centres of mass (B = 0 unless requested)
+
+
+def _terms(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: bool = False) -> _Terms:
+    """Newton-Euler sums over the bodies projected on q (Lagrange's equations), ``q, qd, qdd (N, 3)``.
+
+    For body b with centre of mass p_b, rotation R_b and inertia I_b (body axes):
+    ``τ = Σ_b m_b (∂p_b/∂q)ᵀ (p̈_b - g) + (∂ω_b/∂q̇)ᵀ (I_s ω̇_b + ω_b × I_s ω_b)``, ``I_s = R_b I_b R_bᵀ``.
+    """
+    grav = np.asarray(leg.gravity)
+    N = q.shape[0]
+    tau_m = np.zeros((3, N))
+    tau_g = np.zeros((3, N))
+    M = np.zeros((3, 3, N))
+    kin = np.zeros(N)
+    pot = np.zeros(N)
+    eye = np.broadcast_to(np.eye(3), (N, 3, 3))
+    Rs, ps = [], []
+    groups: dict[int, tuple[Cols, np.ndarray]] = {}
+    for (cols, o), (_, key) in zip(_poses(leg, q, qd, qdd), _body_list(), strict=True):
+        body: RigidBody = leg.bodies[key]
+        m = body.mass
+        c = body.com_vector
+        # mass centre p = o + R c = o + Σ_j c_j r_j
+        p = (
+            o + c
+            if cols is None
+            else o + sum((cols[j] * c[j] for j in range(3) if c[j] != 0.0), start=0.0 * c)
+        )
+        if isinstance(p, jt.Jet):
+            tau_m += np.sum(p.g * (m * p.vdd), axis=-1)
+            tau_g -= m * (p.g @ grav)
+            M += m * np.sum(p.g[:, None] * p.g[None, :], axis=-1)
+            kin += 0.5 * m * np.sum(p.vd * p.vd, axis=-1)
+            pot -= m * (p.v @ grav)
+            if poses:
+                ps.append(p.v)
+        else:  # a mass centre fixed in the hip frame (the hip crosses): potential only
+            pot -= m * float(np.asarray(p) @ grav)
+            if poses:
+                ps.append(np.broadcast_to(np.asarray(p, dtype=float), (N, 3)))
+        if poses:
+            Rs.append(eye if cols is None else np.stack([r.v for r in cols], axis=-1))
+        if cols is None:
+            continue
+        # bodies turning together (a U-joint's two crosses, the drive's two crosses and two shafts) share
+        # one set of columns: their rotational terms are linear in the inertia, so sum the inertias
+        key_cols = id(cols)
+        if key_cols in groups:
+            groups[key_cols] = (cols, groups[key_cols][1] + body.inertia_matrix)
+        else:
+            groups[key_cols] = (cols, body.inertia_matrix)
+    for cols, Iner in groups.values():
+        # ω = ½ Σ_j r_j × ṙ_j, ω̇ = ½ Σ_j r_j × r̈_j, ∂ω/∂q̇_k = ½ Σ_j r_j × ∂r_j/∂q_k  (columns r_j of R)
+        w = 0.5 * sum(jt.cross3(r.v, r.vd) for r in cols)
+        wd = 0.5 * sum(jt.cross3(r.v, r.vdd) for r in cols)
+        Jw = 0.5 * sum(jt.cross3(r.v, r.g) for r in cols)  # (3 q, N, 3 xyz)
+        # body-frame components x_b = Rᵀ x; the inertia then acts as a constant 3x3 matrix (BLAS)
+        wb = np.stack([np.sum(r.v * w, axis=-1) for r in cols], axis=-1)
+        wdb = np.stack([np.sum(r.v * wd, axis=-1) for r in cols], axis=-1)
+        Jwb = np.stack([np.sum(r.v * Jw, axis=-1) for r in cols], axis=-1)  # (3 q, N, 3 body)
+        Iwb = wb @ Iner.T
+        hb = wdb @ Iner.T + jt.cross3(wb, Iwb)  # I ω̇ + ω × I ω in body axes
+        tau_m += np.sum(Jwb * hb, axis=-1)
+        M += np.sum((Jwb @ Iner.T)[:, None] * Jwb[None, :], axis=-1)
+        kin += 0.5 * np.sum(wb * Iwb, axis=-1)
+    R_all = np.stack(Rs, axis=1) if poses else np.zeros((N, 0, 3, 3))
+    p_all = np.stack(ps, axis=1) if poses else np.zeros((N, 0, 3))
+    return _Terms(tau_m.T, tau_g.T, np.moveaxis(M, -1, 0), kin, pot, R_all, p_all)
+
+
+def _terms_chunked(
+    leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: bool = False
+) -> _Terms:
+    """:func:`_terms` over cache-sized chunks of samples (identical results, far fewer cache misses)."""
+    N = q.shape[0]
+    if N <= DYN_CHUNK:
+        return _terms(leg, q, qd, qdd, poses)
+    parts = [
+        _terms(leg, q[s : s + DYN_CHUNK], qd[s : s + DYN_CHUNK], qdd[s : s + DYN_CHUNK], poses)
+        for s in range(0, N, DYN_CHUNK)
+    ]  # loop over chunks of DYN_CHUNK samples, not over samples
+    return _Terms(*(np.concatenate([getattr(t, f) for t in parts]) for f in _Terms.__dataclass_fields__))
+
+
+def _flat(*arrays: np.ndarray) -> tuple[tuple[int, ...], list[np.ndarray]]:
+    batch = np.broadcast_shapes(*(a.shape[:-1] for a in arrays))
+    return batch, [np.ascontiguousarray(np.broadcast_to(a, (*batch, 3)).reshape(-1, 3)) for a in arrays]
+
+
+def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
+    """Body rotations ``R_b (..., 22, 3, 3)`` (in the hip frame) and mass centres ``p_b (..., 22, 3)`` (m)."""
+    q = as_array(q, "q", (3,))
+    batch, (qf,) = _flat(q)
+    t = _terms_chunked(leg, qf, np.zeros_like(qf), np.zeros_like(qf), poses=True)
+    B = len(BODY_NAMES)
+    return t.R.reshape(*batch, B, 3, 3), t.p.reshape(*batch, B, 3)
+
+
+@dataclass(frozen=True)
+class DynamicsResult:
+    """``tau = M q̈ + velocity_terms + gravity_terms + foot_terms`` (each (..., 3), N·m; M (..., 3, 3))."""
+
+    tau: np.ndarray
+    M: np.ndarray
+    velocity_terms: np.ndarray
+    gravity_terms: np.ndarray
+    foot_terms: np.ndarray
+
+
+def inverse_dynamics(
+    leg: OmniLeg, q: object, qd: object, qdd: object, foot_force: object | None = None
+) -> DynamicsResult:
+    """Motor torques (α, β, γ order) for the motion (q, q̇, q̈), optionally with a force on the foot.
+
+    All inputs ``(..., 3)`` broadcast.  ``foot_force (..., 3)`` (N, hip frame) is the external force
+    applied *to* the foot (as a force applied to the foot body in a multibody simulation); it enters as
+    ``-Jᵀ F``.  Paper 2, eqs. (49)-(50) add ``+Jᵀ F_f``, i.e. read F_f as the force the foot delivers:
+    pass ``-F_f`` for that reading.
+    """
+    q = as_array(q, "q", (3,))
+    qd = as_array(qd, "qd", (3,))
+    qdd = as_array(qdd, "qdd", (3,))
+    batch, (qf, qdf, qddf) = _flat(q, qd, qdd)
+    t = _terms_chunked(leg, qf, qdf, qddf)
+    vel = t.tau_motion - np.einsum("nij,nj->ni", t.M, qddf)
+    foot = np.zeros_like(t.tau_motion)
+    if foot_force is not None:
+        F = as_array(foot_force, "foot_force", (3,))
+        F = np.broadcast_to(F, (*batch, 3)).reshape(-1, 3)
+        foot = -np.einsum("nij,ni->nj", jacobian(leg, qf), F)
+    tau = t.tau_motion + t.tau_gravity + foot
+    shp = (*batch, 3)
+    return DynamicsResult(
+        tau.reshape(shp),
+        t.M.reshape(*batch, 3, 3),
+        vel.reshape(shp),
+        t.tau_gravity.reshape(shp),
+        foot.reshape(shp),
+    )
+
+
+def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
+    """Joint-space inertia matrix ``M(q) (..., 3, 3)`` (kg m²), symmetric positive definite."""
+    q = as_array(q, "q", (3,))
+    batch, (qf,) = _flat(q)
+    z = np.zeros_like(qf)
+    return _terms_chunked(leg, qf, z, z).M.reshape(*batch, 3, 3)
+
+
+def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
+    """``G(q) = ∂V/∂q`` (..., 3), N·m: the torques holding the leg still against gravity."""
+    q = as_array(q, "q", (3,))
+    batch, (qf,) = _flat(q)
+    z = np.zeros_like(qf)
+    return _terms_chunked(leg, qf, z, z).tau_gravity.reshape(*batch, 3)
+
+
+def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
+    """Kinetic ``½ q̇ᵀ M q̇`` and potential ``-Σ m_b gᵀ p_b`` energy (J), each (...)."""
+    q = as_array(q, "q", (3,))
+    qd = as_array(qd, "qd", (3,))
+    batch, (qf, qdf) = _flat(q, qd)
+    t = _terms_chunked(leg, qf, qdf, np.zeros_like(qf))
+    return t.kinetic.reshape(batch), t.potential.reshape(batch)
+
+
+def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
+    """Virtual work, paper 2, eq. (50): ``τ = Jᵀ F`` for a force ``F (..., 3)`` (N) delivered by the foot."""
+    q = as_array(q, "q", (3,))
+    F = as_array(force, "force", (3,))
+    return np.einsum("...ij,...i->...j", jacobian(leg, q), F)
+
+
+@dataclass(frozen=True)
+class FootForceResult:
+    """Foot force ``(..., 3)`` (N) from motor torques, per sample.
+
+    ``singular`` marks samples with ``sigma_min / sigma_max < SINGULAR_RCOND`` (γ ≈ 0): there the force is
+    the damped least-squares estimate (its component along the lost direction is not determined by the
+    torques) and ``residual = |Jᵀ F - τ|`` is no longer zero.
+    """
+
+    force: np.ndarray
+    singular: np.ndarray
+    rcond: np.ndarray
+    residual: np.ndarray
+
+
+def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceResult:
+    """Solve ``Jᵀ F = τ`` for the foot force (paper 2, eq. (47)), never by a blind inverse.
+
+    Regular samples: the exact solution by SVD.  Samples with ``rcond < SINGULAR_RCOND`` are flagged and
+    their weak directions damped: ``F = Σ c_i u_i (v_iᵀ τ)`` with ``c_i = 1/σ_i`` where
+    ``σ_i >= SINGULAR_RCOND σ_max`` and ``c_i = σ_i / (σ_i² + λ²)``, ``λ = DAMPING_RELATIVE σ_max``, otherwise
+    (selectively damped least squares: the well-determined components stay exact).
+    """
+    q = as_array(q, "q", (3,))
+    tau = as_array(tau, "tau", (3,))
+    J = jacobian(leg, q)
+    U, s, Vt = np.linalg.svd(J)
+    rcond = s[..., -1] / s[..., 0]
+    singular = rcond < SINGULAR_RCOND
+    lam = DAMPING_RELATIVE * s[..., :1]
+    # Jᵀ = V Σ Uᵀ, so F = U Σ⁺ Vᵀ τ; only the directions with σ_i < SINGULAR_RCOND σ_max are damped
+    weak = s < SINGULAR_RCOND * s[..., :1]
+    coef = np.where(weak, s / (s * s + lam * lam), 1.0 / np.where(weak, 1.0, s))
+    F = np.einsum("...ij,...j->...i", U, coef * np.einsum("...ij,...j->...i", Vt, tau))
+    resid = np.linalg.norm(np.einsum("...ij,...i->...j", J, F) - tau, axis=-1)
+    return FootForceResult(force=F, singular=singular, rcond=rcond, residual=resid)

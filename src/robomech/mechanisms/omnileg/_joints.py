@@ -1,0 +1,86 @@
+"""Every joint of the leg as a spanning tree plus closures (for multibody engines and animations).
+
+The tree (``TREE_JOINTS``): chain 1's four joints θ11..θ14 carry the knee plate; chains 2 and 3 keep their
+first three joints (their fourth joint closes on the knee plate); the shank drive is the input shaft (γ),
+the two joints of the Cardan cross A4 (φ1 about the shaft's y arm, φ2 about the rod's x arm) and the
+first joint of cross B4 (φ3 = -φ2), closing on the output shaft (turning γ in the knee plate); each shank
+chain is crank (γ about its radial axis) and coupler (-2γ relative to the crank); the foot hangs on
+coupler 1 (+γ) and closes on couplers 2 and 3.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array
+
+from . import _jet as jt
+from ._params import OmniLeg
+
+__all__ = ["TREE_JOINTS", "JointMotion", "joint_motion"]
+
+TREE_JOINTS = (
+    "theta11", "theta12", "theta13", "theta14",
+    "theta21", "theta22", "theta23",
+    "theta31", "theta32", "theta33",
+    "drive_in", "drive_phi1", "drive_phi2", "drive_phi3",
+    "drive_out",
+    "crank_1", "coupler_1", "crank_2", "coupler_2", "crank_3", "coupler_3",
+    "foot",
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class JointMotion:
+    """Angles, rates and accelerations of the tree joints ``TREE_JOINTS`` (..., 22), rad-based units."""
+
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+
+
+def joint_motion(leg: OmniLeg, q: object, qd: object, qdd: object) -> JointMotion:
+    """All tree-joint angles, rates and accelerations for the motion ``(q, q̇, q̈)`` of ``(α, β, γ)``.
+
+    Thigh: θ11 = β, θ12 = atan(tan α cos β), θ13 = -θ12, θ14 = -β; θ21 = α, θ22 = -atan(tan β cos α),
+    θ23 = -θ22; θ31 = -β, θ32 = -θ12, θ33 = θ12 (the closure, eqs. (8), (12)).  Drive: with the rod
+    direction u, the shaft arm a1 = Rz(γ) e_y and the rod arm a2 = (a1 × u)/|a1 × u|,
+    φ1 = atan2((Rz(γ) e_x)·(a2 × a1), (Rz(γ) e_x)·a2), φ2 = atan2((a2 × a1)·(u × a2), a1·(u × a2)).
+    """
+    q = as_array(q, "q", (3,))
+    qd = as_array(qd, "qd", (3,))
+    qdd = as_array(qdd, "qdd", (3,))
+    batch = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1])
+    flat = [np.ascontiguousarray(np.broadcast_to(a, (*batch, 3)).reshape(-1, 3)) for a in (q, qd, qdd)]
+    alpha, beta, gamma = jt.Jet.variables(*flat)
+    ta, tb = jt.tan(alpha), jt.tan(beta)
+    ca, cb = jt.cos(alpha), jt.cos(beta)
+    one = ca * 0.0 + 1.0
+    th12 = jt.atan2(ta * cb, one)
+    th22 = -jt.atan2(tb * ca, one)  # paper 2, eq. (12): printed +; the closure gives -
+    inv_n = jt.reciprocal(jt.sqrt(ta * ta + tb * tb + 1.0))
+    u = jt.stack([tb * inv_n, -ta * inv_n, inv_n])
+    cg, sg = jt.cos(gamma), jt.sin(gamma)
+    zero = np.zeros(flat[0].shape[0])
+    a1 = jt.stack([-sg, cg, zero])
+    ex = jt.stack([cg, sg, zero])
+    n_vec = jt.cross(a1, u)
+    a2 = n_vec * jt.reciprocal(jt.sqrt(jt.dot(n_vec, n_vec))).expand()
+    a21 = jt.cross(a2, a1)
+    ua2 = jt.cross(u, a2)
+    phi1 = jt.atan2(jt.dot(ex, a21), jt.dot(ex, a2))
+    phi2 = jt.atan2(jt.dot(a21, ua2), jt.dot(a1, ua2))
+    joints = [
+        beta, th12, -th12, -beta,
+        alpha, th22, -th22,
+        -beta, -th12, th12,
+        gamma, phi1, phi2, -phi2,
+        gamma,
+        gamma, gamma * -2.0, gamma, gamma * -2.0, gamma, gamma * -2.0,
+        gamma,
+    ]  # fmt: skip
+    n = len(joints)
+    out = [np.stack([getattr(j, k) for j in joints], axis=-1).reshape(*batch, n) for k in ("v", "vd", "vdd")]
+    return JointMotion(*out)

@@ -1,0 +1,272 @@
+"""Foot kinematics of the OmniLeg: eq. (11) forward, the corrected eq. (13) inverse, Jacobian, Hessian.
+
+The thigh's knee point O0' lies on a sphere of radius L1 about O0: ``p_knee = L1 u`` with
+``u = (tan β, -tan α, 1) / sqrt(1 + tan²α + tan²β)``, the same vector as eq. (9)/(11) written with
+``cos β`` factored out.  The shank adds ``(0, 0, L5 + 2 L4 cos γ)`` (crank-slider, eq. (10)).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from robomech._validation import as_array
+
+from ._params import OmniLeg
+
+__all__ = [
+    "IKResult",
+    "foot_acceleration",
+    "foot_velocity",
+    "forward_kinematics",
+    "hessian",
+    "inverse_kinematics",
+    "jacobian",
+    "passive_angles",
+    "thigh_direction",
+    "within_limits",
+]
+
+# A foot whose horizontal distance from Z0 reaches L1 (1 - IK_HORIZONTAL_MARGIN) would need the thigh
+# horizontal (|α| or |β| -> 90°), outside every joint range; the margin only keeps sqrt() real.
+IK_HORIZONTAL_MARGIN = 1e-12
+# cos γ computed from a reachable foot depth can exceed 1 by rounding (a few ulps of P_z / 2 L4 near the
+# fully extended shank); values within this are clamped to 1, beyond it the depth is unreachable.
+COS_GAMMA_ROUNDING = 1e-12
+# Joint limits are inclusive up to rounding of degree-to-radian conversions.
+LIMIT_SLACK = 1e-12
+# Samples per chunk of the elementwise kernels: 32768 doubles = 256 KiB per temporary, which keeps the
+# kernels' dozen temporaries in L2 (measured 2-3x faster than whole 1e6-sample arrays).
+KIN_CHUNK = 32768
+
+
+def _cos_sin(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """cos x and sin x from the half-angle tangent t = tan(x/2): cos = (1 - t²)/(1 + t²), sin = 2t/(1 + t²).
+
+    Same accuracy as np.cos/np.sin (a few ulps, checked by the tests) but ~3x faster: numpy's tan is
+    vectorised (SIMD) while sin/cos are not (measured 1.4 ms vs 8.5 ms per 1e6 samples).
+    """
+    t = np.tan(0.5 * x)
+    t2 = t * t
+    d = 1.0 / (1.0 + t2)
+    return (1.0 - t2) * d, 2.0 * t * d
+
+
+def _chunks(n: int):
+    """Slices of at most KIN_CHUNK samples (a loop over chunks, not over samples)."""
+    return (slice(s, min(s + KIN_CHUNK, n)) for s in range(0, n, KIN_CHUNK))
+
+
+def _q(q: object) -> np.ndarray:
+    return as_array(q, "q", (3,))
+
+
+def thigh_direction(alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
+    """Unit vector from O0 to the knee O0' (..., 3), paper 2, eq. (9) divided by L1 (x corrected)."""
+    a, b = np.tan(as_array(alpha, "alpha")), np.tan(as_array(beta, "beta"))
+    inv = 1.0 / np.sqrt(1.0 + a * a + b * b)
+    return np.stack([b * inv, -a * inv, inv], axis=-1)
+
+
+def forward_kinematics(leg: OmniLeg, q: object) -> np.ndarray:
+    """Foot position ``p_F`` in the hip frame (..., 3), metres, from ``q = (α, β, γ)`` (..., 3), rad.
+
+    Exactly paper 2, eq. (11) (Z0 toward the foot).
+    """
+    q = _q(q)
+    qf = q.reshape(-1, 3)
+    out = np.empty_like(qf)
+    L1, L4, L5 = leg.L1, leg.L4, leg.L5
+    for s in _chunks(qf.shape[0]):
+        alpha, beta, gamma = qf[s, 0], qf[s, 1], qf[s, 2]
+        cb, sb = _cos_sin(beta)
+        cta = cb * np.tan(alpha)
+        inv = L1 / np.sqrt(1.0 + cta * cta)
+        out[s, 0] = sb * inv  # paper 2, eq. (11)
+        out[s, 1] = -cta * inv
+        out[s, 2] = cb * inv + 2.0 * L4 * _cos_sin(gamma)[0] + L5
+    return out.reshape(q.shape)
+
+
+def passive_angles(leg: OmniLeg, alpha: object, beta: object) -> tuple[np.ndarray, np.ndarray]:
+    """Passive U-joint angles θ12 (chain 1, about x at A1) and θ22 (chain 2, about -y at A2), rad.
+
+    paper 2, eq. (12): θ12 = arctan(tan α cos β) as printed; θ22 printed as +arctan(tan β cos α) but
+    with chain 2's second axis ω22 = Rz(-π/2)[1 0 0] = [0 -1 0] (eqs. (1), (5), (6)) the closure gives
+    θ22 = -arctan(tan β cos α).
+    """
+    a = as_array(alpha, "alpha")
+    b = as_array(beta, "beta")
+    theta12 = np.arctan(np.tan(a) * np.cos(b))
+    theta22 = -np.arctan(np.tan(b) * np.cos(a))  # paper 2, eq. (12): printed +; the closure gives -
+    return theta12, theta22
+
+
+def _dw(q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """w = (tan β, -tan α, 1), its q-Jacobian (..., 3, 3), u = w/|w| and N = |w|."""
+    a, b = np.tan(q[..., 0]), np.tan(q[..., 1])
+    N = np.sqrt(1.0 + a * a + b * b)
+    u = np.stack([b, -a, np.ones_like(a)], axis=-1) / N[..., None]
+    W = np.zeros((*q.shape[:-1], 3, 3))
+    W[..., 1, 0] = -(1.0 + a * a)
+    W[..., 0, 1] = 1.0 + b * b
+    return u, N, W, np.stack([a, b], axis=-1)
+
+
+def jacobian(leg: OmniLeg, q: object) -> np.ndarray:
+    """Foot Jacobian ``J[..., i, j] = ∂p_F,i/∂q_j`` (..., 3, 3), eq. (14).  Singular whenever γ = 0.
+
+    With a = tan α, b = tan β, N = sqrt(1 + a² + b²) and u = (b, -a, 1)/N:
+    ``∂p/∂α = -L1 (1 + a²)(e_y - u u_y)/N``, ``∂p/∂β = L1 (1 + b²)(e_x - u u_x)/N``,
+    ``∂p/∂γ = (0, 0, -2 L4 sin γ)``.
+    """
+    q = _q(q)
+    qf = q.reshape(-1, 3)
+    J = np.zeros((qf.shape[0], 3, 3))
+    for s in _chunks(qf.shape[0]):
+        a, b = np.tan(qf[s, 0]), np.tan(qf[s, 1])
+        inv = 1.0 / np.sqrt(1.0 + a * a + b * b)
+        ux, uy, uz = b * inv, -a * inv, inv
+        ka = -leg.L1 * (1.0 + a * a) * inv
+        kb = leg.L1 * (1.0 + b * b) * inv
+        J[s, 0, 0] = -ka * ux * uy
+        J[s, 1, 0] = ka * (1.0 - uy * uy)
+        J[s, 2, 0] = -ka * uz * uy
+        J[s, 0, 1] = kb * (1.0 - ux * ux)
+        J[s, 1, 1] = -kb * uy * ux
+        J[s, 2, 1] = -kb * uz * ux
+        J[s, 2, 2] = -2.0 * leg.L4 * _cos_sin(qf[s, 2])[1]
+    return J.reshape(*q.shape, 3)
+
+
+def hessian(leg: OmniLeg, q: object) -> np.ndarray:
+    """Second-order influence coefficients ``H[..., i, j, k] = ∂²p_F,i/∂q_j∂q_k`` (..., 3, 3, 3)."""
+    q = _q(q)
+    u, N, W, ab = _dw(q)
+    eye = np.eye(3)
+    # ∂²(w/|w|)_i/∂w_a∂w_b = -(δ_ia u_b + δ_ib u_a + δ_ab u_i - 3 u_i u_a u_b) / |w|²
+    D2 = (
+        -(
+            eye[:, :, None] * u[..., None, None, :]
+            + eye[:, None, :] * u[..., None, :, None]
+            + eye[None, :, :] * u[..., :, None, None]
+            - 3.0 * u[..., :, None, None] * u[..., None, :, None] * u[..., None, None, :]
+        )
+        / (N * N)[..., None, None, None]
+    )
+    D1 = (eye - u[..., :, None] * u[..., None, :]) / N[..., None, None]
+    a, b = ab[..., 0], ab[..., 1]
+    W2 = np.zeros((*q.shape[:-1], 3, 3, 3))
+    W2[..., 1, 0, 0] = -2.0 * a * (1.0 + a * a)
+    W2[..., 0, 1, 1] = 2.0 * b * (1.0 + b * b)
+    H = leg.L1 * (
+        np.einsum("...iab,...aj,...bk->...ijk", D2, W, W) + np.einsum("...ia,...ajk->...ijk", D1, W2)
+    )
+    H[..., 2, 2, 2] = -2.0 * leg.L4 * np.cos(q[..., 2])
+    return H
+
+
+def foot_velocity(leg: OmniLeg, q: object, qd: object) -> np.ndarray:
+    """``v_F = J q̇`` (..., 3), m/s."""
+    qd = as_array(qd, "qd", (3,))
+    return np.einsum("...ij,...j->...i", jacobian(leg, q), qd)
+
+
+def foot_acceleration(leg: OmniLeg, q: object, qd: object, qdd: object) -> np.ndarray:
+    """``a_F = J q̈ + q̇ᵀ H q̇`` (..., 3), m/s² (the foot does not rotate, Section 2)."""
+    qd = as_array(qd, "qd", (3,))
+    qdd = as_array(qdd, "qdd", (3,))
+    return np.einsum("...ij,...j->...i", jacobian(leg, q), qdd) + np.einsum(
+        "...ijk,...j,...k->...i", hessian(leg, q), qd, qd
+    )
+
+
+def within_limits(leg: OmniLeg, q: object) -> np.ndarray:
+    """Per-sample mask: |α| ≤ α_max, |β| ≤ β_max, γ_min ≤ γ ≤ γ_max (Table 2 as magnitudes)."""
+    q = as_array(q, "q", (3,), finite=False)
+    with np.errstate(invalid="ignore"):
+        return (
+            (np.abs(q[..., 0]) <= leg.alpha_max + LIMIT_SLACK)
+            & (np.abs(q[..., 1]) <= leg.beta_max + LIMIT_SLACK)
+            & (q[..., 2] >= leg.gamma_min - LIMIT_SLACK)
+            & (q[..., 2] <= leg.gamma_max + LIMIT_SLACK)
+        )
+
+
+@dataclass(frozen=True)
+class IKResult:
+    """Inverse kinematics per sample.
+
+    ``q (..., 3)`` is NaN exactly where ``exists`` is false (no real solution: the foot is farther than
+    L1 from Z0 horizontally, or deeper/shallower than the shank can reach).  ``within_limits`` checks the
+    joint ranges; ``reachable = exists & within_limits``.  ``residual`` is ``|FK(q) - p|`` (m, NaN where
+    no solution exists), a diagnostic computed on first access (it costs a forward kinematics).
+    """
+
+    q: np.ndarray
+    exists: np.ndarray
+    within_limits: np.ndarray
+    reachable: np.ndarray
+    leg: OmniLeg = field(repr=False, compare=False)
+    p_foot: np.ndarray = field(repr=False, compare=False)
+
+    @cached_property
+    def residual(self) -> np.ndarray:
+        q_safe = np.where(self.exists[..., None], self.q, 0.0)
+        p_safe = np.where(self.exists[..., None], self.p_foot, 0.0)
+        r = np.linalg.norm(forward_kinematics(self.leg, q_safe) - p_safe, axis=-1)
+        return np.where(self.exists, r, np.nan)
+
+
+def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
+    """Joint angles ``(α, β, γ)`` for foot positions ``p_foot (..., 3)`` (m), branch γ ≥ 0.
+
+    paper 2, eq. (13) corrected: α = arctan(-P_y / s) (printed without the minus, inconsistent with
+    eq. (11)); γ = arccos((P_z - L5 - s) / (2 L4)) (printed with only s divided by 2 L4), where
+    ``s = sqrt(L1² - P_x² - P_y²)`` is the depth of the knee below O0.  Non-finite input samples are
+    flagged (``exists`` false), not raised.
+    """
+    p = as_array(p_foot, "p_foot", (3,), finite=False)
+    pf = p.reshape(-1, 3)
+    n = pf.shape[0]
+    q = np.empty((n, 3))
+    exists = np.empty(n, dtype=bool)
+    lim = np.empty(n, dtype=bool)
+    L1, L4, L5 = leg.L1, leg.L4, leg.L5
+    for s in _chunks(n):
+        finite = np.isfinite(pf[s]).all(axis=-1)
+        ps = pf[s] if finite.all() else np.where(finite[:, None], pf[s], 0.0)  # non-finite: flagged below
+        px, py, pz = ps[:, 0], ps[:, 1], ps[:, 2]
+        s2 = L1 * L1 - (px * px + py * py)
+        thigh_ok = s2 > (L1 * L1) * IK_HORIZONTAL_MARGIN
+        depth = np.sqrt(np.where(thigh_ok, s2, 1.0))
+        c = (pz - L5 - depth) / (2.0 * L4)  # paper 2, eq. (13): the whole numerator is over 2 L4
+        ok = finite & thigh_ok & (c <= 1.0 + COS_GAMMA_ROUNDING) & (c > 0.0)
+        a, b = -py / depth, px / depth  # tan α, tan β (depth > 0)
+        alpha = np.arctan(a)  # paper 2, eq. (13): printed arctan(P_y / s); eq. (11) needs the minus
+        beta = np.arctan(b)
+        gamma = np.arccos(np.clip(c, -1.0, 1.0))
+        exists[s] = ok
+        q[s, 0] = alpha
+        q[s, 1] = beta
+        q[s, 2] = gamma
+        if not ok.all():  # NaN exactly where no solution exists
+            q[s][~ok] = np.nan
+        lim[s] = (
+            ok
+            & (np.abs(alpha) <= leg.alpha_max + LIMIT_SLACK)
+            & (np.abs(beta) <= leg.beta_max + LIMIT_SLACK)
+            & (gamma >= leg.gamma_min - LIMIT_SLACK)
+            & (gamma <= leg.gamma_max + LIMIT_SLACK)
+        )
+    batch = p.shape[:-1]
+    return IKResult(
+        q=q.reshape(p.shape),
+        exists=exists.reshape(batch),
+        within_limits=lim.reshape(batch),
+        reachable=(exists & lim).reshape(batch),
+        leg=leg,
+        p_foot=p,
+    )

@@ -1,0 +1,298 @@
+"""Parameters of the OmniLeg (paper 2): geometry of Table 2, joint ranges, and inertial assumptions.
+
+Frames (paper 2, Section 2): the hip frame O0 has X0 along Axis2 (the α axis of chain 2), Y0 along
+Axis1 (the β axis of chain 1) and Z0 = X0 × Y0 pointing *down, toward the foot*.  Every length is in
+metres, every angle in radians.
+
+The paper gives no masses or inertias.  Every moving body therefore carries a user-replaceable
+:class:`RigidBody`; the defaults of :meth:`OmniLeg.paper` are computed by :func:`default_bodies` from
+plausible link geometry and materials (aluminium links, steel crosses and shafts), each stated there.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+
+import numpy as np
+
+__all__ = ["OmniLeg", "RigidBody", "default_bodies"]
+
+# Density of 6061 aluminium and of steel, kg/m^3 (handbook values).
+RHO_ALUMINIUM = 2700.0
+RHO_STEEL = 7850.0
+# Standard gravity, m/s^2.
+STANDARD_GRAVITY = 9.80665
+# Inertia matrices must be symmetric to this relative tolerance (rounding of user input).
+INERTIA_SYMMETRY_RTOL = 1e-9
+# Principal moments may violate the triangle inequality by this relative amount (rounding only).
+TRIANGLE_RTOL = 1e-9
+
+
+@dataclass(frozen=True)
+class RigidBody:
+    """Inertial parameters of one rigid body, in its own body frame (see ``docs/mechanisms/omnileg.md``).
+
+    ``mass`` in kg; ``com (3,)`` the centre of mass in the body frame (m); ``inertia (3, 3)`` the
+    rotational inertia about the centre of mass in body axes (kg m^2).
+    """
+
+    mass: float
+    com: tuple[float, float, float]
+    inertia: tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
+
+    def __post_init__(self) -> None:
+        m = float(self.mass)
+        if not (math.isfinite(m) and m > 0.0):
+            raise ValueError(f"Expected RigidBody.mass > 0 and finite, got {self.mass!r}.")
+        c = np.asarray(self.com, dtype=float)
+        if c.shape != (3,) or not np.all(np.isfinite(c)):
+            raise ValueError(f"Expected RigidBody.com to be 3 finite numbers, got {self.com!r}.")
+        inertia = np.asarray(self.inertia, dtype=float)
+        if inertia.shape != (3, 3) or not np.all(np.isfinite(inertia)):
+            raise ValueError(
+                f"Expected RigidBody.inertia to be a finite 3x3 matrix, got shape {inertia.shape}."
+            )
+        scale = max(float(np.abs(inertia).max()), 1e-300)
+        if np.abs(inertia - inertia.T).max() > INERTIA_SYMMETRY_RTOL * scale:
+            raise ValueError("Expected RigidBody.inertia to be symmetric, got an asymmetric matrix.")
+        ev = np.linalg.eigvalsh(inertia)
+        if ev[0] < 0 or ev[0] + ev[1] < ev[2] * (1 - TRIANGLE_RTOL):
+            raise ValueError(
+                f"Expected RigidBody.inertia positive semidefinite with principal moments obeying the "
+                f"triangle inequality, got principal moments {ev.tolist()}."
+            )
+        object.__setattr__(self, "mass", m)
+        object.__setattr__(self, "com", tuple(float(v) for v in c))
+        object.__setattr__(self, "inertia", tuple(tuple(float(v) for v in row) for row in inertia))
+
+    @property
+    def inertia_matrix(self) -> np.ndarray:
+        return np.array(self.inertia)
+
+    @property
+    def com_vector(self) -> np.ndarray:
+        return np.array(self.com)
+
+
+def _cylinder(
+    mass: float,
+    radius: float,
+    length: float,
+    com: tuple[float, float, float] = (0, 0, 0),
+    axis: int = 2,
+    inner_radius: float = 0.0,
+) -> RigidBody:
+    """(Hollow) cylinder along body axis ``axis`` about its centre."""
+    r2 = radius**2 + inner_radius**2
+    i_axial = 0.5 * mass * r2
+    i_trans = mass * (3 * r2 + length**2) / 12.0
+    d = [i_trans, i_trans, i_trans]
+    d[axis] = i_axial
+    return RigidBody(
+        mass, com, tuple(tuple(float(d[i]) if i == j else 0.0 for j in range(3)) for i in range(3))
+    )
+
+
+def _box(
+    mass: float, sx: float, sy: float, sz: float, com: tuple[float, float, float] = (0, 0, 0)
+) -> RigidBody:
+    d = (mass * (sy**2 + sz**2) / 12, mass * (sx**2 + sz**2) / 12, mass * (sx**2 + sy**2) / 12)
+    return RigidBody(mass, com, tuple(tuple(d[i] if i == j else 0.0 for j in range(3)) for i in range(3)))
+
+
+def _cross(radius: float, span: float) -> RigidBody:
+    """A universal-joint cross: two steel pins of ``radius`` and length ``span`` along body x and y."""
+    m_pin = RHO_STEEL * math.pi * radius**2 * span
+    a = _cylinder(m_pin, radius, span, axis=0).inertia_matrix
+    b = _cylinder(m_pin, radius, span, axis=1).inertia_matrix
+    inertia = a + b
+    return RigidBody(2 * m_pin, (0.0, 0.0, 0.0), tuple(tuple(float(v) for v in row) for row in inertia))
+
+
+def default_bodies(L1: float, L3: float, L4: float, L5: float, knee_to_crank: float) -> dict[str, RigidBody]:
+    """Plausible inertial parameters from the link geometry (assumptions, see the docs page).
+
+    Body frames are those of ``docs/mechanisms/omnileg.md``; the z axis of every link frame runs along
+    the link.  Sizes: U-joint crosses of 5 mm steel pins spanning 24 mm; thigh rods aluminium tubes
+    16/12 mm diameter plus 20 g of fittings at each end; the central drive shaft a 6 mm steel rod;
+    input/output drive shafts 6 mm steel, 30 mm long, carrying a 40 g bevel gear (output); knee plate
+    an 8 mm aluminium disk of radius L3 + 15 mm with 150 g of gears and bearings; cranks and couplers
+    aluminium bars 12 x 6 mm of length L4 (the crank also carrying a 25 g bevel gear at C); foot a
+    100 g aluminium pad with a 10 mm aluminium rod from the E plane down to the foot point.
+    """
+    cross = _cross(0.0025, 0.024)
+    # Thigh rod: tube plus fittings (2 x 20 g) at its ends; com at mid-length by symmetry.
+    r_o, r_i = 0.008, 0.006
+    m_tube = RHO_ALUMINIUM * math.pi * (r_o**2 - r_i**2) * L1
+    tube = _cylinder(m_tube, r_o, L1, inner_radius=r_i).inertia_matrix
+    m_fit = 0.020
+    # two 20 g fittings at ±L1/2 (point masses) plus their own inertia (~20 g rings of radius ~3 mm:
+    # m r² ≈ 2e-7 kg m² about the rod axis, half that across)
+    ends = np.diag([2 * m_fit * (L1 / 2) ** 2, 2 * m_fit * (L1 / 2) ** 2, 0.0]) + np.diag([1e-7, 1e-7, 2e-7])
+    thigh_rod = RigidBody(m_tube + 2 * m_fit, (0.0, 0.0, L1 / 2), tuple(map(tuple, tube + ends)))
+    r_s = 0.003
+    drive_rod = _cylinder(RHO_STEEL * math.pi * r_s**2 * L1, r_s, L1, com=(0.0, 0.0, L1 / 2))
+    shaft_len = 0.030
+    m_shaft = RHO_STEEL * math.pi * r_s**2 * shaft_len
+    drive_shaft_in = _cylinder(m_shaft, r_s, shaft_len, com=(0.0, 0.0, -shaft_len / 2))
+    gear_m, gear_r, gear_t = 0.040, 0.012, 0.008
+    gear = _cylinder(gear_m, gear_r, gear_t).inertia_matrix
+    shaft = _cylinder(m_shaft, r_s, shaft_len).inertia_matrix
+    # output shaft from the knee point O0' down to the bevel gear at z = knee_to_crank
+    z_s, z_g = shaft_len / 2, knee_to_crank
+    m_out = m_shaft + gear_m
+    z_c = (m_shaft * z_s + gear_m * z_g) / m_out
+    par = np.diag([1.0, 1.0, 0.0])
+    I_out = shaft + gear + par * (m_shaft * (z_s - z_c) ** 2 + gear_m * (z_g - z_c) ** 2)
+    drive_shaft_out = RigidBody(m_out, (0.0, 0.0, z_c), tuple(map(tuple, I_out)))
+    plate_r, plate_t = L3 + 0.015, 0.008
+    m_plate = RHO_ALUMINIUM * math.pi * plate_r**2 * plate_t
+    m_extra = 0.150
+    knee_plate = _cylinder(m_plate + m_extra, plate_r, plate_t, com=(0.0, 0.0, knee_to_crank / 2))
+    bar_w, bar_t = 0.012, 0.006
+    m_bar = RHO_ALUMINIUM * bar_w * bar_t * L4
+    bar = _box(m_bar, bar_t, bar_w, L4).inertia_matrix
+    coupler = RigidBody(m_bar, (0.0, 0.0, L4 / 2), tuple(map(tuple, bar)))
+    m_cg = 0.025
+    z_cr = m_bar * (L4 / 2) / (m_bar + m_cg)
+    I_cr = (
+        bar
+        + np.diag([1.0, 1.0, 0.0]) * (m_bar * (L4 / 2 - z_cr) ** 2 + m_cg * z_cr**2)
+        + np.diag([2e-6, 1e-6, 1e-6])  # the 25 g bevel gear (r ≈ 12 mm) about its own axis x: ½ m r²
+    )
+    crank = RigidBody(m_bar + m_cg, (0.0, 0.0, z_cr), tuple(map(tuple, I_cr)))
+    foot_drop = L5 - knee_to_crank
+    m_pad = 0.100
+    m_frod = RHO_ALUMINIUM * math.pi * 0.005**2 * foot_drop
+    z_f = (m_frod * foot_drop / 2 + m_pad * foot_drop) / (m_frod + m_pad)
+    I_f = (
+        _cylinder(m_frod, 0.005, foot_drop).inertia_matrix
+        + _cylinder(m_pad, 0.03, 0.01).inertia_matrix
+        + par * (m_frod * (foot_drop / 2 - z_f) ** 2 + m_pad * (foot_drop - z_f) ** 2)
+    )
+    foot = RigidBody(m_frod + m_pad, (0.0, 0.0, z_f), tuple(map(tuple, I_f)))
+    return {
+        "hip_cross": cross,
+        "thigh_rod": thigh_rod,
+        "knee_cross": cross,
+        "knee_plate": knee_plate,
+        "drive_shaft_in": drive_shaft_in,
+        "drive_cross": cross,
+        "drive_rod": drive_rod,
+        "drive_shaft_out": drive_shaft_out,
+        "crank": crank,
+        "coupler": coupler,
+        "foot": foot,
+    }
+
+
+BODY_FIELDS = (
+    "hip_cross",
+    "thigh_rod",
+    "knee_cross",
+    "knee_plate",
+    "drive_shaft_in",
+    "drive_cross",
+    "drive_rod",
+    "drive_shaft_out",
+    "crank",
+    "coupler",
+    "foot",
+)
+
+_PAPER = {"L1": 0.15, "L3": 0.075, "L4": 0.095, "L5": 0.160}  # paper 2, Table 2 (m)
+_KNEE_TO_CRANK = 0.030
+_SHANK_RADIUS = 0.025
+
+
+@dataclass(frozen=True)
+class OmniLeg:
+    """The OmniLeg: thigh 3-UU double-parallel mechanism + 3-RRR (crank-slider) shank.
+
+    Geometry (m): ``L1`` thigh rod length A_iB_i; ``L3`` distance of the U joints A_i, B_i from the
+    plate centres O0, O0'; ``L4`` shank link length C_iD_i = D_iE_i; ``L5`` knee height (the constant
+    part of the foot depth below O0' besides 2 L4 cos γ, eq. (11)).  ``knee_to_crank`` splits L5: the
+    C_i joints lie ``knee_to_crank`` below O0', the foot point ``L5 - knee_to_crank`` below the E_i
+    plane; ``shank_radius`` is the radius of the C_i and E_i circles and ``shank_azimuth`` the angle of
+    chain C1D1E1 from X0 (the three shank chains are 120° apart).  Joint ranges (rad) are Table 2
+    read as magnitudes.  ``gravity`` is the gravity acceleration in the hip frame (Z0 down).  The
+    :class:`RigidBody` fields are the inertial parameters of each body kind (the three copies of a
+    chain's bodies share them, rotated with the chain).
+    """
+
+    L1: float
+    L3: float
+    L4: float
+    L5: float
+    alpha_max: float = math.radians(65.0)
+    beta_max: float = math.radians(65.0)
+    gamma_min: float = 0.0
+    gamma_max: float = math.radians(85.0)
+    knee_to_crank: float = _KNEE_TO_CRANK
+    shank_radius: float = _SHANK_RADIUS
+    shank_azimuth: float = math.pi / 2
+    gravity: tuple[float, float, float] = (0.0, 0.0, STANDARD_GRAVITY)
+    bodies: dict[str, RigidBody] = field(default_factory=dict, compare=False, hash=False)
+
+    def __post_init__(self) -> None:
+        for name in ("L1", "L3", "L4", "L5", "shank_radius"):
+            v = float(getattr(self, name))
+            if not (math.isfinite(v) and v > 0):
+                raise ValueError(f"Expected OmniLeg.{name} > 0 and finite, got {getattr(self, name)!r}.")
+            object.__setattr__(self, name, v)
+        h = float(self.knee_to_crank)
+        if not (math.isfinite(h) and 0 <= h <= self.L5):
+            raise ValueError(
+                f"Expected OmniLeg.knee_to_crank in [0, L5 = {self.L5}], got {self.knee_to_crank!r}."
+            )
+        object.__setattr__(self, "knee_to_crank", h)
+        for name in ("alpha_max", "beta_max"):
+            v = float(getattr(self, name))
+            # tan(α), tan(β) enter eq. (11): |α|, |β| must stay below 90°.
+            if not (math.isfinite(v) and 0 < v < math.pi / 2):
+                raise ValueError(f"Expected OmniLeg.{name} in (0, pi/2) rad, got {getattr(self, name)!r}.")
+            object.__setattr__(self, name, v)
+        gmin, gmax = float(self.gamma_min), float(self.gamma_max)
+        # The crank-slider of the shank folds flat at γ = ±90°: the range must lie strictly inside.
+        if not (math.isfinite(gmin) and math.isfinite(gmax) and -math.pi / 2 < gmin < gmax < math.pi / 2):
+            raise ValueError(
+                "Expected -pi/2 < OmniLeg.gamma_min < OmniLeg.gamma_max < pi/2, "
+                f"got {self.gamma_min!r}, {self.gamma_max!r}."
+            )
+        object.__setattr__(self, "gamma_min", gmin)
+        object.__setattr__(self, "gamma_max", gmax)
+        if not math.isfinite(float(self.shank_azimuth)):
+            raise ValueError(f"Expected OmniLeg.shank_azimuth finite, got {self.shank_azimuth!r}.")
+        object.__setattr__(self, "shank_azimuth", float(self.shank_azimuth))
+        g = np.asarray(self.gravity, dtype=float)
+        if g.shape != (3,) or not np.all(np.isfinite(g)):
+            raise ValueError(f"Expected OmniLeg.gravity to be 3 finite numbers, got {self.gravity!r}.")
+        object.__setattr__(self, "gravity", tuple(float(v) for v in g))
+        bodies = dict(self.bodies) if self.bodies else {}
+        defaults = default_bodies(self.L1, self.L3, self.L4, self.L5, self.knee_to_crank)
+        unknown = set(bodies) - set(BODY_FIELDS)
+        if unknown:
+            raise ValueError(
+                f"Expected OmniLeg.bodies keys among {BODY_FIELDS}, got unknown {sorted(unknown)}."
+            )
+        for k in BODY_FIELDS:
+            b = bodies.get(k, defaults[k])
+            if not isinstance(b, RigidBody):
+                raise ValueError(f"Expected OmniLeg.bodies[{k!r}] to be a RigidBody, got {type(b).__name__}.")
+            bodies[k] = b
+        object.__setattr__(self, "bodies", bodies)
+
+    @classmethod
+    def paper(cls) -> OmniLeg:
+        """Table 2 of paper 2 (converted to SI), joint ranges read as magnitudes, default inertias."""
+        return cls(**_PAPER)
+
+    @property
+    def foot_drop(self) -> float:
+        """Depth of the foot point below the E_i plane (m)."""
+        return self.L5 - self.knee_to_crank
+
+    def describe(self) -> dict[str, float]:
+        """Scalar parameters (SI) for reports."""
+        return {f.name: getattr(self, f.name) for f in fields(self) if f.name not in ("bodies", "gravity")}

@@ -1,0 +1,112 @@
+"""The test trajectories of paper 2: eq. (51) (foot, IK test), eq. (52) (joints, FK and dynamics tests)
+and eq. (53) (foot, gait of the single-leg platform), built from :mod:`robomech.trajectory`.
+
+The paper gives eqs. (51) and (53) as foot *displacements* without their start point or the direction of
+Z; robomech's reading (``docs/mechanisms/omnileg.md``): X, Y along X0, Y0, Z a lift (against Z0, toward
+the hip), added to the start point ``FK(0, 0, START_GAMMA)`` (the leg vertical with the shank half
+folded).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array
+from robomech.trajectory import Profile, quintic, sinusoid, swing_sextic
+
+from ._kinematics import forward_kinematics
+from ._params import OmniLeg
+
+__all__ = [
+    "EQ51_PERIOD",
+    "EQ52_DURATION",
+    "START_GAMMA",
+    "GaitProfile",
+    "foot_trajectory_eq51",
+    "gait_eq53",
+    "joint_trajectory_eq52",
+    "start_point",
+]
+
+# Start pose of the foot trajectories: the paper does not give it.  γ = 60° leaves the shank room to
+# extend (the thigh's depth shrinks when it tilts) and to retract (lift), so eq. (51) stays reachable.
+START_GAMMA = np.radians(60.0)
+# eq. (51) is a normalised quintic/sextic written out for a period T = 5 s (errata): X rises over
+# T/2 and returns, Y rises over T, Z lifts and returns over T.
+EQ51_PERIOD = 5.0
+EQ51_X, EQ51_Y, EQ51_Z = 0.1, 0.1, 0.05  # m, paper 2, eq. (51) coefficients
+# eq. (52) is evaluated for 0 <= t <= 6 s (one period of sin(pi t / 3)).
+EQ52_DURATION = 6.0
+EQ52_AMPLITUDE = np.array([np.pi / 6, np.pi / 6, 25 * np.pi / 180])  # rad, paper 2, eq. (52)
+EQ52_FREQUENCY = 1.0 / 6.0  # Hz: sin(pi t / 3) = sin(2 pi t / 6)
+# eq. (53) parameters, paper 2, Section 4: stride L = 0.1 m, swing height H = 0.05 m, L_h = 0, T = 1 s.
+GAIT_STRIDE, GAIT_HEIGHT, GAIT_LATERAL, GAIT_PERIOD = 0.1, 0.05, 0.0, 1.0
+
+
+def start_point(leg: OmniLeg) -> np.ndarray:
+    """Foot start point ``FK(0, 0, START_GAMMA)`` (3,), m."""
+    return forward_kinematics(leg, np.array([0.0, 0.0, START_GAMMA]))
+
+
+def _lift(p0: np.ndarray, x: Profile, y: Profile, z: Profile) -> Profile:
+    """Foot profile ``p0 + (X, Y, -Z)``: Z is a lift, against Z0 (which points toward the foot)."""
+    up = np.array([1.0, 1.0, -1.0])
+    return Profile(p0 + up * x.stack(y, z).q, up * x.stack(y, z).qd, up * x.stack(y, z).qdd)
+
+
+def foot_trajectory_eq51(leg: OmniLeg, t: object) -> Profile:
+    """Foot position, velocity, acceleration (..., 3) of eq. (51) at times ``t`` (...), 0 <= t <= 5 s."""
+    t = as_array(t, "t")
+    half = EQ51_PERIOD / 2
+    rising = t <= half
+    tm = np.where(rising, t, EQ51_PERIOD - t)  # eq. (51): X(t) for t > T/2 is X(T - t)
+    xq = quintic(tm, half, 0.0, EQ51_X)
+    sign = np.where(rising, 1.0, -1.0)
+    x = Profile(xq.q, sign * xq.qd, xq.qdd)
+    y = quintic(t, EQ51_PERIOD, 0.0, EQ51_Y)
+    z = swing_sextic(t, EQ51_PERIOD, EQ51_Z)
+    return _lift(start_point(leg), x, y, z)
+
+
+def joint_trajectory_eq52(t: object) -> Profile:
+    """Joint angles, rates, accelerations (..., 3) of eq. (52): (α, β, γ) = (π/6, π/6, 25π/180) sin(πt/3).
+
+    Note: γ < 0 for 3 s < t < 6 s, outside Table 2's γ range [0°, 85°]; the model is valid there
+    (|γ| < 90°) and the foot retraces its path since eq. (11) is even in γ.
+    """
+    t = as_array(t, "t")
+    return sinusoid(t[..., None], EQ52_AMPLITUDE, EQ52_FREQUENCY)
+
+
+@dataclass(frozen=True)
+class GaitProfile:
+    """Foot profile (position, velocity, acceleration (..., 3)) and ``stance (...)`` mask of eq. (53)."""
+
+    foot: Profile
+    stance: np.ndarray
+
+
+def gait_eq53(leg: OmniLeg, t: object, periods: int = 6) -> GaitProfile:
+    """Gait of the single-leg platform, eq. (53): alternating swing and stance periods of T = 1 s.
+
+    Swing: the foot moves from Y = -L/2 to +L/2 (quintic) while lifting H (sextic); stance: it returns
+    from +L/2 to -L/2 on the ground (H = 0), as the body moves forward.  The paper writes only the swing
+    form (Y from 0 to L); centring the stride under the hip and reversing it in stance is robomech's
+    reading (a foot fixed relative to the ground moves backward relative to the hip).
+    """
+    t = as_array(t, "t")
+    if periods < 1:
+        raise ValueError(f"Expected periods >= 1, got {periods}.")
+    T = GAIT_PERIOD
+    k = np.clip(np.floor(t / T), 0, periods - 1)
+    tau = t - k * T
+    stance = (k.astype(int) % 2) == 1
+    s = quintic(tau, T, 0.0, 1.0)
+    sign = np.where(stance, -1.0, 1.0)
+    y = Profile(sign * GAIT_STRIDE * (s.q - 0.5), sign * GAIT_STRIDE * s.qd, sign * GAIT_STRIDE * s.qdd)
+    x = Profile(GAIT_LATERAL * s.q, GAIT_LATERAL * s.qd, GAIT_LATERAL * s.qdd)
+    zs = swing_sextic(tau, T, GAIT_HEIGHT)
+    z = Profile(np.where(stance, 0.0, zs.q), np.where(stance, 0.0, zs.qd), np.where(stance, 0.0, zs.qdd))
+    return GaitProfile(_lift(start_point(leg), x, y, z), stance)
