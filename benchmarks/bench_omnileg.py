@@ -12,6 +12,7 @@ from functools import cache
 import numpy as np
 
 import robomech.mechanisms.omnileg as ol
+
 from _harness import Workload
 
 N_KIN = 1_000_000
