@@ -150,7 +150,7 @@ def _newton(
                 A[..., 6:12, col] = Js[0][..., :, i]
             else:
                 A[..., 6 * (k - 1) : 6 * k, col] = -Js[k][..., :, i]
-        step = lstsq.solve(A, r, diagnostics=False).x
+        step = lstsq.solve(A, r).x
         for col, (k, i) in enumerate(passive):
             theta[..., k, i] += step[..., col]
     return CLOSURE_MAX_ITER
