@@ -63,3 +63,26 @@ def test_markdown_table_escapes_pipes_in_headers_and_cells(tmp_path):
     assert header == "| max \\|f\\| | b |"
     with pytest.raises(ValueError, match="cells"):
         Table("bad", ["a", "b"], [[1]])
+
+
+def test_verify_cli_passes_and_prints_json(capsys):
+    assert main(["verify", "vectored-thrust", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["passed"] and all(c["passed"] for c in out["checks"]) and len(out["checks"]) >= 5
+    assert all(c["reason"] for c in out["checks"])  # every tolerance carries its reason
+
+
+def test_verify_cli_exits_nonzero_on_a_failed_check(monkeypatch, capsys):
+    from robomech import verify
+    from robomech.verify import Check, Tolerance, Verification
+
+    failing = Verification(
+        name="broken",
+        title="a deliberately failing check",
+        engine="none",
+        run=lambda: [Check("broken", "x", 1.0, Tolerance(1e-3, "test"))],
+    )
+    monkeypatch.setattr(verify, "available_verifications", lambda: {"broken": failing})
+    assert main(["verify", "broken"]) == 1
+    out = capsys.readouterr().out
+    assert "FAIL" in out and "0 passed, 1 failed" in out

@@ -6,8 +6,7 @@ with an underscore are infrastructure.  This is the only layer (with ``cli``) th
 
 from __future__ import annotations
 
-import importlib
-import pkgutil
+from robomech._registry import discover
 
 from ._core import Figure, Progress, Study, StudyResult, Table, comparison_table
 from ._report import write_index, write_study_report
@@ -28,15 +27,7 @@ __all__ = [
 
 def available_studies() -> dict[str, Study]:
     """All registered studies by name, in a stable order."""
-    found: dict[str, Study] = {}
-    for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
-        if info.name.startswith("_"):
-            continue
-        module = importlib.import_module(f"{__name__}.{info.name}")
-        study = getattr(module, "STUDY", None)
-        if isinstance(study, Study):
-            found[study.name] = study
-    return found
+    return discover(__name__, __path__, "STUDY", Study)
 
 
 def get_study(name: str) -> Study:

@@ -6,9 +6,9 @@ mechanism's verification needs no edit elsewhere.  Engines are imported inside t
 
 from __future__ import annotations
 
-import importlib
-import pkgutil
 from collections.abc import Iterable
+
+from robomech._registry import discover
 
 from ._core import Check, Tolerance, Verification, VerificationReport
 
@@ -23,15 +23,8 @@ __all__ = [
 
 
 def available_verifications() -> dict[str, Verification]:
-    found: dict[str, Verification] = {}
-    for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
-        if info.name.startswith("_"):
-            continue
-        module = importlib.import_module(f"{__name__}.{info.name}")
-        v = getattr(module, "VERIFICATION", None)
-        if isinstance(v, Verification):
-            found[v.name] = v
-    return found
+    """All registered verifications by mechanism name, in a stable order."""
+    return discover(__name__, __path__, "VERIFICATION", Verification)
 
 
 def run_verifications(names: Iterable[str] | None = None) -> VerificationReport:

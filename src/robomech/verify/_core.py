@@ -67,13 +67,15 @@ class VerificationReport:
         return all(c.passed for c in self.checks)
 
     def table(self) -> str:
-        header = f"{'mechanism':<16} {'quantity':<44} {'max error':>11} {'tolerance':>11}  result"
+        wq = max([len("quantity"), *(len(c.quantity) for c in self.checks)])
+        wm = max([len("mechanism"), *(len(c.mechanism) for c in self.checks)])
+        header = f"{'mechanism':<{wm}} {'quantity':<{wq}} {'max error':>11} {'tolerance':>11}      result"
         lines = [header, "-" * len(header)]
         for c in self.checks:
             kind = " rel" if c.tolerance.relative else ""
             lines.append(
-                f"{c.mechanism:<16} {c.quantity:<44} {c.max_error:>11.3e} {c.tolerance.value:>11.1e}{kind:4}"
-                f"  {'pass' if c.passed else 'FAIL'}"
+                f"{c.mechanism:<{wm}} {c.quantity:<{wq}} {c.max_error:>11.3e} "
+                f"{c.tolerance.value:>11.1e}{kind:4}  {'pass' if c.passed else 'FAIL'}"
             )
         n_fail = sum(not c.passed for c in self.checks)
         lines.append(f"{len(self.checks) - n_fail} passed, {n_fail} failed")
