@@ -67,9 +67,7 @@ def solve(A: object, b: object, *, exact_cond: bool = False) -> LstsqResult:
     batch = np.broadcast_shapes(A.shape[:-2], b.shape[:-1])
     Af = np.broadcast_to(A, (*batch, m, n)).reshape(-1, m, n)
     bf = np.broadcast_to(b, (*batch, m)).reshape(-1, m)
-    finite = np.all(np.isfinite(Af), axis=(-1, -2)) & np.all(np.isfinite(bf), axis=-1)
-
-    x, resid, cond, R = householder_lstsq(Af, bf, ~finite, exact_cond)
+    x, resid, cond, finite, R = householder_lstsq(Af, bf, exact_cond)
     if exact_cond:
         sv = np.linalg.svd(R, compute_uv=False)
         cond = np.where(sv[:, -1] > 0, sv[:, 0] / np.where(sv[:, -1] > 0, sv[:, -1], 1.0), np.inf)
