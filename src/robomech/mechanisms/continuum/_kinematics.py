@@ -58,10 +58,11 @@ IK_DAMPING_INCREASE = 4.0
 IK_DAMPING_MIN = 1e-12
 IK_DAMPING_MAX = 1e12
 # The Jacobian in the bending vector u needs (d p / d beta) / theta, 0/0 at theta = 0.  p(u) is smooth and
-# its Jacobian continuous in u, so it is evaluated at theta = max(theta, 1e-8 rad): this changes it by
-# O(1e-8) relative (it only steers the step; the residual is always exact), while (d p / d beta) ~ theta
-# l, divided by theta, is still accurate to ~1e-16 of its size (small-angle series below SMALL_ANGLE).
-IK_THETA_FLOOR = 1e-8
+# its Jacobian continuous in u, so it is evaluated at theta = max(theta, 1e-12 rad): any positive floor
+# avoids the 0/0, and this one moves the Jacobian by only ~floor * |d^2 p / d u^2| ~ 1e-12 * n l m/rad
+# (the residual itself is always exact), while (d p / d beta) ~ theta l, divided by theta, stays accurate
+# to ~1e-16 of its size (small-angle series below SMALL_ANGLE; no underflow at 1e-12).
+IK_THETA_FLOOR = 1e-12
 # Alternative starts for n >= 2 where the single arc fails, in the target's azimuthal frame (rotated by
 # beta_t = atan2(y, x)): (theta, plane angle) of the proximal segments, then of the distal segment (rad).
 # Chosen greedily on the failures of the single-arc start over 2 x 10^5 random 2- and 3-segment targets
