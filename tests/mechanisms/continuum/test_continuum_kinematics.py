@@ -8,11 +8,21 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from robomech.mechanisms import continuum as C
+from robomech.mechanisms.continuum._kinematics import (
+    IK_MAX_ITERATIONS,
+    IK_STARTS,
+    _tip_jacobian_u,
+    _tip_u,
+)
 from robomech.spatial import rot_y, rot_z
 from robomech.testing import numerical_jacobian, numerical_space_jacobian
 
 PAPER = C.ContinuumRobot.paper()
 TWO = C.ContinuumRobot(n_segments=2, friction=(0.26, 0.31, 0.28) * 2)
+THREE = C.ContinuumRobot(n_segments=3, friction=(0.26, 0.31, 0.28) * 3)
+# Bend range of the multi-segment IK property tests: up to pi per segment, beyond the 2 rad of the
+# package's random poses and benchmarks (10^5 random 2- and 3-segment targets in this range all reached).
+THETA_MAX_IK = np.pi
 # Central differences of O(0.1 m) functions with step 6e-6: truncation + rounding ~1e-10.
 FD_TOL = 1e-9
 # Double-precision agreement of two closed forms of the same O(1) quantity.
@@ -154,17 +164,73 @@ def test_ik_fk_round_trip_one_segment(theta, beta):
         assert abs(np.angle(np.exp(1j * (ik.psi[1] - beta)))) < 1e-9
 
 
-@settings(max_examples=40, deadline=None)
+def _assert_ik_round_trip(robot, psi):
+    p = C.tip_position(robot, psi)
+    ik = C.inverse_kinematics(robot, p)
+    assert ik.reachable and ik.converged, (ik.residual, ik.iterations)
+    assert ik.residual < C.IK_TOLERANCE
+    assert np.abs(C.tip_position(robot, ik.psi) - p).max() < C.IK_TOLERANCE
+    th, be = ik.psi[0::2], ik.psi[1::2]
+    assert np.all(th >= 0.0) and np.all(np.abs(be) <= np.pi) and np.all(be[th == 0.0] == 0.0)
+    return ik
+
+
+@settings(max_examples=60, deadline=None)
 @given(
-    th=st.lists(st.floats(0.0, 1.5), min_size=2, max_size=2),
+    th=st.lists(st.floats(0.0, THETA_MAX_IK), min_size=2, max_size=2),
     be=st.lists(st.floats(-np.pi, np.pi), min_size=2, max_size=2),
 )
 def test_ik_round_trip_two_segments(th, be):
-    psi = np.array([th[0], be[0], th[1], be[1]])
-    p = C.tip_position(TWO, psi)
-    ik = C.inverse_kinematics(TWO, p)
-    assert ik.reachable, ik.residual
-    assert np.abs(C.tip_position(TWO, ik.psi) - p).max() < C.IK_TOLERANCE
+    _assert_ik_round_trip(TWO, np.array([th[0], be[0], th[1], be[1]]))
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    th=st.lists(st.floats(0.0, THETA_MAX_IK), min_size=3, max_size=3),
+    be=st.lists(st.floats(-np.pi, np.pi), min_size=3, max_size=3),
+)
+def test_ik_round_trip_three_segments(th, be):
+    _assert_ik_round_trip(THREE, np.stack([th, be], -1).ravel())
+
+
+def test_ik_regression_segments_bent_against_each_other():
+    """Found by hypothesis: the old undamped Gauss-Newton in (theta, beta) from the single arc stalled
+    at a 0.17 m residual on this pose (distal segment bent back against the proximal one)."""
+    ik = _assert_ik_round_trip(TWO, np.array([0.25, 0.0, 1.0, 3.0]))
+    assert ik.iterations <= IK_MAX_ITERATIONS * (1 + len(IK_STARTS))
+
+
+@pytest.mark.parametrize(
+    ("robot", "psi"),
+    [
+        (TWO, [0.0, 0.0, 1.2, 0.7]),  # straight proximal segment
+        (TWO, [1.2, -2.0, 0.0, 0.0]),  # straight distal segment
+        (TWO, [0.0, 1.3, 0.0, -0.4]),  # straight robot (beta arbitrary in the target pose)
+        (THREE, [0.9, 0.3, 0.0, 0.0, 1.4, 2.5]),  # straight middle segment
+        (THREE, [0.0, 0.0, 0.0, 0.0, 2.0, -3.0]),
+    ],
+)
+def test_ik_round_trip_through_straight_segments(robot, psi):
+    ik = _assert_ik_round_trip(robot, np.array(psi))
+    if not np.any(psi[0::2]):  # straight target: the solution is the straight robot with beta = 0
+        assert np.all(ik.psi == 0.0)
+
+
+@pytest.mark.parametrize("robot", [TWO, THREE], ids=["two", "three"])
+def test_ik_jacobian_in_bending_vectors_vs_central_differences(robot):
+    """d p_tip / d u is continuous through u = 0 (theta = 0, beta undefined); it is evaluated at the
+    IK_THETA_FLOOR there, which must not spoil it."""
+    n = robot.n_segments
+    rng = np.random.default_rng(6)
+    u = rng.uniform(-2.0, 2.0, (8, n, 2))
+    u[0] = 0.0  # all segments straight
+    u[1, 0] = 0.0  # one straight segment
+    u[2, -1] = [1e-9, -2e-9]  # below the floor
+    u[3, 0] = [3e-5, 0.0]  # below SMALL_ANGLE (series branch)
+    J = _tip_jacobian_u(robot, u)
+    Jn = numerical_jacobian(lambda x: _tip_u(robot, x.reshape(*x.shape[:-1], n, 2)), u.reshape(8, 2 * n))
+    assert J.shape == (8, 3, 2 * n)
+    assert np.abs(J - Jn).max() < FD_TOL
 
 
 def test_ik_flags_unreachable_per_sample():
@@ -173,6 +239,55 @@ def test_ik_flags_unreachable_per_sample():
     ik = C.inverse_kinematics(PAPER, p)
     assert ik.reachable.tolist() == [True, False, False, True]
     assert np.all(np.isfinite(ik.psi))
+
+
+@pytest.mark.parametrize("robot", [TWO, THREE], ids=["two", "three"])
+def test_ik_flags_unreachable_per_sample_multi_segment(robot):
+    n, L = robot.n_segments, robot.segment_length
+    rng = np.random.default_rng(7)
+    dirs = rng.normal(size=(6, 3))
+    dirs /= np.linalg.norm(dirs, axis=-1, keepdims=True)
+    far = dirs * n * L * np.array([1.01, 1.2, 1.5, 2.0, 3.0, 10.0])[:, None]  # beyond the reach n l
+    near = C.tip_position(robot, random_psi(rng, robot, batch=(4,)))
+    p = np.concatenate([near[:2], far, near[2:]])
+    ik = C.inverse_kinematics(robot, p)
+    assert ik.reachable.tolist() == [True] * 2 + [False] * 6 + [True] * 2
+    assert np.all(np.isfinite(ik.psi)) and np.all(np.isfinite(ik.residual))
+    # the tip is never farther than n l from the base: a lower bound of the residual
+    assert np.all(ik.residual[2:8] >= np.linalg.norm(far, axis=-1) - n * L)
+    # the reported residual is that of the returned pose
+    assert np.abs(np.linalg.norm(C.tip_position(robot, ik.psi) - p, axis=-1) - ik.residual).max() < 1e-15
+    # beyond the reach, no restart: one solve only (the cost of an unreachable target is bounded)
+    assert np.all(ik.iterations[2:8] <= IK_MAX_ITERATIONS)
+    assert np.all(ik.converged[[0, 1, 8, 9]])
+
+
+# Poses whose tips the single-arc start does not reach (found by a search over random poses): they
+# exercise the alternative starts.
+NEEDS_RESTART = {2: [3.11, -0.59, 3.02, -1.03], 3: [1.3, 0.36, 2.31, 3.09, 2.23, -2.29]}
+
+
+@pytest.mark.parametrize("robot", [TWO, THREE], ids=["two", "three"])
+def test_ik_batched_equals_per_sample_with_restarts_and_failures(robot):
+    """A batch mixing easy targets, targets that need the alternative starts, straight ones and
+    unreachable ones gives per sample exactly what the sample gives alone."""
+    rng = np.random.default_rng(8)
+    psi = random_psi(rng, robot, batch=(12,), theta_max=THETA_MAX_IK)
+    psi[0, 0::2] = 0.0
+    psi[5] = NEEDS_RESTART[robot.n_segments]
+    p = C.tip_position(robot, psi)
+    p = np.concatenate([p, [[0.0, 0.0, 0.0], [0.3, -0.2, 0.1]]])  # base point, beyond the reach
+    ik = C.inverse_kinematics(robot, p.reshape(2, 7, 3))
+    assert ik.psi.shape == (2, 7, 2 * robot.n_segments) and ik.reachable.shape == (2, 7)
+    single = [C.inverse_kinematics(robot, q) for q in p]
+    for name in ("psi", "residual"):
+        ref = np.stack([getattr(s, name) for s in single]).reshape(getattr(ik, name).shape)
+        assert np.abs(getattr(ik, name) - ref).max() < 1e-12
+    for name in ("reachable", "converged", "iterations"):
+        ref = np.stack([getattr(s, name) for s in single]).reshape(2, 7)
+        assert np.array_equal(getattr(ik, name), ref)
+    assert ik.reachable.ravel()[:12].all() and not ik.reachable.ravel()[13]
+    assert ik.iterations.ravel()[5] > IK_MAX_ITERATIONS  # the alternative starts were used
 
 
 def test_batched_equals_per_sample():
