@@ -121,4 +121,31 @@ def workloads() -> list[Workload]:
             target_floor_ratio=20.0,
         )
     )
+    # Two segments: IK is iterative (Levenberg-Marquardt in bending vectors, multi-start); 10^5 targets.
+    two = C.ContinuumRobot(n_segments=2, friction=(0.26, 0.31, 0.28) * 2)
+    n2 = N_KIN // 10
+    psi2 = np.stack(
+        [
+            rng.uniform(0.0, 1.5, n2),
+            rng.uniform(-np.pi, np.pi, n2),
+            rng.uniform(0.0, 1.5, n2),
+            rng.uniform(-np.pi, np.pi, n2),
+        ],
+        -1,
+    )
+    p2 = C.tip_position(two, psi2)
+    p2_alt = p2[:N_ALT_KIN]
+    out.append(
+        Workload(
+            name="continuum: inverse kinematics, 2 segments (LM)",
+            group="2",
+            run=lambda: C.inverse_kinematics(two, p2),
+            n=n2,
+            bytes_moved=p2.nbytes + psi2.nbytes + n2 * 8 * 2 + n2 * 2,
+            alternative=lambda: [C.inverse_kinematics(two, p) for p in p2_alt],
+            n_alt=N_ALT_KIN,
+            alternative_name="per-sample loop, same function",
+            target_speedup=100.0,
+        )
+    )
     return out

@@ -60,19 +60,23 @@ def _kernel():
             for blk in range(chunk * CHUNK_BLOCKS, min(nblocks, (chunk + 1) * CHUNK_BLOCKS)):
                 s0 = blk * BLOCK
                 cnt = min(BLOCK, batch - s0)
+                # Load [A | b] with the system index innermost (contiguous writes into W).
+                for i in range(m):
+                    for j in range(n):
+                        for s in range(cnt):
+                            W[j, i, s] = A[s0 + s, i, j]
+                    for s in range(cnt):
+                        W[n, i, s] = b[s0 + s, i]
+                # A system is finite iff 0 * (every entry) sums to 0 (NaN and inf give NaN).
                 for s in range(BLOCK):
-                    good = s < cnt
-                    if good:
-                        for i in range(m):
-                            for j in range(n):
-                                W[j, i, s] = A[s0 + s, i, j]
-                            W[n, i, s] = b[s0 + s, i]
-                        # finite iff every entry is (NaN or inf makes the sum non-finite)
-                        total = 0.0
-                        for j in range(n + 1):
-                            for i in range(m):
-                                total += W[j, i, s] * 0.0
-                        good = total == 0.0
+                    norm2[s] = 0.0
+                for j in range(n + 1):
+                    for i in range(m):
+                        for s in range(cnt):
+                            norm2[s] += W[j, i, s] * 0.0
+                for s in range(BLOCK):
+                    good = s < cnt and norm2[s] == 0.0
+                    if s < cnt:
                         ok[s0 + s] = good
                     if not good:  # padding or a non-finite system: a harmless identity system, discarded
                         for j in range(n + 1):
