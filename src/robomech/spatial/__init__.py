@@ -20,7 +20,7 @@ from ._se3 import (
     virtual_power,
     wrench_at,
 )
-from ._so3 import SMALL_ANGLE, exp_so3, hat, log_so3, rot_x, rot_y, rot_z, vee
+from ._so3 import SMALL_ANGLE, exp_so3, hat, log_so3, rot_x, rot_y, rot_z, sincos, vee
 
 __all__ = [
     "SMALL_ANGLE",
@@ -40,6 +40,7 @@ __all__ = [
     "rot_z",
     "screw_from_axis",
     "screw_to_axis",
+    "sincos",
     "transform",
     "vee",
     "vee_se3",

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["exp_so3", "hat", "log_so3", "rot_x", "rot_y", "rot_z", "vee"]
+__all__ = ["exp_so3", "hat", "log_so3", "rot_x", "rot_y", "rot_z", "sincos", "vee"]
 
 # Below this angle the closed forms sin(t)/t, (1-cos t)/t^2 ... are replaced by their Taylor series:
 # the series truncated after the t^4 term has error O(t^6) < 1e-24 at t = 1e-4, while the closed forms
@@ -85,9 +85,23 @@ def log_so3(R: np.ndarray) -> np.ndarray:
     return np.where((theta > 0.5 * np.pi)[..., None], w_far, w_near)
 
 
+def sincos(angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(sin(angle), cos(angle))`` from one tangent of the half angle, for any real angle.
+
+    ``s = 2t / (1 + t^2)``, ``c = (1 - t^2) / (1 + t^2)`` with ``t = tan(angle / 2)``: absolute error
+    within 2.3e-16 of ``np.sin``/``np.cos`` (relative for small angles; tests), and on this project's
+    machines about 3.5x faster than the two calls, whose float64 kernels are not vectorised
+    (docs/performance.md).  Finite at odd multiples of pi, where ``t`` is ~1e16: ``c = -1``.
+    """
+    t = np.tan(0.5 * np.asarray(angle, dtype=float))
+    t2 = t * t
+    d = 1.0 / (1.0 + t2)
+    return 2.0 * t * d, (1.0 - t2) * d
+
+
 def _rot(angle: np.ndarray, i: int, j: int) -> np.ndarray:
     a = np.asarray(angle, dtype=float)
-    c, s = np.cos(a), np.sin(a)
+    s, c = sincos(a)
     R = np.zeros((*a.shape, 3, 3))
     k = 3 - i - j
     R[..., k, k] = 1.0
