@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomech._validation import as_array
+from robomech.spatial import sincos
 
 from ._params import SphericalLeg
 
@@ -98,13 +99,17 @@ def _rotation(sa: np.ndarray, ca: np.ndarray, sb: np.ndarray, cb: np.ndarray) ->
     )
 
 
-def _squared_lengths(leg: SphericalLeg, sa, ca, sb, cb) -> np.ndarray:
+def _squared_length_columns(leg: SphericalLeg, sa, ca, sb, cb) -> tuple[np.ndarray, ...]:
     R, r, h = leg.R, leg.r, leg.h
     K = R * R + r * r + h * h
     q1 = K - 2 * R * (r * cb + h * sb)
     q2 = K - 2 * R * (r * cb - h * sb)
     q3 = K - 2 * R * (r * ca - h * cb * sa)
-    return np.stack([q1, q2, q3], -1)
+    return q1, q2, q3
+
+
+def _squared_lengths(leg: SphericalLeg, sa, ca, sb, cb) -> np.ndarray:
+    return np.stack(_squared_length_columns(leg, sa, ca, sb, cb), -1)
 
 
 @dataclass(frozen=True)
@@ -148,7 +153,7 @@ def inverse_kinematics(leg: SphericalLeg, alpha: object, beta: object) -> Invers
 def _ik_kernel(leg: SphericalLeg, a, b, L, S, B) -> None:
     """B_i = T b_i written out (paper 1, eq. (3) and its analogues), lengths from the closed form."""
     R, r, h = leg.R, leg.r, leg.h
-    sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
+    (sa, ca), (sb, cb) = sincos(a), sincos(b)
     rsb_m_hcb = r * sb - h * cb
     rsb_p_hcb = r * sb + h * cb
     B[:, 0, 0] = r * cb + h * sb
@@ -213,30 +218,60 @@ def forward_kinematics(leg: SphericalLeg, lengths: object, branch: int = 0) -> F
 def _fk_kernel(
     leg: SphericalLeg, branch: int, L, alpha_out, beta_out, resid_out, valid_out, conv_out
 ) -> None:
-    ok_in = np.all(np.isfinite(L) & (L > 0), axis=-1)
-    Lw = np.where(ok_in[:, None], L, 1.0)
+    """Transcendental-light forward kinematics of one chunk.
+
+    The Newton fit carries (cos b, sin b) instead of b, so an iteration needs only square roots and
+    divisions; the closed forms for alpha are written with sin/cos of phi and asin(s) taken from their
+    defining ratios. Per sample this leaves two atan2 calls (beta, alpha) and one half-angle tangent
+    (sincos of the fitted beta, for a residual bit-consistent with ``inverse_kinematics``).
+    """
+    # per-column work: numpy's reductions over a length-3 last axis cost ~15 ms per 10^6 rows here
+    l1, l2, l3 = L[:, 0], L[:, 1], L[:, 2]
+    # positive and finite (NaN fails every comparison and propagates through maximum)
+    ok_in = (l1 > 0) & (l2 > 0) & (l3 > 0) & (np.maximum(np.maximum(l1, l2), l3) < np.inf)
+    m1, m2, m3 = (np.where(ok_in, li, 1.0) for li in (l1, l2, l3))
     R, r, h = leg.R, leg.r, leg.h
     K = R * R + r * r + h * h
-    q = Lw * Lw
-    # paper 1, eq. (6) uses arcsin((l2^2 - l1^2)/(4Rh)); atan2 with the cosine from l1^2 + l2^2 is exact
-    # for consistent lengths, covers |beta| > pi/2 and never leaves the domain for noisy ones.
-    beta = np.arctan2((q[:, 1] - q[:, 0]) / (4 * R * h), (2 * K - q[:, 0] - q[:, 1]) / (4 * R * r))
-    beta, converged = _fit_beta(leg, beta, Lw[:, 0], Lw[:, 1])
-    sb, cb = np.sin(beta), np.cos(beta)
+    q = (m1 * m1, m2 * m2, m3 * m3)
+    # paper 1, eq. (6) uses arcsin((l2^2 - l1^2)/(4Rh)); the direction of (cosine from l1^2 + l2^2,
+    # sine from l2^2 - l1^2) is exact for consistent lengths, covers |beta| > pi/2 and never leaves the
+    # domain for noisy ones (it is atan2 of the same pair, normalised without the angle).
+    y = (q[1] - q[0]) * (1.0 / (4 * R * h))
+    x = (2 * K - q[0] - q[1]) * (1.0 / (4 * R * r))
+    n0 = np.sqrt(x * x + y * y)
+    pos = n0 > 0  # atan2(0, 0) = 0: the start (1, 0)
+    inv = 1.0 / np.where(pos, n0, 1.0)
+    cb0 = np.where(pos, x * inv, 1.0)
+    sb0 = y * inv
+    cb0, sb0, converged = _fit_beta_cs(leg, cb0, sb0, m1, m2)
+    beta = np.arctan2(sb0, cb0)
+    sb, cb = sincos(beta)
     hcb = h * cb
-    rho = np.hypot(hcb, r)
-    phi = np.arctan2(r, hcb)
+    rho = np.sqrt(hcb * hcb + r * r)
     # paper 1, eqs. (7): the printed Ferrari quartic (with a dropped square in k2, 9k2k3k4 for 9k1k2k3
-    # and arctan(2a) for 2 arctan(a)) is replaced by this exact closed form of the l3 equation.
-    s = (q[:, 2] - K) / (2 * R * rho)
+    # and arctan(2a) for 2 arctan(a)) is replaced by this exact closed form of the l3 equation:
+    # sin(alpha - phi) = s with phi = atan2(r, h cos b), so alpha = phi + asin(s) (branch 0) or
+    # phi + pi - asin(s) (branch 1); sin and cos of alpha follow from those of phi (r/rho, h cos b/rho)
+    # and of asin(s) (s, +-sqrt(1 - s^2)), and alpha itself from one atan2 (in (-pi, pi]).
+    inv_rho = 1.0 / rho
+    s = (q[2] - K) * (0.5 / R) * inv_rho
     assembles = np.abs(s) <= 1.0 + ASSEMBLY_TOL
-    asn = np.arcsin(np.clip(s, -1.0, 1.0))
-    alpha = phi + asn if branch == 0 else phi + np.pi - asn
-    alpha = np.mod(alpha + np.pi, 2 * np.pi) - np.pi
+    np.clip(s, -1.0, 1.0, out=s)
+    cw = np.sqrt(np.maximum((1.0 - s) * (1.0 + s), 0.0))
+    if branch == 1:
+        cw = -cw
+    sphi, cphi = r * inv_rho, hcb * inv_rho
+    sa = sphi * cw + cphi * s
+    ca = cphi * cw - sphi * s
+    alpha = np.arctan2(sa, ca)
     valid = ok_in & assembles
-    sa, ca = np.sin(alpha), np.cos(alpha)
-    fitted = np.sqrt(np.maximum(_squared_lengths(leg, sa, ca, sb, cb), 0.0))
-    residual = np.linalg.norm(fitted - Lw, axis=-1)
+    # fitted lengths minus measured, squared, written as inverse_kinematics evaluates them
+    rsq = 0.0
+    for qi, mi in zip(_squared_length_columns(leg, sa, ca, sb, cb), (m1, m2, m3), strict=True):
+        ei = np.sqrt(np.maximum(qi, 0.0))
+        ei -= mi
+        rsq = rsq + ei * ei
+    residual = np.sqrt(rsq)
     alpha_out[:] = np.where(valid, alpha, np.nan)
     beta_out[:] = np.where(valid, beta, np.nan)
     resid_out[:] = np.where(valid, residual, np.nan)
@@ -244,43 +279,65 @@ def _fk_kernel(
     conv_out[:] = converged & valid
 
 
-def _fit_beta(
-    leg: SphericalLeg, beta: np.ndarray, m1: np.ndarray, m2: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Newton's method on f(b) = 1/2 sum_{i=1,2} (l_i(b) - m_i)^2, batched; returns (beta, converged).
+def _fit_beta_cs(
+    leg: SphericalLeg, cb: np.ndarray, sb: np.ndarray, m1: np.ndarray, m2: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Newton's method on f(b) = 1/2 sum_{i=1,2} (l_i(b) - m_i)^2 carried on (cos b, sin b), batched.
 
-    Only the samples not yet converged are iterated (active set); each sample's iterates are those it
-    would have alone.
+    Returns (cos b, sin b, converged). The lengths and their beta-derivatives are polynomial in (cos b,
+    sin b), so an iteration needs no transcendental call: the Newton step d is applied as the rotation
+    by 2 atan(d/2) = d - d^3/12 + ..., whose cosine and sine are rational in d/2. This changes a step by
+    O(d^3) only, so the iteration keeps Newton's fixed points and quadratic convergence (and the
+    Gauss-Newton fallback its linear rate); the stopping rule reads the Newton step d itself. Only
+    samples not yet converged are iterated (active set); each sample's iterates are those it would
+    have alone.
     """
     R, r, h = leg.R, leg.r, leg.h
     K = R * R + r * r + h * h
-    beta = np.array(beta, dtype=float, copy=True)
-    done = np.zeros(beta.shape, dtype=bool)
-    idx = np.arange(beta.size)
+    cb = np.array(cb, dtype=float, copy=True)
+    sb = np.array(sb, dtype=float, copy=True)
+    done = np.zeros(cb.shape, dtype=bool)
+    idx = None  # None: every sample active (no gather needed)
     for _ in range(FK_MAX_ITER):
-        b = beta[idx]
-        sb, cb = np.sin(b), np.cos(b)
-        rcb, hsb, rsb, hcb = r * cb, h * sb, r * sb, h * cb
+        if idx is None:
+            c, s, e1, e2 = cb, sb, -m1, -m2
+        else:
+            c, s, e1, e2 = cb[idx], sb[idx], -m1[idx], -m2[idx]
+        rc, hs, rs, hc = r * c, h * s, r * s, h * c
         # q_i = l_i^2 and its beta-derivatives (closed forms of the module docstring)
-        l1 = np.sqrt(np.maximum(K - 2 * R * (rcb + hsb), LENGTH_FLOOR**2))
-        l2 = np.sqrt(np.maximum(K - 2 * R * (rcb - hsb), LENGTH_FLOOR**2))
-        d1 = R * (rsb - hcb) / l1  # dl/db = (dq/db) / (2 l)
-        d2 = R * (rsb + hcb) / l2
-        dd1 = (R * (rcb + hsb) - d1 * d1) / l1  # d2l/db2 = (q''/2 - l'^2) / l
-        dd2 = (R * (rcb - hsb) - d2 * d2) / l2
-        e1 = l1 - m1[idx]
-        e2 = l2 - m2[idx]
+        l1 = np.sqrt(np.maximum(K - 2 * R * (rc + hs), LENGTH_FLOOR**2))
+        l2 = np.sqrt(np.maximum(K - 2 * R * (rc - hs), LENGTH_FLOOR**2))
+        i1, i2 = 1.0 / l1, 1.0 / l2
+        d1 = R * (rs - hc) * i1  # dl/db = (dq/db) / (2 l)
+        d2 = R * (rs + hc) * i2
+        dd1 = (R * (rc + hs) - d1 * d1) * i1  # d2l/db2 = (q''/2 - l'^2) / l
+        dd2 = (R * (rc - hs) - d2 * d2) * i2
+        e1 += l1
+        e2 += l2
         hgn = d1 * d1 + d2 * d2  # > 0: dl1/db and dl2/db never vanish together (R, r, h > 0)
         hn = hgn + e1 * dd1 + e2 * dd2
         newton = hn > 0.5 * hgn  # Gauss-Newton curvature where Newton's is unsafe (large residuals)
         step = (e1 * d1 + e2 * d2) / np.where(newton, hn, hgn)
-        beta[idx] = b - step
+        # b <- b - step as the rotation by -2 atan(step/2): cos/sin = ((1 - t^2), -2t) / (1 + t^2)
+        t = 0.5 * step
+        w = 1.0 / (1.0 + t * t)
+        ct = (1.0 - t * t) * w
+        st = (2.0 * w) * t
+        c_new = c * ct + s * st
+        s_new = s * ct - c * st
         fin = np.abs(step) <= np.where(newton, FK_NEWTON_STEP_TOL, FK_STEP_TOL)
-        done[idx[fin]] = True
-        idx = idx[~fin]
+        if idx is None:
+            cb, sb = c_new, s_new
+            done = fin
+            idx = np.flatnonzero(~fin)
+        else:
+            cb[idx] = c_new
+            sb[idx] = s_new
+            done[idx[fin]] = True
+            idx = idx[~fin]
         if idx.size == 0:
             break
-    return beta, done
+    return cb, sb, done
 
 
 def jacobian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
@@ -294,7 +351,7 @@ def jacobian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
 def _jacobian_kernel(leg: SphericalLeg, a, b, J) -> None:
     R, r, h = leg.R, leg.r, leg.h
     K = R * R + r * r + h * h
-    sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
+    (sa, ca), (sb, cb) = sincos(a), sincos(b)
     rcb, hsb, rsb, hcb = r * cb, h * sb, r * sb, h * cb
     # dl/dq = (dq/dq) / (2 l) with q = l^2 (module docstring); R/l below is 2R / (2l)
     J[:, 0, 0] = 0.0

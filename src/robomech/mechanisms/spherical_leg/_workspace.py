@@ -11,6 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech.spatial import sincos
+
 from ._kinematics import LENGTH_FLOOR, _angles, _chunked, _squared_lengths
 from ._params import SphericalLeg
 
@@ -56,7 +58,7 @@ def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMa
 
 
 def _kernel(leg: SphericalLeg, a, b, L_out, reach_out, smin_out, smax_out, cond_out, j3a_out) -> None:
-    sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
+    (sa, ca), (sb, cb) = sincos(a), sincos(b)
     R, r, h = leg.R, leg.r, leg.h
     q = _squared_lengths(leg, sa, ca, sb, cb)
     np.sqrt(np.maximum(q, 0.0), out=L_out)
