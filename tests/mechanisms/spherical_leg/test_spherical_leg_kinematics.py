@@ -232,3 +232,30 @@ def test_chunked_batches_equal_per_sample_across_chunk_boundaries():
         assert abs(one.alpha - fk.alpha[k]) <= 1e-12 and abs(one.residual - fk.residual[k]) <= 1e-12
         assert np.max(np.abs(sl.jacobian(LEG, q[k, 0], q[k, 1]) - J[k])) <= 1e-12
         assert abs(sl.workspace_map(LEG, q[k, 0], q[k, 1]).cond - wm.cond[k]) <= 1e-12 * wm.cond[k]
+
+
+def test_compiled_forward_kinematics_matches_the_numpy_path():
+    # batches of at least FK_NUMBA_MIN samples run the compiled kernels; both paths must agree to 1e-12
+    # on noisy, exact, branch-1 and bad samples alike (same flags, NaN in the same places)
+    from robomech.mechanisms.spherical_leg import _kinematics as kin
+
+    rng = np.random.default_rng(11)
+    n = kin.FK_NUMBA_MIN + 5
+    q = rng.uniform(-1.2, 1.2, (n, 2))
+    L = sl.inverse_kinematics(LEG, q[:, 0], q[:, 1]).lengths
+    L[: n // 2] += rng.normal(scale=1e-4, size=(n // 2, 3))
+    L[1] = [np.nan, 0.1, 0.1]
+    L[2] = [0.1, 0.1, 0.5]  # no assembly
+    L[3] = [0.1, -0.1, 0.1]
+    L[4] = [0.1, 0.1, np.inf]
+    L[5] = [0.0, 0.1, 0.1]
+    for branch in (0, 1):
+        fast = sl.forward_kinematics(LEG, L, branch=branch)
+        outs = (np.empty(n), np.empty(n), np.empty(n), np.empty(n, bool), np.empty(n, bool))
+        kin._fk_kernel(LEG, branch, L, *outs)
+        alpha, beta, residual, valid, converged = outs
+        assert np.array_equal(fast.valid, valid) and np.array_equal(fast.converged, converged)
+        assert fast.valid[0] and not fast.valid[1:6].any() and fast.valid[6:].mean() > 0.9
+        for got, ref in ((fast.alpha, alpha), (fast.beta, beta), (fast.residual, residual)):
+            assert np.array_equal(np.isnan(got), ~valid) and np.array_equal(np.isnan(ref), ~valid)
+            assert np.max(np.abs(got[valid] - ref[valid])) <= 1e-12

@@ -13,6 +13,7 @@ so l1, l2 fix beta alone and l3 then fixes alpha: the three lengths over-determi
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -59,6 +60,13 @@ LENGTH_FLOOR = 1e-12
 # memory; on 10^6 poses this roughly halves the time (benchmarks/bench_spherical_leg.py). Every
 # operation is elementwise per sample, so chunking does not change any result bit.
 CHUNK = 16384
+# Forward kinematics of at least this many samples runs its Newton fit and closed forms in compiled
+# kernels (numba, parallel; see _fk_numba_kernels), the rest in numpy: below it the numpy path is
+# as fast and a per-sample caller never pays the one-off compilation (cached on disk afterwards).
+FK_NUMBA_MIN = 4096
+# Samples per block of the compiled Newton fit: a few SIMD widths, so the masked passes vectorise and
+# a block stops as soon as its slowest sample has converged (3 passes for typical noisy lengths).
+FK_BLOCK = 64
 
 
 def _chunked(kernel, inputs: tuple[np.ndarray, ...], outputs: tuple[np.ndarray, ...]) -> None:
@@ -208,7 +216,10 @@ def forward_kinematics(leg: SphericalLeg, lengths: object, branch: int = 0) -> F
     shape = L.shape[:-1]
     n = int(np.prod(shape, dtype=int))
     outs = (np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=bool), np.empty(n, dtype=bool))
-    _chunked(lambda *x: _fk_kernel(leg, branch, *x), (L.reshape(n, 3),), outs)
+    if n >= FK_NUMBA_MIN:
+        _fk_kernel_compiled(leg, branch, np.ascontiguousarray(L.reshape(n, 3)), *outs)
+    else:
+        _chunked(lambda *x: _fk_kernel(leg, branch, *x), (L.reshape(n, 3),), outs)
     alpha, beta, residual, valid, converged = (o.reshape(shape) for o in outs)
     return ForwardKinematicsResult(
         alpha=alpha, beta=beta, residual=residual, valid=valid, converged=converged
@@ -277,6 +288,149 @@ def _fk_kernel(
     resid_out[:] = np.where(valid, residual, np.nan)
     valid_out[:] = valid
     conv_out[:] = converged & valid
+
+
+def _fk_kernel_compiled(
+    leg: SphericalLeg, branch: int, L, alpha_out, beta_out, resid_out, valid_out, conv_out
+) -> None:
+    """``_fk_kernel`` with its arithmetic in two compiled per-sample kernels (same operations in the
+    same order, so results agree with the numpy path to rounding); the three transcendental calls
+    stay in numpy, whose SIMD atan2/tan are several times faster than the scalar libm calls numba makes.
+    Runs on the whole batch: each compiled kernel is one parallel region (one per cache-sized chunk cost
+    ~8 ms each when another process held the second core: the region waits for a scheduler slice).
+    """
+    fit, close = _fk_numba_kernels()
+    R, r, h = leg.R, leg.r, leg.h
+    n = L.shape[0]
+    cb, sb = np.empty(n), np.empty(n)
+    tols = (FK_NEWTON_STEP_TOL, FK_STEP_TOL, LENGTH_FLOOR**2)
+    M = np.empty((3, n))  # lengths (1.0 for bad samples) by column: contiguous loads vectorise
+    fit(L, R, r, h, FK_MAX_ITER, *tols, M, cb, sb, valid_out, conv_out)
+    for start in range(0, n, CHUNK):  # numpy's temporaries stay in cache
+        c = slice(start, start + CHUNK)
+        np.arctan2(sb[c], cb[c], out=beta_out[c])
+        sb[c], cb[c] = sincos(beta_out[c])
+    sa, ca = np.empty(n), np.empty(n)
+    close(
+        M,
+        R,
+        r,
+        h,
+        -1.0 if branch == 1 else 1.0,
+        ASSEMBLY_TOL,
+        sb,
+        cb,
+        sa,
+        ca,
+        beta_out,
+        resid_out,
+        valid_out,
+        conv_out,
+    )
+    np.arctan2(sa, ca, out=alpha_out)
+
+
+@functools.cache
+def _fk_numba_kernels():
+    """Compile (or load from the on-disk cache) the forward-kinematics kernels: (fit, close)."""
+    import numba  # deferred: ~0.3 s import and the compilation are paid by large-batch FK users only
+
+    @numba.njit(parallel=True, cache=True, error_model="numpy")
+    def fit(L, R, r, h, max_iter, newton_tol, gn_tol, floor2, M, cb, sb, ok, conv):  # pragma: no cover
+        # Samples go in blocks of FK_BLOCK; every Newton pass runs over a whole block with a select
+        # for the converged ones (their values freeze), so the pass vectorises (SIMD) across samples
+        # instead of one sample's latency-bound chain of square roots and divisions.
+        K = R * R + r * r + h * h
+        n = L.shape[0]
+        nblocks = (n + FK_BLOCK - 1) // FK_BLOCK
+        for blk in numba.prange(nblocks):
+            i0 = blk * FK_BLOCK
+            cnt = min(FK_BLOCK, n - i0)
+            m1 = np.empty(FK_BLOCK)
+            m2 = np.empty(FK_BLOCK)
+            c = np.empty(FK_BLOCK)
+            s = np.empty(FK_BLOCK)
+            active = np.zeros(FK_BLOCK, dtype=np.bool_)
+            for j in range(cnt):
+                a1, a2, a3 = L[i0 + j, 0], L[i0 + j, 1], L[i0 + j, 2]
+                good = a1 > 0 and a2 > 0 and a3 > 0 and max(max(a1, a2), a3) < np.inf
+                ok[i0 + j] = good
+                if not good:
+                    a1, a2, a3 = 1.0, 1.0, 1.0
+                m1[j], m2[j] = a1, a2
+                M[0, i0 + j], M[1, i0 + j], M[2, i0 + j] = a1, a2, a3
+                q0, q1 = a1 * a1, a2 * a2
+                y = (q1 - q0) * (1.0 / (4 * R * h))
+                x = (2 * K - q0 - q1) * (1.0 / (4 * R * r))
+                n0 = np.sqrt(x * x + y * y)
+                inv = 1.0 / n0 if n0 > 0 else 1.0
+                c[j] = x * inv if n0 > 0 else 1.0
+                s[j] = y * inv
+                active[j] = True
+            for _ in range(max_iter):
+                left = 0
+                for j in range(cnt):
+                    cj, sj = c[j], s[j]
+                    rc, hs, rs, hc = r * cj, h * sj, r * sj, h * cj
+                    l1 = np.sqrt(max(K - 2 * R * (rc + hs), floor2))
+                    l2 = np.sqrt(max(K - 2 * R * (rc - hs), floor2))
+                    i1, i2 = 1.0 / l1, 1.0 / l2
+                    d1 = R * (rs - hc) * i1
+                    d2 = R * (rs + hc) * i2
+                    dd1 = (R * (rc + hs) - d1 * d1) * i1
+                    dd2 = (R * (rc - hs) - d2 * d2) * i2
+                    e1 = -m1[j] + l1
+                    e2 = -m2[j] + l2
+                    hgn = d1 * d1 + d2 * d2
+                    hn = hgn + e1 * dd1 + e2 * dd2
+                    newton = hn > 0.5 * hgn
+                    step = (e1 * d1 + e2 * d2) / (hn if newton else hgn)
+                    t = 0.5 * step
+                    w = 1.0 / (1.0 + t * t)
+                    ct = (1.0 - t * t) * w
+                    st = (2.0 * w) * t
+                    act = active[j]
+                    c[j] = cj * ct + sj * st if act else cj
+                    s[j] = sj * ct - cj * st if act else sj
+                    still = act and abs(step) > (newton_tol if newton else gn_tol)
+                    active[j] = still
+                    left += still
+                if left == 0:
+                    break
+            for j in range(cnt):
+                cb[i0 + j], sb[i0 + j], conv[i0 + j] = c[j], s[j], not active[j]
+
+    @numba.njit(parallel=True, cache=True, error_model="numpy")
+    def close(M, R, r, h, sign, tol, sb, cb, sa, ca, beta, resid, ok, conv):  # pragma: no cover
+        K = R * R + r * r + h * h
+        # branch-free (selects only) and an inner plain loop per block, so that the loop vectorises
+        n = M.shape[1]
+        for blk in numba.prange((n + FK_BLOCK - 1) // FK_BLOCK):
+            for i in range(blk * FK_BLOCK, min(n, (blk + 1) * FK_BLOCK)):
+                good = ok[i]
+                m1, m2, m3 = M[0, i], M[1, i], M[2, i]
+                c, sn = cb[i], sb[i]
+                hcb = h * c
+                rho = np.sqrt(hcb * hcb + r * r)
+                inv_rho = 1.0 / rho
+                s = (m3 * m3 - K) * (0.5 / R) * inv_rho
+                good = good & (abs(s) <= 1.0 + tol)
+                s = min(max(s, -1.0), 1.0)
+                cw = sign * np.sqrt(max((1.0 - s) * (1.0 + s), 0.0))
+                sphi, cphi = r * inv_rho, hcb * inv_rho
+                sai = sphi * cw + cphi * s
+                cai = cphi * cw - sphi * s
+                e1 = np.sqrt(max(K - 2 * R * (r * c + h * sn), 0.0)) - m1
+                e2 = np.sqrt(max(K - 2 * R * (r * c - h * sn), 0.0)) - m2
+                e3 = np.sqrt(max(K - 2 * R * (r * cai - hcb * sai), 0.0)) - m3
+                ok[i] = good
+                conv[i] = conv[i] & good
+                sa[i] = sai if good else np.nan
+                ca[i] = cai if good else np.nan
+                resid[i] = np.sqrt(e1 * e1 + e2 * e2 + e3 * e3) if good else np.nan
+                beta[i] = beta[i] if good else np.nan
+
+    return fit, close
 
 
 def _fit_beta_cs(
