@@ -1,8 +1,17 @@
 """Issue 9 workloads of paper 1 (spherical parallel leg): IK, FK, Jacobian over 10^6 poses, inverse
 dynamics along a 10^5-sample trajectory vs a per-sample loop of MuJoCo's inverse dynamics of the same
-mechanism, and a 10^6-sample workspace/singularity map."""
+mechanism, and a 10^6-sample workspace/singularity map.
+
+Batches of at least ``FK_NUMBA_MIN`` samples run the forward kinematics in compiled (numba) kernels; their
+one-off compile cost (then cached on disk) is measured in a fresh process with an empty cache and printed.
+"""
 
 from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
 
 import numpy as np
 
@@ -16,7 +25,25 @@ N_ALT = 2_000
 N_ALT_ENGINE = 500
 
 
+def _fk_compile_seconds() -> float:
+    """First large-batch FK call in a fresh process with an empty numba cache, minus a second call."""
+    code = (
+        "import time, numpy as np; from robomech.mechanisms import spherical_leg as sl; "
+        "from robomech.mechanisms.spherical_leg._kinematics import FK_NUMBA_MIN as n; "
+        "leg = sl.SphericalLeg.paper(); L = sl.inverse_kinematics(leg, np.zeros(n), np.zeros(n)).lengths; "
+        "t = time.perf_counter(); sl.forward_kinematics(leg, L); t1 = time.perf_counter(); "
+        "sl.forward_kinematics(leg, L); print((t1 - t) - (time.perf_counter() - t1))"
+    )
+    with tempfile.TemporaryDirectory() as d:
+        env = {**os.environ, "NUMBA_CACHE_DIR": d}
+        cmd = [sys.executable, "-c", code]
+        out = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env)
+    return float(out.stdout.strip())
+
+
 def workloads() -> list[Workload]:
+    compile_s = _fk_compile_seconds()
+    print(f"spherical_leg FK kernels: compile on first use {compile_s:.1f} s (then cached on disk)")
     leg = sl.SphericalLeg.paper()
     rng = np.random.default_rng(0)
     q = rng.uniform(-1.0, 1.0, (N_KIN, 2))
