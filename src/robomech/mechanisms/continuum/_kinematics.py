@@ -37,11 +37,12 @@ __all__ = [
 CableModel = Literal["arc", "chord"]
 
 # Samples per chunk of the segment kernels (poses, Jacobian columns, tip positions).  The ~20
-# temporaries of a chunk (64 KB each) stay in the 1-2 MB L2 cache and are recycled by the allocator;
-# whole-batch temporaries (8 MB per 10^6 samples) are fresh pages every call, ~1 ms of page faults each
-# (measured: the 7 passes of spatial.sincos take 11 ms on 10^6 fresh samples, 5 ms with recycled pages).
-# 8192 keeps the ~40 numpy calls per chunk to ~5 % of the time (benchmarks/bench_continuum.py).
-CHUNK = 8192
+# temporaries of a chunk (128 KB each) stay in cache and are recycled by the allocator; whole-batch
+# temporaries (8 MB per 10^6 samples) are fresh pages every call, ~1 ms of page faults each (measured:
+# the 7 passes of spatial.sincos take 11 ms on 10^6 samples, 5 ms with recycled pages).  Measured on
+# 10^6 one-segment poses (FK / Jacobian / IK, ms): 2048: 46/44/45, 4096: 39/34/38, 8192: 34/30/36,
+# 16384: 32/28/32, 32768: 31/29/37 (~40 numpy calls per chunk: small chunks pay the call overhead).
+CHUNK = 16384
 
 # IK: a tip position is reached when the residual is below 1e-10 m (0.1 nm: far below any physical
 # tolerance, above the ~1e-16 * 0.1 m rounding of the forward kinematics).
