@@ -14,7 +14,7 @@ from typing import Literal
 import numpy as np
 
 from robomech._validation import as_array
-from robomech.spatial import SMALL_ANGLE
+from robomech.spatial import SMALL_ANGLE, sincos
 
 from ._params import ContinuumRobot
 
@@ -186,9 +186,13 @@ def _split_views(robot: ContinuumRobot, psi: object) -> tuple[np.ndarray, np.nda
 
 # ---- one segment --------------------------------------------------------------------------------
 def _segment_T(theta: np.ndarray, beta: np.ndarray, length: np.ndarray | float) -> np.ndarray:
-    """Segment poses (..., 4, 4), computed as 16 contiguous planes (4, 4, ...) and returned as a view
-    with the matrix axes last: writing planes is several times faster than 16 strided writes.  Chunks of
-    CHUNK samples keep the temporaries in cache; inputs of any strides."""
+    """Segment poses (..., 4, 4): a view of ``_segment_planes`` with the matrix axes last."""
+    return np.moveaxis(_segment_planes(theta, beta, length), (0, 1), (-2, -1))
+
+
+def _segment_planes(theta: np.ndarray, beta: np.ndarray, length: np.ndarray | float) -> np.ndarray:
+    """Segment poses as 16 contiguous planes (4, 4, ...): writing planes is several times faster than
+    16 strided writes.  Chunks of CHUNK samples keep the temporaries in cache; inputs of any strides."""
     shape = np.broadcast_shapes(np.shape(theta), np.shape(beta), np.shape(length))
     P = np.empty((4, 4, *shape))
     Pf = P.reshape(16, -1)
@@ -226,7 +230,7 @@ def _segment_T(theta: np.ndarray, beta: np.ndarray, length: np.ndarray | float) 
         np.multiply(fs, lc, out=Pf[11, c])
     Pf[12:15] = 0.0
     Pf[15] = 1.0
-    return np.moveaxis(P, (0, 1), (-2, -1))
+    return P
 
 
 def segment_transform(theta: object, beta: object, length: object) -> np.ndarray:
@@ -245,10 +249,23 @@ def segment_transform(theta: object, beta: object, length: object) -> np.ndarray
 
 # ---- the whole robot ----------------------------------------------------------------------------
 def _fk(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray) -> np.ndarray:
-    T = _segment_T(theta, beta, robot.segment_length)  # (..., n, 4, 4), composed in place
+    """Poses ``T_0i (..., n, 4, 4)``: a view of ``_fk_planes`` with the matrix axes last."""
+    return np.moveaxis(_fk_planes(robot, theta, beta), (0, 1), (-2, -1))
+
+
+def _fk_planes(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray) -> np.ndarray:
+    """Poses ``T_0i`` as planes (4, 4, ..., n), composed in place plane by plane:
+    T_0i = T_0,i-1 T_i-1,i as 12 entries of three products each plus the translation (the bottom rows
+    are (0, 0, 0, 1)); a batched 4x4 ``@`` on these strided matrices is several times slower."""
+    P = _segment_planes(theta, beta, robot.segment_length)  # (4, 4, ..., n)
     for i in range(1, robot.n_segments):  # loop over the fixed, small number of segments
-        T[..., i, :, :] = T[..., i - 1, :, :] @ T[..., i, :, :]
-    return T
+        A, B = P[:3, ..., i - 1], P[..., i]
+        C = A[:, 0, None] * B[0]  # (3, 4, ...): C[r, c] = sum_k A[r, k] B[k, c], k in the order 0, 1, 2
+        C += A[:, 1, None] * B[1]
+        C += A[:, 2, None] * B[2]
+        C[:, 3] += A[:, 3]
+        P[:3, ..., i] = C
+    return P
 
 
 def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
@@ -303,23 +320,25 @@ def _tip_jacobian(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray) ->
     n = robot.n_segments
     # Columns as contiguous planes (6, 2, ..., n), returned as a (..., 6, 2n) view (see _segment_T).
     P = _local_columns(theta, beta, robot.segment_length)
+    if n > 1:  # plane arithmetic (a batched @ and np.cross on these strided blocks are several times slower)
+        T = _fk_planes(robot, theta, beta)  # (4, 4, ..., n)
+        p_tip = T[:3, 3, ..., n - 1]  # (3, ...)
+        for i in range(n):  # loop over the fixed, small number of segments
+            W, V = P[:3, :, ..., i], P[3:, :, ..., i]  # (3, 2, ...): angular and linear rows
+            if i > 0:  # rotate the local columns into the base frame: R_0,i-1 W, R_0,i-1 V
+                R = T[:3, :3, None, ..., i - 1]  # (3, 3, 1, ...), broadcast over the two columns
+                W = R[:, 0] * W[0] + R[:, 1] * W[1] + R[:, 2] * W[2]
+                V = R[:, 0] * V[0] + R[:, 1] * V[1] + R[:, 2] * V[2]
+            if i < n - 1:  # the distal segments ride on segment i's end frame: v_tip += omega x r
+                r = (p_tip - T[:3, 3, ..., i])[:, None]  # (3, 1, ...)
+                V = V + np.stack(
+                    [W[1] * r[2] - W[2] * r[1], W[2] * r[0] - W[0] * r[2], W[0] * r[1] - W[1] * r[0]]
+                )
+            P[:3, :, ..., i] = W
+            P[3:, :, ..., i] = V
     # (6, 2, ..., n) -> (..., 6, n, 2) -> (..., 6, 2n) with columns [theta_1, beta_1, theta_2, ...]
     J = np.moveaxis(P, (0, 1), (-3, -1))
-    J = J.reshape(*theta.shape[:-1], 6, 2 * n)
-    if n == 1:  # the local columns are the tip Jacobian: base frame = segment base, tip = segment end
-        return J
-    T = _fk(robot, theta, beta)
-    p_tip = T[..., -1, :3, 3]
-    for i in range(n):  # loop over the fixed, small number of segments
-        cols = slice(2 * i, 2 * i + 2)
-        if i > 0:  # rotate the local columns into the base frame
-            R_prev = T[..., i - 1, :3, :3]
-            J[..., :3, cols] = R_prev @ J[..., :3, cols]
-            J[..., 3:, cols] = R_prev @ J[..., 3:, cols]
-        if i < n - 1:  # the distal segments ride on segment i's end frame: v_tip += omega x r
-            r = p_tip - T[..., i, :3, 3]
-            J[..., 3:, cols] += np.cross(J[..., :3, cols], r[..., :, None], axis=-2)
-    return J
+    return J.reshape(*theta.shape[:-1], 6, 2 * n)
 
 
 def tip_jacobian(robot: ContinuumRobot, psi: object) -> np.ndarray:
@@ -474,7 +493,8 @@ def _normalise(theta: np.ndarray, beta: np.ndarray) -> None:
 
 def _u_to_psi(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Bending vectors ``u (..., n, 2)`` -> ``(theta, beta)`` (..., n); theta >= 0, beta := 0 at theta = 0."""
-    theta = np.hypot(u[..., 0], u[..., 1])
+    ux, uy = u[..., 0], u[..., 1]
+    theta = np.sqrt(ux * ux + uy * uy)  # np.hypot is ~10x slower; only |u| < 1e-154 (straight) loses digits
     # arctan2(-0.0, -0.0) = -pi: the straight segment gets the convention beta = 0 explicitly
     beta = np.where(theta > 0.0, np.arctan2(u[..., 1], u[..., 0]), 0.0)
     return theta, beta
@@ -482,7 +502,8 @@ def _u_to_psi(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def _psi_to_u(theta: np.ndarray, beta: np.ndarray) -> np.ndarray:
     """``(theta, beta)`` (..., n) -> bending vectors ``u = theta (cos beta, sin beta)`` (..., n, 2)."""
-    return np.stack([theta * np.cos(beta), theta * np.sin(beta)], -1)
+    s, c = sincos(beta)
+    return np.stack([theta * c, theta * s], -1)
 
 
 def _tip_u(robot: ContinuumRobot, u: np.ndarray) -> np.ndarray:
@@ -499,7 +520,7 @@ def _tip_jacobian_u(robot: ContinuumRobot, u: np.ndarray) -> np.ndarray:
     theta = np.maximum(theta, IK_THETA_FLOOR)
     J = _tip_jacobian(robot, theta, beta)[..., 3:, :]
     J_th, J_be = J[..., 0::2], J[..., 1::2] / theta[..., None, :]  # (..., 3, n) each
-    c, s = np.cos(beta)[..., None, :], np.sin(beta)[..., None, :]
+    s, c = sincos(beta[..., None, :])
     Ju = np.stack([c * J_th - s * J_be, s * J_th + c * J_be], -1)  # (..., 3, n, 2)
     return Ju.reshape(*Ju.shape[:-2], 2 * robot.n_segments)
 
