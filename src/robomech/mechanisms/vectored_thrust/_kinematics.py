@@ -24,7 +24,7 @@ from typing import TypeVar
 import numpy as np
 
 from robomech._validation import as_array
-from robomech.spatial import lie_bracket
+from robomech.spatial import lie_bracket, sincos
 
 from ._params import VectoredThruster
 
@@ -208,10 +208,19 @@ def joint_axes(th: VectoredThruster, q: object) -> JointAxes:
 
 
 def _in_range(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
+    return _in_range2(th, q[..., 0], q[..., 1])
+
+
+def _in_range2(th: VectoredThruster, q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
+    """q1, q2 within their limits (+- RANGE_TOL); False where NaN."""
     (a1, b1), (a2, b2) = th.q1_limits, th.q2_limits
     a1, a2, b1, b2 = a1 - RANGE_TOL, a2 - RANGE_TOL, b1 + RANGE_TOL, b2 + RANGE_TOL
     with np.errstate(invalid="ignore"):
-        return (q[..., 0] >= a1) & (q[..., 0] <= b1) & (q[..., 1] >= a2) & (q[..., 1] <= b2)
+        r = q1 >= a1
+        r &= q1 <= b1
+        r &= q2 >= a2
+        r &= q2 <= b2
+        return r
 
 
 # Component-wise 3-vector helpers (tuples of arrays): np.cross / np.linalg.norm on (..., 3) arrays cost
@@ -297,10 +306,12 @@ def link_clearance(th: VectoredThruster, q: object) -> np.ndarray:
 def _theta_cs(th: VectoredThruster, q: np.ndarray) -> tuple[np.ndarray, ...]:
     """Kernel: cos q2, sin q2, cos theta, sin theta (NaN where singular), |s22 x s12|, valid."""
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    q1, q2 = q[..., 0], q[..., 1]
-    c1, s1 = np.cos(q1), np.sin(q1)
-    c2, s2 = np.cos(q2), np.sin(q2)
-    x = c1 * c2
+    # one half-angle tangent per input instead of np.sin + np.cos (numpy's float64 sin/cos are not
+    # vectorised: ~9-15 ns per call and sample here, 3.5x the cost of sincos; docs/performance.md)
+    s1, c1 = sincos(q[..., 0])
+    s2, c2 = sincos(q[..., 1])
+    x = c1
+    x *= c2
     x *= sa
     x -= ca * s2  # sa c1 c2 - ca s2
     y = s1
@@ -309,7 +320,7 @@ def _theta_cs(th: VectoredThruster, q: np.ndarray) -> tuple[np.ndarray, ...]:
     d += y * y
     d = np.sqrt(d)  # x, y are O(1): no overflow, so no need for hypot
     valid = d > SINGULAR_TOL
-    inv = np.divide(1.0, d, out=np.full_like(d, np.nan), where=valid)
+    inv = 1.0 / np.where(valid, d, np.nan)  # a select and a divide: cheaper than a masked divide
     x *= inv
     y *= inv
     return c2, s2, x, y, d, valid
@@ -317,17 +328,17 @@ def _theta_cs(th: VectoredThruster, q: np.ndarray) -> tuple[np.ndarray, ...]:
 
 def _fk(th: VectoredThruster, q: np.ndarray) -> FKResult:
     c2, s2, ct, st, _, valid = _theta_cs(th, q)
-    axis = np.empty((*q.shape[:-1], 3))
     # s0 = s22 x s13 = Ry(q2) (0, sin th, cos th): paper 5, eq. (12) with sin(phi1) -> sin(phi2)
-    axis[..., 0] = s2 * ct
-    axis[..., 1] = st
-    axis[..., 2] = c2 * ct
-    tilt = np.arccos(np.clip(axis[..., 2], -1.0, 1.0))
-    tilt_ok = valid & (tilt <= th.tilt_limit)
+    az = c2 * ct
+    axis = np.stack([s2 * ct, st, az], axis=-1)
+    tilt = np.arccos(np.clip(az, -1.0, 1.0))
+    with np.errstate(invalid="ignore"):  # NaN where singular, covered by valid
+        tilt_ok = tilt <= th.tilt_limit
+    tilt_ok &= valid
     in_range = _in_range(th, q)
     return FKResult(
         axis=axis,
-        tip=th.propeller_arm * axis,
+        tip=np.multiply(axis, th.propeller_arm),
         tilt=tilt,
         valid=valid,
         in_range=in_range,
@@ -353,39 +364,72 @@ def platform_rotation(th: VectoredThruster, q: object) -> RotationResult:
 
 
 def _ik(th: VectoredThruster, s: np.ndarray) -> IKResult:
-    norm = np.sqrt(s[..., 0] ** 2 + s[..., 1] ** 2 + s[..., 2] ** 2)
+    # Unmasked element-wise passes (warnings off; every non-finite intermediate is selected away by the
+    # masks below), in-place where possible: on CHUNK-sized blocks each avoided temporary or masked
+    # ufunc (``where=``, not vectorised) saves a pass.  The arithmetic is that of the closed form.
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        return _ik_unmasked(th, s)
+
+
+def _ik_unmasked(th: VectoredThruster, s: np.ndarray) -> IKResult:
+    sx, sy, sz = s[..., 0], s[..., 1], s[..., 2]
+    norm = sx * sx
+    norm += sy * sy
+    norm += sz * sz
+    norm = np.sqrt(norm)
     has_dir = norm > MIN_DIRECTION_NORM
     inv = 1.0 / np.where(has_dir, norm, 1.0)
-    ux, uy, uz = s[..., 0] * inv, s[..., 1] * inv, s[..., 2] * inv
+    ux, uy, uz = sx * inv, sy * inv, sz * inv
     # s0 = (sin q2 cos th, sin th, cos q2 cos th): the branch cos(theta) > 0 is the one through q = 0
     # (|q2| < pi/2 is enforced by the parameters).  paper 5, eq. (13): phi2 = arctan(L*/N*) is right.
-    ct = np.sqrt(ux * ux + uz * uz)  # unit components: no overflow
+    ct2 = ux * ux
+    ct2 += uz * uz
+    ct = np.sqrt(ct2)  # unit components: no overflow
     st = uy
     q2 = np.arctan2(ux, uz)
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    c2 = np.where(ct > 0, uz / np.where(ct > 0, ct, 1.0), 1.0)
-    s2 = np.where(ct > 0, ux / np.where(ct > 0, ct, 1.0), 0.0)
+    pos = ct > 0
+    ict = np.where(pos, 1.0 / ct, 0.0)
+    c2 = np.where(pos, uz * ict, 1.0)
+    s2 = ux * ict  # 0 where ct = 0
     # paper 5, eq. (13): printed phi1 = -arctan(M* N* / L*^2) does not invert eq. (12).  Correct: find
     # t > 0 with t (cos th, sin th) = (sa c1 c2 - ca s2, -sa s1) (the FK closure and its branch), i.e.
     # A t^2 + B t + C = 0 from s1^2 + c1^2 = 1; take the larger root (the only positive one for |q2| < a).
-    A = ct * ct + (c2 * st) ** 2
-    B = 2.0 * ct * ca * s2
-    C = (ca * s2) ** 2 - (sa * c2) ** 2
-    disc = B * B - 4.0 * A * C
-    ok = has_dir & (A > 0) & (disc >= 0)
-    sq = np.sqrt(np.where(ok, disc, 0.0))
-    qq = -0.5 * (B + np.where(B >= 0, sq, -sq))  # stable pair of roots qq / A and C / qq
-    r1 = qq / np.where(ok, A, 1.0)
-    r2 = np.where(qq != 0, C / np.where(qq != 0, qq, 1.0), r1)
-    t = np.maximum(r1, r2)
+    cst = c2 * st
+    A = cst * cst
+    A += ct2  # ct^2 + (c2 st)^2
+    B = ux * (2.0 * ca)  # 2 ct ca s2, with ct s2 = ux
+    cas2 = s2 * ca
+    C = sa * c2
+    C *= C
+    np.subtract(cas2 * cas2, C, out=C)  # (ca s2)^2 - (sa c2)^2
+    disc = B * B
+    disc -= 4.0 * A * C
+    ok = disc >= 0
+    ok &= A > 0
+    ok &= has_dir
+    sq = np.sqrt(np.maximum(disc, 0.0))
+    # qq = -(B + sign(B) sq) / 2: the stable pair of roots qq / A and C / qq (where B = -0.0, copysign
+    # takes the other sign, which gives the same pair)
+    qq = np.copysign(sq, B, out=sq)
+    qq += B
+    qq *= -0.5
+    r1 = qq / A
+    r2 = np.where(qq != 0, C / qq, r1)
+    t = np.maximum(r1, r2, out=r2)
     ok &= t > SINGULAR_TOL
     # (sin q1, cos q1) = (-t st / sa, (t ct + ca s2) / (sa c2)); sa, c2 > 0
-    q1 = np.arctan2(-t * st * c2, t * ct + ca * s2)
-    q = np.empty((*s.shape[:-1], 2))
-    q[..., 0] = np.where(ok, q1, np.nan)
-    q[..., 1] = np.where(ok, q2, np.nan)
-    in_range = ok & _in_range(th, q)
-    tilt_ok = ok & (uz >= np.cos(th.tilt_limit))  # arccos(uz) <= limit, without the arccos
+    ycomp = t * cst
+    np.negative(ycomp, out=ycomp)
+    xcomp = t * ct
+    xcomp += cas2
+    q1 = np.where(ok, np.arctan2(ycomp, xcomp), np.nan)
+    q2 = np.where(ok, q2, np.nan)
+    in_range = _in_range2(th, q1, q2)
+    in_range &= ok
+    tilt_ok = uz >= np.cos(th.tilt_limit)  # arccos(uz) <= limit, without the arccos
+    tilt_ok &= ok
+    q = np.stack([q1, q2], axis=-1)
     return IKResult(q=q, solved=ok, in_range=in_range, tilt_ok=tilt_ok, valid=in_range & tilt_ok)
 
 
@@ -461,22 +505,32 @@ def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
 
 def _jacobian(th: VectoredThruster, q: np.ndarray) -> JacobianResult:
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    c1, s1 = np.cos(q[..., 0]), np.sin(q[..., 0])
-    c2, s2 = np.cos(q[..., 1]), np.sin(q[..., 1])
+    s1, c1 = sincos(q[..., 0])  # see _theta_cs: one tangent instead of np.sin + np.cos
+    s2, c2 = sincos(q[..., 1])
     x = sa * c1 * c2 - ca * s2
     y = -sa * s1
     d2 = x * x + y * y
     valid = d2 > SINGULAR_TOL**2
-    inv = np.where(valid, 1.0 / np.where(valid, d2, 1.0), np.nan)
+    inv = sa / np.where(valid, d2, np.nan)  # NaN where singular; a select is cheaper than a masked divide
     # d theta / d q from theta = atan2(y, x):  omega = q2' Y + theta' s22.
     # paper 5, eq. (21): the printed J = (J_o)^-1 J_i maps inputs to passive rates, not to omega.
-    th1 = sa * (ca * c1 * s2 - sa * c2) * inv
-    th2 = -sa * s1 * (sa * c1 * s2 + ca * c2) * inv
+    # th1 = sa (ca c1 s2 - sa c2) / d2,  th2 = -sa s1 (sa c1 s2 + ca c2) / d2
+    c1s2 = c1 * s2
+    th1 = ca * c1s2
+    th1 -= sa * c2
+    th1 *= inv
+    th2 = c1s2
+    th2 *= sa
+    th2 += ca * c2
+    th2 *= s1
+    th2 *= -inv
     J = np.empty((*q.shape[:-1], 3, 2))
-    np.multiply(-c2, th1, out=J[..., 0, 0])
+    np.multiply(c2, th1, out=J[..., 0, 0])
+    np.negative(J[..., 0, 0], out=J[..., 0, 0])
     np.multiply(0.0, th1, out=J[..., 1, 0])  # 0, or NaN where singular
     np.multiply(s2, th1, out=J[..., 2, 0])
-    np.multiply(-c2, th2, out=J[..., 0, 1])
+    np.multiply(c2, th2, out=J[..., 0, 1])
+    np.negative(J[..., 0, 1], out=J[..., 0, 1])
     np.add(1.0, J[..., 1, 0], out=J[..., 1, 1])
     np.multiply(s2, th2, out=J[..., 2, 1])
     return JacobianResult(J=J, valid=valid, distance=np.sqrt(d2))
