@@ -60,9 +60,12 @@ MIN_DIRECTION_NORM = 1e-12
 # Inputs within this of a range limit count as in range: an IK solution on the boundary carries a few
 # ulps of rounding (1e-16 rad), and a limit is never meaningful to better than a micro-radian.
 RANGE_TOL = 1e-12
-# Samples per block in the batched kernels: ~20 float64 temporaries of 16384 samples (~2.6 MB) stay
-# in cache; measured 1.3-2x faster than whole-array evaluation at 10^6 samples (benchmarks/).
-CHUNK = 1 << 14
+# Samples per block in the batched kernels: ~20 float64 temporaries of 8192 samples (~1.3 MB) stay in
+# cache; measured 1.3-2x faster than whole-array evaluation at 10^6 samples (benchmarks/).  Not 16384:
+# its 128 KiB temporaries reach glibc malloc's default mmap threshold (128 KiB), so until a large free
+# raises that threshold every temporary is a fresh mmap with page faults (first 10^6-sample FK in a fresh
+# process: 113 ms at 16384, 66 ms at 8192; equal once warm).
+CHUNK = 1 << 13
 
 _R = TypeVar("_R")
 
@@ -173,15 +176,15 @@ def _q(q: object) -> np.ndarray:
 def _axes(th: VectoredThruster, q: np.ndarray) -> JointAxes:
     """Kernel: joint axes at inputs ``q (..., 2)`` (trusted)."""
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    c1, s1 = np.cos(q[..., 0]), np.sin(q[..., 0])
-    c2, s2 = np.cos(q[..., 1]), np.sin(q[..., 1])
+    s1, c1 = sincos(q[..., 0])  # see _theta_cs: one tangent instead of np.sin + np.cos
+    s2, c2 = sincos(q[..., 1])
     zero, one = np.zeros_like(c1), np.ones_like(c1)
     s12 = np.stack([ca * one, sa * s1, -sa * c1], axis=-1)  # paper 5, eq. (7), with a = pi/4
     s22 = np.stack([-c2, zero, s2], axis=-1)  # paper 5, eq. (5)
     # theta: RR passive angle, R = Ry(q2) Rx(-theta); (cos, sin)(theta) ~ (x, y), D = |s22 x s12|.
     x = sa * c1 * c2 - ca * s2
     y = -sa * s1
-    d = np.hypot(x, y)
+    d = np.sqrt(x * x + y * y)  # x, y are O(1): no overflow, so no need for (slow) np.hypot
     valid = d > SINGULAR_TOL
     dd = np.where(valid, d, 1.0)
     ct, st = np.where(valid, x / dd, np.nan), np.where(valid, y / dd, np.nan)
@@ -248,30 +251,28 @@ def _angle(u: _V, v: _V) -> np.ndarray:
     return np.arctan2(np.sqrt(_dot(c, c)), _dot(u, v))
 
 
-def _point_arc_distance(p: _V, a: _V, b: _V, n: _V) -> np.ndarray:
-    """Angular distance from unit ``p`` to the minor arc a -> b of the great circle with unit normal ``n``."""
-    pn = _dot(p, n)
-    # the foot of p on the circle lies within the arc: (a x p).n >= 0 and (p x b).n >= 0
-    inside = (_dot(p, _cross(n, a)) >= 0) & (_dot(p, _cross(b, n)) >= 0)
-    perp = np.arcsin(np.minimum(np.abs(pn), 1.0))
-    return np.where(inside, perp, np.minimum(_angle(p, a), _angle(p, b)))
-
-
 def _arc_clearance(a1: _V, b1: _V, a2: _V, b2: _V) -> np.ndarray:
     n1, n2 = _unit(_cross(a1, b1)), _unit(_cross(a2, b2))
+    # p lies within the minor arc a -> b of unit normal n iff p.(n x a) >= 0 and p.(b x n) >= 0
+    e1a, e1b = _cross(n1, a1), _cross(b1, n1)
+    e2a, e2b = _cross(n2, a2), _cross(b2, n2)
     m = _cross(n1, n2)
-    has_m = _dot(m, m) > 0
-    m = _unit(m)
+    has_m = _dot(m, m) > 0  # the signs below do not depend on |m|: no normalisation needed
     # the great circles meet at +-m; the arcs cross if one of those lies within both arcs
-    on1 = (_dot(m, _cross(n1, a1)), _dot(m, _cross(b1, n1)))
-    on2 = (_dot(m, _cross(n2, a2)), _dot(m, _cross(b2, n2)))
+    on1 = (_dot(m, e1a), _dot(m, e1b))
+    on2 = (_dot(m, e2a), _dot(m, e2b))
     plus = (on1[0] >= 0) & (on1[1] >= 0) & (on2[0] >= 0) & (on2[1] >= 0)
     minus = (on1[0] <= 0) & (on1[1] <= 0) & (on2[0] <= 0) & (on2[1] <= 0)
     crosses = has_m & (plus | minus)
-    ends = np.minimum(
-        np.minimum(_point_arc_distance(a1, a2, b2, n2), _point_arc_distance(b1, a2, b2, n2)),
-        np.minimum(_point_arc_distance(a2, a1, b1, n1), _point_arc_distance(b2, a1, b1, n1)),
-    )
+    # Otherwise the closest point is an end of one arc: its distance to the other arc is the distance to
+    # that arc's great circle where its foot lies within the arc (never more than the distance to the
+    # arc's ends), else the nearer end.  So the clearance is the smallest of the four end-to-end angles
+    # and of the perpendicular distances of the ends whose foot lies within the other arc.
+    ends = np.minimum(np.minimum(_angle(a1, a2), _angle(a1, b2)), np.minimum(_angle(b1, a2), _angle(b1, b2)))
+    for p, n, ea, eb in ((a1, n2, e2a, e2b), (b1, n2, e2a, e2b), (a2, n1, e1a, e1b), (b2, n1, e1a, e1b)):
+        inside = (_dot(p, ea) >= 0) & (_dot(p, eb) >= 0)
+        perp = np.arcsin(np.minimum(np.abs(_dot(p, n)), 1.0))
+        ends = np.where(inside, np.minimum(ends, perp), ends)
     return np.where(crosses, 0.0, ends)
 
 
