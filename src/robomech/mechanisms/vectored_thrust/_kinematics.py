@@ -400,22 +400,22 @@ def _ik_unmasked(th: VectoredThruster, s: np.ndarray) -> IKResult:
     np.negative(ncst, out=ncst)  # -c2 st
     A = ncst * ncst
     A += ct2  # ct^2 + (c2 st)^2
-    B = ux * (2.0 * ca)  # 2 ct ca s2, with ct s2 = ux
+    hb = ux * ca  # B / 2 = ct ca s2, with ct s2 = ux (halving B scales the discriminant by 4: exact)
     cas2 = s2 * ca
     C = sa * c2
     C *= C
     np.subtract(cas2 * cas2, C, out=C)  # (ca s2)^2 - (sa c2)^2
-    disc = B * B
-    disc -= 4.0 * A * C
+    disc = hb * hb
+    disc -= A * C  # (B^2 - 4 A C) / 4
     ok = disc >= 0
     ok &= A > 0
     ok &= has_dir
     sq = np.sqrt(np.maximum(disc, 0.0))
-    # qq = -(B + sign(B) sq) / 2: the stable pair of roots qq / A and C / qq (where B = -0.0, copysign
-    # takes the other sign, which gives the same pair)
-    qq = np.copysign(sq, B, out=sq)
-    qq += B
-    qq *= -0.5
+    # qq = -(B + sign(B) sqrt(B^2 - 4AC)) / 2: the stable pair of roots qq / A and C / qq (where
+    # B = -0.0, copysign takes the other sign, which gives the same pair)
+    qq = np.copysign(sq, hb, out=sq)
+    qq += hb
+    np.negative(qq, out=qq)
     r1 = qq / A
     r2 = np.where(qq != 0, C / qq, r1)
     t = np.maximum(r1, r2, out=r2)
