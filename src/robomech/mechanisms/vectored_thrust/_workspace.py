@@ -19,7 +19,7 @@ import numpy as np
 
 from robomech._validation import as_array
 
-from ._kinematics import _axes, _chunked, _fk, _interference, _jacobian, _q
+from ._kinematics import _chunked, _fk, _interference, _jacobian, _q
 from ._params import VectoredThruster
 
 __all__ = [
@@ -88,7 +88,7 @@ def _workspace_map(th: VectoredThruster, q: np.ndarray) -> WorkspaceMap:
     fk = _fk(th, q)
     jr = _jacobian(th, q)
     dex = _dexterity(jr.J, jr.valid)
-    clearance = _interference(th, _axes(th, q))
+    clearance = _interference(th, q)
     singular = ~jr.valid | (dex < DEXTERITY_TOL)
     with np.errstate(invalid="ignore"):
         clear = jr.valid & (clearance >= th.interference_clearance)
