@@ -24,7 +24,7 @@ from typing import TypeVar
 import numpy as np
 
 from robomech._validation import as_array
-from robomech.spatial import lie_bracket
+from robomech.spatial import lie_bracket, sincos
 
 from ._params import VectoredThruster
 
@@ -60,9 +60,12 @@ MIN_DIRECTION_NORM = 1e-12
 # Inputs within this of a range limit count as in range: an IK solution on the boundary carries a few
 # ulps of rounding (1e-16 rad), and a limit is never meaningful to better than a micro-radian.
 RANGE_TOL = 1e-12
-# Samples per block in the batched kernels: ~20 float64 temporaries of 16384 samples (~2.6 MB) stay
-# in cache; measured 1.3-2x faster than whole-array evaluation at 10^6 samples (benchmarks/).
-CHUNK = 1 << 14
+# Samples per block in the batched kernels: ~20 float64 temporaries of 8192 samples (~1.3 MB) stay in
+# cache; measured 1.3-2x faster than whole-array evaluation at 10^6 samples (benchmarks/).  Not 16384:
+# its 128 KiB temporaries reach glibc malloc's default mmap threshold (128 KiB), so until a large free
+# raises that threshold every temporary is a fresh mmap with page faults (first 10^6-sample FK in a fresh
+# process: 113 ms at 16384, 66 ms at 8192; equal once warm).
+CHUNK = 1 << 13
 
 _R = TypeVar("_R")
 
@@ -173,15 +176,15 @@ def _q(q: object) -> np.ndarray:
 def _axes(th: VectoredThruster, q: np.ndarray) -> JointAxes:
     """Kernel: joint axes at inputs ``q (..., 2)`` (trusted)."""
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    c1, s1 = np.cos(q[..., 0]), np.sin(q[..., 0])
-    c2, s2 = np.cos(q[..., 1]), np.sin(q[..., 1])
+    s1, c1 = sincos(q[..., 0])  # see _theta_cs: one tangent instead of np.sin + np.cos
+    s2, c2 = sincos(q[..., 1])
     zero, one = np.zeros_like(c1), np.ones_like(c1)
     s12 = np.stack([ca * one, sa * s1, -sa * c1], axis=-1)  # paper 5, eq. (7), with a = pi/4
     s22 = np.stack([-c2, zero, s2], axis=-1)  # paper 5, eq. (5)
     # theta: RR passive angle, R = Ry(q2) Rx(-theta); (cos, sin)(theta) ~ (x, y), D = |s22 x s12|.
     x = sa * c1 * c2 - ca * s2
     y = -sa * s1
-    d = np.hypot(x, y)
+    d = np.sqrt(x * x + y * y)  # x, y are O(1): no overflow, so no need for (slow) np.hypot
     valid = d > SINGULAR_TOL
     dd = np.where(valid, d, 1.0)
     ct, st = np.where(valid, x / dd, np.nan), np.where(valid, y / dd, np.nan)
@@ -208,10 +211,19 @@ def joint_axes(th: VectoredThruster, q: object) -> JointAxes:
 
 
 def _in_range(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
+    return _in_range2(th, q[..., 0], q[..., 1])
+
+
+def _in_range2(th: VectoredThruster, q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
+    """q1, q2 within their limits (+- RANGE_TOL); False where NaN."""
     (a1, b1), (a2, b2) = th.q1_limits, th.q2_limits
     a1, a2, b1, b2 = a1 - RANGE_TOL, a2 - RANGE_TOL, b1 + RANGE_TOL, b2 + RANGE_TOL
     with np.errstate(invalid="ignore"):
-        return (q[..., 0] >= a1) & (q[..., 0] <= b1) & (q[..., 1] >= a2) & (q[..., 1] <= b2)
+        r = q1 >= a1
+        r &= q1 <= b1
+        r &= q2 >= a2
+        r &= q2 <= b2
+        return r
 
 
 # Component-wise 3-vector helpers (tuples of arrays): np.cross / np.linalg.norm on (..., 3) arrays cost
@@ -239,30 +251,28 @@ def _angle(u: _V, v: _V) -> np.ndarray:
     return np.arctan2(np.sqrt(_dot(c, c)), _dot(u, v))
 
 
-def _point_arc_distance(p: _V, a: _V, b: _V, n: _V) -> np.ndarray:
-    """Angular distance from unit ``p`` to the minor arc a -> b of the great circle with unit normal ``n``."""
-    pn = _dot(p, n)
-    # the foot of p on the circle lies within the arc: (a x p).n >= 0 and (p x b).n >= 0
-    inside = (_dot(p, _cross(n, a)) >= 0) & (_dot(p, _cross(b, n)) >= 0)
-    perp = np.arcsin(np.minimum(np.abs(pn), 1.0))
-    return np.where(inside, perp, np.minimum(_angle(p, a), _angle(p, b)))
-
-
 def _arc_clearance(a1: _V, b1: _V, a2: _V, b2: _V) -> np.ndarray:
     n1, n2 = _unit(_cross(a1, b1)), _unit(_cross(a2, b2))
+    # p lies within the minor arc a -> b of unit normal n iff p.(n x a) >= 0 and p.(b x n) >= 0
+    e1a, e1b = _cross(n1, a1), _cross(b1, n1)
+    e2a, e2b = _cross(n2, a2), _cross(b2, n2)
     m = _cross(n1, n2)
-    has_m = _dot(m, m) > 0
-    m = _unit(m)
+    has_m = _dot(m, m) > 0  # the signs below do not depend on |m|: no normalisation needed
     # the great circles meet at +-m; the arcs cross if one of those lies within both arcs
-    on1 = (_dot(m, _cross(n1, a1)), _dot(m, _cross(b1, n1)))
-    on2 = (_dot(m, _cross(n2, a2)), _dot(m, _cross(b2, n2)))
+    on1 = (_dot(m, e1a), _dot(m, e1b))
+    on2 = (_dot(m, e2a), _dot(m, e2b))
     plus = (on1[0] >= 0) & (on1[1] >= 0) & (on2[0] >= 0) & (on2[1] >= 0)
     minus = (on1[0] <= 0) & (on1[1] <= 0) & (on2[0] <= 0) & (on2[1] <= 0)
     crosses = has_m & (plus | minus)
-    ends = np.minimum(
-        np.minimum(_point_arc_distance(a1, a2, b2, n2), _point_arc_distance(b1, a2, b2, n2)),
-        np.minimum(_point_arc_distance(a2, a1, b1, n1), _point_arc_distance(b2, a1, b1, n1)),
-    )
+    # Otherwise the closest point is an end of one arc: its distance to the other arc is the distance to
+    # that arc's great circle where its foot lies within the arc (never more than the distance to the
+    # arc's ends), else the nearer end.  So the clearance is the smallest of the four end-to-end angles
+    # and of the perpendicular distances of the ends whose foot lies within the other arc.
+    ends = np.minimum(np.minimum(_angle(a1, a2), _angle(a1, b2)), np.minimum(_angle(b1, a2), _angle(b1, b2)))
+    for p, n, ea, eb in ((a1, n2, e2a, e2b), (b1, n2, e2a, e2b), (a2, n1, e1a, e1b), (b2, n1, e1a, e1b)):
+        inside = (_dot(p, ea) >= 0) & (_dot(p, eb) >= 0)
+        perp = np.arcsin(np.minimum(np.abs(_dot(p, n)), 1.0))
+        ends = np.where(inside, np.minimum(ends, perp), ends)
     return np.where(crosses, 0.0, ends)
 
 
@@ -279,11 +289,59 @@ def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
     return _arc_clearance(*(_split(v) for v in arrs))
 
 
-def _interference(th: VectoredThruster, ax: JointAxes) -> np.ndarray:
-    """Clearance (rad) of the 45 deg arc (s11 -> s12) from the fixing device (s22 -> s13); NaN if singular."""
-    s13 = np.where(ax.valid[..., None], ax.s13, -_Y)  # placeholder where singular, masked below
-    c = _arc_clearance(_split(ax.s11), _split(ax.s12), _split(ax.s22), _split(s13))
-    return np.where(ax.valid, c, np.nan)
+def _interference(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
+    """Clearance (rad) of the 45 deg arc (s11 -> s12) from the fixing device (s22 -> s13); NaN if singular.
+
+    :func:`_arc_clearance` specialised to this mechanism's arcs (identical to rounding; tested against the
+    generic form): with ``(s22, s13, s0)`` orthonormal and right-handed (``s0 = s22 x s13``), the first
+    arc's unit normal is ``n1 = X x s12 / sin a = (0, c1, s1)``, the second's is ``s0``, and the side
+    vectors ``n x a``, ``b x n`` are ``(0, s1, -c1)``, ``(sin a, -cos a s1, cos a c1)``, ``s13`` and
+    ``s22``; about 70 element-wise passes instead of ~250 for the generic 3-vector form.
+    """
+    with np.errstate(invalid="ignore"):  # NaN (singular samples) is masked at the end
+        return _interference_unmasked(th, q)
+
+
+def _interference_unmasked(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
+    ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
+    s1, c1 = sincos(q[..., 0])
+    s2, c2 = sincos(q[..., 1])
+    x = sa * c1 * c2 - ca * s2
+    y = -sa * s1
+    d = np.sqrt(x * x + y * y)  # |s12 x s22|
+    valid = d > SINGULAR_TOL
+    inv = 1.0 / np.where(valid, d, np.nan)
+    ct, st = x * inv, y * inv
+    s12: _V = (np.full_like(s1, ca), -y, -sa * c1)
+    s22: _V = (-c2, np.zeros_like(c2), s2)
+    s13: _V = (s2 * st, -ct, c2 * st)
+    c2ct, s2ct = c2 * ct, s2 * ct
+    # the circles meet at +-m, m = n1 x s0; the arcs cross if one of those lies within both arcs
+    m: _V = (c1 * c2ct - s1 * st, s1 * s2ct, -c1 * s2ct)
+    has_m = _dot(m, m) > 0
+    on1 = (m[1] * s1 - m[2] * c1, sa * m[0] - ca * (m[1] * s1 - m[2] * c1))
+    on2 = (_dot(m, s13), _dot(m, s22))
+    plus = (on1[0] >= 0) & (on1[1] >= 0) & (on2[0] >= 0) & (on2[1] >= 0)
+    minus = (on1[0] <= 0) & (on1[1] <= 0) & (on2[0] <= 0) & (on2[1] <= 0)
+    crosses = has_m & (plus | minus)
+    # end-to-end angles: X-s22, X-s13, s12-s22 (|s12 x s22| = d), s12-s13
+    d12_22 = _dot(s12, s22)
+    c2st = c2 * st
+    ends = np.minimum(np.arctan2(np.abs(s2), -c2), np.arctan2(np.sqrt(c2st * c2st + ct * ct), s2 * st))
+    ends = np.minimum(ends, np.arctan2(d, d12_22))
+    ends = np.minimum(ends, _angle(s12, s13))
+    d12_13 = _dot(s12, s13)
+    # ends whose foot on the other arc's great circle lies within that arc: perpendicular distances
+    perps = (
+        ((s2 * st >= 0) & (c2 <= 0), np.abs(s2ct)),  # X to arc 2 (normal s0)
+        ((d12_13 >= 0) & (d12_22 >= 0), np.abs(ca * s2ct + sa * s1 * st - sa * c1 * c2ct)),  # s12 to arc 2
+        ((c1 * s2 <= 0) & (ca * c1 * s2 - sa * c2 >= 0), np.abs(s1 * s2)),  # s22 to arc 1 (normal n1)
+        ((-ct * s1 - c1 * c2 * st >= 0) & (sa * s2 * st + ca * (s1 * ct + c1 * c2 * st) >= 0),
+         np.abs(s1 * c2 * st - c1 * ct)),  # s13 to arc 1
+    )  # fmt: skip
+    for inside, pn in perps:
+        ends = np.where(inside, np.minimum(ends, np.arcsin(np.minimum(pn, 1.0))), ends)
+    return np.where(valid, np.where(crosses, 0.0, ends), np.nan)
 
 
 def link_clearance(th: VectoredThruster, q: object) -> np.ndarray:
@@ -291,16 +349,18 @@ def link_clearance(th: VectoredThruster, q: object) -> np.ndarray:
 
     Section 4.1 (2).  NaN where the configuration is singular (covered by ``joint_axes(...).valid``).
     """
-    return _interference(th, _axes(th, _q(q)))
+    return _interference(th, _q(q))
 
 
 def _theta_cs(th: VectoredThruster, q: np.ndarray) -> tuple[np.ndarray, ...]:
     """Kernel: cos q2, sin q2, cos theta, sin theta (NaN where singular), |s22 x s12|, valid."""
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    q1, q2 = q[..., 0], q[..., 1]
-    c1, s1 = np.cos(q1), np.sin(q1)
-    c2, s2 = np.cos(q2), np.sin(q2)
-    x = c1 * c2
+    # one half-angle tangent per input instead of np.sin + np.cos (numpy's float64 sin/cos are not
+    # vectorised: ~9-15 ns per call and sample here, 3.5x the cost of sincos; docs/performance.md)
+    s1, c1 = sincos(q[..., 0])
+    s2, c2 = sincos(q[..., 1])
+    x = c1
+    x *= c2
     x *= sa
     x -= ca * s2  # sa c1 c2 - ca s2
     y = s1
@@ -309,7 +369,7 @@ def _theta_cs(th: VectoredThruster, q: np.ndarray) -> tuple[np.ndarray, ...]:
     d += y * y
     d = np.sqrt(d)  # x, y are O(1): no overflow, so no need for hypot
     valid = d > SINGULAR_TOL
-    inv = np.divide(1.0, d, out=np.full_like(d, np.nan), where=valid)
+    inv = 1.0 / np.where(valid, d, np.nan)  # a select and a divide: cheaper than a masked divide
     x *= inv
     y *= inv
     return c2, s2, x, y, d, valid
@@ -317,17 +377,17 @@ def _theta_cs(th: VectoredThruster, q: np.ndarray) -> tuple[np.ndarray, ...]:
 
 def _fk(th: VectoredThruster, q: np.ndarray) -> FKResult:
     c2, s2, ct, st, _, valid = _theta_cs(th, q)
-    axis = np.empty((*q.shape[:-1], 3))
     # s0 = s22 x s13 = Ry(q2) (0, sin th, cos th): paper 5, eq. (12) with sin(phi1) -> sin(phi2)
-    axis[..., 0] = s2 * ct
-    axis[..., 1] = st
-    axis[..., 2] = c2 * ct
-    tilt = np.arccos(np.clip(axis[..., 2], -1.0, 1.0))
-    tilt_ok = valid & (tilt <= th.tilt_limit)
+    az = c2 * ct
+    axis = np.stack([s2 * ct, st, az], axis=-1)
+    tilt = np.arccos(np.clip(az, -1.0, 1.0))
+    with np.errstate(invalid="ignore"):  # NaN where singular, covered by valid
+        tilt_ok = tilt <= th.tilt_limit
+    tilt_ok &= valid
     in_range = _in_range(th, q)
     return FKResult(
         axis=axis,
-        tip=th.propeller_arm * axis,
+        tip=np.multiply(axis, th.propeller_arm),
         tilt=tilt,
         valid=valid,
         in_range=in_range,
@@ -353,39 +413,72 @@ def platform_rotation(th: VectoredThruster, q: object) -> RotationResult:
 
 
 def _ik(th: VectoredThruster, s: np.ndarray) -> IKResult:
-    norm = np.sqrt(s[..., 0] ** 2 + s[..., 1] ** 2 + s[..., 2] ** 2)
+    # Unmasked element-wise passes (warnings off; every non-finite intermediate is selected away by the
+    # masks below), in-place where possible: on CHUNK-sized blocks each avoided temporary or masked
+    # ufunc (``where=``, not vectorised) saves a pass.  The arithmetic is that of the closed form.
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        return _ik_unmasked(th, s)
+
+
+def _ik_unmasked(th: VectoredThruster, s: np.ndarray) -> IKResult:
+    sx, sy, sz = s[..., 0], s[..., 1], s[..., 2]
+    norm = sx * sx
+    norm += sy * sy
+    norm += sz * sz
+    norm = np.sqrt(norm)  # (np.einsum over the last axis measured 3x slower here)
     has_dir = norm > MIN_DIRECTION_NORM
     inv = 1.0 / np.where(has_dir, norm, 1.0)
-    ux, uy, uz = s[..., 0] * inv, s[..., 1] * inv, s[..., 2] * inv
+    ux, uy, uz = sx * inv, sy * inv, sz * inv
     # s0 = (sin q2 cos th, sin th, cos q2 cos th): the branch cos(theta) > 0 is the one through q = 0
     # (|q2| < pi/2 is enforced by the parameters).  paper 5, eq. (13): phi2 = arctan(L*/N*) is right.
-    ct = np.sqrt(ux * ux + uz * uz)  # unit components: no overflow
+    ct2 = ux * ux
+    ct2 += uz * uz
+    ct = np.sqrt(ct2)  # unit components: no overflow
     st = uy
     q2 = np.arctan2(ux, uz)
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    c2 = np.where(ct > 0, uz / np.where(ct > 0, ct, 1.0), 1.0)
-    s2 = np.where(ct > 0, ux / np.where(ct > 0, ct, 1.0), 0.0)
+    pos = ct > 0
+    ict = np.where(pos, 1.0 / ct, 0.0)
+    c2 = np.where(pos, uz * ict, 1.0)
+    s2 = ux * ict  # 0 where ct = 0
     # paper 5, eq. (13): printed phi1 = -arctan(M* N* / L*^2) does not invert eq. (12).  Correct: find
     # t > 0 with t (cos th, sin th) = (sa c1 c2 - ca s2, -sa s1) (the FK closure and its branch), i.e.
     # A t^2 + B t + C = 0 from s1^2 + c1^2 = 1; take the larger root (the only positive one for |q2| < a).
-    A = ct * ct + (c2 * st) ** 2
-    B = 2.0 * ct * ca * s2
-    C = (ca * s2) ** 2 - (sa * c2) ** 2
-    disc = B * B - 4.0 * A * C
-    ok = has_dir & (A > 0) & (disc >= 0)
-    sq = np.sqrt(np.where(ok, disc, 0.0))
-    qq = -0.5 * (B + np.where(B >= 0, sq, -sq))  # stable pair of roots qq / A and C / qq
-    r1 = qq / np.where(ok, A, 1.0)
-    r2 = np.where(qq != 0, C / np.where(qq != 0, qq, 1.0), r1)
-    t = np.maximum(r1, r2)
+    ncst = c2 * st
+    np.negative(ncst, out=ncst)  # -c2 st
+    A = ncst * ncst
+    A += ct2  # ct^2 + (c2 st)^2
+    hb = ux * ca  # B / 2 = ct ca s2, with ct s2 = ux (halving B scales the discriminant by 4: exact)
+    cas2 = s2 * ca
+    C = sa * c2
+    C *= C
+    np.subtract(cas2 * cas2, C, out=C)  # (ca s2)^2 - (sa c2)^2
+    disc = hb * hb
+    disc -= A * C  # (B^2 - 4 A C) / 4
+    ok = disc >= 0
+    ok &= A > 0
+    ok &= has_dir
+    sq = np.sqrt(np.maximum(disc, 0.0))
+    # qq = -(B + sign(B) sqrt(B^2 - 4AC)) / 2: the stable pair of roots qq / A and C / qq (where
+    # B = -0.0, copysign takes the other sign, which gives the same pair)
+    qq = np.copysign(sq, hb, out=sq)
+    qq += hb
+    np.negative(qq, out=qq)
+    r1 = qq / A
+    r2 = np.where(qq != 0, C / qq, r1)
+    t = np.maximum(r1, r2, out=r2)
     ok &= t > SINGULAR_TOL
     # (sin q1, cos q1) = (-t st / sa, (t ct + ca s2) / (sa c2)); sa, c2 > 0
-    q1 = np.arctan2(-t * st * c2, t * ct + ca * s2)
-    q = np.empty((*s.shape[:-1], 2))
-    q[..., 0] = np.where(ok, q1, np.nan)
-    q[..., 1] = np.where(ok, q2, np.nan)
-    in_range = ok & _in_range(th, q)
-    tilt_ok = ok & (uz >= np.cos(th.tilt_limit))  # arccos(uz) <= limit, without the arccos
+    ycomp = t * ncst
+    xcomp = t * ct
+    xcomp += cas2
+    q1 = np.where(ok, np.arctan2(ycomp, xcomp), np.nan)
+    q2 = np.where(ok, q2, np.nan)
+    in_range = _in_range2(th, q1, q2)
+    in_range &= ok
+    tilt_ok = uz >= np.cos(th.tilt_limit)  # arccos(uz) <= limit, without the arccos
+    tilt_ok &= ok
+    q = np.stack([q1, q2], axis=-1)
     return IKResult(q=q, solved=ok, in_range=in_range, tilt_ok=tilt_ok, valid=in_range & tilt_ok)
 
 
@@ -461,22 +554,32 @@ def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
 
 def _jacobian(th: VectoredThruster, q: np.ndarray) -> JacobianResult:
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    c1, s1 = np.cos(q[..., 0]), np.sin(q[..., 0])
-    c2, s2 = np.cos(q[..., 1]), np.sin(q[..., 1])
+    s1, c1 = sincos(q[..., 0])  # see _theta_cs: one tangent instead of np.sin + np.cos
+    s2, c2 = sincos(q[..., 1])
     x = sa * c1 * c2 - ca * s2
     y = -sa * s1
     d2 = x * x + y * y
     valid = d2 > SINGULAR_TOL**2
-    inv = np.where(valid, 1.0 / np.where(valid, d2, 1.0), np.nan)
+    inv = sa / np.where(valid, d2, np.nan)  # NaN where singular; a select is cheaper than a masked divide
     # d theta / d q from theta = atan2(y, x):  omega = q2' Y + theta' s22.
     # paper 5, eq. (21): the printed J = (J_o)^-1 J_i maps inputs to passive rates, not to omega.
-    th1 = sa * (ca * c1 * s2 - sa * c2) * inv
-    th2 = -sa * s1 * (sa * c1 * s2 + ca * c2) * inv
+    # th1 = sa (ca c1 s2 - sa c2) / d2,  th2 = -sa s1 (sa c1 s2 + ca c2) / d2
+    c1s2 = c1 * s2
+    th1 = ca * c1s2
+    th1 -= sa * c2
+    th1 *= inv
+    th2 = c1s2
+    th2 *= sa
+    th2 += ca * c2
+    th2 *= s1
+    th2 *= -inv
     J = np.empty((*q.shape[:-1], 3, 2))
-    np.multiply(-c2, th1, out=J[..., 0, 0])
+    np.multiply(c2, th1, out=J[..., 0, 0])
+    np.negative(J[..., 0, 0], out=J[..., 0, 0])
     np.multiply(0.0, th1, out=J[..., 1, 0])  # 0, or NaN where singular
     np.multiply(s2, th1, out=J[..., 2, 0])
-    np.multiply(-c2, th2, out=J[..., 0, 1])
+    np.multiply(c2, th2, out=J[..., 0, 1])
+    np.negative(J[..., 0, 1], out=J[..., 0, 1])
     np.add(1.0, J[..., 1, 0], out=J[..., 1, 1])
     np.multiply(s2, th2, out=J[..., 2, 1])
     return JacobianResult(J=J, valid=valid, distance=np.sqrt(d2))

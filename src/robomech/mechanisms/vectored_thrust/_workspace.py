@@ -19,7 +19,7 @@ import numpy as np
 
 from robomech._validation import as_array
 
-from ._kinematics import _axes, _chunked, _fk, _interference, _jacobian, _q
+from ._kinematics import _chunked, _fk, _interference, _jacobian, _q
 from ._params import VectoredThruster
 
 __all__ = [
@@ -53,17 +53,24 @@ class WorkspaceMap:
 
 
 def _dexterity(J: np.ndarray, ok: np.ndarray) -> np.ndarray:
-    """1/cond of each (..., 3, 2) J from the eigenvalues of the 2x2 J^T J (closed form, no SVD)."""
-    Jz = np.where(ok[..., None, None], J, 0.0)
-    a = np.sum(Jz[..., :, 0] ** 2, -1)
-    b = np.sum(Jz[..., :, 0] * Jz[..., :, 1], -1)
-    c = np.sum(Jz[..., :, 1] ** 2, -1)
-    half_tr = 0.5 * (a + c)
-    root = np.sqrt(np.maximum(0.25 * (a - c) ** 2 + b * b, 0.0))
-    lmax = half_tr + root
-    lmin = np.maximum((a * c - b * b) / np.where(lmax > 0, lmax, 1.0), 0.0)  # det / lmax: no cancellation
-    ratio = np.sqrt(lmin / np.where(lmax > 0, lmax, 1.0))
-    return np.where(ok & (lmax > 0), ratio, 0.0)
+    """1/cond of each (..., 3, 2) J from the eigenvalues of the 2x2 J^T J (closed form, no SVD).
+
+    Component-wise sums (no (..., 3, 2) temporaries); J is NaN where not ``ok``, masked at the end.
+    """
+    with np.errstate(invalid="ignore", divide="ignore"):
+        j00, j10, j20 = J[..., 0, 0], J[..., 1, 0], J[..., 2, 0]
+        j01, j11, j21 = J[..., 0, 1], J[..., 1, 1], J[..., 2, 1]
+        a = j00 * j00 + j10 * j10 + j20 * j20
+        b = j00 * j01 + j10 * j11 + j20 * j21
+        c = j01 * j01 + j11 * j11 + j21 * j21
+        half_tr = 0.5 * (a + c)
+        root = np.sqrt(np.maximum(0.25 * (a - c) ** 2 + b * b, 0.0))
+        lmax = half_tr + root
+        pos = lmax > 0
+        inv_lmax = 1.0 / np.where(pos, lmax, 1.0)
+        lmin = np.maximum((a * c - b * b) * inv_lmax, 0.0)  # det / lmax: no cancellation
+        ratio = np.sqrt(lmin * inv_lmax)
+        return np.where(ok & pos, ratio, 0.0)
 
 
 def dexterity(th: VectoredThruster, q: object) -> np.ndarray:
@@ -81,7 +88,7 @@ def _workspace_map(th: VectoredThruster, q: np.ndarray) -> WorkspaceMap:
     fk = _fk(th, q)
     jr = _jacobian(th, q)
     dex = _dexterity(jr.J, jr.valid)
-    clearance = _interference(th, _axes(th, q))
+    clearance = _interference(th, q)
     singular = ~jr.valid | (dex < DEXTERITY_TOL)
     with np.errstate(invalid="ignore"):
         clear = jr.valid & (clearance >= th.interference_clearance)
