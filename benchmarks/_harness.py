@@ -9,13 +9,17 @@ they are per-sample loops, linear in the sample count.
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Floors", "Workload", "best_time", "measure_floors"]
+__all__ = ["Floors", "Workload", "best_time", "fresh_process_seconds", "measure_floors"]
 
 
 @dataclass(frozen=True)
@@ -59,3 +63,16 @@ def measure_floors() -> Floors:
     x = np.random.default_rng(0).normal(size=(n, n))
     tm = best_time(lambda: x @ x, repeats=3)
     return Floors(bandwidth=bandwidth, matmul_flops=2 * n**3 / tm)
+
+
+def fresh_process_seconds(code: str) -> float:
+    """Run ``code`` in a fresh Python process with an empty numba cache and return the float it prints.
+
+    Used to measure a compiled kernel's one-off compile cost (the cache is then on disk for users).
+    """
+    with tempfile.TemporaryDirectory() as d:
+        env = {**os.environ, "NUMBA_CACHE_DIR": d}
+        out = subprocess.run(
+            [sys.executable, "-c", code], check=True, capture_output=True, text=True, env=env
+        )
+    return float(out.stdout.strip())

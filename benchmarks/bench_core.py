@@ -9,7 +9,7 @@ import numpy as np
 
 from robomech.analysis import lstsq
 
-from _harness import Workload
+from _harness import Workload, fresh_process_seconds
 
 N_SYSTEMS = 250_000  # paper 4's "computationally heavy" count
 M, N = 30, 11  # paper 4's overdetermined system
@@ -29,18 +29,10 @@ def _numpy_batched_qr(A: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _compile_seconds() -> float:
     """First-call time in a fresh process with an empty numba cache: the kernel's compile cost."""
-    import os
-    import tempfile
-
-    code = (
+    return fresh_process_seconds(
         "import time, numpy as np; t=time.perf_counter(); from robomech.analysis import lstsq; "
         "lstsq.solve(np.ones((1, 3, 2)) + np.eye(3, 2), np.ones((1, 3))); print(time.perf_counter() - t)"
     )
-    with tempfile.TemporaryDirectory() as d:
-        env = {**os.environ, "NUMBA_CACHE_DIR": d}
-        cmd = [sys.executable, "-c", code]
-        out = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env)
-    return float(out.stdout.strip())
 
 
 def workloads() -> list[Workload]:

@@ -8,16 +8,11 @@ one-off compile cost (then cached on disk) is measured in a fresh process with a
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
-import tempfile
-
 import numpy as np
 
 from robomech.mechanisms import spherical_leg as sl
 
-from _harness import Workload
+from _harness import Workload, fresh_process_seconds
 
 N_KIN = 1_000_000
 N_DYN = 100_000
@@ -27,18 +22,13 @@ N_ALT_ENGINE = 500
 
 def _fk_compile_seconds() -> float:
     """First large-batch FK call in a fresh process with an empty numba cache, minus a second call."""
-    code = (
+    return fresh_process_seconds(
         "import time, numpy as np; from robomech.mechanisms import spherical_leg as sl; "
         "from robomech.mechanisms.spherical_leg._kinematics import FK_NUMBA_MIN as n; "
         "leg = sl.SphericalLeg.paper(); L = sl.inverse_kinematics(leg, np.zeros(n), np.zeros(n)).lengths; "
         "t = time.perf_counter(); sl.forward_kinematics(leg, L); t1 = time.perf_counter(); "
         "sl.forward_kinematics(leg, L); print((t1 - t) - (time.perf_counter() - t1))"
     )
-    with tempfile.TemporaryDirectory() as d:
-        env = {**os.environ, "NUMBA_CACHE_DIR": d}
-        cmd = [sys.executable, "-c", code]
-        out = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env)
-    return float(out.stdout.strip())
 
 
 def workloads() -> list[Workload]:
