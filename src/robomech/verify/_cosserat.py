@@ -466,6 +466,18 @@ def _project_so3(R: np.ndarray) -> np.ndarray:
     return (U * D[..., None, :]) @ Vt
 
 
+def _loads(
+    rod: TendonRod, tensions: object, tip_force: object, tip_moment: object
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Validated load case: tensions (*B, n_t) >= 0, tip force and moment (*B, 3), zero when None."""
+    tau = as_array(tensions, "tensions", (rod.n_tendons,))
+    if np.any(tau < 0.0):
+        raise ValueError(f"Expected tensions >= 0 (a tendon cannot push), got min {tau.min()!r}.")
+    F = as_array(np.zeros(3) if tip_force is None else tip_force, "tip_force", (3,))
+    Lm = as_array(np.zeros(3) if tip_moment is None else tip_moment, "tip_moment", (3,))
+    return tau, F, Lm
+
+
 def solve_static(
     rod: TendonRod,
     tensions: object,
@@ -482,11 +494,7 @@ def solve_static(
     load cases (each a BVP); this is a reference model, its time is reported in ``seconds``.
     """
     n_t = rod.n_tendons
-    tau = as_array(tensions, "tensions", (n_t,))
-    if np.any(tau < 0.0):
-        raise ValueError(f"Expected tensions >= 0 (a tendon cannot push), got min {tau.min()!r}.")
-    F = as_array(np.zeros(3) if tip_force is None else tip_force, "tip_force", (3,))
-    Lm = as_array(np.zeros(3) if tip_moment is None else tip_moment, "tip_moment", (3,))
+    tau, F, Lm = _loads(rod, tensions, tip_force, tip_moment)
     if not (isinstance(points_per_segment, int) and points_per_segment >= 2):
         raise ValueError(f"Expected points_per_segment an integer >= 2, got {points_per_segment!r}.")
     tol = check_positive(tol, "tol")
@@ -748,11 +756,7 @@ def constant_curvature_statics(
     the dead tip wrench. Batched Newton from the unloaded arcs. tensions (*B, n_t), loads (*B, 3).
     """
     n_t = rod.n_tendons
-    tau = as_array(tensions, "tensions", (n_t,))
-    if np.any(tau < 0.0):
-        raise ValueError(f"Expected tensions >= 0 (a tendon cannot push), got min {tau.min()!r}.")
-    F = as_array(np.zeros(3) if tip_force is None else tip_force, "tip_force", (3,))
-    Lm = as_array(np.zeros(3) if tip_moment is None else tip_moment, "tip_moment", (3,))
+    tau, F, Lm = _loads(rod, tensions, tip_force, tip_moment)
     batch = np.broadcast_shapes(tau.shape[:-1], F.shape[:-1], Lm.shape[:-1])
     L, ei = rod.length, rod.bending_stiffness
     nd = _nondim(rod)
