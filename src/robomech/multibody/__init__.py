@@ -11,6 +11,9 @@ exact, batched kinematics with nothing derived by hand::
     T = mb.site_pose(mech, fk.q, "tip")                  # (..., 4, 4)
     J = mb.site_jacobian(mech, fk.q, "tip")              # (..., 6, n_act), rows [ω; ṗ] (mj_jacSite)
     H = mb.site_hessian(mech, fk.q, "tip")               # (..., 6, n_act, n_act), H[i, j, k] = ∂J_ij/∂q_act,k
+    m = mb.mobility(mech)                                # .dof, .redundant_constraints, .gruebler_kutzbach, ...
+    s = mb.singularities(mech, fk.q, "tip")              # type I / II / constraint, measures in metres
+    mb.draw(mech, fk.q[0])                               # matplotlib wireframe
 
 Coordinates: ``q`` is MuJoCo's ``qpos`` (nq; ``[w, x, y, z]`` quaternions for ball/free joints) and
 every matrix "over all coordinates" has one column per *velocity* coordinate (MuJoCo's ``qvel``, nv:
@@ -41,6 +44,7 @@ from __future__ import annotations
 
 from . import gallery
 from ._assembly import CONVERGED_RTOL, FKResult, IKResult, forward_kinematics, inverse_kinematics
+from ._draw import body_segments, draw
 from ._influence import (
     Influence,
     constraint_jacobian,
@@ -52,7 +56,9 @@ from ._influence import (
     site_pose,
 )
 from ._mjcf import from_mjcf, to_mjcf
+from ._mobility import MobilityReport, mobility
 from ._model import Body, Builder, Closure, Coupling, Inertial, Joint, Mechanism, Site
+from ._singularity import SingularityMapResult, SingularityResult, singularities, singularity_map
 
 __all__ = [
     "CONVERGED_RTOL",
@@ -66,15 +72,23 @@ __all__ = [
     "Influence",
     "Joint",
     "Mechanism",
+    "MobilityReport",
+    "SingularityMapResult",
+    "SingularityResult",
     "Site",
+    "body_segments",
     "constraint_jacobian",
     "constraint_jacobian_rate",
     "constraint_residual",
+    "draw",
     "forward_kinematics",
     "from_mjcf",
     "gallery",
     "influence",
     "inverse_kinematics",
+    "mobility",
+    "singularities",
+    "singularity_map",
     "site_hessian",
     "site_jacobian",
     "site_pose",
