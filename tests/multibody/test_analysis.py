@@ -111,7 +111,7 @@ def test_change_point_is_singular_and_a_generic_configuration_is_not():
 
 
 def test_type_I_and_type_II_depend_on_which_joint_drives():
-    """At the rocker's extreme (crank and coupler aligned): type I driven by the crank, type II by the rocker."""
+    """At the rocker's extreme (crank and coupler aligned): type I crank-driven, type II rocker-driven."""
     mech = dataclasses.replace(
         FOUR_BAR, sites=(*FOUR_BAR.sites, mb.Site("rocker_tip", "rocker", (0.8, 0, 0)))
     )

@@ -11,7 +11,7 @@ exact, batched kinematics with nothing derived by hand::
     T = mb.site_pose(mech, fk.q, "tip")                  # (..., 4, 4)
     J = mb.site_jacobian(mech, fk.q, "tip")              # (..., 6, n_act), rows [ω; ṗ] (mj_jacSite)
     H = mb.site_hessian(mech, fk.q, "tip")               # (..., 6, n_act, n_act), H[i, j, k] = ∂J_ij/∂q_act,k
-    m = mb.mobility(mech)                                # .dof, .redundant_constraints, .gruebler_kutzbach, ...
+    m = mb.mobility(mech)                                # .dof, .redundant_constraints, .gruebler_kutzbach
     s = mb.singularities(mech, fk.q, "tip")              # type I / II / constraint, measures in metres
     mb.draw(mech, fk.q[0])                               # matplotlib wireframe
 

@@ -69,7 +69,8 @@ class MobilityReport:
 
     def summary(self) -> str:
         s = (
-            f"DOF {self.dof} (+{self.idle_dof} idle); {self.n_equations} closure equations, rank {self.rank}, "
+            f"DOF {self.dof} (+{self.idle_dof} idle); {self.n_equations} closure equations, "
+            f"rank {self.rank}, "
             f"{self.redundant_constraints} redundant; Gruebler-Kutzbach {self.gruebler_kutzbach}; "
             f"{self.n_actuated} actuated ({self.actuation}){'; SINGULAR' if self.singular else ''}"
         )
@@ -111,7 +112,7 @@ def _output_bodies(mech: Mechanism) -> list[int]:
 
 
 def _serial_legs(mech: Mechanism, st, platform: int) -> list[np.ndarray] | None:
-    """Joint screws (world, at q) of each serial leg to ``platform``, or None if the mechanism is not of that form."""
+    """Joint screws (world, at q) of each serial leg to ``platform``; None if not of that form."""
     tree = mech.tree
     if mech.couplings:
         return None
@@ -153,7 +154,7 @@ def mobility(mech: Mechanism, q: object = None, *, platform: str | None = None) 
     q = q[None]
     K, st = _scaled_K(mech, q)
     K = K[0]
-    m, nv = K.shape
+    _m, nv = K.shape
     kmax = float(np.max(np.linalg.svd(K, compute_uv=False))) if K.size else 1.0
     rank = _rank(K, kmax)
     total = nv - rank
@@ -179,7 +180,7 @@ def mobility(mech: Mechanism, q: object = None, *, platform: str | None = None) 
         from ._tree import integrate
 
         qn = integrate(tree, np.repeat(q, steps.shape[0], axis=0), steps)
-        qn, rc, _, _ = solve_closure(mech, qn, np.arange(nv))
+        qn, _rc, _, _ = solve_closure(mech, qn, np.arange(nv))
         for k in range(qn.shape[0]):
             nearby.append(_rank(_scaled_K(mech, qn[k : k + 1])[0][0], kmax))
     singular = any(r != rank for r in nearby)

@@ -17,8 +17,9 @@ their singular values are lengths (per unit of scaled rate).  At an assembled ``
 The reference counts (``dof``, ``n_idle``, ``rank_ref``) come from :func:`mobility` at a generic
 configuration (default ``mech.q0``; pass ``reference=`` if that one is singular).  A sample is
 singular of a type when its measure over the largest singular value of the same matrix (or over
-``L`` if that is larger: a one-input Jacobian has a single singular value) is below ``rtol`` (default :data:`robomech.analysis.workspace.SINGULAR_RTOL`, 1e-8); ``cond_*`` are those
-ratios' inverses (condition numbers, dimensionless).
+``L`` if that is larger: a one-input Jacobian has a single singular value) is below ``rtol``
+(default :data:`robomech.analysis.workspace.SINGULAR_RTOL`, 1e-8); ``cond_*`` are those ratios'
+inverses (condition numbers, dimensionless).
 """
 
 from __future__ import annotations
