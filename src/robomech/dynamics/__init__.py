@@ -10,6 +10,16 @@ in the body frame.  This is exact for any holonomic mechanism once the closure i
 ``J_b`` maps the independent coordinates q (a parallel mechanism's platform angles, say) to each
 body's twist: the constraint forces do no virtual work and drop out.  Actuator forces then follow by
 virtual work from the actuator Jacobian (:func:`actuator_forces`).
+
+The same equations about each body's centre of mass, in world axes (:func:`com_inverse_dynamics`,
+used by :mod:`robomech.multibody` for any described mechanism): with ``[w_b; c_b'] = J_b qd`` the
+angular velocity and the centre-of-mass velocity of body b (MuJoCo's ``mj_jacSite`` quantities at the
+centre of mass), ``I_b`` its world-frame rotational inertia about the centre of mass and ``m_b`` its
+mass,
+
+    tau = sum_b J_b^T [ I_b wd_b + w_b x I_b w_b ;  m_b (c_b'' - g) ],   [wd_b; c_b''] = J_b qdd + Jdot_b qd,
+
+which is Newton's and Euler's equations of each body projected onto the coordinates (virtual power).
 """
 
 from __future__ import annotations
@@ -24,11 +34,14 @@ from robomech.spatial import ad, hat
 __all__ = [
     "DynamicsTerms",
     "actuator_forces",
+    "com_inverse_dynamics",
+    "com_kinetic_energy",
     "inverse_dynamics",
     "kinetic_energy",
     "mass_matrix",
     "spatial_inertia",
     "static_torques",
+    "world_inertia",
 ]
 
 
@@ -136,3 +149,74 @@ def actuator_forces(
     f = np.einsum("...ij,...j->...i", np.linalg.pinv(JT, rcond=1e-12 if rcond is None else rcond), tau_q)
     resid = np.linalg.norm(np.einsum("...ij,...j->...i", JT, f) - tau_q, axis=-1)
     return f, resid
+
+
+def world_inertia(R: object, inertia: object) -> np.ndarray:
+    """Rotational inertia in world axes ``R I R^T`` of a body at orientation ``R (..., 3, 3)``.
+
+    ``inertia (..., 3, 3)`` is the inertia about the centre of mass in body axes (a principal
+    inertia ``diag(d)`` in a frame ``R_i`` of the body is ``R_i diag(d) R_i^T``).
+    """
+    R = as_array(R, "R", (3, 3))
+    Ic = as_array(inertia, "inertia", (3, 3))
+    return R @ Ic @ np.swapaxes(R, -1, -2)
+
+
+def com_inverse_dynamics(
+    mass: object,
+    inertia: object,
+    J: object,
+    Jdot_qd: object,
+    qd: object,
+    qdd: object,
+    gravity: object = (0.0, 0.0, -9.81),
+) -> DynamicsTerms:
+    """Generalized forces from centre-of-mass Jacobians in world axes (Newton-Euler per body, projected).
+
+    ``mass (..., B)``; ``inertia (..., B, 3, 3)`` world-axes inertia about each centre of mass
+    (:func:`world_inertia`); ``J (..., B, 6, n)`` maps ``qd`` to ``[w; c']`` of each body (angular
+    velocity, centre-of-mass velocity, world axes); ``Jdot_qd (..., B, 6)`` is ``Jdot qd`` (the
+    velocity-product accelerations ``[wd; c'']`` at ``qdd = 0``); ``gravity (..., 3)`` the gravity
+    acceleration (m/s^2).  Returns ``tau = M qdd + velocity_terms + gravity_terms`` with
+    ``M = sum_b J_b^T diag(I_b, m_b 1) J_b``.
+    """
+    m = as_array(mass, "mass", (None,))
+    B = m.shape[-1]
+    I = as_array(inertia, "inertia", (B, 3, 3))
+    J = as_array(J, "J", (B, 6, None))
+    n = J.shape[-1]
+    a0 = as_array(Jdot_qd, "Jdot_qd", (B, 6))
+    qd = as_array(qd, "qd", (n,))
+    qdd = as_array(qdd, "qdd", (n,))
+    g = as_array(gravity, "gravity", (3,))
+    if np.any(m < 0):
+        raise ValueError(f"Expected mass >= 0, got min {float(np.min(m))}.")
+    return _com_terms(m, I, J, a0, qd, qdd, g)
+
+
+def _com_terms(m, I, J, a0, qd, qdd, g) -> DynamicsTerms:
+    """Kernel of :func:`com_inverse_dynamics` (inputs trusted, broadcast as documented)."""
+    Jw, Jv = J[..., :3, :], J[..., 3:, :]
+    w = np.einsum("...bin,...n->...bi", Jw, qd)
+    Iw = np.einsum("...bij,...bj->...bi", I, w)
+    mom = np.einsum("...bij,...bj->...bi", I, a0[..., :3]) + np.cross(w, Iw)
+    frc = m[..., None] * a0[..., 3:]
+    vel = np.einsum("...bin,...bi->...n", Jw, mom) + np.einsum("...bin,...bi->...n", Jv, frc)
+    M = np.einsum("...bin,...bij,...bjk->...nk", Jw, I, Jw) + np.einsum(
+        "...b,...bin,...bik->...nk", m, Jv, Jv
+    )
+    grav = -np.einsum("...bin,...b,...i->...n", Jv, m, g)
+    tau = np.einsum("...ij,...j->...i", M, qdd) + vel + grav
+    return DynamicsTerms(tau=tau, M=M, velocity_terms=vel, gravity_terms=grav)
+
+
+def com_kinetic_energy(mass: object, inertia: object, J: object, qd: object) -> np.ndarray:
+    """``0.5 sum_b (w_b . I_b w_b + m_b |c'_b|^2)`` with ``[w_b; c'_b] = J_b qd`` (...)."""
+    m = as_array(mass, "mass", (None,))
+    B = m.shape[-1]
+    I = as_array(inertia, "inertia", (B, 3, 3))
+    J = as_array(J, "J", (B, 6, None))
+    qd = as_array(qd, "qd", (J.shape[-1],))
+    V = np.einsum("...bin,...n->...bi", J, qd)
+    w, v = V[..., :3], V[..., 3:]
+    return 0.5 * (np.einsum("...bi,...bij,...bj->...", w, I, w) + np.einsum("...b,...bi,...bi->...", m, v, v))

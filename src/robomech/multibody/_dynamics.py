@@ -1,0 +1,885 @@
+"""Closed-chain dynamics in actuator space for any described mechanism (issue 13).
+
+The spanning tree's rigid-body dynamics (Newton-Euler of every body about its centre of mass,
+:func:`robomech.dynamics.com_inverse_dynamics`) over the tree's velocity coordinates ``qd (nv)``,
+
+    M(q) qdd + c(q, qd) + g(q) = E tau + J_s^T W + K^T lambda,
+
+is projected onto the admissible motions ``qd = G qd_act`` (``G`` the first-order influence
+coefficients, :func:`~robomech.multibody.influence`; ``qdd = G qdd_act + Gdot qd_act``).  Because
+``K G = 0`` the closure forces ``K^T lambda`` drop out, and because the actuated rows of ``G`` are the
+identity ``G^T E = I``:
+
+    tau = G^T (M qdd + c + g - J_s^T W) = M_a qdd_act + c_a + g_a + e_a,     M_a = G^T M G.
+
+``W`` are external wrenches ``[m; f]`` (world axes, moment about the site point) applied *to* the
+mechanism at sites; ``e_a = -G^T J_s^T W`` is their share.  ``G`` is the minimum-norm choice for idle
+motions (a link spinning about its own axis): idle motions are prescribed at rest, as in MuJoCo's
+least-squares projection.
+
+Redundant actuation (more actuators than degrees of freedom; paper 1's three legs on a 2-DOF
+platform): only rates ``qd_act`` in the consistent subspace ``range(N_c)``, ``N_c = null(K G)``, are
+admissible, and virtual work fixes only ``N_c^T tau = N_c^T tau_G``.  The rule that picks ``tau`` is
+stated and selectable: ``weights=None`` the minimum-norm forces (``tau = N_c N_c^T tau_G``, no
+internal preload), ``weights = w (n_act,) >= 0`` the forces minimising ``sum tau_i^2 / w_i`` (an actuator
+with ``w_i = 0`` carries nothing: paper 1's "two legs driven" rule is ``w = (1, 0, 1)``):
+``tau = W N_c (N_c^T W N_c)^-1 N_c^T tau_G``, ``W = diag(w)``.
+
+Forward dynamics works on the tree coordinates with the closure as a constraint (idle motions
+included, as the engine has them): ``qdd = qdd_p + u``, ``K qdd_p = -Kdot qd`` (minimum norm), ``u`` in
+``null(K)`` from ``P (M u - f) = 0`` with ``P = I - K^+ K``.  :func:`simulate` integrates ``(q, qd)`` with
+``scipy.integrate.solve_ivp`` and projects back onto the constraint manifold (positions by the
+closure Newton iteration, velocities onto ``null(K)``) at every output time.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array, check_bool
+from robomech.dynamics import _com_terms
+
+from ._assembly import check_mechanism, check_q, solve_closure
+from ._constraints import jacobian, jacobian_rate
+from ._influence import PASSIVE_RANK_RTOL, _pinv
+from ._model import Mechanism
+from ._tree import (
+    frame_jacobian,
+    kinematics,
+    normalize_quaternions,
+    quat_mul,
+    quat_to_matrix,
+    screw_rates,
+)
+
+__all__ = [
+    "ADMISSIBLE_RTOL",
+    "SINGULAR_COND",
+    "ForwardDynamicsResult",
+    "InverseDynamicsResult",
+    "SimulationResult",
+    "SiteWrenchResult",
+    "StaticsResult",
+    "energy",
+    "forward_dynamics",
+    "inverse_dynamics",
+    "simulate",
+    "site_wrench",
+    "statics",
+]
+
+# A configuration is flagged singular when the passive block K_p of the constraint Jacobian has a
+# condition number above SINGULAR_COND (or lost rank against the reference configuration): actuator
+# forces grow like cond, and the closure is only solved to CONVERGED_RTOL = 1e-10 relative, so beyond
+# 1e6 the forces would carry relative errors of order 1e-4 from the geometry alone — and they are
+# physically unbounded as cond -> inf.  Such samples get valid = False and NaN forces.
+SINGULAR_COND = 1e6
+# The prescribed motion must be admissible: |K qd| and |K qdd + Kdot qd| below ADMISSIBLE_RTOL times
+# their scale (L |qd|, L (|qdd| + |qd|^2)).  Rounding leaves ~1e-15; an inconsistent rate of a
+# redundantly actuated mechanism (or a rank drop) gives O(1).
+ADMISSIBLE_RTOL = 1e-8
+# Rank decisions on K G (redundant actuation) and on the forward-dynamics matrices: singular values
+# below this fraction of the largest are zero (the same reasoning as PASSIVE_RANK_RTOL).
+RANK_RTOL = PASSIVE_RANK_RTOL
+# Samples per block in the batched kernels: bounds the (N, bodies, 6, nv) temporaries to ~100 MB.
+CHUNK = 2048
+
+
+# ----------------------------------------------------------------------------- cached mechanism data
+def _cache(mech: Mechanism, key: str, make: Callable[[], object]) -> object:
+    d = mech.__dict__  # frozen dataclass: cached_property writes here too
+    if key not in d:
+        d[key] = make()
+    return d[key]
+
+
+@dataclass(frozen=True)
+class _Bodies:
+    idx: np.ndarray  # (B,) tree body indices with mass or inertia
+    mass: np.ndarray  # (B,)
+    com: np.ndarray  # (B, 3) body frame
+    inertia: np.ndarray  # (B, 3, 3) about the com, body axes
+
+
+def _bodies(mech: Mechanism) -> _Bodies:
+    def make() -> _Bodies:
+        idx, m, c, inn = [], [], [], []
+        for i, b in enumerate(mech.bodies, start=1):
+            if b.inertial is None:
+                continue
+            it = b.inertial
+            if it.mass == 0 and max(it.diaginertia) == 0:
+                continue
+            Ri = quat_to_matrix(np.asarray(it.quat))
+            idx.append(i)
+            m.append(it.mass)
+            c.append(it.pos)
+            inn.append(Ri @ np.diag(it.diaginertia) @ Ri.T)
+        return _Bodies(
+            np.array(idx, dtype=int),
+            np.array(m, float),
+            np.array(c, float).reshape(-1, 3),
+            np.array(inn, float).reshape(-1, 3, 3),
+        )
+
+    return _cache(mech, "_dyn_bodies", make)
+
+
+def _reference(mech: Mechanism) -> tuple[int, int]:
+    """(passive rank of K at the reference configuration, mobility DOF)."""
+
+    def make() -> tuple[int, int]:
+        from ._mobility import mobility
+
+        tree = mech.tree
+        q0 = tree.q0[None]
+        st = kinematics(tree, q0)
+        K = jacobian(mech.constraints, tree, st, q0)
+        pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
+        _, rank, _, _ = _pinv(K[..., pas])
+        return int(rank[0]), int(mobility(mech).dof)
+
+    return _cache(mech, "_dyn_reference", make)
+
+
+# ----------------------------------------------------------------------------- tree kernels
+def _com_jacobians(tree, state, bd: _Bodies, qd: np.ndarray | None, Sd: np.ndarray | None):
+    """Centre-of-mass points (N, B, 3), Jacobians (N, B, 6, nv) and ``Jdot qd`` (N, B, 6)."""
+    T = state.T[:, bd.idx]
+    p = np.einsum("nbij,bj->nbi", T[..., :3, :3], bd.com) + T[..., :3, 3]
+    S = state.S
+    A = tree.A[bd.idx]  # (B, nv)
+    Sw, Sv = S[..., :3], S[..., 3:]
+    Jw = Sw[:, None] * A[None, :, :, None]  # (N, B, nv, 3)
+    Jv = (Sv[:, None] + np.cross(Sw[:, None], p[:, :, None])) * A[None, :, :, None]
+    J = np.concatenate([Jw, Jv], axis=-1).swapaxes(-1, -2)
+    a0 = None
+    if qd is not None:
+        V = np.einsum("bk,nkx,nk->nbx", A, S, qd)
+        Vd = np.einsum("bk,nkx,nk->nbx", A, Sd, qd)
+        w = V[..., :3]
+        pd = V[..., 3:] + np.cross(w, p)
+        a0 = np.concatenate([Vd[..., :3], Vd[..., 3:] + np.cross(Vd[..., :3], p) + np.cross(w, pd)], axis=-1)
+    return p, J, a0
+
+
+def _tree_terms(mech: Mechanism, state, qd, Sd, qdd, gravity: bool = True):
+    """Tree dynamics ``M (N, nv, nv)``, velocity terms, gravity terms (N, nv) at ``qdd`` (DynamicsTerms)."""
+    tree = mech.tree
+    bd = _bodies(mech)
+    N = state.T.shape[0]
+    R = state.T[:, bd.idx, :3, :3]
+    Iw = R @ bd.inertia @ R.swapaxes(-1, -2)
+    _, J, a0 = _com_jacobians(tree, state, bd, qd, Sd)
+    g = np.asarray(mech.gravity) if gravity else np.zeros(3)
+    m = np.broadcast_to(bd.mass, (N, len(bd.mass)))
+    return _com_terms(m, Iw, J, a0, qd, qdd, np.broadcast_to(g, (N, 3)))
+
+
+def _energy_flat(mech: Mechanism, q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    tree = mech.tree
+    bd = _bodies(mech)
+    st = kinematics(tree, q)
+    p, J, _ = _com_jacobians(tree, st, bd, None, None)
+    V = np.einsum("nbik,nk->nbi", J, qd)
+    R = st.T[:, bd.idx, :3, :3]
+    Iw = R @ bd.inertia @ R.swapaxes(-1, -2)
+    w, v = V[..., :3], V[..., 3:]
+    T = 0.5 * (np.einsum("nbi,nbij,nbj->n", w, Iw, w) + np.einsum("b,nbi,nbi->n", bd.mass, v, v))
+    U = -np.einsum("b,nbi,i->n", bd.mass, p, np.asarray(mech.gravity))
+    return T, U
+
+
+def _site_terms(mech: Mechanism, state, wrenches: dict[int, np.ndarray]) -> np.ndarray:
+    """``-sum_s J_s^T W_s`` (N, nv) for wrenches ``W_s (N, 6)`` applied to the mechanism at sites."""
+    tree = mech.tree
+    out = np.zeros((state.T.shape[0], tree.nv))
+    for si, W in wrenches.items():
+        b = tree.site_body[si]
+        p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
+        Js = frame_jacobian(tree, state, b, p)
+        out -= np.einsum("nik,ni->nk", Js, W)
+    return out
+
+
+# ----------------------------------------------------------------------------- validation helpers
+def _check_wrenches(mech: Mechanism, wrenches: object) -> dict[int, np.ndarray]:
+    if wrenches is None:
+        return {}
+    if not isinstance(wrenches, Mapping):
+        raise ValueError(
+            f"Expected wrenches to be a mapping site name -> (..., 6) wrench, got {type(wrenches).__name__}."
+        )
+    out = {}
+    for name, W in wrenches.items():
+        if not isinstance(name, str) or name not in mech.tree.site_names:
+            raise ValueError(
+                f"Expected wrenches keys to be site names among {list(mech.tree.site_names)}, got {name!r}."
+            )
+        out[mech.tree.site_index(name)] = as_array(W, f"wrenches[{name!r}]", (6,))
+    return out
+
+
+def _check_weights(mech: Mechanism, weights: object) -> np.ndarray | None:
+    if weights is None:
+        return None
+    na = len(mech.actuated)
+    w = as_array(weights, "weights", (na,))
+    if w.shape != (na,) or np.any(w < 0) or not np.any(w > 0):
+        raise ValueError(f"Expected weights to be {na} non-negative numbers, not all zero, got {weights!r}.")
+    return w
+
+
+def _fully_actuated(mech: Mechanism) -> tuple[int, int]:
+    rank0, dof = _reference(mech)
+    na = len(mech.actuated)
+    if na < dof or na == 0:
+        raise ValueError(
+            f"Expected mech to be actuated in every degree of freedom (dof {dof}), "
+            f"got {na} actuated joint(s); inverse dynamics needs the actuators to determine the motion."
+        )
+    return rank0, dof
+
+
+# ----------------------------------------------------------------------------- inverse dynamics
+@dataclass(frozen=True)
+class InverseDynamicsResult:
+    """``tau = M_a qdd_act + velocity_terms + gravity_terms + external_terms`` per sample.
+
+    ``tau (..., n_act)`` generalized force at each actuated joint (N m or N, no gear);
+    ``M_a (..., n_act, n_act)`` the mass matrix in actuator space (``G^T M G``; with redundant actuation
+    the distributed ``Pi G^T M G``, ``Pi`` the stated rule's projector); ``velocity_terms``,
+    ``gravity_terms``, ``external_terms (..., n_act)`` (the last: site wrenches).  ``qd``, ``qdd``
+    ``(..., nv)`` every tree coordinate's rate and acceleration.  ``cond`` the condition number of the
+    passive constraint block (grows without bound at a type II / parallel singularity), ``sigma_min``
+    its smallest kept singular value (m), ``admissibility`` the closure error of the prescribed motion
+    (relative), ``valid`` False at a singular configuration, an inadmissible motion or a non-finite
+    input — forces NaN there.
+    """
+
+    tau: np.ndarray
+    M_a: np.ndarray
+    velocity_terms: np.ndarray
+    gravity_terms: np.ndarray
+    external_terms: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    cond: np.ndarray
+    sigma_min: np.ndarray
+    admissibility: np.ndarray
+    valid: np.ndarray
+
+
+def _projector(mech, K, G, dof, w):
+    """Redundant actuation: the rule's projector Pi (N, na, na); False where null(K G) is not ``dof``-wide."""
+    N, _, na = G.shape
+    KG = (K @ G) / mech.tree.length
+    s_full = np.zeros((N, na))
+    if KG.shape[1]:
+        _, s, Vt = np.linalg.svd(KG, full_matrices=True)
+        s_full[:, : s.shape[1]] = s[:, :na]
+    else:
+        Vt = np.broadcast_to(np.eye(na), (N, na, na))
+    # singular values ascending over the right singular vectors: the last `dof` rows of Vt span null(KG)
+    Nc = Vt[:, na - dof :].swapaxes(-1, -2)  # (N, na, dof)
+    top = np.maximum(np.max(s_full, axis=-1), 1.0)
+    gap_ok = np.all(s_full[:, na - dof :] <= RANK_RTOL * 1e2 * top[:, None], axis=-1)
+    if dof < na:
+        gap_ok &= s_full[:, na - dof - 1] > RANK_RTOL * 1e2 * top
+    if w is None:
+        Pi = Nc @ Nc.swapaxes(-1, -2)
+    else:
+        WN = w[:, None] * Nc
+        A = Nc.swapaxes(-1, -2) @ WN
+        ok = np.linalg.cond(A) < 1.0 / RANK_RTOL
+        A = np.where(ok[:, None, None], A, np.eye(dof))
+        Pi = WN @ np.linalg.solve(A, Nc.swapaxes(-1, -2))
+        gap_ok &= ok
+    return Pi, gap_ok
+
+
+def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
+    tree, cs = mech.tree, mech.constraints
+    rank0, dof = _reference(mech)
+    na = len(tree.act_dof)
+    act = tree.act_dof
+    pas = np.setdiff1d(np.arange(tree.nv), act)
+    N = q.shape[0]
+    state = kinematics(tree, q)
+    K = jacobian(cs, tree, state, q)
+    P, rank, smin, cond = _pinv(K[..., pas])
+    G = np.zeros((N, tree.nv, na))
+    G[:, act, np.arange(na)] = 1.0
+    G[:, pas] = -P @ K[..., act]
+    qd = np.einsum("nij,nj->ni", G, qd_a)
+    Sd = screw_rates(tree, state, qd)
+    Kd = jacobian_rate(cs, tree, state, Sd, q, qd)
+    kdq = np.einsum("nij,nj->ni", Kd, qd)
+    qdd = np.einsum("nij,nj->ni", G, qdd_a)
+    qdd[:, pas] -= np.einsum("nij,nj->ni", P, kdq)
+    terms = _tree_terms(mech, state, qd, Sd, qdd, gravity)
+    ext = _site_terms(mech, state, wr)
+    GT = G.swapaxes(-1, -2)
+    M_a = GT @ terms.M @ G
+    # velocity terms: the tree's c plus the convective part of the acceleration, M (qdd - G qdd_a)
+    vel = np.einsum(
+        "nij,nj->ni",
+        GT,
+        terms.velocity_terms + np.einsum("nij,nj->ni", terms.M, qdd - (G @ qdd_a[..., None])[..., 0]),
+    )
+    grav = np.einsum("nij,nj->ni", GT, terms.gravity_terms)
+    ex = np.einsum("nij,nj->ni", GT, ext)
+    ok = np.ones(N, dtype=bool)
+    if na > dof or weights is not None:
+        Pi, ok = _projector(mech, K, G, dof, weights)
+        M_a = Pi @ M_a
+        vel, grav, ex = (np.einsum("nij,nj->ni", Pi, x) for x in (vel, grav, ex))
+    tau = np.einsum("nij,nj->ni", M_a, qdd_a) + vel + grav + ex
+    L = tree.length
+    sv = np.max(np.abs(qd), axis=-1) if tree.nv else np.zeros(N)
+    sa = np.max(np.abs(qdd), axis=-1) + sv * sv if tree.nv else np.zeros(N)
+    if K.shape[1]:
+        e1 = np.max(np.abs(np.einsum("nij,nj->ni", K, qd)), axis=-1) / (L * np.maximum(sv, 1e-300))
+        e2 = np.max(np.abs(np.einsum("nij,nj->ni", K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, 1e-300))
+        e1 = np.where(sv > 0, e1, 0.0)
+        e2 = np.where(sa > 0, e2, 0.0)
+        adm = np.maximum(e1, e2)
+    else:
+        adm = np.zeros(N)
+    fin = np.all(np.isfinite(tau), axis=-1) & np.all(np.isfinite(M_a), axis=(-1, -2))
+    valid = ok & fin & (rank >= rank0) & (cond <= SINGULAR_COND) & (adm <= ADMISSIBLE_RTOL)
+    return dict(
+        tau=tau,
+        M_a=M_a,
+        velocity_terms=vel,
+        gravity_terms=grav,
+        external_terms=ex,
+        qd=qd,
+        qdd=qdd,
+        cond=cond,
+        sigma_min=smin,
+        admissibility=adm,
+        valid=valid,
+    )
+
+
+def _run_chunked(fn, n: int, arrays: list[np.ndarray], **kw) -> dict[str, np.ndarray]:
+    parts = [fn(*(a[i : i + CHUNK] for a in arrays), **kw) for i in range(0, max(n, 1), CHUNK)]
+    if n == 0:
+        return {k: v[:0] for k, v in parts[0].items()}
+    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+
+
+def _finite_rows(*xs: np.ndarray) -> np.ndarray:
+    ok = np.ones(xs[0].shape[0], dtype=bool)
+    for x in xs:
+        ok &= np.all(np.isfinite(x.reshape(x.shape[0], -1)), axis=-1)
+    return ok
+
+
+def _broadcast(mech, q, others: list[tuple[object, str, int]]):
+    """Validate ``q`` (non-finite allowed: masked) and the others (..., n); broadcast, flatten."""
+    qv = as_array(q, "q", (mech.nq,), finite=False)
+    for a in mech.tree.quat_adr:
+        n = np.linalg.norm(qv[..., a : a + 4], axis=-1)
+        if np.any(np.isfinite(n) & (n < 1e-9)):
+            raise ValueError(f"Expected the quaternion q[..., {a}:{a + 4}] to be non-zero.")
+    arrs = [as_array(x, name, (n,), finite=False) for x, name, n in others]
+    batch = np.broadcast_shapes(qv.shape[:-1], *(a.shape[:-1] for a in arrs))
+    flat = [np.broadcast_to(qv, (*batch, mech.nq)).reshape(-1, mech.nq)]
+    flat += [np.broadcast_to(a, (*batch, a.shape[-1])).reshape(-1, a.shape[-1]) for a in arrs]
+    return batch, flat
+
+
+def _sanitize(mech, flat: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray]]:
+    ok = _finite_rows(*flat)
+    out = []
+    for i, a in enumerate(flat):
+        a = np.array(a, dtype=float)
+        a[~ok] = mech.tree.q0 if i == 0 else 0.0
+        out.append(a)
+    out[0] = normalize_quaternions(mech.tree, out[0])
+    return ok, out
+
+
+def _shape(d: dict, batch, ok: np.ndarray, nan_keys) -> dict:
+    res = {}
+    for k, v in d.items():
+        v = np.array(v)
+        if k == "valid":
+            v = v & ok
+        elif k in nan_keys:
+            bad = ~(d["valid"] & ok)
+            v = np.where(bad.reshape(-1, *(1,) * (v.ndim - 1)), np.nan, v)
+        elif v.dtype.kind == "f":
+            v = np.where(ok.reshape(-1, *(1,) * (v.ndim - 1)), v, np.nan)
+        res[k] = v.reshape(*batch, *v.shape[1:])
+    return res
+
+
+_FORCE_KEYS = ("tau", "M_a", "velocity_terms", "gravity_terms", "external_terms")
+
+
+def inverse_dynamics(
+    mech: Mechanism,
+    q: object,
+    qd_act: object,
+    qdd_act: object,
+    *,
+    wrenches: Mapping[str, object] | None = None,
+    weights: object = None,
+    gravity: bool = True,
+) -> InverseDynamicsResult:
+    """Actuator forces for the motion ``(q, qd_act, qdd_act)`` of any described closed chain.
+
+    ``q (..., nq)`` an assembled configuration (from :func:`forward_kinematics` /
+    :func:`inverse_kinematics`), ``qd_act``, ``qdd_act (..., n_act)`` the actuated joints' rates and
+    accelerations in actuator order; ``wrenches`` maps site names to wrenches ``[m; f] (..., 6)``
+    applied *to* the mechanism at the site (world axes, moment about the site point); gravity from
+    ``mech.gravity`` (MJCF ``<option gravity>``) unless ``gravity=False``.  ``weights (n_act,)``: the
+    redundant-actuation rule (module docstring; default minimum norm).  Actuator ``gear`` is not
+    applied: ``tau`` is the generalized force at each actuated joint.  Batched over any leading shape;
+    non-finite samples and singular configurations give ``valid = False`` and NaN forces.
+    """
+    mech = check_mechanism(mech)
+    _fully_actuated(mech)
+    gravity = check_bool(gravity, "gravity")
+    w = _check_weights(mech, weights)
+    na = len(mech.actuated)
+    wr = _check_wrenches(mech, wrenches)
+    names = list(wr)
+    batch, flat = _broadcast(
+        mech,
+        q,
+        [(qd_act, "qd_act", na), (qdd_act, "qdd_act", na)]
+        + [(wr[s], f"wrenches[{mech.tree.site_names[s]!r}]", 6) for s in names],
+    )
+    ok, flat = _sanitize(mech, flat)
+    n = flat[0].shape[0]
+
+    def fn(qf, qdf, qddf, *ws, **kw):
+        return _inverse_flat(mech, qf, qdf, qddf, dict(zip(names, ws, strict=True)), w, gravity)
+
+    d = _run_chunked(fn, n, flat)
+    return InverseDynamicsResult(**_shape(d, batch, ok, _FORCE_KEYS))
+
+
+# ----------------------------------------------------------------------------- statics
+@dataclass(frozen=True)
+class StaticsResult:
+    """Actuator forces ``tau (..., n_act)`` holding the mechanism at rest against the site wrenches and
+    gravity (virtual work: ``tau = -G^T (J_s^T W - g)``), its parts, the passive-block ``cond`` and
+    ``valid`` (False at a singular configuration; forces NaN there)."""
+
+    tau: np.ndarray
+    gravity_terms: np.ndarray
+    external_terms: np.ndarray
+    cond: np.ndarray
+    valid: np.ndarray
+
+
+def statics(
+    mech: Mechanism,
+    q: object,
+    *,
+    wrenches: Mapping[str, object] | None = None,
+    weights: object = None,
+    gravity: bool = True,
+) -> StaticsResult:
+    """Actuator forces balancing ``wrenches`` (applied to the mechanism at sites) and gravity at rest.
+
+    The same virtual-work projection as :func:`inverse_dynamics` at ``qd = qdd = 0``.
+    """
+    mech = check_mechanism(mech)
+    q = as_array(q, "q", (mech.nq,), finite=False)
+    z = np.zeros(len(mech.actuated))
+    r = inverse_dynamics(mech, q, z, z, wrenches=wrenches, weights=weights, gravity=gravity)
+    return StaticsResult(r.tau, r.gravity_terms, r.external_terms, r.cond, r.valid)
+
+
+@dataclass(frozen=True)
+class SiteWrenchResult:
+    """The wrench ``[m; f] (..., 6)`` the mechanism exerts on its environment at a site under actuator
+    forces ``tau`` (at rest): the least-squares solution of ``J^T W = tau - g_a`` (rotation rows scaled by
+    the characteristic length, so that N m and N are compared as N).  ``residual (...)`` the part of
+    ``tau`` the site cannot transmit (N m or N; non-zero when the actuators preload internally or
+    n_act > 6), ``sigma_min`` the smallest singular value of ``J`` (rotation rows times L, m; zero at an
+    output singularity where the site cannot resist some wrench), ``cond``, ``valid``.  With
+    ``n_act < 6`` the wrench components the structure carries (``null(J^T)``) are not determined by the
+    actuators and are returned as zero (minimum norm)."""
+
+    wrench: np.ndarray
+    residual: np.ndarray
+    sigma_min: np.ndarray
+    cond: np.ndarray
+    valid: np.ndarray
+
+
+def site_wrench(
+    mech: Mechanism, q: object, site: str, tau: object, *, gravity: bool = True
+) -> SiteWrenchResult:
+    """Inverse static map: the site wrench produced by actuator forces ``tau (..., n_act)`` at ``q``."""
+    from ._influence import _influence_flat
+
+    mech = check_mechanism(mech)
+    if not isinstance(site, str):
+        raise ValueError(f"Expected site to be a site name (str), got {type(site).__name__}.")
+    si = mech.tree.site_index(site)
+    gravity = check_bool(gravity, "gravity")
+    _fully_actuated(mech)
+    na = len(mech.actuated)
+    batch, flat = _broadcast(mech, q, [(tau, "tau", na)])
+    ok, (qf, tf) = _sanitize(mech, flat)
+    tree = mech.tree
+    L = tree.length
+    out = {k: [] for k in ("wrench", "residual", "sigma_min", "cond", "valid")}
+    for i in range(0, max(qf.shape[0], 1), CHUNK):
+        qc, tc = qf[i : i + CHUNK], tf[i : i + CHUNK]
+        n = qc.shape[0]
+        z = np.zeros((n, na))
+        st = _inverse_flat(mech, qc, z, z, {}, None, gravity)
+        state, _, G, _, _, _ = _influence_flat(mech, qc, False)
+        b = tree.site_body[si]
+        p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
+        J = frame_jacobian(tree, state, b, p) @ G  # (n, 6, na)
+        Js = np.concatenate([J[:, :3] * L, J[:, 3:]], axis=1)
+        U, s, Vt = np.linalg.svd(Js, full_matrices=False)
+        smax = s[:, :1]
+        keep = s > RANK_RTOL * np.maximum(smax, 1e-300)
+        sinv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
+        rhs = tc - st["gravity_terms"]
+        Ws = np.einsum("nik,nk,nkj,nj->ni", U, sinv, Vt, rhs)  # (J_s^T)^+ rhs
+        W = np.concatenate([Ws[:, :3] * L, Ws[:, 3:]], axis=1)
+        res = np.linalg.norm(np.einsum("nik,ni->nk", J, W) - rhs, axis=-1)
+        smin = s[:, -1] if na <= 6 else s[:, 5]
+        cond = smax[:, 0] / np.maximum(smin, 1e-300)
+        valid = st["valid"] & (cond <= SINGULAR_COND) & np.all(np.isfinite(W), axis=-1)
+        for k, v in zip(out, (W, res, smin, cond, valid), strict=True):
+            out[k].append(v)
+    d = {k: np.concatenate(v) for k, v in out.items()}
+    d = _shape(d, batch, ok, ("wrench",))
+    return SiteWrenchResult(**d)
+
+
+# ----------------------------------------------------------------------------- forward dynamics
+def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True):
+    """Tree accelerations ``qdd (N, nv)`` under actuator forces with the closure enforced, and a
+    conditioning measure of the constrained mass matrix (N,)."""
+    tree, cs = mech.tree, mech.constraints
+    N = q.shape[0]
+    nv = tree.nv
+    state = kinematics(tree, q)
+    K = jacobian(cs, tree, state, q)
+    Sd = screw_rates(tree, state, qd)
+    Kd = jacobian_rate(cs, tree, state, Sd, q, qd)
+    kdq = np.einsum("nij,nj->ni", Kd, qd)
+    terms = _tree_terms(mech, state, qd, Sd, np.zeros_like(qd), gravity)
+    f = -terms.velocity_terms - terms.gravity_terms
+    if wr:
+        f = f - _site_terms(mech, state, wr)
+    f[:, tree.act_dof] += tau_a
+    if K.shape[1]:
+        Kp, _, _, _ = _pinv(K)  # (N, nv, m)
+        qdd_p = -np.einsum("nij,nj->ni", Kp, kdq)
+        Pn = np.eye(nv) - Kp @ K
+    else:
+        qdd_p = np.zeros((N, nv))
+        Pn = np.broadcast_to(np.eye(nv), (N, nv, nv))
+    M = terms.M
+    Mc = Pn @ M @ Pn + (np.eye(nv) - Pn)
+    rhs = np.einsum("nij,nj->ni", Pn, f - np.einsum("nij,nj->ni", M, qdd_p))
+    ev = np.linalg.eigvalsh(0.5 * (Mc + Mc.swapaxes(-1, -2)))
+    cond = ev[:, -1] / np.maximum(ev[:, 0], 1e-300)
+    u = np.einsum("nij,nj->ni", np.linalg.pinv(Mc, rcond=RANK_RTOL, hermitian=True), rhs)
+    return qdd_p + u, cond, K, kdq
+
+
+@dataclass(frozen=True)
+class ForwardDynamicsResult:
+    """``qdd_act (..., n_act)`` and every tree coordinate's ``qdd (..., nv)`` under the actuator forces;
+    ``cond`` the condition number of the constrained mass matrix (large: a nearly massless motion),
+    ``admissibility`` the closure error of the resulting acceleration (relative), ``valid``."""
+
+    qdd_act: np.ndarray
+    qdd: np.ndarray
+    qd: np.ndarray
+    cond: np.ndarray
+    admissibility: np.ndarray
+    valid: np.ndarray
+
+
+def forward_dynamics(
+    mech: Mechanism,
+    q: object,
+    qd_act: object,
+    tau: object,
+    *,
+    wrenches: Mapping[str, object] | None = None,
+    gravity: bool = True,
+) -> ForwardDynamicsResult:
+    """Accelerations under actuator forces ``tau (..., n_act)`` at ``(q, qd_act)`` (idle motions at rest).
+
+    The inverse of :func:`inverse_dynamics`: ``forward_dynamics(mech, q, qd, inverse_dynamics(mech, q,
+    qd, qdd).tau).qdd_act == qdd`` wherever both are valid (idle motions decoupled).
+    """
+    mech = check_mechanism(mech)
+    _fully_actuated(mech)
+    gravity = check_bool(gravity, "gravity")
+    na = len(mech.actuated)
+    wr = _check_wrenches(mech, wrenches)
+    names = list(wr)
+    batch, flat = _broadcast(
+        mech,
+        q,
+        [(qd_act, "qd_act", na), (tau, "tau", na)]
+        + [(wr[s], f"wrenches[{mech.tree.site_names[s]!r}]", 6) for s in names],
+    )
+    ok, flat = _sanitize(mech, flat)
+    rank0, _ = _reference(mech)
+    tree = mech.tree
+    pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
+
+    def fn(qf, qdf, tf, *ws):
+        state = kinematics(tree, qf)
+        K = jacobian(mech.constraints, tree, state, qf)
+        P, rank, _, cK = _pinv(K[..., pas])
+        qd = np.zeros((qf.shape[0], tree.nv))
+        qd[:, tree.act_dof] = qdf
+        qd[:, pas] = -np.einsum("nij,njk,nk->ni", P, K[..., tree.act_dof], qdf)
+        qdd, cond, K, kdq = _forward_full(mech, qf, qd, tf, dict(zip(names, ws, strict=True)), gravity)
+        L = tree.length
+        sa = np.max(np.abs(qdd), axis=-1) + np.max(np.abs(qd), axis=-1) ** 2 if tree.nv else 0.0
+        adm = (
+            np.max(np.abs(np.einsum("nij,nj->ni", K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, 1e-300))
+            if K.shape[1]
+            else np.zeros(qf.shape[0])
+        )
+        valid = (
+            (rank >= rank0)
+            & (cK <= SINGULAR_COND)
+            & (cond < 1.0 / RANK_RTOL)
+            & (adm <= ADMISSIBLE_RTOL)
+            & np.all(np.isfinite(qdd), axis=-1)
+        )
+        return dict(qdd_act=qdd[:, tree.act_dof], qdd=qdd, qd=qd, cond=cond, admissibility=adm, valid=valid)
+
+    d = _run_chunked(fn, flat[0].shape[0], flat)
+    return ForwardDynamicsResult(**_shape(d, batch, ok, ("qdd_act", "qdd")))
+
+
+# ----------------------------------------------------------------------------- energy
+def energy(mech: Mechanism, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
+    """Kinetic and potential energy ``(T, U) (...)`` (J) at ``q (..., nq)`` with every coordinate's rate
+    ``qd (..., nv)`` (``U = -sum m g . c``, zero at the world origin)."""
+    mech = check_mechanism(mech)
+    q = check_q(mech, q)
+    qd = as_array(qd, "qd", (mech.nv,))
+    batch = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1])
+    qf = np.broadcast_to(q, (*batch, mech.nq)).reshape(-1, mech.nq)
+    qdf = np.broadcast_to(qd, (*batch, mech.nv)).reshape(-1, mech.nv)
+    T, U = _energy_flat(mech, qf, qdf)
+    return T.reshape(batch), U.reshape(batch)
+
+
+# ----------------------------------------------------------------------------- simulation
+# Integrator tolerances for solve_ivp (DOP853): relative 1e-10 and absolute 1e-12 (rad, m, rad/s) keep the
+# local error far below the closure tolerance between two projections.
+SIM_RTOL = 1e-10
+SIM_ATOL = 1e-12
+
+
+def _qpos_rate(tree, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """``dq/dt (N, nq)`` from the velocity coordinates (quaternion rates from local angular velocity)."""
+    out = np.zeros_like(q)
+    for k in range(len(tree.jnt_names)):
+        typ, qa, da = tree.jnt_type[k], tree.jnt_qadr[k], tree.jnt_dadr[k]
+        if typ <= 1:
+            out[:, qa] = qd[:, da]
+        elif typ == 2:
+            w = np.concatenate([np.zeros((q.shape[0], 1)), qd[:, da : da + 3]], axis=-1)
+            out[:, qa : qa + 4] = 0.5 * quat_mul(q[:, qa : qa + 4], w)
+        else:
+            out[:, qa : qa + 3] = qd[:, da : da + 3]
+            w = np.concatenate([np.zeros((q.shape[0], 1)), qd[:, da + 3 : da + 6]], axis=-1)
+            out[:, qa + 3 : qa + 7] = 0.5 * quat_mul(q[:, qa + 3 : qa + 7], w)
+    return out
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """A simulated motion, batch ``...`` of initial conditions, ``nt`` output times.
+
+    ``t (nt,)``; ``q (..., nt, nq)``, ``qd (..., nt, nv)``, ``q_act``, ``qd_act (..., nt, n_act)``;
+    ``kinetic``, ``potential`` (J) and ``work`` (the actuators' work since t0, J) ``(..., nt)``;
+    ``energy_drift (...)`` = max over t of ``|T + U - W - (T + U)(t0)|`` (J) and ``energy_drift_rel``
+    the same divided by the largest of ``T``, ``|U - U(t0)|`` and ``W`` over the motion;
+    ``closure (..., nt)`` the closure residual after projection (m); ``success (...)`` the integration
+    succeeded, every state is finite and every closure below CONVERGED_RTOL * L.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    q_act: np.ndarray
+    qd_act: np.ndarray
+    kinetic: np.ndarray
+    potential: np.ndarray
+    work: np.ndarray
+    energy_drift: np.ndarray
+    energy_drift_rel: np.ndarray
+    closure: np.ndarray
+    success: np.ndarray
+
+
+def _project(mech, q, qd):
+    """Back onto the manifold: positions by the closure Newton iteration (all coordinates), velocities
+    onto ``null(K)`` (minimum-norm correction)."""
+    tree = mech.tree
+    q, rc, _, _ = solve_closure(mech, q, np.arange(tree.nv))
+    st = kinematics(tree, q)
+    K = jacobian(mech.constraints, tree, st, q)
+    if K.shape[1]:
+        Kp, _, _, _ = _pinv(K)
+        qd = qd - np.einsum("nij,njk,nk->ni", Kp, K, qd)
+    return q, qd, rc
+
+
+def _simulate_flat(mech, q0, qd0, t, tau_fn, gravity):
+    from scipy.integrate import solve_ivp
+
+    tree = mech.tree
+    N, nq, nv = q0.shape[0], tree.nq, tree.nv
+    na = len(tree.act_dof)
+
+    def unpack(y):
+        Y = y.reshape(N, nq + nv + 1)
+        return Y[:, :nq], Y[:, nq : nq + nv], Y[:, -1]
+
+    def forces(tt, q, qd):
+        if tau_fn is None:
+            return np.zeros((N, na))
+        return np.broadcast_to(np.asarray(tau_fn(tt, q, qd), float), (N, na))
+
+    def rhs(tt, y):
+        q, qd, _ = unpack(y)
+        qn = normalize_quaternions(tree, q) if tree.quat_adr else q
+        tau = forces(tt, qn, qd)
+        qdd, _, _, _ = _forward_full(mech, qn, qd, tau, None, gravity)
+        power = np.sum(tau * qd[:, tree.act_dof], axis=-1)
+        return np.concatenate([_qpos_rate(tree, qn, qd), qdd, power[:, None]], axis=-1).ravel()
+
+    nt = len(t)
+    Q = np.empty((N, nt, nq))
+    QD = np.empty((N, nt, nv))
+    W = np.zeros((N, nt))
+    RC = np.zeros((N, nt))
+    q, qd, rc = _project(mech, q0, qd0)
+    Q[:, 0], QD[:, 0], RC[:, 0] = q, qd, rc
+    ok = True
+    for i in range(1, nt):
+        y0 = np.concatenate([q, qd, W[:, i - 1 : i]], axis=-1).ravel()
+        sol = solve_ivp(rhs, (t[i - 1], t[i]), y0, method="DOP853", rtol=SIM_RTOL, atol=SIM_ATOL)
+        if not sol.success or not np.all(np.isfinite(sol.y[:, -1])):
+            ok = False
+            Q[:, i:], QD[:, i:], W[:, i:], RC[:, i:] = np.nan, np.nan, np.nan, np.inf
+            break
+        q, qd, w = unpack(sol.y[:, -1])
+        q, qd, rc = _project(mech, normalize_quaternions(tree, q), qd)
+        Q[:, i], QD[:, i], W[:, i], RC[:, i] = q, qd, w, rc
+    return Q, QD, W, RC, ok
+
+
+def simulate(
+    mech: Mechanism,
+    q0: object,
+    qd_act0: object,
+    t: object,
+    *,
+    tau: object = None,
+    gravity: bool = True,
+) -> SimulationResult:
+    """Integrate the closed chain from ``(q0 (..., nq), qd_act0 (..., n_act))`` to the output times ``t``.
+
+    ``tau`` the actuator forces: None (passive motion), an array ``(..., n_act)`` held constant, or a
+    callable ``tau(t, q (N, nq), qd (N, nv)) -> (N, n_act)`` over the flattened batch.  The state is
+    every tree coordinate (idle motions included) integrated by ``scipy.integrate.solve_ivp`` (DOP853,
+    :data:`SIM_RTOL`, :data:`SIM_ATOL`) between consecutive output times, projected back onto the
+    constraint manifold at each of them.  Batched over initial conditions (one ODE system; a batch
+    whose integration fails is retried sample by sample so that one bad sample does not spoil the rest).
+    """
+    mech = check_mechanism(mech)
+    _fully_actuated(mech)
+    gravity = check_bool(gravity, "gravity")
+    tree = mech.tree
+    na = len(mech.actuated)
+    t = as_array(t, "t", (None,))
+    if t.ndim != 1 or t.shape[0] < 2 or np.any(np.diff(t) <= 0):
+        raise ValueError(f"Expected t to be increasing output times (at least 2), got shape {t.shape}.")
+    tau_arr = None
+    if tau is not None and not callable(tau):
+        tau_arr = as_array(tau, "tau", (na,))
+    batch, flat = _broadcast(
+        mech, q0, [(qd_act0, "qd_act0", na)] + ([(tau_arr, "tau", na)] if tau_arr is not None else [])
+    )
+    q0f, qa0 = flat[0], flat[1]
+    if not (np.all(np.isfinite(q0f)) and np.all(np.isfinite(qa0))):
+        raise ValueError("Expected q0 and qd_act0 to be finite.")
+    q0f = normalize_quaternions(tree, q0f)
+    N = q0f.shape[0]
+    # the initial rates of every coordinate: qd = G qd_act0 (idle motions at rest)
+    from ._influence import _influence_flat
+
+    _, _, G, _, _, _ = _influence_flat(mech, q0f, False)
+    qd0 = np.einsum("nij,nj->ni", G, qa0)
+    if tau_arr is not None:
+        tv = flat[2]
+
+        def tau_fn(tt, q, qd, tv=tv):
+            return tv if q.shape[0] == tv.shape[0] else tv[: q.shape[0]]
+    else:
+        tau_fn = tau
+    Q, QD, W, RC, ok = _simulate_flat(mech, q0f, qd0, t, tau_fn, gravity)
+    success = np.full(N, ok)
+    if not ok and N > 1:
+        for i in range(N):
+            fn_i = None
+            if tau_arr is not None:
+                fn_i = lambda tt, q, qd, v=flat[2][i : i + 1]: v  # noqa: E731
+            elif tau is not None:
+                fn_i = lambda tt, q, qd, i=i: np.asarray(tau(tt, q, qd), float).reshape(-1, na)[:1]  # noqa: E731
+            Qi, QDi, Wi, RCi, oki = _simulate_flat(mech, q0f[i : i + 1], qd0[i : i + 1], t, fn_i, gravity)
+            Q[i], QD[i], W[i], RC[i], success[i] = Qi[0], QDi[0], Wi[0], RCi[0], oki
+    from ._assembly import CONVERGED_RTOL
+
+    nt = len(t)
+    Tk, U = _energy_flat(mech, np.nan_to_num(Q.reshape(-1, tree.nq)), np.nan_to_num(QD.reshape(-1, tree.nv)))
+    Tk, U = Tk.reshape(N, nt), U.reshape(N, nt)
+    E = Tk + U - W
+    drift = np.max(np.abs(E - E[:, :1]), axis=-1)
+    scale = np.maximum.reduce([np.max(Tk, -1), np.max(np.abs(U - U[:, :1]), -1), np.max(np.abs(W), -1)])
+    rel = drift / np.maximum(scale, 1e-300)
+    success &= np.all(np.isfinite(Q), axis=(-1, -2)) & np.all(RC <= CONVERGED_RTOL * tree.length, axis=-1)
+    bad = ~success
+    drift = np.where(bad, np.nan, drift)
+    rel = np.where(bad, np.nan, rel)
+
+    def rs(x, *tail):
+        return x.reshape(*batch, *tail)
+
+    return SimulationResult(
+        t=t.copy(),
+        q=rs(Q, nt, tree.nq),
+        qd=rs(QD, nt, tree.nv),
+        q_act=rs(Q[..., tree.act_qadr], nt, na),
+        qd_act=rs(QD[..., tree.act_dof], nt, na),
+        kinetic=rs(Tk, nt),
+        potential=rs(U, nt),
+        work=rs(W, nt),
+        energy_drift=rs(drift),
+        energy_drift_rel=rs(rel),
+        closure=rs(RC, nt),
+        success=rs(success),
+    )
