@@ -217,14 +217,15 @@ def _f(x) -> str:
     return " ".join(repr(float(v)) for v in np.atleast_1d(np.asarray(x, dtype=float)))
 
 
-def to_mjcf(mech: Mechanism) -> str:
+def to_mjcf(mech: Mechanism, *, comment: str | None = None) -> str:
     """MJCF text of ``mech`` that MuJoCo loads and :func:`from_mjcf` reads back to the same mechanism.
 
     Angles in radians, every float at full precision, visual capsules (no contacts) from each body's
     origin to its children, joint anchors, closure anchors and sites so the model is visible in
     MuJoCo's viewer.  Bodies without an :class:`Inertial` get MuJoCo's inertia from these geoms.
     A ``revolute`` closure is written as two ``connect`` elements ``name`` and ``name/axis`` one
-    characteristic length apart along the axis (MJCF has no hinge equality).
+    characteristic length apart along the axis (MJCF has no hinge equality).  ``comment`` is written
+    as an XML comment at the top of the model.
     """
     if not isinstance(mech, Mechanism):
         raise ValueError(f"Expected mech to be a robomech.multibody.Mechanism, got {type(mech).__name__}.")
@@ -233,6 +234,8 @@ def to_mjcf(mech: Mechanism) -> str:
     radius = 0.02 * L
     T0 = body_poses(tree, tree.q0[None])[0]
     root = ET.Element("mujoco", model=mech.name)
+    if comment:
+        root.append(ET.Comment(" " + comment.replace("--", "- -").strip() + " "))
     ET.SubElement(root, "compiler", angle="radian", autolimits="true")
     ET.SubElement(root, "option", gravity=_f(mech.gravity))
     default = ET.SubElement(root, "default")

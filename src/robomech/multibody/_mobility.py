@@ -9,7 +9,8 @@ length ``L`` (so that ranks are unit-consistent):
   carry sites; all bodies if there is none) — e.g. an S–S link spinning about its own axis;
 * ``dof = total_dof - idle_dof``: the mechanism's degrees of freedom (the Delta's 3, Bennett's 1);
 * ``gruebler_kutzbach = nv - sum c_i`` (the spatial count ``6(n - 1) - sum (6 - f)`` for the tree plus
-  a cut joint of ``c`` equations per closure: 3 point, 5 revolute, 6 rigid, 1 coupling);
+  a cut joint of ``c`` equations per closure: 3 point, 5 revolute (or two point closures between the
+  same two bodies), 6 rigid, 1 coupling);
 * ``redundant_constraints = sum c_i - rank K``, so that ``total_dof = gruebler_kutzbach +
   redundant_constraints`` (a planar four-bar cut by a hinge: -2 + 3 = 1; Bennett's linkage the same);
 * ``singular``: the rank of K is not locally constant — it differs at configurations assembled a
@@ -118,13 +119,17 @@ def _serial_legs(mech: Mechanism, st, platform: int) -> list[np.ndarray] | None:
         return None
     S = st.S[0]
     chains = [S[tree.A[platform] > 0]]
+    used = tree.A[platform].copy()
     for c in mech.closures:
         b1, b2 = tree.body_index(c.body1), tree.body_index(c.body2)
         if platform not in (b1, b2):
             return None
         other, anchor = (b2, c.anchor2) if b1 == platform else (b1, c.anchor1)
-        if tree.A[other][tree.A[platform] > 0].any():  # the leg shares joints with the platform's own path
+        if (
+            tree.A[other] * used
+        ).any():  # shares joints with another leg: not serial legs (e.g. a parallelogram)
             return None
+        used = np.maximum(used, tree.A[other])
         T = st.T[0, other]
         p = T[:3, :3] @ np.asarray(anchor) + T[:3, 3]
         leg = list(S[tree.A[other] > 0])
@@ -137,6 +142,23 @@ def _serial_legs(mech: Mechanism, st, platform: int) -> list[np.ndarray] | None:
             return None
         chains.append(np.array(leg))
     return chains
+
+
+def _cut_constraints(mech: Mechanism) -> int:
+    """Constraints of the cut joints: point 3, revolute 5, rigid 6, coupling 1.
+
+    Two point closures between the same two bodies are one hinge cut (how MJCF writes a revolute
+    closure: their six equations always have one dependence), 5; three or more are a rigid cut, 6.
+    """
+    pairs: dict[frozenset, int] = {}
+    n = len(mech.couplings)
+    for c in mech.closures:
+        if c.kind == "point":
+            key = frozenset((c.body1, c.body2))
+            pairs[key] = pairs.get(key, 0) + 1
+        else:
+            n += _C[c.kind]
+    return n + sum({1: 3, 2: 5}.get(k, 6) for k in pairs.values())
 
 
 def mobility(mech: Mechanism, q: object = None, *, platform: str | None = None) -> MobilityReport:
@@ -171,7 +193,7 @@ def mobility(mech: Mechanism, q: object = None, *, platform: str | None = None) 
     # Jout has unit screws times L: rows of order L, so a motion that moves an output has |Jout v| ~ L|v|
     idle = locked.shape[1] - _rank(Jout @ locked, tree.length) if locked.shape[1] else 0
     dof = total - idle
-    n_c = sum(_C[c.kind] for c in mech.closures) + len(mech.couplings)
+    n_c = _cut_constraints(mech)
     gk = nv - n_c
     # locally constant rank: re-assemble a small step along each admissible direction
     nearby = []

@@ -441,13 +441,11 @@ class Builder:
         quat: Sequence[float] = (1, 0, 0, 0),
         joints: Sequence[Joint | tuple[Joint, ...]] = (),
         inertial: Inertial | None = None,
-        mass: float | None = None,
     ) -> str:
+        """Add a body (parents before children); ``inertial=None`` lets MJCF export derive it from geoms."""
         flat: list[Joint] = []
         for j in joints:
             flat.extend(j if isinstance(j, tuple) else (j,))
-        if inertial is None and mass is not None:
-            inertial = Inertial(mass)
         self._bodies.append(Body(name, parent, tuple(pos), tuple(quat), tuple(flat), inertial))
         return name
 
