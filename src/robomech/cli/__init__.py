@@ -64,18 +64,13 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
 
 
 def _cmd_verify(args: argparse.Namespace) -> int:
-    from robomech.verify import available_verifications, run_verifications
+    from robomech.verify import available_verifications
+    from robomech.verify._generic import cli_report
 
-    available = available_verifications()
-    unknown = [n for n in args.mechanisms if n not in available]
-    if unknown:
-        print(
-            f"robomech: unknown mechanism {', '.join(map(repr, unknown))}; "
-            f"valid ones are: {', '.join(available)}",
-            file=sys.stderr,
-        )
+    report, error = cli_report(args.mechanisms, available_verifications())  # names and MJCF paths
+    if error:
+        print(f"robomech: {error}", file=sys.stderr)
         return 2
-    report = run_verifications(args.mechanisms)
     if args.json:
         print(json.dumps({"passed": report.passed, "checks": [c.as_dict() for c in report.checks]}, indent=2))
     else:
@@ -100,7 +95,9 @@ def build_parser() -> argparse.ArgumentParser:
     sp.set_defaults(func=_cmd_reproduce)
 
     sp = sub.add_parser("verify", help="check models against an independent engine; non-zero exit on failure")
-    sp.add_argument("mechanisms", nargs="*", metavar="MECHANISM", help="mechanisms to verify (default: all)")
+    sp.add_argument(
+        "mechanisms", nargs="*", metavar="MECHANISM", help="mechanisms or MJCF files to verify (default: all)"
+    )
     sp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     sp.set_defaults(func=_cmd_verify)
     return p

@@ -130,17 +130,41 @@ def _bodies(mech: Mechanism) -> _Bodies:
 
 def _reference(mech: Mechanism) -> tuple[int, int]:
     """(passive rank of K at the reference configuration, mobility DOF)."""
+    return _reference3(mech)[:2]
 
-    def make() -> tuple[int, int]:
+
+def _rank_K(mech: Mechanism) -> int:
+    """Generic rank of the full constraint Jacobian K (nv minus every instantaneous motion, idle included)."""
+    return _reference3(mech)[2]
+
+
+def _pinv_rank(K: np.ndarray, r: int) -> tuple[np.ndarray, np.ndarray]:
+    """Pseudo-inverse of ``K (N, m, n)`` truncated to the mechanism's generic rank ``r``, and the ratio
+    ``s_1 / s_r`` (N,).  A fixed rank rather than a tolerance: between two projections a simulated state
+    is ~1e-12 off the manifold, which lifts the zero singular values of an over-constrained closure
+    (Bennett, planar loops in 3-D) to ~1e-12 — a tolerance would then invert them."""
+    N, m, n = K.shape
+    if r == 0 or m == 0:
+        return np.zeros((N, n, m)), np.ones(N)
+    U, s, Vt = np.linalg.svd(K, full_matrices=False)
+    sr = s[:, r - 1]
+    ok = sr > 0
+    sinv = np.zeros_like(s)
+    sinv[:, :r] = 1.0 / np.where(ok[:, None], s[:, :r], 1.0)
+    P = np.einsum("nji,nj,nkj->nik", Vt, sinv, U)
+    return P, np.where(ok, s[:, 0] / np.where(ok, sr, 1.0), np.inf)
+
+
+def _reference3(mech: Mechanism) -> tuple[int, int, int]:
+    def make() -> tuple[int, int, int]:
         from ._mobility import mobility
 
         tree = mech.tree
-        q0 = tree.q0[None]
-        st = kinematics(tree, q0)
-        K = jacobian(mech.constraints, tree, st, q0)
         pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
-        _, rank, _, _ = _pinv(K[..., pas])
-        return int(rank[0]), int(mobility(mech).dof)
+        mob = mobility(mech)
+        # the passive block has full column rank but for the idle motions (computed, not taken from q0,
+        # which may itself be singular); K's generic rank leaves the DOF and the idle motions free
+        return len(pas) - int(mob.idle_dof), int(mob.dof), int(tree.nv - mob.dof - mob.idle_dof)
 
     return _cache(mech, "_dyn_reference", make)
 
@@ -582,7 +606,7 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True):
         f = f - _site_terms(mech, state, wr)
     f[:, tree.act_dof] += tau_a
     if K.shape[1]:
-        Kp, _, _, _ = _pinv(K)  # (N, nv, m)
+        Kp, _ = _pinv_rank(K, _rank_K(mech))  # (N, nv, m)
         qdd_p = -np.einsum("nij,nj->ni", Kp, kdq)
         Pn = np.eye(nv) - Kp @ K
     else:
@@ -742,7 +766,7 @@ def _project(mech, q, qd):
     st = kinematics(tree, q)
     K = jacobian(mech.constraints, tree, st, q)
     if K.shape[1]:
-        Kp, _, _, _ = _pinv(K)
+        Kp, _ = _pinv_rank(K, _rank_K(mech))
         qd = qd - np.einsum("nij,njk,nk->ni", Kp, K, qd)
     return q, qd, rc
 
@@ -867,7 +891,7 @@ def simulate(
     rel = np.where(bad, np.nan, rel)
 
     def rs(x, *tail):
-        return x.reshape(*batch, *tail)
+        return np.reshape(x, (*batch, *tail))
 
     return SimulationResult(
         t=t.copy(),
