@@ -589,7 +589,7 @@ def site_wrench(
 
 
 # ----------------------------------------------------------------------------- forward dynamics
-def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True):
+def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
     """Tree accelerations ``qdd (N, nv)`` under actuator forces with the closure enforced, and a
     conditioning measure of the constrained mass matrix (N,)."""
     tree, cs = mech.tree, mech.constraints
@@ -615,9 +615,15 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True):
     M = terms.M
     Mc = Pn @ M @ Pn + (np.eye(nv) - Pn)
     rhs = np.einsum("nij,nj->ni", Pn, f - np.einsum("nij,nj->ni", M, qdd_p))
-    ev = np.linalg.eigvalsh(0.5 * (Mc + Mc.swapaxes(-1, -2)))
-    cond = ev[:, -1] / np.maximum(ev[:, 0], 1e-300)
-    u = np.einsum("nij,nj->ni", np.linalg.pinv(Mc, rcond=RANK_RTOL, hermitian=True), rhs)
+    if want_cond:
+        s = np.linalg.svd(Mc, compute_uv=False)
+        cond = s[:, 0] / np.maximum(s[:, -1], 1e-300)
+    else:
+        cond = np.ones(N)
+    try:
+        u = np.linalg.solve(Mc, rhs[..., None])[..., 0]
+    except np.linalg.LinAlgError:  # a massless motion somewhere in the batch: minimum-norm there
+        u = np.einsum("nij,nj->ni", np.linalg.pinv(Mc, rcond=RANK_RTOL), rhs)
     return qdd_p + u, cond, K, kdq
 
 
@@ -673,7 +679,9 @@ def forward_dynamics(
         qd = np.zeros((qf.shape[0], tree.nv))
         qd[:, tree.act_dof] = qdf
         qd[:, pas] = -np.einsum("nij,njk,nk->ni", P, K[..., tree.act_dof], qdf)
-        qdd, cond, K, kdq = _forward_full(mech, qf, qd, tf, dict(zip(names, ws, strict=True)), gravity)
+        qdd, cond, K, kdq = _forward_full(
+            mech, qf, qd, tf, dict(zip(names, ws, strict=True)), gravity, want_cond=True
+        )
         L = tree.length
         sa = np.max(np.abs(qdd), axis=-1) + np.max(np.abs(qd), axis=-1) ** 2 if tree.nv else 0.0
         adm = (
