@@ -1,4 +1,4 @@
-"""The generic engine verification (verify/_generic.py) on the gallery, its teeth, and ``robomech verify FILE``."""
+"""The generic engine verification (verify/_generic.py): gallery, teeth, ``robomech verify FILE``."""
 
 from __future__ import annotations
 
