@@ -235,6 +235,9 @@ class Coupling:
 class Mechanism:
     """A closed-chain mechanism: bodies (parents before children), closures, couplings, sites, actuators.
 
+    The bodies are kept in MuJoCo's depth-first order (each body followed by its subtree), whatever
+    the order given, so that ``q`` is exactly the qpos of :func:`to_mjcf`'s model.
+
     ``actuated`` names hinge or slide joints in actuator order; ``q_act`` are their ``qpos`` entries.
     The reference configuration ``q0`` is MuJoCo's ``qpos0`` (hinge/slide ``ref``, identity
     quaternions, a free body's own pose).
@@ -261,6 +264,7 @@ class Mechanism:
         object.__setattr__(self, "gravity", _vec(self.gravity, 3, "Mechanism.gravity"))
         if len(self.bodies) == 0:
             raise ValueError("Expected Mechanism.bodies to hold at least one Body, got none.")
+        object.__setattr__(self, "bodies", _depth_first(self.bodies))
         seen = {"world"}
         joints: dict[str, Joint] = {}
         for b in self.bodies:
@@ -368,6 +372,25 @@ class Mechanism:
     def dof_address(self, joint: str) -> int:
         """Index of the first velocity coordinate (``qvel`` entry) of ``joint``."""
         return int(self.tree.jnt_dadr[self.tree.joint_index(joint)])
+
+
+def _depth_first(bodies: tuple[Body, ...]) -> tuple[Body, ...]:
+    """Bodies in MuJoCo's order (depth-first, children in the order given), so that ``q`` is its qpos.
+
+    Parents must come before their children in the input (checked afterwards); any body whose parent
+    is unknown is left at the end for that check to name.
+    """
+    children: dict[str, list[Body]] = {}
+    for b in bodies:
+        children.setdefault(b.parent, []).append(b)
+    out: list[Body] = []
+    stack = list(reversed(children.get("world", [])))
+    while stack:
+        b = stack.pop()
+        out.append(b)
+        stack.extend(reversed(children.get(b.name, [])))
+    placed = {id(b) for b in out}
+    return tuple(out) + tuple(b for b in bodies if id(b) not in placed)
 
 
 class Builder:
