@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_int
 
 from ._constraints import jacobian, residual
 from ._model import Mechanism
@@ -204,8 +204,7 @@ def forward_kinematics(mech: Mechanism, q_act: object, guess: object = None, *, 
     tree = mech.tree
     na = len(mech.actuated)
     qa = as_array(q_act, "q_act", (na,), finite=False)
-    if not (isinstance(steps, int | np.integer) and steps >= 1):
-        raise ValueError(f"Expected steps to be an integer >= 1, got {steps!r}.")
+    steps = check_int(steps, "steps", low=1)
     g0 = _guess(mech, guess, qa.shape[:-1])
     batch = np.broadcast_shapes(qa.shape[:-1], g0.shape[:-1])
     qa_f = np.broadcast_to(qa, (*batch, na)).reshape(-1, na)
@@ -269,8 +268,7 @@ def inverse_kinematics(
     w = np.ones(6) if weights is None else as_array(weights, "weights", (6,))
     if w.ndim != 1 or np.any(w < 0) or not np.any(w > 0):
         raise ValueError(f"Expected weights to be 6 non-negative numbers, not all zero, got {w!r}.")
-    if not (isinstance(steps, int | np.integer) and steps >= 1):
-        raise ValueError(f"Expected steps to be an integer >= 1, got {steps!r}.")
+    steps = check_int(steps, "steps", low=1)
     g0 = _guess(mech, guess, T.shape[:-2])
     batch = np.broadcast_shapes(T.shape[:-2], g0.shape[:-1])
     Tf = np.array(np.broadcast_to(T, (*batch, 4, 4)).reshape(-1, 4, 4))
