@@ -305,3 +305,15 @@ def test_mjcf_semantics_degrees_defaults_and_qpos0():
     fk = mb.forward_kinematics(mech, np.array([[0.05, 0.3], [0.1, 0.1]]))
     assert fk.converged.all()
     assert np.max(mujoco_closure(xml, fk.q)) < ENGINE_TOL
+
+
+def test_bodies_follow_mujoco_order_so_q_is_its_qpos():
+    """A builder that adds a subtree late still gives q in MuJoCo's depth-first qpos order."""
+    b = mb.Builder("order")
+    b.body("a", joints=[b.hinge("ja")])
+    b.body("b", joints=[b.hinge("jb")])
+    b.body("a_child", parent="a", pos=(0.1, 0, 0), joints=[b.slide("jc", axis=(1, 0, 0))])
+    mech = b.build()
+    assert [x.name for x in mech.bodies] == ["a", "a_child", "b"]
+    m = mujoco.MjModel.from_xml_string(mb.to_mjcf(mech))
+    assert [m.joint(i).name for i in range(m.njnt)] == list(mech.tree.jnt_names) == ["ja", "jc", "jb"]

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_int
 
 from ._constraints import jacobian, residual
 from ._model import Mechanism
@@ -46,7 +46,8 @@ MU_MAX = 1e10
 # Largest step per iteration, in radians (translations divided by L): Gauss–Newton far from a
 # solution can take steps of many radians and land on another assembly branch; capping the step keeps
 # the iteration on the branch connected to the guess (0.5 rad: the closure equations are nearly
-# linear over such a step) at the cost of a few more iterations for large moves.
+# linear over such a step) at the cost of a few more iterations for large moves.  Only coordinates
+# that move a closure point or the IK site are capped.
 MAX_STEP = 0.5
 # Iterations per continuation stage: from the reference configuration Newton takes 4-8 iterations on
 # the gallery; 60 leaves room for the damped steps far from a solution before a sample is given up.
@@ -108,6 +109,7 @@ def solve_closure(
     active = finite.copy()
     stop = (STOP_RTOL * tree.length) ** 2
     wstep = np.where(tree.dof_translational, 1.0 / tree.length, 1.0)[free]
+    geom_rows = np.array([k != "coupling" for k in cs.row_kind] + [True] * (r.shape[-1] - cs.m), dtype=bool)
     if nf == 0:
         active[:] = False
     for _ in range(max_iter):
@@ -121,7 +123,13 @@ def solve_closure(
         scale = np.trace(JtJ, axis1=-2, axis2=-1) / nf + 1e-300
         Amat = JtJ + (mu[idx] * scale)[:, None, None] * np.eye(nf)
         dx = -np.linalg.solve(Amat, g[..., None])[..., 0]
-        big = np.max(np.abs(dx) * wstep, axis=-1)
+        # coordinates that move no closure point or site (e.g. a lead screw's coupled spin) are not capped
+        geo = (
+            np.any(Js[:, geom_rows[: Js.shape[1]]] != 0.0, axis=1)
+            if geom_rows.size
+            else np.ones_like(dx, bool)
+        )
+        big = np.max(np.abs(dx) * wstep * geo, axis=-1)
         dx *= np.minimum(1.0, MAX_STEP / np.where(big > 0, big, 1.0))[:, None]
         dv = np.zeros((idx.size, tree.nv))
         dv[:, free] = dx
@@ -196,8 +204,7 @@ def forward_kinematics(mech: Mechanism, q_act: object, guess: object = None, *, 
     tree = mech.tree
     na = len(mech.actuated)
     qa = as_array(q_act, "q_act", (na,), finite=False)
-    if not (isinstance(steps, int | np.integer) and steps >= 1):
-        raise ValueError(f"Expected steps to be an integer >= 1, got {steps!r}.")
+    steps = check_int(steps, "steps", low=1)
     g0 = _guess(mech, guess, qa.shape[:-1])
     batch = np.broadcast_shapes(qa.shape[:-1], g0.shape[:-1])
     qa_f = np.broadcast_to(qa, (*batch, na)).reshape(-1, na)
@@ -261,8 +268,7 @@ def inverse_kinematics(
     w = np.ones(6) if weights is None else as_array(weights, "weights", (6,))
     if w.ndim != 1 or np.any(w < 0) or not np.any(w > 0):
         raise ValueError(f"Expected weights to be 6 non-negative numbers, not all zero, got {w!r}.")
-    if not (isinstance(steps, int | np.integer) and steps >= 1):
-        raise ValueError(f"Expected steps to be an integer >= 1, got {steps!r}.")
+    steps = check_int(steps, "steps", low=1)
     g0 = _guess(mech, guess, T.shape[:-2])
     batch = np.broadcast_shapes(T.shape[:-2], g0.shape[:-1])
     Tf = np.array(np.broadcast_to(T, (*batch, 4, 4)).reshape(-1, 4, 4))

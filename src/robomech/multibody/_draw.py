@@ -57,12 +57,18 @@ def draw(mech: Mechanism, q: object = None, ax=None, *, color: str = "C0", title
     mech = check_mechanism(mech)
     q = mech.q0 if q is None else q
     segs = body_segments(mech, q)
+    if not isinstance(color, str):
+        raise ValueError(f"Expected color to be a matplotlib colour string, got {color!r}.")
+    if title is not None and not isinstance(title, str):
+        raise ValueError(f"Expected title to be None or a string, got {title!r}.")
     qn = check_q(mech, q)
     tree = mech.tree
     T = body_poses(tree, qn[None])[0]
     if ax is None:
         fig = plt.figure(figsize=(5, 5))
         ax = fig.add_subplot(projection="3d")
+    elif getattr(ax, "name", None) != "3d":
+        raise ValueError(f"Expected ax to be None or 3-D matplotlib axes, got {type(ax).__name__}.")
     for s in segs.values():
         for a, b in s:
             ax.plot(*np.stack([a, b]).T, color=color, lw=2)

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_bool
 
 from ._assembly import check_mechanism, check_q
 from ._constraints import jacobian, jacobian_rate
@@ -124,6 +124,7 @@ def influence(mech: Mechanism, q: object, *, second_order: bool = True) -> Influ
     dG, qd_act, qd_act)``.
     """
     mech = check_mechanism(mech)
+    second_order = check_bool(second_order, "second_order")
     qf, batch = _flat(mech, q)
     _, _, G, dG, _, (rank, npas, cons, smin, cond) = _influence_flat(mech, qf, second_order)
     nv, na = G.shape[-2:]

@@ -67,7 +67,7 @@ def _compile(mujoco, source: str | os.PathLike):
     except ValueError as exc:
         if "Expected path_or_xml" in str(exc):
             raise
-        raise ValueError(f"MuJoCo could not read the MJCF: {exc}") from exc
+        raise ValueError(f"Expected path_or_xml to be MJCF that MuJoCo compiles; MuJoCo says: {exc}") from exc
 
 
 def from_mjcf(path_or_xml: str | os.PathLike) -> Mechanism:
@@ -229,6 +229,8 @@ def to_mjcf(mech: Mechanism, *, comment: str | None = None) -> str:
     """
     if not isinstance(mech, Mechanism):
         raise ValueError(f"Expected mech to be a robomech.multibody.Mechanism, got {type(mech).__name__}.")
+    if comment is not None and not isinstance(comment, str):
+        raise ValueError(f"Expected comment to be None or a string, got {comment!r}.")
     tree = mech.tree
     L = tree.length
     radius = 0.02 * L

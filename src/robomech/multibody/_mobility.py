@@ -170,6 +170,11 @@ def mobility(mech: Mechanism, q: object = None, *, platform: str | None = None) 
     """
     mech = check_mechanism(mech)
     tree = mech.tree
+    if platform is not None and (not isinstance(platform, str) or platform not in tree.body_names[1:]):
+        raise ValueError(
+            f"Expected platform to be None or a body name among {list(tree.body_names[1:])}, "
+            f"got {platform!r}."
+        )
     q = tree.q0 if q is None else check_q(mech, q)
     if q.ndim != 1:
         raise ValueError(f"Expected q to have shape ({mech.nq},) (one configuration), got {q.shape}.")

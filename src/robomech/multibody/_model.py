@@ -14,6 +14,8 @@ from functools import cached_property
 
 import numpy as np
 
+from robomech._validation import as_array, check_real
+
 __all__ = [
     "JOINT_TYPES",
     "Body",
@@ -37,10 +39,7 @@ ASSEMBLED_RTOL = 1e-10
 
 
 def _vec(x: object, n: int, name: str) -> tuple[float, ...]:
-    try:
-        a = np.asarray(x, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"Expected {name} to be {n} real numbers, got {x!r}.") from exc
+    a = as_array(x, name)
     if a.shape != (n,) or not np.all(np.isfinite(a)):
         raise ValueError(f"Expected {name} to be {n} finite real numbers, got {x!r}.")
     return tuple(float(v) for v in a)
@@ -79,17 +78,12 @@ class Joint:
     ref: float = 0.0
 
     def __post_init__(self) -> None:
-        _name(self.name, "Joint.name")
-        if self.type not in JOINT_TYPES:
-            raise ValueError(
-                f"Expected Joint.type in {JOINT_TYPES}, got {self.type!r} (joint {self.name!r})."
-            )
+        _name(self.name, "name (of a Joint)")
+        if not isinstance(self.type, str) or self.type not in JOINT_TYPES:
+            raise ValueError(f"Expected type in {JOINT_TYPES}, got {self.type!r} (joint {self.name!r}).")
         object.__setattr__(self, "axis", _unit(self.axis, 3, f"axis of joint {self.name!r}"))
         object.__setattr__(self, "pos", _vec(self.pos, 3, f"pos of joint {self.name!r}"))
-        ref = float(self.ref)
-        if not np.isfinite(ref):
-            raise ValueError(f"Expected ref of joint {self.name!r} to be finite, got {self.ref!r}.")
-        object.__setattr__(self, "ref", ref)
+        object.__setattr__(self, "ref", check_real(self.ref, f"ref of joint {self.name!r}"))
 
     @property
     def nq(self) -> int:
@@ -110,15 +104,12 @@ class Inertial:
     diaginertia: tuple[float, ...] = (0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
-        m = float(self.mass)
-        if not (np.isfinite(m) and m >= 0):
-            raise ValueError(f"Expected Inertial.mass >= 0 and finite, got {self.mass!r}.")
-        object.__setattr__(self, "mass", m)
-        object.__setattr__(self, "pos", _vec(self.pos, 3, "Inertial.pos"))
-        object.__setattr__(self, "quat", _unit(self.quat, 4, "Inertial.quat"))
-        d = _vec(self.diaginertia, 3, "Inertial.diaginertia")
+        object.__setattr__(self, "mass", check_real(self.mass, "mass", low=0.0))
+        object.__setattr__(self, "pos", _vec(self.pos, 3, "pos (of an Inertial)"))
+        object.__setattr__(self, "quat", _unit(self.quat, 4, "quat (of an Inertial)"))
+        d = _vec(self.diaginertia, 3, "diaginertia")
         if min(d) < 0:
-            raise ValueError(f"Expected Inertial.diaginertia >= 0, got {d}.")
+            raise ValueError(f"Expected diaginertia >= 0, got {d}.")
         object.__setattr__(self, "diaginertia", d)
 
 
@@ -134,12 +125,16 @@ class Body:
     inertial: Inertial | None = None
 
     def __post_init__(self) -> None:
-        _name(self.name, "Body.name")
+        _name(self.name, "name (of a Body)")
         if self.name == "world":
-            raise ValueError("Expected Body.name other than 'world' (the fixed base is implicit).")
+            raise ValueError("Expected name other than 'world' for a Body (the fixed base is implicit).")
         _name(self.parent, f"parent of body {self.name!r}")
         object.__setattr__(self, "pos", _vec(self.pos, 3, f"pos of body {self.name!r}"))
         object.__setattr__(self, "quat", _unit(self.quat, 4, f"quat of body {self.name!r}"))
+        if not isinstance(self.joints, tuple | list):
+            raise ValueError(
+                f"Expected joints of body {self.name!r} to be a tuple of Joint, got {self.joints!r}."
+            )
         joints = tuple(self.joints)
         if not all(isinstance(j, Joint) for j in joints):
             raise ValueError(f"Expected joints of body {self.name!r} to be Joint objects, got {joints!r}.")
@@ -164,7 +159,7 @@ class Site:
     quat: tuple[float, ...] = (1.0, 0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
-        _name(self.name, "Site.name")
+        _name(self.name, "name (of a Site)")
         _name(self.body, f"body of site {self.name!r}")
         object.__setattr__(self, "pos", _vec(self.pos, 3, f"pos of site {self.name!r}"))
         object.__setattr__(self, "quat", _unit(self.quat, 4, f"quat of site {self.name!r}"))
@@ -195,14 +190,14 @@ class Closure:
     axis2: tuple[float, ...] = (0.0, 0.0, 1.0)
 
     def __post_init__(self) -> None:
-        _name(self.name, "Closure.name")
-        if self.kind not in CLOSURE_KINDS:
-            raise ValueError(f"Expected Closure.kind in {CLOSURE_KINDS}, got {self.kind!r} ({self.name!r}).")
+        _name(self.name, "name (of a Closure)")
+        if not isinstance(self.kind, str) or self.kind not in CLOSURE_KINDS:
+            raise ValueError(f"Expected kind in {CLOSURE_KINDS}, got {self.kind!r} ({self.name!r}).")
         _name(self.body1, f"body1 of closure {self.name!r}")
         _name(self.body2, f"body2 of closure {self.name!r}")
         if self.body1 == self.body2:
             raise ValueError(
-                f"Expected closure {self.name!r} to join two different bodies, got {self.body1!r} twice."
+                f"Expected body2 of closure {self.name!r} to differ from body1, got {self.body1!r} twice."
             )
         for f in ("anchor1", "anchor2", "relpos"):
             object.__setattr__(self, f, _vec(getattr(self, f), 3, f"{f} of closure {self.name!r}"))
@@ -224,7 +219,7 @@ class Coupling:
     polycoef: tuple[float, ...] = (0.0, 1.0, 0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
-        _name(self.name, "Coupling.name")
+        _name(self.name, "name (of a Coupling)")
         _name(self.joint1, f"joint1 of coupling {self.name!r}")
         if self.joint2 is not None:
             _name(self.joint2, f"joint2 of coupling {self.name!r}")
@@ -234,6 +229,9 @@ class Coupling:
 @dataclass(frozen=True)
 class Mechanism:
     """A closed-chain mechanism: bodies (parents before children), closures, couplings, sites, actuators.
+
+    The bodies are kept in MuJoCo's depth-first order (each body followed by its subtree), whatever
+    the order given, so that ``q`` is exactly the qpos of :func:`to_mjcf`'s model.
 
     ``actuated`` names hinge or slide joints in actuator order; ``q_act`` are their ``qpos`` entries.
     The reference configuration ``q0`` is MuJoCo's ``qpos0`` (hinge/slide ``ref``, identity
@@ -253,14 +251,18 @@ class Mechanism:
 
     def __post_init__(self) -> None:
         for f, typ in (("bodies", Body), ("closures", Closure), ("couplings", Coupling), ("sites", Site)):
-            vals = tuple(getattr(self, f))
-            if not all(isinstance(v, typ) for v in vals):
-                raise ValueError(f"Expected Mechanism.{f} to hold {typ.__name__} objects, got {vals!r}.")
-            object.__setattr__(self, f, vals)
+            raw = getattr(self, f)
+            if not isinstance(raw, tuple | list) or not all(isinstance(v, typ) for v in raw):
+                raise ValueError(f"Expected {f} to be a tuple of {typ.__name__} objects, got {raw!r}.")
+            object.__setattr__(self, f, tuple(raw))
+        if not isinstance(self.actuated, tuple | list) or not all(isinstance(a, str) for a in self.actuated):
+            raise ValueError(f"Expected actuated to be a tuple of joint names, got {self.actuated!r}.")
         object.__setattr__(self, "actuated", tuple(self.actuated))
-        object.__setattr__(self, "gravity", _vec(self.gravity, 3, "Mechanism.gravity"))
+        object.__setattr__(self, "gravity", _vec(self.gravity, 3, "gravity"))
+        _name(self.name, "name (of a Mechanism)")
         if len(self.bodies) == 0:
-            raise ValueError("Expected Mechanism.bodies to hold at least one Body, got none.")
+            raise ValueError("Expected bodies to hold at least one Body, got none.")
+        object.__setattr__(self, "bodies", _depth_first(self.bodies))
         seen = {"world"}
         joints: dict[str, Joint] = {}
         for b in self.bodies:
@@ -309,9 +311,9 @@ class Mechanism:
                     f"Expected actuated joint {a!r} to be a hinge or slide, got {joints[a].type!r}."
                 )
         if self.characteristic_length is not None:
-            L = float(self.characteristic_length)
-            if not (np.isfinite(L) and L > 0):
-                raise ValueError(f"Expected characteristic_length > 0, got {self.characteristic_length!r}.")
+            from robomech._validation import check_positive
+
+            L = check_positive(self.characteristic_length, "characteristic_length")
             object.__setattr__(self, "characteristic_length", L)
 
     # -- derived, cached (the dataclass stays frozen: cached_property writes the instance dict) --
@@ -370,6 +372,25 @@ class Mechanism:
         return int(self.tree.jnt_dadr[self.tree.joint_index(joint)])
 
 
+def _depth_first(bodies: tuple[Body, ...]) -> tuple[Body, ...]:
+    """Bodies in MuJoCo's order (depth-first, children in the order given), so that ``q`` is its qpos.
+
+    Parents must come before their children in the input (checked afterwards); any body whose parent
+    is unknown is left at the end for that check to name.
+    """
+    children: dict[str, list[Body]] = {}
+    for b in bodies:
+        children.setdefault(b.parent, []).append(b)
+    out: list[Body] = []
+    stack = list(reversed(children.get("world", [])))
+    while stack:
+        b = stack.pop()
+        out.append(b)
+        stack.extend(reversed(children.get(b.name, [])))
+    placed = {id(b) for b in out}
+    return tuple(out) + tuple(b for b in bodies if id(b) not in placed)
+
+
 class Builder:
     """Assemble a :class:`Mechanism` in Python (no XML), MuJoCo semantics throughout.
 
@@ -384,8 +405,8 @@ class Builder:
     """
 
     def __init__(self, name: str = "mechanism", gravity: Sequence[float] = (0.0, 0.0, -9.81)) -> None:
-        self.name = name
-        self.gravity = tuple(gravity)
+        self.name = _name(name, "name (of the mechanism)")
+        self.gravity = _vec(gravity, 3, "gravity")
         self._bodies: list[Body] = []
         self._sites: list[Site] = []
         self._closures: list[tuple] = []

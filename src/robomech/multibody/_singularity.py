@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_int, check_positive, check_real
 from robomech.analysis import workspace
 
 from ._assembly import check_mechanism, check_q, forward_kinematics, inverse_kinematics
@@ -80,11 +80,12 @@ def singularities(
         raise ValueError(f"Expected site to be a site name (str), got {type(site).__name__}.")
     si = tree.site_index(site)
     q = check_q(mech, q)
-    L = tree.length if length is None else float(length)
-    if not (np.isfinite(L) and L > 0):
-        raise ValueError(f"Expected length > 0 (m), got {length!r}.")
-    if not (np.isfinite(rtol) and 0 < rtol < 1):
-        raise ValueError(f"Expected 0 < rtol < 1, got {rtol!r}.")
+    L = tree.length if length is None else check_positive(length, "length")
+    rtol = check_real(rtol, "rtol", low=0.0, high=1.0, low_open=True, high_open=True)
+    if reference is not None:
+        reference = check_q(mech, reference, "reference")
+        if reference.ndim != 1:
+            raise ValueError(f"Expected reference to have shape ({mech.nq},), got {reference.shape}.")
     ref = mobility(mech, reference)
     batch = q.shape[:-1]
     qf = q.reshape(-1, mech.nq)
@@ -167,6 +168,12 @@ def singularity_map(
     of site targets ``T (..., 4, 4)`` (IK), e.g. from :func:`robomech.analysis.workspace.grid`.
     """
     mech = check_mechanism(mech)
+    if not isinstance(site, str):
+        raise ValueError(f"Expected site to be a site name (str), got {type(site).__name__}.")
+    mech.tree.site_index(site)
+    steps = check_int(steps, "steps", low=1)
+    if length is not None:
+        check_positive(length, "length")
     if (q_act is None) == (T is None):
         raise ValueError("Expected exactly one of q_act (input grid) or T (output grid).")
     if q_act is not None:

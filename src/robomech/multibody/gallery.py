@@ -309,8 +309,8 @@ NAMES = ("four_bar", *BUILDERS)
 
 def path(name: str) -> Path:
     """Path of the gallery MJCF file ``name`` (one of :data:`NAMES`)."""
-    if name not in NAMES:
-        raise ValueError(f"Expected a gallery name among {list(NAMES)}, got {name!r}.")
+    if not isinstance(name, str) or name not in NAMES:
+        raise ValueError(f"Expected name to be a gallery name among {list(NAMES)}, got {name!r}.")
     return _DIR / f"{name}.xml"
 
 
@@ -325,13 +325,17 @@ def mjcf(name: str) -> str:
     """The MJCF text the builder of ``name`` gives (what ``write`` stores in the package)."""
     from ._mjcf import to_mjcf
 
-    if name not in BUILDERS:
-        raise ValueError(f"Expected a generated gallery name among {list(BUILDERS)}, got {name!r}.")
+    if not isinstance(name, str) or name not in BUILDERS:
+        raise ValueError(
+            f"Expected name to be a generated gallery name among {list(BUILDERS)}, got {name!r}."
+        )
     return to_mjcf(BUILDERS[name](), comment=_COMMENTS[name]) + "\n"
 
 
 def write(directory: Path = _DIR) -> list[Path]:
     """Write the generated gallery files into ``directory`` (the package's gallery by default)."""
+    if not isinstance(directory, str | Path) or not Path(directory).is_dir():
+        raise ValueError(f"Expected directory to be an existing directory, got {directory!r}.")
     out = []
     for name in BUILDERS:
         f = Path(directory) / f"{name}.xml"

@@ -79,3 +79,4 @@ __all__ = [
     "thigh_direction",
     "within_limits",
 ]
+from ._multibody import to_multibody as to_multibody

@@ -59,3 +59,4 @@ __all__ = [
     "sway",
     "workspace_map",
 ]
+from ._multibody import to_multibody as to_multibody

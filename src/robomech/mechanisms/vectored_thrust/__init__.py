@@ -68,3 +68,4 @@ __all__ = [
     "singular_points",
     "workspace_map",
 ]
+from ._multibody import to_multibody as to_multibody
