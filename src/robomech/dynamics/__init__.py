@@ -182,12 +182,13 @@ def com_inverse_dynamics(
     """
     m = as_array(mass, "mass", (None,))
     B = m.shape[-1]
-    I = as_array(inertia, "inertia", (B, 3, 3))
-    J = as_array(J, "J", (B, 6, None))
-    n = J.shape[-1]
-    a0 = as_array(Jdot_qd, "Jdot_qd", (B, 6))
-    qd = as_array(qd, "qd", (n,))
-    qdd = as_array(qdd, "qdd", (n,))
+    qd = as_array(qd, "qd", (None,))
+    n = qd.shape[-1]
+    # shapes are checked against mass (B bodies) and qd (n coordinates): a mismatch names both
+    I = as_array(inertia, "inertia (B from mass)", (B, 3, 3))
+    J = as_array(J, "J (B from mass, n from qd)", (B, 6, n))
+    a0 = as_array(Jdot_qd, "Jdot_qd (B from mass)", (B, 6))
+    qdd = as_array(qdd, "qdd (n from qd)", (n,))
     g = as_array(gravity, "gravity", (3,))
     if np.any(m < 0):
         raise ValueError(f"Expected mass >= 0, got min {float(np.min(m))}.")
@@ -214,9 +215,11 @@ def com_kinetic_energy(mass: object, inertia: object, J: object, qd: object) -> 
     """``0.5 sum_b (w_b . I_b w_b + m_b |c'_b|^2)`` with ``[w_b; c'_b] = J_b qd`` (...)."""
     m = as_array(mass, "mass", (None,))
     B = m.shape[-1]
-    I = as_array(inertia, "inertia", (B, 3, 3))
-    J = as_array(J, "J", (B, 6, None))
-    qd = as_array(qd, "qd", (J.shape[-1],))
+    qd = as_array(qd, "qd", (None,))
+    I = as_array(inertia, "inertia (B from mass)", (B, 3, 3))
+    J = as_array(J, "J (B from mass, n from qd)", (B, 6, qd.shape[-1]))
+    if np.any(m < 0):
+        raise ValueError(f"Expected mass >= 0, got min {float(np.min(m))}.")
     V = np.einsum("...bin,...n->...bi", J, qd)
     w, v = V[..., :3], V[..., 3:]
     return 0.5 * (np.einsum("...bi,...bij,...bj->...", w, I, w) + np.einsum("...b,...bi,...bi->...", m, v, v))

@@ -404,13 +404,13 @@ def _finite_rows(*xs: np.ndarray) -> np.ndarray:
     return ok
 
 
-def _broadcast(mech, q, others: list[tuple[object, str, int]]):
+def _broadcast(mech, q, others: list[tuple[object, str, int]], qname: str = "q"):
     """Validate ``q`` (non-finite allowed: masked) and the others (..., n); broadcast, flatten."""
-    qv = as_array(q, "q", (mech.nq,), finite=False)
+    qv = as_array(q, qname, (mech.nq,), finite=False)
     for a in mech.tree.quat_adr:
         n = np.linalg.norm(qv[..., a : a + 4], axis=-1)
         if np.any(np.isfinite(n) & (n < 1e-9)):
-            raise ValueError(f"Expected the quaternion q[..., {a}:{a + 4}] to be non-zero.")
+            raise ValueError(f"Expected the quaternion {qname}[..., {a}:{a + 4}] to be non-zero.")
     arrs = [as_array(x, name, (n,), finite=False) for x, name, n in others]
     batch = np.broadcast_shapes(qv.shape[:-1], *(a.shape[:-1] for a in arrs))
     flat = [np.broadcast_to(qv, (*batch, mech.nq)).reshape(-1, mech.nq)]
@@ -854,11 +854,15 @@ def simulate(
     if tau is not None and not callable(tau):
         tau_arr = as_array(tau, "tau", (na,))
     batch, flat = _broadcast(
-        mech, q0, [(qd_act0, "qd_act0", na)] + ([(tau_arr, "tau", na)] if tau_arr is not None else [])
+        mech,
+        q0,
+        [(qd_act0, "qd_act0", na)] + ([(tau_arr, "tau", na)] if tau_arr is not None else []),
+        qname="q0",
     )
     q0f, qa0 = flat[0], flat[1]
-    if not (np.all(np.isfinite(q0f)) and np.all(np.isfinite(qa0))):
-        raise ValueError("Expected q0 and qd_act0 to be finite.")
+    for x, nm in ((q0f, "q0"), (qa0, "qd_act0")):
+        if not np.all(np.isfinite(x)):
+            raise ValueError(f"Expected {nm} to be finite, got NaN or inf.")
     q0f = normalize_quaternions(tree, q0f)
     N = q0f.shape[0]
     # the initial rates of every coordinate: qd = G qd_act0 (idle motions at rest)
