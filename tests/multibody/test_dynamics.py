@@ -26,10 +26,10 @@ FOUR_BAR = dataclasses.replace(mb.gallery.load("four_bar"), gravity=(0.0, -9.81,
 RRR = dataclasses.replace(mb.gallery.load("planar_3rrr"), gravity=(0.0, -9.81, 0.0))
 
 
-def _motion(mech, n=4, seed=0):
+def _motion(mech, n=4, seed=0, amp=0.2):
     rng = np.random.default_rng(seed)
     na = len(mech.actuated)
-    qa = mech.q0[mech.tree.act_qadr] + 0.2 * rng.uniform(-1, 1, (n, na))
+    qa = mech.q0[mech.tree.act_qadr] + amp * rng.uniform(-1, 1, (n, na))
     fk = mb.forward_kinematics(mech, qa, steps=3)
     assert fk.converged.all()
     return fk.q, rng.normal(size=(n, na)), rng.normal(size=(n, na))
@@ -181,3 +181,18 @@ def test_com_inverse_dynamics_matches_spatial_form():
     T = dynamics.com_kinetic_energy(bd.mass, dynamics.world_inertia(R, bd.inertia), J, r.qd)
     assert np.max(np.abs(T - 0.5 * np.einsum("ni,nij,nj->n", qd, r.M_a, qd))) < IDENTITY_TOL
     del rng
+
+
+@pytest.mark.parametrize("name", ["bennett", "delta", "stewart"])
+def test_kdot_qd_equals_constraint_jacobian_rate(name):
+    """The direct velocity-product closure accelerations against the multibody layer's dK/dt."""
+    from robomech.multibody import _dynamics as D
+    from robomech.multibody._tree import kinematics, screw_rates
+
+    mech = mb.gallery.load(name)
+    q, qd_a, _ = _motion(mech, n=3, seed=6, amp=0.02)
+    qd = np.einsum("nij,nj->ni", mb.influence(mech, q, second_order=False).G, qd_a)
+    st = kinematics(mech.tree, q)
+    got = D._kdot_qd(mech, st, q, qd, screw_rates(mech.tree, st, qd))
+    ref = np.einsum("nij,nj->ni", mb.constraint_jacobian_rate(mech, q, qd), qd)
+    assert np.max(np.abs(got - ref)) < IDENTITY_TOL * max(1.0, np.max(np.abs(ref)))

@@ -198,16 +198,16 @@ def com_inverse_dynamics(
 def _com_terms(m, I, J, a0, qd, qdd, g) -> DynamicsTerms:
     """Kernel of :func:`com_inverse_dynamics` (inputs trusted, broadcast as documented)."""
     Jw, Jv = J[..., :3, :], J[..., 3:, :]
-    w = np.einsum("...bin,...n->...bi", Jw, qd)
-    Iw = np.einsum("...bij,...bj->...bi", I, w)
-    mom = np.einsum("...bij,...bj->...bi", I, a0[..., :3]) + np.cross(w, Iw)
+    w = (Jw @ qd[..., None, :, None])[..., 0]
+    Iw = (I @ w[..., None])[..., 0]
+    mom = (I @ a0[..., :3, None])[..., 0] + np.cross(w, Iw)
     frc = m[..., None] * a0[..., 3:]
-    vel = np.einsum("...bin,...bi->...n", Jw, mom) + np.einsum("...bin,...bi->...n", Jv, frc)
-    M = np.einsum("...bin,...bij,...bjk->...nk", Jw, I, Jw) + np.einsum(
-        "...b,...bin,...bik->...nk", m, Jv, Jv
-    )
-    grav = -np.einsum("...bin,...b,...i->...n", Jv, m, g)
-    tau = np.einsum("...ij,...j->...i", M, qdd) + vel + grav
+    JwT, JvT = np.swapaxes(Jw, -1, -2), np.swapaxes(Jv, -1, -2)
+    vel = np.sum((JwT @ mom[..., None])[..., 0] + (JvT @ frc[..., None])[..., 0], axis=-2)
+    # matmul, not a three-operand einsum: the latter runs as a naive loop (10x slower at 27 coordinates)
+    M = np.sum(JwT @ (I @ Jw) + m[..., None, None] * (JvT @ Jv), axis=-3)
+    grav = -np.sum((JvT @ (m[..., None] * g[..., None, :])[..., None])[..., 0], axis=-2)
+    tau = (M @ qdd[..., None])[..., 0] + vel + grav
     return DynamicsTerms(tau=tau, M=M, velocity_terms=vel, gravity_terms=grav)
 
 

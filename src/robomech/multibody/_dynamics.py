@@ -43,7 +43,7 @@ from robomech._validation import as_array, check_bool
 from robomech.dynamics import _com_terms
 
 from ._assembly import check_mechanism, check_q, solve_closure
-from ._constraints import jacobian, jacobian_rate
+from ._constraints import jacobian
 from ._influence import PASSIVE_RANK_RTOL, _pinv
 from ._model import Mechanism
 from ._tree import (
@@ -155,6 +155,50 @@ def _pinv_rank(K: np.ndarray, r: int) -> tuple[np.ndarray, np.ndarray]:
     return P, np.where(ok, s[:, 0] / np.where(ok, sr, 1.0), np.inf)
 
 
+# Below this 1-norm condition estimate of K_p the Gram-matrix inverse (with one refinement step) is used;
+# above it the sample is recomputed with the SVD pseudo-inverse (exact rank decision).  The Gram matrix
+# squares the condition number: at 1e4, 1e8 * eps ~ 1e-8 before refinement, ~1e-12 after it.
+GRAM_COND_MAX = 1e4
+
+
+def _passive_inverse(Kp: np.ndarray, rank0: int):
+    """Pseudo-inverse of the passive block ``Kp (N, m, n)`` with (rank, sigma_min, cond) per sample.
+
+    Fast path where the generic rank is ``min(m, n)`` (no idle motion *and* redundant rows at once):
+    ``Kp^T (Kp Kp^T)^-1`` (wide) or ``(Kp^T Kp)^-1 Kp^T`` (tall) from a batched inverse, refined once
+    (``P += P (I - Kp P)`` / ``P += (I - P Kp) P``); ``cond`` is then the 1-norm estimate
+    ``sqrt(||Gram||_1 ||Gram^-1||_1)`` (within a factor sqrt(rank) of the 2-norm one) and ``sigma_min``
+    ``1 / sqrt(||Gram^-1||_1)`` (a lower bound within rank^(1/4)).  Samples above GRAM_COND_MAX, and
+    mechanisms without the fast path, get the SVD pseudo-inverse of the multibody layer.
+    """
+    N, m, n = Kp.shape
+    if m == 0 or n == 0 or rank0 != min(m, n):
+        return _pinv(Kp)
+    wide = m <= n
+    KT = Kp.swapaxes(-1, -2)
+    Gm = Kp @ KT if wide else KT @ Kp
+    with np.errstate(all="ignore"):
+        try:
+            Gi = np.linalg.inv(Gm)
+        except np.linalg.LinAlgError:
+            return _pinv(Kp)
+        if wide:
+            P = KT @ Gi
+            P = P + P @ (np.eye(m) - Kp @ P)
+        else:
+            P = Gi @ KT
+            P = P + (np.eye(n) - P @ Kp) @ P
+        ni = np.linalg.norm(Gi, 1, axis=(-2, -1))
+        cond = np.sqrt(np.linalg.norm(Gm, 1, axis=(-2, -1)) * ni)
+        smin = 1.0 / np.sqrt(ni)
+    rank = np.full(N, rank0)
+    bad = ~(np.isfinite(cond) & (cond <= GRAM_COND_MAX) & np.all(np.isfinite(P), axis=(-1, -2)))
+    if np.any(bad):
+        Pb, rb, sb, cb = _pinv(Kp[bad])
+        P[bad], rank[bad], smin[bad], cond[bad] = Pb, rb, sb, cb
+    return P, rank, smin, cond
+
+
 def _reference3(mech: Mechanism) -> tuple[int, int, int]:
     def make() -> tuple[int, int, int]:
         from ._mobility import mobility
@@ -188,6 +232,65 @@ def _com_jacobians(tree, state, bd: _Bodies, qd: np.ndarray | None, Sd: np.ndarr
         pd = V[..., 3:] + np.cross(w, p)
         a0 = np.concatenate([Vd[..., :3], Vd[..., 3:] + np.cross(Vd[..., :3], p) + np.cross(w, pd)], axis=-1)
     return p, J, a0
+
+
+def _cross_rows(a: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``a_col x p`` for every column of ``a (..., 3, k)`` with ``p (..., 3)`` (component arithmetic:
+    np.cross on broadcast blocks moves axes and is several times slower here)."""
+    x, y, z = p[..., 0, None], p[..., 1, None], p[..., 2, None]
+    a0, a1, a2 = a[..., 0, :], a[..., 1, :], a[..., 2, :]
+    return np.stack([a1 * z - a2 * y, a2 * x - a0 * z, a0 * y - a1 * x], axis=-2)
+
+
+def _com_projected(tree, state, bd: _Bodies, qd, Sd, G, extra_qdd):
+    """Centre-of-mass Jacobians through G, ``J_b G (N, B, 6, na)``, and the accelerations
+    ``Jdot_b qd + J_b extra_qdd (N, B, 6)`` — without the (N, B, 6, nv) Jacobians' cross products."""
+    T = state.T[:, bd.idx]
+    p = np.einsum("nbij,bj->nbi", T[..., :3, :3], bd.com) + T[..., :3, 3]
+    S = state.S
+    A = tree.A[bd.idx]  # (B, nv)
+    SG = (S.swapaxes(-1, -2)[:, None] * A[None, :, None, :]) @ G[:, None]  # (N, B, 6, na) at the origin
+    JG = np.concatenate([SG[..., :3, :], SG[..., 3:, :] + _cross_rows(SG[..., :3, :], p)], axis=-2)
+    V = np.einsum("bk,nkx,nk->nbx", A, S, qd)
+    Vd = np.einsum("bk,nkx,nk->nbx", A, Sd, qd) + np.einsum("bk,nkx,nk->nbx", A, S, extra_qdd)
+    w = V[..., :3]
+    pd = V[..., 3:] + np.cross(w, p)
+    a0 = np.concatenate([Vd[..., :3], Vd[..., 3:] + np.cross(Vd[..., :3], p) + np.cross(w, pd)], axis=-1)
+    return JG, a0
+
+
+def _kdot_qd(mech: Mechanism, state, q: np.ndarray, qd: np.ndarray, Sd: np.ndarray) -> np.ndarray:
+    """``Kdot qd (N, m)`` directly (the closure rows' velocity-product accelerations), block by block as
+    ``_constraints.jacobian_rate`` builds ``Kdot``, without forming the (N, m, nv) matrix: a point row is
+    the difference of the two anchors' ``dVd_v + dVd_w x p + w x pdot`` (``Vd = sum_k A Sd_k qd_k``), a
+    rotation row ``L (Vd_w2 - Vd_w1)``, a coupling row ``-s poly''(x) qd2^2``."""
+    from ._constraints import _poly
+
+    tree, cs = mech.tree, mech.constraints
+    V = np.einsum("bk,nkx,nk->nbx", tree.A, state.S, qd)
+    Vd = np.einsum("bk,nkx,nk->nbx", tree.A, Sd, qd)
+    L = tree.length
+    out = []
+    for kind, d in cs.blocks:
+        if kind == "point":
+            b1, x1, b2, x2 = d
+            acc = []
+            for b, x in ((b1, x1), (b2, x2)):
+                pt = (state.T[:, b] @ x)[:, :3]
+                w = V[:, b, :3]
+                pd = V[:, b, 3:] + np.cross(w, pt)
+                acc.append(Vd[:, b, 3:] + np.cross(Vd[:, b, :3], pt) + np.cross(w, pd))
+            out.append(acc[0] - acc[1])
+        elif kind == "rot":
+            b1, _, b2 = d
+            out.append(L * (Vd[:, b2, :3] - Vd[:, b1, :3]))
+        else:
+            _d1, _, _, d2, q2, ref2, c, sc = d
+            row = np.zeros((q.shape[0], 1))
+            if d2 >= 0:
+                row[:, 0] = -sc * _poly(c, q[:, q2] - ref2)[2] * qd[:, d2] ** 2
+            out.append(row)
+    return np.concatenate(out, axis=-1) if out else np.zeros((q.shape[0], 0))
 
 
 def _tree_terms(mech: Mechanism, state, qd, Sd, qdd, gravity: bool = True):
@@ -334,27 +437,29 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
     N = q.shape[0]
     state = kinematics(tree, q)
     K = jacobian(cs, tree, state, q)
-    P, rank, smin, cond = _pinv(K[..., pas])
+    P, rank, smin, cond = _passive_inverse(K[..., pas], rank0)
     G = np.zeros((N, tree.nv, na))
     G[:, act, np.arange(na)] = 1.0
     G[:, pas] = -P @ K[..., act]
     qd = np.einsum("nij,nj->ni", G, qd_a)
     Sd = screw_rates(tree, state, qd)
-    Kd = jacobian_rate(cs, tree, state, Sd, q, qd)
-    kdq = np.einsum("nij,nj->ni", Kd, qd)
+    kdq = _kdot_qd(mech, state, q, qd, Sd)
     qdd = np.einsum("nij,nj->ni", G, qdd_a)
     qdd[:, pas] -= np.einsum("nij,nj->ni", P, kdq)
-    terms = _tree_terms(mech, state, qd, Sd, qdd, gravity)
+    # Project each body's Jacobian through G first (6 x n_act instead of 6 x nv): the tree mass matrix is
+    # never formed.  The convective acceleration J (qdd - G qdd_act) joins the velocity-product terms.
+    bd = _bodies(mech)
+    R = state.T[:, bd.idx, :3, :3]
+    Iw = R @ bd.inertia @ R.swapaxes(-1, -2)
+    conv = qdd - np.einsum("nij,nj->ni", G, qdd_a)
+    JG, a0 = _com_projected(tree, state, bd, qd, Sd, G, conv)
+    gv = np.asarray(mech.gravity) if gravity else np.zeros(3)
+    terms = _com_terms(np.broadcast_to(bd.mass, (N, len(bd.mass))), Iw, JG, a0, qd_a, qdd_a, gv[None])
     ext = _site_terms(mech, state, wr)
     GT = G.swapaxes(-1, -2)
-    M_a = GT @ terms.M @ G
-    # velocity terms: the tree's c plus the convective part of the acceleration, M (qdd - G qdd_a)
-    vel = np.einsum(
-        "nij,nj->ni",
-        GT,
-        terms.velocity_terms + np.einsum("nij,nj->ni", terms.M, qdd - (G @ qdd_a[..., None])[..., 0]),
-    )
-    grav = np.einsum("nij,nj->ni", GT, terms.gravity_terms)
+    M_a = terms.M
+    vel = terms.velocity_terms
+    grav = terms.gravity_terms
     ex = np.einsum("nij,nj->ni", GT, ext)
     ok = np.ones(N, dtype=bool)
     if na > dof or weights is not None:
@@ -598,8 +703,7 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
     state = kinematics(tree, q)
     K = jacobian(cs, tree, state, q)
     Sd = screw_rates(tree, state, qd)
-    Kd = jacobian_rate(cs, tree, state, Sd, q, qd)
-    kdq = np.einsum("nij,nj->ni", Kd, qd)
+    kdq = _kdot_qd(mech, state, q, qd, Sd)
     terms = _tree_terms(mech, state, qd, Sd, np.zeros_like(qd), gravity)
     f = -terms.velocity_terms - terms.gravity_terms
     if wr:
