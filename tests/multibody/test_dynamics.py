@@ -196,3 +196,25 @@ def test_kdot_qd_equals_constraint_jacobian_rate(name):
     got = D._kdot_qd(mech, st, q, qd, screw_rates(mech.tree, st, qd))
     ref = np.einsum("nij,nj->ni", mb.constraint_jacobian_rate(mech, q, qd), qd)
     assert np.max(np.abs(got - ref)) < IDENTITY_TOL * max(1.0, np.max(np.abs(ref)))
+
+
+@pytest.mark.parametrize("name", ["four_bar", "bennett", "delta", "stewart"])
+def test_constraint_matrix_equals_multibody_layer(name):
+    from robomech.multibody import _dynamics as D
+    from robomech.multibody._tree import kinematics
+
+    mech = mb.gallery.load(name)
+    q, _, _ = _motion(mech, n=3, seed=7, amp=0.02)
+    got = D._constraint_matrix(mech, kinematics(mech.tree, q), q)
+    assert np.max(np.abs(got - mb.constraint_jacobian(mech, q))) < IDENTITY_TOL
+
+
+def test_screw_rates_equal_multibody_layer():
+    from robomech.multibody import _dynamics as D
+    from robomech.multibody._tree import kinematics, screw_rates
+
+    mech = mb.gallery.load("stewart")
+    q, _, _ = _motion(mech, n=3, seed=8, amp=0.02)
+    qd = np.random.default_rng(0).normal(size=(3, mech.nv))
+    st = kinematics(mech.tree, q)
+    assert np.max(np.abs(D._screw_rates(mech.tree, st, qd) - screw_rates(mech.tree, st, qd))) < IDENTITY_TOL

@@ -52,7 +52,6 @@ from ._tree import (
     normalize_quaternions,
     quat_mul,
     quat_to_matrix,
-    screw_rates,
 )
 
 __all__ = [
@@ -89,6 +88,11 @@ CHUNK = 2048
 
 
 # ----------------------------------------------------------------------------- cached mechanism data
+def _mv(A: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Batched matrix-vector product ``A (N, i, j) x (N, j) -> (N, i)`` (matmul, BLAS)."""
+    return (A @ x[..., None])[..., 0]
+
+
 def _cache(mech: Mechanism, key: str, make: Callable[[], object]) -> object:
     d = mech.__dict__  # frozen dataclass: cached_property writes here too
     if key not in d:
@@ -217,7 +221,7 @@ def _reference3(mech: Mechanism) -> tuple[int, int, int]:
 def _com_jacobians(tree, state, bd: _Bodies, qd: np.ndarray | None, Sd: np.ndarray | None):
     """Centre-of-mass points (N, B, 3), Jacobians (N, B, 6, nv) and ``Jdot qd`` (N, B, 6)."""
     T = state.T[:, bd.idx]
-    p = np.einsum("nbij,bj->nbi", T[..., :3, :3], bd.com) + T[..., :3, 3]
+    p = (T[..., :3, :3] @ bd.com[:, :, None])[..., 0] + T[..., :3, 3]
     S = state.S
     A = tree.A[bd.idx]  # (B, nv)
     Sw, Sv = S[..., :3], S[..., 3:]
@@ -226,8 +230,8 @@ def _com_jacobians(tree, state, bd: _Bodies, qd: np.ndarray | None, Sd: np.ndarr
     J = np.concatenate([Jw, Jv], axis=-1).swapaxes(-1, -2)
     a0 = None
     if qd is not None:
-        V = np.einsum("bk,nkx,nk->nbx", A, S, qd)
-        Vd = np.einsum("bk,nkx,nk->nbx", A, Sd, qd)
+        V = A @ (S * qd[..., None])
+        Vd = A @ (Sd * qd[..., None])
         w = V[..., :3]
         pd = V[..., 3:] + np.cross(w, p)
         a0 = np.concatenate([Vd[..., :3], Vd[..., 3:] + np.cross(Vd[..., :3], p) + np.cross(w, pd)], axis=-1)
@@ -246,17 +250,80 @@ def _com_projected(tree, state, bd: _Bodies, qd, Sd, G, extra_qdd):
     """Centre-of-mass Jacobians through G, ``J_b G (N, B, 6, na)``, and the accelerations
     ``Jdot_b qd + J_b extra_qdd (N, B, 6)`` — without the (N, B, 6, nv) Jacobians' cross products."""
     T = state.T[:, bd.idx]
-    p = np.einsum("nbij,bj->nbi", T[..., :3, :3], bd.com) + T[..., :3, 3]
+    p = (T[..., :3, :3] @ bd.com[:, :, None])[..., 0] + T[..., :3, 3]
     S = state.S
     A = tree.A[bd.idx]  # (B, nv)
-    SG = (S.swapaxes(-1, -2)[:, None] * A[None, :, None, :]) @ G[:, None]  # (N, B, 6, na) at the origin
+    SG = np.empty((S.shape[0], len(bd.idx), 6, G.shape[-1]))  # (N, B, 6, na): sum over b's path of S_k G_k
+    St = S.swapaxes(-1, -2)
+    for i, b in enumerate(bd.idx):
+        c = _path(tree, b)
+        SG[:, i] = St[:, :, c] @ G[:, c]
     JG = np.concatenate([SG[..., :3, :], SG[..., 3:, :] + _cross_rows(SG[..., :3, :], p)], axis=-2)
-    V = np.einsum("bk,nkx,nk->nbx", A, S, qd)
-    Vd = np.einsum("bk,nkx,nk->nbx", A, Sd, qd) + np.einsum("bk,nkx,nk->nbx", A, S, extra_qdd)
+    V = A @ (S * qd[..., None])
+    Vd = A @ (Sd * qd[..., None] + S * extra_qdd[..., None])
     w = V[..., :3]
     pd = V[..., 3:] + np.cross(w, p)
     a0 = np.concatenate([Vd[..., :3], Vd[..., 3:] + np.cross(Vd[..., :3], p) + np.cross(w, pd)], axis=-1)
     return JG, a0
+
+
+def _screw_rates(tree, state, qd: np.ndarray) -> np.ndarray:
+    """``_tree.screw_rates`` for flat ``qd (N, nv)`` with the carrier twists by matmul (the 3-operand
+    einsum there runs as a naive loop): ``dS_k = [w_c x w_k; w_c x v_k - w_k x v_c]``."""
+    S = state.S
+    Vc = tree.C @ (S * qd[..., None])
+    wc, vc = Vc[..., :3], Vc[..., 3:]
+    ws, vs = S[..., :3], S[..., 3:]
+    return np.concatenate([np.cross(wc, ws), np.cross(wc, vs) - np.cross(ws, vc)], axis=-1)
+
+
+def _path(tree, b: int) -> np.ndarray:
+    """Indices of the velocity coordinates that move body ``b`` (cached on the compiled tree)."""
+    cache = tree.__dict__.setdefault("_dyn_paths", {})
+    if b not in cache:
+        cache[b] = np.flatnonzero(tree.A[b])
+    return cache[b]
+
+
+def _constraint_matrix(mech: Mechanism, state, q: np.ndarray) -> np.ndarray:
+    """``K (N, m, nv)`` as ``_constraints.jacobian`` builds it (same rows, same order), with the point
+    rows' cross products in component arithmetic (the dynamics' hot path; tested equal)."""
+    from ._constraints import _poly
+
+    tree, cs = mech.tree, mech.constraints
+    N, nv = q.shape[0], tree.nv
+    S = state.S
+    w = S[..., :3]
+    w0, w1, w2 = w[..., 0], w[..., 1], w[..., 2]
+    v = S[..., 3:]
+    L = tree.length
+    out = []
+    for kind, d in cs.blocks:
+        if kind == "point":
+            b1, x1, b2, x2 = d
+            rows = np.zeros((N, 3, nv))
+            for b, x, sign in ((b1, x1, 1.0), (b2, x2, -1.0)):
+                if b == 0:
+                    continue
+                p = (state.T[:, b] @ x)[:, :3]
+                c = _path(tree, b)  # only the coordinates that move body b (a loop touches few)
+                p0, p1, p2 = p[:, 0, None], p[:, 1, None], p[:, 2, None]
+                a0, a1, a2 = w0[:, c], w1[:, c], w2[:, c]
+                rows[:, 0, c] += sign * (v[:, c, 0] + a1 * p2 - a2 * p1)
+                rows[:, 1, c] += sign * (v[:, c, 1] + a2 * p0 - a0 * p2)
+                rows[:, 2, c] += sign * (v[:, c, 2] + a0 * p1 - a1 * p0)
+            out.append(rows)
+        elif kind == "rot":
+            b1, _, b2 = d
+            out.append(L * w.swapaxes(-1, -2) * (tree.A[b2] - tree.A[b1]))
+        else:
+            d1, _, _, d2, q2, ref2, c, sc = d
+            row = np.zeros((N, 1, nv))
+            row[:, 0, d1] = sc
+            if d2 >= 0:
+                row[:, 0, d2] -= sc * _poly(c, q[:, q2] - ref2)[1]
+            out.append(row)
+    return np.concatenate(out, axis=-2) if out else np.zeros((N, 0, nv))
 
 
 def _kdot_qd(mech: Mechanism, state, q: np.ndarray, qd: np.ndarray, Sd: np.ndarray) -> np.ndarray:
@@ -267,8 +334,8 @@ def _kdot_qd(mech: Mechanism, state, q: np.ndarray, qd: np.ndarray, Sd: np.ndarr
     from ._constraints import _poly
 
     tree, cs = mech.tree, mech.constraints
-    V = np.einsum("bk,nkx,nk->nbx", tree.A, state.S, qd)
-    Vd = np.einsum("bk,nkx,nk->nbx", tree.A, Sd, qd)
+    V = tree.A @ (state.S * qd[..., None])
+    Vd = tree.A @ (Sd * qd[..., None])
     L = tree.length
     out = []
     for kind, d in cs.blocks:
@@ -429,29 +496,29 @@ def _projector(mech, K, G, dof, w):
 
 
 def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
-    tree, cs = mech.tree, mech.constraints
+    tree = mech.tree
     rank0, dof = _reference(mech)
     na = len(tree.act_dof)
     act = tree.act_dof
     pas = np.setdiff1d(np.arange(tree.nv), act)
     N = q.shape[0]
     state = kinematics(tree, q)
-    K = jacobian(cs, tree, state, q)
+    K = _constraint_matrix(mech, state, q)
     P, rank, smin, cond = _passive_inverse(K[..., pas], rank0)
     G = np.zeros((N, tree.nv, na))
     G[:, act, np.arange(na)] = 1.0
     G[:, pas] = -P @ K[..., act]
-    qd = np.einsum("nij,nj->ni", G, qd_a)
-    Sd = screw_rates(tree, state, qd)
+    qd = _mv(G, qd_a)
+    Sd = _screw_rates(tree, state, qd)
     kdq = _kdot_qd(mech, state, q, qd, Sd)
-    qdd = np.einsum("nij,nj->ni", G, qdd_a)
-    qdd[:, pas] -= np.einsum("nij,nj->ni", P, kdq)
+    qdd = _mv(G, qdd_a)
+    qdd[:, pas] -= _mv(P, kdq)
     # Project each body's Jacobian through G first (6 x n_act instead of 6 x nv): the tree mass matrix is
     # never formed.  The convective acceleration J (qdd - G qdd_act) joins the velocity-product terms.
     bd = _bodies(mech)
     R = state.T[:, bd.idx, :3, :3]
     Iw = R @ bd.inertia @ R.swapaxes(-1, -2)
-    conv = qdd - np.einsum("nij,nj->ni", G, qdd_a)
+    conv = qdd - _mv(G, qdd_a)
     JG, a0 = _com_projected(tree, state, bd, qd, Sd, G, conv)
     gv = np.asarray(mech.gravity) if gravity else np.zeros(3)
     terms = _com_terms(np.broadcast_to(bd.mass, (N, len(bd.mass))), Iw, JG, a0, qd_a, qdd_a, gv[None])
@@ -460,19 +527,19 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
     M_a = terms.M
     vel = terms.velocity_terms
     grav = terms.gravity_terms
-    ex = np.einsum("nij,nj->ni", GT, ext)
+    ex = _mv(GT, ext)
     ok = np.ones(N, dtype=bool)
     if na > dof or weights is not None:
         Pi, ok = _projector(mech, K, G, dof, weights)
         M_a = Pi @ M_a
-        vel, grav, ex = (np.einsum("nij,nj->ni", Pi, x) for x in (vel, grav, ex))
-    tau = np.einsum("nij,nj->ni", M_a, qdd_a) + vel + grav + ex
+        vel, grav, ex = (_mv(Pi, x) for x in (vel, grav, ex))
+    tau = _mv(M_a, qdd_a) + vel + grav + ex
     L = tree.length
     sv = np.max(np.abs(qd), axis=-1) if tree.nv else np.zeros(N)
     sa = np.max(np.abs(qdd), axis=-1) + sv * sv if tree.nv else np.zeros(N)
     if K.shape[1]:
-        e1 = np.max(np.abs(np.einsum("nij,nj->ni", K, qd)), axis=-1) / (L * np.maximum(sv, 1e-300))
-        e2 = np.max(np.abs(np.einsum("nij,nj->ni", K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, 1e-300))
+        e1 = np.max(np.abs(_mv(K, qd)), axis=-1) / (L * np.maximum(sv, 1e-300))
+        e2 = np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, 1e-300))
         e1 = np.where(sv > 0, e1, 0.0)
         e2 = np.where(sa > 0, e2, 0.0)
         adm = np.maximum(e1, e2)
@@ -697,12 +764,12 @@ def site_wrench(
 def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
     """Tree accelerations ``qdd (N, nv)`` under actuator forces with the closure enforced, and a
     conditioning measure of the constrained mass matrix (N,)."""
-    tree, cs = mech.tree, mech.constraints
+    tree = mech.tree
     N = q.shape[0]
     nv = tree.nv
     state = kinematics(tree, q)
-    K = jacobian(cs, tree, state, q)
-    Sd = screw_rates(tree, state, qd)
+    K = _constraint_matrix(mech, state, q)
+    Sd = _screw_rates(tree, state, qd)
     kdq = _kdot_qd(mech, state, q, qd, Sd)
     terms = _tree_terms(mech, state, qd, Sd, np.zeros_like(qd), gravity)
     f = -terms.velocity_terms - terms.gravity_terms
@@ -711,14 +778,14 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
     f[:, tree.act_dof] += tau_a
     if K.shape[1]:
         Kp, _ = _pinv_rank(K, _rank_K(mech))  # (N, nv, m)
-        qdd_p = -np.einsum("nij,nj->ni", Kp, kdq)
+        qdd_p = -_mv(Kp, kdq)
         Pn = np.eye(nv) - Kp @ K
     else:
         qdd_p = np.zeros((N, nv))
         Pn = np.broadcast_to(np.eye(nv), (N, nv, nv))
     M = terms.M
     Mc = Pn @ M @ Pn + (np.eye(nv) - Pn)
-    rhs = np.einsum("nij,nj->ni", Pn, f - np.einsum("nij,nj->ni", M, qdd_p))
+    rhs = _mv(Pn, f - _mv(M, qdd_p))
     if want_cond:
         s = np.linalg.svd(Mc, compute_uv=False)
         cond = s[:, 0] / np.maximum(s[:, -1], 1e-300)
@@ -727,7 +794,7 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
     try:
         u = np.linalg.solve(Mc, rhs[..., None])[..., 0]
     except np.linalg.LinAlgError:  # a massless motion somewhere in the batch: minimum-norm there
-        u = np.einsum("nij,nj->ni", np.linalg.pinv(Mc, rcond=RANK_RTOL), rhs)
+        u = _mv(np.linalg.pinv(Mc, rcond=RANK_RTOL), rhs)
     return qdd_p + u, cond, K, kdq
 
 
@@ -789,7 +856,7 @@ def forward_dynamics(
         L = tree.length
         sa = np.max(np.abs(qdd), axis=-1) + np.max(np.abs(qd), axis=-1) ** 2 if tree.nv else 0.0
         adm = (
-            np.max(np.abs(np.einsum("nij,nj->ni", K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, 1e-300))
+            np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, 1e-300))
             if K.shape[1]
             else np.zeros(qf.shape[0])
         )
@@ -973,7 +1040,7 @@ def simulate(
     from ._influence import _influence_flat
 
     _, _, G, _, _, _ = _influence_flat(mech, q0f, False)
-    qd0 = np.einsum("nij,nj->ni", G, qa0)
+    qd0 = _mv(G, qa0)
     if tau_arr is not None:
         tv = flat[2]
 
