@@ -100,6 +100,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     sp.set_defaults(func=_cmd_verify)
+
+    from ._export import add_parser as add_export_parser  # `robomech export` (issue 13)
+
+    add_export_parser(sub)
     return p
 
 

@@ -36,6 +36,7 @@ from ._core import Check, Tolerance, VerificationReport
 
 __all__ = [
     "check_mechanism",
+    "describe",
     "engine_inverse_dynamics",
     "engine_model",
     "trajectory",
@@ -365,3 +366,33 @@ def cli_report(targets, available) -> tuple[VerificationReport | None, str | Non
         except (ValueError, OSError) as exc:
             return None, f"cannot verify {f!r}: {exc}"
     return report, None
+
+
+def _paper() -> dict:
+    from robomech.mechanisms import omnileg as ol
+    from robomech.mechanisms import spherical_leg as sl
+    from robomech.mechanisms import vectored_thrust as vt
+
+    return {
+        "spherical-leg": lambda: sl.to_multibody(sl.SphericalLeg.paper()),
+        "omnileg": lambda: ol.to_multibody(ol.OmniLeg.paper()),
+        "vectored-thrust": lambda: vt.to_multibody(vt.VectoredThruster.paper()),
+    }
+
+
+def describe(target: str):
+    """The mechanism named by ``target`` (``robomech export``): a paper mechanism with a description
+    (its ``to_multibody`` at the paper's parameters), a gallery name or an MJCF path."""
+    from robomech import multibody as mb
+
+    paper = _paper()
+    if target in paper:
+        return paper[target]()
+    if target in mb.gallery.NAMES:
+        return mb.gallery.load(target)
+    if target.endswith(".xml") or Path(target).is_file():
+        return mb.from_mjcf(Path(target))
+    raise ValueError(
+        f"Expected MECHANISM among {sorted(paper)} or the gallery {list(mb.gallery.NAMES)}, "
+        f"or an MJCF file, got {target!r}."
+    )
