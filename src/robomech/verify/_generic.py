@@ -26,6 +26,7 @@ the exported engine model too, so both sides model the same rigid mechanism.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -109,7 +110,7 @@ def _efc_equality(m, d) -> np.ndarray:
         J = np.zeros((d.nefc, m.nv))
         mujoco.mju_sparse2dense(J, d.efc_J, d.efc_J_rownnz, d.efc_J_rowadr, d.efc_J_colind)
     else:
-        J = np.array(d.efc_J).reshape(d.nefc, m.nv)
+        J = np.array(d.efc_J)[: d.nefc * m.nv].reshape(d.nefc, m.nv)
     return J[eq]
 
 
@@ -179,24 +180,34 @@ def check_mechanism(mech, name: str | None = None, *, simulate: bool = True) -> 
     from robomech import multibody as mb
 
     name = name or mech.name
+    inferred = [b.name for b in mech.bodies if b.inertial is None]
+    if inferred:
+        # to_mjcf lets MuJoCo derive these bodies' inertia from their visual geoms; verify the mechanism
+        # as exported, with those inertias on both sides (read back from the engine's compiled model)
+        mech = mb.from_mjcf(mb.to_mjcf(mech))
     tree = mech.tree
     L = tree.length
     checks: list[Check] = []
-    t, at = trajectory(mech)
+    drv = _driver(mech)  # redundant actuation: a consistent motion is driven through `dof` actuators
+    t, at = trajectory(drv)
     qa, qda, qdda = at(t)
-    q, conv = _assemble_along(mech, qa)
+    q, conv = _assemble_along(drv, qa)
     checks.append(
         Check(
             name,
             "assembly along the test trajectory",
             0.0 if conv.all() else math.inf,
             Tolerance(0.0, "every sample must assemble (FK converged)"),
-            f"{int(conv.sum())}/{len(conv)} converged",
+            f"{int(conv.sum())}/{len(conv)} converged"
+            + (f"; inertia of {len(inferred)} bodies from the exported geoms" if inferred else ""),
         )
     )
     q, qa, qda, qdda = q[conv], qa[conv], qda[conv], qdda[conv]
     if not len(q):
         return checks
+    if drv is not mech:  # every actuator's rates along the driven (consistent) motion
+        rd = mb.inverse_dynamics(drv, q, qda, qdda)
+        qa, qda, qdda = q[:, tree.act_qadr], rd.qd[:, tree.act_dof], rd.qdd[:, tree.act_dof]
     inv = mb.inverse_dynamics(mech, q, qda, qdda)
     m = engine_model(mech)
     d = mujoco.MjData(m)
@@ -256,7 +267,7 @@ def check_mechanism(mech, name: str | None = None, *, simulate: bool = True) -> 
             f"max |tau| {tscale:.3g}; {int(inv.valid.sum())}/{len(inv.valid)} valid",
         )
     )
-    checks.append(_power_check(mech, name, m, d, at, t[conv], q, inv))
+    checks.append(_power_check(drv, name, m, d, at, t[conv], q, inv.tau, inv.qd[:, tree.act_dof]))
     if simulate:
         checks += _simulation_checks(mech, name, q[0], qda[0])
     return checks
@@ -273,7 +284,26 @@ def _engine_energy(m, d, q, qd) -> float:
     return float(d.energy[0] + d.energy[1])
 
 
-def _power_check(mech, name, m, d, at, t, q, inv) -> Check:
+def _driver(mech):
+    """``mech``, or for redundant actuation the same mechanism driven by the first subset of ``dof``
+    actuators that determines its motion (to generate consistent test motions)."""
+    from itertools import combinations
+
+    from robomech import multibody as mb
+
+    dof = mb.mobility(mech).dof
+    if len(mech.actuated) <= dof:
+        return mech
+    for sub in combinations(mech.actuated, dof):
+        drv = dataclasses.replace(mech, actuated=sub)
+        if mb.mobility(drv).dof == dof and mb.influence(drv, drv.q0, second_order=False).consistency < 1e-9:
+            return drv
+    return mech
+
+
+def _power_check(mech, name, m, d, at, t, q, tau, qd_act) -> Check:
+    """``tau . qd_act`` (every actuator's force and rate) against dE/dt of the engine's energy along the
+    motion driven through ``mech``'s actuators (``at``)."""
     import mujoco
 
     from robomech import multibody as mb
@@ -288,7 +318,7 @@ def _power_check(mech, name, m, d, at, t, q, inv) -> Check:
         r = mb.inverse_dynamics(mech, fk.q, qda, qdda)
         E = np.array([_engine_energy(m, d, fk.q[k], r.qd[k]) for k in range(5)])
         dE = (E[0] - 8 * E[1] + 8 * E[3] - E[4]) / (12 * h)
-        P = float(inv.tau[i] @ at(ti)[1])
+        P = float(tau[i] @ qd_act[i])
         err = max(err, abs(P - dE))
         scale = max(scale, abs(P), abs(dE))
     return Check(name, "power balance tau.qd = dE/dt (engine energy)", _rel(err, scale), TOL_POWER, "")
@@ -349,22 +379,27 @@ def verify_file(path: str | Path) -> VerificationReport:
 
 def cli_report(targets, available) -> tuple[VerificationReport | None, str | None]:
     """The CLI's verify: registered names and MJCF paths mixed; (report, None) or (None, error)."""
+    from robomech import multibody as mb
     from robomech.verify import run_verifications
 
-    files = [a for a in targets if a.endswith(".xml") or Path(a).is_file()]
-    names = [a for a in targets if a not in files]
+    described = set(_paper()) | set(mb.gallery.NAMES)
+    files = [a for a in targets if a not in available and (a.endswith(".xml") or Path(a).is_file())]
+    generic = [a for a in targets if a not in available and a in described]
+    names = [a for a in targets if a not in files and a not in generic]
     unknown = [n for n in names if n not in available]
     if unknown:
         return None, (
             f"unknown mechanism {', '.join(map(repr, unknown))}; valid ones are: {', '.join(available)}"
-            " (or a path to an MJCF file)"
+            f" (hand-written), {', '.join(sorted(described))} (generic), or a path to an MJCF file"
         )
-    report = run_verifications(names) if names or not files else VerificationReport()
+    report = run_verifications(names) if names or not (files or generic) else VerificationReport()
     for f in files:
         try:
             report.checks.extend(verify_file(f).checks)
         except (ValueError, OSError) as exc:
             return None, f"cannot verify {f!r}: {exc}"
+    for n in generic:
+        report.checks.extend(check_mechanism(describe(n), f"{n} (generic)"))
     return report, None
 
 
