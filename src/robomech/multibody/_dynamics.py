@@ -163,6 +163,8 @@ def _pinv_rank(K: np.ndarray, r: int) -> tuple[np.ndarray, np.ndarray]:
 # above it the sample is recomputed with the SVD pseudo-inverse (exact rank decision).  The Gram matrix
 # squares the condition number: at 1e4, 1e8 * eps ~ 1e-8 before refinement, ~1e-12 after it.
 GRAM_COND_MAX = 1e4
+# Above this condition estimate the Gram inverse is refined once (below it cond^2 eps < 1e-12).
+GRAM_REFINE_COND = 1e2
 
 
 def _passive_inverse(Kp: np.ndarray, rank0: int):
@@ -186,15 +188,15 @@ def _passive_inverse(Kp: np.ndarray, rank0: int):
             Gi = np.linalg.inv(Gm)
         except np.linalg.LinAlgError:
             return _pinv(Kp)
-        if wide:
-            P = KT @ Gi
-            P = P + P @ (np.eye(m) - Kp @ P)
-        else:
-            P = Gi @ KT
-            P = P + (np.eye(n) - P @ Kp) @ P
+        P = KT @ Gi if wide else Gi @ KT
         ni = np.linalg.norm(Gi, 1, axis=(-2, -1))
         cond = np.sqrt(np.linalg.norm(Gm, 1, axis=(-2, -1)) * ni)
         smin = 1.0 / np.sqrt(ni)
+        # refine where the Gram matrix's squared conditioning could show: cond^2 eps > 1e-12
+        r = np.flatnonzero(~(cond <= GRAM_REFINE_COND))
+        if r.size:
+            Pr, Kr = P[r], Kp[r]
+            P[r] = Pr + Pr @ (np.eye(m) - Kr @ Pr) if wide else Pr + (np.eye(n) - Pr @ Kr) @ Pr
     rank = np.full(N, rank0)
     bad = ~(np.isfinite(cond) & (cond <= GRAM_COND_MAX) & np.all(np.isfinite(P), axis=(-1, -2)))
     if np.any(bad):
