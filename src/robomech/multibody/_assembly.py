@@ -49,6 +49,9 @@ MU_MAX = 1e10
 # linear over such a step) at the cost of a few more iterations for large moves.  Only coordinates
 # that move a closure point or the IK site are capped.
 MAX_STEP = 0.5
+# Batches of at least this many samples run the assembly in the compiled kernels of _compiled.py
+# (the same algorithm per sample); smaller ones in numpy, with no compilation.
+COMPILED_MIN = 256
 # Iterations per continuation stage: from the reference configuration Newton takes 4-8 iterations on
 # the gallery; 60 leaves room for the damped steps far from a solution before a sample is given up.
 MAX_ITER = 60
@@ -130,7 +133,7 @@ def solve_closure(
             else np.ones_like(dx, bool)
         )
         big = np.max(np.abs(dx) * wstep * geo, axis=-1)
-        dx *= np.minimum(1.0, MAX_STEP / np.where(big > 0, big, 1.0))[:, None]
+        dx *= np.where(big > MAX_STEP, MAX_STEP / np.where(big > 0, big, 1.0), 1.0)[:, None]
         dv = np.zeros((idx.size, tree.nv))
         dv[:, free] = dx
         q_try = integrate(tree, q[idx], dv)
@@ -217,7 +220,12 @@ def forward_kinematics(mech: Mechanism, q_act: object, guess: object = None, *, 
     iters = np.zeros(q.shape[0], dtype=int)
     for s in range(1, steps + 1):
         q[:, tree.act_qadr] = start + (target - start) * (s / steps)
-        q, rc, _, it = solve_closure(mech, q, free)
+        if q.shape[0] >= COMPILED_MIN:  # same algorithm, compiled per sample (see _compiled.py)
+            from ._compiled import compiled_fk
+
+            q, rc, it = compiled_fk(mech, q, free)
+        else:
+            q, rc, _, it = solve_closure(mech, q, free)
         iters += it
     conv = ok & (rc <= CONVERGED_RTOL * tree.length)
     q = np.where(ok[:, None], q, np.nan)

@@ -156,6 +156,13 @@ def site_jacobian(mech: Mechanism, q: object, site: str) -> np.ndarray:
     si = _site_index(mech, site)
     qf, batch = _flat(mech, q)
     tree = mech.tree
+    from ._assembly import COMPILED_MIN
+
+    if qf.shape[0] >= COMPILED_MIN:  # same formulas, compiled per sample (see _compiled.py)
+        from ._compiled import compiled_site_jacobian
+
+        J = compiled_site_jacobian(mech, qf, si)
+        return J.reshape(*batch, 6, J.shape[-1])
     state, _, G, _, _, _ = _influence_flat(mech, qf, False)
     b = tree.site_body[si]
     p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]

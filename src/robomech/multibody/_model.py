@@ -324,6 +324,12 @@ class Mechanism:
         return compile_tree(self)
 
     @cached_property
+    def compiled_tables(self):
+        from ._compiled import tables
+
+        return tables(self)
+
+    @cached_property
     def constraints(self):
         from ._constraints import compile_constraints
 
