@@ -1,0 +1,220 @@
+"""What a design study is: variables, metrics, and a per-design evaluation from the batched kernels.
+
+A :class:`DesignStudy` maps each row of a design matrix onto the mechanism's frozen parameter dataclass
+(``dataclasses.replace`` of the study's nominal parameters, for ``kind="range"`` variables) or onto an
+as-built error vector (``kind="normal"`` variables: a manufacturing error with standard deviation
+``sigma``), and evaluates its metrics on the study's pose set with the mechanism's batched kernels.
+A design whose parameters the dataclass rejects is a failed sample (``design_ok`` False, metrics NaN),
+never an exception: a sweep never dies of one bad design.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = ["DesignStudy", "Metric", "Objective", "Variable", "with_variables"]
+
+KINDS = ("range", "normal")
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One design variable.
+
+    ``kind="range"``: a field ``name`` of the study's parameter dataclass, sampled in ``[low, high]``
+    (SI units).  ``kind="normal"``: a manufacturing error ``name`` of the study, zero mean and standard
+    deviation ``sigma`` (SI units).
+    """
+
+    name: str
+    low: float = math.nan
+    high: float = math.nan
+    unit: str = ""
+    kind: str = "range"
+    sigma: float = math.nan
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.isidentifier():
+            raise ValueError(f"Expected variable name to be an identifier, got {self.name!r}.")
+        if self.kind not in KINDS:
+            raise ValueError(f"Expected variable {self.name!r} kind in {KINDS}, got {self.kind!r}.")
+        if self.kind == "range":
+            lo, hi = float(self.low), float(self.high)
+            if not (math.isfinite(lo) and math.isfinite(hi)):
+                raise ValueError(
+                    f"Expected variable {self.name!r} to have a finite range, got [{self.low!r}, {self.high!r}]."
+                )
+            if not lo < hi:
+                what = "an empty" if lo == hi else "an inverted"
+                raise ValueError(
+                    f"Expected variable {self.name!r} to have low < high, got {what} range [{lo!r}, {hi!r}]."
+                )
+            object.__setattr__(self, "low", lo)
+            object.__setattr__(self, "high", hi)
+        else:
+            s = float(self.sigma)
+            if not (math.isfinite(s) and s > 0):
+                raise ValueError(f"Expected variable {self.name!r} sigma > 0 and finite, got {self.sigma!r}.")
+            object.__setattr__(self, "sigma", s)
+
+    def from_unit(self, u: np.ndarray) -> np.ndarray:
+        """Map samples ``u`` in the open unit interval onto this variable (uniform or normal)."""
+        if self.kind == "range":
+            return self.low + (self.high - self.low) * u
+        from scipy.stats import norm
+
+        return self.sigma * norm.ppf(u)
+
+    def as_dict(self) -> dict[str, Any]:
+        d = {"name": self.name, "kind": self.kind, "unit": self.unit, "description": self.description}
+        if self.kind == "range":
+            d.update(low=self.low, high=self.high)
+        else:
+            d.update(sigma=self.sigma)
+        return d
+
+
+@dataclass(frozen=True)
+class Metric:
+    """One per-design output: ``shape`` is the trailing shape of its array (() for a scalar)."""
+
+    name: str
+    unit: str
+    description: str
+    shape: tuple[int, ...] = ()
+    dtype: str = "float64"
+
+
+@dataclass(frozen=True)
+class Objective:
+    """A metric to optimise: ``sense`` is ``"max"`` or ``"min"``."""
+
+    metric: str
+    sense: str
+
+    def __post_init__(self) -> None:
+        if self.sense not in ("max", "min"):
+            raise ValueError(f"Expected objective sense 'max' or 'min', got {self.sense!r}.")
+
+
+# evaluate(study, params, rows, seed) -> {metric name: array (n, *shape)} for the n designs of one chunk;
+# ``params`` is a list of parameter objects (None where the dataclass rejected the design).
+Evaluator = Callable[["DesignStudy", list[Any], np.ndarray, np.random.SeedSequence], dict[str, np.ndarray]]
+
+
+@dataclass(frozen=True)
+class DesignStudy:
+    """A registered design study.
+
+    ``nominal`` builds the nominal parameter object; ``variables`` the default design variables;
+    ``metrics`` what ``evaluate`` returns; ``objectives`` the Pareto/NSGA-II objectives;
+    ``parameters`` the study's fixed settings (pose grids, motions), stored in the results;
+    ``poses_per_design`` the number of pose evaluations one design costs (for throughput figures);
+    ``default_sampler`` / ``default_chunk`` the sampling method and chunk size (designs per task).
+    """
+
+    name: str
+    title: str
+    mechanism: str
+    nominal: Callable[[], Any]
+    variables: tuple[Variable, ...]
+    metrics: tuple[Metric, ...]
+    evaluate: Evaluator
+    parameters: Mapping[str, Any] = field(default_factory=dict)
+    objectives: tuple[Objective, ...] = ()
+    poses_per_design: int = 1
+    default_sampler: str = "sobol"
+    default_chunk: int = 64
+    default_designs: int = 256
+    notes: tuple[str, ...] = ()
+    error_names: tuple[str, ...] = ()  # names a kind="normal" variable may take
+
+    @property
+    def variable_names(self) -> tuple[str, ...]:
+        return tuple(v.name for v in self.variables)
+
+    def parameter_fields(self) -> tuple[str, ...]:
+        return tuple(f.name for f in dataclasses.fields(self.nominal()))
+
+    def designs_to_params(self, rows: np.ndarray) -> list[Any]:
+        """Parameter objects for the ``range`` variables of each row (None where the dataclass refuses)."""
+        base = self.nominal()
+        idx = [(i, v.name) for i, v in enumerate(self.variables) if v.kind == "range"]
+        out: list[Any] = []
+        for row in np.asarray(rows, dtype=float):
+            if not idx:
+                out.append(base)
+                continue
+            try:
+                out.append(dataclasses.replace(base, **{name: float(row[i]) for i, name in idx}))
+            except ValueError:
+                out.append(None)  # the parameter dataclass rejects this combination: a failed design
+        return out
+
+    def evaluate_rows(self, rows: np.ndarray, seed: np.random.SeedSequence) -> dict[str, np.ndarray]:
+        """Every metric for the designs ``rows (n, n_variables)``, plus ``design_ok (n,)``."""
+        params = self.designs_to_params(rows)
+        out = self.evaluate(self, params, np.asarray(rows, dtype=float), seed)
+        ok = np.array([p is not None for p in params], dtype=bool)
+        res = {"design_ok": ok}
+        for m in self.metrics:
+            a = np.asarray(out[m.name], dtype=m.dtype)
+            expected = (len(params), *m.shape)
+            if a.shape != expected:  # a study bug, not a user error
+                raise RuntimeError(f"study {self.name!r}: metric {m.name!r} has shape {a.shape}, not {expected}")
+            res[m.name] = a
+        return res
+
+    def describe(self) -> dict[str, Any]:
+        return {
+            "study": self.name,
+            "title": self.title,
+            "mechanism": self.mechanism,
+            "variables": [v.as_dict() for v in self.variables],
+            "metrics": [{"name": m.name, "unit": m.unit, "description": m.description} for m in self.metrics],
+            "objectives": [{"metric": o.metric, "sense": o.sense} for o in self.objectives],
+            "parameters": dict(self.parameters),
+            "poses_per_design": self.poses_per_design,
+        }
+
+
+def with_variables(study: DesignStudy, overrides: Sequence[Variable]) -> DesignStudy:
+    """The study with its variables replaced or extended by ``overrides`` (validated).
+
+    A ``range`` variable must name a field of the study's parameter dataclass; a ``normal`` variable must
+    name one of the study's manufacturing errors.  An override of an existing variable keeps its unit
+    and description when the override gives none.
+    """
+    fields = study.parameter_fields()
+    current = {v.name: v for v in study.variables}
+    for ov in overrides:
+        if ov.kind == "range":
+            if study.error_names and ov.name in study.error_names:
+                raise ValueError(
+                    f"Expected a standard deviation for error {ov.name!r} of study {study.name!r} "
+                    f"(NAME=SIGMA), got a range."
+                )
+            if ov.name not in fields:
+                raise ValueError(
+                    f"Expected design variable {ov.name!r} to be a field of "
+                    f"{type(study.nominal()).__name__}; its fields are: {', '.join(fields)}."
+                )
+        elif ov.name not in study.error_names:
+            raise ValueError(
+                f"Expected error {ov.name!r} to be one of study {study.name!r}'s manufacturing errors: "
+                f"{', '.join(study.error_names) or '(none)'}."
+            )
+        old = current.get(ov.name)
+        if old is not None and old.kind != ov.kind:
+            raise ValueError(f"Expected variable {ov.name!r} to be of kind {old.kind!r}, got {ov.kind!r}.")
+        if old is not None:
+            ov = dataclasses.replace(ov, unit=ov.unit or old.unit, description=ov.description or old.description)
+        current[ov.name] = ov
+    return dataclasses.replace(study, variables=tuple(current.values()))
