@@ -92,16 +92,23 @@ def register(subparsers) -> None:
         "Studies: spherical-leg-synthesis, vectored-thrust-tolerance, omnileg-synthesis.",
     )
     sp.add_argument("study", metavar="STUDY", help="design study name")
-    sp.add_argument("--out", required=True, help="Zarr store directory (created, or resumed if it is this sweep's)")
+    sp.add_argument(
+        "--out", required=True, help="Zarr store directory (created, or resumed if it is this sweep's)"
+    )
     sp.add_argument("--designs", type=int, default=None, help="number of designs (NSGA-II: population size)")
     sp.add_argument("--seed", type=int, default=0, help="seed of the sampler and of every chunk (default 0)")
     sp.add_argument("--scheduler", default=None, help="tcp://HOST:PORT of an existing Dask scheduler")
     sp.add_argument("--connect-timeout", type=float, default=10.0, help="seconds to reach --scheduler")
-    sp.add_argument("--workers", type=int, default=None, help="LocalCluster worker processes (default: cores)")
+    sp.add_argument(
+        "--workers", type=int, default=None, help="LocalCluster worker processes (default: cores)"
+    )
     sp.add_argument("--sampler", default=None, choices=("sobol", "lhs", "grid", "random"))
     sp.add_argument("--chunk-size", type=int, default=None, help="designs per Dask task")
     sp.add_argument(
-        "--var", action="append", default=[], metavar="NAME=LO:HI|NAME=SIGMA",
+        "--var",
+        action="append",
+        default=[],
+        metavar="NAME=LO:HI|NAME=SIGMA",
         help="override or add a design variable (SI units); repeatable",
     )
     sp.add_argument("--method", default="sample", choices=("sample", "nsga2"))

@@ -107,7 +107,7 @@ STUDY = DesignStudy(
         Objective("min_abs_det_j", "max"),
         Objective("peak_torque", "min"),
     ),
-    poses_per_design=SIMPSON_POINTS**3 + int(round(6.0 / EQ52_STEP)) + 1,
+    poses_per_design=SIMPSON_POINTS**3 + round(6.0 / EQ52_STEP) + 1,
     default_sampler="sobol",
     default_chunk=32,
     default_designs=256,

@@ -59,7 +59,9 @@ def optimize_nsga2(
     P = int(population or 32)
     G = int(generations)
     if P < 4 or G < 1:
-        raise ValueError(f"Expected population >= 4 and generations >= 1, got {population!r}, {generations!r}.")
+        raise ValueError(
+            f"Expected population >= 4 and generations >= 1, got {population!r}, {generations!r}."
+        )
     if isinstance(seed, bool) or int(seed) != seed or seed < 0:
         raise ValueError(f"Expected seed to be a non-negative integer, got {seed!r}.")
     from pymoo.algorithms.moo.nsga2 import NSGA2
@@ -83,7 +85,9 @@ def optimize_nsga2(
             raise RuntimeError(f"NSGA-II proposed {X.shape[0]} rows, more than the population {P}")
         rows = slice(k * P, k * P + X.shape[0])
         if bool(g["chunk_done"][k]) and np.array_equal(g["designs"][rows], X):
-            res = {name: np.asarray(g[name][rows]) for name in ["design_ok", *(m.name for m in study.metrics)]}
+            res = {
+                name: np.asarray(g[name][rows]) for name in ["design_ok", *(m.name for m in study.metrics)]
+            }
         else:
             futures = [
                 c.submit(evaluate_chunk, study, X[i : i + sub], int(seed), k * P + i, pure=False, retries=2)

@@ -92,7 +92,9 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, timeou
 
     if scheduler:
         if not isinstance(scheduler, str) or "://" not in scheduler:
-            raise SchedulerUnreachable(f"Expected a scheduler address like tcp://HOST:PORT, got {scheduler!r}.")
+            raise SchedulerUnreachable(
+                f"Expected a scheduler address like tcp://HOST:PORT, got {scheduler!r}."
+            )
         try:
             client = Client(scheduler, timeout=timeout)
         except (OSError, TimeoutError) as exc:
@@ -218,8 +220,11 @@ def run_sweep(
         raise ValueError(f"Expected workers >= 1, got {workers!r}.")
     n = X.shape[0]
     fp = sweep_fingerprint(study, n, sampler, int(seed), chunk)
-    info = {**study.describe(), "robomech_version": robomech_version(), "units": {
-        **{v.name: v.unit for v in study.variables}, **{m.name: m.unit for m in study.metrics}}}
+    info = {
+        **study.describe(),
+        "robomech_version": robomech_version(),
+        "units": {**{v.name: v.unit for v in study.variables}, **{m.name: m.unit for m in study.metrics}},
+    }
     g = prepare_store(Path(out), study, X, chunk, fp, info)
     done = np.asarray(g["chunk_done"][:], dtype=bool)
     missing = [k for k in range(done.size) if not done[k]]
@@ -235,8 +240,15 @@ def run_sweep(
 
             n_workers = len(c.scheduler_info().get("workers", {}))
             futures = [
-                c.submit(evaluate_chunk, study, X[k * chunk : (k + 1) * chunk], int(seed), k,
-                         pure=False, retries=TASK_RETRIES)
+                c.submit(
+                    evaluate_chunk,
+                    study,
+                    X[k * chunk : (k + 1) * chunk],
+                    int(seed),
+                    k,
+                    pure=False,
+                    retries=TASK_RETRIES,
+                )
                 for k in missing
             ]
             try:

@@ -37,9 +37,7 @@ def grid_size(n: int, d: int) -> int:
     return m
 
 
-def design_matrix(
-    variables: Sequence[Variable], n: int, sampler: str, seed: int, chunk: int
-) -> np.ndarray:
+def design_matrix(variables: Sequence[Variable], n: int, sampler: str, seed: int, chunk: int) -> np.ndarray:
     """``(n', len(variables))`` design rows; ``n' = n`` except for ``grid`` (``grid_size(n, d)**d``)."""
     if sampler not in SAMPLERS:
         raise ValueError(f"Expected sampler in {SAMPLERS}, got {sampler!r}.")
@@ -60,7 +58,9 @@ def design_matrix(
         u = qmc.LatinHypercube(d, seed=np.random.default_rng(seed)).random(n)
     elif sampler == "grid":
         m = grid_size(n, d)
-        axis = (np.arange(m) + 0.5) / m if any(v.kind == "normal" for v in variables) else np.linspace(0, 1, m)
+        axis = (
+            (np.arange(m) + 0.5) / m if any(v.kind == "normal" for v in variables) else np.linspace(0, 1, m)
+        )
         u = np.stack(np.meshgrid(*([axis] * d), indexing="ij"), -1).reshape(-1, d)
     else:
         blocks = []

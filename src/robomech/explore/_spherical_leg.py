@@ -102,7 +102,7 @@ STUDY = DesignStudy(
         Objective("min_dexterity", "max"),
         Objective("peak_force", "min"),
     ),
-    poses_per_design=TASK_GRID**2 + int(round(FIG5B_DURATION / FIG5B_STEP)) + 1,
+    poses_per_design=TASK_GRID**2 + round(FIG5B_DURATION / FIG5B_STEP) + 1,
     default_sampler="sobol",
     default_chunk=128,
     default_designs=512,

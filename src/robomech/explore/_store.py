@@ -77,9 +77,9 @@ def prepare_store(
             if old != fp:
                 diff = sorted(k for k in set(old) | set(fp) if old.get(k) != fp.get(k))
                 raise StoreMismatch(
-                    f"Expected --out {str(out)!r} to hold this sweep ({fp['study']}) or nothing, got the store "
-                    f"of study {old.get('study')!r} differing in {', '.join(diff)}; use another --out "
-                    "(nothing was overwritten)."
+                    f"Expected --out {str(out)!r} to hold this sweep ({fp['study']}) or nothing, "
+                    f"got the store of study {old.get('study')!r} differing in {', '.join(diff)}; "
+                    "use another --out (nothing was overwritten)."
                 )
             if designs is not None and not np.array_equal(g["designs"][:], designs):
                 raise StoreMismatch(f"The design matrix stored in {str(out)!r} differs from this sweep's.")

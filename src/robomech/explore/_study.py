@@ -49,7 +49,8 @@ class Variable:
             lo, hi = float(self.low), float(self.high)
             if not (math.isfinite(lo) and math.isfinite(hi)):
                 raise ValueError(
-                    f"Expected variable {self.name!r} to have a finite range, got [{self.low!r}, {self.high!r}]."
+                    f"Expected variable {self.name!r} to have a finite range, "
+                    f"got [{self.low!r}, {self.high!r}]."
                 )
             if not lo < hi:
                 what = "an empty" if lo == hi else "an inverted"
@@ -168,7 +169,9 @@ class DesignStudy:
             a = np.asarray(out[m.name], dtype=m.dtype)
             expected = (len(params), *m.shape)
             if a.shape != expected:  # a study bug, not a user error
-                raise RuntimeError(f"study {self.name!r}: metric {m.name!r} has shape {a.shape}, not {expected}")
+                raise RuntimeError(
+                    f"study {self.name!r}: metric {m.name!r} has shape {a.shape}, not {expected}"
+                )
             res[m.name] = a
         return res
 
@@ -215,6 +218,8 @@ def with_variables(study: DesignStudy, overrides: Sequence[Variable]) -> DesignS
         if old is not None and old.kind != ov.kind:
             raise ValueError(f"Expected variable {ov.name!r} to be of kind {old.kind!r}, got {ov.kind!r}.")
         if old is not None:
-            ov = dataclasses.replace(ov, unit=ov.unit or old.unit, description=ov.description or old.description)
+            ov = dataclasses.replace(
+                ov, unit=ov.unit or old.unit, description=ov.description or old.description
+            )
         current[ov.name] = ov
     return dataclasses.replace(study, variables=tuple(current.values()))

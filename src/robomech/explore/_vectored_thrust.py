@@ -148,14 +148,20 @@ STUDY = DesignStudy(
     title="Vectored thruster (paper 5): pointing error from manufacturing errors (Monte Carlo)",
     mechanism="vectored_thrust.VectoredThruster",
     nominal=vt.VectoredThruster.paper,
-    variables=tuple(Variable(n, unit="rad", kind="normal", sigma=SIGMA_ANGLE, description=d) for n, d in ERRORS),
+    variables=tuple(
+        Variable(n, unit="rad", kind="normal", sigma=SIGMA_ANGLE, description=d) for n, d in ERRORS
+    ),
     metrics=(
         Metric("rms_error", "rad", "RMS pointing error over the Table 1 workspace"),
         Metric("p50_error", "rad", "median pointing error over the workspace"),
         Metric("p95_error", "rad", "95th percentile of the pointing error over the workspace"),
         Metric("max_error", "rad", "worst pointing error over the workspace"),
-        Metric("assembled_fraction", "1", "fraction of workspace poses where the as-built mechanism assembles"),
-        Metric("assembles", "bool", "the as-built mechanism assembles over the whole workspace", dtype="bool"),
+        Metric(
+            "assembled_fraction", "1", "fraction of workspace poses where the as-built mechanism assembles"
+        ),
+        Metric(
+            "assembles", "bool", "the as-built mechanism assembles over the whole workspace", dtype="bool"
+        ),
     ),
     evaluate=evaluate,
     parameters={
