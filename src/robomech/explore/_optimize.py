@@ -27,7 +27,7 @@ from ._runner import (
     robomech_version,
     sweep_fingerprint,
 )
-from ._store import prepare_store
+from ._store import open_store, prepare_store
 from ._study import DesignStudy, Variable, with_variables
 
 __all__ = ["optimize_nsga2"]
@@ -70,7 +70,8 @@ def optimize_nsga2(
 
     fp = {**sweep_fingerprint(study, P * G, "nsga2", int(seed), P), "population": P, "generations": G}
     info = {**study.describe(), "robomech_version": robomech_version(), "method": "nsga2"}
-    g = prepare_store(Path(out), study, None, P, fp, info, n=P * G)
+    prepare = (Path(out), study, None, P, fp, info, P * G)
+    g = open_store(Path(out), fp, None)  # raises StoreMismatch before anything is written
     xl = np.array([v.low for v in study.variables])
     xu = np.array([v.high for v in study.variables])
     bar = _Bar(f"{study.name} (NSGA-II)", P * G, progress)
@@ -79,6 +80,7 @@ def optimize_nsga2(
     sub = study.default_chunk
 
     def evaluate(X: np.ndarray, c) -> dict[str, np.ndarray]:
+        g = store[0]
         k = gen[0]
         gen[0] += 1
         if X.shape[0] > P:  # pymoo's NSGA-II proposes n_offsprings = pop_size rows per generation
@@ -119,6 +121,7 @@ def optimize_nsga2(
     t0 = time.perf_counter()
     ctx = _existing(client) if client is not None else dask_client(scheduler, workers, connect_timeout)
     with ctx as c:
+        store = [g if g is not None else prepare_store(*prepare)]
         n_workers = len(c.scheduler_info().get("workers", {}))
         minimize(_Problem(c), NSGA2(pop_size=P), ("n_gen", G), seed=int(seed), verbose=False)
     bar.close()

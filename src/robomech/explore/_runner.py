@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from ._sampling import SAMPLERS, chunk_seed, design_matrix
-from ._store import prepare_store
+from ._store import open_store, prepare_store
 from ._study import DesignStudy, Variable, with_variables
 
 __all__ = ["SchedulerUnreachable", "SweepSummary", "evaluate_chunk", "run_sweep"]
@@ -113,7 +113,7 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, timeou
         threads_per_worker=1,
         processes=True,
         host="127.0.0.1",
-        dashboard_address=None,
+        dashboard_address="127.0.0.1:0",  # loopback, any free port (None would mean :8787 on every interface)
         silence_logs=40,
     )
     client = Client(cluster)
@@ -181,10 +181,10 @@ def plan(
     sampler = sampler or study.default_sampler
     if sampler not in SAMPLERS:
         raise ValueError(f"Expected sampler in {SAMPLERS}, got {sampler!r}.")
-    chunk = int(chunk_size or study.default_chunk)
+    chunk = int(study.default_chunk if chunk_size is None else chunk_size)
     if chunk < 1:
         raise ValueError(f"Expected chunk_size >= 1, got {chunk_size!r}.")
-    n = int(designs or study.default_designs)
+    n = int(study.default_designs if designs is None else designs)
     if n < 1:
         raise ValueError(f"Expected designs >= 1, got {designs!r}.")
     if isinstance(seed, bool) or int(seed) != seed or seed < 0:
@@ -225,8 +225,9 @@ def run_sweep(
         "robomech_version": robomech_version(),
         "units": {**{v.name: v.unit for v in study.variables}, **{m.name: m.unit for m in study.metrics}},
     }
-    g = prepare_store(Path(out), study, X, chunk, fp, info)
-    done = np.asarray(g["chunk_done"][:], dtype=bool)
+    n_chunks = -(-n // chunk)
+    g = open_store(Path(out), fp, X)  # raises StoreMismatch before anything is written
+    done = np.zeros(n_chunks, bool) if g is None else np.asarray(g["chunk_done"][:], dtype=bool)
     missing = [k for k in range(done.size) if not done[k]]
     t0 = time.perf_counter()
     computed: list[int] = []
@@ -235,9 +236,11 @@ def run_sweep(
     bar.update(sum(min(chunk, n - k * chunk) for k in range(done.size) if done[k]))
     if missing:
         ctx = _existing(client) if client is not None else dask_client(scheduler, workers, connect_timeout)
-        with ctx as c:
+        with ctx as c:  # connect (or start the LocalCluster) before creating the store
             from distributed import as_completed
 
+            if g is None:
+                g = prepare_store(Path(out), study, X, chunk, fp, info)
             n_workers = len(c.scheduler_info().get("workers", {}))
             futures = [
                 c.submit(

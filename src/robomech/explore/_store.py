@@ -23,7 +23,7 @@ import numpy as np
 
 from ._study import DesignStudy
 
-__all__ = ["StoreMismatch", "open_results", "prepare_store"]
+__all__ = ["StoreMismatch", "open_results", "open_store", "prepare_store"]
 
 FORMAT = "robomech-sweep/1"
 
@@ -34,6 +34,44 @@ class StoreMismatch(ValueError):
 
 def _canonical(obj: Any) -> Any:
     return json.loads(json.dumps(obj, sort_keys=True, default=str))
+
+
+def open_store(out: Path, fingerprint: dict[str, Any], designs: np.ndarray | None):
+    """The existing store of this sweep at ``out``, None if ``out`` is absent or empty; StoreMismatch else."""
+    import zarr
+
+    out = Path(out)
+    fp = _canonical(fingerprint)
+    if not out.exists():
+        return None
+    if not out.is_dir():
+        raise StoreMismatch(f"Expected --out {str(out)!r} to be a directory, got a file.")
+    if not any(out.iterdir()):
+        return None
+    try:
+        g = zarr.open_group(str(out), mode="r+")
+    except Exception as exc:  # zarr raises several kinds for a non-store folder
+        raise StoreMismatch(
+            f"Expected --out {str(out)!r} to be empty or a robomech sweep store, got a folder "
+            "holding other files; nothing was written."
+        ) from exc
+    meta = dict(g.attrs).get("robomech", {})
+    if meta.get("format") != FORMAT:
+        raise StoreMismatch(
+            f"Expected --out {str(out)!r} to be a robomech sweep store, got a Zarr group without "
+            "robomech sweep attributes; nothing was written."
+        )
+    old = meta.get("fingerprint", {})
+    if old != fp:
+        diff = sorted(k for k in set(old) | set(fp) if old.get(k) != fp.get(k))
+        raise StoreMismatch(
+            f"Expected --out {str(out)!r} to hold this sweep ({fp['study']}) or nothing, "
+            f"got the store of study {old.get('study')!r} differing in {', '.join(diff)}; "
+            "use another --out (nothing was overwritten)."
+        )
+    if designs is not None and not np.array_equal(g["designs"][:], designs):
+        raise StoreMismatch(f"The design matrix stored in {str(out)!r} differs from this sweep's.")
+    return g
 
 
 def prepare_store(
@@ -56,34 +94,9 @@ def prepare_store(
     n = designs.shape[0] if designs is not None else int(n)
     d = len(study.variables)
     n_chunks = -(-n // chunk)
-    if out.exists():
-        if not out.is_dir():
-            raise StoreMismatch(f"Expected --out {str(out)!r} to be a directory, got a file.")
-        if any(out.iterdir()):
-            try:
-                g = zarr.open_group(str(out), mode="r+")
-            except Exception as exc:  # zarr raises several kinds for a non-store folder
-                raise StoreMismatch(
-                    f"Expected --out {str(out)!r} to be empty or a robomech sweep store, got a folder "
-                    "holding other files; nothing was written."
-                ) from exc
-            meta = dict(g.attrs).get("robomech", {})
-            if meta.get("format") != FORMAT:
-                raise StoreMismatch(
-                    f"Expected --out {str(out)!r} to be a robomech sweep store, got a Zarr group without "
-                    "robomech sweep attributes; nothing was written."
-                )
-            old = meta.get("fingerprint", {})
-            if old != fp:
-                diff = sorted(k for k in set(old) | set(fp) if old.get(k) != fp.get(k))
-                raise StoreMismatch(
-                    f"Expected --out {str(out)!r} to hold this sweep ({fp['study']}) or nothing, "
-                    f"got the store of study {old.get('study')!r} differing in {', '.join(diff)}; "
-                    "use another --out (nothing was overwritten)."
-                )
-            if designs is not None and not np.array_equal(g["designs"][:], designs):
-                raise StoreMismatch(f"The design matrix stored in {str(out)!r} differs from this sweep's.")
-            return g
+    g = open_store(out, fingerprint, designs)
+    if g is not None:
+        return g
     g = zarr.open_group(str(out), mode="w")
     g.create_array("designs", shape=(n, d), chunks=(chunk, d), dtype="float64", fill_value=np.nan)
     if designs is not None:

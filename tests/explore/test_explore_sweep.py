@@ -1,0 +1,196 @@
+"""Sweeps end to end in one process (an in-process Dask cluster): store, resume, bad input, exit codes."""
+
+import hashlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from robomech.cli import main
+from robomech.explore import (
+    SAMPLERS,
+    StoreMismatch,
+    Variable,
+    design_matrix,
+    get_study,
+    open_results,
+    pareto_front,
+    run_sweep,
+    with_variables,
+)
+
+STUDY = "spherical-leg-synthesis"
+SMALL = {"designs": 24, "chunk_size": 6, "seed": 3}
+
+
+@pytest.fixture(scope="module")
+def client():
+    from distributed import Client, LocalCluster
+
+    cluster = LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address="127.0.0.1:0", silence_logs=40
+    )
+    c = Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def _tree_digest(path: Path) -> str:
+    h = hashlib.sha256()
+    for p in sorted(path.rglob("*")):
+        h.update(str(p.relative_to(path)).encode())
+        if p.is_file():
+            h.update(p.read_bytes())
+    return h.hexdigest()
+
+
+def test_store_layout_and_attributes(tmp_path, client):
+    s = run_sweep(get_study(STUDY), tmp_path / "s", client=client, progress=False, **SMALL)
+    assert s.n_chunks == 4 and s.computed_chunks == (0, 1, 2, 3) and s.skipped_chunks == 0
+    r = open_results(tmp_path / "s")
+    st = get_study(STUDY)
+    assert r["designs"].shape == (24, 3)
+    np.testing.assert_array_equal(r["designs"], design_matrix(st.variables, 24, "sobol", 3, 6))
+    for m in st.metrics:
+        assert r[m.name].shape[0] == 24
+    assert r["chunk_done"].all() and np.all(r["chunk_seconds"] > 0)
+    a = r["attrs"]
+    assert a["study"] == STUDY and a["robomech_version"] and a["units"]["R"] == "m"
+    assert [v["name"] for v in a["variables"]] == ["R", "r", "h"]
+    assert a["parameters"]["task_grid"] == 41 and a["fingerprint"]["seed"] == 3
+    direct = st.evaluate_rows(r["designs"], None)
+    for k, v in direct.items():  # the Dask path returns exactly the direct evaluation
+        np.testing.assert_array_equal(r[k], v)
+
+
+def test_rerun_computes_nothing_and_interrupted_run_resumes_missing_chunks(tmp_path, client):
+    out = tmp_path / "s"
+
+    def stop_after_two(k, seen=[]):  # noqa: B006 - counts calls within this run
+        seen.append(k)
+        if len(seen) == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(get_study(STUDY), out, client=client, progress=False, on_chunk=stop_after_two, **SMALL)
+    done = open_results(out)["chunk_done"]
+    assert done.sum() == 2
+    s = run_sweep(get_study(STUDY), out, client=client, progress=False, **SMALL)
+    assert set(s.computed_chunks) == set(np.flatnonzero(~done)) and s.skipped_chunks == 2
+    again = run_sweep(get_study(STUDY), out, client=client, progress=False, **SMALL)
+    assert again.computed_chunks == () and again.skipped_chunks == 4
+    ref = run_sweep(get_study(STUDY), tmp_path / "ref", client=client, progress=False, **SMALL)
+    assert ref.computed_chunks == (0, 1, 2, 3)
+    a, b = open_results(out), open_results(tmp_path / "ref")
+    for m in get_study(STUDY).metrics:
+        assert a[m.name].tobytes() == b[m.name].tobytes()
+
+
+def test_another_sweep_in_the_same_store_is_refused_and_nothing_is_overwritten(tmp_path, client):
+    out = tmp_path / "s"
+    run_sweep(get_study(STUDY), out, client=client, progress=False, **SMALL)
+    before = _tree_digest(out)
+    with pytest.raises(StoreMismatch, match="nothing was overwritten"):
+        run_sweep(get_study("omnileg-synthesis"), out, client=client, progress=False, designs=4)
+    with pytest.raises(StoreMismatch, match="seed"):
+        run_sweep(get_study(STUDY), out, client=client, progress=False, **{**SMALL, "seed": 4})
+    assert main(["sweep", "omnileg-synthesis", "--out", str(out), "--quiet"]) == 2
+    assert _tree_digest(out) == before
+
+
+def test_a_folder_with_other_files_is_refused(tmp_path, capsys):
+    (tmp_path / "notes.txt").write_text("mine")
+    assert main(["sweep", STUDY, "--out", str(tmp_path), "--designs", "4", "--quiet"]) == 2
+    assert "other files" in capsys.readouterr().err
+    assert [p.name for p in tmp_path.iterdir()] == ["notes.txt"]
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["sweep", "no-such-study"], "valid studies are"),
+        (["sweep", STUDY, "--var", "L9=0.1:0.2"], "to be a field of SphericalLeg"),
+        (["sweep", STUDY, "--var", "R=0.1:0.1"], "empty range"),
+        (["sweep", STUDY, "--var", "R=0.2:0.1"], "inverted range"),
+        (["sweep", STUDY, "--var", "R=a:b"], "Expected numbers"),
+        (["sweep", STUDY, "--var", "R=0.01"], "manufacturing errors"),
+        (["sweep", "vectored-thrust-tolerance", "--var", "q1_offset=0:1"], "standard deviation"),
+        (["sweep", "vectored-thrust-tolerance", "--var", "q1_offset=-1"], "sigma > 0"),
+        (["sweep", STUDY, "--designs", "0"], "designs >= 1"),
+        (["sweep", STUDY, "--scheduler", "127.0.0.1:1"], "tcp://HOST:PORT"),
+        (["sweep", STUDY, "--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "1"], "no answer"),
+    ],
+)
+def test_bad_input_is_a_clear_error_with_exit_code_2(tmp_path, capsys, argv, message):
+    out = tmp_path / "s"
+    assert main([*argv, "--out", str(out), "--quiet"]) == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_variable_validation_and_overrides():
+    st = get_study(STUDY)
+    with pytest.raises(ValueError, match="inverted"):
+        Variable("R", 0.2, 0.1)
+    with pytest.raises(ValueError, match="finite range"):
+        Variable("R", 0.1, float("nan"))
+    narrowed = with_variables(st, [Variable("R", 0.07, 0.08)])
+    assert narrowed.variables[0].low == 0.07 and narrowed.variables[0].unit == "m"
+    extended = with_variables(st, [Variable("length_max", 0.15, 0.2)])
+    assert extended.variable_names == ("R", "r", "h", "length_max")
+
+
+@pytest.mark.parametrize("sampler", SAMPLERS)
+def test_samplers_stay_in_range_and_are_deterministic(sampler):
+    st = get_study(STUDY)
+    X = design_matrix(st.variables, 30, sampler, 7, 8)
+    np.testing.assert_array_equal(X, design_matrix(st.variables, 30, sampler, 7, 8))
+    lo = np.array([v.low for v in st.variables])
+    hi = np.array([v.high for v in st.variables])
+    assert np.all((X >= lo) & (X <= hi))
+    assert X.shape == ((27, 3) if sampler == "grid" else (30, 3))
+    if sampler != "grid":
+        assert not np.array_equal(X, design_matrix(st.variables, 30, sampler, 8, 8))
+
+
+def test_random_sampler_extends_with_more_designs():
+    st = get_study("vectored-thrust-tolerance")
+    a = design_matrix(st.variables, 16, "random", 0, 8)
+    b = design_matrix(st.variables, 40, "random", 0, 8)
+    np.testing.assert_array_equal(a, b[:16])
+    big = design_matrix(st.variables, 20000, "random", 0, 256)
+    assert np.std(big[:, 0]) == pytest.approx(st.variables[0].sigma, rel=0.03)
+
+
+def test_pareto_front_is_nondominated_and_complete():
+    rng = np.random.default_rng(0)
+    m = {"a": rng.random(200), "b": rng.random(200), "design_ok": np.ones(200, bool)}
+    m["a"][5] = np.nan
+    from robomech.explore import Objective
+
+    objs = (Objective("a", "max"), Objective("b", "min"))
+    front = pareto_front(m, objs)
+    F = np.column_stack([-m["a"], m["b"]])
+    for i in range(200):
+        if i == 5:
+            assert i not in front
+            continue
+        dominated = any(np.all(F[j] <= F[i]) and np.any(F[j] < F[i]) for j in range(200) if j != 5 and j != i)
+        assert (i in front) == (not dominated)
+
+
+def test_nsga2_evaluates_through_the_store_and_reuses_it(tmp_path, client):
+    from robomech.explore import optimize_nsga2
+
+    st = get_study(STUDY)
+    s = optimize_nsga2(st, tmp_path / "o", population=8, generations=2, seed=1, client=client, progress=False)
+    assert s.computed_chunks == (0, 1) and s.n_designs == 16
+    r = open_results(tmp_path / "o")
+    assert r["chunk_done"].all() and np.isfinite(r["designs"]).all()
+    direct = st.evaluate_rows(r["designs"], None)
+    np.testing.assert_array_equal(r["workspace_fraction"], direct["workspace_fraction"])
+    again = optimize_nsga2(
+        st, tmp_path / "o", population=8, generations=2, seed=1, client=client, progress=False
+    )
+    assert again.computed_chunks == ()
