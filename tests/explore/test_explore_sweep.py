@@ -110,14 +110,14 @@ def test_a_folder_with_other_files_is_refused(tmp_path, capsys):
     "argv, message",
     [
         (["sweep", "no-such-study"], "valid studies are"),
-        (["sweep", STUDY, "--var", "L9=0.1:0.2"], "to be a field of SphericalLeg"),
+        (["sweep", STUDY, "--var", "L9=0.1:0.2"], "name fields of SphericalLeg"),
         (["sweep", STUDY, "--var", "R=0.1:0.1"], "empty range"),
         (["sweep", STUDY, "--var", "R=0.2:0.1"], "inverted range"),
         (["sweep", STUDY, "--var", "R=a:b"], "Expected numbers"),
         (["sweep", STUDY, "--var", "R=0.01"], "manufacturing errors"),
         (["sweep", "vectored-thrust-tolerance", "--var", "q1_offset=0:1"], "standard deviation"),
         (["sweep", "vectored-thrust-tolerance", "--var", "q1_offset=-1"], "sigma > 0"),
-        (["sweep", STUDY, "--designs", "0"], "designs >= 1"),
+        (["sweep", STUDY, "--designs", "0"], "designs to be an integer in [1, inf]"),
         (["sweep", STUDY, "--scheduler", "127.0.0.1:1"], "tcp://HOST:PORT"),
         (["sweep", STUDY, "--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "1"], "no answer"),
     ],
@@ -133,7 +133,9 @@ def test_variable_validation_and_overrides():
     st = get_study(STUDY)
     with pytest.raises(ValueError, match="inverted"):
         Variable("R", 0.2, 0.1)
-    with pytest.raises(ValueError, match="finite range"):
+    with pytest.raises(ValueError, match="a finite range"):
+        Variable("R", 0.1, float("inf"))
+    with pytest.raises(ValueError, match="high to be a finite real"):
         Variable("R", 0.1, float("nan"))
     narrowed = with_variables(st, [Variable("R", 0.07, 0.08)])
     assert narrowed.variables[0].low == 0.07 and narrowed.variables[0].unit == "m"

@@ -11,8 +11,8 @@ See ``docs/explore.md``.  dask, distributed, zarr and pymoo are imported on firs
 from __future__ import annotations
 
 from ._optimize import optimize_nsga2
-from ._pareto import objective_matrix, pareto_front
-from ._runner import SchedulerUnreachable, SweepSummary, dask_client, evaluate_chunk, plan, run_sweep
+from ._pareto import pareto_front
+from ._runner import SchedulerUnreachable, SweepSummary, run_sweep
 from ._sampling import SAMPLERS, chunk_seed, design_matrix
 from ._store import StoreMismatch, open_results
 from ._study import DesignStudy, Metric, Objective, Variable, with_variables
@@ -28,15 +28,11 @@ __all__ = [
     "Variable",
     "available_studies",
     "chunk_seed",
-    "dask_client",
     "design_matrix",
-    "evaluate_chunk",
     "get_study",
-    "objective_matrix",
     "open_results",
     "optimize_nsga2",
     "pareto_front",
-    "plan",
     "run_sweep",
     "with_variables",
 ]
@@ -56,7 +52,13 @@ def available_studies() -> dict[str, DesignStudy]:
 
 
 def get_study(name: str) -> DesignStudy:
+    """The built-in design study called ``name`` (ValueError listing the valid names otherwise)."""
+    if not isinstance(name, str):
+        raise ValueError(f"Expected name to be a study name (str), got {type(name).__name__}.")
     studies = available_studies()
     if name not in studies:
-        raise ValueError(f"Unknown design study {name!r}; valid studies are: {', '.join(studies)}.")
+        raise ValueError(
+            f"Expected name to be a design study, got unknown {name!r}; "
+            f"valid studies are: {', '.join(studies)}."
+        )
     return studies[name]

@@ -16,19 +16,22 @@ from typing import Any
 
 import numpy as np
 
+from robomech._validation import check_int
+
 from ._pareto import objective_matrix
 from ._runner import (
     CONNECT_TIMEOUT,
     SweepSummary,
     _Bar,
     _existing,
+    check_runtime,
     dask_client,
     evaluate_chunk,
     robomech_version,
     sweep_fingerprint,
 )
 from ._store import open_store, prepare_store
-from ._study import DesignStudy, Variable, with_variables
+from ._study import DesignStudy, Variable, check_variables, with_variables
 
 __all__ = ["optimize_nsga2"]
 
@@ -50,6 +53,11 @@ def optimize_nsga2(
     """NSGA-II over the study's range variables and objectives; all evaluations stored under ``out``."""
     if not isinstance(study, DesignStudy):
         raise ValueError(f"Expected study to be a DesignStudy, got {type(study).__name__}.")
+    variables = check_variables(variables)
+    P = 32 if population is None else check_int(population, "population", low=4)
+    G = check_int(generations, "generations", low=1)
+    seed = check_int(seed, "seed", low=0)
+    out = check_runtime(out, scheduler, workers, progress, connect_timeout)
     study = with_variables(study, variables) if variables else study
     if not study.objectives or any(v.kind != "range" for v in study.variables):
         raise ValueError(

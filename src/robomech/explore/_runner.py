@@ -23,9 +23,11 @@ from typing import Any
 
 import numpy as np
 
+from robomech._validation import check_bool, check_choice, check_int, check_positive
+
 from ._sampling import SAMPLERS, chunk_seed, design_matrix
 from ._store import open_store, prepare_store
-from ._study import DesignStudy, Variable, with_variables
+from ._study import DesignStudy, Variable, check_variables, with_variables
 
 __all__ = ["SchedulerUnreachable", "SweepSummary", "evaluate_chunk", "run_sweep"]
 
@@ -177,18 +179,12 @@ def plan(
     """Validated study, design matrix, sampler and chunk size of a sweep (no computation)."""
     if not isinstance(study, DesignStudy):
         raise ValueError(f"Expected study to be a DesignStudy, got {type(study).__name__}.")
+    variables = check_variables(variables)
     study = with_variables(study, variables) if variables else study
-    sampler = sampler or study.default_sampler
-    if sampler not in SAMPLERS:
-        raise ValueError(f"Expected sampler in {SAMPLERS}, got {sampler!r}.")
-    chunk = int(study.default_chunk if chunk_size is None else chunk_size)
-    if chunk < 1:
-        raise ValueError(f"Expected chunk_size >= 1, got {chunk_size!r}.")
-    n = int(study.default_designs if designs is None else designs)
-    if n < 1:
-        raise ValueError(f"Expected designs >= 1, got {designs!r}.")
-    if isinstance(seed, bool) or int(seed) != seed or seed < 0:
-        raise ValueError(f"Expected seed to be a non-negative integer, got {seed!r}.")
+    sampler = study.default_sampler if sampler is None else check_choice(sampler, "sampler", SAMPLERS)
+    chunk = study.default_chunk if chunk_size is None else check_int(chunk_size, "chunk_size", low=1)
+    n = study.default_designs if designs is None else check_int(designs, "designs", low=1)
+    seed = check_int(seed, "seed", low=0)
     X = design_matrix(study.variables, n, sampler, int(seed), chunk)
     return study, X, sampler, chunk
 
@@ -216,8 +212,7 @@ def run_sweep(
     is called after chunk ``k`` is stored.  Returns which chunks this run computed.
     """
     study, X, sampler, chunk = plan(study, designs, seed, sampler, chunk_size, variables)
-    if workers is not None and (isinstance(workers, bool) or int(workers) < 1):
-        raise ValueError(f"Expected workers >= 1, got {workers!r}.")
+    out = check_runtime(out, scheduler, workers, progress, connect_timeout, on_chunk)
     n = X.shape[0]
     fp = sweep_fingerprint(study, n, sampler, int(seed), chunk)
     info = {
@@ -282,6 +277,21 @@ def run_sweep(
         n_workers,
         sum(min(chunk, n - k * chunk) for k in computed),
     )
+
+
+def check_runtime(out, scheduler, workers, progress, connect_timeout, on_chunk=None) -> Path:
+    """Validate the execution options shared by run_sweep and optimize_nsga2; return ``out`` as a Path."""
+    if not isinstance(out, str | Path) or str(out) == "":
+        raise ValueError(f"Expected out to be a directory path (str or Path), got {out!r}.")
+    if scheduler is not None and (not isinstance(scheduler, str) or "://" not in scheduler):
+        raise SchedulerUnreachable(f"Expected scheduler like tcp://HOST:PORT, got {scheduler!r}.")
+    if workers is not None:
+        check_int(workers, "workers", low=1)
+    check_bool(progress, "progress")
+    check_positive(connect_timeout, "connect_timeout")
+    if on_chunk is not None and not callable(on_chunk):
+        raise ValueError(f"Expected on_chunk to be callable or None, got {type(on_chunk).__name__}.")
+    return Path(out)
 
 
 @contextmanager

@@ -14,7 +14,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ._study import Variable
+from robomech._validation import check_choice, check_int
+
+from ._study import Variable, check_variables
 
 __all__ = ["SAMPLERS", "chunk_seed", "design_matrix", "grid_size"]
 
@@ -26,7 +28,7 @@ UNIT_MARGIN = 1e-12
 
 def chunk_seed(seed: int, chunk: int) -> np.random.SeedSequence:
     """The independent random stream of chunk ``chunk`` of a sweep with ``seed``."""
-    return np.random.SeedSequence([int(seed), int(chunk)])
+    return np.random.SeedSequence([check_int(seed, "seed", low=0), check_int(chunk, "chunk", low=0)])
 
 
 def grid_size(n: int, d: int) -> int:
@@ -39,13 +41,14 @@ def grid_size(n: int, d: int) -> int:
 
 def design_matrix(variables: Sequence[Variable], n: int, sampler: str, seed: int, chunk: int) -> np.ndarray:
     """``(n', len(variables))`` design rows; ``n' = n`` except for ``grid`` (``grid_size(n, d)**d``)."""
-    if sampler not in SAMPLERS:
-        raise ValueError(f"Expected sampler in {SAMPLERS}, got {sampler!r}.")
-    if int(n) < 1:
-        raise ValueError(f"Expected at least 1 design, got {n!r}.")
-    n, d = int(n), len(variables)
+    variables = check_variables(variables)
+    check_choice(sampler, "sampler", SAMPLERS)
+    n = check_int(n, "n", low=1)
+    seed = check_int(seed, "seed", low=0)
+    chunk = check_int(chunk, "chunk", low=1)
+    d = len(variables)
     if d == 0:
-        raise ValueError("Expected at least one design variable, got none.")
+        raise ValueError("Expected variables to hold at least one design variable, got none.")
     if sampler == "sobol":
         from scipy.stats import qmc
 

@@ -32,6 +32,12 @@ class StoreMismatch(ValueError):
     """``--out`` already holds something that is not this sweep's store (nothing is overwritten)."""
 
 
+def _check_path(out: object, name: str) -> Path:
+    if not isinstance(out, str | Path) or str(out) == "":
+        raise ValueError(f"Expected {name} to be a directory path (str or Path), got {out!r}.")
+    return Path(out)
+
+
 def _canonical(obj: Any) -> Any:
     return json.loads(json.dumps(obj, sort_keys=True, default=str))
 
@@ -115,11 +121,19 @@ def prepare_store(
 
 def open_results(out: Path | str) -> dict[str, Any]:
     """A sweep store as plain data: ``attrs`` (the robomech attributes) and every array as numpy."""
+    out = _check_path(out, "out")
+    if not out.is_dir():
+        raise ValueError(f"Expected out to be a sweep store directory, got {str(out)!r} (not a directory).")
     import zarr
 
-    g = zarr.open_group(str(out), mode="r")
+    try:
+        g = zarr.open_group(str(out), mode="r")
+    except Exception as exc:  # zarr raises several kinds for a folder that is not a store
+        raise ValueError(f"Expected out to be a robomech sweep store, got {str(out)!r}.") from exc
     meta = dict(g.attrs).get("robomech", {})
     if meta.get("format") != FORMAT:
-        raise ValueError(f"Expected {str(out)!r} to be a robomech sweep store, got no robomech attributes.")
+        raise ValueError(
+            f"Expected out {str(out)!r} to be a robomech sweep store, got no robomech attributes."
+        )
     arrays = {name: np.asarray(a[...]) for name, a in g.arrays()}
     return {"attrs": meta, **arrays}

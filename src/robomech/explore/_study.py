@@ -18,6 +18,8 @@ from typing import Any
 
 import numpy as np
 
+from robomech._validation import check_choice, check_int, check_positive, check_real
+
 __all__ = ["DesignStudy", "Metric", "Objective", "Variable", "with_variables"]
 
 KINDS = ("range", "normal")
@@ -42,14 +44,16 @@ class Variable:
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.isidentifier():
-            raise ValueError(f"Expected variable name to be an identifier, got {self.name!r}.")
-        if self.kind not in KINDS:
-            raise ValueError(f"Expected variable {self.name!r} kind in {KINDS}, got {self.kind!r}.")
+            raise ValueError(f"Expected name to be an identifier (a variable name), got {self.name!r}.")
+        check_choice(self.kind, "kind", KINDS)
+        _check_text(self.unit, "unit")
+        _check_text(self.description, "description")
         if self.kind == "range":
-            lo, hi = float(self.low), float(self.high)
+            lo = check_real(self.low, "low", finite=False)
+            hi = check_real(self.high, "high", finite=False)
             if not (math.isfinite(lo) and math.isfinite(hi)):
                 raise ValueError(
-                    f"Expected variable {self.name!r} to have a finite range, "
+                    f"Expected low and high of variable {self.name!r} to be a finite range, "
                     f"got [{self.low!r}, {self.high!r}]."
                 )
             if not lo < hi:
@@ -60,9 +64,7 @@ class Variable:
             object.__setattr__(self, "low", lo)
             object.__setattr__(self, "high", hi)
         else:
-            s = float(self.sigma)
-            if not (math.isfinite(s) and s > 0):
-                raise ValueError(f"Expected variable {self.name!r} sigma > 0 and finite, got {self.sigma!r}.")
+            s = check_positive(self.sigma, "sigma")
             object.__setattr__(self, "sigma", s)
 
     def from_unit(self, u: np.ndarray) -> np.ndarray:
@@ -92,6 +94,17 @@ class Metric:
     shape: tuple[int, ...] = ()
     dtype: str = "float64"
 
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.isidentifier():
+            raise ValueError(f"Expected name to be an identifier (a metric name), got {self.name!r}.")
+        _check_text(self.unit, "unit")
+        _check_text(self.description, "description")
+        if not isinstance(self.shape, tuple):
+            raise ValueError(f"Expected shape to be a tuple of ints, got {type(self.shape).__name__}.")
+        for d in self.shape:
+            check_int(d, "shape", low=1)
+        check_choice(self.dtype, "dtype", ("float64", "bool"))
+
 
 @dataclass(frozen=True)
 class Objective:
@@ -101,8 +114,9 @@ class Objective:
     sense: str
 
     def __post_init__(self) -> None:
-        if self.sense not in ("max", "min"):
-            raise ValueError(f"Expected objective sense 'max' or 'min', got {self.sense!r}.")
+        if not isinstance(self.metric, str):
+            raise ValueError(f"Expected metric to be a metric name (str), got {type(self.metric).__name__}.")
+        check_choice(self.sense, "sense", ("max", "min"))
 
 
 # evaluate(study, params, rows, seed) -> {metric name: array (n, *shape)} for the n designs of one chunk;
@@ -136,6 +150,29 @@ class DesignStudy:
     default_designs: int = 256
     notes: tuple[str, ...] = ()
     error_names: tuple[str, ...] = ()  # names a kind="normal" variable may take
+
+    def __post_init__(self) -> None:
+        for n in ("name", "title", "mechanism"):
+            _check_text(getattr(self, n), n)
+        for n in ("nominal", "evaluate"):
+            if not callable(getattr(self, n)):
+                raise ValueError(f"Expected {n} to be callable, got {type(getattr(self, n)).__name__}.")
+        for n, cls in (("variables", Variable), ("metrics", Metric), ("objectives", Objective)):
+            items = getattr(self, n)
+            if not isinstance(items, tuple) or not all(isinstance(x, cls) for x in items):
+                raise ValueError(f"Expected {n} to be a tuple of {cls.__name__}, got {items!r}.")
+        if not self.variables or not self.metrics:
+            raise ValueError("Expected variables and metrics to be non-empty, got an empty tuple.")
+        names = [m.name for m in self.metrics]
+        for o in self.objectives:
+            if o.metric not in names:
+                raise ValueError(f"Expected objectives to name metrics among {names}, got {o.metric!r}.")
+        check_int(self.poses_per_design, "poses_per_design", low=1)
+        check_int(self.default_chunk, "default_chunk", low=1)
+        check_int(self.default_designs, "default_designs", low=1)
+        check_choice(self.default_sampler, "default_sampler", ("sobol", "lhs", "grid", "random"))
+        if not isinstance(self.parameters, Mapping):
+            raise ValueError(f"Expected parameters to be a mapping, got {type(self.parameters).__name__}.")
 
     @property
     def variable_names(self) -> tuple[str, ...]:
@@ -188,35 +225,53 @@ class DesignStudy:
         }
 
 
-def with_variables(study: DesignStudy, overrides: Sequence[Variable]) -> DesignStudy:
-    """The study with its variables replaced or extended by ``overrides`` (validated).
+def _check_text(value: object, name: str) -> None:
+    if not isinstance(value, str):
+        raise ValueError(f"Expected {name} to be a str, got {type(value).__name__}.")
+
+
+def check_variables(variables: object, name: str = "variables") -> tuple[Variable, ...]:
+    """A sequence of Variable (not a str) as a tuple."""
+    if isinstance(variables, str | bytes) or not isinstance(variables, Sequence):
+        raise ValueError(f"Expected {name} to be a sequence of Variable, got {type(variables).__name__}.")
+    if not all(isinstance(v, Variable) for v in variables):
+        bad = next(type(v).__name__ for v in variables if not isinstance(v, Variable))
+        raise ValueError(f"Expected {name} to be a sequence of Variable, got an element of type {bad}.")
+    return tuple(variables)
+
+
+def with_variables(study: DesignStudy, variables: Sequence[Variable]) -> DesignStudy:
+    """The study with its variables replaced or extended by ``variables`` (validated).
 
     A ``range`` variable must name a field of the study's parameter dataclass; a ``normal`` variable must
     name one of the study's manufacturing errors.  An override of an existing variable keeps its unit
     and description when the override gives none.
     """
+    if not isinstance(study, DesignStudy):
+        raise ValueError(f"Expected study to be a DesignStudy, got {type(study).__name__}.")
+    overrides = check_variables(variables, "variables")
     fields = study.parameter_fields()
     current = {v.name: v for v in study.variables}
     for ov in overrides:
         if ov.kind == "range":
             if study.error_names and ov.name in study.error_names:
                 raise ValueError(
-                    f"Expected a standard deviation for error {ov.name!r} of study {study.name!r} "
-                    f"(NAME=SIGMA), got a range."
+                    f"Expected variables to give a standard deviation for error {ov.name!r} of study "
+                    f"{study.name!r} (NAME=SIGMA), got a range."
                 )
             if ov.name not in fields:
                 raise ValueError(
-                    f"Expected design variable {ov.name!r} to be a field of "
-                    f"{type(study.nominal()).__name__}; its fields are: {', '.join(fields)}."
+                    f"Expected variables to name fields of {type(study.nominal()).__name__}, got "
+                    f"design variable {ov.name!r}, not a field; its fields are: {', '.join(fields)}."
                 )
         elif ov.name not in study.error_names:
             raise ValueError(
-                f"Expected error {ov.name!r} to be one of study {study.name!r}'s manufacturing errors: "
-                f"{', '.join(study.error_names) or '(none)'}."
+                f"Expected variables to name study {study.name!r}'s manufacturing errors "
+                f"({', '.join(study.error_names) or 'it has none'}), got error {ov.name!r}."
             )
         old = current.get(ov.name)
         if old is not None and old.kind != ov.kind:
-            raise ValueError(f"Expected variable {ov.name!r} to be of kind {old.kind!r}, got {ov.kind!r}.")
+            raise ValueError(f"Expected variables[{ov.name!r}] to be of kind {old.kind!r}, got {ov.kind!r}.")
         if old is not None:
             ov = dataclasses.replace(
                 ov, unit=ov.unit or old.unit, description=ov.description or old.description
