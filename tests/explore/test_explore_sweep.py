@@ -196,3 +196,37 @@ def test_nsga2_evaluates_through_the_store_and_reuses_it(tmp_path, client):
         st, tmp_path / "o", population=8, generations=2, seed=1, client=client, progress=False
     )
     assert again.computed_chunks == ()
+
+
+def test_report_pages_from_stores(tmp_path, client):
+    from robomech.studies._sweep import write_sweep_report
+
+    run_sweep(get_study(STUDY), tmp_path / "a", client=client, progress=False, **SMALL)
+    md = write_sweep_report(tmp_path / "a", tmp_path / "ra").read_text()
+    assert "Pareto front" in md and "pareto_front.png" in md
+    png = (tmp_path / "ra" / "pareto_front.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+    st = get_study("vectored-thrust-tolerance")
+    run_sweep(st, tmp_path / "b", client=client, progress=False, designs=64, chunk_size=32)
+    md = write_sweep_report(tmp_path / "b", tmp_path / "rb").read_text()
+    assert "Sensitivity ranking" in md and "tolerance_histograms.png" in md and "worst case" in md
+    assert (tmp_path / "rb" / "report.html").exists() and (tmp_path / "rb" / "results.json").exists()
+
+
+def test_cli_report_and_json(tmp_path, capsys):
+    import json
+
+    out = tmp_path / "s"
+    argv = ["sweep", "omnileg-synthesis", "--out", str(out), "--designs", "8", "--chunk-size", "4"]
+    assert main([*argv, "--workers", "1", "--report", "--json", "--quiet"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["computed_chunks"] == 2 and Path(res["report"]).exists()
+    assert (out / "report" / "pareto_front.png").exists()
+    assert main([*argv, "--workers", "1", "--json", "--quiet"]) == 0  # resumed: nothing to compute
+    assert json.loads(capsys.readouterr().out)["computed_chunks"] == 0
+
+
+def test_sweep_demo_is_a_registered_study():
+    from robomech.studies import available_studies
+
+    assert "sweep-demo" in available_studies()

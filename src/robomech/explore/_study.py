@@ -150,10 +150,17 @@ class DesignStudy:
     default_designs: int = 256
     notes: tuple[str, ...] = ()
     error_names: tuple[str, ...] = ()  # names a kind="normal" variable may take
+    # summarize(study, results) -> list of {"title", "columns", "rows", "note"} tables for the report
+    # (results: open_results of the store); study-level analyses such as a sensitivity ranking
+    summarize: Callable[[DesignStudy, Mapping[str, Any]], list[dict[str, Any]]] | None = None
 
     def __post_init__(self) -> None:
         for n in ("name", "title", "mechanism"):
             _check_text(getattr(self, n), n)
+        if self.summarize is not None and not callable(self.summarize):
+            raise ValueError(
+                f"Expected summarize to be callable or None, got {type(self.summarize).__name__}."
+            )
         for n in ("nominal", "evaluate"):
             if not callable(getattr(self, n)):
                 raise ValueError(f"Expected {n} to be callable, got {type(getattr(self, n)).__name__}.")
