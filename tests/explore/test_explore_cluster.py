@@ -18,7 +18,8 @@ import numpy as np
 import pytest
 
 from robomech.cli import main
-from robomech.explore import design_matrix, evaluate_chunk, get_study, open_results, run_sweep
+from robomech.explore import design_matrix, get_study, open_results, run_sweep
+from robomech.explore._runner import evaluate_chunk
 
 pytestmark = pytest.mark.slow
 

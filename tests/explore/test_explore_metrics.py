@@ -173,3 +173,13 @@ def test_l5_translates_the_omnileg_workspace():
     res = om.STUDY.evaluate_rows(rows, None)
     assert res["workspace_volume"][0] == pytest.approx(res["workspace_volume"][1], rel=ROUNDING)
     assert res["min_abs_det_j"][0] == pytest.approx(res["min_abs_det_j"][1], rel=ROUNDING)
+
+
+def test_an_error_that_makes_the_parameters_invalid_is_a_failed_design():
+    st = get_study("vectored-thrust-tolerance")
+    rows = np.zeros((2, len(st.variables)))
+    rows[0, st.variable_names.index("arc_angle")] = -1.0  # arc angle < 0: VectoredThruster refuses it
+    res = st.evaluate_rows(rows, None)
+    assert res["design_ok"].tolist() == [False, True]
+    assert np.isnan(res["rms_error"][0]) and not res["assembles"][0]
+    assert res["max_error"][1] == pytest.approx(0.0, abs=ROUNDING)  # no error: the nominal axis

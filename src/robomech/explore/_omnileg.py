@@ -109,6 +109,6 @@ STUDY = DesignStudy(
     ),
     poses_per_design=SIMPSON_POINTS**3 + round(6.0 / EQ52_STEP) + 1,
     default_sampler="sobol",
-    default_chunk=32,
+    default_chunk=64,
     default_designs=256,
 )

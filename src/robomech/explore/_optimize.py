@@ -35,6 +35,9 @@ from ._study import DesignStudy, Variable, check_variables, with_variables
 
 __all__ = ["optimize_nsga2"]
 
+# A generation's population is split into this many Dask tasks (at most; at least one design each).
+NSGA2_TASKS_PER_GENERATION = 8
+
 
 def optimize_nsga2(
     study: DesignStudy,
@@ -85,7 +88,8 @@ def optimize_nsga2(
     bar = _Bar(f"{study.name} (NSGA-II)", P * G, progress)
     computed: list[int] = []
     gen = [0]
-    sub = study.default_chunk
+    # Dask tasks per generation: a fixed split (never the worker count: chunk seeds must not depend on it)
+    sub = max(1, min(study.default_chunk, -(-P // NSGA2_TASKS_PER_GENERATION)))
 
     def evaluate(X: np.ndarray, c) -> dict[str, np.ndarray]:
         g = store[0]

@@ -171,6 +171,9 @@ class DesignStudy:
         if not self.variables or not self.metrics:
             raise ValueError("Expected variables and metrics to be non-empty, got an empty tuple.")
         names = [m.name for m in self.metrics]
+        reserved = {"designs", "design_ok", "chunk_done", "chunk_seconds", "report"} & set(names)
+        if reserved or len(set(names)) != len(names):
+            raise ValueError(f"Expected metrics with unique, unreserved names, got {names}.")
         for o in self.objectives:
             if o.metric not in names:
                 raise ValueError(f"Expected objectives to name metrics among {names}, got {o.metric!r}.")
@@ -189,16 +192,29 @@ class DesignStudy:
         return tuple(f.name for f in dataclasses.fields(self.nominal()))
 
     def designs_to_params(self, rows: np.ndarray) -> list[Any]:
-        """Parameter objects for the ``range`` variables of each row (None where the dataclass refuses)."""
+        """Parameter objects of each row (None where the dataclass refuses the design).
+
+        A ``range`` variable sets its field; a ``normal`` variable that names a field adds its error to
+        the nominal value (the as-built parameter); other ``normal`` variables are left to ``evaluate``.
+        """
         base = self.nominal()
-        idx = [(i, v.name) for i, v in enumerate(self.variables) if v.kind == "range"]
+        fields = {f.name for f in dataclasses.fields(base)}
+        idx = [
+            (i, v.name, v.kind == "normal")
+            for i, v in enumerate(self.variables)
+            if v.kind == "range" or v.name in fields
+        ]
         out: list[Any] = []
         for row in np.asarray(rows, dtype=float):
             if not idx:
                 out.append(base)
                 continue
+            values = {
+                name: float(getattr(base, name)) + float(row[i]) if err else float(row[i])
+                for i, name, err in idx
+            }
             try:
-                out.append(dataclasses.replace(base, **{name: float(row[i]) for i, name in idx}))
+                out.append(dataclasses.replace(base, **values))
             except ValueError:
                 out.append(None)  # the parameter dataclass rejects this combination: a failed design
         return out
