@@ -32,6 +32,8 @@ START_TIMEOUT = 90.0
 WATCHDOG = 400.0
 # Idle / lifetime limits handed to the processes themselves (they stop even if the test process dies).
 PROCESS_LIFETIME = "600s"
+# Seconds a process gets to exit on SIGTERM before it is killed (a worker may be mid-chunk).
+STOP_GRACE = 3.0
 
 STUDY = "spherical-leg-synthesis"
 ARGS = ["--designs", "48", "--chunk-size", "6", "--seed", "11", "--quiet"]  # 8 chunks
@@ -94,15 +96,17 @@ class _Cluster:
             time.sleep(0.3)
 
     def stop(self) -> None:
+        """SIGTERM every process this module started, SIGKILL what is left after STOP_GRACE seconds."""
         for p in self.procs.values():
             if p.poll() is None:
                 p.send_signal(signal.SIGTERM)
+        deadline = time.monotonic() + STOP_GRACE
         for p in self.procs.values():
             try:
-                p.wait(timeout=15)
+                p.wait(timeout=max(0.1, deadline - time.monotonic()))
             except subprocess.TimeoutExpired:
                 p.kill()
-                p.wait(timeout=15)
+                p.wait(timeout=30)
         self._timer.cancel()
 
 
