@@ -5,6 +5,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as hst
 
 from robomech.cli import main
 from robomech.explore import (
@@ -230,3 +232,36 @@ def test_sweep_demo_is_a_registered_study():
     from robomech.studies import available_studies
 
     assert "sweep-demo" in available_studies()
+
+
+@pytest.mark.parametrize(
+    "name", ["spherical-leg-synthesis", "vectored-thrust-tolerance", "omnileg-synthesis"]
+)
+def test_a_designs_result_does_not_depend_on_its_chunk(name):
+    # the basis of bit-identical sweeps with any chunking of the work among workers
+    st = get_study(name)
+    X = design_matrix(st.variables, 6, st.default_sampler, 2, 6)
+    whole = st.evaluate_rows(X, None)
+    parts = [st.evaluate_rows(X[i : i + 1], None) for i in range(6)]
+    for k, v in whole.items():
+        assert v.tobytes() == np.concatenate([p[k] for p in parts]).tobytes(), k
+
+
+def test_progress_bar_on_stderr(tmp_path, client, capsys):
+    run_sweep(get_study(STUDY), tmp_path / "s", client=client, progress=True, **SMALL)
+    err = capsys.readouterr().err
+    assert "24/24 designs (100%)" in err and "designs/s" in err and "s left" in err
+
+
+@settings(max_examples=25)
+@given(
+    lo=hst.floats(-1e3, 1e3),
+    width=hst.floats(1e-6, 1e3),
+    n=hst.integers(1, 70),
+    sampler=hst.sampled_from(["sobol", "lhs", "random"]),
+    seed=hst.integers(0, 2**32),
+)
+def test_range_samples_stay_inside_any_range(lo, width, n, sampler, seed):
+    v = Variable("x", lo, lo + width)
+    X = design_matrix([v, Variable("y", 0.0, 1.0)], n, sampler, seed, 16)
+    assert X.shape == (n, 2) and np.all((X[:, 0] >= v.low) & (X[:, 0] <= v.high))
