@@ -265,3 +265,14 @@ def test_range_samples_stay_inside_any_range(lo, width, n, sampler, seed):
     v = Variable("x", lo, lo + width)
     X = design_matrix([v, Variable("y", 0.0, 1.0)], n, sampler, seed, 16)
     assert X.shape == (n, 2) and np.all((X[:, 0] >= v.low) & (X[:, 0] <= v.high))
+
+
+def test_cli_interrupt_says_how_to_resume(monkeypatch, tmp_path, capsys):
+    import robomech.explore as ex
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(ex, "run_sweep", interrupted)
+    assert main(["sweep", STUDY, "--out", str(tmp_path / "s"), "--quiet"]) == 130
+    assert "rerun the same command" in capsys.readouterr().err

@@ -66,6 +66,13 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     except ValueError as exc:  # unknown study, bad variable, foreign store, unreachable scheduler
         print(f"robomech sweep: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print(
+            f"\nrobomech sweep: interrupted; finished chunks are stored in {args.out}, "
+            "rerun the same command to compute the rest",
+            file=sys.stderr,
+        )
+        return 130
     result = summary.as_dict()
     if args.report:
         from robomech.studies._sweep import write_sweep_report

@@ -141,11 +141,10 @@ class _Bar:
             return
         dt = time.perf_counter() - self.t0
         rate = self.done / dt if dt > 0 else 0.0
-        left = (self.total - self.done) / rate if rate > 0 else float("nan")
+        left = f"{(self.total - self.done) / rate:6.1f} s left" if rate > 0 else "     ? s left"
         pct = 100.0 * self.done / self.total if self.total else 100.0
         self.stream.write(
-            f"\r{self.label}: {self.done}/{self.total} designs ({pct:3.0f}%), {rate:8.1f} designs/s, "
-            f"{left:6.1f} s left"
+            f"\r{self.label}: {self.done}/{self.total} designs ({pct:3.0f}%), {rate:8.1f} designs/s, {left}"
         )
         self.stream.flush()
 
