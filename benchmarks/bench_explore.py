@@ -69,7 +69,9 @@ def _sweep(name: str, workers: int, chunks: int) -> dict:
         t0 = time.perf_counter()
         s = run_sweep(st, Path(d) / "s", designs=n, client=client, progress=False)
         wall = time.perf_counter() - t0
-        work = float(np.sum(open_results(Path(d) / "s")["chunk_seconds"]))
+        stored = open_results(Path(d) / "s")
+        work = float(np.sum(stored["chunk_seconds"]))
+        cpu = float(np.sum(stored["chunk_cpu_seconds"]))
     return {
         "study": name,
         "workers": workers,
@@ -83,6 +85,8 @@ def _sweep(name: str, workers: int, chunks: int) -> dict:
         "overhead_per_chunk_s": (wall * workers - work) / s.n_chunks,
         "work_per_chunk_s": work / s.n_chunks,
         "utilisation": work / (wall * workers),  # fraction of worker time spent in chunk work
+        "cpu_per_design_s": cpu / n,  # CPU time of the study's own computation per design
+        "cpu_share": cpu / work,  # CPU time / wall time of the chunks: < 1 when the cores are contended
     }
 
 
@@ -94,7 +98,8 @@ def main() -> int:
     rows = []
     print(
         f"{'study':<28} {'workers':>7} {'designs':>7} {'wall s':>7} {'poses/s':>10} {'efficiency':>10} "
-        f"{'chunk work s':>12} {'overhead/chunk s':>16} {'overhead %':>10} {'utilisation':>11}"
+        f"{'chunk work s':>12} {'overhead/chunk s':>16} {'overhead %':>10} {'utilisation':>11} "
+        f"{'cpu share':>9} {'cpu µs/pose':>11} {'free-core eff.':>14}"
     )
     for name in STUDIES:
         if args.only and args.only not in name:
@@ -103,12 +108,18 @@ def main() -> int:
         two = _sweep(name, 2, 2 * CHUNKS_PER_WORKER)
         for r in (one, two):
             r["efficiency"] = r["poses_per_s"] / (r["workers"] * one["poses_per_s"])
+            # free-core estimate: the same CPU per design and the measured Dask utilisation
+            r["cpu_efficiency"] = (
+                one["cpu_per_design_s"] / r["cpu_per_design_s"] * r["utilisation"] / one["utilisation"]
+            )
             pct = 100 * r["overhead_per_chunk_s"] / r["work_per_chunk_s"]
             print(
                 f"{name:<28} {r['workers']:>7} {r['designs']:>7} {r['wall_s']:>7.2f} "
                 f"{r['poses_per_s']:>10.3g} {r['efficiency']:>10.2f} {r['work_per_chunk_s']:>12.3f} "
                 f"{r['overhead_per_chunk_s']:>16.4f} "
-                f"{pct:>10.1f} {r['utilisation']:>11.2f}",
+                f"{pct:>10.1f} {r['utilisation']:>11.2f} {r['cpu_share']:>9.2f} "
+                f"{r['cpu_per_design_s'] / get_study(name).poses_per_design * 1e6:>11.3f} "
+                f"{r['cpu_efficiency']:>14.2f}",
                 flush=True,
             )
             rows.append(r)

@@ -191,7 +191,7 @@ def test_a_worker_killed_mid_run_costs_only_its_chunks(cluster, tmp_path):
     r = open_results(tmp_path / "s")
     X = design_matrix(study.variables, n, study.default_sampler, seed, chunk)
     for k in range(12):
-        _, ref, _ = evaluate_chunk(study, X[k * chunk : (k + 1) * chunk], seed, k)
+        _, ref, _, _ = evaluate_chunk(study, X[k * chunk : (k + 1) * chunk], seed, k)
         for name, arr in ref.items():
             assert r[name][k * chunk : (k + 1) * chunk].tobytes() == arr.tobytes(), (k, name)
     assert np.all(r["chunk_done"])

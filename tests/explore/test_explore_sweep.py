@@ -56,7 +56,7 @@ def test_store_layout_and_attributes(tmp_path, client):
     np.testing.assert_array_equal(r["designs"], design_matrix(st.variables, 24, "sobol", 3, 6))
     for m in st.metrics:
         assert r[m.name].shape[0] == 24
-    assert r["chunk_done"].all() and np.all(r["chunk_seconds"] > 0)
+    assert r["chunk_done"].all() and np.all(r["chunk_seconds"] > 0) and np.all(r["chunk_cpu_seconds"] > 0)
     a = r["attrs"]
     assert a["study"] == STUDY and a["robomech_version"] and a["units"]["R"] == "m"
     assert [v["name"] for v in a["variables"]] == ["R", "r", "h"]

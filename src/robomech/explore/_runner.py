@@ -81,10 +81,10 @@ def robomech_version() -> str:
 
 
 def evaluate_chunk(study: DesignStudy, rows: np.ndarray, seed: int, chunk: int):
-    """One task: the metrics of chunk ``chunk``'s design rows, and the worker seconds it took."""
-    t0 = time.perf_counter()
+    """One task: the metrics of chunk ``chunk``'s design rows, and the wall and CPU seconds it took."""
+    t0, c0 = time.perf_counter(), time.process_time()
     res = study.evaluate_rows(rows, chunk_seed(seed, chunk))
-    return chunk, res, time.perf_counter() - t0
+    return chunk, res, time.perf_counter() - t0, time.process_time() - c0
 
 
 @contextmanager
@@ -250,11 +250,12 @@ def run_sweep(
             ]
             try:
                 for fut in as_completed(futures):
-                    k, res, secs = fut.result()
+                    k, res, secs, cpu = fut.result()
                     rows = slice(k * chunk, min((k + 1) * chunk, n))
                     for name, arr in res.items():
                         g[name][rows] = arr
                     g["chunk_seconds"][k] = secs
+                    g["chunk_cpu_seconds"][k] = cpu
                     g["chunk_done"][k] = True  # last: the chunk's rows are all written
                     computed.append(k)
                     bar.update(rows.stop - rows.start)

@@ -6,7 +6,8 @@ Layout of the group ``DIR``::
     design_ok      (n,) bool                  the parameter dataclass accepted the design
     <metric>       (n, *shape)                one array per metric, chunked like the sweep
     chunk_done     (n_chunks,) bool           chunk k's rows of every metric are written
-    chunk_seconds  (n_chunks,) float64        worker time of chunk k (for the overhead figures)
+    chunk_seconds  (n_chunks,) float64        worker wall time of chunk k (for the overhead figures)
+    chunk_cpu_seconds (n_chunks,) float64     worker CPU time of chunk k (its process)
     attrs          robomech: {format, version, study, fingerprint, variables, metrics, units, ...}
 
 A chunk's metric rows are written before its ``chunk_done`` flag, so an interrupted run never marks
@@ -113,7 +114,8 @@ def prepare_store(
         g.create_array(m.name, shape=(n, *m.shape), chunks=(chunk, *m.shape), dtype=m.dtype, fill_value=fill)
         g[m.name].attrs.update({"unit": m.unit, "description": m.description})
     g.create_array("chunk_done", shape=(n_chunks,), chunks=(1,), dtype="bool", fill_value=False)
-    g.create_array("chunk_seconds", shape=(n_chunks,), chunks=(1,), dtype="float64", fill_value=np.nan)
+    for name in ("chunk_seconds", "chunk_cpu_seconds"):
+        g.create_array(name, shape=(n_chunks,), chunks=(1,), dtype="float64", fill_value=np.nan)
     g["designs"].attrs.update({"columns": [v.name for v in study.variables]})
     g.attrs.update({"robomech": _canonical({"format": FORMAT, "fingerprint": fp, **info})})
     return g

@@ -171,7 +171,14 @@ class DesignStudy:
         if not self.variables or not self.metrics:
             raise ValueError("Expected variables and metrics to be non-empty, got an empty tuple.")
         names = [m.name for m in self.metrics]
-        reserved = {"designs", "design_ok", "chunk_done", "chunk_seconds", "report"} & set(names)
+        reserved = {
+            "designs",
+            "design_ok",
+            "chunk_done",
+            "chunk_seconds",
+            "chunk_cpu_seconds",
+            "report",
+        } & set(names)
         if reserved or len(set(names)) != len(names):
             raise ValueError(f"Expected metrics with unique, unreserved names, got {names}.")
         for o in self.objectives:
