@@ -43,10 +43,12 @@ class Spec:
     ``masked``   array arguments whose non-finite samples are flagged instead: NaN/inf at one sample
                  must give ``mask`` False at exactly that sample, the other samples unchanged (the
                  argument's batch shape must equal the result mask's shape).
-    ``mask``     the result's per-sample mask: attribute name, or index into a returned tuple.
+    ``mask``     the result's per-sample mask: attribute name, index into a returned tuple, or a
+                 function of the result (e.g. ``lambda r: np.isfinite(r[1])``).
     ``params``   parameter-object arguments: None, a str and a foreign object must raise naming them.
     ``options``  scalar options -> bad values (use BAD_REAL, BAD_POSITIVE, BAD_INT, BAD_BOOL, ...).
-    ``wrong_shapes``  extra bad shapes per array argument (default: last core dimension + 1).
+    ``wrong_shapes``  bad shapes per array argument, replacing the default (last core dimension + 1);
+                 ``()`` for an argument whose every shape is acceptable.
     ``call``     what to call (default: the public object itself) as ``call(**args)``.
     ``finite_result``  the good call's result must be finite wherever ``mask`` is true (or everywhere
                  without ``mask``); False for functions whose good output may be inf by design.
@@ -56,7 +58,7 @@ class Spec:
     args: Mapping[str, Any]
     arrays: Mapping[str, int] = field(default_factory=dict)
     masked: tuple[str, ...] = ()
-    mask: str | int | None = None
+    mask: str | int | Callable[[Any], Any] | None = None
     params: tuple[str, ...] = ()
     options: Mapping[str, tuple[Any, ...]] = field(default_factory=dict)
     wrong_shapes: Mapping[str, tuple[tuple[int, ...], ...]] = field(default_factory=dict)

@@ -94,7 +94,10 @@ def _arrays_of(res: Any) -> list[tuple[str, np.ndarray]]:
 
 
 def _mask_of(spec: Spec, res: Any) -> np.ndarray:
-    m = res[spec.mask] if isinstance(spec.mask, int) else getattr(res, spec.mask)
+    if callable(spec.mask):
+        m = spec.mask(res)
+    else:
+        m = res[spec.mask] if isinstance(spec.mask, int) else getattr(res, spec.mask)
     return np.asarray(m, dtype=bool)
 
 
@@ -177,7 +180,7 @@ def _variants(name: str, spec: Spec, arg: str) -> list[tuple[str, Any]]:
     c.flat[0] += 1j
     out.append(("complex", c))
     core = spec.arrays[arg]
-    if core >= 1 and a.ndim >= 1:
+    if arg not in spec.wrong_shapes and core >= 1 and a.ndim >= 1:
         out.append(("shape+1", np.concatenate([a, a[..., :1]], axis=-1)))
     for shape in spec.wrong_shapes.get(arg, ()):
         out.append((f"shape{shape}", np.full(shape, 0.1)))

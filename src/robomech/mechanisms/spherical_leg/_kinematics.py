@@ -333,7 +333,9 @@ def _fk_kernel_compiled(
 @functools.cache
 def _fk_numba_kernels():
     """Compile (or load from the on-disk cache) the forward-kinematics kernels: (fit, close)."""
-    import numba  # deferred: ~0.3 s import and the compilation are paid by large-batch FK users only
+    from robomech._numba import import_numba
+
+    numba = import_numba()  # deferred: ~0.3 s import and compilation, paid by large-batch FK users only
 
     @numba.njit(parallel=True, cache=True, error_model="numpy")
     def fit(L, R, r, h, max_iter, newton_tol, gn_tol, floor2, M, cb, sb, ok, conv):  # pragma: no cover
