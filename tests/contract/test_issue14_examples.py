@@ -119,3 +119,32 @@ def test_mobility_rejects_a_chain_passed_transposed():
     mobility.analyze([chain])
     with pytest.raises(ValueError, match=r"chains\[0\]"):
         mobility.analyze([chain.T])
+
+
+def test_mobility_flags_the_vectored_thruster_on_its_rank_one_curve():
+    """Defect 8: on the idle-input curve the DOF is 1 while the modified count says 2: flagged."""
+    from robomech.mechanisms import vectored_thrust as vt
+
+    th = vt.VectoredThruster()
+    q1 = 0.3
+    m = vt.platform_mobility(th, (q1, float(vt.idle_input_curve(th, q1))))
+    assert (m.dof, m.modified_gruebler_kutzbach) == (1, 2)
+    assert m.singular and "singular" in m.warning
+    regular = vt.platform_mobility(th, (0.3, -0.2))
+    assert regular.dof == 2 and not regular.singular and regular.warning == ""
+
+
+def test_spherical_leg_rejects_a_missing_parameter_object():
+    from robomech.mechanisms import spherical_leg as sl
+
+    with pytest.raises(ValueError, match="Expected leg to be a SphericalLeg, got NoneType."):
+        sl.inverse_kinematics(None, 0.1, 0.2)
+
+
+def test_parameter_fields_store_floats_never_strings():
+    from robomech.mechanisms import spherical_leg as sl
+
+    with pytest.raises(ValueError, match="R"):
+        sl.SphericalLeg(R="0.075")
+    leg = sl.SphericalLeg(R=np.float32(0.075), h=1)
+    assert type(leg.R) is float and type(leg.h) is float

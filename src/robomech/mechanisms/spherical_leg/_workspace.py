@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech._validation import check_params
 from robomech.spatial import sincos
 
 from ._kinematics import LENGTH_FLOOR, _angles, _chunked, _squared_length_columns
@@ -48,6 +49,7 @@ def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMa
 
     The singular values of the 3x2 J come from the eigenvalues of the 2x2 Gram matrix J^T J.
     """
+    check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
     n = a.size
     outs = (np.empty((n, 3)), np.empty(n, dtype=bool), np.empty(n), np.empty(n), np.empty(n), np.empty(n))
