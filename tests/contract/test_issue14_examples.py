@@ -137,7 +137,7 @@ def test_mobility_flags_the_vectored_thruster_on_its_rank_one_curve():
 def test_spherical_leg_rejects_a_missing_parameter_object():
     from robomech.mechanisms import spherical_leg as sl
 
-    with pytest.raises(ValueError, match="Expected leg to be a SphericalLeg, got NoneType."):
+    with pytest.raises(ValueError, match=r"Expected leg to be a SphericalLeg, got NoneType\."):
         sl.inverse_kinematics(None, 0.1, 0.2)
 
 
@@ -148,3 +148,12 @@ def test_parameter_fields_store_floats_never_strings():
         sl.SphericalLeg(R="0.075")
     leg = sl.SphericalLeg(R=np.float32(0.075), h=1)
     assert type(leg.R) is float and type(leg.h) is float
+
+
+def test_continuum_integer_fields_reject_bools_and_capstan_rejects_n_zero():
+    from robomech.mechanisms import continuum as c
+
+    with pytest.raises(ValueError, match="n_segments"):
+        c.ContinuumRobot(n_segments=True)
+    with pytest.raises(ValueError, match="n"):
+        c.capstan_coefficient(np.array([2.0]), 1.0, 0.0)
