@@ -53,6 +53,8 @@ class Spec:
     ``finite_result``  the good call's result must be finite wherever ``mask`` is true (or everywhere
                  without ``mask``); False for functions whose good output may be inf by design.
     ``slow``     mark the good call and its bad calls ``pytest.mark.slow``.
+    ``good_elsewhere``  for a call that takes minutes (a whole engine verification): the test file
+                 that runs the good call; the contract suite then makes only the bad calls.
     """
 
     args: Mapping[str, Any]
@@ -65,8 +67,13 @@ class Spec:
     call: Callable[..., Any] | None = None
     finite_result: bool = True
     slow: bool = False
+    good_elsewhere: str = ""
 
     def __post_init__(self) -> None:
+        if self.good_elsewhere and (self.masked or self.mask is not None):
+            raise ValueError("a spec with good_elsewhere cannot check masks (they need the good call)")
+        if self.good_elsewhere and not (HERE.parent.parent / self.good_elsewhere).exists():
+            raise ValueError(f"good_elsewhere names a missing test file: {self.good_elsewhere}")
         for a in self.masked:
             if a not in self.arrays:
                 raise ValueError(f"masked argument {a!r} must also be listed in arrays")

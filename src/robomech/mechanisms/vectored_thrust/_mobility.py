@@ -44,7 +44,7 @@ def chain_screws(
     if not ax.valid:
         raise ValueError(f"Expected q away from the singularity (|s22 x s12| > 0), got q = {qa.tolist()}.")
     if offsets is not None and not isinstance(offsets, dict):
-        raise ValueError(f"Expected offsets to be a dict of axis name -> point, got {type(offsets).__name__}.")
+        raise ValueError(f"Expected offsets to be a dict of axis name -> point, got {type(offsets).__name__}")
     offsets = dict(offsets or {})
     for k in offsets:
         if k not in _JOINTS:
