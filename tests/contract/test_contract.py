@@ -21,7 +21,6 @@ import pytest
 from contract_spec import Spec, load_specs, public_names, spec_file_for
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from pending import PENDING
 
 # Acceptance of issue 14: no public call takes longer than 5 s on bad input.
 BAD_CALL_SECONDS = 5.0
@@ -214,15 +213,10 @@ ARRAY_CASES, PARAM_CASES, OPTION_CASES = _cases()
 
 # --- coverage -------------------------------------------------------------------------------------
 def test_every_public_name_has_a_spec():
-    missing = [n for n in sorted(PUBLIC) if n not in SPECS and n not in PENDING]
+    missing = [n for n in sorted(PUBLIC) if n not in SPECS]
     assert not missing, "public names without a bad-input spec (see tests/contract/README.md):\n" + "\n".join(
         f"  {n}  -> add it to tests/contract/{spec_file_for(n)}" for n in missing
     )
-
-
-def test_pending_names_have_no_spec_yet():
-    done = sorted(n for n in PENDING if n in SPECS or n not in PUBLIC)
-    assert not done, f"remove these from tests/contract/pending.py: {done}"
 
 
 def test_no_spec_for_a_name_that_is_not_public():
