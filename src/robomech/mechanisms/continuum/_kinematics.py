@@ -14,7 +14,10 @@ from typing import Literal
 import numpy as np
 
 from robomech._validation import as_array, check_params
-from robomech.spatial import SMALL_ANGLE, sincos
+from robomech.spatial import SMALL_ANGLE
+
+# the unvalidated kernel: inputs are validated once at this module's public boundary
+from robomech.spatial._so3 import _sincos as sincos
 
 from ._params import ContinuumRobot
 

@@ -19,7 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomech._validation import as_array, check_int, check_params
-from robomech.spatial import sincos
+
+# the unvalidated kernel: inputs are validated once at this module's public boundary
+from robomech.spatial._so3 import _sincos as sincos
 
 from ._params import SphericalLeg
 

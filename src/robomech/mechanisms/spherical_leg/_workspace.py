@@ -12,7 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomech._validation import check_params
-from robomech.spatial import sincos
+
+# the unvalidated kernel: inputs are validated once at this module's public boundary
+from robomech.spatial._so3 import _sincos as sincos
 
 from ._kinematics import LENGTH_FLOOR, _angles, _chunked, _squared_length_columns
 from ._params import SphericalLeg

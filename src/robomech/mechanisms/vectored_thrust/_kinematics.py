@@ -24,7 +24,10 @@ from typing import TypeVar
 import numpy as np
 
 from robomech._validation import as_array, check_params
-from robomech.spatial import lie_bracket, sincos
+from robomech.spatial import lie_bracket
+
+# the unvalidated kernel: inputs are validated once at this module's public boundary
+from robomech.spatial._so3 import _sincos as sincos
 
 from ._params import VectoredThruster
 
