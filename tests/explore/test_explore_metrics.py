@@ -16,9 +16,9 @@ from robomech.mechanisms import vectored_thrust as vt
 
 # Closed forms vs the kernels: rounding of O(1) trigonometry, a few hundred ulps.
 ROUNDING = 1e-12
-# Simpson with 13 points per axis vs the exact projected-area volume: the integrand is smooth; measured
-# relative error ~1e-6, bounded here with margin.
-SIMPSON_RTOL = 1e-4
+# Simpson with 13 points per axis vs the exact projected-area volume: measured relative error 6.0e-5 for
+# all three designs (the integrand's shape does not change with L1, L4), bounded here with margin.
+SIMPSON_RTOL = 1.5e-4
 # Shoelace polygon of the projected boundary with 4 x 4000 edges: second-order in the edge length.
 POLYGON_RTOL = 1e-6
 # Monte Carlo mean of rms^2 vs the linearised prediction: 5 standard errors, plus the second-order
