@@ -104,6 +104,10 @@ def build_parser() -> argparse.ArgumentParser:
     from ._export import add_parser as add_export_parser  # `robomech export` (issue 13)
 
     add_export_parser(sub)
+
+    from ._sweep import register as register_sweep  # robomech.explore: docs/explore.md
+
+    register_sweep(sub)
     return p
 
 
