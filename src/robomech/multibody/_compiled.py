@@ -13,16 +13,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 
-from ._assembly import MAX_ITER, MAX_STEP, MU_MAX, MU_MIN, MU_START, STOP_RTOL
+from robomech._numba import import_numba
+
+from ._assembly import COMPILED_MIN, MAX_ITER, MAX_STEP, MU_MAX, MU_MIN, MU_START, STOP_RTOL
 from ._influence import PASSIVE_RANK_RTOL
 
+numba = import_numba()  # numba's kernel cache outside the package (robomech._numba)
+
 __all__ = ["COMPILED_MIN", "Tables", "compiled_fk", "compiled_site_jacobian", "tables"]
-
-
-from ._assembly import COMPILED_MIN
 
 
 @dataclass(frozen=True, eq=False)
