@@ -92,7 +92,7 @@ def test_every_module_respects_the_layering():
         lazy = LAZY_ONLY.get((layer, path.name), set())
         for mod in _module_level_imports(path):
             if mod.split(".")[0] in lazy:
-                problems.append(f"{path.relative_to(SRC)} imports {mod} at module level (only lazily allowed)")
+                problems.append(f"{path.relative_to(SRC)} imports {mod} at module level (lazy only)")
         for mod in _imports(path):
             top = mod.split(".")[0]
             if top in ENGINES and layer != "verify" and top not in lazy:

@@ -175,7 +175,7 @@ def test_singularity_map_over_an_output_grid():
     xy = workspace.grid([(-0.05, 0.05), (-0.05, 0.05)], 3).reshape(-1, 2)
     T = np.tile(np.eye(4), (len(xy) + 1, 1, 1))
     T[:-1, :3, 3] = p0 + np.column_stack([xy, np.zeros(len(xy))])
-    T[-1, :3, 3] = p0 + [2.0, 0.0, 0.0]  # beyond the arms' reach
+    T[-1, :3, 3] = p0 + np.array([2.0, 0.0, 0.0])  # beyond the arms' reach
     mp = mb.singularity_map(delta, "tcp", T=T, ik_weights=(0, 0, 0, 1, 1, 1), steps=1)
     assert mp.reachable[:-1].all() and not mp.reachable[-1]
     assert np.all(np.isfinite(mp.dexterity[:-1])) and np.isnan(mp.dexterity[-1])

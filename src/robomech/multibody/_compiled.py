@@ -17,16 +17,13 @@ import numpy as np
 
 from robomech._numba import import_numba
 
-from ._assembly import MAX_ITER, MAX_STEP, MU_MAX, MU_MIN, MU_START, STOP_RTOL
+from ._assembly import COMPILED_MIN, MAX_ITER, MAX_STEP, MU_MAX, MU_MIN, MU_START, STOP_RTOL
 from ._influence import PASSIVE_RANK_RTOL
-
-# this module is imported on the first large batch only; the kernel cache lives in robomech's cache dir
-numba = import_numba()
 
 __all__ = ["COMPILED_MIN", "Tables", "compiled_fk", "compiled_site_jacobian", "tables"]
 
-
-from ._assembly import COMPILED_MIN
+# this module is imported on the first large batch only; the kernel cache lives in robomech's cache dir
+numba = import_numba()
 
 
 @dataclass(frozen=True, eq=False)
