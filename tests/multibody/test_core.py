@@ -10,6 +10,8 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from robomech import multibody as mb
 from robomech.testing import numerical_jacobian
@@ -342,3 +344,15 @@ def test_continuation_along_a_trajectory_keeps_the_branch():
     # the open branch from the reference configuration has the other sign
     open_ = mb.forward_kinematics(FOUR_BAR, np.array([2.0]), steps=8).q
     assert np.sign(np.sin(open_[2] - open_[0])) != side[0]
+
+
+@settings(max_examples=40)
+@given(x=st.floats(-np.pi, np.pi), rate=st.floats(-5.0, 5.0))
+def test_property_four_bar_closes_and_G_is_admissible(x, rate):
+    """Any crank angle assembles (Grashof crank-rocker), satisfies Freudenstein, and K G qd = 0."""
+    fk = mb.forward_kinematics(FOUR_BAR, np.array([x]), steps=4)
+    assert fk.converged
+    assert abs(_freudenstein(fk.q)) < CLOSED_FORM_TOL
+    G = mb.influence(FOUR_BAR, fk.q, second_order=False).G
+    K = mb.constraint_jacobian(FOUR_BAR, fk.q)
+    assert np.max(np.abs(K @ G @ np.array([rate]))) < CLOSED_FORM_TOL * max(1.0, abs(rate))
