@@ -166,3 +166,17 @@ def test_drawing_closes_the_loop():
     assert len(ax.lines) == sum(len(s) for s in segs.values())
     with pytest.raises(ValueError, match="q"):
         mb.draw(FOUR_BAR, np.zeros((2, 3)))
+
+
+def test_singularity_map_over_an_output_grid():
+    """Delta: a grid of platform positions (IK, orientation free), reachable near home, not 2 m away."""
+    delta = mb.gallery.load("delta")
+    p0 = mb.site_pose(delta, delta.q0, "tcp")[:3, 3]
+    xy = workspace.grid([(-0.05, 0.05), (-0.05, 0.05)], 3).reshape(-1, 2)
+    T = np.tile(np.eye(4), (len(xy) + 1, 1, 1))
+    T[:-1, :3, 3] = p0 + np.column_stack([xy, np.zeros(len(xy))])
+    T[-1, :3, 3] = p0 + np.array([2.0, 0.0, 0.0])  # beyond the arms' reach
+    mp = mb.singularity_map(delta, "tcp", T=T, ik_weights=(0, 0, 0, 1, 1, 1), steps=1)
+    assert mp.reachable[:-1].all() and not mp.reachable[-1]
+    assert np.all(np.isfinite(mp.dexterity[:-1])) and np.isnan(mp.dexterity[-1])
+    assert not mp.singular[:-1].any()

@@ -10,6 +10,8 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from robomech import multibody as mb
 from robomech.testing import numerical_jacobian
@@ -317,3 +319,40 @@ def test_bodies_follow_mujoco_order_so_q_is_its_qpos():
     assert [x.name for x in mech.bodies] == ["a", "a_child", "b"]
     m = mujoco.MjModel.from_xml_string(mb.to_mjcf(mech))
     assert [m.joint(i).name for i in range(m.njnt)] == list(mech.tree.jnt_names) == ["ja", "jc", "jb"]
+
+
+def test_continuation_along_a_trajectory_keeps_the_branch():
+    """From the crossed assembly of the four-bar, each step guessed from the last stays crossed."""
+    q0 = FOUR_BAR.q0
+    # the crossed branch at the reference input: reflect C about the line B-D (crank at 90 deg)
+    B, D = np.array([0.0, 0.3]), np.array([0.9, 0.0])
+    C = np.array([0.9, 0.8])
+    e = (D - B) / np.linalg.norm(D - B)
+    Cx = B + 2 * ((C - B) @ e) * e - (C - B)
+    t3 = np.arctan2(*(Cx - B)[::-1])  # coupler angle, world
+    t4 = np.arctan2(*(Cx - D)[::-1])
+    crossed = np.array([q0[0], t3 - 0.0 - np.arctan2(0.5, 0.9), t4 - np.pi / 2])
+    assert np.max(np.abs(mb.constraint_residual(FOUR_BAR, crossed))) < CLOSED_FORM_TOL
+    q, side = crossed, []
+    for x in np.linspace(0.0, 2.0, 21):
+        fk = mb.forward_kinematics(FOUR_BAR, np.array([x]), guess=q)
+        assert fk.converged
+        q = fk.q
+        side.append(np.sign(np.sin(q[2] - q[0])))  # the crossed branch keeps its orientation sign
+        assert abs(_freudenstein(q)) < CLOSED_FORM_TOL
+    assert len(set(side)) == 1
+    # the open branch from the reference configuration has the other sign
+    open_ = mb.forward_kinematics(FOUR_BAR, np.array([2.0]), steps=8).q
+    assert np.sign(np.sin(open_[2] - open_[0])) != side[0]
+
+
+@settings(max_examples=40)
+@given(x=st.floats(-np.pi, np.pi), rate=st.floats(-5.0, 5.0))
+def test_property_four_bar_closes_and_G_is_admissible(x, rate):
+    """Any crank angle assembles (Grashof crank-rocker), satisfies Freudenstein, and K G qd = 0."""
+    fk = mb.forward_kinematics(FOUR_BAR, np.array([x]), steps=4)
+    assert fk.converged
+    assert abs(_freudenstein(fk.q)) < CLOSED_FORM_TOL
+    G = mb.influence(FOUR_BAR, fk.q, second_order=False).G
+    K = mb.constraint_jacobian(FOUR_BAR, fk.q)
+    assert np.max(np.abs(K @ G @ np.array([rate]))) < CLOSED_FORM_TOL * max(1.0, abs(rate))

@@ -20,9 +20,10 @@ from robomech._numba import import_numba
 from ._assembly import COMPILED_MIN, MAX_ITER, MAX_STEP, MU_MAX, MU_MIN, MU_START, STOP_RTOL
 from ._influence import PASSIVE_RANK_RTOL
 
-numba = import_numba()  # numba's kernel cache outside the package (robomech._numba)
-
 __all__ = ["COMPILED_MIN", "Tables", "compiled_fk", "compiled_site_jacobian", "tables"]
+
+# this module is imported on the first large batch only; the kernel cache lives in robomech's cache dir
+numba = import_numba()
 
 
 @dataclass(frozen=True, eq=False)

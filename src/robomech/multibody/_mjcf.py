@@ -88,7 +88,6 @@ def from_mjcf(path_or_xml: str | os.PathLike) -> Mechanism:
     unsupported = [
         ("tendon", m.ntendon),
         ("flex", m.nflex),
-        ("skin", 0),
         ("mocap body", m.nmocap),
     ]
     for what, n in unsupported:

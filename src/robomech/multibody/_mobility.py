@@ -225,9 +225,12 @@ def mobility(mech: Mechanism, q: object = None, *, platform: str | None = None) 
         p_rot = _rank(p_tw[:, :3], 1.0) if p_dof else 0
         legs = _serial_legs(mech, st, pb)
         if legs is not None:
-            # analysis.mobility wants prismatic rows with |v| = length_scale (unit after its scaling)
-            L = tree.length
-            legs = [np.where((np.linalg.norm(c[:, :3], axis=1) < 1e-12)[:, None], c * L, c) for c in legs]
+            # analysis.mobility divides moments by length_scale and wants unit screws after that:
+            # prismatic screws [0; d] are passed as [0; L d]
+            legs = [
+                np.where(np.linalg.norm(c[:, :3], axis=1, keepdims=True) < 1e-12, tree.length * c, c)
+                for c in legs
+            ]
             sm = screw_mobility.analyze(legs, length_scale=tree.length)
     act = "exact" if na == dof else ("redundant" if na > dof else "under")
     return MobilityReport(
