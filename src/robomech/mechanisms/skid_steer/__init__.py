@@ -9,7 +9,9 @@ See ``docs/mechanisms/skid_steer.md``.
 from ._chains import CONFIG_SIZE, N_WHEELS, SIDE_JOINTS, WHEEL_SIDE, WHEELS, contact_frames, wheel_jacobians
 from ._params import ExplorationRobot
 from ._skid import (
+    LATERAL_SLIP_RTOL,
     STRAIGHT_RTOL,
+    LateralSlip,
     SkidSteerTurn,
     dead_reckoning,
     paper_lateral_slip,
@@ -36,6 +38,7 @@ __all__ = [
     "I_ROCKER2",
     "I_ROLL",
     "I_YAW",
+    "LATERAL_SLIP_RTOL",
     "MEASURED_SIZE",
     "N_ROWS",
     "N_WHEELS",
@@ -46,6 +49,7 @@ __all__ = [
     "WHEEL_SIDE",
     "BodyVelocity",
     "ExplorationRobot",
+    "LateralSlip",
     "SkidSteerTurn",
     "assemble",
     "body_velocity",

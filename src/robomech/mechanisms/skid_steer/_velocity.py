@@ -212,11 +212,14 @@ def body_velocity(
         resid[sl] = res.residual_norm
         # the condition number stays reported for finite rank-deficient samples (huge or inf)
         cond[sl] = np.where(res.ok, res.cond, np.nan)
-        valid[sl] = res.ok & res.full_rank
+        # A finite but huge sample can overflow the residual (or x) to inf: never valid (issue 14).
+        valid[sl] = (
+            res.ok & res.full_rank & np.isfinite(res.residual_norm) & np.all(np.isfinite(res.x), axis=-1)
+        )
     x = x.reshape(*batch, UNKNOWN_SIZE)
-    valid = valid.reshape(batch)
     w_by = 0.5 * (m[..., I_ROCKER1] + m[..., I_ROCKER2])
     w_by = np.broadcast_to(w_by, batch)
+    valid = valid.reshape(batch) & np.isfinite(w_by)
     twist = np.stack([x[..., 3], w_by, x[..., 4], x[..., 0], x[..., 1], x[..., 2]], axis=-1)
     rate = np.empty((*batch, CONFIG_SIZE))
     rate[..., 0] = m[..., I_ROCKER1] - w_by
