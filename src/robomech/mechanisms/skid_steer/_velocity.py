@@ -175,6 +175,7 @@ def body_velocity(
     *,
     solver: Literal["qr", "normal_equations"] = "qr",
     exact_cond: bool = False,
+    measurement_sigma: object | None = None,
 ) -> BodyVelocity:
     """Body twist and passive joint rates from wheel and rocker measurements, per sample.
 
@@ -184,12 +185,25 @@ def body_velocity(
     samples (sensor drop-outs) are flagged by ``valid`` instead of raising.  ``cond`` is the exact 1-norm
     condition number of R (within a factor 11 of the 2-norm one); ``exact_cond=True`` gives the 2-norm
     one from the singular values of R (QR only; slower).
+
+    ``measurement_sigma (..., 22)`` (> 0, the standard deviations of the measured vector, independent
+    errors) makes it weighted least squares (QR only): row i of ``A0 ṗ = J q̇`` gets the weight
+    ``1 / Σ_j J_ij² σ_j²``, the inverse variance of its right-hand side.  The rows' correlations (the
+    gyro appears in all six wheels' angular rows) are neglected: a diagonal weighting, not full GLS.
+    ``residual_norm`` is then the weighted (dimensionless) residual.
     """
     q = as_array(state, "state", (CONFIG_SIZE,), finite=False)
     m = as_array(measured, "measured", (MEASURED_SIZE,), finite=False)
     if solver not in ("qr", "normal_equations"):
         raise ValueError(f"Expected solver 'qr' or 'normal_equations', got {solver!r}.")
-    batch = np.broadcast_shapes(q.shape[:-1], m.shape[:-1])
+    sig = None
+    if measurement_sigma is not None:
+        if solver != "qr":
+            raise ValueError(f"Expected solver 'qr' with measurement_sigma (weighted QR), got {solver!r}.")
+        sig = as_array(measurement_sigma, "measurement_sigma", (MEASURED_SIZE,))
+        if np.any(sig <= 0):
+            raise ValueError(f"Expected measurement_sigma > 0, got {int(np.sum(sig <= 0))} value(s) <= 0.")
+    batch = np.broadcast_shapes(q.shape[:-1], m.shape[:-1], () if sig is None else sig.shape[:-1])
     n = int(np.prod(batch))
     qf = np.broadcast_to(q, (*batch, CONFIG_SIZE)).reshape(n, CONFIG_SIZE)
     mf = np.broadcast_to(m, (*batch, MEASURED_SIZE)).reshape(n, MEASURED_SIZE)
@@ -204,7 +218,11 @@ def body_velocity(
         A0, J = _assemble(robot, np.where(finite_q[:, None], qc, 0.0))
         A0[~finite_q] = np.nan  # flagged by lstsq as not ok
         b = np.einsum("nij,nj->ni", J, mc)
-        if solver == "qr":
+        if sig is not None:
+            sc = np.broadcast_to(sig, (*batch, MEASURED_SIZE)).reshape(n, MEASURED_SIZE)[sl]
+            w = 1.0 / np.einsum("nij,nj->ni", J * J, sc * sc)  # inverse variance of each row's b_i
+            res = lstsq.solve(A0, b, exact_cond=exact_cond, weights=w)
+        elif solver == "qr":
             res = lstsq.solve(A0, b, exact_cond=exact_cond)
         else:
             res = lstsq.solve_normal_equations(A0, b)

@@ -1,0 +1,286 @@
+"""Sensor models (wheel encoders, IMU) with stated, seeded noise, and an extended Kalman filter for planar
+odometry from encoders and a gyro, with the ICR model as its measurement model.
+
+Encoder: an incremental encoder of ``counts_per_rev`` counts; the rate at sample k is the count
+difference over the last sample interval, so its error is the difference of two quantisation errors,
+uniform on one count: standard deviation ``q / (dt √6)`` rad/s with ``q = 2π / counts_per_rev``.  The
+first sample has no previous count: NaN (a drop-out, flagged downstream, never silently filled).
+
+IMU: gyro and accelerometer with a constant bias plus white noise of the stated density
+(σ = density · √(rate)); the accelerometer measures specific force (acceleration minus gravity) in body axes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array, check_positive
+
+from ._chains import N_WHEELS
+from ._icr import ICRModel
+
+__all__ = [
+    "SAMPLE_RATE_RTOL",
+    "EKFResult",
+    "EncoderModel",
+    "ImuModel",
+    "encoder_rates",
+    "imu_measurements",
+    "planar_ekf",
+    "track_speed_sigma",
+]
+
+# Relative spread of the sample intervals dt_k beyond which the histories do not share one sample rate
+# (1e-6: far above the rounding of arange(n)/rate, far below any real jitter worth modelling).
+SAMPLE_RATE_RTOL = 1e-6
+
+
+def _check_real(v: object, name: str, positive: bool = True) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
+        raise ValueError(f"Expected {name} to be a real number, got {type(v).__name__}.")
+    return check_positive(v, name, allow_zero=not positive)
+
+
+@dataclass(frozen=True)
+class EncoderModel:
+    """Incremental wheel encoder: ``counts_per_rev`` counts per wheel revolution (quantisation only)."""
+
+    counts_per_rev: int = 2048
+
+    def __post_init__(self) -> None:
+        c = self.counts_per_rev
+        if isinstance(c, bool) or not isinstance(c, (int, np.integer)) or c < 1:
+            raise ValueError(f"Expected counts_per_rev a positive integer, got {c!r}.")
+        object.__setattr__(self, "counts_per_rev", int(c))
+
+    def rate_sigma(self, dt: float) -> float:
+        """Standard deviation of the measured spin rate (rad/s) at sample interval ``dt`` (s)."""
+        return 2.0 * math.pi / self.counts_per_rev / (check_positive(dt, "dt") * math.sqrt(6.0))
+
+
+@dataclass(frozen=True)
+class ImuModel:
+    """Gyro and accelerometer: white-noise densities and constant biases (per axis, SI units).
+
+    Defaults: a MEMS IMU of the ADIS16470 class (gyro 0.008 °/s/√Hz, accelerometer 0.5 mg/√Hz); the
+    biases are of the size left after a start-up calibration.
+    """
+
+    gyro_noise_density: float = math.radians(0.008)  # rad/s/√Hz
+    gyro_bias: tuple[float, float, float] = (0.0, 0.0, math.radians(0.1))  # rad/s
+    accel_noise_density: float = 0.5e-3 * 9.80665  # m/s²/√Hz
+    accel_bias: tuple[float, float, float] = (0.02, -0.01, 0.0)  # m/s²
+
+    def __post_init__(self) -> None:
+        for name in ("gyro_noise_density", "accel_noise_density"):
+            object.__setattr__(self, name, _check_real(getattr(self, name), name, positive=False))
+        for name in ("gyro_bias", "accel_bias"):
+            b = as_array(getattr(self, name), name, (3,))
+            if b.ndim != 1:
+                raise ValueError(f"Expected {name} to have shape (3,), got {b.shape}.")
+            object.__setattr__(self, name, tuple(float(v) for v in b))
+
+    def gyro_sigma(self, dt: float) -> float:
+        return self.gyro_noise_density / math.sqrt(check_positive(dt, "dt"))
+
+    def accel_sigma(self, dt: float) -> float:
+        return self.accel_noise_density / math.sqrt(check_positive(dt, "dt"))
+
+
+def _rng(seed: object) -> np.random.Generator:
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        raise ValueError(f"Expected seed to be an int or a numpy Generator, got {type(seed).__name__}.")
+    return np.random.default_rng(int(seed))
+
+
+def encoder_rates(model: EncoderModel, wheel_rate: object, dt: float, seed: object = 0) -> np.ndarray:
+    """Measured spin rates ``(N, 6)`` from true rates ``(N, 6)`` sampled every ``dt`` s.
+
+    The true angle is integrated by the trapezoidal rule from a random initial phase (seeded), counted,
+    and differenced; the first sample is NaN (no previous count).
+    """
+    if not isinstance(model, EncoderModel):
+        raise ValueError(f"Expected model to be an EncoderModel, got {type(model).__name__}.")
+    w = as_array(wheel_rate, "wheel_rate", (None, N_WHEELS), min_ndim=2)
+    if w.ndim != 2:
+        raise ValueError(f"Expected wheel_rate to have shape (N, 6), got {w.shape}.")
+    h = check_positive(dt, "dt")
+    q = 2.0 * math.pi / model.counts_per_rev
+    rng = _rng(seed)
+    angle = np.concatenate([np.zeros((1, N_WHEELS)), np.cumsum(0.5 * h * (w[1:] + w[:-1]), axis=0)])
+    angle += rng.uniform(0.0, q, size=N_WHEELS)
+    counts = np.floor(angle / q)
+    out = np.full(w.shape, np.nan)
+    out[1:] = np.diff(counts, axis=0) * q / h
+    return out
+
+
+def imu_measurements(
+    model: ImuModel, angular_velocity: object, specific_force: object, dt: float, seed: object = 0
+) -> tuple[np.ndarray, np.ndarray]:
+    """Gyro and accelerometer readings ``(N, 3)`` each from true body-axis values ``(N, 3)``."""
+    if not isinstance(model, ImuModel):
+        raise ValueError(f"Expected model to be an ImuModel, got {type(model).__name__}.")
+    w = as_array(angular_velocity, "angular_velocity", (3,))
+    a = as_array(specific_force, "specific_force", (3,))
+    if w.shape != a.shape:
+        raise ValueError(
+            f"Expected angular_velocity and specific_force of one shape, got {w.shape}, {a.shape}."
+        )
+    rng = _rng(seed)
+    gyro = w + np.asarray(model.gyro_bias) + model.gyro_sigma(dt) * rng.normal(size=w.shape)
+    acc = a + np.asarray(model.accel_bias) + model.accel_sigma(dt) * rng.normal(size=a.shape)
+    return gyro, acc
+
+
+def track_speed_sigma(encoder: EncoderModel, radii: object, dt: float) -> float:
+    """Standard deviation of a side's encoder track speed (mean of its wheels' rim speeds, m/s).
+
+    ``radii``: the side's wheel radii (m); the wheels' quantisation errors are independent.
+    """
+    r = as_array(radii, "radii", (None,))
+    return float(encoder.rate_sigma(dt) * np.sqrt(np.sum(r**2)) / r.size)
+
+
+@dataclass(frozen=True)
+class EKFResult:
+    """Filtered planar odometry, ``N`` samples.
+
+    ``state (N, 6)`` = ``[x, y, ψ, v_x, r, b_gyro]`` (m, rad, m/s, rad/s, rad/s), ``covariance (N, 6, 6)``;
+    ``encoder_used`` / ``gyro_used (N,)``: whether that sample's measurement updated the filter (false
+    for NaN drop-outs: the filter only predicts there).
+    """
+
+    state: np.ndarray
+    covariance: np.ndarray
+    encoder_used: np.ndarray
+    gyro_used: np.ndarray
+
+
+def _check_times(t: object) -> np.ndarray:
+    ta = as_array(t, "t", (None,))
+    if ta.ndim != 1 or ta.size < 2:
+        raise ValueError(f"Expected t to have shape (N,) with N >= 2, got {ta.shape}.")
+    dt = np.diff(ta)
+    if np.any(dt <= 0):
+        raise ValueError(
+            f"Expected t strictly increasing, got {int(np.sum(dt <= 0))} non-increasing step(s)."
+        )
+    return ta
+
+
+def planar_ekf(
+    t: object,
+    v_right: object,
+    v_left: object,
+    gyro_z: object,
+    icr: ICRModel,
+    *,
+    sigma_track: float,
+    sigma_gyro: float,
+    sigma_model: float = 0.0,
+    accel_psd: float = 0.5,
+    yaw_accel_psd: float = 2.0,
+    bias_psd: float = 1e-8,
+    initial_pose: object = (0.0, 0.0, 0.0),
+    initial_bias_sigma: float = 0.01,
+) -> EKFResult:
+    """Extended Kalman filter for planar odometry: encoders through the ICR model, and a gyro.
+
+    State ``s = [x, y, ψ, v_x, r, b]``.  Prediction over ``dt``: ``x += dt (v_x cos ψ - v_y sin ψ)``,
+    ``y += dt (v_x sin ψ + v_y cos ψ)``, ``ψ += dt r`` with ``v_y = -r x_icr`` (the ICR model's lateral
+    slip); ``v_x``, ``r`` and the gyro bias ``b`` are random walks with spectral densities ``accel_psd``
+    (m²/s³), ``yaw_accel_psd`` (rad²/s³) and ``bias_psd`` (rad²/s³).  Measurements: the encoder track
+    speeds ``v_right = v_x - r y_right``, ``v_left = v_x - r y_left`` (the ICR model, noise
+    ``sigma_track² + sigma_model²`` per side, m/s) and the gyro ``z = r + b`` (``sigma_gyro``, rad/s).
+
+    All histories ``(N,)`` share the time stamps ``t`` (one sample rate: arrays of another length, or
+    ``t`` with non-uniform steps, raise ``ValueError``).  A NaN measurement is a drop-out: that update is
+    skipped and ``encoder_used``/``gyro_used`` say so.
+    """
+    ta = _check_times(t)
+    n = ta.size
+    dts = np.diff(ta)
+    if np.max(np.abs(dts - dts.mean())) > SAMPLE_RATE_RTOL * dts.mean():
+        raise ValueError(
+            "Expected t uniformly sampled (one sample rate for all histories), got steps from "
+            f"{dts.min():.6g} s to {dts.max():.6g} s."
+        )
+    hist = {}
+    for a, name in ((v_right, "v_right"), (v_left, "v_left"), (gyro_z, "gyro_z")):
+        arr = as_array(a, name, finite=False)
+        if arr.shape != (n,):
+            raise ValueError(
+                f"Expected {name} to have shape ({n},) like t (one sample rate for all histories), "
+                f"got {arr.shape}."
+            )
+        if np.any(np.isinf(arr)):
+            raise ValueError(f"Expected {name} finite or NaN (a drop-out), got infinite value(s).")
+        hist[name] = arr
+    if not isinstance(icr, ICRModel):
+        raise ValueError(f"Expected icr to be an ICRModel, got {type(icr).__name__}.")
+    s_tr = check_positive(sigma_track, "sigma_track")
+    s_g = check_positive(sigma_gyro, "sigma_gyro")
+    s_m = check_positive(sigma_model, "sigma_model", allow_zero=True)
+    qa = check_positive(accel_psd, "accel_psd")
+    qr = check_positive(yaw_accel_psd, "yaw_accel_psd")
+    qb = check_positive(bias_psd, "bias_psd", allow_zero=True)
+    pose0 = as_array(initial_pose, "initial_pose", (3,))
+    if pose0.shape != (3,):
+        raise ValueError(f"Expected initial_pose to have shape (3,), got {pose0.shape}.")
+    sb0 = check_positive(initial_bias_sigma, "initial_bias_sigma", allow_zero=True)
+
+    yl, yr, xi = icr.y_left, icr.y_right, icr.x_icr
+    H_enc = np.array([[0, 0, 0, 1.0, -yr, 0], [0, 0, 0, 1.0, -yl, 0]])
+    R_enc = np.eye(2) * (s_tr**2 + s_m**2)
+    H_g = np.array([[0, 0, 0, 0, 1.0, 1.0]])
+    R_g = np.array([[s_g**2]])
+    s = np.zeros(6)
+    s[:3] = pose0
+    P = np.diag([1e-12, 1e-12, 1e-12, 1.0, 1.0, max(sb0, 1e-12) ** 2])
+    states = np.empty((n, 6))
+    covs = np.empty((n, 6, 6))
+    enc_used = np.zeros(n, dtype=bool)
+    gyro_used = np.zeros(n, dtype=bool)
+    eye = np.eye(6)
+
+    def update(s, P, z, h, H, R):
+        S = H @ P @ H.T + R
+        K = np.linalg.solve(S, H @ P).T
+        s = s + K @ (z - h)
+        IKH = eye - K @ H
+        return s, IKH @ P @ IKH.T + K @ R @ K.T  # Joseph form: stays symmetric positive definite
+
+    for k in range(n):
+        if k > 0:
+            h = dts[k - 1]
+            _, _, psi, v, r, _ = s
+            c, sn = math.cos(psi), math.sin(psi)
+            vy = -r * xi
+            s = s + h * np.array([v * c - vy * sn, v * sn + vy * c, r, 0.0, 0.0, 0.0])
+            F = eye.copy()
+            F[0, 2] = -h * (v * sn + vy * c)
+            F[0, 3] = h * c
+            F[0, 4] = h * xi * sn
+            F[1, 2] = h * (v * c - vy * sn)
+            F[1, 3] = h * sn
+            F[1, 4] = -h * xi * c
+            F[2, 4] = h
+            Q = np.diag([0.0, 0.0, 0.0, qa * h, qr * h, qb * h])
+            P = F @ P @ F.T + Q
+        z = np.array([hist["v_right"][k], hist["v_left"][k]])
+        if np.all(np.isfinite(z)):
+            s, P = update(s, P, z, H_enc @ s, H_enc, R_enc)
+            enc_used[k] = True
+        g = hist["gyro_z"][k]
+        if math.isfinite(g):
+            s, P = update(s, P, np.array([g]), H_g @ s, H_g, R_g)
+            gyro_used[k] = True
+        states[k] = s
+        covs[k] = P
+    return EKFResult(state=states, covariance=covs, encoder_used=enc_used, gyro_used=gyro_used)
