@@ -193,8 +193,10 @@ def identify_icr(
     b[0::3] = vr[used] - V[used, 0]
     b[1::3] = vl[used] - V[used, 0]
     b[2::3] = V[used, 1]
-    if n == 0:
-        return ICRIdentification(None, np.full(3, np.nan), used, 0, math.inf, False)
+    if n == 0 or not np.any(r != 0.0):
+        # no used sample, or no turning at all: every row is zero, nothing to identify
+        rms = np.sqrt(np.mean(b.reshape(n, 3) ** 2, axis=0)) if n else np.full(3, np.nan)
+        return ICRIdentification(None, rms, used, n, math.inf, False)
     res = lstsq.solve(A, b, weights=np.repeat(w[used], 3))
     resid = (A @ np.nan_to_num(res.x) - b).reshape(n, 3)
     rms = np.sqrt(np.mean(resid**2, axis=0))

@@ -2,8 +2,10 @@
 odometry from encoders and a gyro, with the ICR model as its measurement model.
 
 Encoder: an incremental encoder of ``counts_per_rev`` counts; the rate at sample k is the count
-difference over the last sample interval, so its error is the difference of two quantisation errors,
-uniform on one count: standard deviation ``q / (dt √6)`` rad/s with ``q = 2π / counts_per_rev``.  The
+difference over the last sample interval, so it reads ``floor`` or ``ceil`` of the true count increment:
+with ``δ`` the fractional part of the increment the error has variance ``δ(1-δ) q²/dt²`` (at most
+``q²/(4 dt²)``), ``q = 2π / counts_per_rev``; averaged over rates (δ uniform) the stated standard
+deviation is ``q / (dt √6)`` rad/s.  The
 first sample has no previous count: NaN (a drop-out, flagged downstream, never silently filled).
 
 IMU: gyro and accelerometer with a constant bias plus white noise of the stated density
@@ -57,7 +59,8 @@ class EncoderModel:
         object.__setattr__(self, "counts_per_rev", int(c))
 
     def rate_sigma(self, dt: float) -> float:
-        """Standard deviation of the measured spin rate (rad/s) at sample interval ``dt`` (s)."""
+        """Standard deviation of the measured spin rate (rad/s) at sample interval ``dt`` (s), averaged
+        over rates (module docstring); the worst rate gives ``√1.5`` times this."""
         return 2.0 * math.pi / self.counts_per_rev / (check_positive(dt, "dt") * math.sqrt(6.0))
 
 
