@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_positive
+from robomech._validation import as_array, check_params, check_positive, coerce_float_fields
 from robomech.mechanisms.skid_steer import WHEELS, ExplorationRobot, wheel_radii
 
 __all__ = ["EngineParams", "EngineRun", "Terrain", "build_model", "simulate_engine"]
@@ -57,18 +57,21 @@ class Terrain:
     half_size: float = 6.0
 
     def __post_init__(self) -> None:
-        n = len(self.amplitude)
-        for name in ("kx", "ky", "phase"):
-            if len(getattr(self, name)) != n:
-                raise ValueError(
-                    f"Expected {name} to have {n} terms like amplitude, got {len(getattr(self, name))}."
-                )
+        arrays = {}
         for name in ("amplitude", "kx", "ky", "phase"):
-            vals = tuple(float(v) for v in getattr(self, name))
-            if not all(math.isfinite(v) for v in vals):
-                raise ValueError(f"Expected finite {name}, got {getattr(self, name)!r}.")
-            object.__setattr__(self, name, vals)
-        object.__setattr__(self, "half_size", check_positive(self.half_size, "half_size"))
+            a = as_array(getattr(self, name), name, (None,))
+            if a.ndim != 1:
+                raise ValueError(f"Expected {name} to be a sequence of numbers, got shape {a.shape}.")
+            arrays[name] = a
+        n = arrays["amplitude"].size
+        for name in ("kx", "ky", "phase"):
+            if arrays[name].size != n:
+                raise ValueError(
+                    f"Expected {name} to have {n} terms like amplitude, got {arrays[name].size}."
+                )
+        for name, a in arrays.items():
+            object.__setattr__(self, name, tuple(float(v) for v in a))
+        coerce_float_fields(self, ("half_size",), positive=True)
 
     @classmethod
     def uneven(cls, half_size: float = 6.0) -> Terrain:
@@ -120,8 +123,7 @@ class EngineParams:
     hfield_resolution: float = 0.04  # m between height-field samples
 
     def __post_init__(self) -> None:
-        for name in self.__dataclass_fields__:
-            object.__setattr__(self, name, check_positive(getattr(self, name), name))
+        coerce_float_fields(self, tuple(self.__dataclass_fields__), positive=True)
 
 
 def _site_local(robot: ExplorationRobot, kind: str) -> tuple[float, float, float]:
@@ -140,10 +142,11 @@ def build_model(robot: ExplorationRobot, terrain: Terrain | None = None, params:
     """
     import mujoco
 
-    if not isinstance(robot, ExplorationRobot):
-        raise ValueError(f"Expected robot to be an ExplorationRobot, got {type(robot).__name__}.")
+    check_params(robot, ExplorationRobot, "robot")
     terrain = Terrain.flat() if terrain is None else terrain
+    check_params(terrain, Terrain, "terrain")
     p = EngineParams() if params is None else params
+    check_params(p, EngineParams, "params")
     spec = mujoco.MjSpec()
     spec.modelname = "skid_steer_robot"
     spec.option.timestep = p.timestep
@@ -351,8 +354,11 @@ def simulate_engine(
     """
     import mujoco
 
+    check_params(robot, ExplorationRobot, "robot")
     terrain = Terrain.flat() if terrain is None else terrain
+    check_params(terrain, Terrain, "terrain")
     p = EngineParams() if params is None else params
+    check_params(p, EngineParams, "params")
     T = check_positive(duration, "duration")
     fs = check_positive(rate, "rate")
     settle = check_positive(settle, "settle", allow_zero=True)

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech._validation import check_params
 from robomech.mechanisms.skid_steer import (
     ExplorationRobot,
     ICRModel,
@@ -32,10 +33,11 @@ from robomech.mechanisms.skid_steer import (
 from robomech.spatial import rot_x, rot_y, rot_z, transform, vee
 
 from ._core import Check, Tolerance, Verification
-from ._skid_steer_engine import EngineRun, Terrain, simulate_engine
+from ._skid_steer_engine import EngineParams, EngineRun, Terrain, simulate_engine
 
 __all__ = [
     "VERIFICATION",
+    "EngineParams",
     "EngineRun",
     "GroundTruth",
     "Terrain",
@@ -316,6 +318,7 @@ ENGINE_TRANSIENT_S = 1.0  # s after the start discarded (commands ramp in over 0
 @functools.lru_cache(maxsize=4)
 def engine_runs(robot: ExplorationRobot) -> dict[str, tuple[EngineRun, ...]]:
     """The engine manoeuvres of the checks for the true ``robot`` (cached: the teeth tests reuse them)."""
+    check_params(robot, ExplorationRobot, "robot")
     sim = functools.partial(simulate_engine, robot, duration=ENGINE_RUN_S, rate=ENGINE_RATE)
     return {
         "identification": tuple(sim(v) for v in IDENTIFICATION_RUNS),
@@ -339,7 +342,8 @@ def identify_from_runs(robot: ExplorationRobot, runs) -> ICRModel:
     parts = []
     for u in runs:
         sl = steady(u)
-        vr, vl = encoder_track_speeds(robot, u.wheel_rate[sl])
+        tr = encoder_track_speeds(robot, u.wheel_rate[sl])
+        vr, vl = tr.right, tr.left
         parts.append((vr, vl, planar_twist(u)[sl]))
     vr, vl, V = (np.concatenate(x) for x in zip(*parts, strict=True))
     ident = identify_icr(vr, vl, V)
@@ -349,7 +353,10 @@ def identify_from_runs(robot: ExplorationRobot, runs) -> ICRModel:
 
 
 def engine_checks(robot: ExplorationRobot, est: ExplorationRobot) -> list[Check]:
-    """Checks of the estimators against the MuJoCo contact-physics ground truth."""
+    """Checks of the estimators against the MuJoCo contact-physics ground truth (``robot``: the true
+    geometry the engine is built from; ``est``: the geometry the estimators believe)."""
+    check_params(robot, ExplorationRobot, "robot")
+    check_params(est, ExplorationRobot, "est")
     runs = engine_runs(robot)
     name = "skid-steer"
     checks = []
@@ -371,8 +378,8 @@ def engine_checks(robot: ExplorationRobot, est: ExplorationRobot) -> list[Check]
     )
     u = runs["straight"][0]
     sl = steady(u)
-    vr, vl = encoder_track_speeds(est, u.wheel_rate[sl])
-    speed = 0.5 * (vr + vl)
+    tr = encoder_track_speeds(est, u.wheel_rate[sl])
+    speed = 0.5 * (tr.right + tr.left)
     rel = float(np.max(np.abs(speed - u.twist[sl, 3])) / np.mean(np.abs(u.twist[sl, 3])))
     checks.append(
         Check(name, "engine: straight flat run, encoder speed vs MuJoCo (relative)", rel, TOL_ENGINE_SPEED)
@@ -382,7 +389,8 @@ def engine_checks(robot: ExplorationRobot, est: ExplorationRobot) -> list[Check]
     e_icr, e_ns = [], []
     for u in runs["validation"]:
         sl = steady(u)
-        vr, vl = encoder_track_speeds(est, u.wheel_rate[sl])
+        tr = encoder_track_speeds(est, u.wheel_rate[sl])
+        vr, vl = tr.right, tr.left
         e_icr.append(icr_velocity(model, vr, vl).yaw_rate - u.twist[sl, 2])
         e_ns.append(icr_velocity(no_slip, vr, vl).yaw_rate - u.twist[sl, 2])
     rms_icr = float(np.sqrt(np.mean(np.concatenate(e_icr) ** 2)))

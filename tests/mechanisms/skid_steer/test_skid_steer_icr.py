@@ -84,7 +84,7 @@ def test_straight_data_are_not_identifiable():
     [
         ((np.ones(5), np.ones(4), np.ones((5, 3))), "one N"),
         ((np.ones(5), np.ones(5), np.ones((5, 2))), "body_velocity"),
-        ((np.full(5, np.inf), np.ones(5), np.ones((5, 3))), "v_right"),
+        ((np.ones((5, 1)), np.ones(5), np.ones((5, 3))), "v_right"),
     ],
 )
 def test_identification_rejects_inconsistent_histories(args, match):
@@ -108,8 +108,10 @@ def test_encoder_track_speeds_and_slip_of_a_rolling_and_a_skidding_robot():
     assert radii.tolist() == [0.05, 0.05, 0.1, 0.05, 0.05, 0.1]
     # rolling straight at 0.2 m/s: zero slip everywhere
     rate = np.full(6, 0.2) / radii
-    vr, vl = encoder_track_speeds(ROBOT, rate)
-    assert vr == pytest.approx(0.2) and vl == pytest.approx(0.2)
+    tr = encoder_track_speeds(ROBOT, rate)
+    assert tr.right == pytest.approx(0.2) and tr.left == pytest.approx(0.2) and tr.valid
+    drop = encoder_track_speeds(ROBOT, np.stack([rate, np.r_[np.nan, rate[1:]]]))
+    assert drop.valid.tolist() == [True, False] and np.isnan(drop.right[1]) and np.isnan(drop.left[1])
     slip = wheel_slip(ROBOT, rate, [0.2, 0.0, 0.0])
     np.testing.assert_allclose(slip.ratio, 0.0, atol=1e-15)
     np.testing.assert_allclose(slip.lateral_velocity, 0.0, atol=1e-15)
@@ -122,6 +124,14 @@ def test_encoder_track_speeds_and_slip_of_a_rolling_and_a_skidding_robot():
     assert np.all(slip.ratio[3:] < 0)  # inner side skids (the rims are slower than the ground)
     x = np.array([0.2666, 0.1306, -0.3])  # contact x of the road wheels and the rear wheel (zero angles)
     np.testing.assert_allclose(slip.lateral_velocity[:3], r * x, atol=1e-5)
-    # at rest: 0/0, flagged; NaN encoder: flagged
+    # at rest: 0/0, flagged; NaN encoder: that wheel flagged
     rest = wheel_slip(ROBOT, [np.nan, 0, 0, 0, 0, 0.0], [0.0, 0.0, 0.0])
     assert not rest.valid.any() and np.isnan(rest.ratio).all()
+    drop = wheel_slip(ROBOT, [np.nan, 4, 4, 4, 4, 2.0], [0.2, 0.0, 0.0])
+    assert drop.valid.tolist() == [False, True, True, True, True, True]
+
+
+def test_icr_velocity_flags_drop_outs():
+    v = icr_velocity(ICRModel.no_slip(S), [0.1, np.nan, np.inf], [0.1, 0.1, 0.1])
+    assert v.valid.tolist() == [True, False, False]
+    assert np.isnan(v.yaw_rate[1:]).all() and np.isfinite(v.v_x[0])

@@ -33,15 +33,16 @@ def test_encoder_noise_is_the_stated_quantisation_noise_and_seeded():
     # cycles deterministically and the uniform-phase model does not apply sample by sample)
     t = np.arange(20001)[:, None] * dt
     w = np.linspace(1.0, 6.0, 6) + 0.7 * np.sin(np.linspace(0.3, 1.1, 6) * t)
-    m = encoder_rates(enc, w, dt, seed=3)
-    assert np.isnan(m[0]).all()  # no previous count: a flagged drop-out, not a made-up value
+    reading = encoder_rates(enc, w, dt, seed=3)
+    m = reading.rate
+    assert np.isnan(m[0]).all() and not reading.valid[0] and reading.valid[1:].all()  # no previous count
     err = m[1:] - w[1:]
     # pooled over rates the variance is the stated q²/(6 dt²); at one rate it is δ(1-δ) q²/dt² <= q²/(4 dt²)
     assert np.sqrt(np.mean(err**2)) == pytest.approx(enc.rate_sigma(dt), rel=0.05)
     assert np.all(err.std(axis=0) <= 2.0 * np.pi / 512 / (2 * dt) * 1.01)
     assert abs(err.mean()) < 0.05 * enc.rate_sigma(dt)
-    np.testing.assert_array_equal(m, encoder_rates(enc, w, dt, seed=3))
-    assert not np.array_equal(m[1:], encoder_rates(enc, w, dt, seed=4)[1:])
+    np.testing.assert_array_equal(m, encoder_rates(enc, w, dt, seed=3).rate)
+    assert not np.array_equal(m[1:], encoder_rates(enc, w, dt, seed=4).rate[1:])
 
 
 def test_imu_noise_and_bias_are_as_stated():
@@ -92,7 +93,12 @@ def test_ekf_flags_drop_outs_and_keeps_predicting():
     gyro = v.yaw_rate.copy()
     vr[100:110] = np.nan
     gyro[300] = np.nan
-    res = planar_ekf(t, vr, vl, gyro, model, sigma_track=1e-3, sigma_gyro=1e-3)
+    with pytest.raises(ValueError, match="v_right"):  # unmarked NaN: an error, never skipped silently
+        planar_ekf(t, vr, vl, gyro, model, sigma_track=1e-3, sigma_gyro=1e-3)
+    enc_ok, gyro_ok = np.isfinite(vr), np.isfinite(gyro)
+    res = planar_ekf(
+        t, vr, vl, gyro, model, sigma_track=1e-3, sigma_gyro=1e-3, encoder_ok=enc_ok, gyro_ok=gyro_ok
+    )
     assert (~res.encoder_used).sum() == 10 and not res.encoder_used[100:110].any()
     assert (~res.gyro_used).sum() == 1 and not res.gyro_used[300]
     assert np.all(np.isfinite(res.state)) and np.all(np.isfinite(res.covariance))
@@ -106,6 +112,7 @@ def test_ekf_flags_drop_outs_and_keeps_predicting():
         ({"t": np.r_[np.arange(250) * 0.01, np.arange(250) * 0.02 + 2.5]}, "uniformly sampled"),
         ({"t": np.r_[np.arange(499) * 0.01, 0.0]}, "strictly increasing"),
         ({"v_left": np.full(500, np.inf)}, "v_left"),
+        ({"encoder_ok": np.ones(500)}, "encoder_ok"),
         ({"icr": None}, "icr"),
         ({"sigma_track": 0.0}, "sigma_track"),
     ],
@@ -120,7 +127,7 @@ def test_ekf_rejects_bad_histories(change, match):
     }
     kw = {"sigma_track": 1e-3, "sigma_gyro": 1e-3}
     for k, v in change.items():
-        (kw if k.startswith("sigma") else args)[k] = v
+        (kw if k.startswith(("sigma", "encoder_ok")) else args)[k] = v
     with pytest.raises(ValueError, match=match):
         planar_ekf(*args.values(), **kw)
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_positive
+from robomech._validation import as_array, check_params, check_positive, coerce_float_fields
 from robomech.analysis import lstsq
 
 from ._chains import N_WHEELS, WHEEL_SIDE, WHEELS, contact_frames
@@ -33,6 +33,7 @@ __all__ = [
     "ICRIdentification",
     "ICRModel",
     "PlanarVelocity",
+    "TrackSpeeds",
     "WheelSlip",
     "encoder_track_speeds",
     "icr_velocity",
@@ -58,21 +59,11 @@ class ICRModel:
     x_icr: float = 0.0
 
     def __post_init__(self) -> None:
-        vals = {}
-        for name in ("y_left", "y_right", "x_icr"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
-                raise ValueError(f"Expected {name} to be a real number, got {type(v).__name__}.")
-            v = float(v)
-            if not math.isfinite(v):
-                raise ValueError(f"Expected {name} to be finite, got {v!r}.")
-            vals[name] = v
-        if not vals["y_left"] > vals["y_right"]:
+        coerce_float_fields(self, ("y_left", "y_right", "x_icr"))
+        if not self.y_left > self.y_right:
             raise ValueError(
-                f"Expected y_left > y_right, got y_left={vals['y_left']!r}, y_right={vals['y_right']!r}."
+                f"Expected y_left > y_right, got y_left={self.y_left!r}, y_right={self.y_right!r}."
             )
-        for k, v in vals.items():
-            object.__setattr__(self, k, v)
 
     @classmethod
     def no_slip(cls, track_width: float) -> ICRModel:
@@ -87,54 +78,69 @@ class ICRModel:
 
 @dataclass(frozen=True)
 class PlanarVelocity:
-    """Planar body velocity (batch shape ``...``): ``v_x``, ``v_y`` (m/s, body axes), ``yaw_rate`` (rad/s)."""
+    """Planar body velocity (batch shape ``...``): ``v_x``, ``v_y`` (m/s, body axes), ``yaw_rate``
+    (rad/s); ``valid`` false (and the values NaN) where an input track speed was not finite."""
 
     v_x: np.ndarray
     v_y: np.ndarray
     yaw_rate: np.ndarray
+    valid: np.ndarray
 
 
 def icr_velocity(model: ICRModel, v_right: object, v_left: object) -> PlanarVelocity:
     """Body velocity predicted by the ICR model from the right and left track (encoder) speeds (m/s).
 
-    NaN speeds (encoder drop-outs) give NaN velocities in those samples (the inputs are measurements;
-    callers mask them, e.g. :func:`planar_ekf` skips such updates and says so).
+    Non-finite speeds (encoder drop-outs) are flagged per sample by ``valid``.
     """
-    if not isinstance(model, ICRModel):
-        raise ValueError(f"Expected model to be an ICRModel, got {type(model).__name__}.")
+    check_params(model, ICRModel, "model")
     vr = as_array(v_right, "v_right", finite=False)
     vl = as_array(v_left, "v_left", finite=False)
-    _reject_inf(vr, "v_right")
-    _reject_inf(vl, "v_left")
+    try:
+        vr, vl = np.broadcast_arrays(vr, vl)
+    except ValueError as exc:
+        raise ValueError(f"Expected v_right and v_left to broadcast, got {vr.shape} and {vl.shape}.") from exc
+    valid = np.isfinite(vr) & np.isfinite(vl)
+    vr, vl = np.where(valid, vr, 0.0), np.where(valid, vl, 0.0)
     d = model.y_left - model.y_right
     r = (vr - vl) / d
     vx = (vr * model.y_left - vl * model.y_right) / d
-    return PlanarVelocity(v_x=vx, v_y=-r * model.x_icr, yaw_rate=r)
-
-
-def _reject_inf(a: np.ndarray, name: str) -> None:
-    if np.any(np.isinf(a)):
-        raise ValueError(
-            f"Expected {name} finite or NaN (a drop-out), got {int(np.sum(np.isinf(a)))} infinite value(s)."
-        )
+    vy = -r * model.x_icr
+    nan = np.nan
+    return PlanarVelocity(
+        v_x=np.where(valid, vx, nan),
+        v_y=np.where(valid, vy, nan),
+        yaw_rate=np.where(valid, r, nan),
+        valid=valid,
+    )
 
 
 def wheel_radii(robot: ExplorationRobot) -> np.ndarray:
     """Rolling radius of each wheel in ``WHEELS`` order (m): road wheels, then the rear wheel, per side."""
-    if not isinstance(robot, ExplorationRobot):
-        raise ValueError(f"Expected robot to be an ExplorationRobot, got {type(robot).__name__}.")
+    check_params(robot, ExplorationRobot, "robot")
     return np.array([robot.road_wheel_radius if "road" in w else robot.rear_wheel_radius for w in WHEELS])
 
 
-def encoder_track_speeds(robot: ExplorationRobot, wheel_rate: object) -> tuple[np.ndarray, np.ndarray]:
-    """No-slip track speeds (right, left) from the wheel spin rates ``(..., 6)`` (rad/s): the mean rim
-    speed ``r_w φ̇_w`` of each side's three wheels.  A NaN wheel rate makes its side's speed NaN."""
+@dataclass(frozen=True)
+class TrackSpeeds:
+    """No-slip track speeds (m/s, batch shape ``...``): ``right``, ``left``; ``valid`` false (values
+    NaN) where a wheel rate of the sample was not finite (an encoder drop-out)."""
+
+    right: np.ndarray
+    left: np.ndarray
+    valid: np.ndarray
+
+
+def encoder_track_speeds(robot: ExplorationRobot, wheel_rate: object) -> TrackSpeeds:
+    """No-slip track speeds from the wheel spin rates ``(..., 6)`` (rad/s): the mean rim speed
+    ``r_w φ̇_w`` of each side's three wheels.  A sample with a non-finite wheel rate is flagged."""
     radii = wheel_radii(robot)
     w = as_array(wheel_rate, "wheel_rate", (N_WHEELS,), finite=False)
-    _reject_inf(w, "wheel_rate")
-    rim = w * radii
+    valid = np.all(np.isfinite(w), axis=-1)
+    rim = np.where(valid[..., None], w, 0.0) * radii
     side = np.asarray(WHEEL_SIDE)
-    return rim[..., side == 0].mean(axis=-1), rim[..., side == 1].mean(axis=-1)
+    right = rim[..., side == 0].mean(axis=-1)
+    left = rim[..., side == 1].mean(axis=-1)
+    return TrackSpeeds(right=np.where(valid, right, np.nan), left=np.where(valid, left, np.nan), valid=valid)
 
 
 @dataclass(frozen=True)
@@ -163,23 +169,26 @@ def identify_icr(
 
     Equations per sample: ``-r y_right = v_right - v_x``, ``-r y_left = v_left - v_x``, ``-r x_icr = v_y``.
     ``weights (N,)`` (``>= 0``) weight each sample's three equations (e.g. ``1/σ²`` of that sample).
-    Samples with any non-finite value are not used and are reported in ``used`` (nothing is dropped
-    silently).  Straight driving carries no information (its rows are zero); a data set without turning
-    is reported ``identifiable = False``.
+    Samples with any non-finite value (drop-outs) are not used and are reported in ``used`` (nothing is
+    dropped silently).  Straight driving carries no information (its rows are zero); a data set without
+    turning is reported ``identifiable = False``.
     """
     vr = as_array(v_right, "v_right", finite=False)
     vl = as_array(v_left, "v_left", finite=False)
     V = as_array(body_velocity, "body_velocity", (3,), finite=False)
-    if vr.ndim != 1 or vl.shape != vr.shape or V.shape != (*vr.shape, 3):
+    if vr.ndim != 1:
+        raise ValueError(f"Expected v_right to have shape (N,), got {vr.shape}.")
+    if vl.shape != vr.shape:
         raise ValueError(
-            f"Expected v_right (N,), v_left (N,), body_velocity (N, 3) with one N (one sample rate), got "
-            f"{vr.shape}, {vl.shape}, {V.shape}."
+            f"Expected v_left to have shape {vr.shape} like v_right (one N: one sample rate), got {vl.shape}."
         )
-    for a, name in ((vr, "v_right"), (vl, "v_left"), (V, "body_velocity")):
-        _reject_inf(a, name)
-    w = np.ones(vr.shape) if weights is None else as_array(weights, "weights", ())
+    if V.shape != (*vr.shape, 3):
+        raise ValueError(
+            f"Expected body_velocity to have shape {(*vr.shape, 3)} (one N: one sample rate), got {V.shape}."
+        )
+    w = np.ones(vr.shape) if weights is None else as_array(weights, "weights")
     if w.shape != vr.shape:
-        raise ValueError(f"Expected weights of shape {vr.shape}, got {w.shape}.")
+        raise ValueError(f"Expected weights to have shape {vr.shape}, got {w.shape}.")
     if np.any(w < 0):
         raise ValueError(f"Expected weights >= 0, got {int(np.sum(w < 0))} negative value(s).")
     used = np.isfinite(vr) & np.isfinite(vl) & np.all(np.isfinite(V), axis=-1)
@@ -213,7 +222,8 @@ class WheelSlip:
     ``ratio``: longitudinal slip ``(r φ̇ - v) / max(|r φ̇|, |v|)`` in [-1, 1] (positive: spinning faster
     than the ground passes, i.e. traction slip; negative: skidding, braking); ``v`` is the ground speed
     of the contact along the wheel's heading.  ``lateral_velocity``: sideways sliding of the contact (m/s).
-    ``valid``: finite inputs and not both speeds below ``SLIP_SPEED_FLOOR`` (NaN ratio exactly there).
+    ``valid``: a finite wheel rate (a drop-out is flagged for that wheel) and not both speeds below
+    ``SLIP_SPEED_FLOOR`` (NaN exactly where it is false).
     """
 
     ratio: np.ndarray
@@ -229,7 +239,7 @@ def wheel_slip(
     the nominal slides), planar rigid motion: contact ``(x, y)`` moves at ``(v_x - r y, v_y + r x)``."""
     radii = wheel_radii(robot)
     w = as_array(wheel_rate, "wheel_rate", (N_WHEELS,), finite=False)
-    V = as_array(body_velocity, "body_velocity", (3,), finite=False)
+    V = as_array(body_velocity, "body_velocity", (3,))
     if config is None:
         q = np.zeros(8)
         q[[3, 7]] = robot.rear_wheel_drop
@@ -239,8 +249,10 @@ def wheel_slip(
     vx, vy, r = V[..., 0:1], V[..., 1:2], V[..., 2:3]
     ground = vx - r * p[..., 1]
     lateral = vy + r * p[..., 0]
-    rim = w * radii
+    finite = np.isfinite(w)
+    rim = np.where(finite, w, 0.0) * radii
+    valid, ground, lateral, rim = np.broadcast_arrays(finite, ground, lateral, rim)
     den = np.maximum(np.abs(rim), np.abs(ground))
-    valid = np.isfinite(rim) & np.isfinite(ground) & np.isfinite(lateral) & (den > SLIP_SPEED_FLOOR)
+    valid = valid & (den > SLIP_SPEED_FLOOR)
     ratio = np.where(valid, (rim - ground) / np.where(valid, den, 1.0), np.nan)
     return WheelSlip(ratio=ratio, lateral_velocity=np.where(valid, lateral, np.nan), valid=valid)

@@ -19,7 +19,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_positive
+from robomech._validation import (
+    as_array,
+    check_int,
+    check_params,
+    check_positive,
+    coerce_float_fields,
+    coerce_int_fields,
+)
 
 from ._chains import N_WHEELS
 from ._icr import ICRModel
@@ -28,6 +35,7 @@ __all__ = [
     "SAMPLE_RATE_RTOL",
     "EKFResult",
     "EncoderModel",
+    "EncoderReadings",
     "ImuModel",
     "encoder_rates",
     "imu_measurements",
@@ -40,12 +48,6 @@ __all__ = [
 SAMPLE_RATE_RTOL = 1e-6
 
 
-def _check_real(v: object, name: str, positive: bool = True) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
-        raise ValueError(f"Expected {name} to be a real number, got {type(v).__name__}.")
-    return check_positive(v, name, allow_zero=not positive)
-
-
 @dataclass(frozen=True)
 class EncoderModel:
     """Incremental wheel encoder: ``counts_per_rev`` counts per wheel revolution (quantisation only)."""
@@ -53,10 +55,7 @@ class EncoderModel:
     counts_per_rev: int = 2048
 
     def __post_init__(self) -> None:
-        c = self.counts_per_rev
-        if isinstance(c, bool) or not isinstance(c, (int, np.integer)) or c < 1:
-            raise ValueError(f"Expected counts_per_rev a positive integer, got {c!r}.")
-        object.__setattr__(self, "counts_per_rev", int(c))
+        coerce_int_fields(self, ("counts_per_rev",), low=1)
 
     def rate_sigma(self, dt: float) -> float:
         """Standard deviation of the measured spin rate (rad/s) at sample interval ``dt`` (s), averaged
@@ -78,8 +77,9 @@ class ImuModel:
     accel_bias: tuple[float, float, float] = (0.02, -0.01, 0.0)  # m/s²
 
     def __post_init__(self) -> None:
-        for name in ("gyro_noise_density", "accel_noise_density"):
-            object.__setattr__(self, name, _check_real(getattr(self, name), name, positive=False))
+        coerce_float_fields(
+            self, ("gyro_noise_density", "accel_noise_density"), positive=True, allow_zero=True
+        )
         for name in ("gyro_bias", "accel_bias"):
             b = as_array(getattr(self, name), name, (3,))
             if b.ndim != 1:
@@ -96,19 +96,25 @@ class ImuModel:
 def _rng(seed: object) -> np.random.Generator:
     if isinstance(seed, np.random.Generator):
         return seed
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
-        raise ValueError(f"Expected seed to be an int or a numpy Generator, got {type(seed).__name__}.")
-    return np.random.default_rng(int(seed))
+    return np.random.default_rng(check_int(seed, "seed", low=0))
 
 
-def encoder_rates(model: EncoderModel, wheel_rate: object, dt: float, seed: object = 0) -> np.ndarray:
-    """Measured spin rates ``(N, 6)`` from true rates ``(N, 6)`` sampled every ``dt`` s.
+@dataclass(frozen=True)
+class EncoderReadings:
+    """Measured spin rates ``rate (N, 6)`` (rad/s, ``WHEELS`` order); ``valid (N,)`` false where there
+    is no reading (the first sample: no previous count), and ``rate`` is NaN exactly there."""
 
-    The true angle is integrated by the trapezoidal rule from a random initial phase (seeded), counted,
-    and differenced; the first sample is NaN (no previous count).
+    rate: np.ndarray
+    valid: np.ndarray
+
+
+def encoder_rates(model: EncoderModel, wheel_rate: object, dt: float, seed: object = 0) -> EncoderReadings:
+    """Measured spin rates from true rates ``(N, 6)`` sampled every ``dt`` s.
+
+    The true angle is integrated by the trapezoidal rule from a random initial phase (``seed``: an int
+    or a ``numpy.random.Generator``), counted, and differenced; the first sample has no reading.
     """
-    if not isinstance(model, EncoderModel):
-        raise ValueError(f"Expected model to be an EncoderModel, got {type(model).__name__}.")
+    check_params(model, EncoderModel, "model")
     w = as_array(wheel_rate, "wheel_rate", (None, N_WHEELS), min_ndim=2)
     if w.ndim != 2:
         raise ValueError(f"Expected wheel_rate to have shape (N, 6), got {w.shape}.")
@@ -120,15 +126,16 @@ def encoder_rates(model: EncoderModel, wheel_rate: object, dt: float, seed: obje
     counts = np.floor(angle / q)
     out = np.full(w.shape, np.nan)
     out[1:] = np.diff(counts, axis=0) * q / h
-    return out
+    valid = np.ones(w.shape[0], dtype=bool)
+    valid[0] = False
+    return EncoderReadings(rate=out, valid=valid)
 
 
 def imu_measurements(
     model: ImuModel, angular_velocity: object, specific_force: object, dt: float, seed: object = 0
 ) -> tuple[np.ndarray, np.ndarray]:
     """Gyro and accelerometer readings ``(N, 3)`` each from true body-axis values ``(N, 3)``."""
-    if not isinstance(model, ImuModel):
-        raise ValueError(f"Expected model to be an ImuModel, got {type(model).__name__}.")
+    check_params(model, ImuModel, "model")
     w = as_array(angular_velocity, "angular_velocity", (3,))
     a = as_array(specific_force, "specific_force", (3,))
     if w.shape != a.shape:
@@ -146,7 +153,10 @@ def track_speed_sigma(encoder: EncoderModel, radii: object, dt: float) -> float:
 
     ``radii``: the side's wheel radii (m); the wheels' quantisation errors are independent.
     """
+    check_params(encoder, EncoderModel, "encoder")
     r = as_array(radii, "radii", (None,))
+    if r.ndim != 1 or r.size == 0 or np.any(r <= 0):
+        raise ValueError(f"Expected radii a non-empty 1-d array of positive radii, got {r!r}.")
     return float(encoder.rate_sigma(dt) * np.sqrt(np.sum(r**2)) / r.size)
 
 
@@ -156,7 +166,7 @@ class EKFResult:
 
     ``state (N, 6)`` = ``[x, y, ψ, v_x, r, b_gyro]`` (m, rad, m/s, rad/s, rad/s), ``covariance (N, 6, 6)``;
     ``encoder_used`` / ``gyro_used (N,)``: whether that sample's measurement updated the filter (false
-    for NaN drop-outs: the filter only predicts there).
+    at the drop-outs marked by ``encoder_ok`` / ``gyro_ok``: the filter only predicts there).
     """
 
     state: np.ndarray
@@ -192,6 +202,8 @@ def planar_ekf(
     bias_psd: float = 1e-8,
     initial_pose: object = (0.0, 0.0, 0.0),
     initial_bias_sigma: float = 0.01,
+    encoder_ok: object | None = None,
+    gyro_ok: object | None = None,
 ) -> EKFResult:
     """Extended Kalman filter for planar odometry: encoders through the ICR model, and a gyro.
 
@@ -203,8 +215,10 @@ def planar_ekf(
     ``sigma_track² + sigma_model²`` per side, m/s) and the gyro ``z = r + b`` (``sigma_gyro``, rad/s).
 
     All histories ``(N,)`` share the time stamps ``t`` (one sample rate: arrays of another length, or
-    ``t`` with non-uniform steps, raise ``ValueError``).  A NaN measurement is a drop-out: that update is
-    skipped and ``encoder_used``/``gyro_used`` say so.
+    ``t`` with non-uniform steps, raise ``ValueError``).  Drop-outs are explicit: ``encoder_ok`` /
+    ``gyro_ok`` (bool ``(N,)``, default all true) mark the samples with a reading; the values there must
+    be finite (a NaN elsewhere raises: nothing is skipped silently), the others are ignored, and
+    ``encoder_used`` / ``gyro_used`` report what entered.
     """
     ta = _check_times(t)
     n = ta.size
@@ -214,19 +228,35 @@ def planar_ekf(
             "Expected t uniformly sampled (one sample rate for all histories), got steps from "
             f"{dts.min():.6g} s to {dts.max():.6g} s."
         )
+    oks = {}
+    for a, name in ((encoder_ok, "encoder_ok"), (gyro_ok, "gyro_ok")):
+        if a is None:
+            oks[name] = np.ones(n, dtype=bool)
+            continue
+        arr = np.asarray(a)
+        if arr.dtype != bool or arr.shape != (n,):
+            raise ValueError(f"Expected {name} a bool array of shape ({n},), got {arr.dtype} {arr.shape}.")
+        oks[name] = arr
     hist = {}
-    for a, name in ((v_right, "v_right"), (v_left, "v_left"), (gyro_z, "gyro_z")):
+    for a, name, ok in (
+        (v_right, "v_right", oks["encoder_ok"]),
+        (v_left, "v_left", oks["encoder_ok"]),
+        (gyro_z, "gyro_z", oks["gyro_ok"]),
+    ):
         arr = as_array(a, name, finite=False)
         if arr.shape != (n,):
             raise ValueError(
                 f"Expected {name} to have shape ({n},) like t (one sample rate for all histories), "
                 f"got {arr.shape}."
             )
-        if np.any(np.isinf(arr)):
-            raise ValueError(f"Expected {name} finite or NaN (a drop-out), got infinite value(s).")
+        bad = ok & ~np.isfinite(arr)
+        if np.any(bad):
+            raise ValueError(
+                f"Expected {name} finite where it is marked as read, got {int(bad.sum())} non-finite "
+                "value(s); mark drop-outs in encoder_ok / gyro_ok."
+            )
         hist[name] = arr
-    if not isinstance(icr, ICRModel):
-        raise ValueError(f"Expected icr to be an ICRModel, got {type(icr).__name__}.")
+    check_params(icr, ICRModel, "icr")
     s_tr = check_positive(sigma_track, "sigma_track")
     s_g = check_positive(sigma_gyro, "sigma_gyro")
     s_m = check_positive(sigma_model, "sigma_model", allow_zero=True)
@@ -277,11 +307,11 @@ def planar_ekf(
             Q = np.diag([0.0, 0.0, 0.0, qa * h, qr * h, qb * h])
             P = F @ P @ F.T + Q
         z = np.array([hist["v_right"][k], hist["v_left"][k]])
-        if np.all(np.isfinite(z)):
+        if oks["encoder_ok"][k]:
             s, P = update(s, P, z, H_enc @ s, H_enc, R_enc)
             enc_used[k] = True
         g = hist["gyro_z"][k]
-        if math.isfinite(g):
+        if oks["gyro_ok"][k]:
             s, P = update(s, P, np.array([g]), H_g @ s, H_g, R_g)
             gyro_used[k] = True
         states[k] = s
