@@ -115,6 +115,10 @@ class EngineParams:
     # paper 4, Fig. 3: a spring-damper from the rocker (Q) to the suspension (C) holds the bogie
     bogie_stiffness: float = 150.0
     bogie_damping: float = 3.0
+    # rad: the bogie spring's rest angle is this far nose-up, chosen so that the two road wheels carry
+    # equal static loads (with a relaxed spring the bogie hinge, ahead of its wheels' midpoint, puts
+    # 3/4 of the bogie's load on the front road wheel and the rear one lifts in every turn)
+    bogie_preload: float = 0.021
     joint_limit: float = 0.4  # rad: end stops of the rocker, bogie and side-link hinges
     slide_travel: float = 0.04  # m: rear-wheel slide travel either side of its nominal extension
     wheel_gain: float = 5.0  # velocity actuator gain kv (N·m per rad/s)
@@ -149,6 +153,7 @@ def build_model(robot: ExplorationRobot, terrain: Terrain | None = None, params:
     check_params(p, EngineParams, "params")
     spec = mujoco.MjSpec()
     spec.modelname = "skid_steer_robot"
+    spec.compiler.degree = False  # joint ranges and spring references in radians (MJCF's default is degrees)
     spec.option.timestep = p.timestep
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC  # friction cone, not its pyramid approximation
@@ -176,8 +181,9 @@ def build_model(robot: ExplorationRobot, terrain: Terrain | None = None, params:
     # MuJoCo takes the larger friction of the two geoms in contact: set both to μ.
     ground.friction = [p.friction, 0.0, 0.0]
 
-    def hinge(body, name, damping, stiffness=0.0, limit=None):
+    def hinge(body, name, damping, stiffness=0.0, limit=None, springref=0.0):
         j = body.add_joint(name=name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0.0, 1.0, 0.0])
+        j.springref = springref
         j.damping = [damping, 0.0, 0.0]  # MuJoCo 4: polynomial coefficients
         if stiffness:
             j.stiffness = [stiffness, 0.0, 0.0]
@@ -237,7 +243,7 @@ def build_model(robot: ExplorationRobot, terrain: Terrain | None = None, params:
             friction=[p.friction, 0.0, 0.0],
         )
         bogie = rocker.add_body(name=f"bogie_{side}", pos=[robot.bogie_hinge_x, 0.0, -robot.bogie_hinge_drop])
-        hinge(bogie, f"bogie_{side}", p.bogie_damping, p.bogie_stiffness, p.joint_limit)
+        hinge(bogie, f"bogie_{side}", p.bogie_damping, p.bogie_stiffness, p.joint_limit, -p.bogie_preload)
         bogie.add_geom(
             type=mujoco.mjtGeom.mjGEOM_CAPSULE,
             fromto=[-robot.side_link_hinge_offset, 0, 0, robot.side_link_hinge_offset, 0, 0],
