@@ -351,7 +351,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         r["yaw_rms"][engine_cmp.ESTIMATORS[0]] / r["yaw_rms"][engine_cmp.ESTIMATORS[1]] for r in flat_turns
     ]
     uneven_turn = next(r for r in comp.rows if r["name"] == "turn, uneven")
-    ekf = engine_cmp.ESTIMATORS[3]
+    ekf = engine_cmp.ESTIMATORS[4]
     uneven_factor = (
         uneven_turn["yaw_rms"][engine_cmp.ESTIMATORS[0]] / uneven_turn["yaw_rms"][engine_cmp.ESTIMATORS[1]]
     )
@@ -383,7 +383,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         f"squares (χ = {comp.chi:.2f}) reduces the no-slip yaw-rate RMS error by a factor "
         f"{min(factors):.0f}–{max(factors):.0f} on flat turns and "
         f"{uneven_factor:.1f} "
-        "on uneven ground. The EKF (encoders through the ICR model + a biased gyro) drifts "
+        "on uneven ground. The EKF (encoders through the ICR model, adapted online, + a gyro) drifts "
         + ", ".join(f"{100 * r['drift_per_m'][ekf]:.1f} %" for r in comp.rows)
         + " of the distance travelled over the manoeuvres (in the order of the drift table); its heading is "
         "good, its turns are limited by the ICR model's forward speed. MuJoCo's soft contact is not "

@@ -164,3 +164,26 @@ def test_weighted_30x11_beats_the_unweighted_one_with_unequal_noise():
     np.testing.assert_allclose(exact.twist, V[:50], atol=1e-9)
     with pytest.raises(ValueError, match="measurement_sigma"):
         body_velocity(ROBOT, q[:5], m[:5], measurement_sigma=np.zeros(22))
+
+
+def test_ekf_adapts_the_track_icrs_online():
+    """Synthetic data from an ICR model the filter is not told: varying turns, calibrated gyro.  Encoders
+    and a gyro see the ICR spread y_left - y_right (the yaw-rate scale χ S); their mean trades with v_x."""
+    true = ICRModel(0.7, -0.6, 0.0)
+    start = ICRModel(0.45, -0.45, 0.0)  # no-slip guess
+    n, dt = 3001, 0.01
+    t = np.arange(n) * dt
+    vr = 0.2 + 0.1 * np.sin(0.3 * t)
+    vl = 0.2 - 0.1 * np.sin(0.3 * t + 1.0)
+    v = icr_velocity(true, vr, vl)
+    rng = np.random.default_rng(2)
+    gyro = v.yaw_rate + 1e-3 * rng.normal(size=n)
+    kw = {"sigma_track": 2e-3, "sigma_gyro": 1e-3, "initial_bias_sigma": 0.0, "bias_psd": 0.0}
+    fixed = planar_ekf(t, vr + 2e-3 * rng.normal(size=n), vl, gyro, start, **kw)
+    adapted = planar_ekf(
+        t, vr + 2e-3 * rng.normal(size=n), vl, gyro, start, **kw, icr_sigma=0.3, icr_psd=1e-6
+    )
+    assert adapted.state[-1, 6] - adapted.state[-1, 7] == pytest.approx(1.3, abs=0.01)
+    np.testing.assert_array_equal(
+        fixed.state[:, 6:], np.broadcast_to([0.45, -0.45], (n, 2))
+    )  # fixed: unchanged

@@ -21,6 +21,7 @@ from ._icr import (
     wheel_slip,
 )
 from ._odometry import (
+    N_STATE,
     SAMPLE_RATE_RTOL,
     EKFResult,
     EncoderModel,
@@ -65,6 +66,7 @@ __all__ = [
     "LATERAL_SLIP_RTOL",
     "MEASURED_SIZE",
     "N_ROWS",
+    "N_STATE",
     "N_WHEELS",
     "SAMPLE_RATE_RTOL",
     "SIDE_JOINTS",

@@ -32,6 +32,7 @@ from ._chains import N_WHEELS
 from ._icr import ICRModel
 
 __all__ = [
+    "N_STATE",
     "SAMPLE_RATE_RTOL",
     "EKFResult",
     "EncoderModel",
@@ -46,6 +47,8 @@ __all__ = [
 # Relative spread of the sample intervals dt_k beyond which the histories do not share one sample rate
 # (1e-6: far above the rounding of arange(n)/rate, far below any real jitter worth modelling).
 SAMPLE_RATE_RTOL = 1e-6
+# State of planar_ekf: [x, y, ψ, v_x, r, b_gyro, y_left, y_right].
+N_STATE = 8
 
 
 @dataclass(frozen=True)
@@ -164,7 +167,8 @@ def track_speed_sigma(encoder: EncoderModel, radii: object, dt: float) -> float:
 class EKFResult:
     """Filtered planar odometry, ``N`` samples.
 
-    ``state (N, 6)`` = ``[x, y, ψ, v_x, r, b_gyro]`` (m, rad, m/s, rad/s, rad/s), ``covariance (N, 6, 6)``;
+    ``state (N, 8)`` = ``[x, y, ψ, v_x, r, b_gyro, y_left, y_right]`` (m, m, rad, m/s, rad/s, rad/s, m, m),
+    ``covariance (N, 8, 8)``;
     ``encoder_used`` / ``gyro_used (N,)``: whether that sample's measurement updated the filter (false
     at the drop-outs marked by ``encoder_ok`` / ``gyro_ok``: the filter only predicts there).
     """
@@ -202,17 +206,27 @@ def planar_ekf(
     bias_psd: float = 1e-8,
     initial_pose: object = (0.0, 0.0, 0.0),
     initial_bias_sigma: float = 0.01,
+    icr_sigma: float = 0.0,
+    icr_psd: float = 0.0,
     encoder_ok: object | None = None,
     gyro_ok: object | None = None,
 ) -> EKFResult:
     """Extended Kalman filter for planar odometry: encoders through the ICR model, and a gyro.
 
-    State ``s = [x, y, ψ, v_x, r, b]``.  Prediction over ``dt``: ``x += dt (v_x cos ψ - v_y sin ψ)``,
-    ``y += dt (v_x sin ψ + v_y cos ψ)``, ``ψ += dt r`` with ``v_y = -r x_icr`` (the ICR model's lateral
-    slip); ``v_x``, ``r`` and the gyro bias ``b`` are random walks with spectral densities ``accel_psd``
-    (m²/s³), ``yaw_accel_psd`` (rad²/s³) and ``bias_psd`` (rad²/s³).  Measurements: the encoder track
-    speeds ``v_right = v_x - r y_right``, ``v_left = v_x - r y_left`` (the ICR model, noise
-    ``sigma_track² + sigma_model²`` per side, m/s) and the gyro ``z = r + b`` (``sigma_gyro``, rad/s).
+    State ``s = [x, y, ψ, v_x, r, b, y_left, y_right]`` (``N_STATE = 8``).  Prediction over ``dt``:
+    ``x += dt (v_x cos ψ - v_y sin ψ)``, ``y += dt (v_x sin ψ + v_y cos ψ)``, ``ψ += dt r`` with
+    ``v_y = -r x_icr`` (the ICR model's lateral slip); ``v_x``, ``r`` and the gyro bias ``b`` are random
+    walks with spectral densities ``accel_psd`` (m²/s³), ``yaw_accel_psd`` (rad²/s³) and ``bias_psd``
+    (rad²/s³).  Measurements: the encoder track speeds ``v_right = v_x - r y_right``,
+    ``v_left = v_x - r y_left`` (the ICR model, noise ``sigma_track² + sigma_model²`` per side, m/s)
+    and the gyro ``z = r + b`` (``sigma_gyro``, rad/s).
+
+    The track ICRs ``y_left``, ``y_right`` start at ``icr``'s; with ``icr_sigma > 0`` (their initial
+    1σ, m) and ``icr_psd`` (random-walk density, m²/s) the filter adapts them online (cf. Pentzer et al.
+    2014), otherwise they stay fixed.  Only their spread ``y_left - y_right`` (the yaw-rate scale
+    ``χ S``) is observable from encoders and a gyro; their mean trades with ``v_x``.  Adapting needs a
+    calibrated gyro bias (``initial_bias_sigma`` of the size left by a start-up calibration): in a
+    steady turn the encoders alone cannot tell a gyro bias from an ICR error.
 
     All histories ``(N,)`` share the time stamps ``t`` (one sample rate: arrays of another length, or
     ``t`` with non-uniform steps, raise ``ValueError``).  Drop-outs are explicit: ``encoder_ok`` /
@@ -267,35 +281,38 @@ def planar_ekf(
     if pose0.shape != (3,):
         raise ValueError(f"Expected initial_pose to have shape (3,), got {pose0.shape}.")
     sb0 = check_positive(initial_bias_sigma, "initial_bias_sigma", allow_zero=True)
+    s_icr = check_positive(icr_sigma, "icr_sigma", allow_zero=True)
+    q_icr = check_positive(icr_psd, "icr_psd", allow_zero=True)
 
-    yl, yr, xi = icr.y_left, icr.y_right, icr.x_icr
-    H_enc = np.array([[0, 0, 0, 1.0, -yr, 0], [0, 0, 0, 1.0, -yl, 0]])
-    R_enc = np.eye(2) * (s_tr**2 + s_m**2)
-    H_g = np.array([[0, 0, 0, 0, 1.0, 1.0]])
+    xi = icr.x_icr
+    H_g = np.array([[0, 0, 0, 0, 1.0, 1.0, 0, 0]])
     R_g = np.array([[s_g**2]])
-    s = np.zeros(6)
+    R_enc = np.eye(2) * (s_tr**2 + s_m**2)
+    s = np.zeros(N_STATE)
     s[:3] = pose0
-    P = np.diag([1e-12, 1e-12, 1e-12, 1.0, 1.0, max(sb0, 1e-12) ** 2])
-    states = np.empty((n, 6))
-    covs = np.empty((n, 6, 6))
+    s[6], s[7] = icr.y_left, icr.y_right
+    P = np.diag([0.0, 0.0, 0.0, 1.0, 1.0, sb0**2, s_icr**2, s_icr**2])
+    states = np.empty((n, N_STATE))
+    covs = np.empty((n, N_STATE, N_STATE))
     enc_used = np.zeros(n, dtype=bool)
     gyro_used = np.zeros(n, dtype=bool)
-    eye = np.eye(6)
+    eye = np.eye(N_STATE)
 
     def update(s, P, z, h, H, R):
         S = H @ P @ H.T + R
         K = np.linalg.solve(S, H @ P).T
         s = s + K @ (z - h)
         IKH = eye - K @ H
-        return s, IKH @ P @ IKH.T + K @ R @ K.T  # Joseph form: stays symmetric positive definite
+        return s, IKH @ P @ IKH.T + K @ R @ K.T  # Joseph form: stays symmetric positive semi-definite
 
     for k in range(n):
         if k > 0:
             h = dts[k - 1]
-            _, _, psi, v, r, _ = s
+            psi, v, r = s[2], s[3], s[4]
             c, sn = math.cos(psi), math.sin(psi)
             vy = -r * xi
-            s = s + h * np.array([v * c - vy * sn, v * sn + vy * c, r, 0.0, 0.0, 0.0])
+            s = s.copy()
+            s[:3] += h * np.array([v * c - vy * sn, v * sn + vy * c, r])
             F = eye.copy()
             F[0, 2] = -h * (v * sn + vy * c)
             F[0, 3] = h * c
@@ -304,15 +321,20 @@ def planar_ekf(
             F[1, 3] = h * sn
             F[1, 4] = -h * xi * c
             F[2, 4] = h
-            Q = np.diag([0.0, 0.0, 0.0, qa * h, qr * h, qb * h])
+            Q = np.diag([0.0, 0.0, 0.0, qa * h, qr * h, qb * h, q_icr * h, q_icr * h])
             P = F @ P @ F.T + Q
-        z = np.array([hist["v_right"][k], hist["v_left"][k]])
         if oks["encoder_ok"][k]:
-            s, P = update(s, P, z, H_enc @ s, H_enc, R_enc)
+            v, r, yl, yr = s[3], s[4], s[6], s[7]
+            # v_right = v_x - r y_right, v_left = v_x - r y_left (bilinear when the ICRs are estimated)
+            H = np.zeros((2, N_STATE))
+            H[:, 3] = 1.0
+            H[0, 4], H[0, 7] = -yr, -r
+            H[1, 4], H[1, 6] = -yl, -r
+            z = np.array([hist["v_right"][k], hist["v_left"][k]])
+            s, P = update(s, P, z, np.array([v - r * yr, v - r * yl]), H, R_enc)
             enc_used[k] = True
-        g = hist["gyro_z"][k]
         if oks["gyro_ok"][k]:
-            s, P = update(s, P, np.array([g]), H_g @ s, H_g, R_g)
+            s, P = update(s, P, np.array([hist["gyro_z"][k]]), H_g @ s, H_g, R_g)
             gyro_used[k] = True
         states[k] = s
         covs[k] = P
