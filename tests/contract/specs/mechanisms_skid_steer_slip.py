@@ -28,7 +28,7 @@ N = 20
 T = np.arange(N) * 0.01
 
 SPECS = {
-    **exempt("LATERAL_SLIP_RTOL SLIP_SPEED_FLOOR SAMPLE_RATE_RTOL", CONSTANT, P),
+    **exempt("LATERAL_SLIP_RTOL SLIP_SPEED_FLOOR SAMPLE_RATE_RTOL N_STATE", CONSTANT, P),
     **exempt(
         "LateralSlip PlanarVelocity TrackSpeeds WheelSlip ICRIdentification EKFResult EncoderReadings",
         RESULT_TYPE,
@@ -142,6 +142,8 @@ SPECS = {
             "bias_psd": 1e-8,
             "initial_pose": np.zeros(3),
             "initial_bias_sigma": 0.01,
+            "icr_sigma": 0.1,
+            "icr_psd": 1e-4,
         },
         arrays={"t": 0, "v_right": 0, "v_left": 0, "gyro_z": 0, "initial_pose": 1},
         params=("icr",),
@@ -153,6 +155,8 @@ SPECS = {
             "yaw_accel_psd": BAD_POSITIVE,
             "bias_psd": BAD_NONNEGATIVE,
             "initial_bias_sigma": BAD_NONNEGATIVE,
+            "icr_sigma": BAD_NONNEGATIVE,
+            "icr_psd": BAD_NONNEGATIVE,
         },
         wrong_shapes={"t": ((2, N),), "gyro_z": ((N - 1,),), "v_right": ((N + 1,),)},
     ),
