@@ -193,26 +193,21 @@ def identify_icr(
         raise ValueError(f"Expected weights >= 0, got {int(np.sum(w < 0))} negative value(s).")
     used = np.isfinite(vr) & np.isfinite(vl) & np.all(np.isfinite(V), axis=-1)
     n = int(used.sum())
+    # The three groups decouple (each unknown has its own column): three (N, 1) systems, one batched call.
     r = V[used, 2]
-    A = np.zeros((3 * n, 3))
-    b = np.empty(3 * n)
-    A[0::3, 0] = -r
-    A[1::3, 1] = -r
-    A[2::3, 2] = -r
-    b[0::3] = vr[used] - V[used, 0]
-    b[1::3] = vl[used] - V[used, 0]
-    b[2::3] = V[used, 1]
+    A = np.broadcast_to(-r[None, :, None], (3, n, 1))
+    b = np.stack([vr[used] - V[used, 0], vl[used] - V[used, 0], V[used, 1]])  # (3, n)
     if n == 0 or not np.any(r != 0.0):
         # no used sample, or no turning at all: every row is zero, nothing to identify
-        rms = np.sqrt(np.mean(b.reshape(n, 3) ** 2, axis=0)) if n else np.full(3, np.nan)
+        rms = np.sqrt(np.mean(b**2, axis=1)) if n else np.full(3, np.nan)
         return ICRIdentification(None, rms, used, n, math.inf, False)
-    res = lstsq.solve(A, b, weights=np.repeat(w[used], 3))
-    resid = (A @ np.nan_to_num(res.x) - b).reshape(n, 3)
-    rms = np.sqrt(np.mean(resid**2, axis=0))
-    y_right, y_left, x_icr = (float(v) for v in res.x)
-    ok = bool(res.ok and res.full_rank and np.all(np.isfinite(res.x)) and y_left > y_right)
+    res = lstsq.solve(A, b, weights=w[used])
+    x = res.x[:, 0]
+    rms = np.sqrt(np.mean((A[..., 0] * np.nan_to_num(x)[:, None] - b) ** 2, axis=1))
+    y_right, y_left, x_icr = (float(v) for v in x)
+    ok = bool(np.all(res.ok & res.full_rank) and np.all(np.isfinite(x)) and y_left > y_right)
     model = ICRModel(y_left, y_right, x_icr) if ok else None
-    return ICRIdentification(model, rms, used, n, float(res.cond), ok)
+    return ICRIdentification(model, rms, used, n, float(np.max(res.cond)), ok)
 
 
 @dataclass(frozen=True)
