@@ -58,11 +58,12 @@ def test_paper_lateral_slip_is_the_outer_wheel_half_a_wheelbase_from_the_centre_
 
 def test_paper_lateral_slip_flags_its_singularity_instead_of_returning_inf():
     # issue 14: 2 R + S = 0 (centre of rotation on the inner track) used to return inf.
-    slip = paper_lateral_slip([0.1, 0.1, 0.1, np.nan], 0.5, [-S / 2, 0.9, np.inf, 0.9], S)
-    assert slip.valid.tolist() == [False, True, True, False]
+    slip = paper_lateral_slip([0.1, 0.1, 0.1], 0.5, [-S / 2, 0.9, -S / 2 * (1 + 1e-12)], S)
+    assert slip.valid.tolist() == [False, True, False]
     assert np.isnan(slip.lateral_speed[~slip.valid]).all()
-    assert slip.lateral_speed[2] == 0.0  # straight (radius inf): no lateral slip
     assert np.isfinite(slip.lateral_speed[slip.valid]).all()
+    with pytest.raises(ValueError, match="radius"):  # non-finite input: an error (the contract spec)
+        paper_lateral_slip(0.1, 0.5, np.inf, S)
 
 
 def test_skid_steer_rejects_bad_track_width():

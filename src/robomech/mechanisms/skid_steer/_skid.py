@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_positive
+from robomech._validation import as_array, broadcast_batch, check_positive
 from robomech.spatial import exp_se3
 
 __all__ = [
@@ -55,6 +55,7 @@ def skid_steer_turn(v_right: object, v_left: object, track_width: float) -> Skid
     """
     v1 = as_array(v_right, "v_right")
     v2 = as_array(v_left, "v_left")
+    broadcast_batch((v1, 0, "v_right"), (v2, 0, "v_left"))
     S = check_positive(track_width, "track_width")
     diff = v1 - v2
     total = v1 + v2
@@ -74,6 +75,7 @@ def wheel_lateral_velocity(yaw_rate: object, wheel_x: object, icr_x: object = 0.
     r = as_array(yaw_rate, "yaw_rate")
     x = as_array(wheel_x, "wheel_x")
     xi = as_array(icr_x, "icr_x")
+    broadcast_batch((r, 0, "yaw_rate"), (x, 0, "wheel_x"), (xi, 0, "icr_x"))
     return r * (x - xi)
 
 
@@ -91,15 +93,16 @@ def paper_lateral_slip(v_outer: object, wheelbase: float, radius: object, track_
     wheel a distance ``L/2`` ahead of or behind the centre of rotation, with ``R_s`` the radius of the
     body centre (not of the inner wheel, as printed).
 
-    ``radius`` may be ``±inf`` (straight: no slip, as :func:`skid_steer_turn` reports it).  Samples at
-    the formula's singularity ``2 R + S = 0`` (the inner track at rest) or with NaN input are flagged.
+    Samples at the formula's singularity ``2 R + S = 0`` (the centre of rotation on the inner track, which
+    is then at rest) are flagged (``valid`` false, NaN) instead of returned as huge or infinite values.
     """
-    v = as_array(v_outer, "v_outer", finite=False)
-    R = as_array(radius, "radius", finite=False)
+    v = as_array(v_outer, "v_outer")
+    R = as_array(radius, "radius")
+    broadcast_batch((v, 0, "v_outer"), (R, 0, "radius"))
     L = check_positive(wheelbase, "wheelbase")
     S = check_positive(track_width, "track_width")
     den = 2.0 * R + S
-    valid = np.isfinite(v) & ~np.isnan(R) & (np.abs(den) > LATERAL_SLIP_RTOL * S)
+    valid = np.abs(den) > LATERAL_SLIP_RTOL * S
     out = np.where(valid, v * L / np.where(valid, den, 1.0), np.nan)
     valid = valid & np.isfinite(out)
     return LateralSlip(lateral_speed=np.where(valid, out, np.nan), valid=valid)

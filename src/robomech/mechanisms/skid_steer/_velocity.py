@@ -20,7 +20,7 @@ from typing import Literal
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, broadcast_batch, check_bool, check_params
 from robomech.analysis import lstsq
 
 from ._chains import CONFIG_SIZE, N_WHEELS, _linear_columns
@@ -56,6 +56,7 @@ _PASSIVE = ((5, 6, 9), (7, 8, 10))
 
 def assemble(robot: ExplorationRobot, config: object) -> tuple[np.ndarray, np.ndarray]:
     """``A0 (..., 30, 11)`` and ``J (..., 30, 22)`` of the composite system at ``config (..., 8)``."""
+    check_params(robot, ExplorationRobot, "robot")
     q = as_array(config, "config", (CONFIG_SIZE,))
     batch = q.shape[:-1]
     n = int(np.prod(batch))
@@ -127,6 +128,7 @@ def wheel_measurements(
     recovers everything from these except that it reports ``ω_BY = (ω1 + ω2)/2``, which is the true
     pitch rate only when the differential holds (``θ̇2 = -θ̇1``).
     """
+    check_params(robot, ExplorationRobot, "robot")
     q = as_array(config, "config", (CONFIG_SIZE,))
     V = as_array(twist, "twist", (6,))
     qd = as_array(config_rate, "config_rate", (CONFIG_SIZE,))
@@ -192,10 +194,12 @@ def body_velocity(
     gyro appears in all six wheels' angular rows) are neglected: a diagonal weighting, not full GLS.
     ``residual_norm`` is then the weighted (dimensionless) residual.
     """
+    check_params(robot, ExplorationRobot, "robot")
     q = as_array(state, "state", (CONFIG_SIZE,), finite=False)
     m = as_array(measured, "measured", (MEASURED_SIZE,), finite=False)
     if solver not in ("qr", "normal_equations"):
         raise ValueError(f"Expected solver 'qr' or 'normal_equations', got {solver!r}.")
+    check_bool(exact_cond, "exact_cond")
     sig = None
     if measurement_sigma is not None:
         if solver != "qr":
@@ -203,7 +207,8 @@ def body_velocity(
         sig = as_array(measurement_sigma, "measurement_sigma", (MEASURED_SIZE,))
         if np.any(sig <= 0):
             raise ValueError(f"Expected measurement_sigma > 0, got {int(np.sum(sig <= 0))} value(s) <= 0.")
-    batch = np.broadcast_shapes(q.shape[:-1], m.shape[:-1], () if sig is None else sig.shape[:-1])
+    arrays = [(q, 1, "state"), (m, 1, "measured")] + ([] if sig is None else [(sig, 1, "measurement_sigma")])
+    batch = broadcast_batch(*arrays)
     n = int(np.prod(batch))
     qf = np.broadcast_to(q, (*batch, CONFIG_SIZE)).reshape(n, CONFIG_SIZE)
     mf = np.broadcast_to(m, (*batch, MEASURED_SIZE)).reshape(n, MEASURED_SIZE)
