@@ -282,8 +282,10 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
                 ],
             ],
             note=(
-                "On uneven ground the contact speeds include pitching and suspension motion, so (v1−v2)/S is "
-                "only approximate there; on flat ground it is exact (robomech verify skid-steer)."
+                "This run is the kinematic simulation, which imposes its slip: (v1−v2)/S of the contact "
+                "speeds is then exact on flat ground by construction and approximate on uneven ground "
+                "(pitching, suspension motion). On contact physics (MuJoCo, below) the formula on the "
+                "encoder speeds overestimates the yaw rate about threefold."
             ),
         )
     )
