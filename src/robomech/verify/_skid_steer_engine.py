@@ -184,9 +184,9 @@ def build_model(robot: ExplorationRobot, terrain: Terrain | None = None, params:
     def hinge(body, name, damping, stiffness=0.0, limit=None, springref=0.0):
         j = body.add_joint(name=name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0.0, 1.0, 0.0])
         j.springref = springref
-        j.damping = [damping, 0.0, 0.0]  # MuJoCo 4: polynomial coefficients
+        _set_coef(j, "damping", damping)
         if stiffness:
-            j.stiffness = [stiffness, 0.0, 0.0]
+            _set_coef(j, "stiffness", stiffness)
         if limit is not None:
             j.limited = mujoco.mjtLimited.mjLIMITED_TRUE
             j.range = [-limit, limit]
@@ -226,8 +226,8 @@ def build_model(robot: ExplorationRobot, terrain: Terrain | None = None, params:
             name=f"slide_{side}", pos=[-robot.rear_arm_length, 0.0, -robot.rear_wheel_drop]
         )
         sj = slide.add_joint(name=f"slide_{side}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0.0, 0.0, -1.0])
-        sj.stiffness = [p.slide_stiffness, 0.0, 0.0]
-        sj.damping = [p.slide_damping, 0.0, 0.0]
+        _set_coef(sj, "stiffness", p.slide_stiffness)
+        _set_coef(sj, "damping", p.slide_damping)
         sj.limited = mujoco.mjtLimited.mjLIMITED_TRUE
         sj.range = [-p.slide_travel, p.slide_travel]
         slide.add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.01, 0, 0], mass=0.05, **no_collide)
@@ -276,23 +276,9 @@ def build_model(robot: ExplorationRobot, terrain: Terrain | None = None, params:
                 friction=[p.friction, 0.0, 0.0],
             )
         # the parallelogram: both side links of a side turn together
-        spec.add_equality(
-            type=mujoco.mjtEq.mjEQ_JOINT,
-            name1=f"link_rear_{side}",
-            name2=f"link_front_{side}",
-            data=[0.0, 1.0] + [0.0] * 10,  # polycoef: θ_rear = θ_front
-            solref=list(_EQ_SOLREF),
-            solimp=list(_EQ_SOLIMP),
-        )
+        _joint_equality(spec, f"link_rear_{side}", f"link_front_{side}", 1.0)  # θ_rear = θ_front
     # the differential: the rockers turn oppositely relative to the body
-    spec.add_equality(
-        type=mujoco.mjtEq.mjEQ_JOINT,
-        name1="rocker_left",
-        name2="rocker_right",
-        data=[0.0, -1.0] + [0.0] * 10,  # polycoef: θ_left = -θ_right
-        solref=list(_EQ_SOLREF),
-        solimp=list(_EQ_SOLIMP),
-    )
+    _joint_equality(spec, "rocker_left", "rocker_right", -1.0)  # θ_left = -θ_right
     for w in WHEELS:
         act = spec.add_actuator(name=f"drive_{w}", target=f"wheel_{w}", trntype=mujoco.mjtTrn.mjTRN_JOINT)
         act.set_to_velocity(kv=p.wheel_gain)
@@ -308,6 +294,22 @@ def build_model(robot: ExplorationRobot, terrain: Terrain | None = None, params:
         objname="imu",
     )
     return spec
+
+
+def _set_coef(joint, attr: str, value: float) -> None:
+    """Set a joint's damping/stiffness: a scalar in MuJoCo 3, polynomial coefficients in MuJoCo 4."""
+    current = getattr(joint, attr)
+    setattr(joint, attr, value if np.ndim(current) == 0 else [value] + [0.0] * (len(current) - 1))
+
+
+def _joint_equality(spec, name1: str, name2: str, gain: float) -> None:
+    """``q(name1) = gain · q(name2)`` as a stiffened joint equality (polycoef ``[0, gain, 0, ...]``)."""
+    import mujoco
+
+    eq = spec.add_equality(type=mujoco.mjtEq.mjEQ_JOINT, name1=name1, name2=name2)
+    eq.data = [0.0, gain] + [0.0] * (len(eq.data) - 2)  # 11 entries in MuJoCo 3, 12 in MuJoCo 4
+    eq.solref = list(_EQ_SOLREF)
+    eq.solimp = list(_EQ_SOLIMP)
 
 
 @dataclass(frozen=True)
