@@ -94,3 +94,13 @@ def test_bad_parameters_raise():
         Terrain((0.01,), (), (1.0,), (0.0,))
     with pytest.raises(ValueError, match="robot"):
         build_model(None)
+
+
+def test_accelerometer_sees_the_centripetal_acceleration_of_a_steady_turn():
+    """Specific force in body axes, steady turn: (ω × v)_y + g (R^T z)_y (the body rolls a little)."""
+    run = simulate_engine(ROBOT, (0.25, 0.05), 2.5, rate=50.0)
+    late = slice(75, None)
+    centripetal = run.twist[late, 3] * run.twist[late, 2] - run.twist[late, 5] * run.twist[late, 0]
+    gravity = 9.81 * run.T_GB[late, 2, 1]  # (R^T z)_y = R[2, 1]
+    assert np.mean(centripetal) > 0.005
+    assert np.mean(run.accel[late, 1]) == pytest.approx(np.mean(centripetal + gravity), abs=2e-3)

@@ -403,7 +403,8 @@ def figures(comp: Comparison, out_dir: Path) -> list:
     ax.set_ylabel("drift per metre travelled (m/m)")
     ax.set_title("Dead-reckoning drift per metre, per manoeuvre")
     ax.grid(True, alpha=0.3, which="both", axis="y")
-    ax.legend(fontsize=7, ncol=2)
+    ax.set_ylim(top=30.0)  # room for the legend above the bars
+    ax.legend(fontsize=7, ncol=4, loc="upper center")
     figs.append(
         save_figure(fig, out_dir, "engine_drift", "Dead-reckoning drift per metre by estimator and manoeuvre")
     )

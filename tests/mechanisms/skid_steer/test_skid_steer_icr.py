@@ -135,3 +135,21 @@ def test_icr_velocity_flags_drop_outs():
     v = icr_velocity(ICRModel.no_slip(S), [0.1, np.nan, np.inf], [0.1, 0.1, 0.1])
     assert v.valid.tolist() == [True, False, False]
     assert np.isnan(v.yaw_rate[1:]).all() and np.isfinite(v.v_x[0])
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    st.floats(0.2, 1.0),
+    st.floats(-1.0, -0.2),
+    st.floats(-0.2, 0.2),
+    st.integers(0, 2**31 - 1),
+)
+def test_identification_round_trip_on_random_models(yl, yr, xi, seed):
+    true = ICRModel(yl, yr, xi)
+    rng = np.random.default_rng(seed)
+    vr, vl = rng.uniform(-0.4, 0.4, (2, 50))
+    v = icr_velocity(true, vr, vl)
+    ident = identify_icr(vr, vl, np.stack([v.v_x, v.v_y, v.yaw_rate], -1))
+    assert ident.identifiable
+    for k in ("y_left", "y_right", "x_icr"):
+        assert getattr(ident.model, k) == pytest.approx(getattr(true, k), abs=1e-9)
