@@ -82,7 +82,7 @@ def wheel_lateral_velocity(yaw_rate: object, wheel_x: object, icr_x: object = 0.
 @dataclass(frozen=True)
 class LateralSlip:
     """Lateral slip speed of the outer wheel (m/s, batch shape ``...``); NaN exactly where ``valid`` is
-    false (non-finite input, or the centre of rotation within ``LATERAL_SLIP_RTOL`` of the inner track)."""
+    false: the centre of rotation within ``LATERAL_SLIP_RTOL`` S of the inner track (or an overflow)."""
 
     lateral_speed: np.ndarray
     valid: np.ndarray
