@@ -72,7 +72,7 @@ def test_cli_verifies_a_users_file(capsys, monkeypatch):
     assert main(["verify", path, "--json"]) == 0
     out = json.loads(capsys.readouterr().out, parse_constant=lambda c: pytest.fail(f"non-strict JSON {c}"))
     assert out["passed"] and len(out["checks"]) >= 8
-    monkeypatch.setattr(g, "TOL_TORQUE", Tolerance(0.0, "impossible: forces a failure"))
+    monkeypatch.setattr(g, "TOL_TORQUE", Tolerance(1e-300, "impossible: forces a failure"))
     assert main(["verify", path]) == 1
     assert "FAIL" in capsys.readouterr().out  # the table, with the failed check
     assert main(["verify", "no_such_mechanism"]) == 2
