@@ -13,6 +13,8 @@ import dataclasses
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from robomech import dynamics
 from robomech import multibody as mb
@@ -218,3 +220,37 @@ def test_screw_rates_equal_multibody_layer():
     qd = np.random.default_rng(0).normal(size=(3, mech.nv))
     st = kinematics(mech.tree, q)
     assert np.max(np.abs(D._screw_rates(mech.tree, st, qd) - screw_rates(mech.tree, st, qd))) < IDENTITY_TOL
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    qa=st.floats(-np.pi, np.pi),
+    qd=st.floats(-5, 5),
+    qdd=st.floats(-20, 20),
+    w=st.tuples(st.floats(-2, 2), st.floats(-2, 2), st.floats(-2, 2)),
+)
+def test_property_four_bar_forward_inverts_inverse_with_site_force(qa, qd, qdd, w):
+    """Any crank state and force at the coupler point: forward dynamics undoes inverse dynamics, and the
+    actuator power equals the rate of the mechanism's energy minus the power of the external force."""
+    fk = mb.forward_kinematics(FOUR_BAR, [qa], steps=4)
+    assume(bool(fk.converged))
+    W = np.array([0.0, 0.0, 0.0, *w])
+    r = mb.inverse_dynamics(FOUR_BAR, fk.q, [qd], [qdd], wrenches={"coupler_point": W})
+    assume(bool(r.valid))
+    f = mb.forward_dynamics(FOUR_BAR, fk.q, [qd], r.tau, wrenches={"coupler_point": W})
+    assert abs(f.qdd_act[0] - qdd) < IDENTITY_TOL * max(1.0, abs(qdd))
+    # power: tau qd = dT/dt + dU/dt - W . V_site, with dT/dt + dU/dt = qd_full . (M qdd + c + g) projected
+    J = mb.site_jacobian(FOUR_BAR, fk.q, "coupler_point")
+    P_ext = W @ (J @ [qd])
+    P_int = (r.M_a @ [qdd] + r.velocity_terms + r.gravity_terms) @ [qd]
+    assert abs(r.tau @ [qd] - (P_int - P_ext)) < IDENTITY_TOL * max(1.0, abs(P_int), abs(P_ext))
+
+
+def test_unbatched_calls_return_unbatched_results():
+    q = mb.forward_kinematics(FOUR_BAR, [0.2]).q  # (nq,)
+    assert mb.inverse_dynamics(FOUR_BAR, q, [1.0], [0.0]).valid.shape == ()
+    assert mb.statics(FOUR_BAR, q).tau.shape == (1,)
+    assert mb.site_wrench(FOUR_BAR, q, "coupler_point", [0.1]).wrench.shape == (6,)
+    assert mb.forward_dynamics(FOUR_BAR, q, [0.1], [0.2]).qdd_act.shape == (1,)
+    sim = mb.simulate(FOUR_BAR, q, [1.0], [0.0, 0.01])
+    assert sim.q.shape == (2, FOUR_BAR.nq) and sim.success.shape == ()

@@ -80,6 +80,9 @@ SINGULAR_COND = 1e6
 # their scale (L |qd|, L (|qdd| + |qd|^2)).  Rounding leaves ~1e-15; an inconsistent rate of a
 # redundantly actuated mechanism (or a rank drop) gives O(1).
 ADMISSIBLE_RTOL = 1e-8
+# ... and below RATE_FLOOR (1/s, 1/s^2) of motion the scale is RATE_FLOOR: at rest the test is absolute
+# (1e-8 L per s^2), not relative to zero.
+RATE_FLOOR = 1.0
 # Rank decisions on K G (redundant actuation) and on the forward-dynamics matrices: singular values
 # below this fraction of the largest are zero (the same reasoning as PASSIVE_RANK_RTOL).
 RANK_RTOL = PASSIVE_RANK_RTOL
@@ -540,10 +543,8 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
     sv = np.max(np.abs(qd), axis=-1) if tree.nv else np.zeros(N)
     sa = np.max(np.abs(qdd), axis=-1) + sv * sv if tree.nv else np.zeros(N)
     if K.shape[1]:
-        e1 = np.max(np.abs(_mv(K, qd)), axis=-1) / (L * np.maximum(sv, 1e-300))
-        e2 = np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, 1e-300))
-        e1 = np.where(sv > 0, e1, 0.0)
-        e2 = np.where(sa > 0, e2, 0.0)
+        e1 = np.max(np.abs(_mv(K, qd)), axis=-1) / (L * np.maximum(sv, RATE_FLOOR))
+        e2 = np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
         adm = np.maximum(e1, e2)
     else:
         adm = np.zeros(N)
@@ -614,7 +615,7 @@ def _shape(d: dict, batch, ok: np.ndarray, nan_keys) -> dict:
             v = np.where(bad.reshape(-1, *(1,) * (v.ndim - 1)), np.nan, v)
         elif v.dtype.kind == "f":
             v = np.where(ok.reshape(-1, *(1,) * (v.ndim - 1)), v, np.nan)
-        res[k] = v.reshape(*batch, *v.shape[1:])
+        res[k] = np.reshape(v, (*batch, *v.shape[1:]))
     return res
 
 
@@ -858,7 +859,7 @@ def forward_dynamics(
         L = tree.length
         sa = np.max(np.abs(qdd), axis=-1) + np.max(np.abs(qd), axis=-1) ** 2 if tree.nv else 0.0
         adm = (
-            np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, 1e-300))
+            np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
             if K.shape[1]
             else np.zeros(qf.shape[0])
         )
@@ -886,7 +887,7 @@ def energy(mech: Mechanism, q: object, qd: object) -> tuple[np.ndarray, np.ndarr
     qf = np.broadcast_to(q, (*batch, mech.nq)).reshape(-1, mech.nq)
     qdf = np.broadcast_to(qd, (*batch, mech.nv)).reshape(-1, mech.nv)
     T, U = _energy_flat(mech, qf, qdf)
-    return T.reshape(batch), U.reshape(batch)
+    return np.reshape(T, batch), np.reshape(U, batch)
 
 
 # ----------------------------------------------------------------------------- simulation
