@@ -122,6 +122,10 @@ def test_redundant_actuation_rules():
     r1 = mb.inverse_dynamics(red, q, qd, qdd, weights=[1.0, 0.0])
     assert np.max(np.abs(r1.tau[:, 1])) < IDENTITY_TOL
     assert np.max(np.abs(r1.tau[:, 0] - ref.tau[:, 0])) < IDENTITY_TOL
+    # forward dynamics of the redundantly actuated chain undoes either distribution
+    for forces in (r.tau, r1.tau):
+        f = mb.forward_dynamics(red, q, qd, forces)
+        assert f.valid.all() and np.max(np.abs(f.qdd_act - qdd)) < IDENTITY_TOL
     # inconsistent rates are not a motion of the mechanism
     bad = mb.inverse_dynamics(red, q, qd + np.array([0.0, 1.0]), qdd)
     assert not bad.valid.any() and np.all(np.isnan(bad.tau))
