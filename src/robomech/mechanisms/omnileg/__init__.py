@@ -31,7 +31,7 @@ from ._kinematics import (
     thigh_direction,
     within_limits,
 )
-from ._params import OmniLeg, RigidBody, default_bodies
+from ._params import BodySet, OmniLeg, RigidBody, default_bodies
 from ._trajectories import (
     GaitProfile,
     foot_trajectory_eq51,
@@ -43,6 +43,7 @@ from ._trajectories import (
 __all__ = [
     "BODY_NAMES",
     "TREE_JOINTS",
+    "BodySet",
     "DynamicsResult",
     "FootForceResult",
     "GaitProfile",

@@ -90,10 +90,6 @@ def _poses(
 ) -> list[tuple[Cols, jt.Jet | np.ndarray]]:
     """(columns of R_b, o_b) of every body as jets, in the order of BODY_NAMES; ``q, qd, qdd (N, 3)``."""
     alpha, beta, gamma = jt.Jet.variables(q, qd, qdd)
-    ta, tb = jt.tan(alpha), jt.tan(beta)
-    inv_n = jt.reciprocal(jt.sqrt(ta * ta + tb * tb + 1.0))
-    u = jt.stack([tb * inv_n, -ta * inv_n, inv_n])  # thigh direction, eq. (9) / L1
-    knee = u * leg.L1
     ca, sa, cb, sb, cg, sg = (
         jt.cos(alpha),
         jt.sin(alpha),
@@ -102,6 +98,11 @@ def _poses(
         jt.cos(gamma),
         jt.sin(gamma),
     )
+    # thigh direction, eq. (9) / L1 multiplied through by cos α cos β (not mirrored beyond 90°, _kinematics)
+    cbsa, cbca = cb * sa, cb * ca
+    inv_n = jt.reciprocal(jt.sqrt(ca * ca + cbsa * cbsa))
+    u = jt.stack([sb * ca * inv_n, -cbsa * inv_n, cbca * inv_n])
+    knee = u * leg.L1
     zero = np.zeros(q.shape[0])
     one = cg * 0.0 + 1.0  # constant 1 as a jet (jt.stack needs one jet per stacked vector)
     # Second-joint axis x_k of chain k (carried by the crosses and the rod); fixed axis y_k of chain k.
