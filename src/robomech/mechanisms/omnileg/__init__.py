@@ -8,6 +8,7 @@ crank angle of the shank (motor M3).  The hip frame's Z0 points down, toward the
 from ._chains import ShankResult, ThighClosure, chain_screws, shank_crank_slider, shank_frames, thigh_closure
 from ._dynamics import (
     BODY_NAMES,
+    FOOT_FORCE_CONVENTION,
     DynamicsResult,
     FootForceResult,
     body_poses,

@@ -31,6 +31,7 @@ from ._params import OmniLeg, RigidBody
 
 __all__ = [
     "BODY_NAMES",
+    "FOOT_FORCE_CONVENTION",
     "DynamicsResult",
     "FootForceResult",
     "body_poses",
@@ -42,6 +43,11 @@ __all__ = [
     "static_torques",
 ]
 
+# The one sign convention of every OmniLeg function taking or returning a foot force (inverse_dynamics,
+# static_torques, foot_force_from_torques): F is the force applied TO the foot by its surroundings (the
+# ground reaction; a force on the foot body in a multibody engine), hip frame, N.  It enters the motor
+# torques as -Jᵀ F.  Paper 2's F_f (eqs. (47)-(50), the force the foot delivers) is -F.
+FOOT_FORCE_CONVENTION = "applied to the foot"
 # A foot Jacobian with sigma_min / sigma_max below this is treated as singular (γ ≈ 0, the fully
 # extended shank): 1e-3 bounds the force amplification by 1e3 relative to the best-conditioned direction.
 SINGULAR_RCOND = 1e-3
@@ -270,10 +276,10 @@ def inverse_dynamics(
 ) -> DynamicsResult:
     """Motor torques (α, β, γ order) for the motion (q, q̇, q̈), optionally with a force on the foot.
 
-    All inputs ``(..., 3)`` broadcast.  ``foot_force (..., 3)`` (N, hip frame) is the external force
-    applied *to* the foot (as a force applied to the foot body in a multibody simulation); it enters as
-    ``-Jᵀ F``.  Paper 2, eqs. (49)-(50) add ``+Jᵀ F_f``, i.e. read F_f as the force the foot delivers:
-    pass ``-F_f`` for that reading.
+    All inputs ``(..., 3)`` broadcast.  ``foot_force (..., 3)`` (N, hip frame) is
+    :data:`FOOT_FORCE_CONVENTION`: the external force applied *to* the foot (as a force applied to the
+    foot body in a multibody simulation); it enters as ``-Jᵀ F`` (= :func:`static_torques`).  Paper 2,
+    eqs. (49)-(50) add ``+Jᵀ F_f``, i.e. read F_f as the force the foot delivers: pass ``-F_f``.
     """
     q = as_array(q, "q", (3,))
     qd = as_array(qd, "qd", (3,))
@@ -323,19 +329,24 @@ def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]
 
 
 def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
-    """Virtual work, paper 2, eq. (50): ``τ = Jᵀ F`` for a force ``F (..., 3)`` (N) delivered by the foot."""
+    """Motor torques ``τ = -Jᵀ F`` (..., 3), N·m, holding the leg still against a foot force, gravity aside.
+
+    ``force (..., 3)`` (N, hip frame) is :data:`FOOT_FORCE_CONVENTION`: the force applied *to* the foot,
+    the same as ``inverse_dynamics(foot_force=F)``, whose ``foot_terms`` these torques are.  paper 2,
+    eq. (50): τ = Jᵀ F_f with F_f the force the foot delivers, F_f = -F.
+    """
     q = as_array(q, "q", (3,))
     F = as_array(force, "force", (3,))
-    return np.einsum("...ij,...i->...j", jacobian(leg, q), F)
+    return -np.einsum("...ij,...i->...j", jacobian(leg, q), F)  # paper 2, eq. (50): +Jᵀ F_f, F_f = -F
 
 
 @dataclass(frozen=True)
 class FootForceResult:
-    """Foot force ``(..., 3)`` (N) from motor torques, per sample.
+    """Foot force ``(..., 3)`` (N, applied to the foot: :data:`FOOT_FORCE_CONVENTION`) from motor torques.
 
     ``singular`` marks samples with ``sigma_min / sigma_max < SINGULAR_RCOND`` (γ ≈ 0): there the force is
     the damped least-squares estimate (its component along the lost direction is not determined by the
-    torques) and ``residual = |Jᵀ F - τ|`` is no longer zero.
+    torques) and ``residual = |-Jᵀ F - τ|`` is no longer zero.
     """
 
     force: np.ndarray
@@ -345,7 +356,10 @@ class FootForceResult:
 
 
 def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceResult:
-    """Solve ``Jᵀ F = τ`` for the foot force (paper 2, eq. (47)), never by a blind inverse.
+    """Solve ``-Jᵀ F = τ`` for the force F applied to the foot (paper 2, eq. (47)), never by a blind inverse.
+
+    The torques are those of :func:`static_torques` (F = ``FOOT_FORCE_CONVENTION``; the paper's F_f, the
+    force the foot delivers, is -F).
 
     Regular samples: the exact solution by SVD.  Samples with ``rcond < SINGULAR_RCOND`` are flagged and
     their weak directions damped: ``F = Σ c_i u_i (v_iᵀ τ)`` with ``c_i = 1/σ_i`` where
@@ -362,6 +376,7 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     # Jᵀ = V Σ Uᵀ, so F = U Σ⁺ Vᵀ τ; only the directions with σ_i < SINGULAR_RCOND σ_max are damped
     weak = s < SINGULAR_RCOND * s[..., :1]
     coef = np.where(weak, s / (s * s + lam * lam), 1.0 / np.where(weak, 1.0, s))
-    F = np.einsum("...ij,...j->...i", U, coef * np.einsum("...ij,...j->...i", Vt, tau))
-    resid = np.linalg.norm(np.einsum("...ij,...i->...j", J, F) - tau, axis=-1)
+    # paper 2, eq. (47): F_f = (Jᵀ)⁻¹ τ for the force the foot delivers; the force applied to it is -F_f
+    F = -np.einsum("...ij,...j->...i", U, coef * np.einsum("...ij,...j->...i", Vt, tau))
+    resid = np.linalg.norm(-np.einsum("...ij,...i->...j", J, F) - tau, axis=-1)
     return FootForceResult(force=F, singular=singular, rcond=rcond, residual=resid)
