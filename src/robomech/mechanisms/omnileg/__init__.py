@@ -43,6 +43,7 @@ from ._trajectories import (
 
 __all__ = [
     "BODY_NAMES",
+    "FOOT_FORCE_CONVENTION",
     "TREE_JOINTS",
     "BodySet",
     "DynamicsResult",
