@@ -8,6 +8,7 @@ redundant-actuation force distribution, and workspace/singularity maps.  See
 """
 
 from ._dynamics import (
+    ACTUATION_SIGMA_MIN,
     PAPER_DRIVEN_LEGS,
     ForceDistribution,
     InverseDynamicsResult,
@@ -34,6 +35,7 @@ from ._params import LegBody, SphericalLeg
 from ._workspace import WorkspaceMap, workspace_map
 
 __all__ = [
+    "ACTUATION_SIGMA_MIN",
     "PAPER_DRIVEN_LEGS",
     "ForceDistribution",
     "ForwardKinematicsResult",
