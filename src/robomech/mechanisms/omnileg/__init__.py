@@ -33,6 +33,7 @@ from ._kinematics import (
     within_limits,
 )
 from ._params import BodySet, OmniLeg, RigidBody, default_bodies
+from ._rates import JointRatesResult, joint_rates
 from ._trajectories import (
     GaitProfile,
     foot_trajectory_eq51,
@@ -51,6 +52,7 @@ __all__ = [
     "GaitProfile",
     "IKResult",
     "JointMotion",
+    "JointRatesResult",
     "OmniLeg",
     "RigidBody",
     "ShankResult",
@@ -71,6 +73,7 @@ __all__ = [
     "inverse_kinematics",
     "jacobian",
     "joint_motion",
+    "joint_rates",
     "joint_trajectory_eq52",
     "mass_matrix",
     "passive_angles",
