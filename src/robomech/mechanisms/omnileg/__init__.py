@@ -41,6 +41,16 @@ from ._trajectories import (
     joint_trajectory_eq52,
     start_point,
 )
+from ._workspace import (
+    FootWorkspace,
+    SymmetryResult,
+    WorkspaceMap,
+    foot_workspace,
+    joint_grid,
+    singular_surface,
+    workspace_map,
+    workspace_symmetry,
+)
 
 __all__ = [
     "BODY_NAMES",
@@ -49,6 +59,7 @@ __all__ = [
     "BodySet",
     "DynamicsResult",
     "FootForceResult",
+    "FootWorkspace",
     "GaitProfile",
     "IKResult",
     "JointMotion",
@@ -56,7 +67,9 @@ __all__ = [
     "OmniLeg",
     "RigidBody",
     "ShankResult",
+    "SymmetryResult",
     "ThighClosure",
+    "WorkspaceMap",
     "body_poses",
     "chain_screws",
     "default_bodies",
@@ -65,6 +78,7 @@ __all__ = [
     "foot_force_from_torques",
     "foot_trajectory_eq51",
     "foot_velocity",
+    "foot_workspace",
     "forward_kinematics",
     "gait_eq53",
     "gravity_torques",
@@ -72,6 +86,7 @@ __all__ = [
     "inverse_dynamics",
     "inverse_kinematics",
     "jacobian",
+    "joint_grid",
     "joint_motion",
     "joint_rates",
     "joint_trajectory_eq52",
@@ -79,9 +94,12 @@ __all__ = [
     "passive_angles",
     "shank_crank_slider",
     "shank_frames",
+    "singular_surface",
     "start_point",
     "static_torques",
     "thigh_closure",
     "thigh_direction",
     "within_limits",
+    "workspace_map",
+    "workspace_symmetry",
 ]
