@@ -59,6 +59,58 @@ def _table1(leg: sl.SphericalLeg, res: StudyResult) -> None:
             "2·arctan(a)); the exact closed form returns the given pose to rounding.",
         )
     )
+    # the printed pipeline re-run (paper_as_printed=True) beside the paper's numbers and the exact ones
+    from robomech.mechanisms.spherical_leg._as_printed import forward_as_printed
+
+    given_q = np.array([[t[0], t[1]] for t in TABLE1])
+    L_exact = sl.inverse_kinematics(leg, given_q[:, 0], given_q[:, 1]).lengths
+    fk_pr = sl.forward_kinematics(leg, L_exact, paper_as_printed=True)
+    fk_ex = sl.forward_kinematics(leg, L_exact)
+    single = {
+        name: forward_as_printed(leg, L_exact, **{flag: True})[0]
+        for name, flag in (
+            ("square restored", "fix_square"),
+            ("resolvent 9k1k2k3", "fix_resolvent"),
+            ("2·arctan(a)", "fix_arctan"),
+        )
+    }
+    rows_pr = []
+    for k, name in enumerate(POSE_NAMES):
+        rows_pr.append(
+            [
+                name,
+                float(given_q[k, 0]),
+                TABLE1[k][3][0],
+                float(fk_pr.alpha[k]),
+                float(fk_pr.residual[k]) * 1e3,
+                *(float(v[k]) for v in single.values()),
+                float(fk_ex.alpha[k]),
+            ]
+        )
+    res.tables.append(
+        Table(
+            "Table 1's computed α: the paper's numbers, its printed pipeline re-run, and the exact solution",
+            [
+                "pose",
+                "given α (rad)",
+                "paper's computed α",
+                "printed pipeline (eqs. 6-7 as printed, mm)",
+                "its length residual (mm)",
+                *(f"printed, only {n} fixed" for n in single),
+                "exact (robomech)",
+            ],
+            rows_pr,
+            note="forward_kinematics(..., paper_as_printed=True) evaluates eq. (7) as printed: the quartic "
+            "with k2's lost square (in mm, the paper's unit: the lost square makes k2 unit-dependent), "
+            "Ferrari with the resolvent's 9k2k3k4, α = arctan(2a), keeping the real root in (−π/2, π/2) "
+            "that fits l3 best. Its α does not assemble the lengths (residual column), and with all three "
+            "misprints corrected it returns the given pose to rounding (tested). The paper's own column "
+            "matches neither: its 0.0127 rad error comes from the misprinted pipeline in some form that "
+            "the print does not fully determine (root choice, evaluation order), not from the mechanism.",
+        )
+    )
+    res.data["table1_printed_pipeline_alpha"] = fk_pr.alpha.tolist()
+
     # forward solution over the whole workspace, and from the printed (rounded) lengths
     g = np.stack(np.meshgrid(np.linspace(-1.2, 1.2, 241), np.linspace(-1.2, 1.2, 241), indexing="ij"), -1)
     L = sl.inverse_kinematics(leg, g[..., 0], g[..., 1]).lengths
@@ -263,6 +315,52 @@ def _force_figures(leg: sl.SphericalLeg, out_dir: Path, res: StudyResult, engine
     res.data["fig5_singular_crossings"] = {s[0]: s[1] for s in summary}
 
 
+def _branch_figure(leg: sl.SphericalLeg, out_dir: Path, res: StudyResult) -> None:
+    """Forward kinematics along the lengths of Fig. 5(a): fixed branch vs branch tracking."""
+    t = np.arange(0.0, 30.0 + 1e-9, PLOT_STEP)
+    q, _, _ = sl.fig5_motion("a", t)
+    L = sl.inverse_kinematics(leg, q[:, 0], q[:, 1]).lengths
+    fixed = sl.forward_kinematics(leg, L, branch=0)
+    tr = sl.track_branches(leg, L)
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
+    a1.plot(t, np.degrees(q[:, 0]), "k-", lw=3, alpha=0.3, label="α of the motion (Fig. 5(a))")
+    a1.plot(t, np.degrees(fixed.alpha), "C3--", label="forward kinematics, branch 0 throughout")
+    a1.plot(t, np.degrees(tr.alpha), "C0-", lw=1, label="track_branches (continuation)")
+    a_s = np.degrees(-np.arctan2(leg.h * np.cos(PI / 3), leg.r))
+    a1.axhline(a_s, color="r", lw=0.8, ls=":", label=f"singular curve α = {a_s:.2f}° (branches meet)")
+    for k in np.flatnonzero(tr.meeting):
+        a1.axvline(t[k], color="r", lw=0.8)
+    a1.set_ylabel("α (deg)")
+    a1.set_ylim(-62, -50)
+    a1.legend(fontsize=7, loc="upper right")
+    a1.set_title("Fig. 5(a) lengths: a fixed branch returns the mirror pose beyond the curve (residual 0)")
+    a2.semilogy(t, np.abs(fixed.alpha - q[:, 0]) + 1e-17, "C3--", label="|α error|, branch 0 throughout")
+    a2.semilogy(t, np.abs(tr.alpha - q[:, 0]) + 1e-17, "C0-", label="|α error|, tracked")
+    a2.semilogy(t, fixed.residual + 1e-17, "C7:", label="length residual of the fixed branch (m)")
+    a2.set_xlabel("time t (s)")
+    a2.set_ylabel("error (rad) / residual (m)")
+    a2.legend(fontsize=7)
+    for ax in (a1, a2):
+        ax.grid(True, which="both", alpha=0.3)
+        ax.set_xlim(12, 18)
+    res.figures.append(
+        save_figure(
+            fig,
+            out_dir,
+            "branch_tracking",
+            "Forward kinematics along a trajectory: the motion of Fig. 5(a) crosses the singular curve "
+            "where the two assembly branches meet; track_branches follows it (red lines: the reported "
+            "meetings), a fixed branch does not and its residual cannot tell.",
+        )
+    )
+    res.data["branch_tracking"] = {
+        "fixed_branch_max_error_rad": float(np.abs(fixed.alpha - q[:, 0]).max()),
+        "tracked_max_error_rad": float(np.abs(tr.alpha - q[:, 0]).max()),
+        "meetings": int(tr.meeting.sum()),
+        "switches": int(tr.switched.sum()),
+    }
+
+
 def _engine_table(leg: sl.SphericalLeg, res: StudyResult, engine) -> None:
     """The counterpart of the paper's Fig. 6 (theory vs ADAMS errors): analytic vs MuJoCo."""
     rows = []
@@ -393,6 +491,8 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     _kinematics_figures(leg, out_dir, res, engine)
     progress.step("Fig. 5: actuator forces")
     _force_figures(leg, out_dir, res, engine)
+    progress.step("branch tracking along the Fig. 5(a) lengths")
+    _branch_figure(leg, out_dir, res)
     if engine is not None:
         _engine_table(leg, res, engine)
     progress.step("mechanism picture and workspace map")
