@@ -164,7 +164,20 @@ class _Terms:
     p: np.ndarray  # (N, B, 3) centres of mass (B = 0 unless requested)
 
 
-def _terms(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: bool = False) -> _Terms:
+# paper 2, eqs. (26)-(31): the simplified Cardan drive.  Each drive body turns like the chain-1 body it
+# replaces (cross CS_A4 like CS_A1, rod A4B4 like rod A1B1, cross CS_B4 like CS_B1) plus an independent
+# spin γ̇ about the fixed Z0 (r_γ = [0 0 1]), its inertia carried by that body's rotation (eq. (31)).
+_PAPER_DRIVE = {"drive_cross_a": "hip_cross_1", "drive_rod": "thigh_rod_1", "drive_cross_b": "knee_cross_1"}
+
+
+def _terms(
+    leg: OmniLeg,
+    q: np.ndarray,
+    qd: np.ndarray,
+    qdd: np.ndarray,
+    poses: bool = False,
+    paper_drive: bool = False,
+) -> _Terms:
     """Newton-Euler sums over the bodies projected on q (Lagrange's equations), ``q, qd, qdd (N, 3)``.
 
     For body b with centre of mass p_b, rotation R_b and inertia I_b (body axes):
@@ -180,7 +193,10 @@ def _terms(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: 
     eye = np.broadcast_to(np.eye(3), (N, 3, 3))
     Rs, ps = [], []
     groups: dict[int, tuple[Cols, np.ndarray]] = {}
-    for (cols, o), (_, key) in zip(_poses(leg, q, qd, qdd), _body_list(), strict=True):
+    spun: dict[int, tuple[Cols, np.ndarray]] = {}  # paper_drive: rotations that also spin by γ about Z0
+    by_name: dict[str, Cols] = {}
+    for (cols, o), (name, key) in zip(_poses(leg, q, qd, qdd), _body_list(), strict=True):
+        by_name[name] = cols
         body: RigidBody = leg.bodies[key]
         m = body.mass
         c = body.com_vector
@@ -206,6 +222,11 @@ def _terms(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: 
             Rs.append(eye if cols is None else np.stack([r.v for r in cols], axis=-1))
         if cols is None:
             continue
+        if paper_drive and name in _PAPER_DRIVE:
+            ref = by_name[_PAPER_DRIVE[name]]
+            prev = spun.get(id(ref))
+            spun[id(ref)] = (ref, body.inertia_matrix if prev is None else prev[1] + body.inertia_matrix)
+            continue
         # bodies turning together (a U-joint's two crosses, the drive's two crosses and two shafts) share
         # one set of columns: their rotational terms are linear in the inertia, so sum the inertias
         key_cols = id(cols)
@@ -213,11 +234,17 @@ def _terms(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: 
             groups[key_cols] = (cols, groups[key_cols][1] + body.inertia_matrix)
         else:
             groups[key_cols] = (cols, body.inertia_matrix)
-    for cols, Iner in groups.values():
+    ez = np.array([0.0, 0.0, 1.0])
+    rot = [(c, i, False) for c, i in groups.values()] + [(c, i, True) for c, i in spun.values()]
+    for cols, Iner, spin in rot:
         # ω = ½ Σ_j r_j × ṙ_j, ω̇ = ½ Σ_j r_j × r̈_j, ∂ω/∂q̇_k = ½ Σ_j r_j × ∂r_j/∂q_k  (columns r_j of R)
         w = 0.5 * sum(jt.cross3(r.v, r.vd) for r in cols)
         wd = 0.5 * sum(jt.cross3(r.v, r.vdd) for r in cols)
         Jw = 0.5 * sum(jt.cross3(r.v, r.g) for r in cols)  # (3 q, N, 3 xyz)
+        if spin:  # paper 2, eqs. (26), (29): ω = ω_chain1 + γ̇ Z0, and ω̇ = ω̇_chain1 + γ̈ Z0 (Z0 fixed)
+            w = w + qd[:, 2:3] * ez
+            wd = wd + qdd[:, 2:3] * ez
+            Jw = Jw + np.stack([0 * ez, 0 * ez, ez])[:, None, :]
         # body-frame components x_b = Rᵀ x; the inertia then acts as a constant 3x3 matrix (BLAS)
         wb = np.stack([np.sum(r.v * w, axis=-1) for r in cols], axis=-1)
         wdb = np.stack([np.sum(r.v * wd, axis=-1) for r in cols], axis=-1)
@@ -233,14 +260,19 @@ def _terms(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: 
 
 
 def _terms_chunked(
-    leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: bool = False
+    leg: OmniLeg,
+    q: np.ndarray,
+    qd: np.ndarray,
+    qdd: np.ndarray,
+    poses: bool = False,
+    paper_drive: bool = False,
 ) -> _Terms:
     """:func:`_terms` over cache-sized chunks of samples (identical results, far fewer cache misses)."""
     N = q.shape[0]
     if N <= DYN_CHUNK:
-        return _terms(leg, q, qd, qdd, poses)
+        return _terms(leg, q, qd, qdd, poses, paper_drive)
     parts = [
-        _terms(leg, q[s : s + DYN_CHUNK], qd[s : s + DYN_CHUNK], qdd[s : s + DYN_CHUNK], poses)
+        _terms(leg, q[s : s + DYN_CHUNK], qd[s : s + DYN_CHUNK], qdd[s : s + DYN_CHUNK], poses, paper_drive)
         for s in range(0, N, DYN_CHUNK)
     ]  # loop over chunks of DYN_CHUNK samples, not over samples
     return _Terms(*(np.concatenate([getattr(t, f) for t in parts]) for f in _Terms.__dataclass_fields__))
@@ -272,7 +304,13 @@ class DynamicsResult:
 
 
 def inverse_dynamics(
-    leg: OmniLeg, q: object, qd: object, qdd: object, foot_force: object | None = None
+    leg: OmniLeg,
+    q: object,
+    qd: object,
+    qdd: object,
+    foot_force: object | None = None,
+    *,
+    paper_as_printed: bool = False,
 ) -> DynamicsResult:
     """Motor torques (α, β, γ order) for the motion (q, q̇, q̈), optionally with a force on the foot.
 
@@ -280,12 +318,19 @@ def inverse_dynamics(
     :data:`FOOT_FORCE_CONVENTION`: the external force applied *to* the foot (as a force applied to the
     foot body in a multibody simulation); it enters as ``-Jᵀ F`` (= :func:`static_torques`).  Paper 2,
     eqs. (49)-(50) add ``+Jᵀ F_f``, i.e. read F_f as the force the foot delivers: pass ``-F_f``.
+
+    ``paper_as_printed=True`` replaces the exact double-Cardan drive by paper 2's simplification (eqs.
+    (26)-(31): the crosses CS_A4, CS_B4 and the rod A4B4 turn like chain 1's cross CS_A1, rod A1B1, cross
+    CS_B1 plus an independent spin γ̇ about Z0), for comparison only: the difference is the error the
+    paper's theory carries against its ADAMS model.
     """
+    if not isinstance(paper_as_printed, bool | np.bool_):
+        raise ValueError(f"Expected paper_as_printed to be a bool, got {paper_as_printed!r}.")
     q = as_array(q, "q", (3,))
     qd = as_array(qd, "qd", (3,))
     qdd = as_array(qdd, "qdd", (3,))
     batch, (qf, qdf, qddf) = _flat(q, qd, qdd)
-    t = _terms_chunked(leg, qf, qdf, qddf)
+    t = _terms_chunked(leg, qf, qdf, qddf, paper_drive=bool(paper_as_printed))
     vel = t.tau_motion - np.einsum("nij,nj->ni", t.M, qddf)
     foot = np.zeros_like(t.tau_motion)
     if foot_force is not None:
