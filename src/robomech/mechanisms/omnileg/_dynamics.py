@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_bool
 
 from . import _jet as jt
 from ._chains import shank_frames
@@ -324,8 +324,7 @@ def inverse_dynamics(
     CS_B1 plus an independent spin γ̇ about Z0), for comparison only: the difference is the error the
     paper's theory carries against its ADAMS model.
     """
-    if not isinstance(paper_as_printed, bool | np.bool_):
-        raise ValueError(f"Expected paper_as_printed to be a bool, got {paper_as_printed!r}.")
+    paper_as_printed = check_bool(paper_as_printed, "paper_as_printed")
     q = as_array(q, "q", (3,))
     qd = as_array(qd, "qd", (3,))
     qdd = as_array(qdd, "qdd", (3,))

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_params, check_real
 
 from ._dynamics import SINGULAR_RCOND
 from ._kinematics import hessian, jacobian
@@ -69,15 +69,11 @@ def joint_rates(
     ``λ = damping sigma_max`` (selectively damped least squares: the well-determined components stay
     exact).  ``damping = 0`` drops the weak directions (truncated pseudo-inverse).
     """
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     pd = as_array(foot_velocity, "foot_velocity", (3,))
     pdd = None if foot_acceleration is None else as_array(foot_acceleration, "foot_acceleration", (3,))
-    if (
-        isinstance(damping, bool)
-        or not isinstance(damping, int | float)
-        or not (np.isfinite(damping) and damping >= 0.0)
-    ):
-        raise ValueError(f"Expected damping >= 0 and finite (relative to sigma_max), got {damping!r}.")
+    damping = check_real(damping, "damping", low=0.0)
     shapes = [q.shape[:-1], pd.shape[:-1]] + ([] if pdd is None else [pdd.shape[:-1]])
     try:
         batch = np.broadcast_shapes(*shapes)

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_int, check_params
 from robomech.analysis.workspace import grid, singularity_map
 
 from ._dynamics import SINGULAR_RCOND
@@ -67,21 +67,19 @@ def joint_grid(leg: OmniLeg, n: int | tuple[int, int, int]) -> np.ndarray:
     """Regular grid ``(n_α, n_β, n_γ, 3)`` over Table 2's joint ranges (|α| <= α_max, |β| <= β_max,
     γ_min <= γ <= γ_max), rad."""
     _leg(leg)
-    counts = (n, n, n) if isinstance(n, int | np.integer) and not isinstance(n, bool) else n
-    try:
-        counts = tuple(int(c) for c in counts)  # type: ignore[union-attr]
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"Expected n to be an int >= 2 or three of them, got {n!r}.") from exc
-    if len(counts) != 3 or any(c < 2 for c in counts):
-        raise ValueError(f"Expected n to be an int >= 2 or three of them, got {n!r}.")
+    if isinstance(n, tuple | list):
+        if len(n) != 3:
+            raise ValueError(f"Expected n to be an int >= 2 or three of them, got {n!r}.")
+        counts = tuple(check_int(c, "n", low=2) for c in n)
+    else:
+        counts = (check_int(n, "n", low=2),) * 3
     ranges = [(-leg.alpha_max, leg.alpha_max), (-leg.beta_max, leg.beta_max), (leg.gamma_min, leg.gamma_max)]
     return grid(ranges, list(counts))
 
 
 def _leg(leg: object) -> OmniLeg:
-    if not isinstance(leg, OmniLeg):
-        raise ValueError(f"Expected leg to be an OmniLeg, got {type(leg).__name__}.")
-    return leg
+    check_params(leg, OmniLeg, "leg")
+    return leg  # type: ignore[return-value]
 
 
 def workspace_map(leg: OmniLeg, q: object) -> WorkspaceMap:
@@ -145,9 +143,8 @@ def _projected_jacobian_det(leg: OmniLeg, a: np.ndarray, b: np.ndarray) -> np.nd
 def foot_workspace(leg: OmniLeg, *, nodes: int = AREA_NODES) -> FootWorkspace:
     """Volume, horizontal section, boundary and extent of the foot workspace over Table 2's ranges."""
     _leg(leg)
-    if isinstance(nodes, bool) or not isinstance(nodes, int | np.integer) or nodes < 2:
-        raise ValueError(f"Expected nodes to be an int >= 2, got {nodes!r}.")
-    x, w = np.polynomial.legendre.leggauss(int(nodes))
+    nodes = check_int(nodes, "nodes", low=2)
+    x, w = np.polynomial.legendre.leggauss(nodes)
     A, B = leg.alpha_max, leg.beta_max
     a, b = np.meshgrid(A * x, B * x, indexing="ij")
     area = float(A * B * np.sum(np.outer(w, w) * _projected_jacobian_det(leg, a, b)))

@@ -25,7 +25,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_real
 
 from ._kinematics import LENGTH_FLOOR, _rotation
 from ._params import SphericalLeg
@@ -268,9 +268,7 @@ def distribute_forces(
     """
     J = as_array(J, "J", (3, 2), finite=False)
     t = as_array(tau, "tau", (2,), finite=False)
-    bound = float(sigma_min_bound) if isinstance(sigma_min_bound, int | float) else np.nan
-    if not (np.isfinite(bound) and bound >= 0.0) or isinstance(sigma_min_bound, bool):
-        raise ValueError(f"Expected sigma_min_bound >= 0 and finite (m/rad), got {sigma_min_bound!r}.")
+    bound = check_real(sigma_min_bound, "sigma_min_bound", low=0.0)  # m/rad
     if driven_legs is None:
         A = np.einsum("...ki,...kj->...ij", J, J)
         det = A[..., 0, 0] * A[..., 1, 1] - A[..., 0, 1] * A[..., 1, 0]

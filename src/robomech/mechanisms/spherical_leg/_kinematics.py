@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_bool
 from robomech.spatial import sincos
 
 from ._params import SphericalLeg
@@ -219,8 +219,7 @@ def forward_kinematics(
     """
     if branch not in (0, 1):
         raise ValueError(f"Expected branch to be 0 or 1, got {branch!r}.")
-    if not isinstance(paper_as_printed, bool | np.bool_):
-        raise ValueError(f"Expected paper_as_printed to be a bool, got {paper_as_printed!r}.")
+    paper_as_printed = check_bool(paper_as_printed, "paper_as_printed")
     L = as_array(lengths, "lengths", (3,), finite=False)
     shape = L.shape[:-1]
     n = int(np.prod(shape, dtype=int))

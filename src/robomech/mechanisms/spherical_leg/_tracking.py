@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_int, check_params
 
 from ._kinematics import forward_kinematics
 from ._params import SphericalLeg
@@ -80,10 +80,8 @@ def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> Br
     independent trajectories.  Samples that do not assemble are flagged (``valid`` False) and bridged:
     the branch carries across them.
     """
-    if not isinstance(leg, SphericalLeg):
-        raise ValueError(f"Expected leg to be a SphericalLeg, got {type(leg).__name__}.")
-    if isinstance(branch, bool) or branch not in (0, 1):
-        raise ValueError(f"Expected branch to be 0 or 1, got {branch!r}.")
+    check_params(leg, SphericalLeg, "leg")
+    branch = check_int(branch, "branch", low=0, high=1)
     L = as_array(lengths, "lengths", (None, 3), finite=False)
     shape = L.shape[:-1]
     Lf = L.reshape(-1, shape[-1], 3)

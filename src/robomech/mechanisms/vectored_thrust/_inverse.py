@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_params, check_real
 
 from ._kinematics import _chunked, _jacobian, _q, angular_acceleration
 from ._params import VectoredThruster
@@ -73,18 +73,11 @@ def _damped_pinv_apply(U, s, Vt, b, lam, weak):
 
 
 def _check_damping(damping: object) -> float:
-    if (
-        isinstance(damping, bool)
-        or not isinstance(damping, int | float)
-        or not (np.isfinite(damping) and damping >= 0.0)
-    ):
-        raise ValueError(f"Expected damping >= 0 and finite (relative to sigma_max), got {damping!r}.")
-    return float(damping)
+    return check_real(damping, "damping", low=0.0)
 
 
 def _check_thruster(th: object) -> None:
-    if not isinstance(th, VectoredThruster):
-        raise ValueError(f"Expected th to be a VectoredThruster, got {type(th).__name__}.")
+    check_params(th, VectoredThruster, "th")
 
 
 def inverse_rates(
