@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import robomech.mechanisms.omnileg as ol
 
@@ -96,3 +98,22 @@ def test_bad_input_names_the_argument(kwargs, name):
     args.update(kwargs)
     with pytest.raises(ValueError, match=name):
         ol.joint_rates(LEG, args["q"], args["foot_velocity"], args["foot_acceleration"], damping=damping)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.tuples(
+        st.floats(-LEG.alpha_max, LEG.alpha_max),
+        st.floats(-LEG.beta_max, LEG.beta_max),
+        st.floats(0.05, LEG.gamma_max),
+    ),
+    st.tuples(*(st.floats(-2.0, 2.0) for _ in range(3))),
+    st.tuples(*(st.floats(-5.0, 5.0) for _ in range(3))),
+)
+def test_property_rates_invert_the_forward_map(q, qd, qdd):
+    q, qd, qdd = (np.array(x) for x in (q, qd, qdd))
+    r = ol.joint_rates(LEG, q, ol.foot_velocity(LEG, q, qd), ol.foot_acceleration(LEG, q, qd, qdd))
+    assert r.valid
+    # the γ direction's sensitivity is 2 L4 sin γ >= 0.0095 m/rad here: rounding / that
+    np.testing.assert_allclose(r.qd, qd, atol=1e-9)
+    np.testing.assert_allclose(r.qdd, qdd, atol=1e-8)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import robomech.mechanisms.vectored_thrust as vt
 from robomech.spatial import log_so3
@@ -104,3 +106,18 @@ def test_propeller_thrust_needs_no_motor_torque_its_reaction_torque_does():
 def test_bad_input(call, name):
     with pytest.raises(ValueError, match=name):
         call()
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.tuples(st.floats(*TH.q1_limits), st.floats(*TH.q2_limits)),
+    st.tuples(*(st.floats(-3.0, 3.0) for _ in range(2))),
+    st.tuples(*(st.floats(-10.0, 10.0) for _ in range(2))),
+)
+def test_property_inverse_rates_invert_the_forward_acceleration(q, qd, qdd):
+    q, qd, qdd = (np.array(x) for x in (q, qd, qdd))
+    fwd = vt.angular_acceleration(TH, q, qd, qdd)
+    r = vt.inverse_rates(TH, q, fwd.omega, fwd.omega_dot)
+    assert r.valid
+    np.testing.assert_allclose(r.qd, qd, atol=SOLVE_TOL * 10)
+    np.testing.assert_allclose(r.qdd, qdd, atol=SOLVE_TOL * 100)
