@@ -605,6 +605,14 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         "eq. (52) drives γ below Table 2's 0° for 3 < t < 6 s. See docs/mechanisms/omnileg.md."
     )
     res.summary += (
+        f"\n\nWorkspace: {fw.volume * 1e3:.2f} L over Table 2's ranges, with the four-fold symmetry of a "
+        "square about Z0 (Section 1's 'completely symmetric' holds on every sample for α_max = β_max); its "
+        "whole bottom surface (γ = 0) is singular. The paper's simplified Cardan drive "
+        f"(paper_as_printed=True) moves the Fig. 11 torques by only {float(err_simpl.max()):.1e} N·m: "
+        "it does not explain the paper's "
+        "mN·m theory-vs-ADAMS errors."
+    )
+    res.summary += (
         f"\n\nVerified against MuJoCo (the paper used ADAMS): torques agree to {err_rel:.1e} relative "
         "along eq. (52) with Fig. 11's force; driven open-loop by the analytic torques, the engine follows "
         f"eq. (52) within {np.degrees(float(sim['drift'])):.1e}° over {FIG11_DURATION:.0f} s "

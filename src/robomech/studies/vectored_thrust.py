@@ -491,6 +491,11 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
             f"{100 * over.mean():.0f} % of the period; it stays {d_min:.2f} (sine of the passive-axis angle)",
             "away from the singular point. The link-interference constraint (assumed 0.3 rad clearance) is",
             f"inactive: the 45° arc stays ≥ {clear_min:.0f}° from the fixing device.",
+            "Section 3.3's inverse acceleration model (inverse_rates, with the Lie-bracket terms) returns",
+            "the",
+            f"trajectory's input accelerations to {res.data['inverse']['max_qdd_round_trip']:.0e} rad/s²; by",
+            "virtual work the motors hold only the moment about O (τ = −Jᵀ m_O): the thrust along the shaft",
+            "passes through O and needs no torque.",
         ]
     )
     res.notes.append(
