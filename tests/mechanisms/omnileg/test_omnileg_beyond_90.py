@@ -68,3 +68,16 @@ def test_dynamics_follow_the_unmirrored_pose():
     k = ol.BODY_NAMES.index("knee_plate")
     knee = ol.thigh_direction(q[:, 0], q[:, 1]) * LEG.L1
     np.testing.assert_allclose(p[:, k] - knee, [[0, 0, LEG.knee_to_crank / 2]] * 2, atol=1e-15)
+
+
+def test_passive_angles_beyond_90_degrees_are_the_closure_angles():
+    q = np.array([[0.3, 1.9], [2.0, -2.5], [-1.8, 0.4], [2.6, 2.2], [0.4, 0.3]])
+    c = ol.thigh_closure(LEG, q[:, 0], q[:, 1])
+    assert c.converged.all()
+    t12, t22 = ol.passive_angles(LEG, q[:, 0], q[:, 1])
+
+    def wrap(x):  # the closure's angles are unwrapped
+        return (x + np.pi) % (2 * np.pi) - np.pi
+
+    np.testing.assert_allclose(wrap(c.theta[:, 0, 1] - t12), 0.0, atol=CLOSURE_TOL)
+    np.testing.assert_allclose(wrap(c.theta[:, 1, 1] - t22), 0.0, atol=CLOSURE_TOL)

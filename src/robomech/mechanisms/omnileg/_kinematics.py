@@ -107,12 +107,14 @@ def passive_angles(leg: OmniLeg, alpha: object, beta: object) -> tuple[np.ndarra
 
     paper 2, eq. (12): θ12 = arctan(tan α cos β) as printed; θ22 printed as +arctan(tan β cos α) but
     with chain 2's second axis ω22 = Rz(-π/2)[1 0 0] = [0 -1 0] (eqs. (1), (5), (6)) the closure gives
-    θ22 = -arctan(tan β cos α).
+    θ22 = -arctan(tan β cos α).  Written as atan2(sin α cos β, cos α) and -atan2(sin β cos α, cos β):
+    equal for |α|, |β| < 90°, and continuous beyond, where the arctan form mirrors (module docstring;
+    the closure's angles agree modulo 2π).
     """
     a = as_array(alpha, "alpha")
     b = as_array(beta, "beta")
-    theta12 = np.arctan(np.tan(a) * np.cos(b))
-    theta22 = -np.arctan(np.tan(b) * np.cos(a))  # paper 2, eq. (12): printed +; the closure gives -
+    theta12 = np.arctan2(np.sin(a) * np.cos(b), np.cos(a))  # paper 2, eq. (12), cos α multiplied through
+    theta22 = -np.arctan2(np.sin(b) * np.cos(a), np.cos(b))  # paper 2, eq. (12): printed +; closure gives -
     return theta12, theta22
 
 
