@@ -102,3 +102,9 @@ def test_random_sways_across_the_curve(seed):
     np.testing.assert_allclose(tr.alpha, alpha, atol=NEAR_TOL)
     crossing = np.flatnonzero(np.diff(np.sign(alpha - a_s)) != 0)
     assert tr.switched.sum() == crossing.size
+
+
+def test_empty_trajectories():
+    assert sl.track_branches(LEG, np.zeros((0, 3))).alpha.shape == (0,)
+    assert sl.track_branches(LEG, np.zeros((2, 0, 3))).alpha.shape == (2, 0)
+    assert sl.track_branches(LEG, np.zeros((0, 5, 3))).branch.shape == (0, 5)

@@ -84,7 +84,8 @@ def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> Br
     branch = check_int(branch, "branch", low=0, high=1)
     L = as_array(lengths, "lengths", (None, 3), finite=False)
     shape = L.shape[:-1]
-    Lf = L.reshape(-1, shape[-1], 3)
+    n_traj = int(np.prod(shape[:-1], dtype=int))
+    Lf = L.reshape(n_traj, shape[-1], 3)  # explicit: -1 is ambiguous for an empty batch
     f0 = forward_kinematics(leg, Lf, branch=0)
     f1 = forward_kinematics(leg, Lf, branch=1)
     a = np.stack([f0.alpha, f1.alpha], -1)  # (B, N, 2)
