@@ -117,3 +117,10 @@ def test_property_rates_invert_the_forward_map(q, qd, qdd):
     # the γ direction's sensitivity is 2 L4 sin γ >= 0.0095 m/rad here: rounding / that
     np.testing.assert_allclose(r.qd, qd, atol=1e-9)
     np.testing.assert_allclose(r.qdd, qdd, atol=1e-8)
+
+
+def test_overflowing_sample_is_flagged_not_warned():
+    q = np.array([[0.1, 0.1, 0.5]] * 2)
+    r = ol.joint_rates(LEG, q, [[1e308] * 3, [0.0, 0.0, 0.01]])
+    assert r.valid.tolist() == [False, True]
+    np.testing.assert_array_equal(r.qd[1], ol.joint_rates(LEG, q[1], [0.0, 0.0, 0.01]).qd)

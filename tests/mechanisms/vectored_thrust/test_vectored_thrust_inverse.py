@@ -121,3 +121,11 @@ def test_property_inverse_rates_invert_the_forward_acceleration(q, qd, qdd):
     assert r.valid
     np.testing.assert_allclose(r.qd, qd, atol=SOLVE_TOL * 10)
     np.testing.assert_allclose(r.qdd, qdd, atol=SOLVE_TOL * 100)
+
+
+def test_overflowing_sample_is_flagged_not_warned_and_its_neighbour_unchanged():
+    q = np.array([[0.1, 0.1], [0.2, 0.1]])
+    good = vt.inverse_rates(TH, q[1], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0])
+    r = vt.inverse_rates(TH, q, [[1e308] * 3, [0.0, 0.0, 1.0]], [[0.0] * 3, [0.0, 0.0, 1.0]])
+    assert r.valid.tolist() == [False, True]
+    np.testing.assert_array_equal(r.qdd[1], good.qdd)

@@ -83,6 +83,12 @@ def joint_rates(
         ) from exc
     q = np.broadcast_to(q, (*batch, 3))
     pd = np.broadcast_to(pd, (*batch, 3))
+    # an overflowing sample (|ṗ| ~ 1e300) becomes non-finite and is flagged below, not warned about
+    with np.errstate(over="ignore", invalid="ignore"):
+        return _joint_rates(leg, q, pd, pdd, damping, batch)
+
+
+def _joint_rates(leg, q, pd, pdd, damping, batch) -> JointRatesResult:
     J = jacobian(leg, q)
     U, s, Vt = np.linalg.svd(J)
     smax = s[..., :1]

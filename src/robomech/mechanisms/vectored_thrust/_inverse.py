@@ -107,6 +107,12 @@ def inverse_rates(
         raise ValueError(f"Expected q, omega, omega_dot to broadcast, got batch shapes {shapes}.") from exc
     q = np.broadcast_to(q, (*batch, 2))
     w = np.broadcast_to(w, (*batch, 3))
+    # an overflowing sample (|ω| ~ 1e300) becomes non-finite and is flagged below, not warned about
+    with np.errstate(over="ignore", invalid="ignore"):
+        return _inverse_rates(th, q, w, wd, lam_rel, batch)
+
+
+def _inverse_rates(th, q, w, wd, lam_rel, batch) -> InverseRatesResult:
     jr = _chunked(_jacobian, th, np.ascontiguousarray(q))
     exists = jr.valid
     J = np.where(exists[..., None, None], jr.J, 0.0)
@@ -133,6 +139,7 @@ def inverse_rates(
         wd_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qdd) + vp - wd, axis=-1)
         qdd = np.where(exists[..., None], qdd, np.nan)
         wd_res = np.where(exists, wd_res, np.nan)
+    finite = np.all(np.isfinite(qd), -1) & (wd is None or np.all(np.isfinite(qdd), -1))
     return InverseRatesResult(
         qd=np.where(exists[..., None], qd, np.nan),
         qdd=qdd,
@@ -140,7 +147,7 @@ def inverse_rates(
         singular=singular,
         omega_residual=np.where(exists, w_res, np.nan),
         omega_dot_residual=wd_res,
-        valid=~singular,
+        valid=~singular & finite,  # a flag never says valid where a value overflowed (e.g. |ω| ~ 1e300)
     )
 
 
@@ -178,12 +185,17 @@ def static_torques(th: VectoredThruster, q: object, wrench: object) -> StaticsRe
     m = np.broadcast_to(wr[..., :3], (*batch, 3))
     jr = _chunked(_jacobian, th, np.ascontiguousarray(q))
     J = np.where(jr.valid[..., None, None], jr.J, 0.0)
+    with np.errstate(over="ignore", invalid="ignore"):  # overflow -> non-finite -> flagged below
+        return _statics(J, m, jr.valid)
+
+
+def _statics(J: np.ndarray, m: np.ndarray, exists: np.ndarray) -> StaticsResult:
     tau = -np.einsum("...ij,...i->...j", J, m)
     # component of m_O orthogonal to range(J): spanned by the normal n = J1 x J2 of the two columns
     n = np.cross(J[..., :, 0], J[..., :, 1])
     nn = np.sum(n * n, -1)
     unloaded = n * (np.sum(n * m, -1) / np.where(nn > 0, nn, 1.0))[..., None]
-    ok = jr.valid
+    ok = exists & np.all(np.isfinite(tau), -1)
     return StaticsResult(
         tau=np.where(ok[..., None], tau, np.nan),
         moment=np.array(m),
