@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_bool
+from robomech._validation import as_array, check_bool, check_params
 
 from . import _jet as jt
 from ._chains import shank_frames
@@ -285,6 +285,7 @@ def _flat(*arrays: np.ndarray) -> tuple[tuple[int, ...], list[np.ndarray]]:
 
 def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
     """Body rotations ``R_b (..., 22, 3, 3)`` (in the hip frame) and mass centres ``p_b (..., 22, 3)`` (m)."""
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
     t = _terms_chunked(leg, qf, np.zeros_like(qf), np.zeros_like(qf), poses=True)
@@ -324,6 +325,7 @@ def inverse_dynamics(
     CS_B1 plus an independent spin γ̇ about Z0), for comparison only: the difference is the error the
     paper's theory carries against its ADAMS model.
     """
+    check_params(leg, OmniLeg, "leg")
     paper_as_printed = check_bool(paper_as_printed, "paper_as_printed")
     q = as_array(q, "q", (3,))
     qd = as_array(qd, "qd", (3,))
@@ -349,6 +351,7 @@ def inverse_dynamics(
 
 def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
     """Joint-space inertia matrix ``M(q) (..., 3, 3)`` (kg m²), symmetric positive definite."""
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
     z = np.zeros_like(qf)
@@ -357,6 +360,7 @@ def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
 
 def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
     """``G(q) = ∂V/∂q`` (..., 3), N·m: the torques holding the leg still against gravity."""
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
     z = np.zeros_like(qf)
@@ -365,6 +369,7 @@ def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
 
 def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
     """Kinetic ``½ q̇ᵀ M q̇`` and potential ``-Σ m_b gᵀ p_b`` energy (J), each (...)."""
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     qd = as_array(qd, "qd", (3,))
     batch, (qf, qdf) = _flat(q, qd)
@@ -379,6 +384,7 @@ def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
     the same as ``inverse_dynamics(foot_force=F)``, whose ``foot_terms`` these torques are.  paper 2,
     eq. (50): τ = Jᵀ F_f with F_f the force the foot delivers, F_f = -F.
     """
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     F = as_array(force, "force", (3,))
     return -np.einsum("...ij,...i->...j", jacobian(leg, q), F)  # paper 2, eq. (50): +Jᵀ F_f, F_f = -F
@@ -410,6 +416,7 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     ``σ_i >= SINGULAR_RCOND σ_max`` and ``c_i = σ_i / (σ_i² + λ²)``, ``λ = DAMPING_RELATIVE σ_max``, otherwise
     (selectively damped least squares: the well-determined components stay exact).
     """
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     tau = as_array(tau, "tau", (3,))
     J = jacobian(leg, q)
