@@ -28,6 +28,7 @@ ALLOWED = {
         "testing",
     },
     "cli": {"studies", "verify"},
+    "__main__": {"cli"},  # `python -m robomech`
 }
 ENGINES = {"mujoco", "exudyn", "pinocchio"}
 

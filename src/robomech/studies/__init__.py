@@ -8,11 +8,19 @@ from __future__ import annotations
 
 from robomech._registry import discover
 
-from ._core import Figure, Progress, Study, StudyResult, Table, comparison_table
-from ._report import write_index, write_study_report
+from ._core import Figure, Printed, Progress, Study, StudyResult, Table, comparison_table
+from ._report import (
+    provenance,
+    publish_study,
+    remove_stale_temporaries,
+    write_index,
+    write_study_report,
+    write_verification,
+)
 
 __all__ = [
     "Figure",
+    "Printed",
     "Progress",
     "Study",
     "StudyResult",
@@ -20,8 +28,12 @@ __all__ = [
     "available_studies",
     "comparison_table",
     "get_study",
+    "provenance",
+    "publish_study",
+    "remove_stale_temporaries",
     "write_index",
     "write_study_report",
+    "write_verification",
 ]
 
 
@@ -31,6 +43,7 @@ def available_studies() -> dict[str, Study]:
 
 
 def get_study(name: str) -> Study:
+    """The registered study ``name``; ``ValueError`` listing the valid names otherwise."""
     studies = available_studies()
     if name not in studies:
         raise ValueError(f"Unknown study {name!r}; valid studies are: {', '.join(studies)}.")

@@ -332,8 +332,8 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
                 ],
             ],
             note=f"All {int(np.sum(big.valid))} of {N_THROUGHPUT} systems full rank; median cond "
-            f"{float(np.median(big.cond)):.1f} (1-norm of R). Same machine, same run; 2 shared cores. The "
-            "solve is robomech's compiled batched Householder QR (docs/performance.md); the rest is the "
+            f"{float(np.median(big.cond)):.1f} (1-norm of R). Same machine and run (see provenance). "
+            "The solve is robomech's compiled batched Householder QR (docs/performance.md); the rest is the "
             "assembly of A0 and J.",
         )
     )

@@ -3,17 +3,123 @@
 A module ``robomech/verify/<module>.py`` defines ``VERIFICATION = Verification(name=..., run=...)``;
 ``run()`` returns a list of :class:`Check`.  Each check names the quantity, the maximum error found,
 the tolerance and *why* that tolerance (engine constraint stiffness, step size, model fidelity).
-This layer is the only one that imports a multibody engine.
+This layer is the only one that imports a multibody engine, and only on first use
+(:func:`optional_module`): a verification that needs one declares it in ``requires`` and is skipped,
+with the extra to install, where it is missing.
 """
 
 from __future__ import annotations
 
+import importlib
+import json
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
+from types import ModuleType
 from typing import Any
 
-__all__ = ["Check", "Tolerance", "Verification", "VerificationReport"]
+import numpy as np
+
+from robomech._registry import EXTRAS
+
+__all__ = [
+    "Check",
+    "EngineUnavailable",
+    "Tolerance",
+    "Verification",
+    "VerificationReport",
+    "dumps_json",
+    "optional_module",
+    "to_jsonable",
+]
+
+
+class EngineUnavailable(ImportError):
+    """An optional engine is needed but not installed; the message names the extra to install."""
+
+
+class _OptionalModule:
+    """A module imported on first attribute access, so that importing its user costs nothing."""
+
+    def __init__(self, name: str) -> None:
+        self._name = name
+        self._module: ModuleType | None = None
+
+    def __getattr__(self, attr: str) -> Any:
+        if attr.startswith("__") and attr.endswith("__"):
+            raise AttributeError(attr)  # keep copy/pickle/inspect probes from importing the engine
+        if self._module is None:
+            try:
+                self._module = importlib.import_module(self._name)
+            except ImportError as e:
+                extra = EXTRAS.get(self._name, self._name)
+                raise EngineUnavailable(
+                    f"{self._name} is not installed; install it with: pip install 'robomech[{extra}]'"
+                ) from e
+        return getattr(self._module, attr)
+
+    def __repr__(self) -> str:
+        state = "imported" if self._module is not None else "not yet imported"
+        return f"<optional module {self._name!r} ({state})>"
+
+
+def optional_module(name: str) -> Any:
+    """A stand-in for ``import name`` that imports on first use.
+
+    Parameters
+    ----------
+    name : str
+        Top-level module name, e.g. ``"mujoco"``.
+
+    Returns
+    -------
+    module-like
+        Attribute access imports the module; if it is absent, :class:`EngineUnavailable` (an
+        ``ImportError``) names the robomech extra that installs it.
+
+    Examples
+    --------
+    >>> m = optional_module("no_such_engine_xyz")
+    >>> m.step
+    Traceback (most recent call last):
+    ...
+    robomech.verify._core.EngineUnavailable: no_such_engine_xyz is not installed; ...
+    """
+    return _OptionalModule(name)
+
+
+def to_jsonable(obj: Any) -> Any:
+    """Plain JSON types from numpy arrays and scalars, paths, tuples and dataclass-free containers.
+
+    Non-finite floats become ``None`` (JSON ``null``): strict JSON has no NaN or infinity.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> to_jsonable({"ok": np.bool_(True), "x": np.float64(0.5), "v": np.array([1.0, np.nan])})
+    {'ok': True, 'x': 0.5, 'v': [1.0, None]}
+    """
+    if isinstance(obj, dict):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple | set | frozenset):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray | np.generic):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, bool | int | str) or obj is None:
+        return obj
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, Path):
+        return str(obj)
+    if isinstance(obj, complex):
+        raise TypeError(f"Expected real values for JSON, got the complex number {obj!r}.")
+    raise TypeError(f"Expected a JSON-representable value, got {type(obj).__name__}: {obj!r}.")
+
+
+def dumps_json(obj: Any, *, indent: int | None = 2) -> str:
+    """Strict JSON text (``allow_nan=False``) of :func:`to_jsonable` of ``obj``."""
+    return json.dumps(to_jsonable(obj), indent=indent, allow_nan=False, ensure_ascii=False)
 
 
 @dataclass(frozen=True)
@@ -38,15 +144,17 @@ class Check:
         return math.isfinite(self.max_error) and self.max_error <= self.tolerance.value
 
     def as_dict(self) -> dict[str, Any]:
+        """Plain Python types only (numpy scalars converted; a non-finite error becomes None)."""
+        err = float(self.max_error)
         return {
-            "mechanism": self.mechanism,
-            "quantity": self.quantity,
-            "max_error": self.max_error,
-            "tolerance": self.tolerance.value,
-            "relative": self.tolerance.relative,
-            "reason": self.tolerance.reason,
-            "passed": self.passed,
-            "detail": self.detail,
+            "mechanism": str(self.mechanism),
+            "quantity": str(self.quantity),
+            "max_error": err if math.isfinite(err) else None,
+            "tolerance": float(self.tolerance.value),
+            "relative": bool(self.tolerance.relative),
+            "reason": str(self.tolerance.reason),
+            "passed": bool(self.passed),
+            "detail": str(self.detail),
         }
 
 
@@ -56,15 +164,27 @@ class Verification:
     title: str
     engine: str
     run: Callable[[], Sequence[Check]]
+    # optional modules the run needs (e.g. ("mujoco",)); missing ones skip it with the extra to install
+    requires: tuple[str, ...] = ()
 
 
 @dataclass
 class VerificationReport:
     checks: list[Check] = field(default_factory=list)
+    # (mechanism, reason) of verifications that could not run here, e.g. the engine is not installed
+    skipped: list[tuple[str, str]] = field(default_factory=list)
 
     @property
     def passed(self) -> bool:
+        """Every check that ran passed (skipped verifications are listed, not failed)."""
         return all(c.passed for c in self.checks)
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "passed": self.passed,
+            "checks": [c.as_dict() for c in self.checks],
+            "skipped": [{"mechanism": n, "reason": r} for n, r in self.skipped],
+        }
 
     def table(self) -> str:
         wq = max([len("quantity"), *(len(c.quantity) for c in self.checks)])
@@ -78,5 +198,7 @@ class VerificationReport:
                 f"{c.tolerance.value:>11.1e}{kind:4}  {'pass' if c.passed else 'FAIL'}"
             )
         n_fail = sum(not c.passed for c in self.checks)
-        lines.append(f"{len(self.checks) - n_fail} passed, {n_fail} failed")
+        lines += [f"skipped: {n} — {r}" for n, r in self.skipped]
+        tail = f", {len(self.skipped)} skipped" if self.skipped else ""
+        lines.append(f"{len(self.checks) - n_fail} passed, {n_fail} failed{tail}")
         return "\n".join(lines)

@@ -1,0 +1,111 @@
+"""Without the ``verify`` extra (no MuJoCo) the CLI still runs everything that needs no engine.
+
+How this is tested, and why not in a second virtual environment inside the suite: a venv with
+``pip install .`` and no extras costs a download/installation of numpy, scipy, numba and matplotlib
+(minutes, and network) on every run.  Here a subprocess runs the real CLI with an import hook that
+makes ``import mujoco`` raise ``ModuleNotFoundError`` exactly as an environment without the package
+does (``importlib.util.find_spec`` raises too, so the availability check sees it as absent).  A last
+test shows that, with MuJoCo installed, discovery and ``list`` do not import it.
+``.ci/run`` additionally runs the same commands in a fresh venv without extras (``make check-minimal``).
+"""
+
+import json
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+SRC = Path(__file__).resolve().parents[2] / "src"
+# The subprocesses below run real studies and checks; 300 s bounds a hang, far above their ~20 s.
+TIMEOUT_S = 300
+
+_BLOCKER = textwrap.dedent(
+    """
+    import sys, importlib.abc
+    class _NoEngine(importlib.abc.MetaPathFinder):
+        def find_spec(self, name, path=None, target=None):
+            if name.split(".")[0] == "mujoco":
+                raise ModuleNotFoundError(f"No module named {name!r}", name=name)
+            return None
+    sys.meta_path.insert(0, _NoEngine())
+    sys.modules.pop("mujoco", None)
+    from robomech.cli import main
+    raise SystemExit(main(sys.argv[1:]))
+    """
+)
+
+
+def _run(*args, block=True, cwd=None):
+    env_code = (
+        _BLOCKER
+        if block
+        else "import sys\nfrom robomech.cli import main\nraise SystemExit(main(sys.argv[1:]))"
+    )
+    return subprocess.run(
+        [sys.executable, "-c", env_code, *args],
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT_S,
+        cwd=cwd,
+        env={
+            "PYTHONPATH": str(SRC),
+            "PATH": "/usr/bin:/bin",
+            "MPLBACKEND": "Agg",
+            "HOME": str(cwd or "/tmp"),
+        },
+    )
+
+
+def test_list_names_the_skipped_ones_and_never_imports_the_engine(tmp_path):
+    r = _run("list", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    lines = {line.split()[0]: line for line in r.stdout.splitlines() if line.startswith("  ")}
+    for name in ("omnileg", "vectored-thrust"):
+        assert "skipped: install robomech[verify]" in lines[name]
+    assert "skipped" not in lines["continuum"] and "skipped" not in lines["demo"]
+
+
+def test_a_named_study_that_needs_the_engine_is_a_usage_error(tmp_path):
+    r = _run("reproduce", "omnileg", "--out", str(tmp_path / "out"), cwd=tmp_path)
+    assert r.returncode == 2
+    assert "install robomech[verify]" in r.stderr and "Traceback" not in r.stderr
+    r = _run("verify", "spherical-leg", cwd=tmp_path)
+    assert r.returncode == 2 and "install robomech[verify]" in r.stderr
+
+
+@pytest.mark.slow
+def test_reproduce_continuum_and_verify_all_run_without_the_engine(tmp_path):
+    out = tmp_path / "out"
+    r = _run("reproduce", "continuum", "--out", str(out), "--quiet", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    data = json.loads((out / "continuum" / "results.json").read_text())
+    assert data["name"] == "continuum" and data["tables"]
+
+    r = _run("verify", "--json", "--quiet", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    report = json.loads(r.stdout)
+    ran = {c["mechanism"] for c in report["checks"]}
+    skipped = {s["mechanism"]: s["reason"] for s in report["skipped"]}
+    assert ran == {"continuum", "skid-steer"}
+    assert set(skipped) == {"omnileg", "spherical-leg", "vectored-thrust"}
+    assert all("install robomech[verify]" in why for why in skipped.values())
+    assert report["passed"] and all(c["passed"] for c in report["checks"])
+
+
+def test_with_the_engine_installed_discovery_still_does_not_import_it(tmp_path):
+    code = (
+        "import sys; from robomech.cli import main; main(['list']);"
+        "from robomech.verify import available_verifications; available_verifications();"
+        "print('mujoco' in sys.modules)"
+    )
+    r = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT_S,
+        env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin", "MPLBACKEND": "Agg", "HOME": str(tmp_path)},
+    )
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip().splitlines()[-1] == "False"
