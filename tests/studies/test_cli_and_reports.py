@@ -82,7 +82,8 @@ def test_verify_cli_exits_nonzero_on_a_failed_check(monkeypatch, capsys):
 
 
 def test_printed_values_are_shown_as_the_paper_printed_them(tmp_path):
-    from robomech.studies import Printed, StudyResult, write_study_report
+    from robomech.studies import StudyResult, write_study_report
+    from robomech.studies._core import Printed
 
     t = comparison_table("t", [("l1", 126.7305, 126.73, "mm"), ("r", "1.50", 1.5, "m"), ("n", 12, 12.0, "")])
     assert [r[2] for r in t.rows] == [

@@ -65,6 +65,26 @@ class Command:
     run: Callable[[argparse.Namespace], int]
     description: str | Callable[[], str] = ""
 
+    def __post_init__(self) -> None:
+        if (
+            not isinstance(self.name, str)
+            or not self.name
+            or self.name.strip() != self.name
+            or " " in self.name
+        ):
+            raise ValueError(f"Expected name to be one word such as 'sweep', got {self.name!r}.")
+        if not isinstance(self.help, str):
+            raise ValueError(f"Expected help to be a str, got {type(self.help).__name__}.")
+        for field_name in ("add_arguments", "run"):
+            if not callable(getattr(self, field_name)):
+                raise ValueError(
+                    f"Expected {field_name} to be callable, got {type(getattr(self, field_name)).__name__}."
+                )
+        if not (isinstance(self.description, str) or callable(self.description)):
+            raise ValueError(
+                f"Expected description to be a str or a callable, got {type(self.description).__name__}."
+            )
+
 
 def output_folder(value: str) -> Path:
     """An ``--out`` folder that exists (created if needed) and is writable, or a :class:`CliError`.

@@ -33,13 +33,8 @@ def _add_arguments(p: argparse.ArgumentParser) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     from robomech._registry import skip_reason
-    from robomech.studies import (
-        Progress,
-        available_studies,
-        publish_study,
-        remove_stale_temporaries,
-        write_index,
-    )
+    from robomech.studies import Progress, available_studies, write_index
+    from robomech.studies._report import publish_study, remove_stale_temporaries
     from robomech.verify import dumps_json
 
     studies = available_studies()

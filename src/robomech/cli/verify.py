@@ -60,7 +60,8 @@ def _run(args: argparse.Namespace) -> int:
             print(f"verify: {n} — {v.title} ...", file=sys.stderr, flush=True)
         report.checks.extend(v.run())
     if out is not None:
-        from robomech.studies import available_studies, write_index, write_verification
+        from robomech.studies import available_studies, write_index
+        from robomech.studies._report import write_verification
 
         write_verification(out, report.as_dict())
         write_index(out, available_studies())

@@ -8,19 +8,11 @@ from __future__ import annotations
 
 from robomech._registry import discover
 
-from ._core import Figure, Printed, Progress, Study, StudyResult, Table, comparison_table
-from ._report import (
-    provenance,
-    publish_study,
-    remove_stale_temporaries,
-    write_index,
-    write_study_report,
-    write_verification,
-)
+from ._core import Figure, Progress, Study, StudyResult, Table, comparison_table
+from ._report import write_index, write_study_report
 
 __all__ = [
     "Figure",
-    "Printed",
     "Progress",
     "Study",
     "StudyResult",
@@ -28,12 +20,8 @@ __all__ = [
     "available_studies",
     "comparison_table",
     "get_study",
-    "provenance",
-    "publish_study",
-    "remove_stale_temporaries",
     "write_index",
     "write_study_report",
-    "write_verification",
 ]
 
 

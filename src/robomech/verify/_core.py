@@ -86,6 +86,8 @@ def optional_module(name: str) -> Any:
     ...
     robomech.verify._core.EngineUnavailable: no_such_engine_xyz is not installed; ...
     """
+    if not isinstance(name, str) or not name.isidentifier():
+        raise ValueError(f"Expected name to be a module name such as 'mujoco', got {name!r}.")
     return _OptionalModule(name)
 
 
@@ -113,12 +115,24 @@ def to_jsonable(obj: Any) -> Any:
     if isinstance(obj, Path):
         return str(obj)
     if isinstance(obj, complex):
-        raise TypeError(f"Expected real values for JSON, got the complex number {obj!r}.")
-    raise TypeError(f"Expected a JSON-representable value, got {type(obj).__name__}: {obj!r}.")
+        raise ValueError(f"Expected obj to hold real values only (JSON has no complex), got {obj!r}.")
+    raise ValueError(
+        f"Expected obj to hold JSON-representable values (dict, list, str, number, bool, None, numpy), "
+        f"got {type(obj).__name__}: {obj!r}."
+    )
 
 
 def dumps_json(obj: Any, *, indent: int | None = 2) -> str:
-    """Strict JSON text (``allow_nan=False``) of :func:`to_jsonable` of ``obj``."""
+    """Strict JSON text (``allow_nan=False``) of :func:`to_jsonable` of ``obj``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> dumps_json({"passed": np.bool_(False), "error": float("inf")}, indent=None)
+    '{"passed": false, "error": null}'
+    """
+    if indent is not None and (isinstance(indent, bool) or not isinstance(indent, int) or indent < 0):
+        raise ValueError(f"Expected indent to be None or a non-negative int, got {indent!r}.")
     return json.dumps(to_jsonable(obj), indent=indent, allow_nan=False, ensure_ascii=False)
 
 
