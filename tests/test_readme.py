@@ -53,6 +53,8 @@ def test_citation_and_license_match_the_package():
 
     cff = (ROOT / "CITATION.cff").read_text()
     assert f'version: "{__version__}"' in cff and "license: BSD-3-Clause" in cff
-    assert tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["license"]["text"] == "BSD-3-Clause"
+    assert (
+        tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["license"]["text"] == "BSD-3-Clause"
+    )
     assert (ROOT / "LICENSE").read_text().startswith("BSD 3-Clause License")
     assert f"## [{__version__}]" in (ROOT / "CHANGELOG.md").read_text()

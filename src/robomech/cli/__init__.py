@@ -92,10 +92,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     Examples
     --------
-    >>> main(["--version"])  # doctest: +ELLIPSIS
-    Traceback (most recent call last):
-    ...
-    SystemExit: 0
+    >>> main(["verify", "no-such-mechanism"])  # the message goes to stderr
+    2
     """
     try:
         parser = build_parser()
