@@ -395,7 +395,7 @@ def write_index(
     """
     results = _read_results(out_root)
     verified, verified_at = _verification_status(out_root)
-    skipped = dict(skipped)
+    skipped_by_name = dict(skipped)
     md = ["# robomech — paper reproductions", ""]
     md += [
         "Each row is one study folder; a study's folder is always one complete run (its date and "
@@ -425,11 +425,13 @@ def write_index(
         )
     present = {r["name"] for r in results}
     missing = [
-        (n, skipped.get(n) or "not reproduced yet: `robomech reproduce " + n + "`")
+        (n, skipped_by_name.get(n) or "not reproduced yet: `robomech reproduce " + n + "`")
         for n in (studies or {})
         if n not in present
     ]
-    missing += [(n, why) for n, why in skipped.items() if n not in present and n not in (studies or {})]
+    missing += [
+        (n, why) for n, why in skipped_by_name.items() if n not in present and n not in (studies or {})
+    ]
     if missing:
         md += ["", "## Not in this folder", ""] + [f"- **{n}** — {why}" for n, why in missing]
     md.append("")
