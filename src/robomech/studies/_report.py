@@ -139,9 +139,24 @@ def _cell_md(value: Any) -> str:
     return format_cell(value).replace("|", "\\|").replace("\n", " ")
 
 
+def _numeric(t: Table, j: int) -> bool:
+    cells = [row[j] for row in t.rows if row[j] not in ("—", "", None)]
+    return bool(cells) and all(
+        isinstance(c, int | float | Printed) and not isinstance(c, bool) for c in cells
+    )
+
+
+def _short(text: str, limit: int = 70) -> str:
+    text = " ".join(text.split())
+    if len(text) <= limit:
+        return text
+    return text[: text.rfind(" ", 0, limit)].rstrip(",;:") + " …"
+
+
 def _md_table(t: Table) -> list[str]:
     lines = ["| " + " | ".join(str(c).replace("|", "\\|") for c in t.columns) + " |"]
-    lines.append("|" + "|".join("---" for _ in t.columns) + "|")
+    # alignment in the Markdown itself (GitHub and the HTML agree): a column of numbers to the right
+    lines.append("|" + "|".join("---:" if _numeric(t, j) else ":---" for j in range(len(t.columns))) + "|")
     lines += ["| " + " | ".join(_cell_md(c) for c in row) + " |" for row in t.rows]
     if t.note:
         lines += ["", t.note]
@@ -165,9 +180,8 @@ def _report_markdown(result: StudyResult, prov: Mapping[str, Any], ext: str) -> 
         sections.append(("##", "Figures", []))
         for k, f in enumerate(result.figures, 1):
             alt = (f.alt or f.caption).replace("[", "(").replace("]", ")").replace("\n", " ")
-            sections.append(
-                ("###", f"Figure {k}", [f"![{alt}]({f.path.name})", "", f"*Figure {k}:* {f.caption}"])
-            )
+            lines = [f"![{alt}]({f.path.name})", "", f"*Figure {k}:* {f.caption}"]
+            sections.append(("###", f"Figure {k}: {_short(f.caption)}", lines))
     if result.notes:
         sections.append(("##", "Notes", [f"- {n}" for n in result.notes]))
 
@@ -403,7 +417,7 @@ def write_index(
         f"{out_root.name}`" + (f" (run {verified_at})." if verified_at else " (not run yet)."),
         "",
         "| study | title | verification | figures | tables | time (s) | run (UTC) | robomech | commit |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "|:---|:---|:---|---:|---:|---:|:---|:---|:---|",
     ]
     for r in results:
         p = r.get("provenance") or {}
@@ -418,7 +432,7 @@ def write_index(
                 f=len(r.get("figures", [])),
                 tb=len(r.get("tables", [])),
                 s=f"{secs:.1f}" if isinstance(secs, int | float) else "—",
-                d=p.get("date_utc", "—"),
+                d=str(p.get("date_utc", "—")).replace("T", " ").removesuffix("+00:00"),
                 ver=p.get("robomech", "—"),
                 c=commit,
             )
