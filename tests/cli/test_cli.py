@@ -134,7 +134,11 @@ def test_interrupt_exits_130_and_keeps_only_complete_study_folders(monkeypatch, 
     new = strict_json((tmp_path / "demo" / "results.json").read_text())["provenance"]["date_utc"]
     assert new != old  # demo completed in this run, and the index (written last) says so
     index = (tmp_path / "index.md").read_text()
-    assert new.replace("T", " ").removesuffix("+00:00") in index and "zz-long" in index and "not reproduced yet" in index
+    assert (
+        new.replace("T", " ").removesuffix("+00:00") in index
+        and "zz-long" in index
+        and "not reproduced yet" in index
+    )
 
 
 def test_real_sigint_mid_study_exits_130_without_traceback(tmp_path):
