@@ -229,8 +229,7 @@ def test_every_study_reproduces_with_strict_json_and_a_complete_index(tmp_path, 
     monkeypatch.setattr(ss, "N_THROUGHPUT", 5_000)
     monkeypatch.setattr(ss, "N_LOOP", 50)
     monkeypatch.setattr(ss, "RATE", 100.0)
-    # continuum reproduces (and its JSON is checked) in test_optional_engine
-    names = [n for n in available_studies() if n != "continuum"]
+    names = list(available_studies())
     assert main(["reproduce", *names, "--out", str(tmp_path), "--json", "--quiet"]) == 0
     summary = strict_json(capsys.readouterr().out)
     assert [s["study"] for s in summary["studies"]] == names
@@ -242,4 +241,4 @@ def test_every_study_reproduces_with_strict_json_and_a_complete_index(tmp_path, 
         assert all((tmp_path / n / f["file"]).exists() for f in data["figures"])
         assert html.count('<img alt="') == len(data["figures"])  # every figure has its alt text
     index = (tmp_path / "index.md").read_text()
-    assert all(f"]({n}/report.md)" in index for n in names) and "continuum" in index
+    assert all(f"]({n}/report.md)" in index for n in names)
