@@ -7,7 +7,8 @@ from pathlib import Path
 
 SRC = Path(__file__).resolve().parents[1] / "src" / "robomech"
 
-# layer -> robomech layers it may import (besides itself and robomech._validation)
+# layer -> robomech layers it may import (besides itself and the infrastructure modules
+# robomech._validation, robomech._registry, robomech._numba)
 ALLOWED = {
     "spatial": set(),
     "kinematics": {"spatial"},
@@ -30,6 +31,7 @@ ALLOWED = {
     "cli": {"studies", "verify"},
     "__main__": {"cli"},  # `python -m robomech`
 }
+INFRASTRUCTURE = {"robomech", "robomech._validation", "robomech._registry", "robomech._numba"}
 ENGINES = {"mujoco", "exudyn", "pinocchio"}
 
 
@@ -63,7 +65,7 @@ def test_every_module_respects_the_layering():
     problems = []
     for path in SRC.rglob("*.py"):
         layer = _layer(path)
-        if layer in ("__init__", "_validation", "_registry"):
+        if layer in ("__init__", "_validation", "_registry", "_numba"):
             continue
         for mod in _imports(path):
             top = mod.split(".")[0]
@@ -71,7 +73,7 @@ def test_every_module_respects_the_layering():
                 problems.append(f"{path.relative_to(SRC)} imports engine {mod}")
             if top == "matplotlib" and layer != "studies":
                 problems.append(f"{path.relative_to(SRC)} imports matplotlib")
-            if top != "robomech" or mod in ("robomech", "robomech._validation", "robomech._registry"):
+            if top != "robomech" or mod in INFRASTRUCTURE:
                 continue
             target = mod.split(".")[1]
             if target != layer and target not in ALLOWED[layer]:

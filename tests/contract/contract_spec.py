@@ -43,28 +43,37 @@ class Spec:
     ``masked``   array arguments whose non-finite samples are flagged instead: NaN/inf at one sample
                  must give ``mask`` False at exactly that sample, the other samples unchanged (the
                  argument's batch shape must equal the result mask's shape).
-    ``mask``     the result's per-sample mask: attribute name, or index into a returned tuple.
+    ``mask``     the result's per-sample mask: attribute name, index into a returned tuple, or a
+                 function of the result (e.g. ``lambda r: np.isfinite(r[1])``).
     ``params``   parameter-object arguments: None, a str and a foreign object must raise naming them.
     ``options``  scalar options -> bad values (use BAD_REAL, BAD_POSITIVE, BAD_INT, BAD_BOOL, ...).
-    ``wrong_shapes``  extra bad shapes per array argument (default: last core dimension + 1).
+    ``wrong_shapes``  bad shapes per array argument, replacing the default (last core dimension + 1);
+                 ``()`` for an argument whose every shape is acceptable.
     ``call``     what to call (default: the public object itself) as ``call(**args)``.
     ``finite_result``  the good call's result must be finite wherever ``mask`` is true (or everywhere
                  without ``mask``); False for functions whose good output may be inf by design.
     ``slow``     mark the good call and its bad calls ``pytest.mark.slow``.
+    ``good_elsewhere``  for a call that takes minutes (a whole engine verification): the test file
+                 that runs the good call; the contract suite then makes only the bad calls.
     """
 
     args: Mapping[str, Any]
     arrays: Mapping[str, int] = field(default_factory=dict)
     masked: tuple[str, ...] = ()
-    mask: str | int | None = None
+    mask: str | int | Callable[[Any], Any] | None = None
     params: tuple[str, ...] = ()
     options: Mapping[str, tuple[Any, ...]] = field(default_factory=dict)
     wrong_shapes: Mapping[str, tuple[tuple[int, ...], ...]] = field(default_factory=dict)
     call: Callable[..., Any] | None = None
     finite_result: bool = True
     slow: bool = False
+    good_elsewhere: str = ""
 
     def __post_init__(self) -> None:
+        if self.good_elsewhere and (self.masked or self.mask is not None):
+            raise ValueError("a spec with good_elsewhere cannot check masks (they need the good call)")
+        if self.good_elsewhere and not (HERE.parent.parent / self.good_elsewhere).exists():
+            raise ValueError(f"good_elsewhere names a missing test file: {self.good_elsewhere}")
         for a in self.masked:
             if a not in self.arrays:
                 raise ValueError(f"masked argument {a!r} must also be listed in arrays")

@@ -21,7 +21,6 @@ import pytest
 from contract_spec import Spec, load_specs, public_names, spec_file_for
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from pending import PENDING
 
 # Acceptance of issue 14: no public call takes longer than 5 s on bad input.
 BAD_CALL_SECONDS = 5.0
@@ -94,7 +93,10 @@ def _arrays_of(res: Any) -> list[tuple[str, np.ndarray]]:
 
 
 def _mask_of(spec: Spec, res: Any) -> np.ndarray:
-    m = res[spec.mask] if isinstance(spec.mask, int) else getattr(res, spec.mask)
+    if callable(spec.mask):
+        m = spec.mask(res)
+    else:
+        m = res[spec.mask] if isinstance(spec.mask, int) else getattr(res, spec.mask)
     return np.asarray(m, dtype=bool)
 
 
@@ -127,7 +129,7 @@ def _expect_value_error(name: str, spec: Spec, args: dict[str, Any], arg: str, w
     with pytest.raises(ValueError) as info:
         _call(name, spec, args)
     msg = str(info.value)
-    assert re.search(rf"(?<![\w.]){re.escape(arg)}(?![\w])", msg), (
+    assert re.search(rf"(?<![\w]){re.escape(arg)}(?![\w])", msg), (
         f"{name}({arg}={what}): the ValueError must name {arg!r}; got: {msg}"
     )
     assert "xpected" in msg, f"{name}({arg}={what}): say what was expected and what was got; got: {msg}"
@@ -177,7 +179,7 @@ def _variants(name: str, spec: Spec, arg: str) -> list[tuple[str, Any]]:
     c.flat[0] += 1j
     out.append(("complex", c))
     core = spec.arrays[arg]
-    if core >= 1 and a.ndim >= 1:
+    if arg not in spec.wrong_shapes and core >= 1 and a.ndim >= 1:
         out.append(("shape+1", np.concatenate([a, a[..., :1]], axis=-1)))
     for shape in spec.wrong_shapes.get(arg, ()):
         out.append((f"shape{shape}", np.full(shape, 0.1)))
@@ -197,6 +199,8 @@ def _cases():
                 arrays.append(pytest.param(name, arg, label, marks=marks, id=f"{name}-{arg}-{label}"))
         for arg in spec.params:
             for label in ("None", "str", "object"):
+                if label == "None" and _default_is_none(name, spec, arg):
+                    continue
                 params.append(pytest.param(name, arg, label, marks=marks, id=f"{name}-{arg}-{label}"))
         for opt, bad in spec.options.items():
             for i, v in enumerate(bad):
@@ -209,15 +213,10 @@ ARRAY_CASES, PARAM_CASES, OPTION_CASES = _cases()
 
 # --- coverage -------------------------------------------------------------------------------------
 def test_every_public_name_has_a_spec():
-    missing = [n for n in sorted(PUBLIC) if n not in SPECS and n not in PENDING]
+    missing = [n for n in sorted(PUBLIC) if n not in SPECS]
     assert not missing, "public names without a bad-input spec (see tests/contract/README.md):\n" + "\n".join(
         f"  {n}  -> add it to tests/contract/{spec_file_for(n)}" for n in missing
     )
-
-
-def test_pending_names_have_no_spec_yet():
-    done = sorted(n for n in PENDING if n in SPECS or n not in PUBLIC)
-    assert not done, f"remove these from tests/contract/pending.py: {done}"
 
 
 def test_no_spec_for_a_name_that_is_not_public():
@@ -231,6 +230,8 @@ def test_no_spec_for_a_name_that_is_not_public():
 )
 def test_good_call(name):
     spec = ACTIVE[name]
+    if spec.good_elsewhere:
+        pytest.skip(f"the good call takes minutes: it runs in {spec.good_elsewhere}")
     res = _good(name, spec)
     if spec.mask is not None:
         assert _mask_of(spec, res).any(), f"spec of {name}: the good call should have valid samples"

@@ -22,6 +22,7 @@ from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+from robomech._validation import check_params, check_real
 from robomech.verify._core import dumps_json
 
 from ._core import Printed, Progress, Study, StudyResult, Table
@@ -258,10 +259,39 @@ def _payload(result: StudyResult, prov: Mapping[str, Any], seconds: float | None
     }
 
 
+def _as_path(p: object, name: str) -> Path:
+    if not isinstance(p, str | os.PathLike) or str(p) == "":
+        raise ValueError(f"Expected {name} to be a non-empty path, got {p!r}.")
+    return Path(p)
+
+
 def write_study_report(
     result: StudyResult, out_dir: Path, *, seconds: float | None = None, prov: Mapping[str, Any] | None = None
 ) -> dict[str, Path]:
-    """Write ``report.md``, ``report.html`` and ``results.json`` (strict JSON) into ``out_dir``."""
+    """Write ``report.md``, ``report.html`` and ``results.json`` (strict JSON) into ``out_dir``.
+
+    Parameters
+    ----------
+    result : StudyResult
+        What the study returned.
+    out_dir : path
+        The study's folder (created if needed); its figures are already there.
+    seconds : float, optional
+        Run time of the study (s), recorded in ``results.json`` and shown in the index.
+    prov : mapping, optional
+        Provenance to record (default: :func:`provenance` of this process).
+
+    Returns
+    -------
+    dict
+        Paths ``md``, ``html`` and ``json`` of the three files.
+    """
+    check_params(result, StudyResult, "result")
+    out_dir = _as_path(out_dir, "out_dir")
+    if seconds is not None:
+        seconds = check_real(seconds, "seconds", low=0.0)
+    if prov is not None and not isinstance(prov, Mapping):
+        raise ValueError(f"Expected prov to be a mapping (see provenance()), got {type(prov).__name__}.")
     out_dir.mkdir(parents=True, exist_ok=True)
     prov = provenance() if prov is None else prov
     text = dumps_json(_payload(result, prov, seconds))  # first: a non-JSON value fails before any write
@@ -407,6 +437,19 @@ def write_index(
     Path
         ``out_root / "index.md"`` (``index.html`` beside it).
     """
+    out_root = _as_path(out_root, "out_root")
+    if studies is not None and not (
+        isinstance(studies, Mapping) and all(isinstance(v, Study) for v in studies.values())
+    ):
+        raise ValueError(f"Expected studies to be a mapping name -> Study (or None), got {studies!r}.")
+    if isinstance(skipped, str | bytes) or not isinstance(skipped, Iterable):
+        raise ValueError(f"Expected skipped to be (name, reason) pairs, got {skipped!r}.")
+    skipped = list(skipped)
+    for i, pair in enumerate(skipped):
+        if not (isinstance(pair, tuple) and len(pair) == 2 and all(isinstance(x, str) for x in pair)):
+            raise ValueError(f"Expected skipped[{i}] to be a (name, reason) pair of str, got {pair!r}.")
+    if not out_root.is_dir():
+        raise ValueError(f"Expected out_root to be an existing folder, got {str(out_root)!r}.")
     results = _read_results(out_root)
     verified, verified_at = _verification_status(out_root)
     skipped_by_name = dict(skipped)

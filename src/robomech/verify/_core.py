@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from robomech._registry import EXTRAS
+from robomech._validation import check_bool, check_positive
 
 __all__ = [
     "Check",
@@ -143,6 +144,12 @@ class Tolerance:
     value: float
     reason: str
     relative: bool = False
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "value", check_positive(self.value, "value"))
+        if not isinstance(self.reason, str) or not self.reason.strip():
+            raise ValueError(f"Expected reason to be a non-empty str (why this value), got {self.reason!r}.")
+        object.__setattr__(self, "relative", check_bool(self.relative, "relative"))
 
 
 @dataclass(frozen=True)

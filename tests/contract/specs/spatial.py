@@ -18,12 +18,14 @@ SPECS = {
     P + "hat": Spec(args={"w": W2}, arrays={"w": 1}),
     P + "vee": Spec(args={"W": R2}, arrays={"W": 2}, wrong_shapes={"W": ((2, 3, 4),)}),
     P + "exp_so3": Spec(args={"w": W2}, arrays={"w": 1}),
-    P + "log_so3": Spec(args={"R": R2}, arrays={"R": 2}, wrong_shapes={"R": ((2, 3, 4), (3,))}),
+    P + "log_so3": Spec(args={"R": R2}, arrays={"R": 2}, wrong_shapes={"R": ((2, 3, 4), (3,), (2, 4, 4))}),
     P + "rot_x": Spec(args={"angle": ANG}, arrays={"angle": 0}),
     P + "rot_y": Spec(args={"angle": ANG}, arrays={"angle": 0}),
     P + "rot_z": Spec(args={"angle": ANG}, arrays={"angle": 0}),
     P + "sincos": Spec(args={"angle": ANG}, arrays={"angle": 0}),
-    P + "transform": Spec(args={"R": R2, "p": W2}, arrays={"R": 2, "p": 1}, wrong_shapes={"p": ((3, 3),)}),
+    P + "transform": Spec(
+        args={"R": R2, "p": W2}, arrays={"R": 2, "p": 1}, wrong_shapes={"p": ((3, 3), (2, 4))}
+    ),
     P + "inverse_transform": Spec(args={"T": T2}, arrays={"T": 2}, wrong_shapes={"T": ((2, 3, 4),)}),
     P + "hat_se3": Spec(args={"V": V2}, arrays={"V": 1}),
     P + "vee_se3": Spec(args={"X": T2}, arrays={"X": 2}, wrong_shapes={"X": ((2, 3, 4),)}),
