@@ -62,12 +62,39 @@ def solve(A: object, b: object, *, exact_cond: bool = False) -> LstsqResult:
 
     Each system is factorised as ``[A | b] = Q [R, c; 0, r]`` (unblocked Householder, the algorithm
     of LAPACK's ``dgeqr2``, compiled and run in parallel over the batch: see ``_householder.py``), so
-    ``x = R^-1 c`` and the residual norm is ``|r|``.
+    ``x = R^-1 c`` and the residual norm is ``|r|``.  The first call in a process compiles the kernel
+    (several seconds; cached on disk afterwards).
 
     ``cond`` is the exact 1-norm condition number ``||R||_1 ||R^-1||_1`` of R (within a factor n of
     the 2-norm condition number of A) unless ``exact_cond=True``, which computes the 2-norm one from
     the singular values of R.  A system whose condition exceeds :func:`rank_cond_limit` is rank
     deficient: its rank comes from the SVD and ``x`` is the minimum-norm solution.
+
+    Parameters
+    ----------
+    A : array_like, shape (..., m, n)
+        Coefficient matrices, ``m >= n`` (any consistent units).
+    b : array_like, shape (..., m)
+        Right-hand sides; batch dimensions broadcast with those of ``A``.
+    exact_cond : bool, optional
+        Report the 2-norm condition number (from the SVD of R) instead of the 1-norm one of R.
+
+    Returns
+    -------
+    LstsqResult
+        ``x (..., n)``, ``residual_norm (...)``, ``rank (...)``, ``cond (...)``, ``full_rank (...)``,
+        ``ok (...)``: per system; a non-finite system gives ``ok`` False and NaN in ``x`` without
+        affecting the others.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> A = np.array([[[1.0, 0.0], [0.0, 1.0], [1.0, 1.0]], [[1.0, 2.0], [2.0, 4.0], [3.0, 6.0]]])
+    >>> r = solve(A, np.array([[1.0, 2.0, 3.0], [1.0, 2.0, 3.0]]))
+    >>> r.x[0].round(12), bool(r.full_rank[0])          # a consistent full-rank system
+    (array([1., 2.]), True)
+    >>> int(r.rank[1]), bool(r.full_rank[1]), bool(r.ok[1])   # rank 1: minimum-norm solution, flagged
+    (1, False, True)
     """
     from ._householder import householder_lstsq
 
@@ -111,7 +138,22 @@ def solve(A: object, b: object, *, exact_cond: bool = False) -> LstsqResult:
 
 
 def rank_cond_limit(m: int, n: int) -> float:
-    """Condition number above which a system counts as rank deficient: ``1 / (10 max(m, n) eps)``."""
+    """Condition number above which a system counts as rank deficient: ``1 / (10 max(m, n) eps)``.
+
+    Parameters
+    ----------
+    m, n : int
+        Rows and columns of the systems.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> f"{rank_cond_limit(30, 11):.3e}"
+    '1.501e+13'
+    """
     m = check_int(m, "m", low=1)
     n = check_int(n, "n", low=1)
     return 1.0 / (RANK_RTOL_FACTOR * max(m, n) * np.finfo(float).eps)
@@ -122,6 +164,25 @@ def solve_normal_equations(A: object, b: object) -> LstsqResult:
 
     Accuracy degrades like ``cond(A)^2 eps``; a numerically singular ``A^T A`` is flagged as not
     full rank (x is then the minimum-norm solution of the normal equations).
+
+    Parameters
+    ----------
+    A : array_like, shape (..., m, n)
+        Coefficient matrices, ``m >= n``.
+    b : array_like, shape (..., m)
+        Right-hand sides; batch dimensions broadcast.
+
+    Returns
+    -------
+    LstsqResult
+        As :func:`solve`; ``cond`` is the 2-norm condition number of ``A`` from the normal matrix.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> A = np.array([[1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
+    >>> solve_normal_equations(A, np.array([1.0, 2.0, 3.0])).x.round(12)
+    array([1., 2.])
     """
     A, b = _validate(A, b)
     m, n = A.shape[-2:]
