@@ -10,6 +10,7 @@ test shows that, with MuJoCo installed, discovery and ``list`` do not import it.
 """
 
 import json
+import os
 import subprocess
 import sys
 import textwrap
@@ -55,12 +56,8 @@ def _run(*args, block=True, cwd=None, keep_studies=""):
         text=True,
         timeout=TIMEOUT_S,
         cwd=cwd,
-        env={
-            "PYTHONPATH": str(SRC),
-            "PATH": "/usr/bin:/bin",
-            "MPLBACKEND": "Agg",
-            "HOME": str(cwd or "/tmp"),
-        },
+        # the caller's environment (HOME: the numba kernel cache is shared, not rebuilt per test)
+        env={**os.environ, "PYTHONPATH": str(SRC), "MPLBACKEND": "Agg", "KEEP_STUDIES": keep_studies},
     )
 
 
@@ -84,11 +81,12 @@ def test_a_named_study_that_needs_the_engine_is_a_usage_error(tmp_path):
 @pytest.mark.slow
 def test_reproduce_and_verify_all_run_without_the_engine(tmp_path):
     # `reproduce continuum` (the acceptance command) runs in CI's `make check-minimal` in a real venv
-    # without extras; here `reproduce` (all) over four studies shows the same paths in less time:
-    # two need the engine (skipped), spherical-leg runs without its engine overlays, demo needs none.
-    # (continuum reproduces, with strict JSON, in tests/cli/test_cli.py.)
+    # without extras; here `reproduce` (all) over three studies shows the same paths in less time:
+    # two need the engine (skipped), demo needs none.  (Every study reproduces, with strict JSON, in
+    # tests/cli/test_cli.py; spherical-leg's own no-engine fallback catches EngineUnavailable, an
+    # ImportError: test_engine_unavailable_is_an_import_error_naming_the_extra.)
     out = tmp_path / "out"
-    keep = "demo,omnileg,spherical-leg,vectored-thrust"
+    keep = "demo,omnileg,vectored-thrust"
     r = _run("reproduce", "--out", str(out), "--quiet", cwd=tmp_path, keep_studies=keep)
     assert r.returncode == 0, r.stderr
     skipped_lines = [line for line in r.stdout.splitlines() if line.startswith("skipped:")]
@@ -96,9 +94,7 @@ def test_reproduce_and_verify_all_run_without_the_engine(tmp_path):
     assert all("install robomech[verify]" in line for line in skipped_lines)
     index = (out / "index.md").read_text()
     assert "**omnileg** — install robomech[verify]" in index
-    assert "[spherical-leg](spherical-leg/report.md)" in index
-    notes = json.loads((out / "spherical-leg" / "results.json").read_text())["notes"]
-    assert any("MuJoCo is not installed" in n for n in notes)  # the study's own fallback, not a crash
+    assert "[demo](demo/report.md)" in index
 
     r = _run("verify", "--json", "--quiet", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
@@ -122,7 +118,17 @@ def test_with_the_engine_installed_discovery_still_does_not_import_it(tmp_path):
         capture_output=True,
         text=True,
         timeout=TIMEOUT_S,
-        env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin", "MPLBACKEND": "Agg", "HOME": str(tmp_path)},
+        env={**os.environ, "PYTHONPATH": str(SRC), "MPLBACKEND": "Agg"},
     )
     assert r.returncode == 0, r.stderr
     assert r.stdout.strip().splitlines()[-1] == "False"
+
+
+def test_engine_unavailable_is_an_import_error_naming_the_extra():
+    from robomech.verify import EngineUnavailable, optional_module
+
+    engine = optional_module("robomech_no_such_engine")
+    with pytest.raises(ImportError, match=r"pip install 'robomech\[robomech_no_such_engine\]'") as e:
+        engine.MjModel  # noqa: B018 - the attribute access is the import
+    assert isinstance(e.value, EngineUnavailable)
+    assert "not yet imported" in repr(engine)

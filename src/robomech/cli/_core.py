@@ -158,6 +158,9 @@ def announce_compiles(enabled: bool = True) -> bool:
     if _INSTALLED:
         return True
     try:
+        from robomech._numba import import_numba
+
+        import_numba()  # first, so that robomech's kernel cache location applies (see _numba)
         from numba.core import event
     except ImportError:  # pragma: no cover - numba is a dependency
         return False
