@@ -15,11 +15,11 @@ install: $(STAMP)
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[verify,test]"
+	$(BIN)/python -m pip install --quiet -e ".[verify,explore,test]"
 	touch $(STAMP)
 
 $(DOCS_STAMP): $(STAMP)
-	$(BIN)/python -m pip install --quiet -e ".[verify,test,docs]"
+	$(BIN)/python -m pip install --quiet -e ".[verify,explore,test,docs]"
 	touch $(DOCS_STAMP)
 
 run: install

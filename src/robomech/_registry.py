@@ -19,7 +19,13 @@ __all__ = ["EXTRAS", "discover", "missing_requirements", "skip_reason"]
 T = TypeVar("T")
 
 # Optional top-level modules -> the pip extra of robomech that installs them.
-EXTRAS = {"mujoco": "verify"}
+EXTRAS = {
+    "mujoco": "verify",
+    "dask": "explore",
+    "distributed": "explore",
+    "zarr": "explore",
+    "pymoo": "explore",
+}
 
 
 def discover(package: str, path: Iterable[str], attribute: str, kind: type[T]) -> dict[str, T]:
