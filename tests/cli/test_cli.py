@@ -172,8 +172,8 @@ def test_strict_json_of_list(capsys):
 
 
 def test_verify_json_is_strict_for_the_engine_mechanisms(capsys):
-    # continuum and skid-steer: strict JSON checked in test_optional_engine (they run there)
-    names = ["omnileg", "spherical-leg", "vectored-thrust"]
+    # continuum: strict JSON checked in test_optional_engine (it runs there without the engine)
+    names = ["omnileg", "skid-steer", "spherical-leg", "vectored-thrust"]
     assert main(["verify", *names, "--json", "--quiet"]) == 0
     out = strict_json(capsys.readouterr().out)
     assert {c["mechanism"] for c in out["checks"]} == set(names) and out["passed"]
