@@ -39,6 +39,8 @@ __all__ = [
     "describe",
     "engine_inverse_dynamics",
     "engine_model",
+    "run_generic",
+    "split_targets",
     "trajectory",
     "verify_file",
 ]
@@ -378,30 +380,32 @@ def verify_file(path: str | Path) -> VerificationReport:
     return report
 
 
-def cli_report(targets, available) -> tuple[VerificationReport | None, str | None]:
-    """The CLI's verify: registered names and MJCF paths mixed; (report, None) or (None, error)."""
+def split_targets(targets, available) -> tuple[list[str], list[str]]:
+    """``robomech verify`` arguments: (registered names and unknown words, generic targets).
+
+    Generic targets are MJCF paths and gallery / paper-description names that are not registered
+    verifications; they get :func:`check_mechanism`."""
     from robomech import multibody as mb
-    from robomech.verify import run_verifications
 
     described = set(_paper()) | set(mb.gallery.NAMES)
-    files = [a for a in targets if a not in available and (a.endswith(".xml") or Path(a).is_file())]
-    generic = [a for a in targets if a not in available and a in described]
-    names = [a for a in targets if a not in files and a not in generic]
-    unknown = [n for n in names if n not in available]
-    if unknown:
-        return None, (
-            f"unknown mechanism {', '.join(map(repr, unknown))}; valid ones are: {', '.join(available)}"
-            f" (hand-written), {', '.join(sorted(described))} (generic), or a path to an MJCF file"
-        )
-    report = run_verifications(names) if names or not (files or generic) else VerificationReport()
-    for f in files:
+    def is_generic(a: str) -> bool:
+        return a not in available and (a in described or a.endswith(".xml") or Path(a).is_file())
+
+    generic = [a for a in targets if is_generic(a)]
+    return [a for a in targets if a not in generic], generic
+
+
+def run_generic(targets) -> list[Check]:
+    """The generic checks of each target (MJCF path, gallery or description name); ValueError if one
+    cannot be read."""
+    checks: list[Check] = []
+    for t in targets:
         try:
-            report.checks.extend(verify_file(f).checks)
-        except (ValueError, OSError) as exc:
-            return None, f"cannot verify {f!r}: {exc}"
-    for n in generic:
-        report.checks.extend(check_mechanism(describe(n), f"{n} (generic)"))
-    return report, None
+            mech = describe(t)
+        except OSError as exc:
+            raise ValueError(f"cannot read {t!r}: {exc}") from exc
+        checks.extend(check_mechanism(mech, Path(t).stem if t.endswith(".xml") else f"{t} (generic)"))
+    return checks
 
 
 def _paper() -> dict:
