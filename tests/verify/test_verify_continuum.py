@@ -47,3 +47,14 @@ def test_error_table_is_physical():
     assert np.all(np.diff(lateral, axis=1) > 0) and np.all(np.diff(axial, axis=1) > 0)
     # and is not small: at 0.2 N the constant-curvature tip is off by millimetres on this slender core
     assert np.min(t.position_error[:, 3]) > 1e-3
+
+
+def test_convergence_table_small_slice():
+    """Two cases of the docs' convergence table (the full one: benchmarks/continuum_reference.py):
+    two segments at 15 N and 120° (the old reference failed at 5 N), loaded and unloaded."""
+    from robomech.verify.continuum import convergence_table
+
+    t = convergence_table((2,), (15.0,), (120.0,))
+    assert t.taut.all() and t.converged.all() and t.loaded_converged.all()
+    assert np.nanmax(t.tip_error) < 1e-9 * 0.18  # unloaded: the CC arcs are exact
+    assert "✓" in t.markdown()

@@ -1,0 +1,29 @@
+"""Tables of the continuum references recorded in ``docs/mechanisms/continuum_cosserat.md``.
+
+Not a timed benchmark (``run.py`` collects ``bench_*.py`` only): the Cosserat solves are expensive
+(~1-3 minutes on one core), so the tables are generated here once and recorded in the docs, while the
+tests solve a few cases of each.  Run: ``PYTHONPATH=src python benchmarks/continuum_reference.py``.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+from robomech.verify import continuum as V
+
+
+def main(argv: list[str]) -> None:
+    which = set(argv) or {"convergence"}
+    if "convergence" in which:
+        t0 = time.perf_counter()
+        table = V.convergence_table()
+        print(table.markdown())
+        print(
+            f"\n{int(table.taut.sum())} taut cases, {int(table.converged.sum())} converged unloaded, "
+            f"{int(table.loaded_converged.sum())} converged loaded; {time.perf_counter() - t0:.0f} s"
+        )
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
