@@ -10,6 +10,8 @@ from __future__ import annotations
 import sys
 import time
 
+import numpy as np
+
 from robomech.verify import continuum as V
 
 
@@ -22,6 +24,19 @@ def main(argv: list[str]) -> None:
         print(
             f"\n{int(table.taut.sum())} taut cases, {int(table.converged.sum())} converged unloaded, "
             f"{int(table.loaded_converged.sum())} converged loaded; {time.perf_counter() - t0:.0f} s"
+        )
+    if "disks" in which:
+        t0 = time.perf_counter()
+        table = V.disk_agreement_table()
+        print(table.markdown())
+        v = table.valid
+        print(
+            f"\nchord model: max {1e3 * np.nanmax(table.chord_error[v]):.2f} mm, median "
+            f"{1e3 * np.nanmedian(table.chord_error[v]):.2f} mm; arc model: max "
+            f"{1e3 * np.nanmax(table.arc_error[v]):.2f} mm, median "
+            f"{1e3 * np.nanmedian(table.arc_error[v]):.2f} mm; elongation max "
+            f"{1e6 * np.nanmax(table.elongation_error[v]):.1f} µm; {int(v.sum())}/{v.size} valid; "
+            f"{time.perf_counter() - t0:.0f} s"
         )
 
 

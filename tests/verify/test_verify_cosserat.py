@@ -454,10 +454,10 @@ def test_non_convergence_is_a_finite_per_case_flag(rod: TendonRod, monkeypatch) 
 
 
 # ---------------------------------------------------------------------------------------------- verify
-def test_verification_module_passes_and_is_registered() -> None:
+def test_verification_module_is_registered() -> None:
+    """Registered under its name; running it (~1 min of Cosserat and disk solves) is
+    tests/verify/test_verify_continuum.py::test_continuum_verification_passes (once, not twice)."""
     from robomech.verify import available_verifications
 
     v = available_verifications()["continuum"]
-    checks = v.run()
-    assert len(checks) >= 4
-    assert all(c.passed for c in checks), [c.as_dict() for c in checks if not c.passed]
+    assert v.name == "continuum" and callable(v.run)

@@ -203,7 +203,9 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     be = np.linspace(0.0, 2.0 * np.pi, 181)
     psi_c = np.stack([np.full_like(be, np.radians(CIRCLE_THETA_DEG)), be], -1)
     dq = np.gradient(C.theoretical_drive(truth, psi_c, "arc"), axis=0)
-    dir_c = np.sign(dq)  # each cable slides in the direction its actuator moves
+    # each cable slides in the direction its actuator moves; at a turning point (dq = 0) it would stick
+    # (paper 3, eq. (19)'s stuck branch, not modelled: the direction of the motion that follows is taken)
+    dir_c = np.where(dq >= 0.0, 1.0, -1.0)
     pd_c, tips_c, errs_c, ok_c, (sim_c, _) = _run_trajectory(truth, model, psi_c, dir_c)
 
     mm = 1e3

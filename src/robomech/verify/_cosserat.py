@@ -38,9 +38,9 @@ elastic constitutive law; tip force and moment constant in the base frame (dead 
 Base frame: ``p(0) = 0``, ``R(0) = I``, the undeformed rod along +z; tendon ``i`` at
 ``r_i = r (cos α_i, sin α_i, 0)`` in every disk frame.
 
-The constant-curvature (CC) functions at the end of this file exist ONLY as a comparison helper for
-the tests and the error table; the real comparison will use ``robomech.mechanisms.continuum`` once it
-is merged (the lead wires it).
+The constant-curvature (CC) functions at the end of this file are an independent comparison helper for
+the reference's own tests and its error table; the library's model ``robomech.mechanisms.continuum`` is
+compared with this reference in ``robomech.verify.continuum``.
 """
 
 from __future__ import annotations
@@ -233,16 +233,19 @@ class TendonRod:
     def paper(
         cls,
         *,
-        rod_diameter: float = 1.0e-3,
+        rod_diameter: float = 0.8e-3,
         youngs_modulus: float = 60e9,
         poisson_ratio: float = 0.33,
-        hole_radius: float = 3.5e-3,
+        hole_radius: float = 4.0e-3,
         rigid_axial_shear: bool = False,
     ) -> TendonRod:
         """Paper 3's robot: one 90 mm segment, 3 cables at 0°, 120°, 240° (eq. 4), NiTi core rod.
 
-        Not in the paper (documented defaults): core diameter 1.0 mm, NiTi austenite E = 60 GPa, ν = 0.33,
-        cable-hole radius 3.5 mm (inside the 10 mm disks, leaving room for the 0.8 mm cable).
+        The one "paper robot" of robomech: the same unprinted values as
+        ``robomech.mechanisms.continuum.ContinuumRobot.paper()`` (a test checks it): core diameter
+        0.8 mm, NiTi austenite E = 60 GPa (EI = 1.2e-3 N m²), ν = 0.33, cable-hole radius 4 mm.
+        (Before issue 16 this rod had a 1.0 mm core and 3.5 mm holes, so the docs' and the study's
+        error tables disagreed.)
         """
         return cls.from_round_rod(
             segment_lengths=(0.090,),
@@ -706,8 +709,8 @@ def elastica_cantilever_tip(
 
 
 # ----------------------------------------------------------------------------------------------------
-# Constant-curvature comparison helper (tests and error table only; the library model is
-# robomech.mechanisms.continuum, which the lead will wire in once merged)
+# Constant-curvature comparison helper (tests and error table only; the library model,
+# robomech.mechanisms.continuum, is compared in robomech.verify.continuum)
 # ----------------------------------------------------------------------------------------------------
 def _cc_transform_kernel(u_xy: np.ndarray, ell: np.ndarray) -> np.ndarray:
     """Arc of constant body curvature (u_x, u_y, 0) over length ell: (..., 4, 4), finite at u = 0."""

@@ -15,11 +15,13 @@ from ._compensation import (
 )
 from ._friction import (
     FrictionEstimate,
+    TensionHistory,
     capstan_coefficient,
     capstan_tension_ratio,
     classical_capstan_ratio,
     friction_factors,
     identify_friction,
+    stick_slip_tensions,
     wrap_angles,
 )
 from ._kinematics import (
@@ -52,6 +54,7 @@ __all__ = [
     "FrictionEstimate",
     "IKResult",
     "SimulationResult",
+    "TensionHistory",
     "TensionResult",
     "cable_elongation",
     "cable_jacobian",
@@ -73,6 +76,7 @@ __all__ = [
     "simulate",
     "span_jacobian",
     "span_lengths",
+    "stick_slip_tensions",
     "theoretical_drive",
     "tip_jacobian",
     "tip_position",
