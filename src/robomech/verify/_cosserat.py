@@ -900,7 +900,7 @@ axial = -z (along the base axis, compressing the straight robot, e.g. a payload'
 def constant_curvature_error_table(
     rod: TendonRod | None = None,
     bend_angles_deg: object = (0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0),
-    loads_n: object = (0.0, 0.1, 0.5, 1.0),
+    loads_n: object = (0.0, 0.05, 0.1, 0.2),
     directions: tuple[str, ...] = ("lateral", "axial"),
     *,
     tendon: int = 0,
