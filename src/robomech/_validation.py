@@ -4,20 +4,56 @@ Kernels trust their inputs; public functions call these once and raise ``ValueEr
 argument with what was expected and what was received (the SciPy style).  Physical failures
 (unreachable poses, singular configurations) are *not* errors: they are reported per sample by the
 result objects of each model.
+
+Helpers:
+
+- arrays: ``as_array`` (real float64, trailing shape, finiteness), ``check_finite``,
+  ``broadcast_batch``, ``finite_samples`` (per-sample finiteness mask for models that mask instead
+  of raising);
+- parameter objects: ``check_params`` (``Expected leg to be a SphericalLeg, got NoneType.``);
+- scalar options: ``check_real``, ``check_positive``, ``check_int``, ``check_bool``, ``check_choice``;
+- frozen dataclass fields: ``coerce_float_fields``, ``coerce_int_fields`` (store the validated value
+  with ``object.__setattr__``, so a field never keeps a str, a bool or a NumPy 0-d array).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import math
+import numbers
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 
-__all__ = ["as_array", "broadcast_batch", "check_finite", "check_positive"]
+__all__ = [
+    "as_array",
+    "broadcast_batch",
+    "check_bool",
+    "check_choice",
+    "check_finite",
+    "check_int",
+    "check_params",
+    "check_positive",
+    "check_real",
+    "coerce_float_fields",
+    "coerce_int_fields",
+    "finite_samples",
+]
+
+# dtype kinds accepted as real numbers: signed/unsigned integers and floats.  Complex ('c') would lose
+# its imaginary part in a float64 cast, bool ('b') is a flag not a number, and str/bytes/object/
+# datetime kinds are not numbers at all.
+_REAL_KINDS = frozenset("iuf")
 
 
 def _shape_text(tail: Sequence[int | None]) -> str:
     parts = ["..."] + ["n" if d is None else str(d) for d in tail]
     return "(" + ", ".join(parts) + ")"
+
+
+def _type_text(x: object) -> str:
+    if isinstance(x, np.ndarray):
+        return f"an array of dtype {x.dtype}"
+    return type(x).__name__
 
 
 def as_array(
@@ -30,13 +66,23 @@ def as_array(
 ) -> np.ndarray:
     """Return ``x`` as a float64 array whose trailing dimensions are ``tail``.
 
-    ``None`` in ``tail`` accepts any length.  ``finite=True`` rejects NaN and infinity; a model that
-    prefers to flag such samples per sample passes ``finite=False`` and masks them itself.
+    Only real numbers are accepted (integer or float dtypes); complex, bool, str and object inputs
+    (including ``None`` and ragged lists) raise.  ``None`` in ``tail`` accepts any length.
+    ``finite=True`` rejects NaN and infinity; a model that prefers to flag such samples per sample
+    passes ``finite=False`` and masks them itself (see ``finite_samples``).
     """
+    if x is None or isinstance(x, str | bytes):
+        raise ValueError(f"Expected {name} to be an array of real numbers, got {type(x).__name__}.")
     try:
-        a = np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"Expected {name} to be an array of real numbers, got {type(x).__name__}.") from exc
+        raw = np.asarray(x)
+    except (TypeError, ValueError) as exc:  # ragged nested sequences
+        raise ValueError(f"Expected {name} to be an array of real numbers, got {_type_text(x)}.") from exc
+    if raw.dtype.kind not in _REAL_KINDS:
+        got = f"dtype {raw.dtype}"
+        if not isinstance(x, np.ndarray):
+            got = f"{type(x).__name__} of {got}"
+        raise ValueError(f"Expected {name} to be an array of real numbers, got {got}.")
+    a = raw.astype(np.float64, copy=False)
     need = len(tail) if min_ndim is None else max(min_ndim, len(tail))
     if a.ndim < need or any(
         d is not None and a.shape[a.ndim - len(tail) + i] != d for i, d in enumerate(tail)
@@ -48,28 +94,138 @@ def as_array(
     return a
 
 
+def finite_samples(a: np.ndarray, n_core: int) -> np.ndarray:
+    """Per-sample finiteness: ``all(isfinite)`` over the last ``n_core`` axes of ``a``."""
+    f = np.isfinite(a)
+    if n_core:
+        f = f.all(axis=tuple(range(a.ndim - n_core, a.ndim)))
+    return np.asarray(f)
+
+
 def check_finite(a: np.ndarray, name: str) -> None:
     if not np.all(np.isfinite(a)):
         raise ValueError(f"Expected {name} to be finite, got non-finite value(s).")
 
 
-def check_positive(value: float, name: str, *, allow_zero: bool = False) -> float:
-    """Validate one scalar parameter of a frozen parameter dataclass."""
-    v = float(value)
-    ok = np.isfinite(v) and (v >= 0.0 if allow_zero else v > 0.0)
+def check_params(obj: object, cls: type | tuple[type, ...], name: str) -> None:
+    """Raise unless ``obj`` is an instance of ``cls`` (the mechanism's parameter dataclass)."""
+    if not isinstance(obj, cls):
+        want = cls.__name__ if isinstance(cls, type) else " or ".join(c.__name__ for c in cls)
+        article = "an" if want[:1].lower() in "aeiou" else "a"
+        raise ValueError(f"Expected {name} to be {article} {want}, got {type(obj).__name__}.")
+
+
+def _scalar(value: object, name: str) -> float:
+    """A real scalar (Python or NumPy number, or a 0-d / size-1 real array) as a float."""
+    if isinstance(value, bool | np.bool_) or value is None or isinstance(value, str | bytes):
+        raise ValueError(f"Expected {name} to be a real number, got {type(value).__name__}.")
+    if isinstance(value, numbers.Real):
+        return float(value)
+    if isinstance(value, np.ndarray) and value.size == 1 and value.dtype.kind in _REAL_KINDS:
+        return float(value.reshape(()))
+    raise ValueError(f"Expected {name} to be a real number, got {_type_text(value)}.")
+
+
+def check_real(
+    value: object,
+    name: str,
+    *,
+    low: float | None = None,
+    high: float | None = None,
+    low_open: bool = False,
+    high_open: bool = False,
+    finite: bool = True,
+) -> float:
+    """Validate a real scalar option and return it as a float (bounds inclusive unless ``*_open``)."""
+    v = _scalar(value, name)
+    if math.isnan(v) or (finite and not math.isfinite(v)):
+        raise ValueError(f"Expected {name} to be a finite real number, got {value!r}.")
+    if low is not None and (v < low or (low_open and v == low)):
+        raise ValueError(f"Expected {name} {'>' if low_open else '>='} {low}, got {value!r}.")
+    if high is not None and (v > high or (high_open and v == high)):
+        raise ValueError(f"Expected {name} {'<' if high_open else '<='} {high}, got {value!r}.")
+    return v
+
+
+def check_positive(value: object, name: str, *, allow_zero: bool = False) -> float:
+    """Validate one positive (or non-negative) finite real scalar; return it as a float."""
+    v = _scalar(value, name)
+    ok = math.isfinite(v) and (v >= 0.0 if allow_zero else v > 0.0)
     if not ok:
         rel = ">= 0" if allow_zero else "> 0"
         raise ValueError(f"Expected {name} {rel} and finite, got {value!r}.")
     return v
 
 
-def broadcast_batch(*arrays_and_tails: tuple[np.ndarray, int]) -> tuple[int, ...]:
-    """Broadcast the batch parts of several arrays; ``(array, n_core_dims)`` pairs.
+def check_int(value: object, name: str, *, low: int | None = None, high: int | None = None) -> int:
+    """Validate an integer option (bool and non-integral floats rejected); return it as an int."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Integral):
+        raise ValueError(f"Expected {name} to be an integer, got {type(value).__name__}.")
+    v = int(value)
+    if (low is not None and v < low) or (high is not None and v > high):
+        lo = "-inf" if low is None else str(low)
+        hi = "inf" if high is None else str(high)
+        raise ValueError(f"Expected {name} to be an integer in [{lo}, {hi}], got {v}.")
+    return v
 
-    Returns the common batch shape, or raises ``ValueError`` naming the shapes.
+
+def check_bool(value: object, name: str) -> bool:
+    """Validate a flag: only ``True``/``False`` (or NumPy bools); ``"yes"``, 1, None are rejected."""
+    if not isinstance(value, bool | np.bool_):
+        raise ValueError(f"Expected {name} to be True or False, got {value!r}.")
+    return bool(value)
+
+
+def check_choice(value: object, name: str, choices: Iterable[object]) -> object:
+    """Validate that ``value`` is one of ``choices`` (compared with ==, hashable types only)."""
+    options = tuple(choices)
+    try:
+        ok = any(type(value) is type(c) and value == c for c in options)
+    except (TypeError, ValueError):  # an uncomparable value (e.g. an array) is not one of the choices
+        ok = False
+    if not ok:
+        raise ValueError(f"Expected {name} to be one of {', '.join(map(repr, options))}; got {value!r}.")
+    return value
+
+
+def coerce_float_fields(
+    obj: object,
+    names: Iterable[str],
+    *,
+    positive: bool = False,
+    allow_zero: bool = False,
+    prefix: str = "",
+) -> None:
+    """Validate the named fields of a frozen dataclass as real finite scalars and store them as float.
+
+    ``positive`` requires > 0 (or >= 0 with ``allow_zero``).  Raises ``ValueError`` naming the field
+    (``prefix`` is prepended, e.g. ``"lower[0]."``).
     """
-    shapes = [a.shape[: a.ndim - k] for a, k in arrays_and_tails]
+    for n in names:
+        v = getattr(obj, n)
+        label = prefix + n
+        f = check_positive(v, label, allow_zero=allow_zero) if positive else check_real(v, label)
+        object.__setattr__(obj, n, f)
+
+
+def coerce_int_fields(
+    obj: object, names: Iterable[str], *, low: int | None = None, high: int | None = None, prefix: str = ""
+) -> None:
+    """Validate the named fields of a frozen dataclass as integers (bool rejected); store them as int."""
+    for n in names:
+        object.__setattr__(obj, n, check_int(getattr(obj, n), prefix + n, low=low, high=high))
+
+
+def broadcast_batch(*arrays_and_tails: tuple) -> tuple[int, ...]:
+    """Broadcast the batch parts of several arrays: ``(array, n_core_dims)`` or
+    ``(array, n_core_dims, name)`` triples.
+
+    Returns the common batch shape, or raises ``ValueError`` naming the arguments and their shapes.
+    """
+    shapes = [t[0].shape[: t[0].ndim - t[1]] for t in arrays_and_tails]
     try:
         return tuple(np.broadcast_shapes(*shapes))
     except ValueError as exc:
-        raise ValueError(f"Batch shapes do not broadcast: {shapes}.") from exc
+        names = [t[2] if len(t) > 2 else f"argument {i + 1}" for i, t in enumerate(arrays_and_tails)]
+        parts = ", ".join(f"{n} {s}" for n, s in zip(names, shapes, strict=True))
+        raise ValueError(f"Expected batch shapes that broadcast together, got {parts}.") from exc

@@ -10,6 +10,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from robomech._validation import as_array, check_positive
 from robomech.spatial import inverse_transform, vee_se3
 
 __all__ = ["numerical_hessian", "numerical_jacobian", "numerical_space_jacobian"]
@@ -19,6 +20,11 @@ FD_STEP = 6e-6
 # The Hessian differences the analytic Jacobian once, so the same optimal step applies.
 
 
+def _check_callable(f: object, name: str) -> None:
+    if not callable(f):
+        raise ValueError(f"Expected {name} to be a callable, got {type(f).__name__}.")
+
+
 def numerical_jacobian(
     f: Callable[[np.ndarray], np.ndarray], x: np.ndarray, h: float = FD_STEP
 ) -> np.ndarray:
@@ -26,7 +32,9 @@ def numerical_jacobian(
 
     ``f`` must be batched: ``f(x (..., n)) -> (..., *out)``.
     """
-    x = np.asarray(x, dtype=float)
+    _check_callable(f, "f")
+    x = as_array(x, "x", (None,), min_ndim=1)
+    h = check_positive(h, "h")
     n = x.shape[-1]
     cols = []
     for k in range(n):
@@ -40,6 +48,7 @@ def numerical_hessian(
     jac: Callable[[np.ndarray], np.ndarray], x: np.ndarray, h: float = FD_STEP
 ) -> np.ndarray:
     """Central differences of an analytic Jacobian ``jac(x) -> (..., m, n)``: ``(..., m, n, n)``."""
+    _check_callable(jac, "jac")
     return numerical_jacobian(jac, x, h)
 
 
@@ -47,7 +56,8 @@ def numerical_space_jacobian(
     fk: Callable[[np.ndarray], np.ndarray], q: np.ndarray, h: float = FD_STEP
 ) -> np.ndarray:
     """Space Jacobian of a pose map ``fk(q) -> T (..., 4, 4)``: column k is ``vee(dT/dq_k T^-1)``."""
-    q = np.asarray(q, dtype=float)
+    _check_callable(fk, "fk")
+    q = as_array(q, "q", (None,), min_ndim=1)
     T_inv = inverse_transform(fk(q))
     dT = numerical_jacobian(fk, q, h)  # (..., 4, 4, n)
     return vee_se3(np.einsum("...abk,...bc->...kac", dT, T_inv)).swapaxes(-1, -2)

@@ -85,7 +85,7 @@ def test_bad_input_names_the_argument():
     with pytest.raises(ValueError, match="chains"):
         mobility.analyze([])
     with pytest.raises(ValueError, match=r"chains\[1\]"):
-        mobility.analyze([np.zeros((2, 6)), np.zeros((2, 5))])
+        mobility.analyze([CHAINS["3-RPS"][0], np.zeros((2, 5))])
     with pytest.raises(ValueError, match=r"chains\[0\]"):
         mobility.analyze([np.full((2, 6), np.nan)])
     with pytest.raises(ValueError, match="length_scale"):

@@ -8,7 +8,8 @@ row n has the residual norm.  Systems are processed in blocks of :data:`BLOCK` w
 innermost (``W[column, row, system]``): every loop of the algorithm then runs over contiguous systems
 and vectorises (SIMD), and blocks run in parallel.  The arithmetic of each system is exactly that of
 the one-system algorithm.  ``benchmarks/bench_core.py`` keeps the evidence (docs/performance.md).
-Compilation is cached on disk (``cache=True``); numba is imported on first use only, never at
+Compilation is cached on disk (``cache=True``, in ``robomech._numba.cache_dir()``, not in the
+installed package); numba is imported on first use only, never at
 ``import robomech``.
 """
 
@@ -36,7 +37,9 @@ _FASTMATH = {"reassoc", "contract", "nsz"}
 
 @functools.cache
 def _kernel():
-    import numba  # deferred: ~0.3 s import, paid only by users of the batched solver
+    from robomech._numba import import_numba
+
+    numba = import_numba()  # deferred: ~0.3 s import, paid only by users of the batched solver
 
     @numba.njit(parallel=True, cache=True, fastmath=_FASTMATH)
     def kernel(A, b, x, resid, cond1, ok, R_out, want_R):  # pragma: no cover - compiled

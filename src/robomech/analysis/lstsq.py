@@ -1,8 +1,10 @@
-"""Batched linear least squares by Householder QR (LAPACK), with per-system diagnostics.
+"""Batched linear least squares by Householder QR (a compiled numba kernel), with per-system diagnostics.
 
 ``solve(A, b)`` handles stacks ``A (..., m, n)``, ``b (..., m)`` with ``m >= n``.  Every system is
 solved independently; a rank-deficient or non-finite system is flagged in the result and never
-aborts the batch.  ``solve_normal_equations`` is the textbook alternative kept for comparison: it
+aborts the batch.  The QR is robomech's own compiled kernel (``_householder.py``: LAPACK's ``dgeqr2``
+algorithm, not a LAPACK call); LAPACK's SVD is used only for the rank-deficient systems.
+``solve_normal_equations`` is the textbook alternative kept for comparison: it
 squares the condition number (``cond(A^T A) = cond(A)^2``), which is what paper 4 means by choosing
 QR.
 """
@@ -13,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, broadcast_batch, check_bool, check_int, finite_samples
 
 __all__ = ["RANK_RTOL_FACTOR", "LstsqResult", "rank_cond_limit", "solve", "solve_normal_equations"]
 
@@ -27,8 +29,14 @@ RANK_RTOL_FACTOR = 10.0
 class LstsqResult:
     """Per-system solution and diagnostics (batch shape ``...``).
 
-    ``x (..., n)`` is NaN exactly where ``ok`` is false (non-finite input); for rank-deficient
-    systems it is the minimum-norm solution and ``full_rank`` is false.
+    ``x (..., n)`` and ``residual_norm`` are NaN exactly where ``ok`` is false: non-finite input, or
+    a finite system whose solution or residual overflows float64.  For rank-deficient systems ``x``
+    is the minimum-norm solution and ``full_rank`` is false.
+
+    ``cond`` is the condition number of the triangular factor R of ``A = QR`` in the **1-norm**,
+    ``||R||_1 ||R^-1||_1`` (it equals that of A in the 2-norm within a factor n; ``solve(...,
+    exact_cond=True)`` gives the 2-norm condition number instead; ``solve_normal_equations`` gives
+    the 2-norm one of A from the normal matrix).
     """
 
     x: np.ndarray
@@ -45,6 +53,7 @@ def _validate(A: object, b: object) -> tuple[np.ndarray, np.ndarray]:
     if m < n:
         raise ValueError(f"Expected A to have at least as many rows as columns (m >= n), got {A.shape}.")
     b = as_array(b, "b", (m,), finite=False)
+    broadcast_batch((A, 2, "A"), (b, 1, "b"))
     return A, b
 
 
@@ -55,20 +64,25 @@ def solve(A: object, b: object, *, exact_cond: bool = False) -> LstsqResult:
     of LAPACK's ``dgeqr2``, compiled and run in parallel over the batch: see ``_householder.py``), so
     ``x = R^-1 c`` and the residual norm is ``|r|``.
 
-    ``cond`` is the exact 1-norm condition number of R (within a factor n of the 2-norm condition
-    number of A) unless ``exact_cond=True``, which computes the 2-norm one from the singular values
-    of R.  A system whose condition exceeds :func:`rank_cond_limit` is rank deficient: its rank comes
-    from the SVD and ``x`` is the minimum-norm solution.
+    ``cond`` is the exact 1-norm condition number ``||R||_1 ||R^-1||_1`` of R (within a factor n of
+    the 2-norm condition number of A) unless ``exact_cond=True``, which computes the 2-norm one from
+    the singular values of R.  A system whose condition exceeds :func:`rank_cond_limit` is rank
+    deficient: its rank comes from the SVD and ``x`` is the minimum-norm solution.
     """
     from ._householder import householder_lstsq
 
+    # A bool check, not truthiness: any other object would also compile a new kernel specialisation.
+    exact_cond = check_bool(exact_cond, "exact_cond")
     A, b = _validate(A, b)
     m, n = A.shape[-2:]
     batch = np.broadcast_shapes(A.shape[:-2], b.shape[:-1])
     Af = np.broadcast_to(A, (*batch, m, n)).reshape(-1, m, n)
     bf = np.broadcast_to(b, (*batch, m)).reshape(-1, m)
     x, resid, cond, finite, R = householder_lstsq(Af, bf, exact_cond)
+    # A finite system can still overflow (entries ~1e200): its solution is then not a number either.
+    finite = finite & finite_samples(x, 1) & np.isfinite(resid)
     if exact_cond:
+        R = np.where(finite[:, None, None], R, np.eye(n))
         sv = np.linalg.svd(R, compute_uv=False)
         cond = np.where(sv[:, -1] > 0, sv[:, 0] / np.where(sv[:, -1] > 0, sv[:, -1], 1.0), np.inf)
     full = finite & (cond <= rank_cond_limit(m, n))
@@ -83,11 +97,13 @@ def solve(A: object, b: object, *, exact_cond: bool = False) -> LstsqResult:
         xd = np.einsum("kij,kj->ki", np.linalg.pinv(Ad, rcond=tol[:, 0] / sv[:, 0]), bd)
         x[deficient] = xd
         resid[deficient] = np.linalg.norm(np.einsum("kij,kj->ki", Ad, xd) - bd, axis=-1)
+        finite = finite & finite_samples(x, 1) & np.isfinite(resid)
+        full &= finite
     nan = np.nan
     return LstsqResult(
         x=np.where(finite[:, None], x, nan).reshape(*batch, n),
         residual_norm=np.where(finite, resid, nan).reshape(batch),
-        rank=rank.reshape(batch),
+        rank=np.where(finite, rank, 0).reshape(batch),
         cond=np.where(finite, cond, nan).reshape(batch),
         full_rank=full.reshape(batch),
         ok=finite.reshape(batch),
@@ -96,6 +112,8 @@ def solve(A: object, b: object, *, exact_cond: bool = False) -> LstsqResult:
 
 def rank_cond_limit(m: int, n: int) -> float:
     """Condition number above which a system counts as rank deficient: ``1 / (10 max(m, n) eps)``."""
+    m = check_int(m, "m", low=1)
+    n = check_int(n, "n", low=1)
     return 1.0 / (RANK_RTOL_FACTOR * max(m, n) * np.finfo(float).eps)
 
 
@@ -113,8 +131,16 @@ def solve_normal_equations(A: object, b: object) -> LstsqResult:
     finite = np.all(np.isfinite(A), axis=(-1, -2)) & np.all(np.isfinite(b), axis=-1)
     safe_A = np.where(finite[..., None, None], A, np.eye(m, n))
     safe_b = np.where(finite[..., None], b, 0.0)
-    AtA = np.einsum("...mi,...mj->...ij", safe_A, safe_A)
-    Atb = np.einsum("...mi,...m->...i", safe_A, safe_b)
+    with np.errstate(over="ignore", invalid="ignore"):
+        AtA = np.einsum("...mi,...mj->...ij", safe_A, safe_A)
+        Atb = np.einsum("...mi,...m->...i", safe_A, safe_b)
+    # Squaring overflows for entries beyond ~1e154 (the normal equations' defect): such a system is
+    # flagged, never handed to LAPACK (an SVD of inf raises for the whole batch).
+    finite = finite & finite_samples(AtA, 2) & finite_samples(Atb, 1)
+    AtA = np.where(finite[..., None, None], AtA, np.eye(n))
+    Atb = np.where(finite[..., None], Atb, 0.0)
+    safe_A = np.where(finite[..., None, None], safe_A, np.eye(m, n))
+    safe_b = np.where(finite[..., None], safe_b, 0.0)
     sv = np.linalg.svd(AtA, compute_uv=False)
     tol = RANK_RTOL_FACTOR * n * np.finfo(float).eps * sv[..., 0]
     rank = np.sum(sv > tol[..., None], axis=-1)
@@ -124,7 +150,9 @@ def solve_normal_equations(A: object, b: object) -> LstsqResult:
         x[full] = np.linalg.solve(AtA[full], Atb[full][..., None])[..., 0]
     if not np.all(full):
         x[~full] = np.einsum("...ij,...j->...i", np.linalg.pinv(AtA[~full]), Atb[~full])
-    resid = np.linalg.norm(np.einsum("...ij,...j->...i", safe_A, x) - safe_b, axis=-1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        resid = np.linalg.norm(np.einsum("...ij,...j->...i", safe_A, x) - safe_b, axis=-1)
+    finite = finite & finite_samples(x, 1) & np.isfinite(resid)
     cond = np.sqrt(
         np.where(sv[..., -1] > 0, sv[..., 0] / np.where(sv[..., -1] > 0, sv[..., -1], 1.0), np.inf)
     )

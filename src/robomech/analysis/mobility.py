@@ -20,14 +20,25 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_real
 
-__all__ = ["RANK_RTOL", "ChainScrews", "MobilityResult", "analyze", "constraint_wrenches", "reciprocal_basis"]
+__all__ = [
+    "RANK_RTOL",
+    "UNIT_SCREW_ATOL",
+    "ChainScrews", "MobilityResult", "analyze", "constraint_wrenches", "reciprocal_basis",
+]
 
 # Singular values below RANK_RTOL * max(1, sigma_max) count as zero.  Unit screws of a mechanism of
 # size ~1 have entries of order one; rounding in their construction leaves ~1e-15, while a
 # genuinely independent direction of a non-degenerate mechanism is far above 1e-9.
 RANK_RTOL = 1e-9
+
+# analyze() takes *unit* joint screws: |w| = 1 (revolute/helical) or w = 0 and |v| = 1 (prismatic, in
+# units of length_scale),
+# within this tolerance (screws built in float64 are unit to ~1e-15; a value read with 6 digits to
+# ~1e-6).  The check also catches a chain passed transposed, (6, n) instead of (n, 6), whose rows are
+# then not unit screws.
+UNIT_SCREW_ATOL = 1e-5
 
 _DELTA = np.block([[np.zeros((3, 3)), np.eye(3)], [np.eye(3), np.zeros((3, 3))]])
 
@@ -51,9 +62,15 @@ def _null_basis(X: np.ndarray, tol: float) -> np.ndarray:
     return Vt[r:]
 
 
+def _check_tol(tol: object) -> float:
+    # A relative rank tolerance: NaN would make every singular value "zero" (DOF 6 for anything).
+    return check_real(tol, "tol", low=0.0, high=1.0, low_open=True, high_open=True)
+
+
 def reciprocal_basis(screws: object, *, tol: float = RANK_RTOL) -> np.ndarray:
     """Basis (k, 6) of the screws (axis-moment order) reciprocal to every row of ``screws (m, 6)``."""
     S = as_array(screws, "screws", (None, 6))
+    tol = _check_tol(tol)
     if S.ndim != 2:
         raise ValueError(f"Expected screws to have shape (m, 6), got {S.shape}.")
     return _null_basis(S @ _DELTA, tol) if S.shape[0] else np.eye(6)
@@ -62,6 +79,7 @@ def reciprocal_basis(screws: object, *, tol: float = RANK_RTOL) -> np.ndarray:
 def constraint_wrenches(twists: object, *, tol: float = RANK_RTOL) -> np.ndarray:
     """Basis (k, 6) of the wrenches ``[m; f]`` that do no work on any row of ``twists (m, 6)``."""
     S = as_array(twists, "twists", (None, 6))
+    tol = _check_tol(tol)
     if S.ndim != 2:
         raise ValueError(f"Expected twists to have shape (m, 6), got {S.shape}.")
     return _null_basis(S, tol) if S.shape[0] else np.eye(6)
@@ -87,6 +105,12 @@ class MobilityResult:
     redundant_constraints: int  # nu: constraints beyond the common ones that repeat others
     gruebler_kutzbach: int  # 6(n - g - 1) + sum f, the spatial count
     modified_gruebler_kutzbach: int  # (6 - lambda)(n - g - 1) + sum f + nu
+    # True when the screw-theory DOF disagrees with the modified Grübler–Kutzbach count computed from
+    # the same constraint systems: the configuration is singular (the rank of the constraint system
+    # is not locally constant, e.g. the vectored thruster on its rank-1 curve), and ``dof`` holds only
+    # at this instant, not in a neighbourhood.
+    singular: bool = False
+    warning: str = ""  # why ``singular`` is set, empty otherwise
 
     def summary(self) -> str:
         return (
@@ -112,10 +136,15 @@ def analyze(chains: Sequence[object], *, length_scale: float = 1.0, tol: float =
     mechanism's radius in the units used).  The Grübler–Kutzbach counts assume each chain is a serial
     chain of one-DOF joints from base to platform (a universal joint is two screws, a spherical three).
     """
+    if isinstance(chains, np.ndarray) or not isinstance(chains, Sequence) or isinstance(chains, str):
+        raise ValueError(
+            "Expected chains to be a sequence (list or tuple) of (n_i, 6) arrays of joint screws, "
+            f"got {type(chains).__name__}."
+        )
     if len(chains) == 0:
         raise ValueError("Expected chains to hold at least one (n_i, 6) array of joint screws, got none.")
-    if not (np.isfinite(length_scale) and length_scale > 0):
-        raise ValueError(f"Expected length_scale > 0, got {length_scale!r}.")
+    length_scale = check_real(length_scale, "length_scale", low=0.0, low_open=True)
+    tol = _check_tol(tol)
     scale = np.array([1, 1, 1, 1 / length_scale, 1 / length_scale, 1 / length_scale])
     per_chain = []
     for i, c in enumerate(chains):
@@ -123,6 +152,16 @@ def analyze(chains: Sequence[object], *, length_scale: float = 1.0, tol: float =
         if S.ndim != 2 or S.shape[0] == 0:
             raise ValueError(f"Expected chains[{i}] to have shape (n_i, 6) with n_i >= 1, got {S.shape}.")
         S = S * scale
+        w = np.linalg.norm(S[:, :3], axis=1)
+        v = np.linalg.norm(S[:, 3:], axis=1)
+        unit = np.where(w > UNIT_SCREW_ATOL, np.abs(w - 1.0), np.abs(v - 1.0)) <= UNIT_SCREW_ATOL
+        if not np.all(unit):
+            raise ValueError(
+                f"Expected chains[{i}] to hold unit joint screws as rows, shape (n_i, 6) "
+                f"(|w| = 1, or w = 0 and |v| = length_scale), got rows "
+                f"{np.flatnonzero(~unit).tolist()} of shape "
+                f"{S.shape} that are not (a chain passed transposed?)."
+            )
         twists = _row_basis(S, tol)
         constraints = _null_basis(S, tol)
         per_chain.append(ChainScrews(twists=twists, constraints=constraints))
@@ -139,6 +178,15 @@ def analyze(chains: Sequence[object], *, length_scale: float = 1.0, tol: float =
     n_joints = sum(np.asarray(c).shape[0] for c in chains)
     n_links = 2 + sum(np.asarray(c).shape[0] - 1 for c in chains)
     loops = n_links - n_joints - 1
+    modified = (6 - lam) * loops + n_joints + nu
+    singular = dof != modified
+    warning = (
+        f"singular configuration: the screw-theory DOF {dof} differs from the modified "
+        f"Grübler–Kutzbach count {modified}; the rank of the constraint system is not locally "
+        "constant here, so the DOF holds at this instant only"
+        if singular
+        else ""
+    )
     return MobilityResult(
         dof=dof,
         platform_twists=platform / scale,
@@ -149,5 +197,7 @@ def analyze(chains: Sequence[object], *, length_scale: float = 1.0, tol: float =
         common_constraints=lam,
         redundant_constraints=nu,
         gruebler_kutzbach=6 * loops + n_joints,
-        modified_gruebler_kutzbach=(6 - lam) * loops + n_joints + nu,
+        modified_gruebler_kutzbach=modified,
+        singular=singular,
+        warning=warning,
     )

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from robomech._validation import as_array
-from robomech.spatial import ad, adjoint, exp_se3
+from robomech._validation import as_array, broadcast_batch
+from robomech.spatial._se3 import _exp_se3, ad, adjoint
 
 __all__ = [
     "hessian_body",
@@ -26,18 +26,20 @@ def _check(screws: object, q: object, name: str = "screws") -> tuple[np.ndarray,
     qa = as_array(q, "q", (None,), min_ndim=1)
     if qa.shape[-1] != S.shape[-2]:
         raise ValueError(f"Expected q to have shape (..., {S.shape[-2]}) to match {name}, got {qa.shape}.")
+    broadcast_batch((S, 2, name), (qa, 1, "q"))
     return S, qa
 
 
 def _joint_exps(S: np.ndarray, q: np.ndarray) -> np.ndarray:
     """exp([S_i] q_i) for every joint: (..., n, 4, 4)."""
-    return exp_se3(S * q[..., None])
+    return _exp_se3(S * q[..., None])
 
 
 def poe_fk(M: object, screws: object, q: object) -> np.ndarray:
     """Space-form product of exponentials ``T = exp([S1]q1) ... exp([Sn]qn) M`` -> (..., 4, 4)."""
     M = as_array(M, "M", (4, 4))
     S, qa = _check(screws, q)
+    broadcast_batch((M, 2, "M"), (S, 2, "screws"), (qa, 1, "q"))
     E = _joint_exps(S, qa)
     T = np.broadcast_to(np.eye(4), (*E.shape[:-3], 4, 4))
     for i in range(E.shape[-3]):
@@ -65,7 +67,7 @@ def jacobian_body(body_screws: object, q: object) -> np.ndarray:
     Column i is ``Ad(exp(-[Bn]qn)...exp(-[B_{i+1}]q_{i+1})) B_i``.
     """
     B, qa = _check(body_screws, q, "body_screws")
-    E = exp_se3(-B * qa[..., None])
+    E = _exp_se3(-B * qa[..., None])
     n = B.shape[-2]
     batch = np.broadcast_shapes(B.shape[:-2], qa.shape[:-1])
     J = np.empty((*batch, 6, n))
@@ -117,4 +119,9 @@ def jacobian_derivative(H: np.ndarray, qd: np.ndarray) -> np.ndarray:
     ``H (..., m, n, n)`` and ``qd (..., n)`` broadcast over their batch dimensions; for a stack of
     bodies ``H (..., B, 6, n, n)`` pass ``qd[..., None, :]``.
     """
+    H = as_array(H, "H", (None, None, None))
+    if H.shape[-1] != H.shape[-2]:
+        raise ValueError(f"Expected H to have shape (..., m, n, n), got {H.shape}.")
+    qd = as_array(qd, "qd", (H.shape[-1],), min_ndim=1)
+    broadcast_batch((H, 3, "H"), (qd, 1, "qd"))
     return np.einsum("...ijk,...k->...ij", H, qd)

@@ -4,17 +4,27 @@ from __future__ import annotations
 
 import numpy as np
 
+from robomech._validation import as_array
+
 __all__ = ["exp_so3", "hat", "log_so3", "rot_x", "rot_y", "rot_z", "sincos", "vee"]
 
 # Below this angle the closed forms sin(t)/t, (1-cos t)/t^2 ... are replaced by their Taylor series:
 # the series truncated after the t^4 term has error O(t^6) < 1e-24 at t = 1e-4, while the closed forms
 # lose about eps/t^2 ~ 1e-8 relative accuracy there through cancellation.
 SMALL_ANGLE = 1e-4
+# log_so3 accepts R only if |R^T R - I| and |det R - 1| are below this: a rotation composed from a
+# few hundred float64 products stays within ~1e-13, a matrix read from a text file with 6 digits
+# within ~1e-6; anything further is not a rotation and its "logarithm" would be meaningless.
+ROTATION_ATOL = 1e-5
 
 
 def hat(w: np.ndarray) -> np.ndarray:
     """Skew-symmetric matrix of ``w`` (..., 3) -> (..., 3, 3), so that ``hat(a) @ b == cross(a, b)``."""
-    w = np.asarray(w, dtype=float)
+    w = as_array(w, "w", (3,))
+    return _hat(w)
+
+
+def _hat(w: np.ndarray) -> np.ndarray:
     z = np.zeros_like(w[..., 0])
     return np.stack(
         [
@@ -28,7 +38,11 @@ def hat(w: np.ndarray) -> np.ndarray:
 
 def vee(W: np.ndarray) -> np.ndarray:
     """Inverse of :func:`hat` (uses the antisymmetric part): (..., 3, 3) -> (..., 3)."""
-    W = np.asarray(W, dtype=float)
+    W = as_array(W, "W", (3, 3))
+    return _vee(W)
+
+
+def _vee(W: np.ndarray) -> np.ndarray:
     return 0.5 * np.stack(
         [W[..., 2, 1] - W[..., 1, 2], W[..., 0, 2] - W[..., 2, 0], W[..., 1, 0] - W[..., 0, 1]], -1
     )
@@ -47,10 +61,13 @@ def _series_coeffs(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarra
 
 def exp_so3(w: np.ndarray) -> np.ndarray:
     """Rotation matrix ``exp(hat(w))`` of the rotation vector ``w`` (..., 3) (Rodrigues)."""
-    w = np.asarray(w, dtype=float)
+    return _exp_so3(as_array(w, "w", (3,)))
+
+
+def _exp_so3(w: np.ndarray) -> np.ndarray:
     theta = np.linalg.norm(w, axis=-1)
     A, B, _ = _series_coeffs(theta)
-    W = hat(w)
+    W = _hat(w)
     return np.eye(3) + A[..., None, None] * W + B[..., None, None] * (W @ W)
 
 
@@ -62,8 +79,20 @@ def log_so3(R: np.ndarray) -> np.ndarray:
     part ``(R + R^T)/2 - cos t I = (1 - cos t) u u^T`` (the antisymmetric part vanishes at pi), with
     the sign taken from the antisymmetric part.
     """
-    R = np.asarray(R, dtype=float)
-    s_vec = vee(R)  # = sin(t) u
+    R = as_array(R, "R", (3, 3))
+    err = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-2, -1), initial=0.0)
+    det_err = np.abs(np.linalg.det(R) - 1.0) if R.size else np.zeros(R.shape[:-2])
+    if np.any(err > ROTATION_ATOL) or np.any(det_err > ROTATION_ATOL):
+        worst = float(max(np.max(err, initial=0.0), np.max(det_err, initial=0.0)))
+        raise ValueError(
+            f"Expected R to be rotation matrices (R^T R = I, det R = 1 within {ROTATION_ATOL}), "
+            f"got a deviation of {worst:.3g}."
+        )
+    return _log_so3(R)
+
+
+def _log_so3(R: np.ndarray) -> np.ndarray:
+    s_vec = _vee(R)  # = sin(t) u
     sin_t = np.linalg.norm(s_vec, axis=-1)
     cos_t = 0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0)
     theta = np.arctan2(sin_t, cos_t)
@@ -93,15 +122,19 @@ def sincos(angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     machines about 3.5x faster than the two calls, whose float64 kernels are not vectorised
     (docs/performance.md).  Finite at odd multiples of pi, where ``t`` is ~1e16: ``c = -1``.
     """
-    t = np.tan(0.5 * np.asarray(angle, dtype=float))
+    return _sincos(as_array(angle, "angle"))
+
+
+def _sincos(angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    t = np.tan(0.5 * angle)
     t2 = t * t
     d = 1.0 / (1.0 + t2)
     return 2.0 * t * d, (1.0 - t2) * d
 
 
 def _rot(angle: np.ndarray, i: int, j: int) -> np.ndarray:
-    a = np.asarray(angle, dtype=float)
-    s, c = sincos(a)
+    a = as_array(angle, "angle")
+    s, c = _sincos(a)
     R = np.zeros((*a.shape, 3, 3))
     k = 3 - i - j
     R[..., k, k] = 1.0

@@ -32,6 +32,8 @@ def available_studies() -> dict[str, Study]:
 
 def get_study(name: str) -> Study:
     studies = available_studies()
-    if name not in studies:
-        raise ValueError(f"Unknown study {name!r}; valid studies are: {', '.join(studies)}.")
+    if not isinstance(name, str) or name not in studies:
+        raise ValueError(
+            f"Expected name to be a registered study, got {name!r}; valid studies are: {', '.join(studies)}."
+        )
     return studies[name]

@@ -10,6 +10,7 @@ edit anywhere else.
 from __future__ import annotations
 
 import math
+import numbers
 import sys
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
@@ -90,6 +91,19 @@ def comparison_table(
     ``rows`` are ``(quantity, printed, robomech, unit)``; ``printed`` may be ``None`` where the paper
     gives no number.
     """
+    if not isinstance(title, str):
+        raise ValueError(f"Expected title to be a str, got {type(title).__name__}.")
+    if isinstance(rows, str) or not isinstance(rows, Iterable):
+        raise ValueError(f"Expected rows to be an iterable of 4-tuples, got {rows!r}.")
+    rows = list(rows)
+    for i, row in enumerate(rows):
+        if not isinstance(row, tuple | list) or len(row) != 4:
+            raise ValueError(f"Expected rows[{i}] to be (quantity, printed, robomech, unit), got {row!r}.")
+        for value, what in ((row[1], "printed"), (row[2], "robomech")):
+            if (value is not None or what == "robomech") and (
+                isinstance(value, bool) or not isinstance(value, numbers.Real)
+            ):
+                raise ValueError(f"Expected rows[{i}] {what} value to be a real number, got {value!r}.")
     out = []
     for quantity, printed, ours, unit in rows:
         if printed is None or not math.isfinite(float(printed)):

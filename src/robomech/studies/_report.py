@@ -5,9 +5,12 @@ from __future__ import annotations
 import html
 import json
 import math
+import os
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
+
+from robomech._validation import check_params, check_real
 
 from ._core import StudyResult, Table, to_jsonable
 
@@ -63,8 +66,16 @@ def _paragraphs_html(text: str) -> str:
     return "".join(f"<p>{html.escape(p.strip())}</p>" for p in text.split("\n\n") if p.strip())
 
 
+def _as_path(p: object, name: str) -> Path:
+    if not isinstance(p, str | os.PathLike) or str(p) == "":
+        raise ValueError(f"Expected {name} to be a non-empty path, got {p!r}.")
+    return Path(p)
+
+
 def write_study_report(result: StudyResult, out_dir: Path) -> dict[str, Path]:
     """Write ``report.md``, ``report.html`` and ``results.json`` into ``out_dir``."""
+    check_params(result, StudyResult, "result")
+    out_dir = _as_path(out_dir, "out_dir")
     out_dir.mkdir(parents=True, exist_ok=True)
     md = [f"# {result.title}", "", f"*Source:* {result.source}", ""]
     if result.summary:
@@ -113,6 +124,13 @@ def write_study_report(result: StudyResult, out_dir: Path) -> dict[str, Path]:
 
 def write_index(out_root: Path, entries: Sequence[tuple[StudyResult, float]]) -> Path:
     """``index.md`` and ``index.html`` linking every study report, with run times."""
+    out_root = _as_path(out_root, "out_root")
+    if not isinstance(entries, Sequence) or isinstance(entries, str):
+        raise ValueError(f"Expected entries to be a sequence of (StudyResult, seconds), got {entries!r}.")
+    for i, entry in enumerate(entries):
+        if not (isinstance(entry, tuple) and len(entry) == 2 and isinstance(entry[0], StudyResult)):
+            raise ValueError(f"Expected entries[{i}] to be a (StudyResult, seconds) pair, got {entry!r}.")
+        check_real(entry[1], f"entries[{i}] seconds", low=0.0)
     md = [
         "# robomech — paper reproductions",
         "",

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_positive
+from robomech._validation import as_array, broadcast_batch, check_positive
 
 __all__ = ["Profile", "polynomial", "quintic", "sinusoid", "swing_sextic"]
 
@@ -35,6 +35,13 @@ def polynomial(t: object, coeffs: object) -> Profile:
     """``sum_k c_k t^k`` with ``coeffs (..., K)`` lowest order first, and its two derivatives."""
     t = as_array(t, "t")
     c = as_array(coeffs, "coeffs", (None,))
+    if c.shape[-1] == 0:
+        raise ValueError("Expected coeffs to have shape (..., K) with K >= 1, got K = 0.")
+    broadcast_batch((t, 0, "t"), (c, 1, "coeffs"))
+    return _polynomial(t, c)
+
+
+def _polynomial(t: np.ndarray, c: np.ndarray) -> Profile:
     k = np.arange(c.shape[-1])
     tt = t[..., None]
     pw = lambda e: np.where(e >= 0, tt ** np.maximum(e, 0), 0.0)  # noqa: E731
@@ -44,13 +51,14 @@ def polynomial(t: object, coeffs: object) -> Profile:
     return Profile(q, qd, qdd)
 
 
-def _normalised(t: object, duration: float, coeffs: np.ndarray, scale: object) -> Profile:
+def _normalised(t: object, duration: float, coeffs: np.ndarray, scale: np.ndarray, name: str) -> Profile:
     T = check_positive(duration, "duration")
     t = as_array(t, "t")
+    broadcast_batch((t, 0, "t"), (scale, 0, name))
     s = np.clip(t / T, 0.0, 1.0)
     inside = (t >= 0.0) & (t <= T)
-    p = polynomial(s, coeffs)
-    a = np.asarray(scale, dtype=float)
+    p = _polynomial(s, coeffs)
+    a = scale
     return Profile(a * p.q, a * np.where(inside, p.qd, 0.0) / T, a * np.where(inside, p.qdd, 0.0) / T**2)
 
 
@@ -60,14 +68,16 @@ _SWING = np.array([0.0, 0.0, 0.0, 64.0, -192.0, 192.0, -64.0])
 
 def quintic(t: object, duration: float, start: object = 0.0, end: object = 1.0) -> Profile:
     """Rest-to-rest quintic from ``start`` to ``end`` over ``duration`` (held constant outside)."""
-    start = np.asarray(start, dtype=float)
-    p = _normalised(t, duration, _QUINTIC, np.asarray(end, dtype=float) - start)
+    start = as_array(start, "start")
+    end = as_array(end, "end")
+    broadcast_batch((start, 0, "start"), (end, 0, "end"))
+    p = _normalised(t, duration, _QUINTIC, end - start, "end")
     return Profile(start + p.q, p.qd, p.qdd)
 
 
 def swing_sextic(t: object, duration: float, height: object = 1.0) -> Profile:
     """Swing sextic 0 -> ``height`` -> 0 over ``duration`` (paper 2, eq. (53) Z), at rest at both ends."""
-    return _normalised(t, duration, _SWING, height)
+    return _normalised(t, duration, _SWING, as_array(height, "height"), "height")
 
 
 def sinusoid(
@@ -75,9 +85,13 @@ def sinusoid(
 ) -> Profile:
     """``offset + amplitude sin(2 pi f t + phase)`` (frequency in Hz)."""
     t = as_array(t, "t")
-    w = 2.0 * np.pi * np.asarray(frequency, dtype=float)
-    arg = w * t + np.asarray(phase, dtype=float)
-    a = np.asarray(amplitude, dtype=float)
-    return Profile(
-        np.asarray(offset, dtype=float) + a * np.sin(arg), a * w * np.cos(arg), -a * w * w * np.sin(arg)
+    a = as_array(amplitude, "amplitude")
+    f = as_array(frequency, "frequency")
+    ph = as_array(phase, "phase")
+    off = as_array(offset, "offset")
+    broadcast_batch(
+        (t, 0, "t"), (a, 0, "amplitude"), (f, 0, "frequency"), (ph, 0, "phase"), (off, 0, "offset")
     )
+    w = 2.0 * np.pi * f
+    arg = w * t + ph
+    return Profile(off + a * np.sin(arg), a * w * np.cos(arg), -a * w * w * np.sin(arg))

@@ -30,11 +30,14 @@ def available_verifications() -> dict[str, Verification]:
 def run_verifications(names: Iterable[str] | None = None) -> VerificationReport:
     """Run the named verifications (all when ``names`` is empty or None)."""
     available = available_verifications()
+    if isinstance(names, str) or not (names is None or isinstance(names, Iterable)):
+        raise ValueError(f"Expected names to be a list of mechanism names or None, got {names!r}.")
     names = list(names or available)
     unknown = [n for n in names if n not in available]
     if unknown:
         raise ValueError(
-            f"Unknown mechanism(s) {', '.join(map(repr, unknown))}; valid ones are: {', '.join(available)}."
+            f"Expected names of registered verifications, got unknown {', '.join(map(repr, unknown))}; "
+            f"valid ones are: {', '.join(available)}."
         )
     report = VerificationReport()
     for n in names:

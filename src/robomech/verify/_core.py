@@ -13,6 +13,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from robomech._validation import check_bool, check_positive
+
 __all__ = ["Check", "Tolerance", "Verification", "VerificationReport"]
 
 
@@ -23,6 +25,12 @@ class Tolerance:
     value: float
     reason: str
     relative: bool = False
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "value", check_positive(self.value, "value"))
+        if not isinstance(self.reason, str) or not self.reason.strip():
+            raise ValueError(f"Expected reason to be a non-empty str (why this value), got {self.reason!r}.")
+        object.__setattr__(self, "relative", check_bool(self.relative, "relative"))
 
 
 @dataclass(frozen=True)

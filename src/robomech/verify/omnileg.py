@@ -27,6 +27,7 @@ import mujoco
 import numpy as np
 
 import robomech.mechanisms.omnileg as ol
+from robomech._validation import as_array, broadcast_batch, check_params
 
 from ._core import Check, Tolerance, Verification
 
@@ -86,6 +87,7 @@ def _kR(k: int) -> np.ndarray:
 
 def build_mjcf(leg: ol.OmniLeg) -> str:
     """MJCF of the whole leg at its home pose (q = 0), from the parameter dataclass."""
+    check_params(leg, ol.OmniLeg, "leg")
     b = leg.bodies
     S = ol.shank_frames(leg)
     r, h = leg.shank_radius, leg.knee_to_crank
@@ -179,6 +181,7 @@ class EngineModel:
 
 
 def build_model(leg: ol.OmniLeg) -> EngineModel:
+    check_params(leg, ol.OmniLeg, "leg")
     m = mujoco.MjModel.from_xml_string(build_mjcf(leg))
     d = mujoco.MjData(m)
     jid = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n) for n in ol.TREE_JOINTS]
@@ -210,8 +213,14 @@ def engine_inverse_dynamics(
     out), then least squares on ``[Sᵀ J_cᵀ] [τ; λ] = τ_tree`` (minimum norm: the thigh's redundant
     closure rows leave λ, not τ, undetermined).
     """
+    check_params(em, EngineModel, "em")
+    check_params(jm, ol.JointMotion, "jm")
     m, d = em.model, em.data
     N = jm.q.shape[0]
+    if foot_force is not None:
+        foot_force = as_array(foot_force, "foot_force", (3,))
+        broadcast_batch((foot_force, 1, "foot_force"), (jm.q, 1, "jm.q"))
+        foot_force = np.broadcast_to(foot_force, (N, 3))
     out = np.empty((N, 3))
     nv = m.nv
     S = np.zeros((3, nv))

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech._validation import check_params, check_positive, check_real
 from robomech.mechanisms.skid_steer import (
     ExplorationRobot,
     body_velocity,
@@ -195,7 +196,12 @@ def simulate(
     icr_x: float = 0.05,
 ) -> GroundTruth:
     """Simulate ``duration`` s sampled at ``rate`` Hz; the right tracks run at ``speed_ratio × v_left``."""
+    check_params(robot, ExplorationRobot, "robot")
+    duration, rate = check_positive(duration, "duration"), check_positive(rate, "rate")
+    v_left, icr_x = check_real(v_left, "v_left"), check_real(icr_x, "icr_x")
+    speed_ratio = check_real(speed_ratio, "speed_ratio")
     terrain = Terrain.uneven() if terrain is None else terrain
+    check_params(terrain, Terrain, "terrain")
     n = round(duration * rate) + 1
     t = np.arange(n) / rate
     v1, v2 = speed_ratio * v_left, v_left
@@ -266,6 +272,8 @@ def run_checks(
     """All checks; ``estimator_robot`` (default: ``robot``) is the geometry the estimator believes."""
     robot = ExplorationRobot.paper() if robot is None else robot
     est = robot if estimator_robot is None else estimator_robot
+    check_params(robot, ExplorationRobot, "robot")
+    check_params(est, ExplorationRobot, "estimator_robot")
     gt = simulate(robot, duration=10.0, rate=200.0)
     name = "skid-steer"
     contact = float(np.max(np.abs(gt.contact_residual)))

@@ -28,6 +28,7 @@ from dataclasses import replace
 import mujoco
 import numpy as np
 
+from robomech._validation import as_array, check_params, check_positive
 from robomech.mechanisms import spherical_leg as sl
 from robomech.spatial import exp_so3
 
@@ -88,6 +89,8 @@ def _quat(R: np.ndarray) -> np.ndarray:
 
 def build_model(leg: sl.SphericalLeg, timestep: float = SIM_TIMESTEP) -> mujoco.MjModel:
     """The MJCF of the mechanism, built from ``leg`` (SI units)."""
+    check_params(leg, sl.SphericalLeg, "leg")
+    timestep = check_positive(timestep, "timestep")
     home = sl.inverse_kinematics(leg, 0.0, 0.0)
     Ip = np.diag(leg.platform_inertia)
     k = leg.spin_ratio
@@ -219,6 +222,10 @@ def inverse_dynamics_engine(
     equality-constraint forces ``J_c^T lambda`` and, on the lead-screw legs, an axial torque on the
     sleeve (the reaction that keeps it from spinning, which the analytic model assumes).
     """
+    check_params(leg, sl.SphericalLeg, "leg")
+    q, qd, qdd = (as_array(v, k, (2,), min_ndim=2) for v, k in ((q, "q"), (qd, "qd"), (qdd, "qdd")))
+    if not (q.ndim == 2 and q.shape == qd.shape == qdd.shape):
+        raise ValueError(f"Expected q, qd, qdd of one shape (n, 2), got {q.shape}, {qd.shape}, {qdd.shape}.")
     m = build_model(leg)
     d = mujoco.MjData(m)
     lay = _Layout(m, leg)
@@ -347,6 +354,8 @@ def forward_simulation(leg: sl.SphericalLeg, analytic: sl.SphericalLeg) -> tuple
 def run_checks(analytic: sl.SphericalLeg | None = None) -> list[Check]:
     """All checks of the paper-1 verification; ``analytic`` (default: the engine's own parameters) is the
     model being verified: pass a deliberately wrong one to see the checks fail."""
+    if analytic is not None:
+        check_params(analytic, sl.SphericalLeg, "analytic")
     leg = sl.SphericalLeg.paper()
     analytic = leg if analytic is None else analytic
     name = "spherical-leg"
@@ -401,6 +410,7 @@ def run_checks(analytic: sl.SphericalLeg | None = None) -> list[Check]:
 
 def study_overlays(leg: sl.SphericalLeg) -> dict:
     """Engine curves for the study's figures: leg accelerations of both sway modes, Fig. 5(b) forces."""
+    check_params(leg, sl.SphericalLeg, "leg")
     t = np.arange(0.0, 30.0, 0.1)
     acc = {}
     for about in ("x", "y"):

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from robomech._validation import as_array, check_bool, check_params, check_real
 from robomech.mechanisms import vectored_thrust as vt
 
 from ._core import Check, Tolerance, Verification
@@ -56,6 +57,9 @@ def table1_trajectory(
     t: np.ndarray, amplitude: float = np.pi / 4, omega: float = 1.0
 ) -> tuple[np.ndarray, ...]:
     """Table 1: q1 = (pi/4) sin(w t), q2 = -(pi/4) sin(w t); returns q, qd, qdd (..., 2)."""
+    t = as_array(t, "t")
+    amplitude = check_real(amplitude, "amplitude")
+    omega = check_real(omega, "omega")
     s, c = np.sin(omega * t), np.cos(omega * t)
     sign = np.array([1.0, -1.0])
     q = amplitude * s[..., None] * sign
@@ -70,6 +74,8 @@ def _vec(v: np.ndarray) -> str:
 
 def build_mjcf(th: vt.VectoredThruster, *, actuated: bool = False) -> str:
     """MJCF of the mechanism (home pose q = 0: every body frame at O, identity orientation)."""
+    check_params(th, vt.VectoredThruster, "th")
+    actuated = check_bool(actuated, "actuated")
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
     a12 = np.array([ca, 0.0, -sa])
     a13 = np.array([0.0, -1.0, 0.0])
@@ -160,6 +166,13 @@ def engine_trace(
     omega_dot_model=None,
 ) -> EngineTrace:
     """Evaluate engine and analytic kinematics at trajectory samples ``q, qd, qdd (n, 2)``."""
+    check_params(th, vt.VectoredThruster, "th")
+    t = as_array(t, "t", (None,))
+    q, qd, qdd = (as_array(v, k, (2,), min_ndim=2) for v, k in ((q, "q"), (qd, "qd"), (qdd, "qdd")))
+    if not (t.ndim == 1 and q.shape == qd.shape == qdd.shape == (t.shape[0], 2)):
+        raise ValueError(
+            f"Expected t (n,) and q, qd, qdd (n, 2), got {t.shape}, {q.shape}, {qd.shape}, {qdd.shape}."
+        )
     m = mujoco.MjModel.from_xml_string(build_mjcf(th))
     d = mujoco.MjData(m)
     qpos, qvel, qacc = _joint_data(th, q, qd, qdd)
@@ -250,6 +263,9 @@ def forward_simulation(th: vt.VectoredThruster, duration: float = SIM_DURATION) 
 def run(th: vt.VectoredThruster | None = None, omega_dot_model=None) -> list[Check]:
     """All checks along one period of the Table 1 trajectory (``omega_dot_model`` replaces the analytic ω̇)."""
     th = vt.VectoredThruster.paper() if th is None else th
+    check_params(th, vt.VectoredThruster, "th")
+    if omega_dot_model is not None and not callable(omega_dot_model):
+        raise ValueError(f"Expected omega_dot_model to be a callable, got {type(omega_dot_model).__name__}.")
     t = np.linspace(0.0, 2 * np.pi, N_SAMPLES)
     q, qd, qdd = table1_trajectory(t)
     if omega_dot_model is not None:

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_params
 
 from ._friction import _as_direction, _factors, _wrap
 from ._kinematics import CableModel, _segment_spans, _split, span_lengths
@@ -74,6 +74,7 @@ def cable_elongation(
     actuator and the base and reduced span by span by the disk friction (``direction``).  This is the
     discrete form of eq. (36) (which integrates an exponential tension profile).
     """
+    check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     t = as_array(tension, "tension", (robot.n_cables,))
     d = _as_direction(robot, direction, theta.shape[:-1])
@@ -83,6 +84,7 @@ def cable_elongation(
 
 def theoretical_drive(robot: ContinuumRobot, psi: object, model: CableModel = "arc") -> np.ndarray:
     """Cable pulled in by each actuator for a rigid, frictionless robot: q = -(L(psi) - L(0))."""
+    check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     psi_a = np.stack([theta, beta], -1).reshape(*theta.shape[:-1], -1)
     return -(span_lengths(robot, psi_a, model).sum(axis=-1) - _l0(robot, model))
@@ -114,6 +116,7 @@ def compensated_drive(
     The tensions come from :func:`cable_tensions` (virtual work, friction along the disks in the sliding
     ``direction``, pretension in the null space), the elongation from :func:`cable_elongation`.
     """
+    check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     psi_a = np.stack([theta, beta], -1).reshape(*theta.shape[:-1], -1)
     tr: TensionResult = cable_tensions(robot, psi_a, wrench=wrench, direction=direction, model=model)
@@ -185,6 +188,7 @@ def simulate(
     would push go slack (tension 0, ``taut`` false).  Solved by Newton in bending-vector coordinates
     (smooth through the straight pose), starting from ``initial`` psi or the rigid-cable arc solution.
     """
+    check_params(robot, ContinuumRobot, "robot")
     qa = as_array(q, "q", (robot.n_cables,))
     batch = qa.shape[:-1]
     d = _as_direction(robot, direction, batch)

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, broadcast_batch, check_params, check_positive
 
 from ._kinematics import _disk_T, _split
 from ._params import ContinuumRobot
@@ -58,6 +58,7 @@ def wrap_angles(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Zero beyond the cable's termination disk.  Under constant curvature every cable of a segment wraps
     theta / (2 N) at the segment's base and theta / N at each interior disk.
     """
+    check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     return _wrap(robot, theta, beta)
 
@@ -94,6 +95,7 @@ def friction_factors(robot: ContinuumRobot, psi: object, direction: object | Non
     paid out; ``None``: frictionless.  0 (sticking, eq. (19)'s stuck branch) raises ValueError for a cable
     with friction: its tension is undetermined within the friction band without a stick-slip memory.
     """
+    check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     d = _as_direction(robot, direction, theta.shape[:-1])
     return _factors(robot, _wrap(robot, theta, beta), d)
@@ -124,7 +126,11 @@ _GROWTH_MARGIN = 1.1
 
 
 def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np.ndarray:
-    """c = (rho / n) ((1 + rho) / (alpha rho))^(1/n) of paper 3, eq. (29)."""
+    """c = (rho / n) ((1 + rho) / (alpha rho))^(1/n) of paper 3, eq. (29); rho, alpha > 0, n in (0, 1]."""
+    rho, alpha, n = as_array(rho, "rho"), as_array(alpha, "alpha"), as_array(n, "n")
+    if np.any(rho <= 0.0) or np.any(alpha <= 0.0) or np.any(n <= 0.0) or np.any(n > 1.0):
+        bad = "rho" if np.any(rho <= 0.0) else "alpha" if np.any(alpha <= 0.0) else "n"
+        raise ValueError(f"Expected rho > 0, alpha > 0 and n in (0, 1], got an invalid {bad}.")
     return (rho / n) * ((1.0 + rho) / (alpha * rho)) ** (1.0 / n)
 
 
@@ -301,8 +307,9 @@ def identify_friction(
     s = as_array(direction, "direction", (None,))
     if np.any(ti <= 0.0) or np.any(to <= 0.0):
         raise ValueError("Expected t_in and t_out > 0 (a slack cable carries no friction information).")
-    if sigma_t is not None and not (np.isfinite(sigma_t) and sigma_t > 0.0):
-        raise ValueError(f"Expected sigma_t > 0 and finite, got {sigma_t!r}.")
+    if sigma_t is not None:
+        sigma_t = check_positive(sigma_t, "sigma_t")
+    broadcast_batch((eta, 0, "wrap"), (ti, 0, "t_in"), (to, 0, "t_out"), (s, 0, "direction"))
     eta, ti, to, s = np.broadcast_arrays(eta, ti, to, s)
     y = np.log(ti / to)
     x = s * eta

@@ -13,8 +13,11 @@ from typing import Literal
 
 import numpy as np
 
-from robomech._validation import as_array
-from robomech.spatial import SMALL_ANGLE, sincos
+from robomech._validation import as_array, check_params
+from robomech.spatial import SMALL_ANGLE
+
+# the unvalidated kernel: inputs are validated once at this module's public boundary
+from robomech.spatial._so3 import _sincos as sincos
 
 from ._params import ContinuumRobot
 
@@ -273,12 +276,14 @@ def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
 
     The array may be a non-contiguous view (the matrix entries are computed as contiguous planes).
     """
+    check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split_views(robot, psi)
     return _fk(robot, theta, beta)
 
 
 def tip_position(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """Tip position ``(..., 3)`` in the base frame (m)."""
+    check_params(robot, ContinuumRobot, "robot")
     return forward_kinematics(robot, psi)[..., -1, :3, 3]
 
 
@@ -347,12 +352,14 @@ def tip_jacobian(robot: ContinuumRobot, psi: object) -> np.ndarray:
     ``omega`` is the tip frame's angular velocity and ``v_tip`` the velocity of the tip point (paper 3,
     eq. (6): J_xomega stacked on J_xv, angular first as in robomech's twists).
     """
+    check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split_views(robot, psi)
     return _tip_jacobian(robot, theta, beta)
 
 
 def disk_transforms(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """Poses of the base plate and of every disk, ``(..., 1 + n N, 4, 4)``, in the base frame."""
+    check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     return _disk_T(robot, theta, beta)
 
@@ -420,6 +427,7 @@ def _active(robot: ContinuumRobot) -> np.ndarray:
 
 def span_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "chord") -> np.ndarray:
     """Length of every cable span ``(..., 3 n, n N)`` (zero beyond the cable's termination disk)."""
+    check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     ell, _, _ = _segment_spans(robot, theta, beta, model)
     return np.repeat(np.where(_active(robot), ell, 0.0), robot.disks_per_segment, axis=-1)
@@ -427,6 +435,7 @@ def span_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "chord"
 
 def span_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "chord") -> np.ndarray:
     """``d span / d psi``: ``(..., 3 n, n N, 2 n)``."""
+    check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     return _span_jac(robot, theta, beta, model)
 
@@ -449,6 +458,7 @@ def cable_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "arc")
     ``model="arc"`` is paper 3, eq. (4) (cable parallel to the core); ``model="chord"`` takes straight
     cable spans between the holes of consecutive disks (what a real cable does).
     """
+    check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     ell, _, _ = _segment_spans(robot, theta, beta, model)
     return robot.disks_per_segment * np.sum(np.where(_active(robot), ell, 0.0), axis=-1)
@@ -456,6 +466,7 @@ def cable_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "arc")
 
 def cable_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "arc") -> np.ndarray:
     """``J_qpsi = d cable_lengths / d psi``, ``(..., 3 n, 2 n)`` (paper 3, eq. (5) for one segment)."""
+    check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     return _span_jac(robot, theta, beta, model).sum(axis=-2)
 
@@ -647,6 +658,7 @@ def inverse_kinematics(robot: ContinuumRobot, p_tip: object) -> IKResult:
     shapes (IK_STARTS: segments bent in opposite or crossed planes, different bends); the pose with the
     smallest residual is kept, with its ``converged`` flag.  Targets beyond the reach get one solve only.
     """
+    check_params(robot, ContinuumRobot, "robot")
     p = as_array(p_tip, "p_tip", (3,))
     n = robot.n_segments
     batch = p.shape[:-1]

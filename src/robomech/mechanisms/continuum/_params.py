@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import check_positive
+from robomech._validation import as_array, coerce_float_fields, coerce_int_fields
 
 __all__ = ["ContinuumRobot"]
 
@@ -52,31 +52,21 @@ class ContinuumRobot:
     cable_offset: float = math.pi / 3.0
 
     def __post_init__(self) -> None:
-        if not isinstance(self.n_segments, int | np.integer) or self.n_segments < 1:
-            raise ValueError(f"Expected n_segments to be an integer >= 1, got {self.n_segments!r}.")
-        if not isinstance(self.disks_per_segment, int | np.integer) or self.disks_per_segment < 1:
-            raise ValueError(
-                f"Expected disks_per_segment to be an integer >= 1, got {self.disks_per_segment!r}."
-            )
-        for name in (
-            "segment_length",
-            "hole_radius",
-            "core_modulus",
-            "core_diameter",
-            "cable_modulus",
-            "cable_diameter",
-        ):
-            check_positive(getattr(self, name), name)
-        check_positive(self.pretension, "pretension", allow_zero=True)
-        check_positive(self.free_length, "free_length", allow_zero=True)
-        if not math.isfinite(float(self.cable_offset)):
-            raise ValueError(f"Expected cable_offset to be finite, got {self.cable_offset!r}.")
+        # integers stay integers (bool rejected) and every real field is stored as a float
+        coerce_int_fields(self, ("n_segments", "disks_per_segment"), low=1)
+        lengths = ("segment_length", "hole_radius", "core_diameter", "cable_diameter")
+        coerce_float_fields(self, (*lengths, "core_modulus", "cable_modulus"), positive=True)
+        coerce_float_fields(self, ("pretension", "free_length"), positive=True, allow_zero=True)
+        coerce_float_fields(self, ("cable_offset",))
         if self.hole_radius * self.n_segments >= self.segment_length:
             raise ValueError(
                 f"Expected hole_radius well below segment_length, got {self.hole_radius!r} m vs "
                 f"{self.segment_length!r} m."
             )
-        mu = tuple(float(m) for m in self.friction)
+        mu_a = as_array(self.friction, "friction", (None,))
+        if mu_a.ndim != 1:
+            raise ValueError(f"Expected friction to be a flat sequence of numbers, got shape {mu_a.shape}.")
+        mu = tuple(float(m) for m in mu_a)
         n_cables = CABLES_PER_SEGMENT * self.n_segments
         if len(mu) != n_cables:
             raise ValueError(f"Expected friction to have {n_cables} entries (3 per segment), got {len(mu)}.")

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_params, check_positive
 
 from ._friction import _as_direction, _factors, _wrap
 from ._kinematics import CableModel, _span_jac, _split, _tip_jacobian
@@ -28,6 +28,7 @@ TENSION_FLOOR = 0.0
 
 def elastic_energy(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """Bending energy of the cores, U = sum EI theta_i^2 / (2 l) (paper 3, eq. (8)), ``(...)`` in J."""
+    check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
     return 0.5 * robot.bending_stiffness / robot.segment_length * np.sum(theta**2, axis=-1)
 
@@ -40,6 +41,7 @@ def _grad_u(robot: ContinuumRobot, theta: np.ndarray) -> np.ndarray:
 
 def elastic_gradient(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """dU/dpsi ``(..., 2 n)``: (EI theta_i / l, 0) per segment."""
+    check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
     return _grad_u(robot, theta)
 
@@ -51,6 +53,7 @@ def coupling_moments(robot: ContinuumRobot, psi: object) -> np.ndarray:
     coupling exactly (distal cables run through proximal segments); this function is the paper's
     one-neighbour form, for comparison.
     """
+    check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
     M = np.zeros((*theta.shape, 2))
     M[..., :-1, 0] = -robot.bending_stiffness / robot.segment_length * theta[..., 1:]
@@ -98,12 +101,11 @@ def cable_tensions(
     tip, in the base frame.  Solution: ``tau = -(G^T)^+ (grad U - J_x^T W) + (I - (G^T)^+ G^T) eta`` with
     ``eta = pretension * 1`` (default ``robot.pretension``).
     """
+    check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     batch = theta.shape[:-1]
     d = _as_direction(robot, direction, batch)
-    T0 = robot.pretension if pretension is None else float(pretension)
-    if not np.isfinite(T0) or T0 < 0.0:
-        raise ValueError(f"Expected pretension >= 0 and finite, got {pretension!r}.")
+    T0 = robot.pretension if pretension is None else check_positive(pretension, "pretension", allow_zero=True)
     G = _effective_jacobian(robot, theta, beta, d, model)
     rhs = _grad_u(robot, theta)
     if wrench is not None:

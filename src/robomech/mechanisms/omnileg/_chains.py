@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_params
 from robomech.kinematics import jacobian_space, poe_fk
 from robomech.spatial import inverse_transform, log_se3, screw_from_axis
 
@@ -55,6 +55,7 @@ def _kR(k: int) -> np.ndarray:
 
 def chain_screws(leg: OmniLeg) -> tuple[np.ndarray, np.ndarray]:
     """Space screws of the three UU chains at the home pose, (3, 4, 6), and their home pose M (4, 4)."""
+    check_params(leg, OmniLeg, "leg")
     w1 = np.array([[0.0, 1, 0], [1, 0, 0], [1, 0, 0], [0, 1, 0]])  # paper 2, eq. (1)
     p1 = np.array([[0.0, leg.L3, 0], [0, leg.L3, 0], [0, leg.L3, leg.L1], [0, leg.L3, leg.L1]])  # eq. (2)
     S = np.stack([screw_from_axis(w1 @ _kR(k).T, p1 @ _kR(k).T) for k in range(3)])  # eqs. (6), (7)
@@ -100,6 +101,7 @@ def thigh_closure(leg: OmniLeg, alpha: object, beta: object) -> ThighClosure:
     ``dθ`` must satisfy ``J_1 dθ_1 - J_k dθ_k = log(T_k T_1^-1)`` (k = 2, 3), a 12 x 10 least-squares
     system solved per sample by batched Householder QR.
     """
+    check_params(leg, OmniLeg, "leg")
     a = as_array(alpha, "alpha")
     b = as_array(beta, "beta")
     batch = np.broadcast_shapes(a.shape, b.shape)
@@ -177,6 +179,7 @@ class ShankResult:
 
 def shank_frames(leg: OmniLeg) -> np.ndarray:
     """Rotations S_i (3, 3, 3) of the shank chain frames: x radial outward along the C_i axis, z = Z0'."""
+    check_params(leg, OmniLeg, "leg")
     psi = leg.shank_azimuth + 2.0 * np.pi * np.arange(3) / 3.0
     c, s = np.cos(psi), np.sin(psi)
     S = np.zeros((3, 3, 3))
@@ -192,6 +195,7 @@ def shank_crank_slider(leg: OmniLeg, gamma: object) -> ShankResult:
     Crank C_iD_i turns by γ about the radial axis X_Ci; the slider position below C_i is the crank-slider
     law ``s = r cos γ + sqrt(l² - (r sin γ)²)`` with r = l = L4, i.e. 2 L4 cos γ (eq. (10)).
     """
+    check_params(leg, OmniLeg, "leg")
     g_in = as_array(gamma, "gamma")
     valid = np.abs(g_in) < 0.5 * np.pi  # the chain folds flat at |γ| = 90°: outside, flagged and NaN
     g = np.where(valid, g_in, 0.0)

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_params
 
 from . import _jet as jt
 from ._chains import shank_frames
@@ -246,6 +246,7 @@ def _flat(*arrays: np.ndarray) -> tuple[tuple[int, ...], list[np.ndarray]]:
 
 def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
     """Body rotations ``R_b (..., 22, 3, 3)`` (in the hip frame) and mass centres ``p_b (..., 22, 3)`` (m)."""
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
     t = _terms_chunked(leg, qf, np.zeros_like(qf), np.zeros_like(qf), poses=True)
@@ -274,6 +275,7 @@ def inverse_dynamics(
     ``-Jᵀ F``.  Paper 2, eqs. (49)-(50) add ``+Jᵀ F_f``, i.e. read F_f as the force the foot delivers:
     pass ``-F_f`` for that reading.
     """
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     qd = as_array(qd, "qd", (3,))
     qdd = as_array(qdd, "qdd", (3,))
@@ -298,6 +300,7 @@ def inverse_dynamics(
 
 def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
     """Joint-space inertia matrix ``M(q) (..., 3, 3)`` (kg m²), symmetric positive definite."""
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
     z = np.zeros_like(qf)
@@ -306,6 +309,7 @@ def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
 
 def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
     """``G(q) = ∂V/∂q`` (..., 3), N·m: the torques holding the leg still against gravity."""
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
     z = np.zeros_like(qf)
@@ -314,6 +318,7 @@ def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
 
 def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
     """Kinetic ``½ q̇ᵀ M q̇`` and potential ``-Σ m_b gᵀ p_b`` energy (J), each (...)."""
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     qd = as_array(qd, "qd", (3,))
     batch, (qf, qdf) = _flat(q, qd)
@@ -323,6 +328,7 @@ def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]
 
 def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
     """Virtual work, paper 2, eq. (50): ``τ = Jᵀ F`` for a force ``F (..., 3)`` (N) delivered by the foot."""
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     F = as_array(force, "force", (3,))
     return np.einsum("...ij,...i->...j", jacobian(leg, q), F)
@@ -351,6 +357,7 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     ``σ_i >= SINGULAR_RCOND σ_max`` and ``c_i = σ_i / (σ_i² + λ²)``, ``λ = DAMPING_RELATIVE σ_max``, otherwise
     (selectively damped least squares: the well-determined components stay exact).
     """
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     tau = as_array(tau, "tau", (3,))
     J = jacobian(leg, q)

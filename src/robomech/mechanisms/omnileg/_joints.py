@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_params
 
 from . import _jet as jt
 from ._params import OmniLeg
@@ -49,6 +49,7 @@ def joint_motion(leg: OmniLeg, q: object, qd: object, qdd: object) -> JointMotio
     direction u, the shaft arm a1 = Rz(γ) e_y and the rod arm a2 = (a1 × u)/|a1 × u|,
     φ1 = atan2((Rz(γ) e_x)·(a2 × a1), (Rz(γ) e_x)·a2), φ2 = atan2((a2 × a1)·(u × a2), a1·(u × a2)).
     """
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     qd = as_array(qd, "qd", (3,))
     qdd = as_array(qdd, "qdd", (3,))

@@ -12,7 +12,7 @@ from functools import cached_property
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_params
 
 from ._params import OmniLeg
 
@@ -75,6 +75,7 @@ def forward_kinematics(leg: OmniLeg, q: object) -> np.ndarray:
 
     Exactly paper 2, eq. (11) (Z0 toward the foot).
     """
+    check_params(leg, OmniLeg, "leg")
     q = _q(q)
     qf = q.reshape(-1, 3)
     out = np.empty_like(qf)
@@ -97,6 +98,7 @@ def passive_angles(leg: OmniLeg, alpha: object, beta: object) -> tuple[np.ndarra
     with chain 2's second axis ω22 = Rz(-π/2)[1 0 0] = [0 -1 0] (eqs. (1), (5), (6)) the closure gives
     θ22 = -arctan(tan β cos α).
     """
+    check_params(leg, OmniLeg, "leg")
     a = as_array(alpha, "alpha")
     b = as_array(beta, "beta")
     theta12 = np.arctan(np.tan(a) * np.cos(b))
@@ -122,6 +124,7 @@ def jacobian(leg: OmniLeg, q: object) -> np.ndarray:
     ``∂p/∂α = -L1 (1 + a²)(e_y - u u_y)/N``, ``∂p/∂β = L1 (1 + b²)(e_x - u u_x)/N``,
     ``∂p/∂γ = (0, 0, -2 L4 sin γ)``.
     """
+    check_params(leg, OmniLeg, "leg")
     q = _q(q)
     qf = q.reshape(-1, 3)
     J = np.zeros((qf.shape[0], 3, 3))
@@ -143,6 +146,7 @@ def jacobian(leg: OmniLeg, q: object) -> np.ndarray:
 
 def hessian(leg: OmniLeg, q: object) -> np.ndarray:
     """Second-order influence coefficients ``H[..., i, j, k] = ∂²p_F,i/∂q_j∂q_k`` (..., 3, 3, 3)."""
+    check_params(leg, OmniLeg, "leg")
     q = _q(q)
     u, N, W, ab = _dw(q)
     eye = np.eye(3)
@@ -170,12 +174,14 @@ def hessian(leg: OmniLeg, q: object) -> np.ndarray:
 
 def foot_velocity(leg: OmniLeg, q: object, qd: object) -> np.ndarray:
     """``v_F = J q̇`` (..., 3), m/s."""
+    check_params(leg, OmniLeg, "leg")
     qd = as_array(qd, "qd", (3,))
     return np.einsum("...ij,...j->...i", jacobian(leg, q), qd)
 
 
 def foot_acceleration(leg: OmniLeg, q: object, qd: object, qdd: object) -> np.ndarray:
     """``a_F = J q̈ + q̇ᵀ H q̇`` (..., 3), m/s² (the foot does not rotate, Section 2)."""
+    check_params(leg, OmniLeg, "leg")
     qd = as_array(qd, "qd", (3,))
     qdd = as_array(qdd, "qdd", (3,))
     return np.einsum("...ij,...j->...i", jacobian(leg, q), qdd) + np.einsum(
@@ -185,6 +191,7 @@ def foot_acceleration(leg: OmniLeg, q: object, qd: object, qdd: object) -> np.nd
 
 def within_limits(leg: OmniLeg, q: object) -> np.ndarray:
     """Per-sample mask: |α| ≤ α_max, |β| ≤ β_max, γ_min ≤ γ ≤ γ_max (Table 2 as magnitudes)."""
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,), finite=False)
     with np.errstate(invalid="ignore"):
         return (
@@ -228,6 +235,7 @@ def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
     ``s = sqrt(L1² - P_x² - P_y²)`` is the depth of the knee below O0.  Non-finite input samples are
     flagged (``exists`` false), not raised.
     """
+    check_params(leg, OmniLeg, "leg")
     p = as_array(p_foot, "p_foot", (3,), finite=False)
     pf = p.reshape(-1, 3)
     n = pf.shape[0]

@@ -16,6 +16,8 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from robomech._validation import as_array, check_positive, check_real
+
 __all__ = ["OmniLeg", "RigidBody", "default_bodies"]
 
 # Density of 6061 aluminium and of steel, kg/m^3 (handbook values).
@@ -27,6 +29,11 @@ STANDARD_GRAVITY = 9.80665
 INERTIA_SYMMETRY_RTOL = 1e-9
 # Principal moments may violate the triangle inequality by this relative amount (rounding only).
 TRIANGLE_RTOL = 1e-9
+
+
+def _real(value: object, name: str) -> float:
+    """A real scalar field as a float: a str, bool, complex or None raises instead of being converted."""
+    return check_real(value, name, finite=False)
 
 
 @dataclass(frozen=True)
@@ -42,13 +49,13 @@ class RigidBody:
     inertia: tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
 
     def __post_init__(self) -> None:
-        m = float(self.mass)
+        m = _real(self.mass, "RigidBody.mass")
         if not (math.isfinite(m) and m > 0.0):
             raise ValueError(f"Expected RigidBody.mass > 0 and finite, got {self.mass!r}.")
-        c = np.asarray(self.com, dtype=float)
+        c = as_array(self.com, "RigidBody.com")
         if c.shape != (3,) or not np.all(np.isfinite(c)):
             raise ValueError(f"Expected RigidBody.com to be 3 finite numbers, got {self.com!r}.")
-        inertia = np.asarray(self.inertia, dtype=float)
+        inertia = as_array(self.inertia, "RigidBody.inertia")
         if inertia.shape != (3, 3) or not np.all(np.isfinite(inertia)):
             raise ValueError(
                 f"Expected RigidBody.inertia to be a finite 3x3 matrix, got shape {inertia.shape}."
@@ -121,6 +128,8 @@ def default_bodies(L1: float, L3: float, L4: float, L5: float, knee_to_crank: fl
     aluminium bars 12 x 6 mm of length L4 (the crank also carrying a 25 g bevel gear at C); foot a
     100 g aluminium pad with a 10 mm aluminium rod from the E plane down to the foot point.
     """
+    L1, L3, L4, L5 = (check_positive(v, n) for v, n in ((L1, "L1"), (L3, "L3"), (L4, "L4"), (L5, "L5")))
+    knee_to_crank = check_real(knee_to_crank, "knee_to_crank")
     cross = _cross(0.0025, 0.024)
     # Thigh rod: tube plus fittings (2 x 20 g) at its ends; com at mid-length by symmetry.
     r_o, r_i = 0.008, 0.006
@@ -237,23 +246,23 @@ class OmniLeg:
 
     def __post_init__(self) -> None:
         for name in ("L1", "L3", "L4", "L5", "shank_radius"):
-            v = float(getattr(self, name))
+            v = _real(getattr(self, name), f"OmniLeg.{name}")
             if not (math.isfinite(v) and v > 0):
                 raise ValueError(f"Expected OmniLeg.{name} > 0 and finite, got {getattr(self, name)!r}.")
             object.__setattr__(self, name, v)
-        h = float(self.knee_to_crank)
+        h = _real(self.knee_to_crank, "OmniLeg.knee_to_crank")
         if not (math.isfinite(h) and 0 <= h <= self.L5):
             raise ValueError(
                 f"Expected OmniLeg.knee_to_crank in [0, L5 = {self.L5}], got {self.knee_to_crank!r}."
             )
         object.__setattr__(self, "knee_to_crank", h)
         for name in ("alpha_max", "beta_max"):
-            v = float(getattr(self, name))
+            v = _real(getattr(self, name), f"OmniLeg.{name}")
             # tan(α), tan(β) enter eq. (11): |α|, |β| must stay below 90°.
             if not (math.isfinite(v) and 0 < v < math.pi / 2):
                 raise ValueError(f"Expected OmniLeg.{name} in (0, pi/2) rad, got {getattr(self, name)!r}.")
             object.__setattr__(self, name, v)
-        gmin, gmax = float(self.gamma_min), float(self.gamma_max)
+        gmin, gmax = _real(self.gamma_min, "OmniLeg.gamma_min"), _real(self.gamma_max, "OmniLeg.gamma_max")
         # The crank-slider of the shank folds flat at γ = ±90°: the range must lie strictly inside.
         if not (math.isfinite(gmin) and math.isfinite(gmax) and -math.pi / 2 < gmin < gmax < math.pi / 2):
             raise ValueError(
@@ -262,10 +271,10 @@ class OmniLeg:
             )
         object.__setattr__(self, "gamma_min", gmin)
         object.__setattr__(self, "gamma_max", gmax)
-        if not math.isfinite(float(self.shank_azimuth)):
+        if not math.isfinite(_real(self.shank_azimuth, "OmniLeg.shank_azimuth")):
             raise ValueError(f"Expected OmniLeg.shank_azimuth finite, got {self.shank_azimuth!r}.")
         object.__setattr__(self, "shank_azimuth", float(self.shank_azimuth))
-        g = np.asarray(self.gravity, dtype=float)
+        g = as_array(self.gravity, "OmniLeg.gravity")
         if g.shape != (3,) or not np.all(np.isfinite(g)):
             raise ValueError(f"Expected OmniLeg.gravity to be 3 finite numbers, got {self.gravity!r}.")
         object.__setattr__(self, "gravity", tuple(float(v) for v in g))

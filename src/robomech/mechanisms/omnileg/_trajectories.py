@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_int, check_params
 from robomech.trajectory import Profile, quintic, sinusoid, swing_sextic
 
 from ._kinematics import forward_kinematics
@@ -47,6 +47,7 @@ GAIT_STRIDE, GAIT_HEIGHT, GAIT_LATERAL, GAIT_PERIOD = 0.1, 0.05, 0.0, 1.0
 
 def start_point(leg: OmniLeg) -> np.ndarray:
     """Foot start point ``FK(0, 0, START_GAMMA)`` (3,), m."""
+    check_params(leg, OmniLeg, "leg")
     return forward_kinematics(leg, np.array([0.0, 0.0, START_GAMMA]))
 
 
@@ -58,6 +59,7 @@ def _lift(p0: np.ndarray, x: Profile, y: Profile, z: Profile) -> Profile:
 
 def foot_trajectory_eq51(leg: OmniLeg, t: object) -> Profile:
     """Foot position, velocity, acceleration (..., 3) of eq. (51) at times ``t`` (...), 0 <= t <= 5 s."""
+    check_params(leg, OmniLeg, "leg")
     t = as_array(t, "t")
     half = EQ51_PERIOD / 2
     rising = t <= half
@@ -96,9 +98,9 @@ def gait_eq53(leg: OmniLeg, t: object, periods: int = 6) -> GaitProfile:
     form (Y from 0 to L); centring the stride under the hip and reversing it in stance is robomech's
     reading (a foot fixed relative to the ground moves backward relative to the hip).
     """
+    check_params(leg, OmniLeg, "leg")
     t = as_array(t, "t")
-    if periods < 1:
-        raise ValueError(f"Expected periods >= 1, got {periods}.")
+    periods = check_int(periods, "periods", low=1)
     T = GAIT_PERIOD
     k = np.clip(np.floor(t / T), 0, periods - 1)
     tau = t - k * T

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_params
 
 from ._params import ExplorationRobot
 
@@ -62,6 +62,7 @@ def side_points(robot: ExplorationRobot, q: np.ndarray) -> dict[str, np.ndarray]
     hinges ``LF``/``LH``, contacts ``AF``/``AH``/``P``, and the contact-frame angles ``alpha_road``
     (θ+θ01+θ02) and ``alpha_rear`` (θ), each ``(...,)``.  Kernel: no validation.
     """
+    check_params(robot, ExplorationRobot, "robot")
     th, t1, t2, s = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     c0, s0 = np.cos(th), np.sin(th)
     a1 = th + t1
@@ -113,6 +114,7 @@ def _blocked(kernel, q: np.ndarray, tail: tuple[int, ...]) -> np.ndarray:
 
 def contact_frames(robot: ExplorationRobot, config: object) -> np.ndarray:
     """Poses ``T_BP`` of the six contact frames in the body frame: ``(..., 6, 4, 4)``, order ``WHEELS``."""
+    check_params(robot, ExplorationRobot, "robot")
     q = _check_config(config)
     return _blocked(lambda qc: _contact_frames(robot, qc), q, (N_WHEELS, 4, 4))
 
@@ -183,6 +185,7 @@ def wheel_jacobians(robot: ExplorationRobot, config: object) -> np.ndarray:
     of contact frame ``w`` relative to the body per unit rate of joint ``j`` of its side
     (``SIDE_JOINTS``); joints outside the wheel's chain give zero columns.  ``ω = (0, Σ rates, 0)``.
     """
+    check_params(robot, ExplorationRobot, "robot")
     q = _check_config(config)
     return _blocked(lambda qc: _wheel_jacobians(robot, qc), q, (N_WHEELS, 6, 4))
 

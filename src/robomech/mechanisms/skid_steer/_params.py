@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
-from robomech._validation import check_positive
+from robomech._validation import check_positive, check_real
 
 __all__ = ["ExplorationRobot"]
 
@@ -71,7 +71,7 @@ class ExplorationRobot:
             if f.name == "side_link_rake":
                 continue
             object.__setattr__(self, f.name, check_positive(getattr(self, f.name), f.name))
-        rake = float(self.side_link_rake)
+        rake = check_real(self.side_link_rake, "side_link_rake", finite=False)
         if not (math.isfinite(rake) and 0.0 < rake < 0.5 * math.pi):
             # A vertical side link (rake 0) makes the two road-wheel rates indistinguishable from the
             # bogie rate at first order; a horizontal one (pi/2) cannot lift the wheels.

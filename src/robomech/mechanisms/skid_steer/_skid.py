@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_positive
+from robomech._validation import as_array, broadcast_batch, check_positive
 from robomech.spatial import exp_se3
 
 __all__ = [
@@ -48,6 +48,7 @@ def skid_steer_turn(v_right: object, v_left: object, track_width: float) -> Skid
     """
     v1 = as_array(v_right, "v_right")
     v2 = as_array(v_left, "v_left")
+    broadcast_batch((v1, 0, "v_right"), (v2, 0, "v_left"))
     S = check_positive(track_width, "track_width")
     diff = v1 - v2
     total = v1 + v2
@@ -67,6 +68,7 @@ def wheel_lateral_velocity(yaw_rate: object, wheel_x: object, icr_x: object = 0.
     r = as_array(yaw_rate, "yaw_rate")
     x = as_array(wheel_x, "wheel_x")
     xi = as_array(icr_x, "icr_x")
+    broadcast_batch((r, 0, "yaw_rate"), (x, 0, "wheel_x"), (xi, 0, "icr_x"))
     return r * (x - xi)
 
 
@@ -76,6 +78,7 @@ def paper_lateral_slip(v_outer: object, wheelbase: float, radius: object, track_
     body centre (not of the inner wheel, as printed)."""
     v = as_array(v_outer, "v_outer")
     R = as_array(radius, "radius")
+    broadcast_batch((v, 0, "v_outer"), (R, 0, "radius"))
     L = check_positive(wheelbase, "wheelbase")
     S = check_positive(track_width, "track_width")
     return v * L / (2.0 * R + S)

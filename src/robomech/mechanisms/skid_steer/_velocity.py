@@ -20,7 +20,7 @@ from typing import Literal
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_bool, check_params
 from robomech.analysis import lstsq
 
 from ._chains import CONFIG_SIZE, N_WHEELS, _linear_columns
@@ -56,6 +56,7 @@ _PASSIVE = ((5, 6, 9), (7, 8, 10))
 
 def assemble(robot: ExplorationRobot, config: object) -> tuple[np.ndarray, np.ndarray]:
     """``A0 (..., 30, 11)`` and ``J (..., 30, 22)`` of the composite system at ``config (..., 8)``."""
+    check_params(robot, ExplorationRobot, "robot")
     q = as_array(config, "config", (CONFIG_SIZE,))
     batch = q.shape[:-1]
     n = int(np.prod(batch))
@@ -127,6 +128,7 @@ def wheel_measurements(
     recovers everything from these except that it reports ``ω_BY = (ω1 + ω2)/2``, which is the true
     pitch rate only when the differential holds (``θ̇2 = -θ̇1``).
     """
+    check_params(robot, ExplorationRobot, "robot")
     q = as_array(config, "config", (CONFIG_SIZE,))
     V = as_array(twist, "twist", (6,))
     qd = as_array(config_rate, "config_rate", (CONFIG_SIZE,))
@@ -185,10 +187,12 @@ def body_velocity(
     condition number of R (within a factor 11 of the 2-norm one); ``exact_cond=True`` gives the 2-norm
     one from the singular values of R (QR only; slower).
     """
+    check_params(robot, ExplorationRobot, "robot")
     q = as_array(state, "state", (CONFIG_SIZE,), finite=False)
     m = as_array(measured, "measured", (MEASURED_SIZE,), finite=False)
     if solver not in ("qr", "normal_equations"):
         raise ValueError(f"Expected solver 'qr' or 'normal_equations', got {solver!r}.")
+    check_bool(exact_cond, "exact_cond")
     batch = np.broadcast_shapes(q.shape[:-1], m.shape[:-1])
     n = int(np.prod(batch))
     qf = np.broadcast_to(q, (*batch, CONFIG_SIZE)).reshape(n, CONFIG_SIZE)

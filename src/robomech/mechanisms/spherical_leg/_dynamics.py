@@ -25,7 +25,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_int, check_params, finite_samples
 
 from ._kinematics import LENGTH_FLOOR, _rotation
 from ._params import SphericalLeg
@@ -102,10 +102,13 @@ def _motion(leg: SphericalLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -
     return _Motion(E, w, dw, p, Rp, s, sd, sdd, l, ld, ldd, Jl, Ps)
 
 
-def _check_state(q: object, qd: object, qdd: object | None = None):
+_NO_QDD = object()
+
+
+def _check_state(q: object, qd: object, qdd: object = _NO_QDD):
     qa = as_array(q, "q", (2,))
     qda = as_array(qd, "qd", (2,))
-    qdda = None if qdd is None else as_array(qdd, "qdd", (2,))
+    qdda = None if qdd is _NO_QDD else as_array(qdd, "qdd", (2,))
     shapes = [x.shape for x in (qa, qda, qdda) if x is not None]
     try:
         shape = np.broadcast_shapes(*shapes)
@@ -171,6 +174,7 @@ def generalized_forces(
     ``platform_wrench (..., 6)``: external wrench ``[m_O; f]`` on the platform, base frame, moment
     about O (conventions); tau is what the actuators must supply.
     """
+    check_params(leg, SphericalLeg, "leg")
     qa, qda, qdda = _check_state(q, qd, qdd)
     w = None if platform_wrench is None else as_array(platform_wrench, "platform_wrench", (6,))
     return _generalized(leg, _motion(leg, qa, qda, qdda), w)
@@ -178,6 +182,7 @@ def generalized_forces(
 
 def mass_matrix(leg: SphericalLeg, q: object) -> np.ndarray:
     """Mass matrix M(q) (..., 2, 2) of the coordinates (alpha, beta): tau = M qdd + c(q, qd) + g(q)."""
+    check_params(leg, SphericalLeg, "leg")
     qa = as_array(q, "q", (2,))
     zero_g = _replace_gravity(leg)
     cols = []
@@ -196,6 +201,7 @@ def _replace_gravity(leg: SphericalLeg) -> SphericalLeg:
 
 def mechanical_energy(leg: SphericalLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
     """Kinetic and potential energy (J) of platform and legs, each (...); potential zero at O."""
+    check_params(leg, SphericalLeg, "leg")
     qa, qda = _check_state(q, qd)
     m = _motion(leg, qa, qda, np.zeros_like(qa))
     g = np.asarray(leg.gravity)
@@ -244,6 +250,9 @@ def distribute_forces(
     """
     J = as_array(J, "J", (3, 2), finite=False)
     t = as_array(tau, "tau", (2,), finite=False)
+    # non-finite samples: zeroed before any arithmetic (then flagged by ok below), never propagated
+    good = finite_samples(J, 2)[..., None] & finite_samples(t, 1)[..., None]
+    J, t = np.where(good[..., None], J, 0.0), np.where(good, t, 0.0)
     if driven_legs is None:
         A = np.einsum("...ki,...kj->...ij", J, J)
         det = A[..., 0, 0] * A[..., 1, 1] - A[..., 0, 1] * A[..., 1, 0]
@@ -257,8 +266,9 @@ def distribute_forces(
         x = np.einsum("...ij,...j->...i", inv, t) / dsafe[..., None]
         f = np.einsum("...ij,...j->...i", J, x)
     else:
-        pair = tuple(driven_legs)
-        if len(pair) != 2 or pair[0] == pair[1] or not set(pair) <= {0, 1, 2}:
+        pair = tuple(driven_legs) if isinstance(driven_legs, tuple | list) else ()
+        pair = tuple(check_int(x, "driven_legs", low=0, high=2) for x in pair)
+        if len(pair) != 2 or pair[0] == pair[1]:
             raise ValueError(
                 f"Expected driven_legs to be two different leg indices in 0..2, got {driven_legs!r}."
             )
@@ -274,7 +284,7 @@ def distribute_forces(
         f = np.zeros((*det.shape, 3))
         f[..., i] = f0
         f[..., j] = f1
-    ok = ok & np.all(np.isfinite(t), -1)
+    ok = ok & good[..., 0]
     f = np.where(ok[..., None], f, np.nan)
     resid = np.linalg.norm(
         np.einsum("...ki,...k->...i", J, np.where(ok[..., None], f, 0.0)) - np.where(ok[..., None], t, 0.0),
@@ -308,6 +318,7 @@ def inverse_dynamics(
     q = (alpha, beta) rad; ``platform_wrench (..., 6)`` ``[m_O; f]`` on the platform (base frame, moment
     about O); ``driven_legs`` selects the force distribution (see :func:`distribute_forces`).
     """
+    check_params(leg, SphericalLeg, "leg")
     qa, qda, qdda = _check_state(q, qd, qdd)
     w = None if platform_wrench is None else as_array(platform_wrench, "platform_wrench", (6,))
     m = _motion(leg, qa, qda, qdda)

@@ -18,8 +18,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
-from robomech.spatial import sincos
+from robomech._validation import as_array, check_int, check_params
+
+# the unvalidated kernel: inputs are validated once at this module's public boundary
+from robomech.spatial._so3 import _sincos as sincos
 
 from ._params import SphericalLeg
 
@@ -141,6 +143,7 @@ def inverse_kinematics(leg: SphericalLeg, alpha: object, beta: object) -> Invers
 
     Every finite (alpha, beta) has a solution; non-finite angles raise ``ValueError``.
     """
+    check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
     shape = a.shape
     n = a.size
@@ -210,8 +213,8 @@ def forward_kinematics(leg: SphericalLeg, lengths: object, branch: int = 0) -> F
     alpha = 0; ``branch=1`` is ``a = phi + pi - asin(s)``. Bad samples (non-finite, non-positive, no
     assembly) are flagged in ``.valid``; a wrong shape raises ``ValueError``.
     """
-    if branch not in (0, 1):
-        raise ValueError(f"Expected branch to be 0 or 1, got {branch!r}.")
+    check_params(leg, SphericalLeg, "leg")
+    branch = check_int(branch, "branch", low=0, high=1)
     L = as_array(lengths, "lengths", (3,), finite=False)
     shape = L.shape[:-1]
     n = int(np.prod(shape, dtype=int))
@@ -333,7 +336,9 @@ def _fk_kernel_compiled(
 @functools.cache
 def _fk_numba_kernels():
     """Compile (or load from the on-disk cache) the forward-kinematics kernels: (fit, close)."""
-    import numba  # deferred: ~0.3 s import and the compilation are paid by large-batch FK users only
+    from robomech._numba import import_numba
+
+    numba = import_numba()  # deferred: ~0.3 s import and compilation, paid by large-batch FK users only
 
     @numba.njit(parallel=True, cache=True, error_model="numpy")
     def fit(L, R, r, h, max_iter, newton_tol, gn_tol, floor2, M, cb, sb, ok, conv):  # pragma: no cover
@@ -496,6 +501,7 @@ def _fit_beta_cs(
 
 def jacobian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
     """``J[..., i, j] = d l_i / d (alpha, beta)_j`` -> (..., 3, 2) in m/rad."""
+    check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
     J = np.empty((a.size, 3, 2))
     _chunked(lambda *x: _jacobian_kernel(leg, *x), (a.reshape(-1), b.reshape(-1)), (J,))
@@ -549,6 +555,7 @@ def _derivatives(leg: SphericalLeg, sa, ca, sb, cb):
 
 def hessian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
     """``H[..., i, j, k] = d^2 l_i / dq_j dq_k`` with q = (alpha, beta) -> (..., 3, 2, 2) in m/rad^2."""
+    check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
     q, dq, d2q = _derivatives(leg, np.sin(a), np.cos(a), np.sin(b), np.cos(b))
     l = np.sqrt(np.maximum(q, LENGTH_FLOOR**2))[..., None, None]
@@ -577,6 +584,7 @@ def influence_coefficients(leg: SphericalLeg, alpha: object, beta: object) -> np
     paper 1, eqs. (8)-(12) with the reference point moved from P to O; eq. (12)'s first row lacks a
     factor sin(alpha) on its ``R r`` term (errata). ``jacobian = G[..., :3] @ angular_velocity_jacobian``.
     """
+    check_params(leg, SphericalLeg, "leg")
     ik = inverse_kinematics(leg, alpha, beta)
     G = np.empty((*ik.lengths.shape[:-1], 3, 6))
     G[..., :3] = np.cross(ik.platform_points, ik.unit_vectors)
@@ -591,6 +599,7 @@ def leg_rates(
 
     ``ldot = J qd``, ``lddot = J qdd + qd^T H qd`` (conventions: H[..., i, j, k] = dJ_ij/dq_k).
     """
+    check_params(leg, SphericalLeg, "leg")
     qa = as_array(q, "q", (2,))
     qda = as_array(qd, "qd", (2,))
     qdda = as_array(qdd, "qdd", (2,))

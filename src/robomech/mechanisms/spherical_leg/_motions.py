@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_choice, check_real
 from robomech.trajectory import quintic, sinusoid
 
 __all__ = ["AMPLITUDE", "FREQUENCY", "fig5_motion", "sway"]
@@ -21,8 +21,8 @@ def sway(t: object, about: str, beta0: float = 0.0) -> tuple[np.ndarray, np.ndar
 
     Returns q, qd, qdd, each (..., 2) with q = (alpha, beta).
     """
-    if about not in ("x", "y"):
-        raise ValueError(f"Expected about to be 'x' or 'y', got {about!r}.")
+    check_choice(about, "about", ("x", "y"))
+    beta0 = check_real(beta0, "beta0")
     t = as_array(t, "t")
     p = sinusoid(t, AMPLITUDE, FREQUENCY)
     z = np.zeros_like(t)
@@ -39,6 +39,7 @@ def fig5_motion(case: str, t: object) -> tuple[np.ndarray, np.ndarray, np.ndarra
     A 2 pi f = 0.33 rad/s at t = 5 s (an impulse the forces cannot show). ``"c"``: sway about X at
     beta = 0 (the print does not state beta for case (c): an assumption).
     """
+    check_choice(case, "case", ("a", "b", "c"))
     t = as_array(t, "t")
     if case == "a":
         return sway(t, "x", np.pi / 3)

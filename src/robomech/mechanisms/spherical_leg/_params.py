@@ -20,17 +20,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from robomech._validation import as_array, check_bool, check_choice, check_positive
+
 __all__ = ["LegBody", "SphericalLeg"]
 
 _MM = 1e-3
 
 
-def _positive(value: float, name: str, *, allow_zero: bool = False) -> float:
-    v = float(value)
-    ok = math.isfinite(v) and (v >= 0.0 if allow_zero else v > 0.0)
-    if not ok:
-        raise ValueError(f"Expected {name} {'>= 0' if allow_zero else '> 0'} and finite, got {value!r}.")
-    return v
+def _positive(obj: object, field_name: str, label: str, *, allow_zero: bool = False) -> None:
+    """Validate a scalar field and store it as a float (a str, bool or array never stays in a field)."""
+    value = check_positive(getattr(obj, field_name), label, allow_zero=allow_zero)
+    object.__setattr__(obj, field_name, value)
 
 
 @dataclass(frozen=True)
@@ -50,12 +50,13 @@ class LegBody:
     shape: str = "round"
 
     def __post_init__(self) -> None:
-        _positive(self.length, f"{self.name}.length")
-        _positive(self.width, f"{self.name}.width")
-        _positive(self.wall, f"{self.name}.wall")
-        _positive(self.mass, f"{self.name}.mass", allow_zero=True)
-        if self.shape not in ("round", "square"):
-            raise ValueError(f"Expected {self.name}.shape to be 'round' or 'square', got {self.shape!r}.")
+        if not isinstance(self.name, str):
+            raise ValueError(f"Expected name to be a str, got {type(self.name).__name__}.")
+        _positive(self, "length", f"{self.name}.length")
+        _positive(self, "width", f"{self.name}.width")
+        _positive(self, "wall", f"{self.name}.wall")
+        _positive(self, "mass", f"{self.name}.mass", allow_zero=True)
+        check_choice(self.shape, f"{self.name}.shape", ("round", "square"))
 
     @property
     def axial_inertia(self) -> float:
@@ -118,10 +119,11 @@ class SphericalLeg:
 
     def __post_init__(self) -> None:
         for name in ("R", "r", "h", "platform_side", "platform_thickness", "screw_lead"):
-            _positive(getattr(self, name), name)
-        _positive(self.platform_mass, "platform_mass", allow_zero=True)
-        _positive(self.length_min, "length_min", allow_zero=True)
-        _positive(self.length_max, "length_max")
+            _positive(self, name, name)
+        _positive(self, "platform_mass", "platform_mass", allow_zero=True)
+        _positive(self, "length_min", "length_min", allow_zero=True)
+        _positive(self, "length_max", "length_max")
+        object.__setattr__(self, "screw_spin", check_bool(self.screw_spin, "screw_spin"))
         if self.length_max <= self.length_min:
             raise ValueError(
                 f"Expected length_max > length_min, got length_max={self.length_max!r}, "
@@ -131,10 +133,11 @@ class SphericalLeg:
             bodies = getattr(self, name)
             if len(bodies) != 3 or not all(isinstance(b, LegBody) for b in bodies):
                 raise ValueError(f"Expected {name} to be a tuple of 3 LegBody, got {bodies!r}.")
-        g = tuple(float(x) for x in self.gravity)
-        if len(g) != 3 or not all(math.isfinite(x) for x in g):
+        g = as_array(self.gravity, "gravity", (3,))
+        flags = any(isinstance(x, bool | np.bool_) for x in np.asarray(self.gravity, dtype=object).ravel())
+        if g.ndim != 1 or flags:
             raise ValueError(f"Expected gravity to be 3 finite numbers, got {self.gravity!r}.")
-        object.__setattr__(self, "gravity", g)
+        object.__setattr__(self, "gravity", tuple(float(x) for x in g))
 
     @classmethod
     def paper(cls) -> SphericalLeg:

@@ -11,7 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech.spatial import sincos
+from robomech._validation import check_params
+
+# the unvalidated kernel: inputs are validated once at this module's public boundary
+from robomech.spatial._so3 import _sincos as sincos
 
 from ._kinematics import LENGTH_FLOOR, _angles, _chunked, _squared_length_columns
 from ._params import SphericalLeg
@@ -48,6 +51,7 @@ def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMa
 
     The singular values of the 3x2 J come from the eigenvalues of the 2x2 Gram matrix J^T J.
     """
+    check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
     n = a.size
     outs = (np.empty((n, 3)), np.empty(n, dtype=bool), np.empty(n), np.empty(n), np.empty(n), np.empty(n))

@@ -23,8 +23,11 @@ from typing import TypeVar
 
 import numpy as np
 
-from robomech._validation import as_array
-from robomech.spatial import lie_bracket, sincos
+from robomech._validation import as_array, check_params
+from robomech.spatial import lie_bracket
+
+# the unvalidated kernel: inputs are validated once at this module's public boundary
+from robomech.spatial._so3 import _sincos as sincos
 
 from ._params import VectoredThruster
 
@@ -207,6 +210,7 @@ def joint_axes(th: VectoredThruster, q: object) -> JointAxes:
 
     Singular samples have NaN s13 and s0 and ``valid`` False.
     """
+    check_params(th, VectoredThruster, "th")
     return _axes(th, _q(q))
 
 
@@ -349,6 +353,7 @@ def link_clearance(th: VectoredThruster, q: object) -> np.ndarray:
 
     Section 4.1 (2).  NaN where the configuration is singular (covered by ``joint_axes(...).valid``).
     """
+    check_params(th, VectoredThruster, "th")
     return _interference(th, _q(q))
 
 
@@ -403,11 +408,13 @@ def forward_kinematics(th: VectoredThruster, q: object) -> FKResult:
     (``|s22 x s12| <= SINGULAR_TOL``) give NaN outputs with ``valid`` False.  The link-interference
     limit (Section 4.1 (2)) is evaluated by :func:`link_clearance` and ``workspace_map``.
     """
+    check_params(th, VectoredThruster, "th")
     return _chunked(_fk, th, _q(q))
 
 
 def platform_rotation(th: VectoredThruster, q: object) -> RotationResult:
     """Platform rotation ``R_OP (..., 3, 3)`` = Ry(q2) Rx(-theta), columns (-s22, -s13, s0)."""
+    check_params(th, VectoredThruster, "th")
     ax = _axes(th, _q(q))
     return RotationResult(R=np.stack([-ax.s22, -ax.s13, ax.s0], axis=-1), valid=ax.valid)
 
@@ -489,6 +496,7 @@ def inverse_kinematics(th: VectoredThruster, s: object) -> IKResult:
     ``tilt_ok`` (universal joint); ``valid`` is all of them.  The link-interference limit is checked
     on the inputs by :func:`link_clearance` / ``workspace_map``.
     """
+    check_params(th, VectoredThruster, "th")
     return _chunked(_ik, th, as_array(s, "s", (3,)))
 
 
@@ -524,6 +532,7 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
     Product of exponentials from the home axes: ``R = Ry(q2) exp(s22(0) theta)`` on the RR chain and
     ``R = Rx(q1) exp(s12(0) rho2) exp(s13(0) rho3)`` on the RRR chain.
     """
+    check_params(th, VectoredThruster, "th")
     q = _q(q)
     ax = _axes(th, q)
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
@@ -546,6 +555,7 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
 
 def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
     """Passive joint rates (..., 3), rad/s, ordered (RR s22, RRR s12, RRR s13), from ``q, qd (..., 2)``."""
+    check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
     ax = _axes(th, q)
     x = _rates(ax, qd)
@@ -591,6 +601,7 @@ def jacobian(th: VectoredThruster, q: object) -> JacobianResult:
     ``omega`` is the angular velocity of the platform carrying the propeller shaft (the propeller's
     own spin about s0 excluded).  NaN with ``valid`` False at singular inputs.
     """
+    check_params(th, VectoredThruster, "th")
     return _chunked(_jacobian, th, _q(q))
 
 
@@ -602,6 +613,7 @@ class VelocityResult:
 
 def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityResult:
     """Platform angular velocity ``omega = J qd`` (..., 3), rad/s, from ``q, qd (..., 2)``."""
+    check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
     jr = _jacobian(th, q)
     return VelocityResult(omega=np.einsum("...ij,...j->...i", jr.J, qd), valid=jr.valid)
@@ -622,6 +634,7 @@ def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: objec
     paper 5, eq. (24): printed with the Klein form (a scalar, zero for axes through O) where the Lie
     bracket is needed; eq. (32) therefore lacks the velocity-product terms included here.
     """
+    check_params(th, VectoredThruster, "th")
     q, qd, qdd = _q(q), as_array(qd, "qd", (2,)), as_array(qdd, "qdd", (2,))
     ax = _axes(th, q)
     s13 = np.where(ax.valid[..., None], ax.s13, 0.0)

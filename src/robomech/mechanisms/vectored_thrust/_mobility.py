@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_params
 from robomech.analysis import mobility
 from robomech.spatial import screw_from_axis
 
@@ -36,12 +36,15 @@ def chain_screws(
     the given point (3,) in metres instead of through O (a design perturbation; the paper's axes all
     pass through O, eqs. (5) and (7)).
     """
+    check_params(th, VectoredThruster, "th")
     qa = as_array(q, "q", (2,))
     if qa.ndim != 1:
         raise ValueError(f"Expected q to have shape (2,), got {qa.shape}.")
     ax = _axes(th, qa)
     if not ax.valid:
         raise ValueError(f"Expected q away from the singularity (|s22 x s12| > 0), got q = {qa.tolist()}.")
+    if offsets is not None and not isinstance(offsets, dict):
+        raise ValueError(f"Expected offsets to be a dict of axis name -> point, got {type(offsets).__name__}")
     offsets = dict(offsets or {})
     for k in offsets:
         if k not in _JOINTS:
@@ -60,6 +63,7 @@ def platform_mobility(
     far above the SVD rank tolerance (1e-9).  The returned ``constraint_wrenches`` are wrenches
     ``[m; f]`` that do no work on any joint screw S: ``virtual_power(W, S) = 0``.
     """
+    check_params(th, VectoredThruster, "th")
     rrr, rr = chain_screws(th, q, offsets)
     return mobility.analyze([rrr, rr], length_scale=CORE_LENGTH_SCALE)
 
@@ -83,6 +87,7 @@ def mechanism_mobility(
     taken as an equivalent chain) followed by the shaft bearing R about s0 through O.  The propeller has
     3 rotational DOF (platform 2R + spin) when the universal-joint centre coincides with O.
     """
+    check_params(th, VectoredThruster, "th")
     plat = platform_mobility(th, q, offsets)
     qa = as_array(q, "q", (2,))
     c = as_array(ujoint_centre, "ujoint_centre", (3,))

@@ -5,21 +5,22 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from robomech._validation import check_real
+
 __all__ = ["VectoredThruster"]
 
 
 def _check_range(name: str, lim: tuple[float, float], bound: float) -> tuple[float, float]:
-    try:
-        lo, hi = (float(v) for v in lim)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"Expected {name} to be a (lo, hi) pair of radians, got {lim!r}.") from exc
+    if not isinstance(lim, tuple | list) or len(lim) != 2:
+        raise ValueError(f"Expected {name} to be a (lo, hi) pair of radians, got {lim!r}.")
+    lo, hi = (check_real(v, name, finite=False) for v in lim)
     if not (math.isfinite(lo) and math.isfinite(hi) and -bound <= lo < hi <= bound):
         raise ValueError(f"Expected {name} to satisfy -{bound:.4g} <= lo < hi <= {bound:.4g}, got {lim!r}.")
     return lo, hi
 
 
 def _check_pos(name: str, value: float, upper: float = math.inf) -> float:
-    v = float(value)
+    v = check_real(value, name, finite=False)
     if not (math.isfinite(v) and 0.0 < v < upper):
         raise ValueError(f"Expected {name} in (0, {upper:.4g}), got {value!r}.")
     return v
@@ -59,7 +60,7 @@ class VectoredThruster:
     interference_clearance: float = 0.3
 
     def __post_init__(self) -> None:
-        _check_pos("arc_angle", self.arc_angle, math.pi / 2)
+        object.__setattr__(self, "arc_angle", _check_pos("arc_angle", self.arc_angle, math.pi / 2))
         radius_names = (
             "platform_radius",
             "rr_arc_radius",
@@ -68,15 +69,16 @@ class VectoredThruster:
             "propeller_arm",
         )
         for name in radius_names:
-            _check_pos(name, getattr(self, name))
+            object.__setattr__(self, name, _check_pos(name, getattr(self, name)))
         object.__setattr__(self, "q1_limits", _check_range("q1_limits", self.q1_limits, math.pi))
         object.__setattr__(self, "q2_limits", _check_range("q2_limits", self.q2_limits, math.pi / 2))
-        _check_pos("tilt_limit", self.tilt_limit, math.pi / 2)
-        v = float(self.interference_clearance)
+        object.__setattr__(self, "tilt_limit", _check_pos("tilt_limit", self.tilt_limit, math.pi / 2))
+        v = check_real(self.interference_clearance, "interference_clearance", finite=False)
         if not (math.isfinite(v) and 0.0 <= v < math.pi / 2):
             raise ValueError(
                 f"Expected interference_clearance in [0, pi/2) rad, got {self.interference_clearance!r}."
             )
+        object.__setattr__(self, "interference_clearance", v)
         radii = (self.platform_radius, self.rr_arc_radius, self.rrr_arc2_radius, self.rrr_arc1_radius)
         if self.propeller_arm <= max(radii):
             raise ValueError(

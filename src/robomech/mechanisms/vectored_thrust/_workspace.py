@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array
+from robomech._validation import as_array, check_int, check_params
 
 from ._kinematics import _chunked, _fk, _interference, _jacobian, _q
 from ._params import VectoredThruster
@@ -75,12 +75,14 @@ def _dexterity(J: np.ndarray, ok: np.ndarray) -> np.ndarray:
 
 def dexterity(th: VectoredThruster, q: object) -> np.ndarray:
     """Dexterity 1/cond(J) (...,) in [0, 1] at inputs ``q (..., 2)``; 0 at singular inputs."""
+    check_params(th, VectoredThruster, "th")
     jr = _jacobian(th, _q(q))
     return _dexterity(jr.J, jr.valid)
 
 
 def workspace_map(th: VectoredThruster, q: object) -> WorkspaceMap:
     """Section 4 at each input sample ``q (..., 2)`` (rad): tip, limits, singularity, dexterity."""
+    check_params(th, VectoredThruster, "th")
     return _chunked(_workspace_map, th, _q(q))
 
 
@@ -109,23 +111,29 @@ def _workspace_map(th: VectoredThruster, q: np.ndarray) -> WorkspaceMap:
 
 def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = None) -> np.ndarray:
     """Regular grid (n1, n2, 2) over ``limits`` ((lo, hi) per input, rad; default the input ranges)."""
+    check_params(th, VectoredThruster, "th")
     lim = np.array([th.q1_limits, th.q2_limits]) if limits is None else as_array(limits, "limits", (2, 2))
     if lim.shape != (2, 2) or np.any(lim[:, 1] <= lim[:, 0]):
         raise ValueError(f"Expected limits of shape (2, 2) with lo < hi per input, got {lim.tolist()}.")
-    n1, n2 = (n, n) if isinstance(n, int) else n
-    if n1 < 2 or n2 < 2:
-        raise ValueError(f"Expected n >= 2 per input, got {n!r}.")
+    if isinstance(n, tuple | list):
+        if len(n) != 2:
+            raise ValueError(f"Expected n to be an int or a pair of ints >= 2, got {n!r}.")
+        n1, n2 = (check_int(k, "n", low=2) for k in n)
+    else:
+        n1 = n2 = check_int(n, "n", low=2)
     g1, g2 = np.linspace(*lim[0], n1), np.linspace(*lim[1], n2)
     return np.stack(np.meshgrid(g1, g2, indexing="ij"), axis=-1)
 
 
 def singular_points(th: VectoredThruster) -> np.ndarray:
     """Passive-axes-parallel singular inputs (2, 2), q1 in (-pi, pi], |q2| < pi/2: (0, a), (pi, -a)."""
+    check_params(th, VectoredThruster, "th")
     a = th.arc_angle
     return np.array([[0.0, a], [np.pi, -a]])
 
 
 def idle_input_curve(th: VectoredThruster, q1: object) -> np.ndarray:
     """q2 (...,) on the rank-deficient curve ``tan q2 = tan a / cos q1`` for |q1| < pi/2 (rad)."""
+    check_params(th, VectoredThruster, "th")
     q1 = as_array(q1, "q1")
     return np.arctan2(np.tan(th.arc_angle), np.cos(q1))

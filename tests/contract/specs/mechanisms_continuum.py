@@ -1,0 +1,150 @@
+"""Bad-input specs of robomech.mechanisms.continuum (paper 3)."""
+
+import numpy as np
+from contract_spec import (
+    BAD_INT,
+    BAD_NONNEGATIVE,
+    BAD_POSITIVE,
+    CONSTANT,
+    RESULT_TYPE,
+    Spec,
+    exempt,
+)
+
+from robomech.mechanisms import continuum as c
+
+P = "robomech.mechanisms.continuum."
+ROBOT = c.ContinuumRobot.paper()
+PSI = np.array([[0.3, 0.1], [0.5, -1.0], [0.1, 2.0]])
+TIP = c.tip_position(ROBOT, PSI)
+TENSION = c.cable_tensions(ROBOT, PSI).tension
+DIRECTION = np.ones((3, 3))
+Q = c.compensated_drive(ROBOT, PSI).q
+BAD_MODEL = ("helix", None, 1)
+_W = np.abs(np.random.default_rng(0).normal(size=(3, 8)))
+
+
+def _psi(**extra):
+    return Spec(args={"robot": ROBOT, "psi": PSI, **extra}, arrays={"psi": 1}, params=("robot",))
+
+
+def _psi_model(default):
+    return Spec(
+        args={"robot": ROBOT, "psi": PSI, "model": default},
+        arrays={"psi": 1},
+        params=("robot",),
+        options={"model": BAD_MODEL},
+    )
+
+
+SPECS = {
+    P + "IK_TOLERANCE": CONSTANT,
+    **exempt("DriveResult FrictionEstimate IKResult SimulationResult TensionResult", RESULT_TYPE, P),
+    P + "ContinuumRobot": Spec(
+        args={"n_segments": 1, "segment_length": 0.09, "friction": (0.2, 0.3, 0.25), "pretension": 5.0},
+        options={
+            "n_segments": (*BAD_INT, 0, True),
+            "segment_length": BAD_POSITIVE,
+            "pretension": BAD_NONNEGATIVE,
+            "friction": (
+                None,
+                "abc",
+                (0.1, 0.2),
+                (0.1, 0.2, np.nan),
+                (0.1, 0.2, -0.1),
+                ((0.1, 0.2, 0.3),) * 2,
+            ),
+        },
+    ),
+    P + "forward_kinematics": _psi(),
+    P + "tip_position": _psi(),
+    P + "tip_jacobian": _psi(),
+    P + "disk_transforms": _psi(),
+    P + "elastic_energy": _psi(),
+    P + "elastic_gradient": _psi(),
+    P + "coupling_moments": _psi(),
+    P + "wrap_angles": _psi(),
+    P + "span_lengths": _psi_model("chord"),
+    P + "span_jacobian": _psi_model("chord"),
+    P + "cable_lengths": _psi_model("arc"),
+    P + "cable_jacobian": _psi_model("arc"),
+    P + "theoretical_drive": _psi_model("arc"),
+    P + "friction_factors": Spec(
+        args={"robot": ROBOT, "psi": PSI, "direction": DIRECTION},
+        arrays={"psi": 1, "direction": 1},
+        params=("robot",),
+    ),
+    P + "segment_transform": Spec(
+        args={"theta": PSI[:, 0], "beta": PSI[:, 1], "length": 0.09},
+        arrays={"theta": 0, "beta": 0, "length": 0},
+        options={"length": (-0.1,)},
+    ),
+    P + "inverse_kinematics": Spec(
+        args={"robot": ROBOT, "p_tip": TIP}, arrays={"p_tip": 1}, params=("robot",), mask="reachable"
+    ),
+    P + "cable_tensions": Spec(
+        args={
+            "robot": ROBOT,
+            "psi": PSI,
+            "wrench": np.zeros((3, 6)),
+            "direction": DIRECTION,
+            "model": "chord",
+            "pretension": 5.0,
+        },
+        arrays={"psi": 1, "wrench": 1, "direction": 1},
+        params=("robot",),
+        mask="taut",
+        options={"pretension": tuple(v for v in BAD_NONNEGATIVE if v is not None), "model": BAD_MODEL},
+    ),
+    P + "cable_elongation": Spec(
+        args={"robot": ROBOT, "psi": PSI, "tension": TENSION, "direction": DIRECTION, "model": "chord"},
+        arrays={"psi": 1, "tension": 1, "direction": 1},
+        params=("robot",),
+        options={"model": BAD_MODEL},
+    ),
+    P + "compensated_drive": Spec(
+        args={
+            "robot": ROBOT,
+            "psi": PSI,
+            "direction": DIRECTION,
+            "wrench": np.zeros((3, 6)),
+            "model": "chord",
+        },
+        arrays={"psi": 1, "direction": 1, "wrench": 1},
+        params=("robot",),
+        mask="taut",
+        options={"model": BAD_MODEL},
+    ),
+    P + "simulate": Spec(
+        args={"robot": ROBOT, "q": Q, "direction": DIRECTION, "model": "chord"},
+        arrays={"q": 1, "direction": 1},
+        params=("robot",),
+        mask="converged",
+        options={"model": BAD_MODEL},
+    ),
+    P + "capstan_coefficient": Spec(
+        args={"rho": np.array([2.0, 3.0]), "alpha": 1.0, "n": 0.5},
+        arrays={"rho": 0, "alpha": 0, "n": 0},
+        options={"n": (0.0, -0.5, 1.5), "rho": (0.0,), "alpha": (-1.0,)},
+    ),
+    P + "capstan_tension_ratio": Spec(
+        args={"phi": np.array([0.5, 1.0]), "rho": np.array([2.0, 3.0]), "alpha": 1.0, "n": 0.5, "t_out": 1.0},
+        arrays={"phi": 0, "alpha": 0, "n": 0, "t_out": 0},
+        options={"n": (0.0, 1.5), "rho": (0.0, np.nan, None, "2"), "phi": (-1.0,), "t_out": (0.0,)},
+    ),
+    P + "classical_capstan_ratio": Spec(
+        args={"phi": np.array([0.5, 1.0]), "mu": 0.3}, arrays={"phi": 0, "mu": 0}
+    ),
+    P + "identify_friction": Spec(
+        args={
+            "wrap": _W,
+            "t_in": 5 * np.exp(0.3 * _W),
+            "t_out": np.full((3, 8), 5.0),
+            "direction": np.ones((3, 8)),
+            "sigma_t": 0.1,
+        },
+        arrays={"wrap": 1, "t_in": 1, "t_out": 1, "direction": 1},
+        wrong_shapes={"wrap": ((3, 9),), "t_in": ((3, 9),), "t_out": ((3, 9),), "direction": ((3, 9),)},
+        options={"sigma_t": tuple(v for v in BAD_POSITIVE if v is not None)},
+    ),
+}

@@ -1,0 +1,297 @@
+"""The contract suite: every public name has a bad-input spec, and every spec holds.
+
+See README.md in this folder for how to add a spec.  What is checked (docs/conventions.md):
+bad input raises ``ValueError`` naming the argument with expected vs got, never another exception;
+per-sample failures are masked, never an unmasked non-finite value, never a changed good sample;
+no call on bad input takes longer than ``BAD_CALL_SECONDS``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import faulthandler
+import inspect
+import re
+import signal
+from typing import Any
+
+import numpy as np
+import pytest
+from contract_spec import Spec, load_specs, public_names, spec_file_for
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+# Acceptance of issue 14: no public call takes longer than 5 s on bad input.
+BAD_CALL_SECONDS = 5.0
+# A good call may include a one-off numba compile or a MuJoCo model build.
+GOOD_CALL_SECONDS = 120.0
+# A hang inside compiled code (LAPACK, numba) ignores Python signals: the process is then ended with a
+# traceback by faulthandler after this many seconds, so the suite can never hang.
+HARD_KILL_FACTOR = 4.0
+# Good samples of a mixed batch must be unchanged by a bad sample beside them.  Batched kernels process
+# samples independently, so they agree to round-off; this allows a few ulps of reassociation.
+SAME_RTOL = 1e-12
+SAME_ATOL = 1e-12
+
+PUBLIC = public_names()
+SPECS, WHERE = load_specs()
+ACTIVE = {k: v for k, v in SPECS.items() if isinstance(v, Spec)}
+
+
+# --- helpers --------------------------------------------------------------------------------------
+class _CallTimeout(Exception):
+    pass
+
+
+@contextlib.contextmanager
+def bounded(seconds: float):
+    """Fail a call that takes longer than ``seconds`` (SIGALRM; faulthandler for compiled code)."""
+
+    def _alarm(signum, frame):
+        raise _CallTimeout(f"call took longer than {seconds} s")
+
+    old = signal.signal(signal.SIGALRM, _alarm)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    faulthandler.dump_traceback_later(seconds * HARD_KILL_FACTOR, exit=True)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        faulthandler.cancel_dump_traceback_later()
+        signal.signal(signal.SIGALRM, old)
+
+
+def _target(name: str, spec: Spec):
+    return spec.call if spec.call is not None else PUBLIC[name]
+
+
+def _call(name: str, spec: Spec, args: dict[str, Any], seconds: float = BAD_CALL_SECONDS):
+    with bounded(seconds):
+        return _target(name, spec)(**args)
+
+
+def _default_is_none(name: str, spec: Spec, arg: str) -> bool:
+    try:
+        p = inspect.signature(_target(name, spec)).parameters.get(arg)
+    except (TypeError, ValueError):
+        return False
+    return p is not None and p.default is None
+
+
+def _arrays_of(res: Any) -> list[tuple[str, np.ndarray]]:
+    """The numeric arrays of a result: itself, a tuple's items, or a dataclass's fields."""
+    if isinstance(res, np.ndarray):
+        items = [("result", res)]
+    elif isinstance(res, tuple | list):
+        items = [(f"[{i}]", r) for i, r in enumerate(res)]
+    elif dataclasses.is_dataclass(res):
+        items = [(f.name, getattr(res, f.name)) for f in dataclasses.fields(res)]
+    else:
+        items = []
+    return [(k, v) for k, v in items if isinstance(v, np.ndarray) and v.dtype.kind in "biuf"]
+
+
+def _mask_of(spec: Spec, res: Any) -> np.ndarray:
+    if callable(spec.mask):
+        m = spec.mask(res)
+    else:
+        m = res[spec.mask] if isinstance(spec.mask, int) else getattr(res, spec.mask)
+    return np.asarray(m, dtype=bool)
+
+
+def _check_finite_where_valid(name: str, spec: Spec, res: Any) -> None:
+    if not spec.finite_result:
+        return
+    if spec.mask is None:
+        for label, a in _arrays_of(res):
+            assert np.all(np.isfinite(a)), f"{name}: result {label} has non-finite values"
+        return
+    mask = _mask_of(spec, res)
+    for label, a in _arrays_of(res):
+        if a.dtype.kind != "f" or a.shape[: mask.ndim] != mask.shape:
+            continue
+        flat = np.isfinite(a).reshape(mask.size, -1).all(axis=1)
+        bad = np.flatnonzero(mask.reshape(-1) & ~flat)
+        assert bad.size == 0, f"{name}: result {label} not finite at samples {bad} where {spec.mask} is True"
+
+
+_GOOD: dict[str, Any] = {}
+
+
+def _good(name: str, spec: Spec) -> Any:
+    if name not in _GOOD:
+        _GOOD[name] = _call(name, spec, dict(spec.args), GOOD_CALL_SECONDS)
+    return _GOOD[name]
+
+
+def _expect_value_error(name: str, spec: Spec, args: dict[str, Any], arg: str, what: str) -> None:
+    with pytest.raises(ValueError) as info:
+        _call(name, spec, args)
+    msg = str(info.value)
+    assert re.search(rf"(?<![\w]){re.escape(arg)}(?![\w])", msg), (
+        f"{name}({arg}={what}): the ValueError must name {arg!r}; got: {msg}"
+    )
+    assert "xpected" in msg, f"{name}({arg}={what}): say what was expected and what was got; got: {msg}"
+
+
+def _check_masked(name: str, spec: Spec, arg: str, args: dict[str, Any], flat_index: int) -> None:
+    good = _good(name, spec)
+    a = np.asarray(spec.args[arg], dtype=float)
+    core = spec.arrays[arg]
+    batch = a.shape[: a.ndim - core]
+    core_size = int(np.prod(a.shape[a.ndim - core :], dtype=int))
+    res = _call(name, spec, args)
+    mask = _mask_of(spec, res)
+    gmask = _mask_of(spec, good)
+    assert mask.shape == batch, (
+        f"spec of {name}: masked argument {arg} must have the batch shape {mask.shape} of the result "
+        f"mask, it has {batch}"
+    )
+    sample = flat_index // core_size
+    assert not mask.reshape(-1)[sample], f"{name}: non-finite {arg} at sample {sample} is not masked"
+    _check_finite_where_valid(name, spec, res)
+    keep = np.ones(mask.size, dtype=bool)
+    keep[sample] = False
+    assert np.array_equal(mask.reshape(-1)[keep], gmask.reshape(-1)[keep]), (
+        f"{name}: a bad {arg} sample changed the mask of good samples"
+    )
+    good_arrays = dict(_arrays_of(good))
+    for label, v in _arrays_of(res):
+        g = good_arrays.get(label)
+        if g is None or v.shape != g.shape or v.shape[: mask.ndim] != mask.shape:
+            continue
+        vv = v.reshape(mask.size, -1)[keep].astype(float)
+        gg = g.reshape(mask.size, -1)[keep].astype(float)
+        assert np.allclose(vv, gg, rtol=SAME_RTOL, atol=SAME_ATOL, equal_nan=True), (
+            f"{name}: a bad {arg} sample changed {label} of good samples"
+        )
+
+
+def _variants(name: str, spec: Spec, arg: str) -> list[tuple[str, Any]]:
+    a = np.array(spec.args[arg], dtype=float)
+    out = []
+    for label, val in (("nan", np.nan), ("inf", np.inf), ("-inf", -np.inf)):
+        b = a.copy()
+        b.flat[0] = val
+        out.append((label, b))
+    c = a.astype(complex)
+    c.flat[0] += 1j
+    out.append(("complex", c))
+    core = spec.arrays[arg]
+    if arg not in spec.wrong_shapes and core >= 1 and a.ndim >= 1:
+        out.append(("shape+1", np.concatenate([a, a[..., :1]], axis=-1)))
+    for shape in spec.wrong_shapes.get(arg, ()):
+        out.append((f"shape{shape}", np.full(shape, 0.1)))
+    out.append(("str", "abc"))
+    if not _default_is_none(name, spec, arg):
+        out.append(("None", None))
+    out.append(("bool", np.ones(a.shape, dtype=bool)))
+    return out
+
+
+def _cases():
+    arrays, params, options = [], [], []
+    for name, spec in sorted(ACTIVE.items()):
+        marks = [pytest.mark.slow] if spec.slow else []
+        for arg in spec.arrays:
+            for label, _ in _variants(name, spec, arg):
+                arrays.append(pytest.param(name, arg, label, marks=marks, id=f"{name}-{arg}-{label}"))
+        for arg in spec.params:
+            for label in ("None", "str", "object"):
+                if label == "None" and _default_is_none(name, spec, arg):
+                    continue
+                params.append(pytest.param(name, arg, label, marks=marks, id=f"{name}-{arg}-{label}"))
+        for opt, bad in spec.options.items():
+            for i, v in enumerate(bad):
+                options.append(pytest.param(name, opt, i, marks=marks, id=f"{name}-{opt}-{v!r}"))
+    return arrays, params, options
+
+
+ARRAY_CASES, PARAM_CASES, OPTION_CASES = _cases()
+
+
+# --- coverage -------------------------------------------------------------------------------------
+def test_every_public_name_has_a_spec():
+    missing = [n for n in sorted(PUBLIC) if n not in SPECS]
+    assert not missing, "public names without a bad-input spec (see tests/contract/README.md):\n" + "\n".join(
+        f"  {n}  -> add it to tests/contract/{spec_file_for(n)}" for n in missing
+    )
+
+
+def test_no_spec_for_a_name_that_is_not_public():
+    stale = [f"{n} (in {WHERE[n]})" for n in sorted(SPECS) if n not in PUBLIC]
+    assert not stale, "specs for names that are not in any public __all__:\n  " + "\n  ".join(stale)
+
+
+# --- the good call --------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "name", [pytest.param(n, marks=[pytest.mark.slow] if s.slow else []) for n, s in sorted(ACTIVE.items())]
+)
+def test_good_call(name):
+    spec = ACTIVE[name]
+    if spec.good_elsewhere:
+        pytest.skip(f"the good call takes minutes: it runs in {spec.good_elsewhere}")
+    res = _good(name, spec)
+    if spec.mask is not None:
+        assert _mask_of(spec, res).any(), f"spec of {name}: the good call should have valid samples"
+    _check_finite_where_valid(name, spec, res)
+
+
+# --- bad arrays -----------------------------------------------------------------------------------
+@pytest.mark.parametrize(("name", "arg", "variant"), ARRAY_CASES)
+def test_bad_array(name, arg, variant):
+    spec = ACTIVE[name]
+    value = dict(_variants(name, spec, arg))[variant]
+    args = {**spec.args, arg: value}
+    if arg in spec.masked and variant in ("nan", "inf", "-inf"):
+        _check_masked(name, spec, arg, args, 0)
+    else:
+        _expect_value_error(name, spec, args, arg, variant)
+
+
+@pytest.mark.parametrize(
+    ("name", "arg"),
+    [
+        pytest.param(n, a, marks=[pytest.mark.slow] if s.slow else [], id=f"{n}-{a}")
+        for n, s in sorted(ACTIVE.items())
+        for a in s.arrays
+        if np.size(s.args[a]) > 1
+    ],
+)
+def test_bad_element_anywhere(name, arg):
+    """Hypothesis: a non-finite value at any element of any array argument."""
+    spec = ACTIVE[name]
+    a = np.array(spec.args[arg], dtype=float)
+
+    @settings(max_examples=4, deadline=None, database=None)
+    @given(k=st.integers(0, a.size - 1), v=st.sampled_from([np.nan, np.inf, -np.inf]))
+    def check(k, v):
+        b = a.copy()
+        b.flat[k] = v
+        args = {**spec.args, arg: b}
+        if arg in spec.masked:
+            _check_masked(name, spec, arg, args, k)
+        else:
+            _expect_value_error(name, spec, args, arg, f"non-finite at flat index {k}")
+
+    check()
+
+
+# --- parameter objects and options ----------------------------------------------------------------
+class _Foreign:
+    """A parameter object of the wrong kind (think: another mechanism's parameters)."""
+
+
+@pytest.mark.parametrize(("name", "arg", "variant"), PARAM_CASES)
+def test_bad_parameter_object(name, arg, variant):
+    spec = ACTIVE[name]
+    value = {"None": None, "str": "params", "object": _Foreign()}[variant]
+    _expect_value_error(name, spec, {**spec.args, arg: value}, arg, variant)
+
+
+@pytest.mark.parametrize(("name", "opt", "index"), OPTION_CASES)
+def test_bad_option(name, opt, index):
+    spec = ACTIVE[name]
+    value = spec.options[opt][index]
+    _expect_value_error(name, spec, {**spec.args, opt: value}, opt, repr(value))
