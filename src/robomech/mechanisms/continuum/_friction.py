@@ -358,6 +358,7 @@ def stick_slip_tensions(
     path-dependent.  This is the rigid-cable (inextensible) limit of a tendon-through-holes model: the
     tension change travels from the actuator; cable stretch does not feed back on the sliding.
     """
+    check_params(robot, ContinuumRobot, "robot")
     p = as_array(psi, "psi", (None, 2 * robot.n_segments))
     t = as_array(t_act, "t_act", (None, robot.n_cables))
     if p.ndim < 2 or t.ndim < 2:
