@@ -38,6 +38,14 @@ def main(argv: list[str]) -> None:
             f"{1e6 * np.nanmax(table.elongation_error[v]):.1f} µm; {int(v.sum())}/{v.size} valid; "
             f"{time.perf_counter() - t0:.0f} s"
         )
+    if "ident" in which:
+        t0 = time.perf_counter()
+        est, ok = V.identification_from_reference()
+        print(f"mu {est.mu}, std {est.std}, 95% CI low {est.ci_low}, high {est.ci_high}")
+        print(
+            f"residual rms {est.residual_rms:.3f} N, {int(ok.sum())}/{ok.size} reference solves converged, "
+            f"{time.perf_counter() - t0:.0f} s"
+        )
 
 
 if __name__ == "__main__":

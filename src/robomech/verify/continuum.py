@@ -587,6 +587,41 @@ def disk_agreement_table(
     )
 
 
+IDENT_TENSION_NOISE = 0.05
+"""Load-cell noise (N) of the identification data: JLBS-MD 10 kg cells, ~0.05 % of full scale."""
+IDENT_TRACKER_NOISE = 0.022e-3
+"""Tip tracker noise (m): CTrac-380, 0.022 mm (paper 3, Section 5)."""
+
+
+def identification_from_reference(
+    robot: ContinuumRobot | None = None, bends_deg: object = None, seed: int = 38
+) -> tuple[object, np.ndarray]:
+    """Paper 3, Table 1 protocol on the disk-resolved reference: β = 0°, 120°, 240° (cable 1, 2, 3
+    pulled in, the others paid out), θ = 40-90° in 5° steps.  The actuator tensions are the library's
+    for the commanded pose (Table 1 μ); the reference gives the tip, measured with tracker noise and
+    converted to a pose by IK; the load cells add noise to the actuator tensions; then
+    :func:`identify_friction_from_pose`.  Returns ``(estimate, converged mask of the reference solves)``."""
+    from robomech.mechanisms.continuum import identify_friction_from_pose, inverse_kinematics
+
+    robot = ContinuumRobot.paper() if robot is None else robot
+    bends = np.arange(40.0, 90.1, 5.0) if bends_deg is None else np.asarray(bends_deg, float)
+    rng = np.random.default_rng(seed)
+    psi, dirs = [], []
+    for k, b in enumerate(np.radians([0.0, 120.0, 240.0])):
+        psi.append(np.stack([np.radians(bends), np.full(bends.size, b)], -1))
+        dirs.append(np.where(np.arange(3) == k, 1.0, -1.0) * np.ones((bends.size, 1)))
+    psi, d = np.concatenate(psi), np.concatenate(dirs)
+    t = cable_tensions(robot, psi, direction=d).tension
+    sol = solve_disk_robot(disk_robot_for(robot), tension=t, direction=d)
+    tip = sol.T_tip[:, :3, 3] + rng.normal(0.0, IDENT_TRACKER_NOISE, (psi.shape[0], 3))
+    psi_meas = inverse_kinematics(robot, tip).psi
+    t_meas = t + rng.normal(0.0, IDENT_TENSION_NOISE, t.shape)
+    ok = sol.converged
+    start = dataclasses.replace(robot, friction=(0.2,) * robot.n_cables)
+    est = identify_friction_from_pose(start, psi_meas[ok], t_meas[ok], d[ok], sigma_t=IDENT_TENSION_NOISE)
+    return est, ok
+
+
 VERIFICATION = Verification(
     name=_NAME,
     title="Paper 3 continuum robot vs a Cosserat-rod reference (Rucker & Webster 2011)",

@@ -39,8 +39,12 @@ def _psi_model(default):
 
 SPECS = {
     P + "IK_TOLERANCE": CONSTANT,
+    P + "IDENTIFY_MU_MAX": CONSTANT,
     **exempt(
-        "DriveResult FrictionEstimate IKResult SimulationResult TensionHistory TensionResult", RESULT_TYPE, P
+        "DriveResult FrictionEstimate IKResult PoseFrictionEstimate SimulationResult TensionHistory "
+        "TensionResult",
+        RESULT_TYPE,
+        P,
     ),
     P + "ContinuumRobot": Spec(
         args={"n_segments": 1, "segment_length": 0.09, "friction": (0.2, 0.3, 0.25), "pretension": 5.0},
@@ -157,5 +161,18 @@ SPECS = {
         },
         arrays={"psi": 1, "t_act": 1},
         params=("robot",),
+    ),
+    P + "identify_friction_from_pose": Spec(
+        args={
+            "robot": ROBOT,
+            "psi": np.array([[0.8, 0.0], [1.2, 0.0], [1.0, 2.1]]),
+            "t_act": np.array([[8.0, 4.0, 4.0], [9.0, 3.0, 3.0], [4.0, 7.0, 4.0]]),
+            "direction": np.array([[1.0, -1.0, -1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0]]),
+            "sigma_t": 0.05,
+            "model": "chord",
+        },
+        arrays={"psi": 1, "t_act": 1, "direction": 1},
+        params=("robot",),
+        options={"sigma_t": tuple(v for v in BAD_POSITIVE if v is not None), "model": BAD_MODEL},
     ),
 }

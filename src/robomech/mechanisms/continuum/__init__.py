@@ -24,6 +24,7 @@ from ._friction import (
     stick_slip_tensions,
     wrap_angles,
 )
+from ._identification import IDENTIFY_MU_MAX, PoseFrictionEstimate, identify_friction_from_pose
 from ._kinematics import (
     IK_TOLERANCE,
     IKResult,
@@ -48,11 +49,13 @@ from ._statics import (
 )
 
 __all__ = [
+    "IDENTIFY_MU_MAX",
     "IK_TOLERANCE",
     "ContinuumRobot",
     "DriveResult",
     "FrictionEstimate",
     "IKResult",
+    "PoseFrictionEstimate",
     "SimulationResult",
     "TensionHistory",
     "TensionResult",
@@ -71,6 +74,7 @@ __all__ = [
     "forward_kinematics",
     "friction_factors",
     "identify_friction",
+    "identify_friction_from_pose",
     "inverse_kinematics",
     "segment_transform",
     "simulate",
