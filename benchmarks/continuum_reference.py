@@ -27,17 +27,21 @@ def main(argv: list[str]) -> None:
         )
     if "disks" in which:
         t0 = time.perf_counter()
-        table = V.disk_agreement_table()
-        print(table.markdown())
-        v = table.valid
-        print(
-            f"\nchord model: max {1e3 * np.nanmax(table.chord_error[v]):.2f} mm, median "
-            f"{1e3 * np.nanmedian(table.chord_error[v]):.2f} mm; arc model: max "
-            f"{1e3 * np.nanmax(table.arc_error[v]):.2f} mm, median "
-            f"{1e3 * np.nanmedian(table.arc_error[v]):.2f} mm; elongation max "
-            f"{1e6 * np.nanmax(table.elongation_error[v]):.1f} µm; {int(v.sum())}/{v.size} valid; "
-            f"{time.perf_counter() - t0:.0f} s"
-        )
+        segments = (1, 2) if "disks2" in which else (1,)
+        for n in segments:  # row by row, printed as they finish (the whole table takes long)
+            for t in V.CONVERGENCE_PRETENSIONS_N:
+                table = V.disk_agreement_table((n,), (t,))
+                print(table.markdown().splitlines()[-1], flush=True)
+                v = table.valid
+                if v.any():
+                    print(
+                        f"  chord max {1e3 * np.nanmax(table.chord_error[v]):.2f} mm, arc max "
+                        f"{1e3 * np.nanmax(table.arc_error[v]):.2f} mm, elongation max "
+                        f"{1e6 * np.nanmax(table.elongation_error[v]):.1f} µm, "
+                        f"{int(v.sum())}/{v.size} valid, "
+                        f"{time.perf_counter() - t0:.0f} s",
+                        flush=True,
+                    )
     if "ident" in which:
         t0 = time.perf_counter()
         est, ok = V.identification_from_reference()
