@@ -401,6 +401,8 @@ def stick_slip_tensions(
             lo = proximal * np.exp(-mu[:, 0] * eta[i][..., k])
             hi = proximal * np.exp(mu[:, 0] * eta[i][..., k])
             old = prev[..., k]
+            # paper 3, eq. (19): stuck (q_dot = 0) keeps T(t^-1); the print gives no criterion for
+            # sticking: here a span sticks while within the Coulomb-capstan bounds, else slides at them
             new = np.clip(old, lo, hi)
             state[i][..., k] = np.where(old < lo, 1, np.where(old > hi, -1, 0))
             cur[..., k] = np.where(active[:, k], new, 0.0)

@@ -76,6 +76,8 @@ def identify_friction_from_pose(
     if model not in ("arc", "chord"):
         raise ValueError(f"Expected model 'arc' or 'chord', got {model!r}.")
 
+    # paper 3, eq. (38): printed as a linear least-squares fit of the factors eps; eps = exp(-mu eta) of
+    # the measured geometry, so mu is fitted here (nonlinear), per cable, with bounds.
     def residual(mu: np.ndarray) -> np.ndarray:
         r = dataclasses.replace(robot, friction=tuple(float(m) for m in mu))
         return (cable_tensions(r, p, direction=d, model=model).tension - t).ravel()
