@@ -1012,7 +1012,7 @@ def simulate(
     ``tau`` the actuator forces: None (passive motion), an array ``(..., n_act)`` held constant, or a
     callable ``tau(t, q (N, nq), qd (N, nv)) -> (N, n_act)`` over the flattened batch.  The state is
     every tree coordinate (idle motions included) integrated by ``scipy.integrate.solve_ivp`` (DOP853,
-    :data:`SIM_RTOL`, :data:`SIM_ATOL`) between consecutive output times, projected back onto the
+    ``SIM_RTOL = 1e-10``, ``SIM_ATOL = 1e-12``) between consecutive output times, projected back onto the
     constraint manifold at each of them.  Batched over initial conditions (one ODE system; a batch
     whose integration fails is retried sample by sample so that one bad sample does not spoil the rest).
     """
