@@ -278,6 +278,26 @@ def test_bad_element_anywhere(name, arg):
     check()
 
 
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(n, marks=[pytest.mark.slow] if s.slow else [])
+        for n, s in sorted(ACTIVE.items())
+        if s.arrays
+        and s.empty_batch
+        and not s.good_elsewhere
+        and all(np.ndim(s.args[a]) > core for a, core in s.arrays.items())
+    ],
+)
+def test_empty_batch(name):
+    """A batch of zero samples is a batch: empty results, no exception."""
+    spec = ACTIVE[name]
+    args = {**spec.args, **{a: np.asarray(spec.args[a], dtype=float)[:0] for a in spec.arrays}}
+    res = _call(name, spec, args)
+    if spec.mask is not None:
+        assert _mask_of(spec, res).size == 0, f"{name}: an empty batch gave a non-empty mask"
+
+
 # --- parameter objects and options ----------------------------------------------------------------
 class _Foreign:
     """A parameter object of the wrong kind (think: another mechanism's parameters)."""
