@@ -171,7 +171,7 @@ def _check_masked(name: str, spec: Spec, arg: str, args: dict[str, Any], flat_in
 def _variants(name: str, spec: Spec, arg: str) -> list[tuple[str, Any]]:
     a = np.array(spec.args[arg], dtype=float)
     out = []
-    for label, val in (("nan", np.nan), ("inf", np.inf), ("-inf", -np.inf)):
+    for label, val in (("nan", np.nan), ("inf", np.inf), ("-inf", -np.inf), ("1e300", 1e300)):
         b = a.copy()
         b.flat[0] = val
         out.append((label, b))
@@ -244,7 +244,7 @@ def test_bad_array(name, arg, variant):
     spec = ACTIVE[name]
     value = dict(_variants(name, spec, arg))[variant]
     args = {**spec.args, arg: value}
-    if arg in spec.masked and variant in ("nan", "inf", "-inf"):
+    if arg in spec.masked and variant in ("nan", "inf", "-inf", "1e300"):
         _check_masked(name, spec, arg, args, 0)
     else:
         _expect_value_error(name, spec, args, arg, variant)
@@ -260,12 +260,12 @@ def test_bad_array(name, arg, variant):
     ],
 )
 def test_bad_element_anywhere(name, arg):
-    """Hypothesis: a non-finite value at any element of any array argument."""
+    """Hypothesis: a non-finite or overflowing (1e300) value at any element of any array argument."""
     spec = ACTIVE[name]
     a = np.array(spec.args[arg], dtype=float)
 
     @settings(max_examples=4, deadline=None, database=None)
-    @given(k=st.integers(0, a.size - 1), v=st.sampled_from([np.nan, np.inf, -np.inf]))
+    @given(k=st.integers(0, a.size - 1), v=st.sampled_from([np.nan, np.inf, -np.inf, 1e300, -1e300]))
     def check(k, v):
         b = a.copy()
         b.flat[k] = v

@@ -189,3 +189,19 @@ def test_dynamics_kernels_reject_non_finite_input():
     J[0, 0, 0] = np.nan
     with pytest.raises(ValueError, match="J"):
         dynamics.mass_matrix(G, J)
+
+
+def test_values_beyond_max_magnitude_are_rejected_or_masked_never_overflowed():
+    """1e300 in a finite input overflowed to inf inside the models (squares, products): now a
+    ValueError where a number is required, a false mask where the model flags samples."""
+    from robomech._validation import MAX_MAGNITUDE
+    from robomech.mechanisms import spherical_leg as sl
+
+    leg = sl.SphericalLeg.paper()
+    with pytest.raises(ValueError, match="alpha"):
+        sl.inverse_kinematics(leg, np.array([0.1, 1e300]), 0.0)
+    lengths = sl.inverse_kinematics(leg, np.array([0.1, 0.2]), 0.0).lengths
+    lengths[1, 0] = 1e300
+    fk = sl.forward_kinematics(leg, lengths)
+    assert fk.valid[0] and not fk.valid[1]
+    assert MAX_MAGNITUDE**3 < np.finfo(float).max
