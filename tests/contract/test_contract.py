@@ -298,6 +298,31 @@ def test_empty_batch(name):
         assert _mask_of(spec, res).size == 0, f"{name}: an empty batch gave a non-empty mask"
 
 
+def _dataclass_specs():
+    out = []
+    for n, s in sorted(ACTIVE.items()):
+        target = _target(n, s)
+        if inspect.isclass(target) and dataclasses.is_dataclass(target):
+            out.append(n)
+    return out
+
+
+@pytest.mark.parametrize("name", _dataclass_specs())
+def test_dataclass_fields_are_stored_as_plain_numbers(name):
+    """A parameter dataclass stores validated Python floats/ints, whatever real type it was given
+    (``SphericalLeg(R=np.float32(0.075)).R`` is a float), so equality and hashing see values."""
+    spec = ACTIVE[name]
+    numeric = {
+        k: (np.int64(v) if isinstance(v, int) else np.float32(v))
+        for k, v in spec.args.items()
+        if isinstance(v, int | float) and not isinstance(v, bool)
+    }
+    obj = _call(name, spec, {**spec.args, **numeric})
+    for k in numeric:
+        v = getattr(obj, k)
+        assert type(v) in (float, int), f"{name}.{k} stored as {type(v).__name__}, expected a plain float/int"
+
+
 # --- parameter objects and options ----------------------------------------------------------------
 class _Foreign:
     """A parameter object of the wrong kind (think: another mechanism's parameters)."""
