@@ -68,7 +68,7 @@ def as_array(
     name: str,
     tail: Sequence[int | None] = (),
     *,
-    finite: bool = True,
+    finite: bool | str = True,
     min_ndim: int | None = None,
 ) -> np.ndarray:
     """Return ``x`` as a float64 array whose trailing dimensions are ``tail``.
@@ -77,7 +77,8 @@ def as_array(
     (including ``None`` and ragged lists) raise.  ``None`` in ``tail`` accepts any length.
     ``finite=True`` rejects NaN, infinity and magnitudes above :data:`MAX_MAGNITUDE`; a model that
     prefers to flag such samples per sample passes ``finite=False`` and masks them itself (see
-    ``finite_samples`` and ``usable``).
+    ``finite_samples``), or ``finite="mask"``, which also turns every magnitude above
+    :data:`MAX_MAGNITUDE` (and inf) into NaN, for models that mask NaN samples.
     """
     if x is None or isinstance(x, str | bytes):
         raise ValueError(f"Expected {name} to be an array of real numbers, got {type(x).__name__}.")
@@ -96,6 +97,8 @@ def as_array(
         d is not None and a.shape[a.ndim - len(tail) + i] != d for i, d in enumerate(tail)
     ):
         raise ValueError(f"Expected {name} to have shape {_shape_text(tail)}, got {a.shape}.")
+    if finite == "mask":
+        return usable(a)
     if finite:
         if not np.all(np.isfinite(a)):
             bad = int(np.size(a) - np.count_nonzero(np.isfinite(a)))

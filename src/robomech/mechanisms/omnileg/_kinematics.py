@@ -12,7 +12,7 @@ from functools import cached_property
 
 import numpy as np
 
-from robomech._validation import as_array, check_params, usable
+from robomech._validation import as_array, check_params
 
 from ._params import OmniLeg
 
@@ -236,7 +236,7 @@ def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
     flagged (``exists`` false), not raised.
     """
     check_params(leg, OmniLeg, "leg")
-    p = usable(as_array(p_foot, "p_foot", (3,), finite=False))  # beyond 1e100: masked like NaN
+    p = as_array(p_foot, "p_foot", (3,), finite="mask")  # NaN, inf, beyond 1e100: masked
     pf = p.reshape(-1, 3)
     n = pf.shape[0]
     q = np.empty((n, 3))

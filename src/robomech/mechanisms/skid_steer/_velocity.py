@@ -20,7 +20,7 @@ from typing import Literal
 
 import numpy as np
 
-from robomech._validation import as_array, check_bool, check_params, usable
+from robomech._validation import as_array, check_bool, check_params
 from robomech.analysis import lstsq
 
 from ._chains import CONFIG_SIZE, N_WHEELS, _linear_columns
@@ -188,9 +188,8 @@ def body_velocity(
     one from the singular values of R (QR only; slower).
     """
     check_params(robot, ExplorationRobot, "robot")
-    # beyond _validation.MAX_MAGNITUDE a value is flagged like NaN (a drop-out), never computed with
-    q = usable(as_array(state, "state", (CONFIG_SIZE,), finite=False))
-    m = usable(as_array(measured, "measured", (MEASURED_SIZE,), finite=False))
+    q = as_array(state, "state", (CONFIG_SIZE,), finite="mask")  # NaN, inf, beyond 1e100: drop-outs
+    m = as_array(measured, "measured", (MEASURED_SIZE,), finite="mask")
     if solver not in ("qr", "normal_equations"):
         raise ValueError(f"Expected solver 'qr' or 'normal_equations', got {solver!r}.")
     check_bool(exact_cond, "exact_cond")

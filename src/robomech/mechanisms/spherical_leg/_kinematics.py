@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_int, check_params, usable
+from robomech._validation import as_array, check_int, check_params
 
 # the unvalidated kernel: inputs are validated once at this module's public boundary
 from robomech.spatial._so3 import _sincos as sincos
@@ -215,7 +215,7 @@ def forward_kinematics(leg: SphericalLeg, lengths: object, branch: int = 0) -> F
     """
     check_params(leg, SphericalLeg, "leg")
     branch = check_int(branch, "branch", low=0, high=1)
-    L = usable(as_array(lengths, "lengths", (3,), finite=False))  # beyond 1e100: masked like NaN
+    L = as_array(lengths, "lengths", (3,), finite="mask")  # NaN, inf, beyond 1e100: masked
     shape = L.shape[:-1]
     n = int(np.prod(shape, dtype=int))
     outs = (np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=bool), np.empty(n, dtype=bool))
