@@ -215,8 +215,8 @@ def forward_kinematics(leg: SphericalLeg, lengths: object, branch: int = 0) -> F
     """
     check_params(leg, SphericalLeg, "leg")
     branch = check_int(branch, "branch", low=0, high=1)
-    L = as_array(lengths, "lengths", (3,), finite="mask")  # NaN, inf, beyond 1e100: masked
-    shape = L.shape[:-1]
+    L = as_array(lengths, "lengths", (3,), finite=False)
+    L, shape = as_array(L, "lengths", finite="mask"), L.shape[:-1]  # beyond 1e100: masked like NaN
     n = int(np.prod(shape, dtype=int))
     outs = (np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=bool), np.empty(n, dtype=bool))
     if n >= FK_NUMBA_MIN:
