@@ -17,7 +17,8 @@ ALLOWED = {
     "dynamics": {"spatial", "kinematics"},
     "analysis": {"spatial", "kinematics"},
     "mechanisms": {"spatial", "kinematics", "trajectory", "dynamics", "analysis"},
-    "verify": {"spatial", "kinematics", "trajectory", "dynamics", "analysis", "mechanisms"},
+    "explore": {"spatial", "kinematics", "trajectory", "dynamics", "analysis", "mechanisms"},
+    "verify": {"spatial", "kinematics", "trajectory", "dynamics", "analysis", "mechanisms", "explore"},
     "studies": {
         "spatial",
         "kinematics",
@@ -25,13 +26,16 @@ ALLOWED = {
         "dynamics",
         "analysis",
         "mechanisms",
+        "explore",
         "verify",
         "testing",
     },
-    "cli": {"studies", "verify"},
+    "cli": {"studies", "verify", "explore"},
 }
 INFRASTRUCTURE = {"robomech", "robomech._validation", "robomech._registry", "robomech._numba"}
 ENGINES = {"mujoco", "exudyn", "pinocchio"}
+# The distributed-computing stack of robomech.explore: imported inside functions only (first use).
+LAZY = {"dask", "distributed", "zarr", "pymoo"}
 
 
 def _imports(path: Path) -> list[str]:
@@ -85,10 +89,43 @@ def test_every_module_respects_the_layering():
     assert not problems, "\n".join(problems)
 
 
+def _module_level_imports(path: Path) -> list[str]:
+    tree = ast.parse(path.read_text())
+    names = []
+    for node in tree.body:
+        if isinstance(node, ast.Import):
+            names += [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom) and not node.level:
+            names.append(node.module or "")
+    return names
+
+
+def test_distributed_stack_is_imported_lazily():
+    problems = [
+        f"{path.relative_to(SRC)} imports {mod} at module level"
+        for path in SRC.rglob("*.py")
+        for mod in _module_level_imports(path)
+        if mod.split(".")[0] in LAZY
+    ]
+    assert not problems, "\n".join(problems)
+
+
+def test_import_robomech_explore_does_not_load_the_distributed_stack():
+    code = (
+        "import sys, robomech, robomech.explore as e; e.available_studies(); "
+        "print(','.join(m for m in ('dask', 'distributed', 'zarr', 'pymoo') if m in sys.modules))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout.strip()
+    assert out == "", f"import robomech.explore pulled in: {out}"
+
+
 def test_import_robomech_is_light():
     code = (
         "import sys, robomech; "
-        "heavy = [m for m in ('scipy', 'sympy', 'matplotlib', 'mujoco') if m in sys.modules];"
+        "heavy = [m for m in ('scipy', 'sympy', 'matplotlib', 'mujoco', 'dask', 'zarr', 'pymoo', "
+        "'robomech.explore') if m in sys.modules];"
         "print(','.join(heavy))"
     )
     out = subprocess.run(

@@ -103,6 +103,10 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("mechanisms", nargs="*", metavar="MECHANISM", help="mechanisms to verify (default: all)")
     sp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     sp.set_defaults(func=_cmd_verify)
+
+    from ._sweep import register as register_sweep  # robomech.explore: docs/explore.md
+
+    register_sweep(sub)
     return p
 
 

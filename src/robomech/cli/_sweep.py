@@ -1,0 +1,126 @@
+"""``robomech sweep STUDY --out DIR``: a design study on Dask into a Zarr store (robomech.explore)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+__all__ = ["register"]
+
+
+def _variable(text: str):
+    """``NAME=LO:HI`` (a range, SI units) or ``NAME=SIGMA`` (a manufacturing error's sigma)."""
+    from robomech.explore import Variable
+
+    name, sep, spec = text.partition("=")
+    if not sep or not name:
+        raise ValueError(f"Expected --var NAME=LO:HI or NAME=SIGMA, got {text!r}.")
+    try:
+        if ":" in spec:
+            lo, hi = spec.split(":", 1)
+            return Variable(name.strip(), float(lo), float(hi))
+        return Variable(name.strip(), kind="normal", sigma=float(spec))
+    except ValueError as exc:
+        if "Expected" in str(exc):
+            raise
+        raise ValueError(f"Expected numbers in --var {text!r} (NAME=LO:HI or NAME=SIGMA).") from exc
+
+
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    from robomech.explore import get_study, run_sweep
+
+    try:
+        study = get_study(args.study)
+        variables = [_variable(v) for v in args.var]
+        if args.method == "nsga2":
+            from robomech.explore import optimize_nsga2
+
+            summary = optimize_nsga2(
+                study,
+                args.out,
+                population=args.designs,
+                generations=args.generations,
+                seed=args.seed,
+                variables=variables,
+                scheduler=args.scheduler,
+                workers=args.workers,
+                progress=not args.quiet,
+                connect_timeout=args.connect_timeout,
+            )
+        else:
+            summary = run_sweep(
+                study,
+                args.out,
+                designs=args.designs,
+                seed=args.seed,
+                sampler=args.sampler,
+                chunk_size=args.chunk_size,
+                variables=variables,
+                scheduler=args.scheduler,
+                workers=args.workers,
+                progress=not args.quiet,
+                connect_timeout=args.connect_timeout,
+            )
+    except ValueError as exc:  # unknown study, bad variable, foreign store, unreachable scheduler
+        print(f"robomech sweep: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(
+            f"\nrobomech sweep: interrupted; finished chunks are stored in {args.out}, "
+            "rerun the same command to compute the rest",
+            file=sys.stderr,
+        )
+        return 130
+    result = summary.as_dict()
+    if args.report:
+        from robomech.studies._sweep import write_sweep_report
+
+        result["report"] = str(write_sweep_report(Path(args.out), Path(args.out) / "report"))
+    if args.json:
+        print(json.dumps(result, indent=2))
+    else:
+        print(
+            f"{result['study']}: {result['n_designs']} designs in {result['n_chunks']} chunks "
+            f"({result['computed_chunks']} computed, {result['skipped_chunks']} already stored) "
+            f"in {result['seconds']:.1f} s -> {result['out']}"
+            + (f"; report {result['report']}" if "report" in result else "")
+        )
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add the ``sweep`` subcommand to the ``robomech`` parser's subparsers."""
+    sp = subparsers.add_parser(
+        "sweep",
+        help="design study (synthesis / tolerances) on Dask into a Zarr store",
+        description="Run or resume a design study; results are a Zarr group under --out (docs/explore.md). "
+        "Studies: spherical-leg-synthesis, vectored-thrust-tolerance, omnileg-synthesis.",
+    )
+    sp.add_argument("study", metavar="STUDY", help="design study name")
+    sp.add_argument(
+        "--out", required=True, help="Zarr store directory (created, or resumed if it is this sweep's)"
+    )
+    sp.add_argument("--designs", type=int, default=None, help="number of designs (NSGA-II: population size)")
+    sp.add_argument("--seed", type=int, default=0, help="seed of the sampler and of every chunk (default 0)")
+    sp.add_argument("--scheduler", default=None, help="tcp://HOST:PORT of an existing Dask scheduler")
+    sp.add_argument("--connect-timeout", type=float, default=10.0, help="seconds to reach --scheduler")
+    sp.add_argument(
+        "--workers", type=int, default=None, help="LocalCluster worker processes (default: cores)"
+    )
+    sp.add_argument("--sampler", default=None, choices=("sobol", "lhs", "grid", "random"))
+    sp.add_argument("--chunk-size", type=int, default=None, help="designs per Dask task")
+    sp.add_argument(
+        "--var",
+        action="append",
+        default=[],
+        metavar="NAME=LO:HI|NAME=SIGMA",
+        help="override or add a design variable (SI units); repeatable",
+    )
+    sp.add_argument("--method", default="sample", choices=("sample", "nsga2"))
+    sp.add_argument("--generations", type=int, default=10, help="NSGA-II generations (default 10)")
+    sp.add_argument("--report", action="store_true", help="write PNGs and a report page under DIR/report")
+    sp.add_argument("--json", action="store_true", help="print a JSON summary")
+    sp.add_argument("--quiet", action="store_true", help="no progress bar")
+    sp.set_defaults(func=_cmd_sweep)

@@ -1,0 +1,64 @@
+"""Design exploration at scale: dimensional synthesis and tolerance studies on Dask, results in Zarr.
+
+A :class:`DesignStudy` maps design variables onto a mechanism's frozen parameter dataclass
+(``dataclasses.replace``) or onto manufacturing errors, and computes metrics per design with the
+mechanism's batched kernels.  :func:`run_sweep` evaluates chunks of designs as Dask tasks (a LocalCluster
+by default, or an existing cluster) and writes a resumable Zarr store; :func:`optimize_nsga2` runs pymoo's
+NSGA-II with its populations evaluated by the same machinery.  ``robomech sweep`` is the command line.
+See ``docs/explore.md``.  dask, distributed, zarr and pymoo are imported on first use only.
+"""
+
+from __future__ import annotations
+
+from ._optimize import optimize_nsga2
+from ._pareto import pareto_front
+from ._runner import SchedulerUnreachable, SweepSummary, run_sweep
+from ._sampling import SAMPLERS, chunk_seed, design_matrix
+from ._store import StoreMismatch, open_results
+from ._study import DesignStudy, Metric, Objective, Variable, with_variables
+
+__all__ = [
+    "SAMPLERS",
+    "DesignStudy",
+    "Metric",
+    "Objective",
+    "SchedulerUnreachable",
+    "StoreMismatch",
+    "SweepSummary",
+    "Variable",
+    "available_studies",
+    "chunk_seed",
+    "design_matrix",
+    "get_study",
+    "open_results",
+    "optimize_nsga2",
+    "pareto_front",
+    "run_sweep",
+    "with_variables",
+]
+
+_BUILTIN = ("_spherical_leg", "_vectored_thrust", "_omnileg")
+
+
+def available_studies() -> dict[str, DesignStudy]:
+    """The built-in design studies by name."""
+    import importlib
+
+    out = {}
+    for mod in _BUILTIN:
+        s = importlib.import_module(f"{__name__}.{mod}").STUDY
+        out[s.name] = s
+    return out
+
+
+def get_study(name: str) -> DesignStudy:
+    """The built-in design study called ``name`` (ValueError listing the valid names otherwise)."""
+    if not isinstance(name, str):
+        raise ValueError(f"Expected name to be a study name (str), got {type(name).__name__}.")
+    studies = available_studies()
+    if name not in studies:
+        raise ValueError(
+            f"Expected name to be a design study, got unknown {name!r}; "
+            f"valid studies are: {', '.join(studies)}."
+        )
+    return studies[name]

@@ -1,0 +1,114 @@
+"""Built-in study ``omnileg-synthesis``: dimensional synthesis of paper 2's OmniLeg over (L1, L4, L5).
+
+Metrics per design (defined in ``docs/explore.md``):
+
+* ``workspace_volume``: volume (m^3) of the foot workspace, the image of the joint box |alpha| <= alpha_max,
+  |beta| <= beta_max, GAMMA_USABLE_MIN <= gamma <= gamma_max under eq. (11), as the integral of |det J|
+  over the box (composite Simpson, SIMPSON_POINTS per axis).  eq. (11) is injective on the box (the thigh
+  direction is injective in (alpha, beta) and cos gamma is monotonic on [0, pi/2)), so this is the volume.
+* ``min_abs_det_j``: min of |det J| (m^3/rad^3) over the same grid (the box's faces included).
+* ``peak_torque``: max over the eq. (52) motion (0-6 s) and the three motors of |tau| (N m), and
+  ``peak_torque_joint`` the per-motor peaks (alpha, beta, gamma order).
+
+gamma = 0 (the shank stretched straight) is singular for every design (J[2, 2] = -2 L4 sin gamma), so
+the minimum of |det J| over Table 2's full range [0, 85 deg] is 0 for every design; the study's usable
+workspace starts at GAMMA_USABLE_MIN.  L5 translates the workspace along Z0 and changes neither metric.
+
+``dataclasses.replace`` of an OmniLeg keeps the inertias of the nominal design (``bodies`` was filled
+from the paper's lengths): the torques use the paper's link inertias at the new geometry.  That is a
+known defect of the parameter object, left to its owner (docs/explore.md).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from robomech.mechanisms import omnileg as ol
+
+from ._study import DesignStudy, Metric, Objective, Variable
+
+__all__ = ["STUDY", "simpson_weights"]
+
+# gamma = 0 is singular for every design: the usable knee range starts here (an assumption, stated).
+GAMMA_USABLE_MIN = math.radians(10.0)
+# Simpson points per joint axis (odd): the integrand is smooth, 13 points give 6e-5 relative accuracy
+# (measured in tests/explore against the projected-area closed form, for every tested design).
+SIMPSON_POINTS = 13
+# eq. (52) motion: one 6 s period, 0.05 s steps.
+EQ52_STEP = 0.05
+
+
+def simpson_weights(lo: float, hi: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes and weights of the composite Simpson rule with ``n`` (odd) points on [lo, hi]."""
+    x = np.linspace(lo, hi, n)
+    w = np.ones(n)
+    w[1:-1:2], w[2:-1:2] = 4.0, 2.0
+    return x, w * (hi - lo) / (3.0 * (n - 1))
+
+
+def _grid(leg: ol.OmniLeg) -> tuple[np.ndarray, np.ndarray]:
+    g_lo = max(leg.gamma_min, GAMMA_USABLE_MIN)
+    axes = [
+        simpson_weights(-leg.alpha_max, leg.alpha_max, SIMPSON_POINTS),
+        simpson_weights(-leg.beta_max, leg.beta_max, SIMPSON_POINTS),
+        simpson_weights(g_lo, leg.gamma_max, SIMPSON_POINTS),
+    ]
+    q = np.stack(np.meshgrid(*[a[0] for a in axes], indexing="ij"), -1).reshape(-1, 3)
+    w = np.einsum("i,j,k->ijk", *[a[1] for a in axes]).ravel()
+    return q, w
+
+
+def evaluate(study: DesignStudy, params: list, rows: np.ndarray, seed) -> dict[str, np.ndarray]:
+    n = len(params)
+    out = {m.name: np.full((n, *m.shape), np.nan) for m in study.metrics}
+    t = np.arange(0.0, 6.0 + 1e-9, EQ52_STEP)
+    motion = ol.joint_trajectory_eq52(t)
+    for i, leg in enumerate(params):
+        if leg is None:
+            continue
+        q, w = _grid(leg)
+        det = np.abs(np.linalg.det(ol.jacobian(leg, q)))
+        out["workspace_volume"][i] = np.dot(w, det)
+        out["min_abs_det_j"][i] = det.min()
+        tau = ol.inverse_dynamics(leg, motion.q, motion.qd, motion.qdd).tau
+        peaks = np.abs(tau).max(axis=0)
+        out["peak_torque_joint"][i] = peaks
+        out["peak_torque"][i] = peaks.max()
+    return out
+
+
+STUDY = DesignStudy(
+    name="omnileg-synthesis",
+    title="OmniLeg (paper 2): dimensional synthesis over L1, L4, L5",
+    mechanism="omnileg.OmniLeg",
+    nominal=ol.OmniLeg.paper,
+    variables=(
+        Variable("L1", 0.10, 0.20, "m", description="thigh rod length A_iB_i"),
+        Variable("L4", 0.06, 0.12, "m", description="shank link length C_iD_i = D_iE_i"),
+        Variable("L5", 0.12, 0.20, "m", description="knee height below O0'"),
+    ),
+    metrics=(
+        Metric("workspace_volume", "m^3", "foot workspace volume (integral of |det J| over the joint box)"),
+        Metric("min_abs_det_j", "m^3", "min |det J| over the usable joint box"),
+        Metric("peak_torque", "N m", "max |tau| over the eq. (52) motion and the three motors"),
+        Metric("peak_torque_joint", "N m", "per-motor max |tau| along eq. (52) (alpha, beta, gamma)", (3,)),
+    ),
+    evaluate=evaluate,
+    parameters={
+        "gamma_usable_min_rad": GAMMA_USABLE_MIN,
+        "simpson_points": SIMPSON_POINTS,
+        "eq52_step_s": EQ52_STEP,
+        "inertias": "nominal (paper) bodies kept by dataclasses.replace: see docs/explore.md",
+    },
+    objectives=(
+        Objective("workspace_volume", "max"),
+        Objective("min_abs_det_j", "max"),
+        Objective("peak_torque", "min"),
+    ),
+    poses_per_design=SIMPSON_POINTS**3 + round(6.0 / EQ52_STEP) + 1,
+    default_sampler="sobol",
+    default_chunk=64,
+    default_designs=256,
+)

@@ -1,0 +1,299 @@
+"""Running a sweep on Dask: chunks of designs as tasks, results written to the Zarr store as they arrive.
+
+By default a ``LocalCluster`` on this machine's cores (one single-threaded worker process per core);
+``scheduler="tcp://HOST:PORT"`` uses an existing cluster.  Each chunk is one task computing
+``study.evaluate_rows`` on its rows with its own seed (:func:`chunk_seed`), so a chunk's result does not
+depend on which worker runs it, on how many workers there are, or on whether it ran before: the same
+sweep is bit-identical locally and on a cluster (same numpy build and CPU family).  The client is the only
+writer of the store.  A worker that dies takes only its running chunk with it: the scheduler reruns it
+elsewhere.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import os
+import sys
+import time
+from collections.abc import Callable, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from robomech._validation import check_bool, check_choice, check_int, check_positive
+
+from ._sampling import SAMPLERS, chunk_seed, design_matrix
+from ._store import open_store, prepare_store
+from ._study import DesignStudy, Variable, check_variables, with_variables
+
+__all__ = ["SchedulerUnreachable", "SweepSummary", "evaluate_chunk", "run_sweep"]
+
+# Seconds to wait for an existing scheduler before calling it unreachable.
+CONNECT_TIMEOUT = 10.0
+# Retries of a chunk whose task raised (a worker dying is handled by the scheduler, not by these).
+TASK_RETRIES = 2
+
+
+class SchedulerUnreachable(ValueError):
+    """The ``--scheduler`` address does not answer."""
+
+
+@dataclass(frozen=True)
+class SweepSummary:
+    study: str
+    out: str
+    n_designs: int
+    n_chunks: int
+    computed_chunks: tuple[int, ...]  # chunks computed by this run
+    skipped_chunks: int  # chunks already in the store
+    seconds: float
+    workers: int
+    computed_designs: int  # designs computed by this run
+
+    @property
+    def designs_per_second(self) -> float:
+        return self.computed_designs / self.seconds if self.seconds > 0 else float("nan")
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "study": self.study,
+            "out": self.out,
+            "n_designs": self.n_designs,
+            "n_chunks": self.n_chunks,
+            "computed_chunks": len(self.computed_chunks),
+            "skipped_chunks": self.skipped_chunks,
+            "seconds": self.seconds,
+            "workers": self.workers,
+            "computed_designs": self.computed_designs,
+        }
+
+
+def robomech_version() -> str:
+    import robomech
+
+    try:
+        return importlib.metadata.version("robomech")
+    except importlib.metadata.PackageNotFoundError:
+        return robomech.__version__
+
+
+def evaluate_chunk(study: DesignStudy, rows: np.ndarray, seed: int, chunk: int):
+    """One task: the metrics of chunk ``chunk``'s design rows, and the wall and CPU seconds it took."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    res = study.evaluate_rows(rows, chunk_seed(seed, chunk))
+    return chunk, res, time.perf_counter() - t0, time.process_time() - c0
+
+
+@contextmanager
+def dask_client(scheduler: str | None = None, workers: int | None = None, timeout: float = CONNECT_TIMEOUT):
+    """A ``distributed.Client``: to ``scheduler`` if given, else to a new LocalCluster (closed after)."""
+    from distributed import Client, LocalCluster
+
+    if scheduler:
+        if not isinstance(scheduler, str) or "://" not in scheduler:
+            raise SchedulerUnreachable(
+                f"Expected a scheduler address like tcp://HOST:PORT, got {scheduler!r}."
+            )
+        try:
+            client = Client(scheduler, timeout=timeout)
+        except (OSError, TimeoutError) as exc:
+            raise SchedulerUnreachable(
+                f"Expected a Dask scheduler at {scheduler!r}, got no answer within {timeout:g} s "
+                f"({type(exc).__name__}: {exc})."
+            ) from exc
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    n = int(workers) if workers else (os.cpu_count() or 1)
+    cluster = LocalCluster(
+        n_workers=n,
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",
+        dashboard_address="127.0.0.1:0",  # loopback, any free port (None would mean :8787 on every interface)
+        silence_logs=40,
+    )
+    client = Client(cluster)
+    try:
+        yield client
+    finally:
+        client.close()
+        cluster.close()
+
+
+class _Bar:
+    """One progress line on stderr: designs done, rate, time left."""
+
+    def __init__(self, label: str, total: int, enabled: bool, stream=None) -> None:
+        self.label, self.total, self.enabled = label, total, enabled
+        self.stream = stream if stream is not None else sys.stderr
+        self.t0 = time.perf_counter()
+        self.done = 0
+
+    def update(self, n: int) -> None:
+        self.done += n
+        if not self.enabled:
+            return
+        dt = time.perf_counter() - self.t0
+        rate = self.done / dt if dt > 0 else 0.0
+        left = f"{(self.total - self.done) / rate:6.1f} s left" if rate > 0 else "     ? s left"
+        pct = 100.0 * self.done / self.total if self.total else 100.0
+        self.stream.write(
+            f"\r{self.label}: {self.done}/{self.total} designs ({pct:3.0f}%), {rate:8.1f} designs/s, {left}"
+        )
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.enabled:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+def sweep_fingerprint(study: DesignStudy, n: int, sampler: str, seed: int, chunk: int) -> dict[str, Any]:
+    """What identifies a sweep's results (a store is resumed only by a sweep with the same fingerprint)."""
+    return {
+        "study": study.name,
+        "variables": [v.as_dict() for v in study.variables],
+        "parameters": dict(study.parameters),
+        "sampler": sampler,
+        "seed": int(seed),
+        "n_designs": int(n),
+        "chunk_size": int(chunk),
+    }
+
+
+def plan(
+    study: DesignStudy,
+    designs: int | None = None,
+    seed: int = 0,
+    sampler: str | None = None,
+    chunk_size: int | None = None,
+    variables: Sequence[Variable] = (),
+) -> tuple[DesignStudy, np.ndarray, str, int]:
+    """Validated study, design matrix, sampler and chunk size of a sweep (no computation)."""
+    if not isinstance(study, DesignStudy):
+        raise ValueError(f"Expected study to be a DesignStudy, got {type(study).__name__}.")
+    variables = check_variables(variables)
+    study = with_variables(study, variables) if variables else study
+    sampler = study.default_sampler if sampler is None else check_choice(sampler, "sampler", SAMPLERS)
+    chunk = study.default_chunk if chunk_size is None else check_int(chunk_size, "chunk_size", low=1)
+    n = study.default_designs if designs is None else check_int(designs, "designs", low=1)
+    seed = check_int(seed, "seed", low=0)
+    X = design_matrix(study.variables, n, sampler, int(seed), chunk)
+    return study, X, sampler, chunk
+
+
+def run_sweep(
+    study: DesignStudy,
+    out: Path | str,
+    *,
+    designs: int | None = None,
+    seed: int = 0,
+    sampler: str | None = None,
+    chunk_size: int | None = None,
+    variables: Sequence[Variable] = (),
+    scheduler: str | None = None,
+    workers: int | None = None,
+    client: Any = None,
+    progress: bool = True,
+    on_chunk: Callable[[int], None] | None = None,
+    connect_timeout: float = CONNECT_TIMEOUT,
+) -> SweepSummary:
+    """Run (or resume) a sweep of ``study`` into the Zarr store ``out``; see the module docstring.
+
+    ``variables`` override or extend the study's design variables; ``client`` an existing
+    ``distributed.Client`` (else ``scheduler`` / a LocalCluster of ``workers`` processes).  ``on_chunk(k)``
+    is called after chunk ``k`` is stored.  Returns which chunks this run computed.
+    """
+    study, X, sampler, chunk = plan(study, designs, seed, sampler, chunk_size, variables)
+    out = check_runtime(out, scheduler, workers, progress, connect_timeout, on_chunk)
+    n = X.shape[0]
+    fp = sweep_fingerprint(study, n, sampler, int(seed), chunk)
+    info = {
+        **study.describe(),
+        "robomech_version": robomech_version(),
+        "units": {**{v.name: v.unit for v in study.variables}, **{m.name: m.unit for m in study.metrics}},
+    }
+    n_chunks = -(-n // chunk)
+    g = open_store(Path(out), fp, X)  # raises StoreMismatch before anything is written
+    done = np.zeros(n_chunks, bool) if g is None else np.asarray(g["chunk_done"][:], dtype=bool)
+    missing = [k for k in range(done.size) if not done[k]]
+    t0 = time.perf_counter()
+    computed: list[int] = []
+    n_workers = 0
+    bar = _Bar(study.name, n, progress)
+    bar.update(sum(min(chunk, n - k * chunk) for k in range(done.size) if done[k]))
+    if missing:
+        ctx = _existing(client) if client is not None else dask_client(scheduler, workers, connect_timeout)
+        with ctx as c:  # connect (or start the LocalCluster) before creating the store
+            from distributed import as_completed
+
+            if g is None:
+                g = prepare_store(Path(out), study, X, chunk, fp, info)
+            n_workers = len(c.scheduler_info().get("workers", {}))
+            futures = [
+                c.submit(
+                    evaluate_chunk,
+                    study,
+                    X[k * chunk : (k + 1) * chunk],
+                    int(seed),
+                    k,
+                    pure=False,
+                    retries=TASK_RETRIES,
+                )
+                for k in missing
+            ]
+            try:
+                for fut in as_completed(futures):
+                    k, res, secs, cpu = fut.result()
+                    rows = slice(k * chunk, min((k + 1) * chunk, n))
+                    for name, arr in res.items():
+                        g[name][rows] = arr
+                    g["chunk_seconds"][k] = secs
+                    g["chunk_cpu_seconds"][k] = cpu
+                    g["chunk_done"][k] = True  # last: the chunk's rows are all written
+                    computed.append(k)
+                    bar.update(rows.stop - rows.start)
+                    if on_chunk is not None:
+                        on_chunk(k)
+            finally:
+                for fut in futures:
+                    if not fut.done():
+                        fut.cancel()
+    bar.close()
+    return SweepSummary(
+        study.name,
+        str(out),
+        n,
+        done.size,
+        tuple(sorted(computed)),
+        done.size - len(missing),
+        time.perf_counter() - t0,
+        n_workers,
+        sum(min(chunk, n - k * chunk) for k in computed),
+    )
+
+
+def check_runtime(out, scheduler, workers, progress, connect_timeout, on_chunk=None) -> Path:
+    """Validate the execution options shared by run_sweep and optimize_nsga2; return ``out`` as a Path."""
+    if not isinstance(out, str | Path) or str(out) == "":
+        raise ValueError(f"Expected out to be a directory path (str or Path), got {out!r}.")
+    if scheduler is not None and (not isinstance(scheduler, str) or "://" not in scheduler):
+        raise SchedulerUnreachable(f"Expected scheduler like tcp://HOST:PORT, got {scheduler!r}.")
+    if workers is not None:
+        check_int(workers, "workers", low=1)
+    check_bool(progress, "progress")
+    check_positive(connect_timeout, "connect_timeout")
+    if on_chunk is not None and not callable(on_chunk):
+        raise ValueError(f"Expected on_chunk to be callable or None, got {type(on_chunk).__name__}.")
+    return Path(out)
+
+
+@contextmanager
+def _existing(client):
+    yield client

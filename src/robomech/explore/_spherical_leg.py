@@ -1,0 +1,109 @@
+"""Built-in study ``spherical-leg-synthesis``: dimensional synthesis of paper 1's leg over (R, r, h).
+
+Metrics per design (defined in ``docs/explore.md``):
+
+* ``workspace_fraction``: fraction of the task grid |alpha|, |beta| <= pi/3 (paper 1, Section 6.1: the
+  sway amplitude) where every leg length is within [length_min, length_max] and J is not singular;
+* ``min_dexterity``, ``mean_dexterity``: sigma_min / sigma_max of J = dl/d(alpha, beta) (1 / cond) over
+  those reachable poses (NaN, under ``has_workspace`` False, when there are none);
+* ``peak_force``: max over the Fig. 5(b) motion (0-25 s) of max_i |f_i| under paper 1's force rule
+  (legs 1 and 3 drive), N; NaN under ``fig5b_ok`` False when the motion leaves the stroke limits, meets
+  an actuation singularity, or crosses one between samples (a sign change of dl3/dalpha).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from robomech.mechanisms import spherical_leg as sl
+
+from ._study import DesignStudy, Metric, Objective, Variable
+
+__all__ = ["STUDY"]
+
+_MM = 1e-3
+# Task grid: paper 1, Section 6.1 sways alpha or beta with amplitude pi/3.
+TASK_HALF_RANGE = math.pi / 3
+TASK_GRID = 41  # per axis: 1681 poses, a 3 deg step
+# Fig. 5(b): beta pi/3 -> pi/6 in 5 s, then one 20 s sway period about X; sampled as the study's plots.
+FIG5B_DURATION = 25.0
+FIG5B_STEP = 0.1
+
+
+def _task_grid() -> tuple[np.ndarray, np.ndarray]:
+    a = np.linspace(-TASK_HALF_RANGE, TASK_HALF_RANGE, TASK_GRID)
+    g = np.meshgrid(a, a, indexing="ij")
+    return g[0].ravel(), g[1].ravel()
+
+
+def _fig5b() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    t = np.arange(0.0, FIG5B_DURATION + 1e-9, FIG5B_STEP)
+    return sl.fig5_motion("b", t)
+
+
+def evaluate(study: DesignStudy, params: list, rows: np.ndarray, seed) -> dict[str, np.ndarray]:
+    n = len(params)
+    out = {m.name: np.full(n, np.nan) for m in study.metrics}
+    for k in ("has_workspace", "fig5b_ok"):
+        out[k] = np.zeros(n, dtype=bool)
+    a, b = _task_grid()
+    q, qd, qdd = _fig5b()
+    for i, leg in enumerate(params):
+        if leg is None:
+            continue
+        wm = sl.workspace_map(leg, a, b)
+        reach = wm.reachable & ~wm.singular
+        out["workspace_fraction"][i] = reach.mean()
+        if reach.any():
+            dex = wm.sigma_min[reach] / wm.sigma_max[reach]
+            out["min_dexterity"][i] = dex.min()
+            out["mean_dexterity"][i] = dex.mean()
+            out["has_workspace"][i] = True
+        path = sl.workspace_map(leg, q[:, 0], q[:, 1])
+        sign = np.sign(path.dl3_dalpha)
+        dyn = sl.inverse_dynamics(leg, q, qd, qdd, driven_legs=sl.PAPER_DRIVEN_LEGS)
+        ok = bool(path.reachable.all() and dyn.valid.all() and np.all(sign == sign[0]) and sign[0] != 0)
+        out["fig5b_ok"][i] = ok
+        if ok:
+            out["peak_force"][i] = np.max(np.abs(dyn.leg_forces))
+    return out
+
+
+STUDY = DesignStudy(
+    name="spherical-leg-synthesis",
+    title="Spherical parallel leg (paper 1): dimensional synthesis over R, r, h",
+    mechanism="spherical_leg.SphericalLeg",
+    nominal=sl.SphericalLeg.paper,
+    variables=(
+        Variable("R", 50 * _MM, 100 * _MM, "m", description="base joint circle radius OA_i"),
+        Variable("r", 20 * _MM, 45 * _MM, "m", description="platform joint circle radius PB_i"),
+        Variable("h", 70 * _MM, 140 * _MM, "m", description="height OP of the platform centre"),
+    ),
+    metrics=(
+        Metric("workspace_fraction", "1", "reachable, non-singular fraction of |alpha|, |beta| <= pi/3"),
+        Metric("min_dexterity", "1", "min of 1/cond(J) over the reachable task poses"),
+        Metric("mean_dexterity", "1", "mean of 1/cond(J) over the reachable task poses"),
+        Metric("has_workspace", "bool", "at least one reachable task pose", dtype="bool"),
+        Metric("peak_force", "N", "max |f_i| along Fig. 5(b), legs 1 and 3 driving (paper 1's rule)"),
+        Metric("fig5b_ok", "bool", "Fig. 5(b) within stroke limits and free of singularities", dtype="bool"),
+    ),
+    evaluate=evaluate,
+    parameters={
+        "task_half_range_rad": TASK_HALF_RANGE,
+        "task_grid": TASK_GRID,
+        "fig5b_duration_s": FIG5B_DURATION,
+        "fig5b_step_s": FIG5B_STEP,
+        "force_rule": "paper 1: legs 1 and 3 drive",
+    },
+    objectives=(
+        Objective("workspace_fraction", "max"),
+        Objective("min_dexterity", "max"),
+        Objective("peak_force", "min"),
+    ),
+    poses_per_design=TASK_GRID**2 + round(FIG5B_DURATION / FIG5B_STEP) + 1,
+    default_sampler="sobol",
+    default_chunk=256,
+    default_designs=1024,
+)

@@ -1,0 +1,310 @@
+"""What a design study is: variables, metrics, and a per-design evaluation from the batched kernels.
+
+A :class:`DesignStudy` maps each row of a design matrix onto the mechanism's frozen parameter dataclass
+(``dataclasses.replace`` of the study's nominal parameters, for ``kind="range"`` variables) or onto an
+as-built error vector (``kind="normal"`` variables: a manufacturing error with standard deviation
+``sigma``), and evaluates its metrics on the study's pose set with the mechanism's batched kernels.
+A design whose parameters the dataclass rejects is a failed sample (``design_ok`` False, metrics NaN),
+never an exception: a sweep never dies of one bad design.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from robomech._validation import check_choice, check_int, check_positive, check_real
+
+__all__ = ["DesignStudy", "Metric", "Objective", "Variable", "with_variables"]
+
+KINDS = ("range", "normal")
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One design variable.
+
+    ``kind="range"``: a field ``name`` of the study's parameter dataclass, sampled in ``[low, high]``
+    (SI units).  ``kind="normal"``: a manufacturing error ``name`` of the study, zero mean and standard
+    deviation ``sigma`` (SI units).
+    """
+
+    name: str
+    low: float = math.nan
+    high: float = math.nan
+    unit: str = ""
+    kind: str = "range"
+    sigma: float = math.nan
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.isidentifier():
+            raise ValueError(f"Expected name to be an identifier (a variable name), got {self.name!r}.")
+        check_choice(self.kind, "kind", KINDS)
+        _check_text(self.unit, "unit")
+        _check_text(self.description, "description")
+        if self.kind == "range":
+            lo = check_real(self.low, "low", finite=False)
+            hi = check_real(self.high, "high", finite=False)
+            if not (math.isfinite(lo) and math.isfinite(hi)):
+                raise ValueError(
+                    f"Expected low and high of variable {self.name!r} to be a finite range, "
+                    f"got [{self.low!r}, {self.high!r}]."
+                )
+            if not lo < hi:
+                what = "an empty" if lo == hi else "an inverted"
+                raise ValueError(
+                    f"Expected variable {self.name!r} to have low < high, got {what} range [{lo!r}, {hi!r}]."
+                )
+            object.__setattr__(self, "low", lo)
+            object.__setattr__(self, "high", hi)
+        else:
+            s = check_positive(self.sigma, "sigma")
+            object.__setattr__(self, "sigma", s)
+
+    def from_unit(self, u: np.ndarray) -> np.ndarray:
+        """Map samples ``u`` in the open unit interval onto this variable (uniform or normal)."""
+        if self.kind == "range":
+            return self.low + (self.high - self.low) * u
+        from scipy.stats import norm
+
+        return self.sigma * norm.ppf(u)
+
+    def as_dict(self) -> dict[str, Any]:
+        d = {"name": self.name, "kind": self.kind, "unit": self.unit, "description": self.description}
+        if self.kind == "range":
+            d.update(low=self.low, high=self.high)
+        else:
+            d.update(sigma=self.sigma)
+        return d
+
+
+@dataclass(frozen=True)
+class Metric:
+    """One per-design output: ``shape`` is the trailing shape of its array (() for a scalar)."""
+
+    name: str
+    unit: str
+    description: str
+    shape: tuple[int, ...] = ()
+    dtype: str = "float64"
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.isidentifier():
+            raise ValueError(f"Expected name to be an identifier (a metric name), got {self.name!r}.")
+        _check_text(self.unit, "unit")
+        _check_text(self.description, "description")
+        if not isinstance(self.shape, tuple):
+            raise ValueError(f"Expected shape to be a tuple of ints, got {type(self.shape).__name__}.")
+        for d in self.shape:
+            check_int(d, "shape", low=1)
+        check_choice(self.dtype, "dtype", ("float64", "bool"))
+
+
+@dataclass(frozen=True)
+class Objective:
+    """A metric to optimise: ``sense`` is ``"max"`` or ``"min"``."""
+
+    metric: str
+    sense: str
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.metric, str):
+            raise ValueError(f"Expected metric to be a metric name (str), got {type(self.metric).__name__}.")
+        check_choice(self.sense, "sense", ("max", "min"))
+
+
+# evaluate(study, params, rows, seed) -> {metric name: array (n, *shape)} for the n designs of one chunk;
+# ``params`` is a list of parameter objects (None where the dataclass rejected the design).
+Evaluator = Callable[["DesignStudy", list[Any], np.ndarray, np.random.SeedSequence], dict[str, np.ndarray]]
+
+
+@dataclass(frozen=True)
+class DesignStudy:
+    """A registered design study.
+
+    ``nominal`` builds the nominal parameter object; ``variables`` the default design variables;
+    ``metrics`` what ``evaluate`` returns; ``objectives`` the Pareto/NSGA-II objectives;
+    ``parameters`` the study's fixed settings (pose grids, motions), stored in the results;
+    ``poses_per_design`` the number of pose evaluations one design costs (for throughput figures);
+    ``default_sampler`` / ``default_chunk`` the sampling method and chunk size (designs per task).
+    """
+
+    name: str
+    title: str
+    mechanism: str
+    nominal: Callable[[], Any]
+    variables: tuple[Variable, ...]
+    metrics: tuple[Metric, ...]
+    evaluate: Evaluator
+    parameters: Mapping[str, Any] = field(default_factory=dict)
+    objectives: tuple[Objective, ...] = ()
+    poses_per_design: int = 1
+    default_sampler: str = "sobol"
+    default_chunk: int = 64
+    default_designs: int = 256
+    notes: tuple[str, ...] = ()
+    error_names: tuple[str, ...] = ()  # names a kind="normal" variable may take
+    # summarize(study, results) -> list of {"title", "columns", "rows", "note"} tables for the report
+    # (results: open_results of the store); study-level analyses such as a sensitivity ranking
+    summarize: Callable[[DesignStudy, Mapping[str, Any]], list[dict[str, Any]]] | None = None
+
+    def __post_init__(self) -> None:
+        for n in ("name", "title", "mechanism"):
+            _check_text(getattr(self, n), n)
+        if self.summarize is not None and not callable(self.summarize):
+            raise ValueError(
+                f"Expected summarize to be callable or None, got {type(self.summarize).__name__}."
+            )
+        for n in ("nominal", "evaluate"):
+            if not callable(getattr(self, n)):
+                raise ValueError(f"Expected {n} to be callable, got {type(getattr(self, n)).__name__}.")
+        for n, cls in (("variables", Variable), ("metrics", Metric), ("objectives", Objective)):
+            items = getattr(self, n)
+            if not isinstance(items, tuple) or not all(isinstance(x, cls) for x in items):
+                raise ValueError(f"Expected {n} to be a tuple of {cls.__name__}, got {items!r}.")
+        if not self.variables or not self.metrics:
+            raise ValueError("Expected variables and metrics to be non-empty, got an empty tuple.")
+        names = [m.name for m in self.metrics]
+        reserved = {
+            "designs",
+            "design_ok",
+            "chunk_done",
+            "chunk_seconds",
+            "chunk_cpu_seconds",
+            "report",
+        } & set(names)
+        if reserved or len(set(names)) != len(names):
+            raise ValueError(f"Expected metrics with unique, unreserved names, got {names}.")
+        for o in self.objectives:
+            if o.metric not in names:
+                raise ValueError(f"Expected objectives to name metrics among {names}, got {o.metric!r}.")
+        check_int(self.poses_per_design, "poses_per_design", low=1)
+        check_int(self.default_chunk, "default_chunk", low=1)
+        check_int(self.default_designs, "default_designs", low=1)
+        check_choice(self.default_sampler, "default_sampler", ("sobol", "lhs", "grid", "random"))
+        if not isinstance(self.parameters, Mapping):
+            raise ValueError(f"Expected parameters to be a mapping, got {type(self.parameters).__name__}.")
+
+    @property
+    def variable_names(self) -> tuple[str, ...]:
+        return tuple(v.name for v in self.variables)
+
+    def parameter_fields(self) -> tuple[str, ...]:
+        return tuple(f.name for f in dataclasses.fields(self.nominal()))
+
+    def designs_to_params(self, rows: np.ndarray) -> list[Any]:
+        """Parameter objects of each row (None where the dataclass refuses the design).
+
+        A ``range`` variable sets its field; a ``normal`` variable that names a field adds its error to
+        the nominal value (the as-built parameter); other ``normal`` variables are left to ``evaluate``.
+        """
+        base = self.nominal()
+        fields = {f.name for f in dataclasses.fields(base)}
+        idx = [
+            (i, v.name, v.kind == "normal")
+            for i, v in enumerate(self.variables)
+            if v.kind == "range" or v.name in fields
+        ]
+        out: list[Any] = []
+        for row in np.asarray(rows, dtype=float):
+            if not idx:
+                out.append(base)
+                continue
+            values = {
+                name: float(getattr(base, name)) + float(row[i]) if err else float(row[i])
+                for i, name, err in idx
+            }
+            try:
+                out.append(dataclasses.replace(base, **values))
+            except ValueError:
+                out.append(None)  # the parameter dataclass rejects this combination: a failed design
+        return out
+
+    def evaluate_rows(self, rows: np.ndarray, seed: np.random.SeedSequence) -> dict[str, np.ndarray]:
+        """Every metric for the designs ``rows (n, n_variables)``, plus ``design_ok (n,)``."""
+        params = self.designs_to_params(rows)
+        out = self.evaluate(self, params, np.asarray(rows, dtype=float), seed)
+        ok = np.array([p is not None for p in params], dtype=bool)
+        res = {"design_ok": ok}
+        for m in self.metrics:
+            a = np.asarray(out[m.name], dtype=m.dtype)
+            expected = (len(params), *m.shape)
+            if a.shape != expected:  # a study bug, not a user error
+                raise RuntimeError(
+                    f"study {self.name!r}: metric {m.name!r} has shape {a.shape}, not {expected}"
+                )
+            res[m.name] = a
+        return res
+
+    def describe(self) -> dict[str, Any]:
+        return {
+            "study": self.name,
+            "title": self.title,
+            "mechanism": self.mechanism,
+            "variables": [v.as_dict() for v in self.variables],
+            "metrics": [{"name": m.name, "unit": m.unit, "description": m.description} for m in self.metrics],
+            "objectives": [{"metric": o.metric, "sense": o.sense} for o in self.objectives],
+            "parameters": dict(self.parameters),
+            "poses_per_design": self.poses_per_design,
+        }
+
+
+def _check_text(value: object, name: str) -> None:
+    if not isinstance(value, str):
+        raise ValueError(f"Expected {name} to be a str, got {type(value).__name__}.")
+
+
+def check_variables(variables: object, name: str = "variables") -> tuple[Variable, ...]:
+    """A sequence of Variable (not a str) as a tuple."""
+    if isinstance(variables, str | bytes) or not isinstance(variables, Sequence):
+        raise ValueError(f"Expected {name} to be a sequence of Variable, got {type(variables).__name__}.")
+    if not all(isinstance(v, Variable) for v in variables):
+        bad = next(type(v).__name__ for v in variables if not isinstance(v, Variable))
+        raise ValueError(f"Expected {name} to be a sequence of Variable, got an element of type {bad}.")
+    return tuple(variables)
+
+
+def with_variables(study: DesignStudy, variables: Sequence[Variable]) -> DesignStudy:
+    """The study with its variables replaced or extended by ``variables`` (validated).
+
+    A ``range`` variable must name a field of the study's parameter dataclass; a ``normal`` variable must
+    name one of the study's manufacturing errors.  An override of an existing variable keeps its unit
+    and description when the override gives none.
+    """
+    if not isinstance(study, DesignStudy):
+        raise ValueError(f"Expected study to be a DesignStudy, got {type(study).__name__}.")
+    overrides = check_variables(variables, "variables")
+    fields = study.parameter_fields()
+    current = {v.name: v for v in study.variables}
+    for ov in overrides:
+        if ov.kind == "range":
+            if study.error_names and ov.name in study.error_names:
+                raise ValueError(
+                    f"Expected variables to give a standard deviation for error {ov.name!r} of study "
+                    f"{study.name!r} (NAME=SIGMA), got a range."
+                )
+            if ov.name not in fields:
+                raise ValueError(
+                    f"Expected variables to name fields of {type(study.nominal()).__name__}, got "
+                    f"design variable {ov.name!r}, not a field; its fields are: {', '.join(fields)}."
+                )
+        elif ov.name not in study.error_names:
+            raise ValueError(
+                f"Expected variables to name study {study.name!r}'s manufacturing errors "
+                f"({', '.join(study.error_names) or 'it has none'}), got error {ov.name!r}."
+            )
+        old = current.get(ov.name)
+        if old is not None and old.kind != ov.kind:
+            raise ValueError(f"Expected variables[{ov.name!r}] to be of kind {old.kind!r}, got {ov.kind!r}.")
+        if old is not None:
+            ov = dataclasses.replace(
+                ov, unit=ov.unit or old.unit, description=ov.description or old.description
+            )
+        current[ov.name] = ov
+    return dataclasses.replace(study, variables=tuple(current.values()))
