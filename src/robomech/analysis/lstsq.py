@@ -57,7 +57,20 @@ def _validate(A: object, b: object) -> tuple[np.ndarray, np.ndarray]:
     return A, b
 
 
-def solve(A: object, b: object, *, exact_cond: bool = False) -> LstsqResult:
+def _apply_weights(A: np.ndarray, b: np.ndarray, weights: object | None) -> tuple[np.ndarray, np.ndarray]:
+    """Scale the rows of ``A`` and ``b`` by ``sqrt(weights)``: least squares then minimises
+    ``Σ_i w_i r_i²`` (weighted least squares; ``w_i = 1/σ_i²`` for independent row errors)."""
+    if weights is None:
+        return A, b
+    w = as_array(weights, "weights", (A.shape[-2],))
+    broadcast_batch((A, 2, "A"), (w, 1, "weights"))
+    if np.any(w < 0.0):
+        raise ValueError(f"Expected weights >= 0, got {int(np.sum(w < 0.0))} negative value(s).")
+    sw = np.sqrt(w)
+    return A * sw[..., :, None], b * sw
+
+
+def solve(A: object, b: object, *, exact_cond: bool = False, weights: object | None = None) -> LstsqResult:
     """Least-squares solution of every system in the stack by Householder QR.
 
     Each system is factorised as ``[A | b] = Q [R, c; 0, r]`` (unblocked Householder, the algorithm
@@ -68,12 +81,17 @@ def solve(A: object, b: object, *, exact_cond: bool = False) -> LstsqResult:
     the 2-norm condition number of A) unless ``exact_cond=True``, which computes the 2-norm one from
     the singular values of R.  A system whose condition exceeds :func:`rank_cond_limit` is rank
     deficient: its rank comes from the SVD and ``x`` is the minimum-norm solution.
+
+    ``weights (..., m)`` (finite, ``>= 0``, broadcasting with the stack) makes it weighted least squares,
+    ``min Σ_i w_i (A x - b)_i²``, solved as the ordinary problem on rows scaled by ``sqrt(w_i)``;
+    ``residual_norm`` and ``cond`` are then those of the weighted system.
     """
     from ._householder import householder_lstsq
 
     # A bool check, not truthiness: any other object would also compile a new kernel specialisation.
     exact_cond = check_bool(exact_cond, "exact_cond")
     A, b = _validate(A, b)
+    A, b = _apply_weights(A, b, weights)
     m, n = A.shape[-2:]
     batch = np.broadcast_shapes(A.shape[:-2], b.shape[:-1])
     Af = np.broadcast_to(A, (*batch, m, n)).reshape(-1, m, n)

@@ -15,6 +15,7 @@ the bogie, side links and rear slides take whatever values put the wheels on the
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,15 +23,30 @@ import numpy as np
 from robomech._validation import check_params, check_positive, check_real
 from robomech.mechanisms.skid_steer import (
     ExplorationRobot,
+    ICRModel,
     body_velocity,
     dead_reckoning,
-    skid_steer_turn,
+    encoder_track_speeds,
+    icr_velocity,
+    identify_icr,
 )
 from robomech.spatial import rot_x, rot_y, rot_z, transform, vee
 
 from ._core import Check, Tolerance, Verification
+from ._skid_steer_engine import EngineParams, EngineRun, Terrain, simulate_engine
 
-__all__ = ["VERIFICATION", "GroundTruth", "Terrain", "run_checks", "simulate"]
+__all__ = [
+    "VERIFICATION",
+    "EngineParams",
+    "EngineRun",
+    "GroundTruth",
+    "Terrain",
+    "engine_checks",
+    "engine_runs",
+    "run_checks",
+    "simulate",
+    "simulate_engine",
+]
 
 # Newton on the contact conditions stops when every residual is below this (m): a few hundred eps of
 # the 0.3 m geometry, the level below which the residual is rounding.
@@ -44,31 +60,6 @@ NEWTON_FD_STEP = 1e-7
 TIME_FD_STEP = 1e-3
 
 _SIGN = (-1.0, 1.0)  # side 1 right at y = -b, side 2 left at y = +b
-
-
-@dataclass(frozen=True)
-class Terrain:
-    """Height field ``z = Σ a_k sin(kx_k x + ky_k y + φ_k)`` (m); ``flat()`` has no terms."""
-
-    amplitude: tuple[float, ...]
-    kx: tuple[float, ...]
-    ky: tuple[float, ...]
-    phase: tuple[float, ...]
-
-    @classmethod
-    def uneven(cls) -> Terrain:
-        """Three crossing undulations, 8–12 mm high, wavelengths 0.9–1.6 m (rough ground)."""
-        return cls((0.012, 0.010, 0.008), (4.0, 1.5, -2.5), (1.0, 5.0, 4.5), (0.3, 1.1, 2.0))
-
-    @classmethod
-    def flat(cls) -> Terrain:
-        return cls((), (), (), ())
-
-    def height(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        z = np.zeros(np.broadcast_shapes(np.shape(x), np.shape(y)))
-        for a, kx, ky, ph in zip(self.amplitude, self.kx, self.ky, self.phase, strict=True):
-            z = z + a * np.sin(kx * x + ky * y + ph)
-        return z
 
 
 @dataclass(frozen=True)
@@ -263,7 +254,24 @@ TOL_RATES = Tolerance(1e-9, "passive joint rates: same sources, divided by lever
 TOL_DEAD_RECKONING = Tolerance(
     1e-6, "pose from integrating the true twists at 200 Hz with the mean-twist rule: O(dt²) drift over 10 s"
 )
-TOL_SKID = Tolerance(1e-9, "on flat ground (v1-v2)/S of the contact speeds is the yaw rate exactly")
+# --- engine checks (MuJoCo contact physics, ``_skid_steer_engine``) ---
+TOL_ENGINE_TWIST = Tolerance(
+    1.5e-4,
+    "30x11 estimate from the engine's carrier-fixed contact velocities vs the engine's chassis twist: "
+    "exact kinematics except the soft joint equalities (parallelogram, differential), measured 5e-5; "
+    "a 10 % track-width error gives 4e-4",
+)
+TOL_ENGINE_SPEED = Tolerance(
+    0.02,
+    "straight run on flat ground: encoder speed r·φ̇ vs the engine's forward speed; MuJoCo's soft "
+    "contact leaves ~0.4 % longitudinal creep; a 10 % radius error gives > 6 %",
+    relative=True,
+)
+TOL_ENGINE_ICR = Tolerance(
+    0.03,
+    "yaw rate of the ICR model identified on five other flat manoeuvres vs the engine, RMS over "
+    "validation turns (rad/s): χ varies with the turn, measured 0.011; the no-slip formula errs 0.2",
+)
 
 
 def run_checks(
@@ -302,15 +310,106 @@ def run_checks(
     T = dead_reckoning(gt.twist, gt.t[1] - gt.t[0], gt.T_GB[0])
     drift = float(np.max(np.linalg.norm(T[:, :3, 3] - gt.T_GB[:, :3, 3], axis=-1)))
     checks.append(Check(name, "dead reckoning of true twists: position (m)", drift, TOL_DEAD_RECKONING))
-    flat = simulate(robot, duration=2.0, rate=100.0, terrain=Terrain.flat())
-    vx = flat.measured[:, :18].reshape(-1, 6, 3)[..., 0]
-    turn = skid_steer_turn(vx[:, :3].mean(axis=1), vx[:, 3:].mean(axis=1), est.track_width)
+    checks += engine_checks(robot, est)
+    return checks
+
+
+# Engine manoeuvres (right, left track speeds, m/s): identification set and validation set (disjoint).
+IDENTIFICATION_RUNS = ((0.25, 0.05), (0.05, 0.25), (0.3, 0.15), (0.2, -0.1), (0.1, 0.3))
+VALIDATION_TURNS = ((0.3, 0.1), (0.15, 0.25), (0.2, 0.0))
+ENGINE_RUN_S = 3.0  # s recorded per manoeuvre
+ENGINE_RATE = 50.0  # Hz recorded
+ENGINE_TRANSIENT_S = 1.0  # s after the start discarded (commands ramp in over 0.5 s, then settle)
+
+
+@functools.lru_cache(maxsize=4)
+def engine_runs(robot: ExplorationRobot) -> dict[str, tuple[EngineRun, ...]]:
+    """The engine manoeuvres of the checks for the true ``robot`` (cached: the teeth tests reuse them)."""
+    check_params(robot, ExplorationRobot, "robot")
+    sim = functools.partial(simulate_engine, robot, duration=ENGINE_RUN_S, rate=ENGINE_RATE)
+    return {
+        "identification": tuple(sim(v) for v in IDENTIFICATION_RUNS),
+        "validation": tuple(sim(v) for v in VALIDATION_TURNS),
+        "straight": (sim((0.2, 0.2)),),
+        "uneven": (sim((0.25, 0.1), terrain=Terrain.uneven()),),
+    }
+
+
+def planar_twist(run: EngineRun) -> np.ndarray:
+    """``(v_x, v_y, r)`` of the chassis in body axes, ``(N, 3)``."""
+    return np.stack([run.twist[:, 3], run.twist[:, 4], run.twist[:, 2]], axis=-1)
+
+
+def steady(run: EngineRun) -> slice:
+    return slice(round(ENGINE_TRANSIENT_S * run.rate), None)
+
+
+def identify_from_runs(robot: ExplorationRobot, runs) -> ICRModel:
+    """ICR model identified from encoder speeds (``robot``'s radii) and the engine's body twists."""
+    parts = []
+    for u in runs:
+        sl = steady(u)
+        tr = encoder_track_speeds(robot, u.wheel_rate[sl])
+        vr, vl = tr.right, tr.left
+        parts.append((vr, vl, planar_twist(u)[sl]))
+    vr, vl, V = (np.concatenate(x) for x in zip(*parts, strict=True))
+    ident = identify_icr(vr, vl, V)
+    if not ident.identifiable:
+        raise RuntimeError("ICR identification data carry no turning (internal manoeuvre set is wrong).")
+    return ident.model
+
+
+def engine_checks(robot: ExplorationRobot, est: ExplorationRobot) -> list[Check]:
+    """Checks of the estimators against the MuJoCo contact-physics ground truth (``robot``: the true
+    geometry the engine is built from; ``est``: the geometry the estimators believe)."""
+    check_params(robot, ExplorationRobot, "robot")
+    check_params(est, ExplorationRobot, "est")
+    runs = engine_runs(robot)
+    name = "skid-steer"
+    checks = []
+    err = []
+    for u in (*runs["validation"], *runs["uneven"]):
+        sl = steady(u)
+        bv = body_velocity(est, u.config[sl], u.measured[sl])
+        e = np.abs(bv.twist - u.twist[sl])[:, [0, 2, 3, 4, 5]]
+        err.append(np.where(bv.valid[:, None], e, np.inf).max())
+    contact = min(float(u.in_contact.mean()) for u in (*runs["validation"], *runs["uneven"]))
     checks.append(
         Check(
             name,
-            "flat ground: yaw rate (v1-v2)/S vs truth (rad/s)",
-            float(np.max(np.abs(turn.yaw_rate - flat.twist[:, 2]))),
-            TOL_SKID,
+            "engine: 30x11 body twist (ω_BX, ω_BZ, v_B) vs MuJoCo (m/s, rad/s)",
+            float(max(err)),
+            TOL_ENGINE_TWIST,
+            f"3 flat turns + uneven ground; wheels in contact ≥ {100 * contact:.0f} % of samples",
+        )
+    )
+    u = runs["straight"][0]
+    sl = steady(u)
+    tr = encoder_track_speeds(est, u.wheel_rate[sl])
+    speed = 0.5 * (tr.right + tr.left)
+    rel = float(np.max(np.abs(speed - u.twist[sl, 3])) / np.mean(np.abs(u.twist[sl, 3])))
+    checks.append(
+        Check(name, "engine: straight flat run, encoder speed vs MuJoCo (relative)", rel, TOL_ENGINE_SPEED)
+    )
+    model = identify_from_runs(est, runs["identification"])
+    no_slip = ICRModel.no_slip(est.track_width)
+    e_icr, e_ns = [], []
+    for u in runs["validation"]:
+        sl = steady(u)
+        tr = encoder_track_speeds(est, u.wheel_rate[sl])
+        vr, vl = tr.right, tr.left
+        e_icr.append(icr_velocity(model, vr, vl).yaw_rate - u.twist[sl, 2])
+        e_ns.append(icr_velocity(no_slip, vr, vl).yaw_rate - u.twist[sl, 2])
+    rms_icr = float(np.sqrt(np.mean(np.concatenate(e_icr) ** 2)))
+    rms_ns = float(np.sqrt(np.mean(np.concatenate(e_ns) ** 2)))
+    checks.append(
+        Check(
+            name,
+            "engine: flat turns, yaw rate of the identified ICR model vs MuJoCo, RMS (rad/s)",
+            rms_icr,
+            TOL_ENGINE_ICR,
+            f"χ = {model.track_width_factor(est.track_width):.2f}; no-slip (v1−v2)/S RMS error "
+            f"{rms_ns:.3f} rad/s ({rms_ns / rms_icr:.0f}× larger)",
         )
     )
     return checks
@@ -318,7 +417,8 @@ def run_checks(
 
 VERIFICATION = Verification(
     name="skid-steer",
-    title="Skid-steer velocity estimator vs an independent kinematic simulation on uneven ground",
-    engine="kinematic rigid-body simulation (transform chains + Newton contact, time differences)",
+    title="Skid-steer estimators vs an independent kinematic simulation and MuJoCo contact physics",
+    engine="kinematic rigid-body simulation (transform chains + Newton contact) and MuJoCo (MjSpec model, "
+    "wheel-ground friction, height field)",
     run=run_checks,
 )

@@ -27,8 +27,8 @@ SPECS = {
     P + "lstsq.RANK_RTOL_FACTOR": CONSTANT,
     P + "lstsq.LstsqResult": RESULT_TYPE,
     P + "lstsq.solve": Spec(
-        args={"A": A, "b": B, "exact_cond": False},
-        arrays={"A": 2, "b": 1},
+        args={"A": A, "b": B, "exact_cond": False, "weights": np.linspace(0.5, 2.0, 5)},
+        arrays={"A": 2, "b": 1, "weights": 1},
         masked=("A", "b"),
         mask="ok",
         wrong_shapes={"A": ((3, 2, 3),)},  # fewer rows than columns

@@ -51,7 +51,19 @@ def test_paper_lateral_slip_is_the_outer_wheel_half_a_wheelbase_from_the_centre_
     L, r, R = 0.5, 0.4, 0.9
     v_outer = r * (R + S / 2)  # right track when turning left
     lateral = wheel_lateral_velocity(r, -L / 2, 0.0)  # rear wheel, centre of rotation abeam the centre
-    assert abs(lateral) == pytest.approx(float(paper_lateral_slip(v_outer, L, R, S)), rel=1e-14)
+    slip = paper_lateral_slip(v_outer, L, R, S)
+    assert bool(slip.valid)
+    assert abs(lateral) == pytest.approx(float(slip.lateral_speed), rel=1e-14)
+
+
+def test_paper_lateral_slip_flags_its_singularity_instead_of_returning_inf():
+    # issue 14: 2 R + S = 0 (centre of rotation on the inner track) used to return inf.
+    slip = paper_lateral_slip([0.1, 0.1, 0.1], 0.5, [-S / 2, 0.9, -S / 2 * (1 + 1e-12)], S)
+    assert slip.valid.tolist() == [False, True, False]
+    assert np.isnan(slip.lateral_speed[~slip.valid]).all()
+    assert np.isfinite(slip.lateral_speed[slip.valid]).all()
+    with pytest.raises(ValueError, match="radius"):  # non-finite input: an error (the contract spec)
+        paper_lateral_slip(0.1, 0.5, np.inf, S)
 
 
 def test_skid_steer_rejects_bad_track_width():

@@ -179,3 +179,17 @@ def test_batched_equals_per_sample():
         i, j = divmod(k, 6)
         np.testing.assert_allclose(one.twist, batch.twist[i, j], rtol=0, atol=1e-12)
         np.testing.assert_allclose(one.residual_norm, batch.residual_norm[i, j], rtol=0, atol=1e-12)
+
+
+def test_overflowing_sample_is_not_valid():
+    """issue 14: a finite 1e160 sample overflowed the residual to inf with valid = True."""
+    q = np.zeros(8)
+    q[[3, 7]] = ROBOT.rear_wheel_drop
+    m = np.full((3, 22), 0.1)
+    m[1] = 1e160
+    m[2] = 1e200
+    est = body_velocity(ROBOT, q, m)
+    assert est.valid.tolist() == [True, False, False]
+    for a in (est.twist, est.config_rate, est.unknowns, est.residual_norm):
+        assert np.all(np.isnan(a[~est.valid]))
+        assert np.all(np.isfinite(a[est.valid]))

@@ -10,7 +10,9 @@ from robomech._validation import as_array, broadcast_batch, check_positive
 from robomech.spatial import exp_se3
 
 __all__ = [
+    "LATERAL_SLIP_RTOL",
     "STRAIGHT_RTOL",
+    "LateralSlip",
     "SkidSteerTurn",
     "dead_reckoning",
     "paper_lateral_slip",
@@ -21,6 +23,11 @@ __all__ = [
 # Track speeds whose difference is below this fraction of their magnitude are "straight": the radius
 # (S/2)(v1+v2)/(v1-v2) would then be dominated by the rounding of v1 - v2 (relative 1e-13 ~ 500 eps).
 STRAIGHT_RTOL = 1e-13
+# paper_lateral_slip divides by 2R + S, which vanishes when the centre of rotation lies on the inner
+# track line (R = -S/2, the inner track at rest).  There the outer speed is 0 as well and v_Y = r L/2 is
+# indeterminate from (v_outer, R); within this fraction of S the quotient amplifies the rounding of
+# v_outer by more than 1e9 L/S, so such samples are flagged instead of returned as huge or inf values.
+LATERAL_SLIP_RTOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -72,16 +79,33 @@ def wheel_lateral_velocity(yaw_rate: object, wheel_x: object, icr_x: object = 0.
     return r * (x - xi)
 
 
-def paper_lateral_slip(v_outer: object, wheelbase: float, radius: object, track_width: float) -> np.ndarray:
+@dataclass(frozen=True)
+class LateralSlip:
+    """Lateral slip speed of the outer wheel (m/s, batch shape ``...``); NaN exactly where ``valid`` is
+    false: the centre of rotation within ``LATERAL_SLIP_RTOL`` S of the inner track (or an overflow)."""
+
+    lateral_speed: np.ndarray
+    valid: np.ndarray
+
+
+def paper_lateral_slip(v_outer: object, wheelbase: float, radius: object, track_width: float) -> LateralSlip:
     """paper 4, Sec. 1.2: ``v_Y = v_X L / (2 R_s + S)``, magnitude of the lateral slip of an outer
     wheel a distance ``L/2`` ahead of or behind the centre of rotation, with ``R_s`` the radius of the
-    body centre (not of the inner wheel, as printed)."""
+    body centre (not of the inner wheel, as printed).
+
+    Samples at the formula's singularity ``2 R + S = 0`` (the centre of rotation on the inner track, which
+    is then at rest) are flagged (``valid`` false, NaN) instead of returned as huge or infinite values.
+    """
     v = as_array(v_outer, "v_outer")
     R = as_array(radius, "radius")
     broadcast_batch((v, 0, "v_outer"), (R, 0, "radius"))
     L = check_positive(wheelbase, "wheelbase")
     S = check_positive(track_width, "track_width")
-    return v * L / (2.0 * R + S)
+    den = 2.0 * R + S
+    valid = np.abs(den) > LATERAL_SLIP_RTOL * S
+    out = np.where(valid, v * L / np.where(valid, den, 1.0), np.nan)
+    valid = valid & np.isfinite(out)
+    return LateralSlip(lateral_speed=np.where(valid, out, np.nan), valid=valid)
 
 
 def dead_reckoning(twists: object, dt: float, T0: object | None = None) -> np.ndarray:

@@ -20,7 +20,7 @@ from typing import Literal
 
 import numpy as np
 
-from robomech._validation import as_array, check_bool, check_params
+from robomech._validation import as_array, broadcast_batch, check_bool, check_params
 from robomech.analysis import lstsq
 
 from ._chains import CONFIG_SIZE, N_WHEELS, _linear_columns
@@ -177,6 +177,7 @@ def body_velocity(
     *,
     solver: Literal["qr", "normal_equations"] = "qr",
     exact_cond: bool = False,
+    measurement_sigma: object | None = None,
 ) -> BodyVelocity:
     """Body twist and passive joint rates from wheel and rocker measurements, per sample.
 
@@ -186,6 +187,12 @@ def body_velocity(
     samples (sensor drop-outs) are flagged by ``valid`` instead of raising.  ``cond`` is the exact 1-norm
     condition number of R (within a factor 11 of the 2-norm one); ``exact_cond=True`` gives the 2-norm
     one from the singular values of R (QR only; slower).
+
+    ``measurement_sigma (..., 22)`` (> 0, the standard deviations of the measured vector, independent
+    errors) makes it weighted least squares (QR only): row i of ``A0 ṗ = J q̇`` gets the weight
+    ``1 / Σ_j J_ij² σ_j²``, the inverse variance of its right-hand side.  The rows' correlations (the
+    gyro appears in all six wheels' angular rows) are neglected: a diagonal weighting, not full GLS.
+    ``residual_norm`` is then the weighted (dimensionless) residual.
     """
     check_params(robot, ExplorationRobot, "robot")
     q = as_array(state, "state", (CONFIG_SIZE,), finite="mask")  # NaN, inf, beyond 1e100: drop-outs
@@ -193,7 +200,15 @@ def body_velocity(
     if solver not in ("qr", "normal_equations"):
         raise ValueError(f"Expected solver 'qr' or 'normal_equations', got {solver!r}.")
     check_bool(exact_cond, "exact_cond")
-    batch = np.broadcast_shapes(q.shape[:-1], m.shape[:-1])
+    sig = None
+    if measurement_sigma is not None:
+        if solver != "qr":
+            raise ValueError(f"Expected solver 'qr' with measurement_sigma (weighted QR), got {solver!r}.")
+        sig = as_array(measurement_sigma, "measurement_sigma", (MEASURED_SIZE,))
+        if np.any(sig <= 0):
+            raise ValueError(f"Expected measurement_sigma > 0, got {int(np.sum(sig <= 0))} value(s) <= 0.")
+    arrays = [(q, 1, "state"), (m, 1, "measured")] + ([] if sig is None else [(sig, 1, "measurement_sigma")])
+    batch = broadcast_batch(*arrays)
     n = int(np.prod(batch))
     qf = np.broadcast_to(q, (*batch, CONFIG_SIZE)).reshape(n, CONFIG_SIZE)
     mf = np.broadcast_to(m, (*batch, MEASURED_SIZE)).reshape(n, MEASURED_SIZE)
@@ -208,7 +223,11 @@ def body_velocity(
         A0, J = _assemble(robot, np.where(finite_q[:, None], qc, 0.0))
         A0[~finite_q] = np.nan  # flagged by lstsq as not ok
         b = np.einsum("nij,nj->ni", J, mc)
-        if solver == "qr":
+        if sig is not None:
+            sc = np.broadcast_to(sig, (*batch, MEASURED_SIZE)).reshape(n, MEASURED_SIZE)[sl]
+            w = 1.0 / np.einsum("nij,nj->ni", J * J, sc * sc)  # inverse variance of each row's b_i
+            res = lstsq.solve(A0, b, exact_cond=exact_cond, weights=w)
+        elif solver == "qr":
             res = lstsq.solve(A0, b, exact_cond=exact_cond)
         else:
             res = lstsq.solve_normal_equations(A0, b)
@@ -216,11 +235,14 @@ def body_velocity(
         resid[sl] = res.residual_norm
         # the condition number stays reported for finite rank-deficient samples (huge or inf)
         cond[sl] = np.where(res.ok, res.cond, np.nan)
-        valid[sl] = res.ok & res.full_rank
+        # A finite but huge sample can overflow the residual (or x) to inf: never valid (issue 14).
+        valid[sl] = (
+            res.ok & res.full_rank & np.isfinite(res.residual_norm) & np.all(np.isfinite(res.x), axis=-1)
+        )
     x = x.reshape(*batch, UNKNOWN_SIZE)
-    valid = valid.reshape(batch)
     w_by = 0.5 * (m[..., I_ROCKER1] + m[..., I_ROCKER2])
     w_by = np.broadcast_to(w_by, batch)
+    valid = valid.reshape(batch) & np.isfinite(w_by)
     twist = np.stack([x[..., 3], w_by, x[..., 4], x[..., 0], x[..., 1], x[..., 2]], axis=-1)
     rate = np.empty((*batch, CONFIG_SIZE))
     rate[..., 0] = m[..., I_ROCKER1] - w_by

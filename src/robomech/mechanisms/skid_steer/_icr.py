@@ -1,0 +1,253 @@
+"""ICR kinematics of a skid-steered vehicle (Martínez et al. 2005; Mandow et al. 2007), its identification
+from encoders and a measured body twist by least squares, and per-wheel slip.
+
+Planar body twist ``(v_x, v_y, r)`` in body axes (x forward, y left, r yaw rate).  Each track (side) has
+an instantaneous centre of rotation: the point of the track plane where the belt's ground velocity
+vanishes.  With the track moving backwards relative to the body at its encoder speed ``v_i``, the belt
+point at body ``(x, y)`` moves over the ground at ``(v_x - r y - v_i, v_y + r x)``; it vanishes at
+``y = y_i``, ``x = x_icr = -v_y / r``.  Hence
+
+    v_right = v_x - r y_right,   v_left = v_x - r y_left,   v_y = -r x_icr,
+
+so ``r = (v_right - v_left)/(y_left - y_right)`` and
+``v_x = (v_right y_left - v_left y_right)/(y_left - y_right)``.
+No slip is ``y_left = -y_right = S/2``, ``x_icr = 0``; ``χ = (y_left - y_right)/S >= 1`` is the effective
+track-width factor of the skid.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array, check_params, check_positive, coerce_float_fields
+from robomech.analysis import lstsq
+
+from ._chains import N_WHEELS, WHEEL_SIDE, WHEELS, contact_frames
+from ._params import ExplorationRobot
+
+__all__ = [
+    "SLIP_SPEED_FLOOR",
+    "ICRIdentification",
+    "ICRModel",
+    "PlanarVelocity",
+    "TrackSpeeds",
+    "WheelSlip",
+    "encoder_track_speeds",
+    "icr_velocity",
+    "identify_icr",
+    "wheel_radii",
+    "wheel_slip",
+]
+
+# Below this speed (m/s) of both the wheel rim and the ground under it a slip ratio is 0/0: flagged.
+# 1 µm/s is far below any encoder's resolution at 100 Hz (~1 mm/s for 2048 counts per revolution).
+SLIP_SPEED_FLOOR = 1e-6
+
+
+@dataclass(frozen=True)
+class ICRModel:
+    """Lateral ICR positions of the left and right tracks and the longitudinal ICR position (m, body axes).
+
+    ``y_left > y_right`` is required (otherwise the yaw rate has the wrong sign or is undefined).
+    """
+
+    y_left: float
+    y_right: float
+    x_icr: float = 0.0
+
+    def __post_init__(self) -> None:
+        coerce_float_fields(self, ("y_left", "y_right", "x_icr"))
+        if not self.y_left > self.y_right:
+            raise ValueError(
+                f"Expected y_left > y_right, got y_left={self.y_left!r}, y_right={self.y_right!r}."
+            )
+
+    @classmethod
+    def no_slip(cls, track_width: float) -> ICRModel:
+        """Ideal differential drive: the track ICRs on the wheel planes, ``x_icr = 0``."""
+        S = check_positive(track_width, "track_width")
+        return cls(0.5 * S, -0.5 * S, 0.0)
+
+    def track_width_factor(self, track_width: float) -> float:
+        """``χ = (y_left - y_right) / S``: the effective track width in units of the real one."""
+        return (self.y_left - self.y_right) / check_positive(track_width, "track_width")
+
+
+@dataclass(frozen=True)
+class PlanarVelocity:
+    """Planar body velocity (batch shape ``...``): ``v_x``, ``v_y`` (m/s, body axes), ``yaw_rate``
+    (rad/s); ``valid`` false (and the values NaN) where an input track speed was not finite."""
+
+    v_x: np.ndarray
+    v_y: np.ndarray
+    yaw_rate: np.ndarray
+    valid: np.ndarray
+
+
+def icr_velocity(model: ICRModel, v_right: object, v_left: object) -> PlanarVelocity:
+    """Body velocity predicted by the ICR model from the right and left track (encoder) speeds (m/s).
+
+    Non-finite speeds (encoder drop-outs) are flagged per sample by ``valid``.
+    """
+    check_params(model, ICRModel, "model")
+    vr = as_array(v_right, "v_right", finite=False)
+    vl = as_array(v_left, "v_left", finite=False)
+    try:
+        vr, vl = np.broadcast_arrays(vr, vl)
+    except ValueError as exc:
+        raise ValueError(f"Expected v_right and v_left to broadcast, got {vr.shape} and {vl.shape}.") from exc
+    valid = np.isfinite(vr) & np.isfinite(vl)
+    vr, vl = np.where(valid, vr, 0.0), np.where(valid, vl, 0.0)
+    d = model.y_left - model.y_right
+    r = (vr - vl) / d
+    vx = (vr * model.y_left - vl * model.y_right) / d
+    vy = -r * model.x_icr
+    nan = np.nan
+    return PlanarVelocity(
+        v_x=np.where(valid, vx, nan),
+        v_y=np.where(valid, vy, nan),
+        yaw_rate=np.where(valid, r, nan),
+        valid=valid,
+    )
+
+
+def wheel_radii(robot: ExplorationRobot) -> np.ndarray:
+    """Rolling radius of each wheel in ``WHEELS`` order (m): road wheels, then the rear wheel, per side."""
+    check_params(robot, ExplorationRobot, "robot")
+    return np.array([robot.road_wheel_radius if "road" in w else robot.rear_wheel_radius for w in WHEELS])
+
+
+@dataclass(frozen=True)
+class TrackSpeeds:
+    """No-slip track speeds (m/s, batch shape ``...``): ``right``, ``left``; ``valid`` false (values
+    NaN) where a wheel rate of the sample was not finite (an encoder drop-out)."""
+
+    right: np.ndarray
+    left: np.ndarray
+    valid: np.ndarray
+
+
+def encoder_track_speeds(robot: ExplorationRobot, wheel_rate: object) -> TrackSpeeds:
+    """No-slip track speeds from the wheel spin rates ``(..., 6)`` (rad/s): the mean rim speed
+    ``r_w φ̇_w`` of each side's three wheels.  A sample with a non-finite wheel rate is flagged."""
+    radii = wheel_radii(robot)
+    w = as_array(wheel_rate, "wheel_rate", (N_WHEELS,), finite=False)
+    valid = np.all(np.isfinite(w), axis=-1)
+    rim = np.where(valid[..., None], w, 0.0) * radii
+    side = np.asarray(WHEEL_SIDE)
+    right = rim[..., side == 0].mean(axis=-1)
+    left = rim[..., side == 1].mean(axis=-1)
+    return TrackSpeeds(right=np.where(valid, right, np.nan), left=np.where(valid, left, np.nan), valid=valid)
+
+
+@dataclass(frozen=True)
+class ICRIdentification:
+    """Least-squares ICR parameters and their quality.
+
+    ``model``: the identified :class:`ICRModel` (``None`` when not identifiable: ``identifiable`` false);
+    ``residual_rms (3,)``: RMS misfit of the three equation groups (right track, left track, lateral; m/s);
+    ``used (N,)``: samples that entered (finite); ``n_used``; ``cond``: condition number of the system;
+    ``identifiable``: enough turning in the used samples for a full-rank system with ``y_left > y_right``.
+    """
+
+    model: ICRModel | None
+    residual_rms: np.ndarray
+    used: np.ndarray
+    n_used: int
+    cond: float
+    identifiable: bool
+
+
+def identify_icr(
+    v_right: object, v_left: object, body_velocity: object, *, weights: object | None = None
+) -> ICRIdentification:
+    """Identify ``(y_right, y_left, x_icr)`` from track speeds ``(N,)`` and measured planar body
+    velocities ``(N, 3)`` = ``(v_x, v_y, r)`` by linear least squares (``analysis.lstsq``).
+
+    Equations per sample: ``-r y_right = v_right - v_x``, ``-r y_left = v_left - v_x``, ``-r x_icr = v_y``.
+    ``weights (N,)`` (``>= 0``) weight each sample's three equations (e.g. ``1/σ²`` of that sample).
+    Samples with any non-finite value (drop-outs) are not used and are reported in ``used`` (nothing is
+    dropped silently).  Straight driving carries no information (its rows are zero); a data set without
+    turning is reported ``identifiable = False``.
+    """
+    vr = as_array(v_right, "v_right", finite=False)
+    vl = as_array(v_left, "v_left", finite=False)
+    V = as_array(body_velocity, "body_velocity", (3,), finite=False)
+    if vr.ndim != 1:
+        raise ValueError(f"Expected v_right to have shape (N,), got {vr.shape}.")
+    if vl.shape != vr.shape:
+        raise ValueError(
+            f"Expected v_left to have shape {vr.shape} like v_right (one N: one sample rate), got {vl.shape}."
+        )
+    if V.shape != (*vr.shape, 3):
+        raise ValueError(
+            f"Expected body_velocity to have shape {(*vr.shape, 3)} (one N: one sample rate), got {V.shape}."
+        )
+    w = np.ones(vr.shape) if weights is None else as_array(weights, "weights")
+    if w.shape != vr.shape:
+        raise ValueError(f"Expected weights to have shape {vr.shape}, got {w.shape}.")
+    if np.any(w < 0):
+        raise ValueError(f"Expected weights >= 0, got {int(np.sum(w < 0))} negative value(s).")
+    used = np.isfinite(vr) & np.isfinite(vl) & np.all(np.isfinite(V), axis=-1)
+    n = int(used.sum())
+    # The three groups decouple (each unknown has its own column): three (N, 1) systems, one batched call.
+    r = V[used, 2]
+    A = np.broadcast_to(-r[None, :, None], (3, n, 1))
+    b = np.stack([vr[used] - V[used, 0], vl[used] - V[used, 0], V[used, 1]])  # (3, n)
+    if n == 0 or not np.any(r != 0.0):
+        # no used sample, or no turning at all: every row is zero, nothing to identify
+        rms = np.sqrt(np.mean(b**2, axis=1)) if n else np.full(3, np.nan)
+        return ICRIdentification(None, rms, used, n, math.inf, False)
+    res = lstsq.solve(A, b, weights=w[used])
+    x = res.x[:, 0]
+    rms = np.sqrt(np.mean((A[..., 0] * np.nan_to_num(x)[:, None] - b) ** 2, axis=1))
+    y_right, y_left, x_icr = (float(v) for v in x)
+    ok = bool(np.all(res.ok & res.full_rank) and np.all(np.isfinite(x)) and y_left > y_right)
+    model = ICRModel(y_left, y_right, x_icr) if ok else None
+    return ICRIdentification(model, rms, used, n, float(np.max(res.cond)), ok)
+
+
+@dataclass(frozen=True)
+class WheelSlip:
+    """Per-wheel slip (batch shape ``...``, last axis the six wheels in ``WHEELS`` order).
+
+    ``ratio``: longitudinal slip ``(r φ̇ - v) / max(|r φ̇|, |v|)`` in [-1, 1] (positive: spinning faster
+    than the ground passes, i.e. traction slip; negative: skidding, braking); ``v`` is the ground speed
+    of the contact along the wheel's heading.  ``lateral_velocity``: sideways sliding of the contact (m/s).
+    ``valid``: a finite wheel rate (a drop-out is flagged for that wheel) and not both speeds below
+    ``SLIP_SPEED_FLOOR`` (NaN exactly where it is false).
+    """
+
+    ratio: np.ndarray
+    lateral_velocity: np.ndarray
+    valid: np.ndarray
+
+
+def wheel_slip(
+    robot: ExplorationRobot, wheel_rate: object, body_velocity: object, config: object | None = None
+) -> WheelSlip:
+    """Slip of each wheel from its spin rate ``(..., 6)`` (rad/s) and the planar body velocity
+    ``(..., 3)`` = ``(v_x, v_y, r)``; contacts at ``config (..., 8)`` (default: zero joint angles with
+    the nominal slides), planar rigid motion: contact ``(x, y)`` moves at ``(v_x - r y, v_y + r x)``."""
+    radii = wheel_radii(robot)
+    w = as_array(wheel_rate, "wheel_rate", (N_WHEELS,), finite=False)
+    V = as_array(body_velocity, "body_velocity", (3,))
+    if config is None:
+        q = np.zeros(8)
+        q[[3, 7]] = robot.rear_wheel_drop
+    else:
+        q = as_array(config, "config", (8,))
+    p = contact_frames(robot, q)[..., :3, 3]  # (..., 6, 3)
+    vx, vy, r = V[..., 0:1], V[..., 1:2], V[..., 2:3]
+    ground = vx - r * p[..., 1]
+    lateral = vy + r * p[..., 0]
+    finite = np.isfinite(w)
+    rim = np.where(finite, w, 0.0) * radii
+    valid, ground, lateral, rim = np.broadcast_arrays(finite, ground, lateral, rim)
+    den = np.maximum(np.abs(rim), np.abs(ground))
+    valid = valid & (den > SLIP_SPEED_FLOOR)
+    ratio = np.where(valid, (rim - ground) / np.where(valid, den, 1.0), np.nan)
+    return WheelSlip(ratio=ratio, lateral_velocity=np.where(valid, lateral, np.nan), valid=valid)

@@ -1,0 +1,341 @@
+"""Sensor models (wheel encoders, IMU) with stated, seeded noise, and an extended Kalman filter for planar
+odometry from encoders and a gyro, with the ICR model as its measurement model.
+
+Encoder: an incremental encoder of ``counts_per_rev`` counts; the rate at sample k is the count
+difference over the last sample interval, so it reads ``floor`` or ``ceil`` of the true count increment:
+with ``δ`` the fractional part of the increment the error has variance ``δ(1-δ) q²/dt²`` (at most
+``q²/(4 dt²)``), ``q = 2π / counts_per_rev``; averaged over rates (δ uniform) the stated standard
+deviation is ``q / (dt √6)`` rad/s.  The
+first sample has no previous count: NaN (a drop-out, flagged downstream, never silently filled).
+
+IMU: gyro and accelerometer with a constant bias plus white noise of the stated density
+(σ = density · √(rate)); the accelerometer measures specific force (acceleration minus gravity) in body axes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import (
+    as_array,
+    check_int,
+    check_params,
+    check_positive,
+    coerce_float_fields,
+    coerce_int_fields,
+)
+
+from ._chains import N_WHEELS
+from ._icr import ICRModel
+
+__all__ = [
+    "N_STATE",
+    "SAMPLE_RATE_RTOL",
+    "EKFResult",
+    "EncoderModel",
+    "EncoderReadings",
+    "ImuModel",
+    "encoder_rates",
+    "imu_measurements",
+    "planar_ekf",
+    "track_speed_sigma",
+]
+
+# Relative spread of the sample intervals dt_k beyond which the histories do not share one sample rate
+# (1e-6: far above the rounding of arange(n)/rate, far below any real jitter worth modelling).
+SAMPLE_RATE_RTOL = 1e-6
+# State of planar_ekf: [x, y, ψ, v_x, r, b_gyro, y_left, y_right].
+N_STATE = 8
+
+
+@dataclass(frozen=True)
+class EncoderModel:
+    """Incremental wheel encoder: ``counts_per_rev`` counts per wheel revolution (quantisation only)."""
+
+    counts_per_rev: int = 2048
+
+    def __post_init__(self) -> None:
+        coerce_int_fields(self, ("counts_per_rev",), low=1)
+
+    def rate_sigma(self, dt: float) -> float:
+        """Standard deviation of the measured spin rate (rad/s) at sample interval ``dt`` (s), averaged
+        over rates (module docstring); the worst rate gives ``√1.5`` times this."""
+        return 2.0 * math.pi / self.counts_per_rev / (check_positive(dt, "dt") * math.sqrt(6.0))
+
+
+@dataclass(frozen=True)
+class ImuModel:
+    """Gyro and accelerometer: white-noise densities and constant biases (per axis, SI units).
+
+    Defaults: a MEMS IMU of the ADIS16470 class (gyro 0.008 °/s/√Hz, accelerometer 0.5 mg/√Hz); the
+    biases are of the size left after a start-up calibration.
+    """
+
+    gyro_noise_density: float = math.radians(0.008)  # rad/s/√Hz
+    gyro_bias: tuple[float, float, float] = (0.0, 0.0, math.radians(0.1))  # rad/s
+    accel_noise_density: float = 0.5e-3 * 9.80665  # m/s²/√Hz
+    accel_bias: tuple[float, float, float] = (0.02, -0.01, 0.0)  # m/s²
+
+    def __post_init__(self) -> None:
+        coerce_float_fields(
+            self, ("gyro_noise_density", "accel_noise_density"), positive=True, allow_zero=True
+        )
+        for name in ("gyro_bias", "accel_bias"):
+            b = as_array(getattr(self, name), name, (3,))
+            if b.ndim != 1:
+                raise ValueError(f"Expected {name} to have shape (3,), got {b.shape}.")
+            object.__setattr__(self, name, tuple(float(v) for v in b))
+
+    def gyro_sigma(self, dt: float) -> float:
+        return self.gyro_noise_density / math.sqrt(check_positive(dt, "dt"))
+
+    def accel_sigma(self, dt: float) -> float:
+        return self.accel_noise_density / math.sqrt(check_positive(dt, "dt"))
+
+
+def _rng(seed: object) -> np.random.Generator:
+    if isinstance(seed, np.random.Generator):
+        return seed
+    return np.random.default_rng(check_int(seed, "seed", low=0))
+
+
+@dataclass(frozen=True)
+class EncoderReadings:
+    """Measured spin rates ``rate (N, 6)`` (rad/s, ``WHEELS`` order); ``valid (N,)`` false where there
+    is no reading (the first sample: no previous count), and ``rate`` is NaN exactly there."""
+
+    rate: np.ndarray
+    valid: np.ndarray
+
+
+def encoder_rates(model: EncoderModel, wheel_rate: object, dt: float, seed: object = 0) -> EncoderReadings:
+    """Measured spin rates from true rates ``(N, 6)`` sampled every ``dt`` s.
+
+    The true angle is integrated by the trapezoidal rule from a random initial phase (``seed``: an int
+    or a ``numpy.random.Generator``), counted, and differenced; the first sample has no reading.
+    """
+    check_params(model, EncoderModel, "model")
+    w = as_array(wheel_rate, "wheel_rate", (None, N_WHEELS), min_ndim=2)
+    if w.ndim != 2:
+        raise ValueError(f"Expected wheel_rate to have shape (N, 6), got {w.shape}.")
+    h = check_positive(dt, "dt")
+    q = 2.0 * math.pi / model.counts_per_rev
+    rng = _rng(seed)
+    angle = np.concatenate([np.zeros((1, N_WHEELS)), np.cumsum(0.5 * h * (w[1:] + w[:-1]), axis=0)])
+    angle += rng.uniform(0.0, q, size=N_WHEELS)
+    counts = np.floor(angle / q)
+    out = np.full(w.shape, np.nan)
+    out[1:] = np.diff(counts, axis=0) * q / h
+    valid = np.ones(w.shape[0], dtype=bool)
+    valid[0] = False
+    return EncoderReadings(rate=out, valid=valid)
+
+
+def imu_measurements(
+    model: ImuModel, angular_velocity: object, specific_force: object, dt: float, seed: object = 0
+) -> tuple[np.ndarray, np.ndarray]:
+    """Gyro and accelerometer readings ``(N, 3)`` each from true body-axis values ``(N, 3)``."""
+    check_params(model, ImuModel, "model")
+    w = as_array(angular_velocity, "angular_velocity", (3,))
+    a = as_array(specific_force, "specific_force", (3,))
+    if w.shape != a.shape:
+        raise ValueError(
+            f"Expected angular_velocity and specific_force of one shape, got {w.shape}, {a.shape}."
+        )
+    rng = _rng(seed)
+    gyro = w + np.asarray(model.gyro_bias) + model.gyro_sigma(dt) * rng.normal(size=w.shape)
+    acc = a + np.asarray(model.accel_bias) + model.accel_sigma(dt) * rng.normal(size=a.shape)
+    return gyro, acc
+
+
+def track_speed_sigma(encoder: EncoderModel, radii: object, dt: float) -> float:
+    """Standard deviation of a side's encoder track speed (mean of its wheels' rim speeds, m/s).
+
+    ``radii``: the side's wheel radii (m); the wheels' quantisation errors are independent.
+    """
+    check_params(encoder, EncoderModel, "encoder")
+    r = as_array(radii, "radii", (None,))
+    if r.ndim != 1 or r.size == 0 or np.any(r <= 0):
+        raise ValueError(f"Expected radii a non-empty 1-d array of positive radii, got {r!r}.")
+    return float(encoder.rate_sigma(dt) * np.sqrt(np.sum(r**2)) / r.size)
+
+
+@dataclass(frozen=True)
+class EKFResult:
+    """Filtered planar odometry, ``N`` samples.
+
+    ``state (N, 8)`` = ``[x, y, ψ, v_x, r, b_gyro, y_left, y_right]`` (m, m, rad, m/s, rad/s, rad/s, m, m),
+    ``covariance (N, 8, 8)``;
+    ``encoder_used`` / ``gyro_used (N,)``: whether that sample's measurement updated the filter (false
+    at the drop-outs marked by ``encoder_ok`` / ``gyro_ok``: the filter only predicts there).
+    """
+
+    state: np.ndarray
+    covariance: np.ndarray
+    encoder_used: np.ndarray
+    gyro_used: np.ndarray
+
+
+def _check_times(t: object) -> np.ndarray:
+    ta = as_array(t, "t", (None,))
+    if ta.ndim != 1 or ta.size < 2:
+        raise ValueError(f"Expected t to have shape (N,) with N >= 2, got {ta.shape}.")
+    dt = np.diff(ta)
+    if np.any(dt <= 0):
+        raise ValueError(
+            f"Expected t strictly increasing, got {int(np.sum(dt <= 0))} non-increasing step(s)."
+        )
+    return ta
+
+
+def planar_ekf(
+    t: object,
+    v_right: object,
+    v_left: object,
+    gyro_z: object,
+    icr: ICRModel,
+    *,
+    sigma_track: float,
+    sigma_gyro: float,
+    sigma_model: float = 0.0,
+    accel_psd: float = 0.5,
+    yaw_accel_psd: float = 2.0,
+    bias_psd: float = 1e-8,
+    initial_pose: object = (0.0, 0.0, 0.0),
+    initial_bias_sigma: float = 0.01,
+    icr_sigma: float = 0.0,
+    icr_psd: float = 0.0,
+    encoder_ok: object | None = None,
+    gyro_ok: object | None = None,
+) -> EKFResult:
+    """Extended Kalman filter for planar odometry: encoders through the ICR model, and a gyro.
+
+    State ``s = [x, y, ψ, v_x, r, b, y_left, y_right]`` (``N_STATE = 8``).  Prediction over ``dt``:
+    ``x += dt (v_x cos ψ - v_y sin ψ)``, ``y += dt (v_x sin ψ + v_y cos ψ)``, ``ψ += dt r`` with
+    ``v_y = -r x_icr`` (the ICR model's lateral slip); ``v_x``, ``r`` and the gyro bias ``b`` are random
+    walks with spectral densities ``accel_psd`` (m²/s³), ``yaw_accel_psd`` (rad²/s³) and ``bias_psd``
+    (rad²/s³).  Measurements: the encoder track speeds ``v_right = v_x - r y_right``,
+    ``v_left = v_x - r y_left`` (the ICR model, noise ``sigma_track² + sigma_model²`` per side, m/s)
+    and the gyro ``z = r + b`` (``sigma_gyro``, rad/s).
+
+    The track ICRs ``y_left``, ``y_right`` start at ``icr``'s; with ``icr_sigma > 0`` (their initial
+    1σ, m) and ``icr_psd`` (random-walk density, m²/s) the filter adapts them online (cf. Pentzer et al.
+    2014), otherwise they stay fixed.  Only their spread ``y_left - y_right`` (the yaw-rate scale
+    ``χ S``) is observable from encoders and a gyro; their mean trades with ``v_x``.  Adapting needs a
+    calibrated gyro bias (``initial_bias_sigma`` of the size left by a start-up calibration): in a
+    steady turn the encoders alone cannot tell a gyro bias from an ICR error.
+
+    All histories ``(N,)`` share the time stamps ``t`` (one sample rate: arrays of another length, or
+    ``t`` with non-uniform steps, raise ``ValueError``).  Drop-outs are explicit: ``encoder_ok`` /
+    ``gyro_ok`` (bool ``(N,)``, default all true) mark the samples with a reading; the values there must
+    be finite (a NaN elsewhere raises: nothing is skipped silently), the others are ignored, and
+    ``encoder_used`` / ``gyro_used`` report what entered.
+    """
+    ta = _check_times(t)
+    n = ta.size
+    dts = np.diff(ta)
+    if np.max(np.abs(dts - dts.mean())) > SAMPLE_RATE_RTOL * dts.mean():
+        raise ValueError(
+            "Expected t uniformly sampled (one sample rate for all histories), got steps from "
+            f"{dts.min():.6g} s to {dts.max():.6g} s."
+        )
+    oks = {}
+    for a, name in ((encoder_ok, "encoder_ok"), (gyro_ok, "gyro_ok")):
+        if a is None:
+            oks[name] = np.ones(n, dtype=bool)
+            continue
+        arr = np.asarray(a)
+        if arr.dtype != bool or arr.shape != (n,):
+            raise ValueError(f"Expected {name} a bool array of shape ({n},), got {arr.dtype} {arr.shape}.")
+        oks[name] = arr
+    hist = {}
+    for a, name, ok in (
+        (v_right, "v_right", oks["encoder_ok"]),
+        (v_left, "v_left", oks["encoder_ok"]),
+        (gyro_z, "gyro_z", oks["gyro_ok"]),
+    ):
+        arr = as_array(a, name, finite=False)
+        if arr.shape != (n,):
+            raise ValueError(
+                f"Expected {name} to have shape ({n},) like t (one sample rate for all histories), "
+                f"got {arr.shape}."
+            )
+        bad = ok & ~np.isfinite(arr)
+        if np.any(bad):
+            raise ValueError(
+                f"Expected {name} finite where it is marked as read, got {int(bad.sum())} non-finite "
+                "value(s); mark drop-outs in encoder_ok / gyro_ok."
+            )
+        hist[name] = arr
+    check_params(icr, ICRModel, "icr")
+    s_tr = check_positive(sigma_track, "sigma_track")
+    s_g = check_positive(sigma_gyro, "sigma_gyro")
+    s_m = check_positive(sigma_model, "sigma_model", allow_zero=True)
+    qa = check_positive(accel_psd, "accel_psd")
+    qr = check_positive(yaw_accel_psd, "yaw_accel_psd")
+    qb = check_positive(bias_psd, "bias_psd", allow_zero=True)
+    pose0 = as_array(initial_pose, "initial_pose", (3,))
+    if pose0.shape != (3,):
+        raise ValueError(f"Expected initial_pose to have shape (3,), got {pose0.shape}.")
+    sb0 = check_positive(initial_bias_sigma, "initial_bias_sigma", allow_zero=True)
+    s_icr = check_positive(icr_sigma, "icr_sigma", allow_zero=True)
+    q_icr = check_positive(icr_psd, "icr_psd", allow_zero=True)
+
+    xi = icr.x_icr
+    H_g = np.array([[0, 0, 0, 0, 1.0, 1.0, 0, 0]])
+    R_g = np.array([[s_g**2]])
+    R_enc = np.eye(2) * (s_tr**2 + s_m**2)
+    s = np.zeros(N_STATE)
+    s[:3] = pose0
+    s[6], s[7] = icr.y_left, icr.y_right
+    P = np.diag([0.0, 0.0, 0.0, 1.0, 1.0, sb0**2, s_icr**2, s_icr**2])
+    states = np.empty((n, N_STATE))
+    covs = np.empty((n, N_STATE, N_STATE))
+    enc_used = np.zeros(n, dtype=bool)
+    gyro_used = np.zeros(n, dtype=bool)
+    eye = np.eye(N_STATE)
+
+    def update(s, P, z, h, H, R):
+        S = H @ P @ H.T + R
+        K = np.linalg.solve(S, H @ P).T
+        s = s + K @ (z - h)
+        IKH = eye - K @ H
+        return s, IKH @ P @ IKH.T + K @ R @ K.T  # Joseph form: stays symmetric positive semi-definite
+
+    for k in range(n):
+        if k > 0:
+            h = dts[k - 1]
+            psi, v, r = s[2], s[3], s[4]
+            c, sn = math.cos(psi), math.sin(psi)
+            vy = -r * xi
+            s = s.copy()
+            s[:3] += h * np.array([v * c - vy * sn, v * sn + vy * c, r])
+            F = eye.copy()
+            F[0, 2] = -h * (v * sn + vy * c)
+            F[0, 3] = h * c
+            F[0, 4] = h * xi * sn
+            F[1, 2] = h * (v * c - vy * sn)
+            F[1, 3] = h * sn
+            F[1, 4] = -h * xi * c
+            F[2, 4] = h
+            Q = np.diag([0.0, 0.0, 0.0, qa * h, qr * h, qb * h, q_icr * h, q_icr * h])
+            P = F @ P @ F.T + Q
+        if oks["encoder_ok"][k]:
+            v, r, yl, yr = s[3], s[4], s[6], s[7]
+            # v_right = v_x - r y_right, v_left = v_x - r y_left (bilinear when the ICRs are estimated)
+            H = np.zeros((2, N_STATE))
+            H[:, 3] = 1.0
+            H[0, 4], H[0, 7] = -yr, -r
+            H[1, 4], H[1, 6] = -yl, -r
+            z = np.array([hist["v_right"][k], hist["v_left"][k]])
+            s, P = update(s, P, z, np.array([v - r * yr, v - r * yl]), H, R_enc)
+            enc_used[k] = True
+        if oks["gyro_ok"][k]:
+            s, P = update(s, P, np.array([hist["gyro_z"][k]]), H_g @ s, H_g, R_g)
+            gyro_used[k] = True
+        states[k] = s
+        covs[k] = P
+    return EKFResult(state=states, covariance=covs, encoder_used=enc_used, gyro_used=gyro_used)
