@@ -14,9 +14,9 @@ gamma = 0 (the shank stretched straight) is singular for every design (J[2, 2] =
 the minimum of |det J| over Table 2's full range [0, 85 deg] is 0 for every design; the study's usable
 workspace starts at GAMMA_USABLE_MIN.  L5 translates the workspace along Z0 and changes neither metric.
 
-``dataclasses.replace`` of an OmniLeg keeps the inertias of the nominal design (``bodies`` was filled
-from the paper's lengths): the torques use the paper's link inertias at the new geometry.  That is a
-known defect of the parameter object, left to its owner (docs/explore.md).
+``dataclasses.replace`` of an OmniLeg derives the default inertias from the new dimensions (issue 14,
+defect 1, fixed in the parameter object): the torques use each design's own link inertias
+(docs/explore.md).
 """
 
 from __future__ import annotations
@@ -100,7 +100,7 @@ STUDY = DesignStudy(
         "gamma_usable_min_rad": GAMMA_USABLE_MIN,
         "simpson_points": SIMPSON_POINTS,
         "eq52_step_s": EQ52_STEP,
-        "inertias": "nominal (paper) bodies kept by dataclasses.replace: see docs/explore.md",
+        "inertias": "default bodies derived from each design's dimensions (OmniLeg.bodies, docs/explore.md)",
     },
     objectives=(
         Objective("workspace_volume", "max"),

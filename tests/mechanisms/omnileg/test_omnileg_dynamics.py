@@ -99,7 +99,7 @@ def test_inverse_dynamics_parts_and_foot_force_sign():
     np.testing.assert_allclose(
         r.tau, r.M @ qdd + r.velocity_terms + r.gravity_terms + r.foot_terms, atol=1e-14
     )
-    np.testing.assert_allclose(r.foot_terms, -ol.static_torques(LEG, q, F), atol=1e-14)
+    np.testing.assert_allclose(r.foot_terms, ol.static_torques(LEG, q, F), atol=1e-14)
     z = np.zeros(3)
     np.testing.assert_allclose(ol.inverse_dynamics(LEG, q, z, z).tau, ol.gravity_torques(LEG, q), atol=1e-15)
     # velocity terms are quadratic in q̇

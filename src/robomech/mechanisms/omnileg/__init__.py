@@ -8,6 +8,7 @@ crank angle of the shank (motor M3).  The hip frame's Z0 points down, toward the
 from ._chains import ShankResult, ThighClosure, chain_screws, shank_crank_slider, shank_frames, thigh_closure
 from ._dynamics import (
     BODY_NAMES,
+    FOOT_FORCE_CONVENTION,
     DynamicsResult,
     FootForceResult,
     body_poses,
@@ -31,7 +32,8 @@ from ._kinematics import (
     thigh_direction,
     within_limits,
 )
-from ._params import OmniLeg, RigidBody, default_bodies
+from ._params import BodySet, OmniLeg, RigidBody, default_bodies
+from ._rates import JointRatesResult, joint_rates
 from ._trajectories import (
     GaitProfile,
     foot_trajectory_eq51,
@@ -39,19 +41,35 @@ from ._trajectories import (
     joint_trajectory_eq52,
     start_point,
 )
+from ._workspace import (
+    FootWorkspace,
+    SymmetryResult,
+    WorkspaceMap,
+    foot_workspace,
+    joint_grid,
+    singular_surface,
+    workspace_map,
+    workspace_symmetry,
+)
 
 __all__ = [
     "BODY_NAMES",
+    "FOOT_FORCE_CONVENTION",
     "TREE_JOINTS",
+    "BodySet",
     "DynamicsResult",
     "FootForceResult",
+    "FootWorkspace",
     "GaitProfile",
     "IKResult",
     "JointMotion",
+    "JointRatesResult",
     "OmniLeg",
     "RigidBody",
     "ShankResult",
+    "SymmetryResult",
     "ThighClosure",
+    "WorkspaceMap",
     "body_poses",
     "chain_screws",
     "default_bodies",
@@ -60,6 +78,7 @@ __all__ = [
     "foot_force_from_torques",
     "foot_trajectory_eq51",
     "foot_velocity",
+    "foot_workspace",
     "forward_kinematics",
     "gait_eq53",
     "gravity_torques",
@@ -67,15 +86,20 @@ __all__ = [
     "inverse_dynamics",
     "inverse_kinematics",
     "jacobian",
+    "joint_grid",
     "joint_motion",
+    "joint_rates",
     "joint_trajectory_eq52",
     "mass_matrix",
     "passive_angles",
     "shank_crank_slider",
     "shank_frames",
+    "singular_surface",
     "start_point",
     "static_torques",
     "thigh_closure",
     "thigh_direction",
     "within_limits",
+    "workspace_map",
+    "workspace_symmetry",
 ]

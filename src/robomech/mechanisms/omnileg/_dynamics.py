@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_params
+from robomech._validation import as_array, check_bool, check_params
 
 from . import _jet as jt
 from ._chains import shank_frames
@@ -31,6 +31,7 @@ from ._params import OmniLeg, RigidBody
 
 __all__ = [
     "BODY_NAMES",
+    "FOOT_FORCE_CONVENTION",
     "DynamicsResult",
     "FootForceResult",
     "body_poses",
@@ -42,6 +43,11 @@ __all__ = [
     "static_torques",
 ]
 
+# The one sign convention of every OmniLeg function taking or returning a foot force (inverse_dynamics,
+# static_torques, foot_force_from_torques): F is the force applied TO the foot by its surroundings (the
+# ground reaction; a force on the foot body in a multibody engine), hip frame, N.  It enters the motor
+# torques as -Jᵀ F.  Paper 2's F_f (eqs. (47)-(50), the force the foot delivers) is -F.
+FOOT_FORCE_CONVENTION = "applied to the foot"
 # A foot Jacobian with sigma_min / sigma_max below this is treated as singular (γ ≈ 0, the fully
 # extended shank): 1e-3 bounds the force amplification by 1e3 relative to the best-conditioned direction.
 SINGULAR_RCOND = 1e-3
@@ -90,10 +96,6 @@ def _poses(
 ) -> list[tuple[Cols, jt.Jet | np.ndarray]]:
     """(columns of R_b, o_b) of every body as jets, in the order of BODY_NAMES; ``q, qd, qdd (N, 3)``."""
     alpha, beta, gamma = jt.Jet.variables(q, qd, qdd)
-    ta, tb = jt.tan(alpha), jt.tan(beta)
-    inv_n = jt.reciprocal(jt.sqrt(ta * ta + tb * tb + 1.0))
-    u = jt.stack([tb * inv_n, -ta * inv_n, inv_n])  # thigh direction, eq. (9) / L1
-    knee = u * leg.L1
     ca, sa, cb, sb, cg, sg = (
         jt.cos(alpha),
         jt.sin(alpha),
@@ -102,6 +104,11 @@ def _poses(
         jt.cos(gamma),
         jt.sin(gamma),
     )
+    # thigh direction, eq. (9) / L1 multiplied through by cos α cos β (not mirrored beyond 90°, _kinematics)
+    cbsa, cbca = cb * sa, cb * ca
+    inv_n = jt.reciprocal(jt.sqrt(ca * ca + cbsa * cbsa))
+    u = jt.stack([sb * ca * inv_n, -cbsa * inv_n, cbca * inv_n])
+    knee = u * leg.L1
     zero = np.zeros(q.shape[0])
     one = cg * 0.0 + 1.0  # constant 1 as a jet (jt.stack needs one jet per stacked vector)
     # Second-joint axis x_k of chain k (carried by the crosses and the rod); fixed axis y_k of chain k.
@@ -157,7 +164,20 @@ class _Terms:
     p: np.ndarray  # (N, B, 3) centres of mass (B = 0 unless requested)
 
 
-def _terms(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: bool = False) -> _Terms:
+# paper 2, eqs. (26)-(31): the simplified Cardan drive.  Each drive body turns like the chain-1 body it
+# replaces (cross CS_A4 like CS_A1, rod A4B4 like rod A1B1, cross CS_B4 like CS_B1) plus an independent
+# spin γ̇ about the fixed Z0 (r_γ = [0 0 1]), its inertia carried by that body's rotation (eq. (31)).
+_PAPER_DRIVE = {"drive_cross_a": "hip_cross_1", "drive_rod": "thigh_rod_1", "drive_cross_b": "knee_cross_1"}
+
+
+def _terms(
+    leg: OmniLeg,
+    q: np.ndarray,
+    qd: np.ndarray,
+    qdd: np.ndarray,
+    poses: bool = False,
+    paper_drive: bool = False,
+) -> _Terms:
     """Newton-Euler sums over the bodies projected on q (Lagrange's equations), ``q, qd, qdd (N, 3)``.
 
     For body b with centre of mass p_b, rotation R_b and inertia I_b (body axes):
@@ -173,7 +193,10 @@ def _terms(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: 
     eye = np.broadcast_to(np.eye(3), (N, 3, 3))
     Rs, ps = [], []
     groups: dict[int, tuple[Cols, np.ndarray]] = {}
-    for (cols, o), (_, key) in zip(_poses(leg, q, qd, qdd), _body_list(), strict=True):
+    spun: dict[int, tuple[Cols, np.ndarray]] = {}  # paper_drive: rotations that also spin by γ about Z0
+    by_name: dict[str, Cols] = {}
+    for (cols, o), (name, key) in zip(_poses(leg, q, qd, qdd), _body_list(), strict=True):
+        by_name[name] = cols
         body: RigidBody = leg.bodies[key]
         m = body.mass
         c = body.com_vector
@@ -199,6 +222,11 @@ def _terms(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: 
             Rs.append(eye if cols is None else np.stack([r.v for r in cols], axis=-1))
         if cols is None:
             continue
+        if paper_drive and name in _PAPER_DRIVE:
+            ref = by_name[_PAPER_DRIVE[name]]
+            prev = spun.get(id(ref))
+            spun[id(ref)] = (ref, body.inertia_matrix if prev is None else prev[1] + body.inertia_matrix)
+            continue
         # bodies turning together (a U-joint's two crosses, the drive's two crosses and two shafts) share
         # one set of columns: their rotational terms are linear in the inertia, so sum the inertias
         key_cols = id(cols)
@@ -206,11 +234,17 @@ def _terms(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: 
             groups[key_cols] = (cols, groups[key_cols][1] + body.inertia_matrix)
         else:
             groups[key_cols] = (cols, body.inertia_matrix)
-    for cols, Iner in groups.values():
+    ez = np.array([0.0, 0.0, 1.0])
+    rot = [(c, i, False) for c, i in groups.values()] + [(c, i, True) for c, i in spun.values()]
+    for cols, Iner, spin in rot:
         # ω = ½ Σ_j r_j × ṙ_j, ω̇ = ½ Σ_j r_j × r̈_j, ∂ω/∂q̇_k = ½ Σ_j r_j × ∂r_j/∂q_k  (columns r_j of R)
         w = 0.5 * sum(jt.cross3(r.v, r.vd) for r in cols)
         wd = 0.5 * sum(jt.cross3(r.v, r.vdd) for r in cols)
         Jw = 0.5 * sum(jt.cross3(r.v, r.g) for r in cols)  # (3 q, N, 3 xyz)
+        if spin:  # paper 2, eqs. (26), (29): ω = ω_chain1 + γ̇ Z0, and ω̇ = ω̇_chain1 + γ̈ Z0 (Z0 fixed)
+            w = w + qd[:, 2:3] * ez
+            wd = wd + qdd[:, 2:3] * ez
+            Jw = Jw + np.stack([0 * ez, 0 * ez, ez])[:, None, :]
         # body-frame components x_b = Rᵀ x; the inertia then acts as a constant 3x3 matrix (BLAS)
         wb = np.stack([np.sum(r.v * w, axis=-1) for r in cols], axis=-1)
         wdb = np.stack([np.sum(r.v * wd, axis=-1) for r in cols], axis=-1)
@@ -226,14 +260,19 @@ def _terms(leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: 
 
 
 def _terms_chunked(
-    leg: OmniLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, poses: bool = False
+    leg: OmniLeg,
+    q: np.ndarray,
+    qd: np.ndarray,
+    qdd: np.ndarray,
+    poses: bool = False,
+    paper_drive: bool = False,
 ) -> _Terms:
     """:func:`_terms` over cache-sized chunks of samples (identical results, far fewer cache misses)."""
     N = q.shape[0]
     if N <= DYN_CHUNK:
-        return _terms(leg, q, qd, qdd, poses)
+        return _terms(leg, q, qd, qdd, poses, paper_drive)
     parts = [
-        _terms(leg, q[s : s + DYN_CHUNK], qd[s : s + DYN_CHUNK], qdd[s : s + DYN_CHUNK], poses)
+        _terms(leg, q[s : s + DYN_CHUNK], qd[s : s + DYN_CHUNK], qdd[s : s + DYN_CHUNK], poses, paper_drive)
         for s in range(0, N, DYN_CHUNK)
     ]  # loop over chunks of DYN_CHUNK samples, not over samples
     return _Terms(*(np.concatenate([getattr(t, f) for t in parts]) for f in _Terms.__dataclass_fields__))
@@ -266,21 +305,33 @@ class DynamicsResult:
 
 
 def inverse_dynamics(
-    leg: OmniLeg, q: object, qd: object, qdd: object, foot_force: object | None = None
+    leg: OmniLeg,
+    q: object,
+    qd: object,
+    qdd: object,
+    foot_force: object | None = None,
+    *,
+    paper_as_printed: bool = False,
 ) -> DynamicsResult:
     """Motor torques (α, β, γ order) for the motion (q, q̇, q̈), optionally with a force on the foot.
 
-    All inputs ``(..., 3)`` broadcast.  ``foot_force (..., 3)`` (N, hip frame) is the external force
-    applied *to* the foot (as a force applied to the foot body in a multibody simulation); it enters as
-    ``-Jᵀ F``.  Paper 2, eqs. (49)-(50) add ``+Jᵀ F_f``, i.e. read F_f as the force the foot delivers:
-    pass ``-F_f`` for that reading.
+    All inputs ``(..., 3)`` broadcast.  ``foot_force (..., 3)`` (N, hip frame) is
+    :data:`FOOT_FORCE_CONVENTION`: the external force applied *to* the foot (as a force applied to the
+    foot body in a multibody simulation); it enters as ``-Jᵀ F`` (= :func:`static_torques`).  Paper 2,
+    eqs. (49)-(50) add ``+Jᵀ F_f``, i.e. read F_f as the force the foot delivers: pass ``-F_f``.
+
+    ``paper_as_printed=True`` replaces the exact double-Cardan drive by paper 2's simplification (eqs.
+    (26)-(31): the crosses CS_A4, CS_B4 and the rod A4B4 turn like chain 1's cross CS_A1, rod A1B1, cross
+    CS_B1 plus an independent spin γ̇ about Z0), for comparison only: the difference is the error the
+    paper's theory carries against its ADAMS model.
     """
     check_params(leg, OmniLeg, "leg")
+    paper_as_printed = check_bool(paper_as_printed, "paper_as_printed")
     q = as_array(q, "q", (3,))
     qd = as_array(qd, "qd", (3,))
     qdd = as_array(qdd, "qdd", (3,))
     batch, (qf, qdf, qddf) = _flat(q, qd, qdd)
-    t = _terms_chunked(leg, qf, qdf, qddf)
+    t = _terms_chunked(leg, qf, qdf, qddf, paper_drive=bool(paper_as_printed))
     vel = t.tau_motion - np.einsum("nij,nj->ni", t.M, qddf)
     foot = np.zeros_like(t.tau_motion)
     if foot_force is not None:
@@ -327,20 +378,25 @@ def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]
 
 
 def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
-    """Virtual work, paper 2, eq. (50): ``τ = Jᵀ F`` for a force ``F (..., 3)`` (N) delivered by the foot."""
+    """Motor torques ``τ = -Jᵀ F`` (..., 3), N·m, holding the leg still against a foot force, gravity aside.
+
+    ``force (..., 3)`` (N, hip frame) is :data:`FOOT_FORCE_CONVENTION`: the force applied *to* the foot,
+    the same as ``inverse_dynamics(foot_force=F)``, whose ``foot_terms`` these torques are.  paper 2,
+    eq. (50): τ = Jᵀ F_f with F_f the force the foot delivers, F_f = -F.
+    """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     F = as_array(force, "force", (3,))
-    return np.einsum("...ij,...i->...j", jacobian(leg, q), F)
+    return -np.einsum("...ij,...i->...j", jacobian(leg, q), F)  # paper 2, eq. (50): +Jᵀ F_f, F_f = -F
 
 
 @dataclass(frozen=True)
 class FootForceResult:
-    """Foot force ``(..., 3)`` (N) from motor torques, per sample.
+    """Foot force ``(..., 3)`` (N, applied to the foot: :data:`FOOT_FORCE_CONVENTION`) from motor torques.
 
     ``singular`` marks samples with ``sigma_min / sigma_max < SINGULAR_RCOND`` (γ ≈ 0): there the force is
     the damped least-squares estimate (its component along the lost direction is not determined by the
-    torques) and ``residual = |Jᵀ F - τ|`` is no longer zero.
+    torques) and ``residual = |-Jᵀ F - τ|`` is no longer zero.
     """
 
     force: np.ndarray
@@ -350,7 +406,10 @@ class FootForceResult:
 
 
 def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceResult:
-    """Solve ``Jᵀ F = τ`` for the foot force (paper 2, eq. (47)), never by a blind inverse.
+    """Solve ``-Jᵀ F = τ`` for the force F applied to the foot (paper 2, eq. (47)), never by a blind inverse.
+
+    The torques are those of :func:`static_torques` (F = ``FOOT_FORCE_CONVENTION``; the paper's F_f, the
+    force the foot delivers, is -F).
 
     Regular samples: the exact solution by SVD.  Samples with ``rcond < SINGULAR_RCOND`` are flagged and
     their weak directions damped: ``F = Σ c_i u_i (v_iᵀ τ)`` with ``c_i = 1/σ_i`` where
@@ -368,6 +427,7 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     # Jᵀ = V Σ Uᵀ, so F = U Σ⁺ Vᵀ τ; only the directions with σ_i < SINGULAR_RCOND σ_max are damped
     weak = s < SINGULAR_RCOND * s[..., :1]
     coef = np.where(weak, s / (s * s + lam * lam), 1.0 / np.where(weak, 1.0, s))
-    F = np.einsum("...ij,...j->...i", U, coef * np.einsum("...ij,...j->...i", Vt, tau))
-    resid = np.linalg.norm(np.einsum("...ij,...i->...j", J, F) - tau, axis=-1)
+    # paper 2, eq. (47): F_f = (Jᵀ)⁻¹ τ for the force the foot delivers; the force applied to it is -F_f
+    F = -np.einsum("...ij,...j->...i", U, coef * np.einsum("...ij,...j->...i", Vt, tau))
+    resid = np.linalg.norm(-np.einsum("...ij,...i->...j", J, F) - tau, axis=-1)
     return FootForceResult(force=F, singular=singular, rcond=rcond, residual=resid)

@@ -1,8 +1,12 @@
 """Foot kinematics of the OmniLeg: eq. (11) forward, the corrected eq. (13) inverse, Jacobian, Hessian.
 
 The thigh's knee point O0' lies on a sphere of radius L1 about O0: ``p_knee = L1 u`` with
-``u = (tan β, -tan α, 1) / sqrt(1 + tan²α + tan²β)``, the same vector as eq. (9)/(11) written with
-``cos β`` factored out.  The shank adds ``(0, 0, L5 + 2 L4 cos γ)`` (crank-slider, eq. (10)).
+``u = w / |w|``, ``w = (sin β cos α, -cos β sin α, cos β cos α)`` (``|w|² = cos²α + cos²β sin²α``):
+the thigh direction is normal to the two carried U-joint axes Ry(β) e_x and Rx(α)(-e_y), with the sign
+that is continuous from the home pose.  Dividing by cos α cos β gives eq. (9)/(11)'s
+``(tan β, -tan α, 1) / sqrt(1 + tan²α + tan²β)``, which equals it only for |α|, |β| < 90°: beyond, the
+tangent form mirrors the pose (paper 2, eq. (11) is written for the joint ranges of Table 2).  The shank
+adds ``(0, 0, L5 + 2 L4 cos γ)`` (crank-slider, eq. (10)).
 """
 
 from __future__ import annotations
@@ -64,10 +68,15 @@ def _q(q: object) -> np.ndarray:
 
 
 def thigh_direction(alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
-    """Unit vector from O0 to the knee O0' (..., 3), paper 2, eq. (9) divided by L1 (x corrected)."""
-    a, b = np.tan(as_array(alpha, "alpha")), np.tan(as_array(beta, "beta"))
-    inv = 1.0 / np.sqrt(1.0 + a * a + b * b)
-    return np.stack([b * inv, -a * inv, inv], axis=-1)
+    """Unit vector from O0 to the knee O0' (..., 3), paper 2, eq. (9) divided by L1 (x corrected).
+
+    Written as ``w / |w|`` with ``w = (sin β cos α, -cos β sin α, cos β cos α)`` (module docstring): the
+    printed tangent form mirrors the pose for |α| or |β| > 90°.
+    """
+    a, b = as_array(alpha, "alpha"), as_array(beta, "beta")
+    ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
+    inv = 1.0 / np.sqrt(ca * ca + (cb * sa) ** 2)
+    return np.stack([sb * ca * inv, -cb * sa * inv, cb * ca * inv], axis=-1)
 
 
 def forward_kinematics(leg: OmniLeg, q: object) -> np.ndarray:
@@ -82,12 +91,15 @@ def forward_kinematics(leg: OmniLeg, q: object) -> np.ndarray:
     L1, L4, L5 = leg.L1, leg.L4, leg.L5
     for s in _chunks(qf.shape[0]):
         alpha, beta, gamma = qf[s, 0], qf[s, 1], qf[s, 2]
+        ca, sa = _cos_sin(alpha)
         cb, sb = _cos_sin(beta)
-        cta = cb * np.tan(alpha)
-        inv = L1 / np.sqrt(1.0 + cta * cta)
-        out[s, 0] = sb * inv  # paper 2, eq. (11)
-        out[s, 1] = -cta * inv
-        out[s, 2] = cb * inv + 2.0 * L4 * _cos_sin(gamma)[0] + L5
+        cbsa = cb * sa
+        inv = L1 / np.sqrt(ca * ca + cbsa * cbsa)
+        # paper 2, eq. (11) multiplied through by cos α: identical for |α| < 90°, and not mirrored beyond
+        cainv = ca * inv
+        out[s, 0] = sb * cainv
+        out[s, 1] = -cbsa * inv
+        out[s, 2] = cb * cainv + 2.0 * L4 * _cos_sin(gamma)[0] + L5
     return out.reshape(q.shape)
 
 
@@ -96,50 +108,56 @@ def passive_angles(leg: OmniLeg, alpha: object, beta: object) -> tuple[np.ndarra
 
     paper 2, eq. (12): θ12 = arctan(tan α cos β) as printed; θ22 printed as +arctan(tan β cos α) but
     with chain 2's second axis ω22 = Rz(-π/2)[1 0 0] = [0 -1 0] (eqs. (1), (5), (6)) the closure gives
-    θ22 = -arctan(tan β cos α).
+    θ22 = -arctan(tan β cos α).  Written as atan2(sin α cos β, cos α) and -atan2(sin β cos α, cos β):
+    equal for |α|, |β| < 90°, and continuous beyond, where the arctan form mirrors (module docstring;
+    the closure's angles agree modulo 2π).
     """
     check_params(leg, OmniLeg, "leg")
     a = as_array(alpha, "alpha")
     b = as_array(beta, "beta")
-    theta12 = np.arctan(np.tan(a) * np.cos(b))
-    theta22 = -np.arctan(np.tan(b) * np.cos(a))  # paper 2, eq. (12): printed +; the closure gives -
+    theta12 = np.arctan2(np.sin(a) * np.cos(b), np.cos(a))  # paper 2, eq. (12), cos α multiplied through
+    theta22 = -np.arctan2(np.sin(b) * np.cos(a), np.cos(b))  # paper 2, eq. (12): printed +; closure gives -
     return theta12, theta22
 
 
 def _dw(q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """w = (tan β, -tan α, 1), its q-Jacobian (..., 3, 3), u = w/|w| and N = |w|."""
-    a, b = np.tan(q[..., 0]), np.tan(q[..., 1])
-    N = np.sqrt(1.0 + a * a + b * b)
-    u = np.stack([b, -a, np.ones_like(a)], axis=-1) / N[..., None]
+    """w = (sβ cα, -cβ sα, cβ cα), its q-Jacobian W (..., 3, 3), u = w/|w|, N = |w|, ∂²w (..., 3, 3, 3)."""
+    ca, sa, cb, sb = np.cos(q[..., 0]), np.sin(q[..., 0]), np.cos(q[..., 1]), np.sin(q[..., 1])
+    w = np.stack([sb * ca, -cb * sa, cb * ca], axis=-1)
+    N = np.sqrt(np.sum(w * w, axis=-1))
+    u = w / N[..., None]
     W = np.zeros((*q.shape[:-1], 3, 3))
-    W[..., 1, 0] = -(1.0 + a * a)
-    W[..., 0, 1] = 1.0 + b * b
-    return u, N, W, np.stack([a, b], axis=-1)
+    W[..., :, 0] = np.stack([-sb * sa, -cb * ca, -cb * sa], axis=-1)  # ∂w/∂α
+    W[..., :, 1] = np.stack([cb * ca, sb * sa, -sb * ca], axis=-1)  # ∂w/∂β
+    W2 = np.zeros((*q.shape[:-1], 3, 3, 3))
+    W2[..., :, 0, 0] = -w  # ∂²w/∂α² = ∂²w/∂β² = -w
+    W2[..., :, 1, 1] = -w
+    cross = np.stack([-cb * sa, sb * ca, sb * sa], axis=-1)  # ∂²w/∂α∂β
+    W2[..., :, 0, 1] = cross
+    W2[..., :, 1, 0] = cross
+    return u, N, W, W2
 
 
 def jacobian(leg: OmniLeg, q: object) -> np.ndarray:
     """Foot Jacobian ``J[..., i, j] = ∂p_F,i/∂q_j`` (..., 3, 3), eq. (14).  Singular whenever γ = 0.
 
-    With a = tan α, b = tan β, N = sqrt(1 + a² + b²) and u = (b, -a, 1)/N:
-    ``∂p/∂α = -L1 (1 + a²)(e_y - u u_y)/N``, ``∂p/∂β = L1 (1 + b²)(e_x - u u_x)/N``,
-    ``∂p/∂γ = (0, 0, -2 L4 sin γ)``.
+    With w = (sβ cα, -cβ sα, cβ cα), N = |w| and u = w/N (module docstring):
+    ``∂p/∂(α, β) = L1 (I - u uᵀ) ∂w/∂(α, β) / N``, ``∂p/∂γ = (0, 0, -2 L4 sin γ)``.
     """
     check_params(leg, OmniLeg, "leg")
     q = _q(q)
     qf = q.reshape(-1, 3)
     J = np.zeros((qf.shape[0], 3, 3))
     for s in _chunks(qf.shape[0]):
-        a, b = np.tan(qf[s, 0]), np.tan(qf[s, 1])
-        inv = 1.0 / np.sqrt(1.0 + a * a + b * b)
-        ux, uy, uz = b * inv, -a * inv, inv
-        ka = -leg.L1 * (1.0 + a * a) * inv
-        kb = leg.L1 * (1.0 + b * b) * inv
-        J[s, 0, 0] = -ka * ux * uy
-        J[s, 1, 0] = ka * (1.0 - uy * uy)
-        J[s, 2, 0] = -ka * uz * uy
-        J[s, 0, 1] = kb * (1.0 - ux * ux)
-        J[s, 1, 1] = -kb * uy * ux
-        J[s, 2, 1] = -kb * uz * ux
+        ca, sa = _cos_sin(qf[s, 0])
+        cb, sb = _cos_sin(qf[s, 1])
+        inv = 1.0 / np.sqrt(ca * ca + (cb * sa) ** 2)
+        u = (sb * ca * inv, -cb * sa * inv, cb * ca * inv)
+        k = leg.L1 * inv
+        for j, dw in enumerate(((-sb * sa, -cb * ca, -cb * sa), (cb * ca, sb * sa, -sb * ca))):
+            ud = u[0] * dw[0] + u[1] * dw[1] + u[2] * dw[2]
+            for i in range(3):
+                J[s, i, j] = k * (dw[i] - u[i] * ud)
         J[s, 2, 2] = -2.0 * leg.L4 * _cos_sin(qf[s, 2])[1]
     return J.reshape(*q.shape, 3)
 
@@ -148,7 +166,7 @@ def hessian(leg: OmniLeg, q: object) -> np.ndarray:
     """Second-order influence coefficients ``H[..., i, j, k] = ∂²p_F,i/∂q_j∂q_k`` (..., 3, 3, 3)."""
     check_params(leg, OmniLeg, "leg")
     q = _q(q)
-    u, N, W, ab = _dw(q)
+    u, N, W, W2 = _dw(q)
     eye = np.eye(3)
     # ∂²(w/|w|)_i/∂w_a∂w_b = -(δ_ia u_b + δ_ib u_a + δ_ab u_i - 3 u_i u_a u_b) / |w|²
     D2 = (
@@ -161,10 +179,6 @@ def hessian(leg: OmniLeg, q: object) -> np.ndarray:
         / (N * N)[..., None, None, None]
     )
     D1 = (eye - u[..., :, None] * u[..., None, :]) / N[..., None, None]
-    a, b = ab[..., 0], ab[..., 1]
-    W2 = np.zeros((*q.shape[:-1], 3, 3, 3))
-    W2[..., 1, 0, 0] = -2.0 * a * (1.0 + a * a)
-    W2[..., 0, 1, 1] = 2.0 * b * (1.0 + b * b)
     H = leg.L1 * (
         np.einsum("...iab,...aj,...bk->...ijk", D2, W, W) + np.einsum("...ia,...ajk->...ijk", D1, W2)
     )

@@ -12,13 +12,14 @@ plausible link geometry and materials (aluminium links, steel crosses and shafts
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, fields
 
 import numpy as np
 
 from robomech._validation import as_array, check_positive, check_real
 
-__all__ = ["OmniLeg", "RigidBody", "default_bodies"]
+__all__ = ["BodySet", "OmniLeg", "RigidBody", "default_bodies"]
 
 # Density of 6061 aluminium and of steel, kg/m^3 (handbook values).
 RHO_ALUMINIUM = 2700.0
@@ -210,6 +211,44 @@ BODY_FIELDS = (
     "foot",
 )
 
+
+class BodySet(Mapping):
+    """The 11 body parameter sets of an :class:`OmniLeg` (read-only mapping body kind -> RigidBody).
+
+    Remembers which entries were given explicitly (``explicit``): the others are the defaults
+    :func:`default_bodies` derives from the leg's dimensions, and are derived again whenever the leg is
+    rebuilt (``dataclasses.replace(leg, L1=...)`` passes this mapping back to ``OmniLeg``, which keeps
+    only its explicit entries).  Two sets compare equal when all 11 bodies are equal.
+    """
+
+    __slots__ = ("_bodies", "_explicit")
+
+    def __init__(self, bodies: Mapping[str, RigidBody], explicit: frozenset[str]) -> None:
+        self._bodies = dict(bodies)
+        self._explicit = frozenset(explicit)
+
+    @property
+    def explicit(self) -> frozenset[str]:
+        """Body kinds given explicitly (not derived from the dimensions)."""
+        return self._explicit
+
+    def overrides(self) -> dict[str, RigidBody]:
+        """The explicitly given bodies only."""
+        return {k: self._bodies[k] for k in self._explicit}
+
+    def __getitem__(self, key: str) -> RigidBody:
+        return self._bodies[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._bodies)
+
+    def __len__(self) -> int:
+        return len(self._bodies)
+
+    def __repr__(self) -> str:
+        return f"BodySet(explicit={sorted(self._explicit)})"
+
+
 _PAPER = {"L1": 0.15, "L3": 0.075, "L4": 0.095, "L5": 0.160}  # paper 2, Table 2 (m)
 _KNEE_TO_CRANK = 0.030
 _SHANK_RADIUS = 0.025
@@ -227,7 +266,10 @@ class OmniLeg:
     chain C1D1E1 from X0 (the three shank chains are 120° apart).  Joint ranges (rad) are Table 2
     read as magnitudes.  ``gravity`` is the gravity acceleration in the hip frame (Z0 down).  The
     :class:`RigidBody` fields are the inertial parameters of each body kind (the three copies of a
-    chain's bodies share them, rotated with the chain).
+    chain's bodies share them, rotated with the chain).  ``bodies`` takes the explicit overrides
+    (a mapping of some body kinds to :class:`RigidBody`); every other body is derived from the
+    dimensions by :func:`default_bodies`, and is derived again when a dimension changes
+    (``dataclasses.replace``).  ``leg.bodies`` is the full :class:`BodySet`; equality compares it.
     """
 
     L1: float
@@ -242,7 +284,9 @@ class OmniLeg:
     shank_radius: float = _SHANK_RADIUS
     shank_azimuth: float = math.pi / 2
     gravity: tuple[float, float, float] = (0.0, 0.0, STANDARD_GRAVITY)
-    bodies: dict[str, RigidBody] = field(default_factory=dict, compare=False, hash=False)
+    # compare=True: two legs are equal only if every body is (hash=False: a mapping is unhashable; equal
+    # legs still hash equal since the hash covers the other fields).
+    bodies: Mapping[str, RigidBody] = field(default_factory=dict, hash=False)
 
     def __post_init__(self) -> None:
         for name in ("L1", "L3", "L4", "L5", "shank_radius"):
@@ -278,19 +322,32 @@ class OmniLeg:
         if g.shape != (3,) or not np.all(np.isfinite(g)):
             raise ValueError(f"Expected OmniLeg.gravity to be 3 finite numbers, got {self.gravity!r}.")
         object.__setattr__(self, "gravity", tuple(float(v) for v in g))
-        bodies = dict(self.bodies) if self.bodies else {}
+        # A BodySet (e.g. passed back by dataclasses.replace) contributes only its explicit entries: the
+        # defaults follow the (possibly new) dimensions.
+        if isinstance(self.bodies, BodySet):
+            bodies = self.bodies.overrides()
+        elif isinstance(self.bodies, Mapping):
+            bodies = dict(self.bodies)
+        elif self.bodies is None:
+            bodies = {}
+        else:
+            raise ValueError(
+                "Expected OmniLeg.bodies to be a mapping of body kind to RigidBody, "
+                f"got {type(self.bodies).__name__}."
+            )
+        explicit = frozenset(bodies)
         defaults = default_bodies(self.L1, self.L3, self.L4, self.L5, self.knee_to_crank)
         unknown = set(bodies) - set(BODY_FIELDS)
         if unknown:
             raise ValueError(
-                f"Expected OmniLeg.bodies keys among {BODY_FIELDS}, got unknown {sorted(unknown)}."
+                f"Expected OmniLeg.bodies keys among {BODY_FIELDS}, got unknown {sorted(map(repr, unknown))}."
             )
         for k in BODY_FIELDS:
             b = bodies.get(k, defaults[k])
             if not isinstance(b, RigidBody):
                 raise ValueError(f"Expected OmniLeg.bodies[{k!r}] to be a RigidBody, got {type(b).__name__}.")
             bodies[k] = b
-        object.__setattr__(self, "bodies", bodies)
+        object.__setattr__(self, "bodies", BodySet({k: bodies[k] for k in BODY_FIELDS}, explicit))
 
     @classmethod
     def paper(cls) -> OmniLeg:

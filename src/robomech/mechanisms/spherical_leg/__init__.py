@@ -8,6 +8,7 @@ redundant-actuation force distribution, and workspace/singularity maps.  See
 """
 
 from ._dynamics import (
+    ACTUATION_SIGMA_MIN,
     PAPER_DRIVEN_LEGS,
     ForceDistribution,
     InverseDynamicsResult,
@@ -31,10 +32,13 @@ from ._kinematics import (
 )
 from ._motions import fig5_motion, sway
 from ._params import LegBody, SphericalLeg
+from ._tracking import BranchTrack, track_branches
 from ._workspace import WorkspaceMap, workspace_map
 
 __all__ = [
+    "ACTUATION_SIGMA_MIN",
     "PAPER_DRIVEN_LEGS",
+    "BranchTrack",
     "ForceDistribution",
     "ForwardKinematicsResult",
     "InverseDynamicsResult",
@@ -57,5 +61,6 @@ __all__ = [
     "mechanical_energy",
     "platform_rotation",
     "sway",
+    "track_branches",
     "workspace_map",
 ]

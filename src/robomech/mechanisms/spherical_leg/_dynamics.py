@@ -25,12 +25,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from robomech._validation import as_array, check_int, check_params, finite_samples
+from robomech._validation import as_array, check_int, check_params, check_real, finite_samples
 
 from ._kinematics import LENGTH_FLOOR, _rotation
 from ._params import SphericalLeg
 
 __all__ = [
+    "ACTUATION_SIGMA_MIN",
     "PAPER_DRIVEN_LEGS",
     "ForceDistribution",
     "InverseDynamicsResult",
@@ -45,9 +46,18 @@ __all__ = [
 # chains, legs 1 and 3 (indices 0 and 2); leg 2 (RUPR) carries the wheel lift.
 PAPER_DRIVEN_LEGS = (0, 2)
 # The actuation is singular where the leg Jacobian (or the driven legs' 2x2 block) loses rank: below
-# this ratio sigma_min/sigma_max the forces exceed 1e8 times the generalized force scale and are
-# reported invalid (same threshold as robomech.analysis.workspace.SINGULAR_RTOL).
+# this ratio sigma_min/sigma_max the 2x2 solve itself loses all accuracy (same threshold as
+# robomech.analysis.workspace.SINGULAR_RTOL); the forces are NaN there.
 ACTUATION_SINGULAR_RTOL = 1e-8
+# Physical bound of the actuation (m/rad): sigma_min of the leg Jacobian (or of the driven legs' block)
+# is the smallest leg-length change per radian of platform motion, i.e. the lever arm through which the
+# legs hold the platform (leg forces = generalized forces / lever arm).  Below 1 mm/rad (i) every N m of
+# generalized force needs more than 1 kN of leg force, 10x the largest force of any well-conditioned
+# sample of paper 1's Fig. 5 (max 345 N, typical 100 N), and (ii) 10 um of leg-length error (lead-screw
+# backlash) leaves more than 10 mrad (0.6 deg) of platform play: the legs no longer hold the pose.
+# Samples below it are flagged (valid False) with their finite forces kept for inspection; before issue
+# 14 only the 1e-8 ratio flagged, which let ~1e8 N through as valid 1e-6 rad from the singular curve.
+ACTUATION_SIGMA_MIN = 1e-3
 
 
 @dataclass(frozen=True)
@@ -232,24 +242,39 @@ def mechanical_energy(leg: SphericalLeg, q: object, qd: object) -> tuple[np.ndar
 @dataclass(frozen=True)
 class ForceDistribution:
     """Leg forces f (..., 3) (N, positive extends the leg) with J^T f = tau; residual (...) N m is
-    |J^T f - tau| (rounding level where valid); valid (...) False at an actuation singularity (f NaN)."""
+    |J^T f - tau| (rounding level where the solve is regular).
+
+    ``sigma_min`` (...) m/rad: the conditioning measure, the smallest singular value of J (minimum-norm
+    rule) or of the driven legs' 2x2 block (the lever arm through which the legs act; 0 where singular
+    or non-finite); ``rcond`` (...) its ratio to the largest.  ``valid`` (...) is False where
+    ``sigma_min < sigma_min_bound`` (default :data:`ACTUATION_SIGMA_MIN`, an actuation singularity or its
+    neighbourhood): there f is NaN if the solve is numerically singular (``rcond`` below
+    ``ACTUATION_SINGULAR_RTOL``), else the exact but physically meaningless value."""
 
     forces: np.ndarray
     residual: np.ndarray
     valid: np.ndarray
+    sigma_min: np.ndarray
+    rcond: np.ndarray
 
 
 def distribute_forces(
-    J: object, tau: object, driven_legs: tuple[int, int] | None = None
+    J: object,
+    tau: object,
+    driven_legs: tuple[int, int] | None = None,
+    *,
+    sigma_min_bound: float = ACTUATION_SIGMA_MIN,
 ) -> ForceDistribution:
     """Leg forces balancing the generalized forces ``tau (..., 2)`` through ``J (..., 3, 2)``.
 
     ``driven_legs=None``: minimum-norm forces ``f = J (J^T J)^-1 tau`` (all three legs share the load,
     no internal preload). ``driven_legs=(i, j)``: only those two legs act (paper 1's choice is
-    :data:`PAPER_DRIVEN_LEGS`, legs 1 and 3), the third carries no force.
+    :data:`PAPER_DRIVEN_LEGS`, legs 1 and 3), the third carries no force.  ``sigma_min_bound`` (m/rad,
+    >= 0): the lever arm below which a sample is flagged (see :data:`ACTUATION_SIGMA_MIN`).
     """
     J = as_array(J, "J", (3, 2), finite=False)
     t = as_array(tau, "tau", (2,), finite=False)
+    bound = check_real(sigma_min_bound, "sigma_min_bound", low=0.0)  # m/rad
     # non-finite samples: zeroed before any arithmetic (then flagged by ok below), never propagated
     good = finite_samples(J, 2)[..., None] & finite_samples(t, 1)[..., None]
     J, t = np.where(good[..., None], J, 0.0), np.where(good, t, 0.0)
@@ -265,6 +290,7 @@ def distribute_forces(
         )
         x = np.einsum("...ij,...j->...i", inv, t) / dsafe[..., None]
         f = np.einsum("...ij,...j->...i", J, x)
+        smin, smax = _singular_values_2x2_gram(A)
     else:
         pair = tuple(driven_legs) if isinstance(driven_legs, tuple | list) else ()
         pair = tuple(check_int(x, "driven_legs", low=0, high=2) for x in pair)
@@ -284,24 +310,47 @@ def distribute_forces(
         f = np.zeros((*det.shape, 3))
         f[..., i] = f0
         f[..., j] = f1
+        smin, smax = _singular_values_2x2_gram(np.einsum("...ki,...kj->...ij", Js, Js))
     ok = ok & good[..., 0]
     f = np.where(ok[..., None], f, np.nan)
     resid = np.linalg.norm(
         np.einsum("...ki,...k->...i", J, np.where(ok[..., None], f, 0.0)) - np.where(ok[..., None], t, 0.0),
         axis=-1,
     )
-    return ForceDistribution(forces=f, residual=np.where(ok, resid, np.nan), valid=ok)
+    finite = good[..., 0]  # a non-finite J (zeroed above) has no conditioning: 0
+    smin = np.where(finite & np.isfinite(smin), smin, 0.0)
+    smax = np.where(finite & np.isfinite(smax), smax, 0.0)
+    rcond = np.where(smax > 0, smin / np.where(smax > 0, smax, 1.0), 0.0)
+    valid = ok & (smin >= bound)
+    return ForceDistribution(
+        forces=f, residual=np.where(ok, resid, np.nan), valid=valid, sigma_min=smin, rcond=rcond
+    )
+
+
+def _singular_values_2x2_gram(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(sigma_min, sigma_max) of a matrix from its 2x2 Gram matrix ``A (..., 2, 2)`` (closed form)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        a, b, c = A[..., 0, 0], A[..., 0, 1], A[..., 1, 1]
+        half_tr = 0.5 * (a + c)
+        root = np.sqrt(np.maximum(0.25 * (a - c) ** 2 + b * b, 0.0))
+        lmax = half_tr + root
+        lmin = np.maximum(a * c - b * b, 0.0) / np.where(lmax > 0, lmax, 1.0)  # det / lmax: no cancellation
+        return np.sqrt(lmin), np.sqrt(np.maximum(lmax, 0.0))
 
 
 @dataclass(frozen=True)
 class InverseDynamicsResult:
     """generalized_forces (..., 2) N m on (alpha, beta); leg_forces (..., 3) N (positive extends);
-    residual (...) N m of J^T f = tau; valid (...) False at an actuation singularity (forces NaN)."""
+    residual (...) N m of J^T f = tau; valid (...) False at or near an actuation singularity
+    (``sigma_min < ACTUATION_SIGMA_MIN``; forces NaN where the solve is numerically singular);
+    sigma_min (...) m/rad and rcond (...) the per-sample conditioning (:class:`ForceDistribution`)."""
 
     generalized_forces: np.ndarray
     leg_forces: np.ndarray
     residual: np.ndarray
     valid: np.ndarray
+    sigma_min: np.ndarray
+    rcond: np.ndarray
 
 
 def inverse_dynamics(
@@ -324,4 +373,4 @@ def inverse_dynamics(
     m = _motion(leg, qa, qda, qdda)
     tau = _generalized(leg, m, w)
     dist = distribute_forces(m.Jl, tau, driven_legs)
-    return InverseDynamicsResult(tau, dist.forces, dist.residual, dist.valid)
+    return InverseDynamicsResult(tau, dist.forces, dist.residual, dist.valid, dist.sigma_min, dist.rcond)

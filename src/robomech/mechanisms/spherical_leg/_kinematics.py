@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_int, check_params
+from robomech._validation import as_array, check_bool, check_int, check_params
 
 # the unvalidated kernel: inputs are validated once at this module's public boundary
 from robomech.spatial._so3 import _sincos as sincos
@@ -203,7 +203,9 @@ class ForwardKinematicsResult:
     converged: np.ndarray
 
 
-def forward_kinematics(leg: SphericalLeg, lengths: object, branch: int = 0) -> ForwardKinematicsResult:
+def forward_kinematics(
+    leg: SphericalLeg, lengths: object, branch: int = 0, *, paper_as_printed: bool = False
+) -> ForwardKinematicsResult:
     """Platform angles from leg lengths ``(..., 3)`` (m): exact closed form, least squares if noisy.
 
     beta is the least-squares fit of (l1, l2) (which depend on beta only), started from the exact
@@ -212,12 +214,23 @@ def forward_kinematics(leg: SphericalLeg, lengths: object, branch: int = 0) -> F
     ``phi = atan2(r, h cos b)``. ``branch=0`` is the assembly ``a = phi + asin(s)`` that contains
     alpha = 0; ``branch=1`` is ``a = phi + pi - asin(s)``. Bad samples (non-finite, non-positive, no
     assembly) are flagged in ``.valid``; a wrong shape raises ``ValueError``.
+
+    ``paper_as_printed=True`` runs paper 1's printed pipeline instead (eq. (6), the quartic of eq. (7)
+    with its lost square, Ferrari with the misprinted resolvent, α = arctan(2a); ``_as_printed.py``),
+    for comparison only: its ``residual`` shows how far the printed α is from assembling the lengths
+    (``branch`` is then ignored: the print keeps the real root in (-π/2, π/2) that fits l3 best).
     """
     check_params(leg, SphericalLeg, "leg")
     branch = check_int(branch, "branch", low=0, high=1)
+    paper_as_printed = check_bool(paper_as_printed, "paper_as_printed")
     L = as_array(lengths, "lengths", (3,), finite=False)
     L, shape = as_array(L, "lengths", finite="mask"), L.shape[:-1]  # beyond 1e100: masked like NaN
     n = int(np.prod(shape, dtype=int))
+    if paper_as_printed:
+        from ._as_printed import forward_as_printed
+
+        a, b, res, ok = (o.reshape(shape) for o in forward_as_printed(leg, L.reshape(n, 3)))
+        return ForwardKinematicsResult(alpha=a, beta=b, residual=res, valid=ok, converged=ok.copy())
     outs = (np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=bool), np.empty(n, dtype=bool))
     if n >= FK_NUMBA_MIN:
         _fk_kernel_compiled(leg, branch, np.ascontiguousarray(L.reshape(n, 3)), *outs)

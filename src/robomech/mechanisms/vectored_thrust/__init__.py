@@ -1,5 +1,6 @@
 """Paper 5: the RRR-RR vectored-thrust spherical mechanism (kinematics, mobility, workspace, singularity)."""
 
+from ._inverse import INPUT_GAIN_MAX, InverseRatesResult, StaticsResult, inverse_rates, static_torques
 from ._kinematics import (
     SINGULAR_TOL,
     AccelerationResult,
@@ -36,15 +37,18 @@ from ._workspace import (
 
 __all__ = [
     "DEXTERITY_TOL",
+    "INPUT_GAIN_MAX",
     "SINGULAR_TOL",
     "AccelerationResult",
     "FKResult",
     "IKResult",
+    "InverseRatesResult",
     "JacobianResult",
     "JointAxes",
     "MechanismMobility",
     "PassiveResult",
     "RotationResult",
+    "StaticsResult",
     "VectoredThruster",
     "VelocityResult",
     "WorkspaceMap",
@@ -57,6 +61,7 @@ __all__ = [
     "idle_input_curve",
     "input_grid",
     "inverse_kinematics",
+    "inverse_rates",
     "jacobian",
     "joint_axes",
     "link_clearance",
@@ -66,5 +71,6 @@ __all__ = [
     "platform_mobility",
     "platform_rotation",
     "singular_points",
+    "static_torques",
     "workspace_map",
 ]

@@ -436,17 +436,23 @@ def _ik_unmasked(th: VectoredThruster, s: np.ndarray) -> IKResult:
     has_dir = norm > MIN_DIRECTION_NORM
     inv = 1.0 / np.where(has_dir, norm, 1.0)
     ux, uy, uz = sx * inv, sy * inv, sz * inv
-    # s0 = (sin q2 cos th, sin th, cos q2 cos th): the branch cos(theta) > 0 is the one through q = 0
-    # (|q2| < pi/2 is enforced by the parameters).  paper 5, eq. (13): phi2 = arctan(L*/N*) is right.
+    # s0 = (sin q2 cos th, sin th, cos q2 cos th).  |q2| < pi/2 (enforced by the parameters) needs
+    # cos q2 > 0, so cos(theta) takes the sign of u_z: the branch through q = 0 for a propeller above the
+    # horizontal, and theta beyond 90 deg (the propeller past the horizontal, as the FK allows) below it.
+    # Taking cos(theta) > 0 there (as before issue 14) gave |q2| > pi/2 and a wrong root below, i.e. a
+    # "solved" q whose FK was another direction.  paper 5, eq. (13): phi2 = arctan(L*/N*) is right for
+    # u_z > 0 only.
     ct2 = ux * ux
     ct2 += uz * uz
+    sgn = np.where(uz < 0.0, -1.0, 1.0)
     ct = np.sqrt(ct2)  # unit components: no overflow
+    ct *= sgn
     st = uy
-    q2 = np.arctan2(ux, uz)
+    q2 = np.arctan2(sgn * ux, sgn * uz)
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    pos = ct > 0
+    pos = ct2 > 0
     ict = np.where(pos, 1.0 / ct, 0.0)
-    c2 = np.where(pos, uz * ict, 1.0)
+    c2 = np.where(pos, uz * ict, 1.0)  # >= 0
     s2 = ux * ict  # 0 where ct = 0
     # paper 5, eq. (13): printed phi1 = -arctan(M* N* / L*^2) does not invert eq. (12).  Correct: find
     # t > 0 with t (cos th, sin th) = (sa c1 c2 - ca s2, -sa s1) (the FK closure and its branch), i.e.

@@ -1,0 +1,118 @@
+"""Inverse differential kinematics of the OmniLeg: joint rates and accelerations for a foot motion.
+
+``q̇ = J⁻¹ ṗ`` and ``q̈ = J⁻¹ (p̈ - q̇ᵀ H q̇)`` (conventions: ``ÿ = J q̈ + q̇ᵀ H q̇``), solved per sample by
+the SVD of the foot Jacobian with the weak directions damped where J is near singular (γ ≈ 0, the
+fully extended shank, where ∂p/∂γ = (0, 0, -2 L4 sin γ) vanishes: paper 2, eq. (47)'s inverse does
+not exist there).  The flagged samples keep a finite, damped solution and report their residual.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array, check_params, check_real
+
+from ._dynamics import SINGULAR_RCOND
+from ._kinematics import hessian, jacobian
+from ._params import OmniLeg
+
+__all__ = ["JointRatesResult", "joint_rates"]
+
+# Default damping of the weak singular directions, relative to sigma_max: equal to the singular flag's
+# threshold SINGULAR_RCOND (as foot_force_from_torques), so no direction is amplified by more than
+# 1 / (2 SINGULAR_RCOND) = 500 (a rate of 1 m/s maps to at most ~500 / sigma_max rad/s).
+DEFAULT_DAMPING = SINGULAR_RCOND
+
+
+@dataclass(frozen=True)
+class JointRatesResult:
+    """Joint rates and accelerations per sample for a foot motion.
+
+    ``qd (..., 3)`` rad/s and ``qdd (..., 3)`` rad/s² (NaN if no foot acceleration was given);
+    ``rcond (...)`` = sigma_min / sigma_max of J; ``singular (...)`` where ``rcond < SINGULAR_RCOND``
+    (γ ≈ 0): there the weak direction is damped, so the solution is the damped least-squares one and
+    ``velocity_residual = |J q̇ - ṗ|`` (m/s) and ``acceleration_residual = |J q̈ + q̇ᵀHq̇ - p̈|`` (m/s²)
+    are no longer zero; ``valid = ~singular`` and every value finite.
+    """
+
+    qd: np.ndarray
+    qdd: np.ndarray
+    rcond: np.ndarray
+    singular: np.ndarray
+    velocity_residual: np.ndarray
+    acceleration_residual: np.ndarray
+    valid: np.ndarray
+
+
+def _damped_solve(U, s, Vt, b, lam, weak):
+    """x = V diag(c) Uᵀ b with c = 1/σ on regular directions and σ/(σ² + λ²) on weak ones."""
+    den = s * s + lam * lam
+    coef = np.where(weak, s / np.where(den > 0, den, 1.0), 1.0 / np.where(weak, 1.0, s))  # 0 if σ = λ = 0
+    return np.einsum("...ji,...j->...i", Vt, coef * np.einsum("...ji,...j->...i", U, b))
+
+
+def joint_rates(
+    leg: OmniLeg,
+    q: object,
+    foot_velocity: object,
+    foot_acceleration: object | None = None,
+    *,
+    damping: float = DEFAULT_DAMPING,
+) -> JointRatesResult:
+    """Joint rates ``q̇`` (and accelerations ``q̈``) realising the foot velocity ``ṗ`` (and acceleration ``p̈``).
+
+    ``q (..., 3)`` rad (typically from :func:`inverse_kinematics`), ``foot_velocity (..., 3)`` m/s,
+    ``foot_acceleration (..., 3)`` m/s² or None; all broadcast.  ``damping`` (>= 0, relative to
+    sigma_max) damps the directions with ``sigma < SINGULAR_RCOND sigma_max``: ``c = σ / (σ² + λ²)``,
+    ``λ = damping sigma_max`` (selectively damped least squares: the well-determined components stay
+    exact).  ``damping = 0`` drops the weak directions (truncated pseudo-inverse).
+    """
+    check_params(leg, OmniLeg, "leg")
+    q = as_array(q, "q", (3,))
+    pd = as_array(foot_velocity, "foot_velocity", (3,))
+    pdd = None if foot_acceleration is None else as_array(foot_acceleration, "foot_acceleration", (3,))
+    damping = check_real(damping, "damping", low=0.0)
+    shapes = [q.shape[:-1], pd.shape[:-1]] + ([] if pdd is None else [pdd.shape[:-1]])
+    try:
+        batch = np.broadcast_shapes(*shapes)
+    except ValueError as exc:
+        raise ValueError(
+            f"Expected q, foot_velocity, foot_acceleration to broadcast, got batch shapes {shapes}."
+        ) from exc
+    q = np.broadcast_to(q, (*batch, 3))
+    pd = np.broadcast_to(pd, (*batch, 3))
+    # an overflowing sample (|ṗ| ~ 1e300) becomes non-finite and is flagged below, not warned about
+    with np.errstate(over="ignore", invalid="ignore"):
+        return _joint_rates(leg, q, pd, pdd, damping, batch)
+
+
+def _joint_rates(leg, q, pd, pdd, damping, batch) -> JointRatesResult:
+    J = jacobian(leg, q)
+    U, s, Vt = np.linalg.svd(J)
+    smax = s[..., :1]
+    rcond = s[..., -1] / smax[..., 0]
+    weak = s < SINGULAR_RCOND * smax
+    lam = float(damping) * smax
+    qd = _damped_solve(U, s, Vt, pd, lam, weak)
+    v_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qd) - pd, axis=-1)
+    if pdd is None:
+        qdd = np.full((*batch, 3), np.nan)
+        a_res = np.full(batch, np.nan)
+    else:
+        pdd = np.broadcast_to(pdd, (*batch, 3))
+        bias = np.einsum("...ijk,...j,...k->...i", hessian(leg, q), qd, qd)  # q̇ᵀ H q̇
+        qdd = _damped_solve(U, s, Vt, pdd - bias, lam, weak)
+        a_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qdd) + bias - pdd, axis=-1)
+    singular = rcond < SINGULAR_RCOND
+    finite = np.all(np.isfinite(qd), -1) & (pdd is None or np.all(np.isfinite(qdd), -1))
+    return JointRatesResult(
+        qd=qd,
+        qdd=qdd,
+        rcond=rcond,
+        singular=singular,
+        velocity_residual=v_res,
+        acceleration_residual=a_res,
+        valid=~singular & finite,
+    )

@@ -1,0 +1,212 @@
+"""Foot workspace and singularity map of the OmniLeg over the joint ranges of Table 2 (paper 2).
+
+The foot is the knee point ``L1 u(α, β)`` (a patch of the sphere of radius L1 about O0) shifted down by
+the shank, ``L5 + 2 L4 cos γ`` (eq. (11)).  For |α|, |β| < 90° the patch projects one-to-one onto the
+horizontal plane, so the workspace is the vertical sweep of the patch over the shank's stroke and its
+volume is exactly ``area(projected patch) x stroke``, with the area a smooth double integral over (α, β)
+(Gauss-Legendre quadrature).  The foot Jacobian is singular only where γ = 0 (∂p/∂γ = 0): with
+Table 2's γ range starting at 0 the whole bottom surface of the workspace (the leg fully extended) is
+singular.
+
+Paper 2, Section 1 claims "the foot workspace is completely symmetric" (足端运动区域呈现出完全的对称).
+Written out: the reflections x -> -x (β -> -β) and y -> -y (α -> -α) map the workspace onto itself for
+any ranges read as magnitudes, and the swap x <-> y (with a sign: (x, y) -> (-y, -x), i.e. α <-> β) does
+too when α_max = β_max, as in Table 2: the symmetry group of a square (D4) about Z0.
+:func:`workspace_symmetry` tests each of these per sample.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array, check_int, check_params
+from robomech.analysis.workspace import grid, singularity_map
+
+from ._dynamics import SINGULAR_RCOND
+from ._kinematics import forward_kinematics, inverse_kinematics, jacobian, within_limits
+from ._params import OmniLeg
+
+__all__ = [
+    "FootWorkspace",
+    "SymmetryResult",
+    "WorkspaceMap",
+    "foot_workspace",
+    "joint_grid",
+    "singular_surface",
+    "workspace_map",
+    "workspace_symmetry",
+]
+
+# Gauss-Legendre nodes per joint coordinate for the area integral: the integrand is analytic on the
+# box, and 48 nodes integrate it to rounding (tested against 96 nodes and the boundary's shoelace area).
+AREA_NODES = 48
+# Points per box edge of the projected boundary polyline returned by foot_workspace.
+BOUNDARY_POINTS = 200
+
+
+@dataclass(frozen=True)
+class WorkspaceMap:
+    """Per joint sample (...): foot position (..., 3) m; within_limits (Table 2); det (...) of J (m²/rad³);
+    cond (...) 2-norm condition number (inf where singular); dexterity 1/cond in [0, 1]; sigma_min (...)
+    m/rad; singular (...) where sigma_min / sigma_max < SINGULAR_RCOND (the threshold of the damped
+    solves, γ ≈ 0)."""
+
+    q: np.ndarray
+    foot: np.ndarray
+    within_limits: np.ndarray
+    det: np.ndarray
+    cond: np.ndarray
+    dexterity: np.ndarray
+    sigma_min: np.ndarray
+    singular: np.ndarray
+
+
+def joint_grid(leg: OmniLeg, n: int | tuple[int, int, int]) -> np.ndarray:
+    """Regular grid ``(n_α, n_β, n_γ, 3)`` over Table 2's joint ranges (|α| <= α_max, |β| <= β_max,
+    γ_min <= γ <= γ_max), rad."""
+    _leg(leg)
+    if isinstance(n, tuple | list):
+        if len(n) != 3:
+            raise ValueError(f"Expected n to be an int >= 2 or three of them, got {n!r}.")
+        counts = tuple(check_int(c, "n", low=2) for c in n)
+    else:
+        counts = (check_int(n, "n", low=2),) * 3
+    ranges = [(-leg.alpha_max, leg.alpha_max), (-leg.beta_max, leg.beta_max), (leg.gamma_min, leg.gamma_max)]
+    return grid(ranges, list(counts))
+
+
+def _leg(leg: object) -> OmniLeg:
+    check_params(leg, OmniLeg, "leg")
+    return leg  # type: ignore[return-value]
+
+
+def workspace_map(leg: OmniLeg, q: object) -> WorkspaceMap:
+    """Foot position and Jacobian conditioning at joint samples ``q (..., 3)`` (e.g. :func:`joint_grid`)."""
+    _leg(leg)
+    q = as_array(q, "q", (3,))
+    J = jacobian(leg, q)
+    sm = singularity_map(J, rtol=SINGULAR_RCOND)
+    return WorkspaceMap(
+        q=q,
+        foot=forward_kinematics(leg, q),
+        within_limits=within_limits(leg, q),
+        det=np.linalg.det(J),
+        cond=sm.cond,
+        dexterity=sm.dexterity,
+        sigma_min=sm.sigma_min,
+        singular=sm.singular,
+    )
+
+
+def singular_surface(leg: OmniLeg, alpha: object, beta: object) -> np.ndarray:
+    """Foot positions (..., 3) m on the singular surface γ = 0 (the fully extended shank) at (α, β) rad."""
+    _leg(leg)
+    a = as_array(alpha, "alpha")
+    b = as_array(beta, "beta")
+    try:
+        a, b = np.broadcast_arrays(a, b)
+    except ValueError as exc:
+        raise ValueError(
+            f"Expected alpha and beta to broadcast, got shapes {a.shape} and {b.shape}."
+        ) from exc
+    return forward_kinematics(leg, np.stack([a, b, np.zeros_like(a)], -1))
+
+
+@dataclass(frozen=True)
+class FootWorkspace:
+    """The foot workspace over the joint ranges.
+
+    volume (m³) = projected_area (m², the knee patch seen from above, = the workspace's horizontal
+    section) x stroke (m, the shank's vertical travel 2 L4 (max cos γ - min cos γ)); boundary (M, 2) m:
+    the closed horizontal boundary (x, y), images of the edges |α| = α_max, |β| = β_max; depth_min,
+    depth_max (m): the shallowest and deepest foot positions along Z0; radius_max (m): the largest
+    horizontal distance of the foot from Z0.
+    """
+
+    volume: float
+    projected_area: float
+    stroke: float
+    boundary: np.ndarray
+    depth_min: float
+    depth_max: float
+    radius_max: float
+
+
+def _projected_jacobian_det(leg: OmniLeg, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """|∂(x, y)/∂(α, β)| of the knee (the foot's horizontal position), from the analytic J."""
+    J = jacobian(leg, np.stack([a, b, np.zeros_like(a)], -1))
+    return np.abs(J[..., 0, 0] * J[..., 1, 1] - J[..., 0, 1] * J[..., 1, 0])
+
+
+def foot_workspace(leg: OmniLeg, *, nodes: int = AREA_NODES) -> FootWorkspace:
+    """Volume, horizontal section, boundary and extent of the foot workspace over Table 2's ranges."""
+    _leg(leg)
+    nodes = check_int(nodes, "nodes", low=2)
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    A, B = leg.alpha_max, leg.beta_max
+    a, b = np.meshgrid(A * x, B * x, indexing="ij")
+    area = float(A * B * np.sum(np.outer(w, w) * _projected_jacobian_det(leg, a, b)))
+    # cos γ over [γ_min, γ_max] ⊂ (-90°, 90°): smallest at an end, largest at 0 if the range holds it
+    ends = (float(np.cos(leg.gamma_min)), float(np.cos(leg.gamma_max)))
+    c_lo = min(ends)
+    c_hi = 1.0 if leg.gamma_min <= 0.0 <= leg.gamma_max else max(ends)
+    stroke = 2.0 * leg.L4 * (c_hi - c_lo)
+    t = np.linspace(-1.0, 1.0, BOUNDARY_POINTS)
+    one = np.ones_like(t)
+    edges = [
+        np.stack([A * one, B * t], -1),
+        np.stack([-A * t, B * one], -1),
+        np.stack([-A * one, -B * t], -1),
+        np.stack([A * t, -B * one], -1),
+    ]
+    ab = np.concatenate(edges)
+    knee = forward_kinematics(leg, np.concatenate([ab, np.zeros((len(ab), 1))], -1))
+    boundary = knee[:, :2]
+    # depths: the knee is shallowest at the box's corners and deepest at α = β = 0
+    corner = forward_kinematics(leg, [A, B, 0.0])[2] - (leg.L5 + 2 * leg.L4)
+    return FootWorkspace(
+        volume=area * stroke,
+        projected_area=area,
+        stroke=stroke,
+        boundary=boundary,
+        depth_min=float(corner + leg.L5 + 2 * leg.L4 * c_lo),
+        depth_max=float(leg.L1 + leg.L5 + 2 * leg.L4 * c_hi),
+        radius_max=float(np.max(np.linalg.norm(boundary, axis=-1))),
+    )
+
+
+@dataclass(frozen=True)
+class SymmetryResult:
+    """Per foot sample (...): reachable (within Table 2's ranges) and, for each symmetry of the claim,
+    whether the image's reachability agrees: mirror_x (x -> -x), mirror_y (y -> -y), swap
+    ((x, y) -> (-y, -x), the α <-> β exchange); holds = all three agree."""
+
+    reachable: np.ndarray
+    mirror_x: np.ndarray
+    mirror_y: np.ndarray
+    swap: np.ndarray
+    holds: np.ndarray
+
+
+def workspace_symmetry(leg: OmniLeg, p_foot: object) -> SymmetryResult:
+    """Test paper 2's claim that the foot workspace is symmetric at foot positions ``p_foot (..., 3)`` m.
+
+    Non-finite samples are unreachable, as are their images (they agree).
+    """
+    _leg(leg)
+    p = as_array(p_foot, "p_foot", (3,), finite=False)
+    images = np.stack(
+        [
+            p,
+            p * np.array([-1.0, 1.0, 1.0]),
+            p * np.array([1.0, -1.0, 1.0]),
+            np.stack([-p[..., 1], -p[..., 0], p[..., 2]], -1),
+        ],
+        axis=-2,
+    )
+    r = inverse_kinematics(leg, images).reachable
+    base = r[..., 0]
+    mx, my, sw = (r[..., k] == base for k in (1, 2, 3))
+    return SymmetryResult(reachable=base, mirror_x=mx, mirror_y=my, swap=sw, holds=mx & my & sw)

@@ -1,0 +1,204 @@
+"""Inverse rates and accelerations (paper 5, Section 3.3) and statics of the vectored thruster.
+
+Inverse accelerations: for a commanded platform motion (ω, ω̇) (the propeller shaft's carrier, base
+frame), the input rates solve ``J q̇ = ω`` and the input accelerations ``J q̈ = ω̇ - J̇ q̇``, where
+``J̇ q̇`` is the velocity-product (Lie-bracket) term of :func:`angular_acceleration` (paper 5, eqs.
+(22)-(28) solve the same closure chain by chain; their Klein form drops the velocity products, errata).
+J is 3 x 2: a commanded ω is realisable only in J's range (the platform has two rotational degrees of
+freedom), so q̇ is the least-squares solution and the unrealised part is reported as a residual.
+
+Statics: every joint axis passes through O, so a wrench ``[m_O; f]`` on the platform (moment about O)
+does work only through its moment: ``τ·q̇ + m_O·ω = 0`` for every motion (virtual work), i.e. the motor
+torques holding it are ``τ = -Jᵀ m_O``; the force f is carried by the universal joint at O.  In
+particular the propeller's thrust along its shaft (a line through O) needs no motor torque at all;
+its reaction torque about the shaft does.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array, check_params, check_real
+
+from ._kinematics import _chunked, _jacobian, _q, angular_acceleration
+from ._params import VectoredThruster
+
+__all__ = [
+    "INPUT_GAIN_MAX",
+    "InverseRatesResult",
+    "StaticsResult",
+    "inverse_rates",
+    "static_torques",
+]
+
+# The input rates are q̇ = J⁺ω: an input must turn 1/sigma_min(J) times faster than the platform in
+# J's weakest direction.  Beyond 100 (sigma_min < 0.01) the mechanism is flagged singular: a platform
+# rate of 0.1 rad/s would already need 10 rad/s at an input (the speed class of the servo motors of
+# such thrusters), and the flagged band is the neighbourhood of the idle-input curve and of the
+# passive-axes-parallel points; over Table 1's input box sigma_min >= 0.47 (tests).
+INPUT_GAIN_MAX = 100.0
+# Default damping of the weak direction at flagged samples, relative to sigma_max: with
+# lambda = sigma_min_bound = 1 / INPUT_GAIN_MAX no direction is amplified by more than INPUT_GAIN_MAX / 2.
+DEFAULT_DAMPING = 1.0 / INPUT_GAIN_MAX
+
+
+@dataclass(frozen=True)
+class InverseRatesResult:
+    """Input rates and accelerations per sample for a commanded platform motion.
+
+    ``qd (..., 2)`` rad/s, ``qdd (..., 2)`` rad/s² (NaN if no ω̇ was given, and NaN at the
+    passive-axes-parallel singularity where J does not exist); ``sigma_min (...)`` the smallest
+    singular value of J (0 where J does not exist); ``singular (...)`` where ``sigma_min <
+    1 / INPUT_GAIN_MAX`` or J does not exist (there the weak direction is damped); ``omega_residual``
+    ``|J q̇ - ω|`` (rad/s) and ``omega_dot_residual`` ``|J q̈ + J̇q̇ - ω̇|`` (rad/s²): the part of the
+    command the mechanism cannot realise (ω outside J's range, or damped); ``valid = ~singular``.
+    """
+
+    qd: np.ndarray
+    qdd: np.ndarray
+    sigma_min: np.ndarray
+    singular: np.ndarray
+    omega_residual: np.ndarray
+    omega_dot_residual: np.ndarray
+    valid: np.ndarray
+
+
+def _damped_pinv_apply(U, s, Vt, b, lam, weak):
+    """V diag(c) Uᵀ b for J = U diag(s) Vt (thin SVD, U (..., 3, 2)); c = σ/(σ² + λ²) on weak directions."""
+    den = s * s + lam * lam
+    coef = np.where(weak, s / np.where(den > 0, den, 1.0), 1.0 / np.where(weak, 1.0, s))
+    return np.einsum("...ki,...k->...i", Vt, coef * np.einsum("...ki,...k->...i", U, b))
+
+
+def _check_damping(damping: object) -> float:
+    return check_real(damping, "damping", low=0.0)
+
+
+def _check_thruster(th: object) -> None:
+    check_params(th, VectoredThruster, "th")
+
+
+def inverse_rates(
+    th: VectoredThruster,
+    q: object,
+    omega: object,
+    omega_dot: object | None = None,
+    *,
+    damping: float = DEFAULT_DAMPING,
+) -> InverseRatesResult:
+    """Input rates ``q̇`` (and accelerations ``q̈``) for the platform's ``omega`` (and ``omega_dot``).
+
+    ``q (..., 2)`` rad; ``omega (..., 3)`` rad/s and ``omega_dot (..., 3)`` rad/s² in the base frame;
+    all broadcast.  paper 5, Section 3.3 (eqs. (22)-(28)): the inverse acceleration model, here with
+    the Lie-bracket velocity products the print drops.  ``damping`` (>= 0, relative to sigma_max)
+    applies to the directions with ``sigma < 1 / INPUT_GAIN_MAX`` (selectively damped least squares).
+    """
+    _check_thruster(th)
+    q = _q(q)
+    w = as_array(omega, "omega", (3,))
+    wd = None if omega_dot is None else as_array(omega_dot, "omega_dot", (3,))
+    lam_rel = _check_damping(damping)
+    shapes = [q.shape[:-1], w.shape[:-1]] + ([] if wd is None else [wd.shape[:-1]])
+    try:
+        batch = np.broadcast_shapes(*shapes)
+    except ValueError as exc:
+        raise ValueError(f"Expected q, omega, omega_dot to broadcast, got batch shapes {shapes}.") from exc
+    q = np.broadcast_to(q, (*batch, 2))
+    w = np.broadcast_to(w, (*batch, 3))
+    # an overflowing sample (|ω| ~ 1e300) becomes non-finite and is flagged below, not warned about
+    with np.errstate(over="ignore", invalid="ignore"):
+        return _inverse_rates(th, q, w, wd, lam_rel, batch)
+
+
+def _inverse_rates(th, q, w, wd, lam_rel, batch) -> InverseRatesResult:
+    jr = _chunked(_jacobian, th, np.ascontiguousarray(q))
+    exists = jr.valid
+    J = np.where(exists[..., None, None], jr.J, 0.0)
+    U, s, Vt = np.linalg.svd(J, full_matrices=False)
+    smax = s[..., :1]
+    bound = 1.0 / INPUT_GAIN_MAX
+    weak = s < bound
+    lam = lam_rel * smax
+    qd = _damped_pinv_apply(U, s, Vt, w, lam, weak)
+    w_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qd) - w, axis=-1)
+    sigma_min = np.where(exists, s[..., -1], 0.0)
+    singular = ~exists | (sigma_min < bound)
+    nan = np.full((*batch, 2), np.nan)
+    if wd is None:
+        qdd = nan
+        wd_res = np.full(batch, np.nan)
+    else:
+        wd = np.broadcast_to(wd, (*batch, 3))
+        q_safe = np.where(exists[..., None], q, 0.0)
+        qd_safe = np.where(exists[..., None], qd, 0.0)
+        vp = angular_acceleration(th, q_safe, qd_safe, np.zeros_like(qd_safe)).velocity_product
+        vp = np.where(exists[..., None], vp, 0.0)
+        qdd = _damped_pinv_apply(U, s, Vt, wd - vp, lam, weak)
+        wd_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qdd) + vp - wd, axis=-1)
+        qdd = np.where(exists[..., None], qdd, np.nan)
+        wd_res = np.where(exists, wd_res, np.nan)
+    finite = np.all(np.isfinite(qd), -1) & (wd is None or np.all(np.isfinite(qdd), -1))
+    return InverseRatesResult(
+        qd=np.where(exists[..., None], qd, np.nan),
+        qdd=qdd,
+        sigma_min=sigma_min,
+        singular=singular,
+        omega_residual=np.where(exists, w_res, np.nan),
+        omega_dot_residual=wd_res,
+        valid=~singular & finite,  # a flag never says valid where a value overflowed (e.g. |ω| ~ 1e300)
+    )
+
+
+@dataclass(frozen=True)
+class StaticsResult:
+    """Motor torques ``tau (..., 2)`` N·m (inputs q1, q2) holding a wrench on the platform; NaN where
+    not ``valid`` (J does not exist: passive axes parallel); ``moment (..., 3)`` N·m the wrench's moment
+    about O, the only part that loads the motors; ``unloaded (..., 3)`` N·m its component outside J's
+    range, carried by the closure without motor torque."""
+
+    tau: np.ndarray
+    moment: np.ndarray
+    unloaded: np.ndarray
+    valid: np.ndarray
+
+
+def static_torques(th: VectoredThruster, q: object, wrench: object) -> StaticsResult:
+    """Motor torques ``τ = -Jᵀ m_O`` holding the platform against a wrench ``[m_O; f] (..., 6)``.
+
+    The wrench is applied *to* the platform (propeller and shaft included), base frame, moment about O
+    (conventions: ``[m; f]``); virtual work ``τ·q̇ + m_O·ω = 0``.  The force f passes through the
+    universal joint at O and needs no motor torque.  For a propeller thrust T along the shaft s0 and a
+    reaction torque Q about it, the wrench is ``[Q s0; T s0]`` (the thrust line passes through O).
+    """
+    _check_thruster(th)
+    q = _q(q)
+    wr = as_array(wrench, "wrench", (6,))
+    try:
+        batch = np.broadcast_shapes(q.shape[:-1], wr.shape[:-1])
+    except ValueError as exc:
+        raise ValueError(
+            f"Expected q and wrench to broadcast, got batch shapes {q.shape[:-1]} and {wr.shape[:-1]}."
+        ) from exc
+    q = np.broadcast_to(q, (*batch, 2))
+    m = np.broadcast_to(wr[..., :3], (*batch, 3))
+    jr = _chunked(_jacobian, th, np.ascontiguousarray(q))
+    J = np.where(jr.valid[..., None, None], jr.J, 0.0)
+    with np.errstate(over="ignore", invalid="ignore"):  # overflow -> non-finite -> flagged below
+        return _statics(J, m, jr.valid)
+
+
+def _statics(J: np.ndarray, m: np.ndarray, exists: np.ndarray) -> StaticsResult:
+    tau = -np.einsum("...ij,...i->...j", J, m)
+    # component of m_O orthogonal to range(J): spanned by the normal n = J1 x J2 of the two columns
+    n = np.cross(J[..., :, 0], J[..., :, 1])
+    nn = np.sum(n * n, -1)
+    unloaded = n * (np.sum(n * m, -1) / np.where(nn > 0, nn, 1.0))[..., None]
+    ok = exists & np.all(np.isfinite(tau), -1)
+    return StaticsResult(
+        tau=np.where(ok[..., None], tau, np.nan),
+        moment=np.array(m),
+        unloaded=np.where(ok[..., None], unloaded, np.nan),
+        valid=ok,
+    )

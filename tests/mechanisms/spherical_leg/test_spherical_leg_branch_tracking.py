@@ -1,0 +1,110 @@
+"""Forward kinematics along a trajectory keeps its assembly branch (issue 15, item 4)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from robomech.mechanisms import spherical_leg as sl
+
+LEG = sl.SphericalLeg.paper()
+BETA = np.pi / 3
+A_SING = -np.arctan2(LEG.h * np.cos(BETA), LEG.r)  # the singular curve at β = π/3 (-59.04°)
+# Closed-form FK round trip away from the singular curve: rounding; near it asin loses half the
+# digits (sqrt(eps) ~ 1e-8 rad within a few samples of a meeting).
+FAR_TOL = 1e-10
+NEAR_TOL = 1e-7
+
+
+def _lengths(alpha, beta):
+    return sl.inverse_kinematics(LEG, alpha, beta).lengths
+
+
+def test_fig5a_crossings_are_followed_and_reported():
+    t = np.arange(0.0, 30.0 + 1e-9, 0.01)
+    q, _, _ = sl.fig5_motion("a", t)
+    L = _lengths(q[:, 0], q[:, 1])
+    plain = sl.forward_kinematics(LEG, L)
+    # today's FK on branch 0 returns the mirror pose beyond the curve, with a residual of 0
+    assert np.abs(plain.alpha - q[:, 0]).max() > 0.03 and plain.residual.max() < 1e-15
+    tr = sl.track_branches(LEG, L)
+    assert tr.valid.all()
+    near = np.convolve(tr.meeting, np.ones(9), "same") > 0
+    np.testing.assert_allclose(tr.alpha[~near], q[~near, 0], atol=FAR_TOL)
+    np.testing.assert_allclose(tr.alpha, q[:, 0], atol=NEAR_TOL)
+    np.testing.assert_allclose(tr.beta, q[:, 1], atol=FAR_TOL)
+    # the meetings are where α crosses the singular curve, and the motion switches branch there
+    crossing = np.flatnonzero(np.diff(np.sign(q[:, 0] - A_SING)) != 0)
+    assert tr.meeting.sum() == crossing.size == 2 and tr.switched.sum() == 2
+    assert np.all(np.abs(np.flatnonzero(tr.meeting)[:, None] - crossing[None]).min(axis=1) <= 1)
+    assert set(np.unique(tr.branch)) == {0, 1}
+    np.testing.assert_allclose(tr.separation[tr.meeting], 0.0, atol=0.01)
+
+
+def test_a_touch_of_the_curve_keeps_the_branch():
+    t = np.linspace(-1.0, 1.0, 401)
+    alpha = A_SING + 0.3 * t**2  # reaches the curve at t = 0 and turns back
+    tr = sl.track_branches(LEG, _lengths(alpha, BETA))
+    assert tr.meeting.sum() == 1 and not tr.switched.any()
+    assert np.all(tr.branch == 0)
+    np.testing.assert_allclose(tr.alpha, alpha, atol=NEAR_TOL)
+
+
+def test_start_on_branch_1_and_batches_of_trajectories():
+    t = np.linspace(0.0, 1.0, 101)
+    a_far = A_SING - 0.2 - 0.1 * t  # entirely beyond the curve: branch 1
+    a_cross = A_SING + 0.2 - 0.4 * t  # crosses it once
+    L = np.stack([_lengths(a_far, BETA), _lengths(a_cross, BETA)])
+    tr1 = sl.track_branches(LEG, L[0], branch=1)
+    np.testing.assert_allclose(tr1.alpha, a_far, atol=FAR_TOL)
+    both = sl.track_branches(LEG, L)
+    assert both.alpha.shape == (2, 101)
+    np.testing.assert_allclose(both.alpha[1], a_cross, atol=NEAR_TOL)
+    assert both.switched[1].sum() == 1 and not both.switched[0].any()
+    # starting on branch 0 the far trajectory is the mirror pose (no meeting, nothing to switch)
+    assert np.abs(both.alpha[0] - a_far).min() > 0.3
+
+
+def test_bad_samples_are_flagged_and_bridged():
+    t = np.linspace(0.0, 1.0, 101)
+    a = A_SING + 0.2 - 0.4 * t
+    L = _lengths(a, BETA)
+    L[30] = np.nan
+    L[70] = [0.001, 0.001, 0.5]  # does not assemble
+    tr = sl.track_branches(LEG, L)
+    assert not tr.valid[30] and not tr.valid[70] and tr.valid.sum() == 99
+    assert tr.branch[30] == -1 and np.isnan(tr.alpha[30])
+    ok = tr.valid
+    np.testing.assert_allclose(tr.alpha[ok], a[ok], atol=NEAR_TOL)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [({"lengths": np.zeros(3)}, "lengths"), ({"branch": 2}, "branch"), ({"leg": None}, "leg")],
+)
+def test_bad_input(kwargs, name):
+    args = {"leg": LEG, "lengths": np.full((4, 3), 0.1), "branch": 0}
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=name):
+        sl.track_branches(args["leg"], args["lengths"], branch=args["branch"])
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_random_sways_across_the_curve(seed):
+    rng = np.random.default_rng(seed)
+    beta = rng.uniform(-1.2, 1.2)
+    a_s = -np.arctan2(LEG.h * np.cos(beta), LEG.r)
+    t = np.linspace(0.0, 10.0, 2001)
+    alpha = a_s + rng.uniform(0.05, 0.4) * np.sin(rng.uniform(0.5, 2.0) * t + rng.uniform(0, 2 * np.pi))
+    # branch 0 is the side of the curve that holds α = 0: h cos β cos α + r sin α > 0 (dl3/dα > 0)
+    start = 0 if LEG.h * np.cos(beta) * np.cos(alpha[0]) + LEG.r * np.sin(alpha[0]) > 0 else 1
+    tr = sl.track_branches(LEG, _lengths(alpha, beta), branch=start)
+    np.testing.assert_allclose(tr.alpha, alpha, atol=NEAR_TOL)
+    crossing = np.flatnonzero(np.diff(np.sign(alpha - a_s)) != 0)
+    assert tr.switched.sum() == crossing.size
+
+
+def test_empty_trajectories():
+    assert sl.track_branches(LEG, np.zeros((0, 3))).alpha.shape == (0,)
+    assert sl.track_branches(LEG, np.zeros((2, 0, 3))).alpha.shape == (2, 0)
+    assert sl.track_branches(LEG, np.zeros((0, 5, 3))).branch.shape == (0, 5)
