@@ -16,15 +16,26 @@ ALLOWED = {
     "testing": {"spatial"},
     "dynamics": {"spatial", "kinematics"},
     "analysis": {"spatial", "kinematics"},
-    "mechanisms": {"spatial", "kinematics", "trajectory", "dynamics", "analysis"},
-    "explore": {"spatial", "kinematics", "trajectory", "dynamics", "analysis", "mechanisms"},
-    "verify": {"spatial", "kinematics", "trajectory", "dynamics", "analysis", "mechanisms", "explore"},
+    "multibody": {"spatial", "kinematics", "trajectory", "dynamics", "analysis"},
+    "mechanisms": {"spatial", "kinematics", "trajectory", "dynamics", "analysis", "multibody"},
+    "explore": {"spatial", "kinematics", "trajectory", "dynamics", "analysis", "multibody", "mechanisms"},
+    "verify": {
+        "spatial",
+        "kinematics",
+        "trajectory",
+        "dynamics",
+        "analysis",
+        "multibody",
+        "mechanisms",
+        "explore",
+    },
     "studies": {
         "spatial",
         "kinematics",
         "trajectory",
         "dynamics",
         "analysis",
+        "multibody",
         "mechanisms",
         "explore",
         "verify",
@@ -36,6 +47,14 @@ INFRASTRUCTURE = {"robomech", "robomech._validation", "robomech._registry", "rob
 ENGINES = {"mujoco", "exudyn", "pinocchio"}
 # The distributed-computing stack of robomech.explore: imported inside functions only (first use).
 LAZY = {"dask", "distributed", "zarr", "pymoo"}
+# Deliberate exceptions to the engine / matplotlib rules, each imported lazily inside a function (never
+# at module level), so that the rest of the layer and `import robomech.multibody` need neither: reading
+# MJCF needs MuJoCo's own compiler (an optional extra), and the wireframe drawing needs matplotlib
+# (docs/architecture.md).
+LAZY_ONLY = {
+    ("multibody", "_mjcf.py"): {"mujoco"},
+    ("multibody", "_draw.py"): {"matplotlib"},
+}
 
 
 def _imports(path: Path) -> list[str]:
@@ -70,11 +89,15 @@ def test_every_module_respects_the_layering():
         layer = _layer(path)
         if layer in ("__init__", "_validation", "_registry", "_numba"):
             continue
+        lazy = LAZY_ONLY.get((layer, path.name), set())
+        for mod in _module_level_imports(path):
+            if mod.split(".")[0] in lazy:
+                problems.append(f"{path.relative_to(SRC)} imports {mod} at module level (lazy only)")
         for mod in _imports(path):
             top = mod.split(".")[0]
-            if top in ENGINES and layer != "verify":
+            if top in ENGINES and layer != "verify" and top not in lazy:
                 problems.append(f"{path.relative_to(SRC)} imports engine {mod}")
-            if top == "matplotlib" and layer != "studies":
+            if top == "matplotlib" and layer != "studies" and top not in lazy:
                 problems.append(f"{path.relative_to(SRC)} imports matplotlib")
             if top != "robomech" or mod in INFRASTRUCTURE:
                 continue
@@ -123,7 +146,7 @@ def test_import_robomech_explore_does_not_load_the_distributed_stack():
 
 def test_import_robomech_is_light():
     code = (
-        "import sys, robomech; "
+        "import sys, robomech, robomech.multibody; "
         "heavy = [m for m in ('scipy', 'sympy', 'matplotlib', 'mujoco', 'dask', 'zarr', 'pymoo', "
         "'robomech.explore') if m in sys.modules];"
         "print(','.join(heavy))"

@@ -2,7 +2,7 @@
 
 Layers (each imports only those above it; see docs/architecture.md):
 
-    spatial -> kinematics, trajectory -> dynamics, analysis -> mechanisms.<one per paper>
+    spatial -> kinematics, trajectory -> dynamics, analysis -> multibody -> mechanisms.<one per paper>
             -> verify -> studies -> cli
 
 ``import robomech`` is cheap: subpackages are imported on first use.
@@ -21,6 +21,7 @@ _SUBPACKAGES = (
     "trajectory",
     "dynamics",
     "analysis",
+    "multibody",
     "mechanisms",
     "verify",
     "studies",

@@ -103,3 +103,4 @@ __all__ = [
     "workspace_map",
     "workspace_symmetry",
 ]
+from ._multibody import to_multibody as to_multibody

@@ -240,13 +240,15 @@ def body_velocity(
             res.ok & res.full_rank & np.isfinite(res.residual_norm) & np.all(np.isfinite(res.x), axis=-1)
         )
     x = x.reshape(*batch, UNKNOWN_SIZE)
-    w_by = 0.5 * (m[..., I_ROCKER1] + m[..., I_ROCKER2])
-    w_by = np.broadcast_to(w_by, batch)
-    valid = valid.reshape(batch) & np.isfinite(w_by)
-    twist = np.stack([x[..., 3], w_by, x[..., 4], x[..., 0], x[..., 1], x[..., 2]], axis=-1)
-    rate = np.empty((*batch, CONFIG_SIZE))
-    rate[..., 0] = m[..., I_ROCKER1] - w_by
-    rate[..., 4] = m[..., I_ROCKER2] - w_by
+    # A non-finite rocker reading (inf - inf) only reaches samples that the mask below flags.
+    with np.errstate(invalid="ignore", over="ignore"):
+        w_by = 0.5 * (m[..., I_ROCKER1] + m[..., I_ROCKER2])
+        w_by = np.broadcast_to(w_by, batch)
+        valid = valid.reshape(batch) & np.isfinite(w_by)
+        twist = np.stack([x[..., 3], w_by, x[..., 4], x[..., 0], x[..., 1], x[..., 2]], axis=-1)
+        rate = np.empty((*batch, CONFIG_SIZE))
+        rate[..., 0] = m[..., I_ROCKER1] - w_by
+        rate[..., 4] = m[..., I_ROCKER2] - w_by
     for side in range(2):
         for j, col in zip((1, 2, 3), _PASSIVE[side], strict=True):
             rate[..., 4 * side + j] = x[..., col]

@@ -64,3 +64,4 @@ __all__ = [
     "track_branches",
     "workspace_map",
 ]
+from ._multibody import to_multibody as to_multibody

@@ -74,3 +74,4 @@ __all__ = [
     "static_torques",
     "workspace_map",
 ]
+from ._multibody import to_multibody as to_multibody

@@ -1,0 +1,95 @@
+"""The spherical parallel leg described generically (``robomech.multibody``), from its parameters.
+
+Nothing here is derived by hand: the generic layer assembles, differentiates and analyses this
+description, and the tests compare it with the closed forms of ``_kinematics.py`` (lengths, FK from
+three lengths, J, H) to 1e-10.
+
+* central chain 0 (RUR): two hinges at O, ``alpha`` about X then ``beta`` about the turned Y, so the
+  platform turns by ``Rx(alpha) Ry(beta)`` about O (paper 1, eq. (1));
+* leg i: a universal joint at A_i (two hinges across the leg), then the upper body sliding along the
+  leg (qpos of ``l{i}`` = length - home length), and a point closure (the upper spherical joint) at
+  B_i; legs 1 and 3 also carry the lead screw, spinning about the leg axis at 2 pi / lead per metre of
+  stroke (a joint coupling, ``screw_spin``), as the analytic dynamics assumes.
+* inertias as in ``_params.py`` (lower body from A_i, upper body ending at B_i, platform box about P);
+  the cardan and the central chain are massless there and have no ``Inertial`` here.
+
+``actuate="legs"`` (the robot: three legs on a 2-DOF platform, redundantly actuated) or
+``"platform"`` (alpha, beta as inputs: then ``G``'s leg rows are the analytic Jacobian dl/d(alpha, beta)).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robomech.multibody import Builder, Inertial, Mechanism
+
+from ._params import SphericalLeg
+
+__all__ = ["to_multibody"]
+
+
+def _quat(R: np.ndarray) -> tuple[float, ...]:
+    from robomech.multibody._model import _quat_from_matrix
+
+    return tuple(_quat_from_matrix(R))
+
+
+def to_multibody(leg: SphericalLeg, actuate: str = "legs") -> Mechanism:
+    """The generic description of ``leg``; q_act = the leg extensions, or (alpha, beta)."""
+    if not isinstance(leg, SphericalLeg):
+        raise ValueError(f"Expected leg to be a SphericalLeg, got {type(leg).__name__}.")
+    if actuate not in ("legs", "platform"):
+        raise ValueError(f"Expected actuate to be 'legs' or 'platform', got {actuate!r}.")
+    b = Builder("spherical_leg", gravity=leg.gravity)
+    b.body("cross", joints=[b.hinge("alpha", axis=(1, 0, 0))])
+    pi_ = leg.platform_inertia
+    b.body(
+        "platform",
+        "cross",
+        joints=[b.hinge("beta", axis=(0, 1, 0))],
+        inertial=Inertial(leg.platform_mass, (0.0, 0.0, leg.h), (1, 0, 0, 0), tuple(np.diag(pi_))),
+    )
+    b.site("platform", "platform", pos=(0.0, 0.0, leg.h))
+    A, B = leg.base_points, leg.platform_points_home
+    spin = leg.spin_ratio
+    for i in range(3):
+        v = B[i] - A[i]
+        l0 = float(np.linalg.norm(v))
+        x = v / l0
+        y = np.cross((0.0, 0.0, 1.0), x) if abs(x[2]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        y /= np.linalg.norm(y)
+        R = np.column_stack([x, y, np.cross(x, y)])  # x along the leg; U axes y, z across it
+        k = i + 1
+        lo, up = leg.lower[i], leg.upper[i]
+        b.body(
+            f"cardan{k}",
+            pos=A[i],
+            quat=_quat(R),
+            joints=[b.hinge(f"u{k}a", axis=(0, 1, 0)), b.hinge(f"u{k}b", axis=(0, 0, 1))],
+        )
+        lower = Inertial(
+            lo.mass,
+            (lo.length / 2, 0, 0),
+            (1, 0, 0, 0),
+            (lo.axial_inertia, lo.transverse_inertia, lo.transverse_inertia),
+        )
+        if spin[i] != 0.0:
+            # legs 1, 3 (RUHU): the lead screw spins about the leg axis relative to the non-spinning sleeve
+            b.body(f"screw{k}", f"cardan{k}", joints=[b.hinge(f"spin{k}", axis=(1, 0, 0))], inertial=lower)
+        else:
+            b.body(f"lower{k}", f"cardan{k}", inertial=lower)
+        upper = Inertial(
+            up.mass,
+            (l0 - up.length / 2, 0, 0),
+            (1, 0, 0, 0),
+            (up.axial_inertia, up.transverse_inertia, up.transverse_inertia),
+        )
+        b.body(f"upper{k}", f"cardan{k}", joints=[b.slide(f"l{k}", axis=(1, 0, 0))], inertial=upper)
+        b.connect(f"B{k}", f"upper{k}", "platform", anchor1=(l0, 0.0, 0.0), anchor2=B[i])
+        if spin[i] != 0.0:
+            b.couple(f"screw{k}", f"spin{k}", f"l{k}", (0.0, float(spin[i])))
+    if actuate == "legs":
+        b.actuate("l1", "l2", "l3")
+    else:
+        b.actuate("alpha", "beta")
+    return b.build()

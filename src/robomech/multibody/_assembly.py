@@ -1,0 +1,334 @@
+"""Assembly (position analysis): forward and inverse kinematics of any described closed chain.
+
+Both solve the closure equations (plus, for IK, the site's pose error) by a batched
+Levenberg–Marquardt iteration on the velocity constraint matrix, in least squares, so that redundant
+constraints (more equations than independent ones) and redundant actuation (more inputs than DOF,
+consistent inputs) work.  Every sample has its own damping, its own acceptance test and its own
+stop; a sample that cannot close stops with ``converged = False`` and does not affect the others.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array, check_int
+
+from ._constraints import jacobian, residual
+from ._model import Mechanism
+from ._tree import frame_jacobian, integrate, kinematics, normalize_quaternions
+
+__all__ = [
+    "CONVERGED_RTOL",
+    "FKResult",
+    "IKResult",
+    "check_mechanism",
+    "check_q",
+    "forward_kinematics",
+    "inverse_kinematics",
+    "solve_closure",
+]
+
+# A configuration is assembled when every closure row is below CONVERGED_RTOL * L (L the
+# characteristic length): 1e-10 m for a 1 m mechanism, far below any manufacturing tolerance and
+# well above the ~1e-15 L where Newton's quadratic convergence stops (rounding).
+CONVERGED_RTOL = 1e-10
+# A sample stops iterating once its residual is below STOP_RTOL * L: a few ulps of the coordinates.
+STOP_RTOL = 1e-14
+# Levenberg–Marquardt damping, relative to the mean diagonal of K^T K.  Start nearly at Gauss–Newton
+# (quadratic convergence near a solution); x10 on a rejected step, /10 on an accepted one; a sample
+# whose damping exceeds MU_MAX takes steps of relative size < 1e-10: it has stalled and stops.
+MU_START = 1e-8
+MU_MIN = 1e-14
+MU_MAX = 1e10
+# Largest step per iteration, in radians (translations divided by L): Gauss–Newton far from a
+# solution can take steps of many radians and land on another assembly branch; capping the step keeps
+# the iteration on the branch connected to the guess (0.5 rad: the closure equations are nearly
+# linear over such a step) at the cost of a few more iterations for large moves.  Only coordinates
+# that move a closure point or the IK site are capped.
+MAX_STEP = 0.5
+# Batches of at least this many samples run the assembly in the compiled kernels of _compiled.py
+# (the same algorithm per sample); smaller ones in numpy, with no compilation.
+COMPILED_MIN = 256
+# Iterations per continuation stage: from the reference configuration Newton takes 4-8 iterations on
+# the gallery; 60 leaves room for the damped steps far from a solution before a sample is given up.
+MAX_ITER = 60
+
+
+def check_mechanism(mech: object) -> Mechanism:
+    if not isinstance(mech, Mechanism):
+        raise ValueError(f"Expected mech to be a robomech.multibody.Mechanism, got {type(mech).__name__}.")
+    return mech
+
+
+def check_q(mech: Mechanism, q: object, name: str = "q") -> np.ndarray:
+    """``q (..., nq)`` finite, quaternions non-zero; returns it with quaternions normalised."""
+    q = as_array(q, name, (mech.nq,))
+    for a in mech.tree.quat_adr:
+        n = np.linalg.norm(q[..., a : a + 4], axis=-1)
+        if np.any(n < 1e-9):
+            raise ValueError(
+                f"Expected the quaternion {name}[..., {a}:{a + 4}] to be non-zero, got norm {n.min()}."
+            )
+    return normalize_quaternions(mech.tree, q)
+
+
+def solve_closure(
+    mech: Mechanism,
+    q: np.ndarray,
+    free: np.ndarray,
+    extra: Callable[[object, np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None,
+    max_iter: int = MAX_ITER,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """LM on the closure rows (plus ``extra(state, q, idx) -> (r, J)`` rows) over the coordinates ``free``.
+
+    ``q (N, nq)`` start (normalised); ``free`` indices of velocity coordinates that may move.
+    Returns ``q, closure residual (N,) max-abs, total residual (N,), iterations (N,)``.
+    """
+    tree, cs = mech.tree, mech.constraints
+    N = q.shape[0]
+    nf = len(free)
+
+    def fun(qs: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        st = kinematics(tree, qs)
+        r = residual(cs, tree, st, qs)
+        J = jacobian(cs, tree, st, qs)
+        rc = np.max(np.abs(r), axis=-1) if r.shape[-1] else np.zeros(qs.shape[0])
+        if extra is not None:
+            r2, J2 = extra(st, qs, idx)
+            r = np.concatenate([r, r2], axis=-1)
+            J = np.concatenate([J, J2], axis=-2)
+        return r, J[..., free], rc
+
+    q = np.array(q, copy=True)
+    all_idx = np.arange(N)
+    r, J, rc = fun(q, all_idx)
+    finite = np.all(np.isfinite(r), axis=-1) & np.all(np.isfinite(J), axis=(-1, -2))
+    cost = np.where(finite, np.sum(np.where(finite[:, None], r, 0.0) ** 2, axis=-1), np.inf)
+    mu = np.full(N, MU_START)
+    iters = np.zeros(N, dtype=int)
+    active = finite.copy()
+    stop = (STOP_RTOL * tree.length) ** 2
+    wstep = np.where(tree.dof_translational, 1.0 / tree.length, 1.0)[free]
+    geom_rows = np.array([k != "coupling" for k in cs.row_kind] + [True] * (r.shape[-1] - cs.m), dtype=bool)
+    if nf == 0:
+        active[:] = False
+    for _ in range(max_iter):
+        active &= cost > stop
+        idx = np.flatnonzero(active)
+        if idx.size == 0:
+            break
+        Js, rs = J[idx], r[idx]
+        JtJ = np.einsum("nmi,nmj->nij", Js, Js)
+        g = np.einsum("nmi,nm->ni", Js, rs)
+        scale = np.trace(JtJ, axis1=-2, axis2=-1) / nf + 1e-300
+        Amat = JtJ + (mu[idx] * scale)[:, None, None] * np.eye(nf)
+        dx = -np.linalg.solve(Amat, g[..., None])[..., 0]
+        # coordinates that move no closure point or site (e.g. a lead screw's coupled spin) are not capped
+        geo = (
+            np.any(Js[:, geom_rows[: Js.shape[1]]] != 0.0, axis=1)
+            if geom_rows.size
+            else np.ones_like(dx, bool)
+        )
+        big = np.max(np.abs(dx) * wstep * geo, axis=-1)
+        dx *= np.where(big > MAX_STEP, MAX_STEP / np.where(big > 0, big, 1.0), 1.0)[:, None]
+        dv = np.zeros((idx.size, tree.nv))
+        dv[:, free] = dx
+        q_try = integrate(tree, q[idx], dv)
+        r_t, J_t, rc_t = fun(q_try, idx)
+        ok_f = np.all(np.isfinite(r_t), axis=-1) & np.all(np.isfinite(J_t), axis=(-1, -2))
+        c_t = np.where(ok_f, np.sum(np.where(ok_f[:, None], r_t, 0.0) ** 2, axis=-1), np.inf)
+        acc = c_t < cost[idx]
+        ia = idx[acc]
+        q[ia], r[ia], J[ia], rc[ia], cost[ia] = q_try[acc], r_t[acc], J_t[acc], rc_t[acc], c_t[acc]
+        mu[ia] = np.maximum(mu[ia] / 10.0, MU_MIN)
+        ir = idx[~acc]
+        mu[ir] *= 10.0
+        iters[idx] += 1
+        active[ir[mu[ir] > MU_MAX]] = False
+    rc = np.where(finite, rc, np.inf)
+    return q, rc, np.sqrt(cost), iters
+
+
+@dataclass(frozen=True)
+class FKResult:
+    """Forward kinematics per sample (batch shape ``...`` of ``q_act``).
+
+    ``q (..., nq)`` the assembled configuration (MuJoCo qpos; NaN where the input was not finite);
+    ``residual (...)`` the largest closure row (m); ``converged`` = residual <= CONVERGED_RTOL * L;
+    ``iterations`` the LM iterations used.
+    """
+
+    q: np.ndarray
+    residual: np.ndarray
+    converged: np.ndarray
+    iterations: np.ndarray
+
+
+@dataclass(frozen=True)
+class IKResult:
+    """Inverse kinematics per sample (batch shape ``...`` of ``T_target``).
+
+    ``q (..., nq)``, ``q_act (..., n_act)``; ``residual`` the largest closure row (m);
+    ``pose_error`` the weighted pose error left (rotation times L, m); ``converged`` both below
+    CONVERGED_RTOL * L.
+    """
+
+    q: np.ndarray
+    q_act: np.ndarray
+    residual: np.ndarray
+    pose_error: np.ndarray
+    converged: np.ndarray
+    iterations: np.ndarray
+
+
+def _guess(mech: Mechanism, guess: object, batch: tuple[int, ...]) -> np.ndarray:
+    if guess is None:
+        return np.broadcast_to(mech.tree.q0, (*batch, mech.nq))
+    g = as_array(guess, "guess", (mech.nq,))
+    for a in mech.tree.quat_adr:
+        if np.any(np.linalg.norm(g[..., a : a + 4], axis=-1) < 1e-9):
+            raise ValueError(f"Expected the quaternion guess[..., {a}:{a + 4}] to be non-zero.")
+    return normalize_quaternions(mech.tree, g)
+
+
+def forward_kinematics(mech: Mechanism, q_act: object, guess: object = None, *, steps: int = 1) -> FKResult:
+    """Assemble the mechanism at the actuated coordinates ``q_act (..., n_act)`` (actuator order).
+
+    The passive coordinates start from ``guess (..., nq)`` (default the reference configuration
+    ``mech.q0``) and the solution is the assembly branch connected to it.  ``steps > 1`` moves the
+    inputs from the guess's values to ``q_act`` in that many equal stages (continuation), which
+    keeps the branch over large moves; along a trajectory pass the previous solution as the guess.
+    Non-finite inputs give ``converged = False`` and NaN for that sample only.
+    """
+    mech = check_mechanism(mech)
+    tree = mech.tree
+    na = len(mech.actuated)
+    qa = as_array(q_act, "q_act", (na,), finite=False)
+    steps = check_int(steps, "steps", low=1)
+    g0 = _guess(mech, guess, qa.shape[:-1])
+    batch = np.broadcast_shapes(qa.shape[:-1], g0.shape[:-1])
+    qa_f = np.broadcast_to(qa, (*batch, na)).reshape(-1, na)
+    q = np.array(np.broadcast_to(g0, (*batch, mech.nq)).reshape(-1, mech.nq))
+    ok = np.all(np.isfinite(qa_f), axis=-1)
+    q[~ok] = tree.q0
+    start = q[:, tree.act_qadr].copy()
+    target = np.where(ok[:, None], qa_f, start)
+    free = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
+    iters = np.zeros(q.shape[0], dtype=int)
+    for s in range(1, steps + 1):
+        q[:, tree.act_qadr] = start + (target - start) * (s / steps)
+        if q.shape[0] >= COMPILED_MIN:  # same algorithm, compiled per sample (see _compiled.py)
+            from ._compiled import compiled_fk
+
+            q, rc, it = compiled_fk(mech, q, free)
+        else:
+            q, rc, _, it = solve_closure(mech, q, free)
+        iters += it
+    conv = ok & (rc <= CONVERGED_RTOL * tree.length)
+    q = np.where(ok[:, None], q, np.nan)
+    rc = np.where(ok, rc, np.nan)
+    return FKResult(
+        q=q.reshape(*batch, mech.nq),
+        residual=rc.reshape(batch),
+        converged=conv.reshape(batch),
+        iterations=iters.reshape(batch),
+    )
+
+
+def _site_error(tree, state, site: int, T_target: np.ndarray, w: np.ndarray):
+    """Pose error rows ``[L rot; pos]`` (N, 6) of a site against ``T_target`` and their matrix (N, 6, nv)."""
+    b = tree.site_body[site]
+    Ts = state.T[:, b] @ tree.T_site[site]
+    L = tree.length
+    rot = 0.5 * L * np.sum(np.cross(T_target[:, :3, :3], Ts[:, :3, :3], axis=-2), axis=-1)
+    pos = Ts[:, :3, 3] - T_target[:, :3, 3]
+    Jf = frame_jacobian(tree, state, b, Ts[:, :3, 3])
+    Jf = np.concatenate([L * Jf[:, :3], Jf[:, 3:]], axis=-2)
+    return np.concatenate([rot, pos], axis=-1) * w, Jf * w[:, None]
+
+
+def inverse_kinematics(
+    mech: Mechanism,
+    site: str,
+    T_target: object,
+    guess: object = None,
+    *,
+    weights: object = None,
+    steps: int = 1,
+) -> IKResult:
+    """Configuration(s) that put ``site`` at ``T_target (..., 4, 4)`` (world) with the loops closed.
+
+    ``weights (6,)`` scale the error rows ``[rot_x, rot_y, rot_z, x, y, z]`` (rotation rows in
+    length units, times the characteristic length); a zero weight leaves that component free (e.g.
+    ``(0, 0, 0, 1, 1, 1)`` for a point target).  All coordinates move, from ``guess`` (default
+    ``mech.q0``), in least squares; ``steps > 1`` moves the target from the guess's site pose in
+    stages (continuation).  A target the mechanism cannot reach leaves ``converged = False``.
+    """
+    mech = check_mechanism(mech)
+    tree = mech.tree
+    if not isinstance(site, str):
+        raise ValueError(f"Expected site to be a site name (str), got {type(site).__name__}.")
+    si = tree.site_index(site)
+    T = as_array(T_target, "T_target", (4, 4), finite=False)
+    w = np.ones(6) if weights is None else as_array(weights, "weights", (6,))
+    if w.ndim != 1 or np.any(w < 0) or not np.any(w > 0):
+        raise ValueError(f"Expected weights to be 6 non-negative numbers, not all zero, got {w!r}.")
+    steps = check_int(steps, "steps", low=1)
+    g0 = _guess(mech, guess, T.shape[:-2])
+    batch = np.broadcast_shapes(T.shape[:-2], g0.shape[:-1])
+    Tf = np.array(np.broadcast_to(T, (*batch, 4, 4)).reshape(-1, 4, 4))
+    q = np.array(np.broadcast_to(g0, (*batch, mech.nq)).reshape(-1, mech.nq))
+    ok = np.all(np.isfinite(Tf), axis=(-1, -2))
+    # a target must be a rigid transform: orthonormal rotation, last row (0, 0, 0, 1)
+    Rt = np.where(ok[:, None, None], Tf[:, :3, :3], np.eye(3))
+    orth = np.max(np.abs(Rt.swapaxes(-1, -2) @ Rt - np.eye(3)), axis=(-1, -2))
+    if np.any(ok & ((orth > 1e-6) | (np.max(np.abs(Tf[:, 3] - [0, 0, 0, 1]), axis=-1) > 1e-12))):
+        raise ValueError("Expected T_target to hold rigid transforms (orthonormal R, last row 0 0 0 1).")
+    Tf[~ok] = np.eye(4)
+    free = np.arange(tree.nv)
+    start = None
+    if steps > 1:
+        st = kinematics(tree, q)
+        start = st.T[:, tree.site_body[si]] @ tree.T_site[si]
+    iters = np.zeros(q.shape[0], dtype=int)
+    pose_err = np.zeros(q.shape[0])
+    rc = np.zeros(q.shape[0])
+    for s in range(1, steps + 1):
+        if start is None or s == steps:
+            Ts = Tf
+        else:
+            Ts = _interp_pose(start, Tf, s / steps)
+
+        def extra(state, qs, idx, Ts=Ts):
+            return _site_error(tree, state, si, Ts[idx], w)
+
+        q, rc, _, it = solve_closure(mech, q, free, extra)
+        iters += it
+    st = kinematics(tree, q)
+    e, _ = _site_error(tree, st, si, Tf, w)
+    pose_err = np.max(np.abs(e), axis=-1)
+    tol = CONVERGED_RTOL * tree.length
+    conv = ok & (rc <= tol) & (pose_err <= tol)
+    q = np.where(ok[:, None], q, np.nan)
+    return IKResult(
+        q=q.reshape(*batch, mech.nq),
+        q_act=q[:, tree.act_qadr].reshape(*batch, len(mech.actuated)),
+        residual=np.where(ok, rc, np.nan).reshape(batch),
+        pose_error=np.where(ok, pose_err, np.nan).reshape(batch),
+        converged=conv.reshape(batch),
+        iterations=iters.reshape(batch),
+    )
+
+
+def _interp_pose(T0: np.ndarray, T1: np.ndarray, t: float) -> np.ndarray:
+    """Pose ``t`` of the way from T0 to T1 (straight line in position, geodesic in rotation)."""
+    from robomech.spatial import exp_so3, log_so3
+
+    R = T0[:, :3, :3] @ exp_so3(t * log_so3(T0[:, :3, :3].swapaxes(-1, -2) @ T1[:, :3, :3]))
+    out = np.array(T1, copy=True)
+    out[:, :3, :3] = R
+    out[:, :3, 3] = (1 - t) * T0[:, :3, 3] + t * T1[:, :3, 3]
+    return out

@@ -1,0 +1,174 @@
+"""Closure equations ``phi(q) = 0``, their velocity matrix ``K`` and its time derivative (internal).
+
+Rows, in the order of ``mech.closures`` then ``mech.couplings`` (all in length units, so that a
+rotation error counts as the arc it sweeps at the characteristic length ``L``):
+
+* point pair (``connect``; ``revolute`` gives two, the second ``L`` along the axis): ``p1 - p2`` (3);
+* rigid (``weld``): ``p1 - p2`` at MuJoCo's anchor (3), then the rotation error
+  ``L/2 sum_i (R_t e_i) × (R_2 e_i)`` with ``R_t = R_1 R_rel`` (3);
+* coupling: ``s ((q1 - ref1) - poly(q2 - ref2))`` with ``s = L`` for a hinge ``q1``, 1 for a slide.
+
+``K (N, m, nv)`` is the velocity constraint matrix: ``K qd`` is the time derivative of the point and
+coupling rows and ``L (ω_2 - ω_1)`` for the rotation rows, which is the exact derivative of the
+rotation residual wherever it vanishes (on the constraint manifold).  So ``K qd = 0`` is exactly the
+set of admissible velocities, and ``K qdd + Kdot qd = 0`` exactly the admissible accelerations, at
+every assembled configuration; away from it, Newton with ``K`` converges as with the exact Jacobian.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._tree import Tree, TreeState, frame_jacobian, frame_jacobian_rate, quat_to_matrix
+
+__all__ = ["Constraints", "compile_constraints", "jacobian", "jacobian_rate", "residual"]
+
+
+@dataclass(frozen=True, eq=False)
+class Constraints:
+    """Compiled closure rows.  ``blocks``: (kind, data) with kind in ``point``, ``rot``, ``coupling``."""
+
+    blocks: tuple[tuple, ...]
+    m: int
+    row_owner: tuple[str, ...]  # (m,) the closure or coupling each row comes from
+    row_kind: tuple[str, ...]  # (m,) "point", "rot" or "coupling"
+
+
+def _h(x) -> np.ndarray:
+    return np.array([*x, 1.0])
+
+
+def compile_constraints(mech, tree: Tree) -> Constraints:
+    L = tree.length
+    blocks: list[tuple] = []
+    owner: list[str] = []
+    kind: list[str] = []
+
+    def add(k: str, data: tuple, name: str, rows: int) -> None:
+        blocks.append((k, data))
+        owner.extend([name] * rows)
+        kind.extend([k] * rows)
+
+    for c in mech.closures:
+        b1, b2 = tree.body_index(c.body1), tree.body_index(c.body2)
+        if c.kind == "point":
+            add("point", (b1, _h(c.anchor1), b2, _h(c.anchor2)), c.name, 3)
+        elif c.kind == "revolute":
+            add("point", (b1, _h(c.anchor1), b2, _h(c.anchor2)), c.name, 3)
+            a1 = np.asarray(c.anchor1) + L * np.asarray(c.axis)
+            a2 = np.asarray(c.anchor2) + L * np.asarray(c.axis2)
+            add("point", (b1, _h(a1), b2, _h(a2)), c.name, 3)
+        else:
+            Rrel = quat_to_matrix(np.asarray(c.relquat))
+            p1_local = np.asarray(c.relpos) + Rrel @ np.asarray(c.anchor2)  # MuJoCo's eq_data[3:6]
+            add("point", (b1, _h(p1_local), b2, _h(c.anchor2)), c.name, 3)
+            add("rot", (b1, Rrel, b2), c.name, 3)
+    for c in mech.couplings:
+        j1 = tree.joint_index(c.joint1)
+        s = L if tree.jnt_type[j1] == 0 else 1.0
+        if c.joint2 is None:
+            j2d, j2q, ref2 = -1, -1, 0.0
+        else:
+            j2 = tree.joint_index(c.joint2)
+            j2d, j2q, ref2 = int(tree.jnt_dadr[j2]), int(tree.jnt_qadr[j2]), float(tree.jnt_ref[j2])
+        data = (
+            int(tree.jnt_dadr[j1]),
+            int(tree.jnt_qadr[j1]),
+            float(tree.jnt_ref[j1]),
+            j2d,
+            j2q,
+            ref2,
+            np.asarray(c.polycoef, float),
+            s,
+        )
+        add("coupling", data, c.name, 1)
+    return Constraints(blocks=tuple(blocks), m=len(owner), row_owner=tuple(owner), row_kind=tuple(kind))
+
+
+def _poly(c: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    f = c[0] + x * (c[1] + x * (c[2] + x * (c[3] + x * c[4])))
+    d1 = c[1] + x * (2 * c[2] + x * (3 * c[3] + x * 4 * c[4]))
+    d2 = 2 * c[2] + x * (6 * c[3] + x * 12 * c[4])
+    return f, d1, d2
+
+
+def _points(
+    state: TreeState, b1: int, x1: np.ndarray, b2: int, x2: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    return (state.T[:, b1] @ x1)[:, :3], (state.T[:, b2] @ x2)[:, :3]
+
+
+def residual(cs: Constraints, tree: Tree, state: TreeState, q: np.ndarray) -> np.ndarray:
+    """Closure residual ``(N, m)`` in length units."""
+    out = []
+    L = tree.length
+    for k, d in cs.blocks:
+        if k == "point":
+            p1, p2 = _points(state, *d)
+            out.append(p1 - p2)
+        elif k == "rot":
+            b1, Rrel, b2 = d
+            Rt = state.T[:, b1, :3, :3] @ Rrel
+            R2 = state.T[:, b2, :3, :3]
+            out.append(0.5 * L * np.sum(np.cross(Rt, R2, axis=-2), axis=-1))
+        else:
+            _d1, q1, ref1, _, q2, ref2, c, s = d
+            x = q[:, q2] - ref2 if q2 >= 0 else np.zeros(q.shape[0])
+            out.append((s * ((q[:, q1] - ref1) - _poly(c, x)[0]))[:, None])
+    return np.concatenate(out, axis=-1) if out else np.zeros((q.shape[0], 0))
+
+
+def jacobian(cs: Constraints, tree: Tree, state: TreeState, q: np.ndarray) -> np.ndarray:
+    """Velocity constraint matrix ``K (N, m, nv)``."""
+    N = state.T.shape[0]
+    L = tree.length
+    out = []
+    for k, d in cs.blocks:
+        if k == "point":
+            b1, _x1, b2, _x2 = d
+            p1, p2 = _points(state, *d)
+            out.append(
+                frame_jacobian(tree, state, b1, p1)[:, 3:] - frame_jacobian(tree, state, b2, p2)[:, 3:]
+            )
+        elif k == "rot":
+            b1, _, b2 = d
+            w = state.S[..., :3].swapaxes(-1, -2)
+            out.append(L * w * (tree.A[b2] - tree.A[b1]))
+        else:
+            d1, _, _, d2, q2, ref2, c, s = d
+            row = np.zeros((N, 1, tree.nv))
+            row[:, 0, d1] = s
+            if d2 >= 0:
+                row[:, 0, d2] -= s * _poly(c, q[:, q2] - ref2)[1]
+            out.append(row)
+    return np.concatenate(out, axis=-2) if out else np.zeros((N, 0, tree.nv))
+
+
+def jacobian_rate(
+    cs: Constraints, tree: Tree, state: TreeState, Sd: np.ndarray, q: np.ndarray, qd: np.ndarray
+) -> np.ndarray:
+    """``dK/dt (N, ..., m, nv)`` along ``qd (N, ..., nv)`` (``Sd = screw_rates(tree, state, qd)``)."""
+    L = tree.length
+    extra = qd.ndim - 2
+    out = []
+    for k, d in cs.blocks:
+        if k == "point":
+            b1, _x1, b2, _x2 = d
+            p1, p2 = _points(state, *d)
+            out.append(
+                frame_jacobian_rate(tree, state, Sd, b1, p1, qd)[..., 3:, :]
+                - frame_jacobian_rate(tree, state, Sd, b2, p2, qd)[..., 3:, :]
+            )
+        elif k == "rot":
+            b1, _, b2 = d
+            out.append(L * Sd[..., :3].swapaxes(-1, -2) * (tree.A[b2] - tree.A[b1]))
+        else:
+            _d1, _, _, d2, q2, ref2, c, s = d
+            row = np.zeros((*qd.shape[:-1], 1, tree.nv))
+            if d2 >= 0:
+                x = (q[:, q2] - ref2).reshape(-1, *(1,) * extra)
+                row[..., 0, d2] = -s * _poly(c, x)[2] * qd[..., d2]
+            out.append(row)
+    return np.concatenate(out, axis=-2) if out else np.zeros((*qd.shape[:-1], 0, tree.nv))

@@ -1,0 +1,225 @@
+"""First- and second-order influence coefficients of any closed chain (exact, batched).
+
+At an assembled ``q`` the admissible velocities satisfy ``K qd = 0``.  Splitting the velocity
+coordinates into actuated (a) and passive (p), ``qd_p = -K_p^+ K_a qd_a``, so
+
+    G = ∂qd/∂qd_a = [I; -K_p^+ K_a]                       (nv, n_act), rows in qvel order,
+
+the minimum-norm choice where the passive coordinates include idle motions (a leg spinning about its
+own axis), which move no site and so leave every site Jacobian unique.  Differentiating ``K G = 0``
+along the motion ``qd = G e_k``:
+
+    ∂G/∂q_a,k = [0; -K_p^+ (dK/dt|_{qd = G e_k}) G]        (the papers' second-order coefficients),
+
+and for a site with ``[ω; ṗ] = J_f qd``: ``J = J_f G`` and ``∂J/∂q_a,k = (dJ_f/dt) G + J_f ∂G/∂q_a,k``.
+Nothing here is a finite difference; the tests compare with ``robomech.testing``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array, check_bool
+
+from ._assembly import check_mechanism, check_q
+from ._constraints import jacobian, jacobian_rate
+from ._model import Mechanism
+from ._tree import frame_jacobian, frame_jacobian_rate, kinematics, screw_rates
+
+__all__ = [
+    "PASSIVE_RANK_RTOL",
+    "Influence",
+    "constraint_jacobian",
+    "constraint_jacobian_rate",
+    "constraint_residual",
+    "influence",
+    "site_hessian",
+    "site_jacobian",
+    "site_pose",
+]
+
+# Singular values of K_p below PASSIVE_RANK_RTOL * sigma_max are zero in the pseudo-inverse: K_p is
+# built from unit screws times lengths of order L, so rounding leaves ~1e-15 relative; a genuine
+# (non-singular) passive direction of a well-posed mechanism is far above 1e-10.
+PASSIVE_RANK_RTOL = 1e-10
+
+
+@dataclass(frozen=True)
+class Influence:
+    """``G (..., nv, n_act)`` and ``dG (..., nv, n_act, n_act)`` with ``dG[..., i, j, k] = ∂G_ij/∂q_act,k``.
+
+    ``passive_rank`` the rank of K_p, ``n_passive`` its columns (``passive_rank < n_passive``: idle
+    or undetermined passive motion); ``consistency`` = max |K G| / L: zero where every input rate is
+    admissible, > 0 with redundant actuation (only admissible ``qd_act`` then have a meaning);
+    ``sigma_min`` the smallest non-zero singular value of K_p (m) and ``cond`` its condition number.
+    """
+
+    G: np.ndarray
+    dG: np.ndarray | None
+    passive_rank: np.ndarray
+    n_passive: int
+    consistency: np.ndarray
+    sigma_min: np.ndarray
+    cond: np.ndarray
+
+
+def _pinv(Kp: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Batched pseudo-inverse of ``Kp (N, m, n)`` with its rank, smallest kept singular value, cond."""
+    N, m, n = Kp.shape
+    if m == 0 or n == 0:
+        return np.zeros((N, n, m)), np.zeros(N, dtype=int), np.full(N, np.inf), np.ones(N)
+    U, s, Vt = np.linalg.svd(Kp, full_matrices=False)
+    cut = PASSIVE_RANK_RTOL * s[:, :1]
+    keep = s > cut
+    sinv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
+    P = np.einsum("nji,nj,nkj->nik", Vt, sinv, U)
+    rank = np.sum(keep, axis=-1)
+    smin = np.min(np.where(keep, s, np.inf), axis=-1)
+    cond = np.where(rank > 0, s[:, 0] / np.where(np.isfinite(smin), smin, 1.0), np.inf)
+    return P, rank, smin, cond
+
+
+def _influence_flat(mech: Mechanism, q: np.ndarray, second: bool):
+    tree, cs = mech.tree, mech.constraints
+    state = kinematics(tree, q)
+    K = jacobian(cs, tree, state, q)
+    N = q.shape[0]
+    na = len(tree.act_dof)
+    act = tree.act_dof
+    pas = np.setdiff1d(np.arange(tree.nv), act)
+    P, rank, smin, cond = _pinv(K[..., pas])
+    G = np.zeros((N, tree.nv, na))
+    G[:, act, np.arange(na)] = 1.0
+    G[:, pas] = -P @ K[..., act]
+    cons = np.max(np.abs(K @ G), axis=(-1, -2)) / tree.length if K.shape[1] and na else np.zeros(N)
+    dG = None
+    Sd = None
+    if second and na:
+        qd = G.swapaxes(-1, -2)  # (N, na, nv): the motion of unit rate of input k
+        Sd = screw_rates(tree, state, qd)
+        Kd = jacobian_rate(cs, tree, state, Sd, q, qd)  # (N, na, m, nv)
+        dGk = np.zeros((N, na, tree.nv, na))
+        dGk[:, :, pas] = -np.einsum("nim,nkmj->nkij", P, Kd @ G[:, None])
+        dG = dGk.transpose(0, 2, 3, 1)
+    return state, K, G, dG, Sd, (rank, len(pas), cons, smin, cond)
+
+
+def _site_index(mech: Mechanism, site: object) -> int:
+    if not isinstance(site, str):
+        raise ValueError(f"Expected site to be a site name (str), got {type(site).__name__}.")
+    return mech.tree.site_index(site)
+
+
+def _flat(mech: Mechanism, q: object) -> tuple[np.ndarray, tuple[int, ...]]:
+    q = check_q(mech, q)
+    return q.reshape(-1, mech.nq), q.shape[:-1]
+
+
+def influence(mech: Mechanism, q: object, *, second_order: bool = True) -> Influence:
+    """``G = ∂q/∂q_act`` (velocity coordinates) and ``∂G/∂q_act`` at assembled configurations ``q (..., nq)``.
+
+    ``Ġ = einsum("...ijk,...k->...ij", dG, qd_act)`` and ``qdd = G qdd_act + einsum("...ijk,...j,...k->...i",
+    dG, qd_act, qd_act)``.
+    """
+    mech = check_mechanism(mech)
+    second_order = check_bool(second_order, "second_order")
+    qf, batch = _flat(mech, q)
+    _, _, G, dG, _, (rank, npas, cons, smin, cond) = _influence_flat(mech, qf, second_order)
+    nv, na = G.shape[-2:]
+    return Influence(
+        G=G.reshape(*batch, nv, na),
+        dG=None if dG is None else dG.reshape(*batch, nv, na, na),
+        passive_rank=rank.reshape(batch),
+        n_passive=npas,
+        consistency=cons.reshape(batch),
+        sigma_min=smin.reshape(batch),
+        cond=cond.reshape(batch),
+    )
+
+
+def site_pose(mech: Mechanism, q: object, site: str) -> np.ndarray:
+    """World pose ``T (..., 4, 4)`` of ``site`` at ``q (..., nq)`` (any q: tree kinematics, no closure)."""
+    mech = check_mechanism(mech)
+    si = _site_index(mech, site)
+    qf, batch = _flat(mech, q)
+    from ._tree import body_poses
+
+    T = body_poses(mech.tree, qf)[:, mech.tree.site_body[si]] @ mech.tree.T_site[si]
+    return T.reshape(*batch, 4, 4)
+
+
+def site_jacobian(mech: Mechanism, q: object, site: str) -> np.ndarray:
+    """``[ω; ṗ] = J qd_act`` for ``site`` at assembled ``q (..., nq)``: ``(..., 6, n_act)`` (mj_jacSite)."""
+    mech = check_mechanism(mech)
+    si = _site_index(mech, site)
+    qf, batch = _flat(mech, q)
+    tree = mech.tree
+    from ._assembly import COMPILED_MIN
+
+    if qf.shape[0] >= COMPILED_MIN:  # same formulas, compiled per sample (see _compiled.py)
+        from ._compiled import compiled_site_jacobian
+
+        J = compiled_site_jacobian(mech, qf, si)
+        return J.reshape(*batch, 6, J.shape[-1])
+    state, _, G, _, _, _ = _influence_flat(mech, qf, False)
+    b = tree.site_body[si]
+    p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
+    J = frame_jacobian(tree, state, b, p) @ G
+    return J.reshape(*batch, 6, G.shape[-1])
+
+
+def site_hessian(mech: Mechanism, q: object, site: str) -> np.ndarray:
+    """``H[..., i, j, k] = ∂J[..., i, j]/∂q_act,k`` for ``site`` at assembled ``q``: (..., 6, n_act, n_act).
+
+    ``[ω̇; p̈] = J qdd_act + einsum("...ijk,...j,...k->...i", H, qd_act, qd_act)``.
+    """
+    mech = check_mechanism(mech)
+    si = _site_index(mech, site)
+    qf, batch = _flat(mech, q)
+    tree = mech.tree
+    state, _, G, dG, Sd, _ = _influence_flat(mech, qf, True)
+    na = G.shape[-1]
+    if na == 0:
+        return np.zeros((*batch, 6, 0, 0))
+    b = tree.site_body[si]
+    p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
+    Jf = frame_jacobian(tree, state, b, p)
+    Jfd = frame_jacobian_rate(tree, state, Sd, b, p, G.swapaxes(-1, -2))  # (N, na_k, 6, nv)
+    Hk = Jfd @ G[:, None] + Jf[:, None] @ dG.transpose(0, 3, 1, 2)  # (N, k, 6, j)
+    return Hk.transpose(0, 2, 3, 1).reshape(*batch, 6, na, na)
+
+
+def constraint_residual(mech: Mechanism, q: object) -> np.ndarray:
+    """Closure residual ``(..., m)`` in length units (rotation rows times the characteristic length)."""
+    from ._constraints import residual
+
+    mech = check_mechanism(mech)
+    qf, batch = _flat(mech, q)
+    st = kinematics(mech.tree, qf)
+    r = residual(mech.constraints, mech.tree, st, qf)
+    return r.reshape(*batch, r.shape[-1])
+
+
+def constraint_jacobian(mech: Mechanism, q: object) -> np.ndarray:
+    """Velocity constraint matrix ``K (..., m, nv)``: admissible ``qd`` (qvel) satisfy ``K qd = 0``."""
+    mech = check_mechanism(mech)
+    qf, batch = _flat(mech, q)
+    st = kinematics(mech.tree, qf)
+    K = jacobian(mech.constraints, mech.tree, st, qf)
+    return K.reshape(*batch, *K.shape[1:])
+
+
+def constraint_jacobian_rate(mech: Mechanism, q: object, qd: object) -> np.ndarray:
+    """``dK/dt (..., m, nv)`` along ``qd (..., nv)``: ``K qdd + dK/dt qd = 0`` for admissible motions."""
+    mech = check_mechanism(mech)
+    q = check_q(mech, q)
+    qd = as_array(qd, "qd", (mech.nv,))
+    batch = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1])
+    qf = np.broadcast_to(q, (*batch, mech.nq)).reshape(-1, mech.nq)
+    qdf = np.broadcast_to(qd, (*batch, mech.nv)).reshape(-1, mech.nv)
+    st = kinematics(mech.tree, qf)
+    Sd = screw_rates(mech.tree, st, qdf)
+    Kd = jacobian_rate(mech.constraints, mech.tree, st, Sd, qf, qdf)
+    return Kd.reshape(*batch, *Kd.shape[1:])

@@ -1,0 +1,255 @@
+"""Mobility of a described mechanism from its constraint Jacobian, with screw theory where it fits.
+
+At an assembled ``q`` the admissible velocities are ``null(K)`` (``K (m, nv)`` the velocity constraint
+matrix).  With all rotation rows and translational columns scaled to metres by the characteristic
+length ``L`` (so that ranks are unit-consistent):
+
+* ``total_dof = nv - rank K``: every instantaneous motion, idle ones included;
+* ``idle_dof``: motions with every actuated joint locked that move no output body (the bodies that
+  carry sites; all bodies if there is none) — e.g. an S–S link spinning about its own axis;
+* ``dof = total_dof - idle_dof``: the mechanism's degrees of freedom (the Delta's 3, Bennett's 1);
+* ``gruebler_kutzbach = nv - sum c_i`` (the spatial count ``6(n - 1) - sum (6 - f)`` for the tree plus
+  a cut joint of ``c`` equations per closure: 3 point, 5 revolute (or two point closures between the
+  same two bodies), 6 rigid, 1 coupling);
+* ``redundant_constraints = sum c_i - rank K``, so that ``total_dof = gruebler_kutzbach +
+  redundant_constraints`` (a planar four-bar cut by a hinge: -2 + 3 = 1; Bennett's linkage the same);
+* ``singular``: the rank of K is not locally constant — it differs at configurations assembled a
+  small step away along the admissible motions.
+
+For a platform carried by serial legs (every closure joins the platform to a leg), the same
+configuration is also passed to :func:`robomech.analysis.mobility.analyze` (reciprocal screws),
+which gives the platform's twist system, common and redundant constraints and the modified
+Grübler–Kutzbach count; ``platform_dof`` from the constraint Jacobian must agree with it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech.analysis import mobility as screw_mobility
+
+from ._assembly import check_mechanism, check_q, solve_closure
+from ._constraints import jacobian
+from ._model import Mechanism
+from ._tree import kinematics, space_jacobian
+
+__all__ = ["MOBILITY_RTOL", "NEIGHBOUR_STEP", "MobilityReport", "mobility"]
+
+# Singular values of the unit-scaled K below MOBILITY_RTOL * sigma_max count as zero: entries are
+# unit screws times lengths of order L, rounding leaves ~1e-15 relative, and a configuration
+# 1e-4 rad from a singularity (NEIGHBOUR_STEP) still has the vanishing value ~1e-4 >> 1e-9.
+MOBILITY_RTOL = 1e-9
+# The "locally constant rank" test re-assembles the mechanism this far (rad, or L for translations)
+# along each admissible direction and compares the ranks there.
+NEIGHBOUR_STEP = 1e-4
+_C = {"point": 3, "revolute": 5, "rigid": 6}
+
+
+@dataclass(frozen=True)
+class MobilityReport:
+    dof: int
+    total_dof: int
+    idle_dof: int
+    locked_dof: int  # motions left with every actuated joint locked (idle + uncontrolled)
+    redundant_constraints: int
+    n_equations: int  # sum of the cut joints' constraint counts c_i
+    rank: int  # rank of the constraint Jacobian
+    gruebler_kutzbach: int
+    singular: bool
+    rank_nearby: tuple[int, ...]
+    n_actuated: int
+    actuation: str  # "exact", "redundant" (n_act > dof) or "under" (n_act < dof)
+    platform: str | None
+    platform_dof: int | None  # rank of the platform twists over the admissible motions
+    platform_rotational_dof: int | None
+    platform_twists: np.ndarray | None  # (platform_dof, 6) orthonormal basis (angular, linear/L)
+    screw_theory: screw_mobility.MobilityResult | None  # analysis.mobility on the serial legs, if it fits
+    length: float
+
+    def summary(self) -> str:
+        s = (
+            f"DOF {self.dof} (+{self.idle_dof} idle); {self.n_equations} closure equations, "
+            f"rank {self.rank}, "
+            f"{self.redundant_constraints} redundant; Gruebler-Kutzbach {self.gruebler_kutzbach}; "
+            f"{self.n_actuated} actuated ({self.actuation}){'; SINGULAR' if self.singular else ''}"
+        )
+        if self.platform is not None:
+            s += f"; platform {self.platform}: {self.platform_dof} DOF ({self.platform_rotational_dof}R)"
+        return s
+
+
+def _scaled_K(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, object]:
+    tree = mech.tree
+    st = kinematics(tree, q)
+    K = jacobian(mech.constraints, tree, st, q)
+    col = np.where(tree.dof_translational, tree.length, 1.0)
+    return K * col, st
+
+
+def _rank(X: np.ndarray, scale: float | None = None) -> int:
+    """Numerical rank; ``scale`` the size of a non-zero entry (default the largest singular value)."""
+    if X.size == 0:
+        return 0
+    s = np.linalg.svd(X, compute_uv=False)
+    ref = s[0] if scale is None else scale
+    return int(np.sum(s > MOBILITY_RTOL * max(ref, 1e-300))) if s.size else 0
+
+
+def _null(X: np.ndarray, n: int) -> np.ndarray:
+    if X.shape[0] == 0:
+        return np.eye(n)
+    _, s, Vt = np.linalg.svd(X)
+    r = int(np.sum(s > MOBILITY_RTOL * max(s[0] if s.size else 0.0, 1e-300)))
+    return Vt[r:].T
+
+
+def _output_bodies(mech: Mechanism) -> list[int]:
+    tree = mech.tree
+    if len(tree.site_names):
+        return sorted(set(int(b) for b in tree.site_body))
+    return list(range(1, len(tree.body_names)))
+
+
+def _serial_legs(mech: Mechanism, st, platform: int) -> list[np.ndarray] | None:
+    """Joint screws (world, at q) of each serial leg to ``platform``; None if not of that form."""
+    tree = mech.tree
+    if mech.couplings:
+        return None
+    S = st.S[0]
+    chains = [S[tree.A[platform] > 0]]
+    used = tree.A[platform].copy()
+    for c in mech.closures:
+        b1, b2 = tree.body_index(c.body1), tree.body_index(c.body2)
+        if platform not in (b1, b2):
+            return None
+        other, anchor = (b2, c.anchor2) if b1 == platform else (b1, c.anchor1)
+        if (
+            tree.A[other] * used
+        ).any():  # shares joints with another leg: not serial legs (e.g. a parallelogram)
+            return None
+        used = np.maximum(used, tree.A[other])
+        T = st.T[0, other]
+        p = T[:3, :3] @ np.asarray(anchor) + T[:3, 3]
+        leg = list(S[tree.A[other] > 0])
+        if c.kind == "point":
+            leg += [np.concatenate([e, np.cross(p, e)]) for e in np.eye(3)]
+        elif c.kind == "revolute":
+            a = T[:3, :3] @ np.asarray(c.axis2 if b1 == platform else c.axis)
+            leg.append(np.concatenate([a, np.cross(p, a)]))
+        if not leg:
+            return None
+        chains.append(np.array(leg))
+    return chains
+
+
+def _cut_constraints(mech: Mechanism) -> int:
+    """Constraints of the cut joints: point 3, revolute 5, rigid 6, coupling 1.
+
+    Two point closures between the same two bodies are one hinge cut (how MJCF writes a revolute
+    closure: their six equations always have one dependence), 5; three or more are a rigid cut, 6.
+    """
+    pairs: dict[frozenset, int] = {}
+    n = len(mech.couplings)
+    for c in mech.closures:
+        if c.kind == "point":
+            key = frozenset((c.body1, c.body2))
+            pairs[key] = pairs.get(key, 0) + 1
+        else:
+            n += _C[c.kind]
+    return n + sum({1: 3, 2: 5}.get(k, 6) for k in pairs.values())
+
+
+def mobility(mech: Mechanism, q: object = None, *, platform: str | None = None) -> MobilityReport:
+    """Mobility at one assembled configuration ``q (nq,)`` (default the reference configuration).
+
+    ``platform`` (a body name; default the body of the first site, if any) adds the platform's twist
+    system, and the screw-theory analysis of :mod:`robomech.analysis.mobility` when the platform is
+    carried by serial legs.
+    """
+    mech = check_mechanism(mech)
+    tree = mech.tree
+    if platform is not None and (not isinstance(platform, str) or platform not in tree.body_names[1:]):
+        raise ValueError(
+            f"Expected platform to be None or a body name among {list(tree.body_names[1:])}, "
+            f"got {platform!r}."
+        )
+    q = tree.q0 if q is None else check_q(mech, q)
+    if q.ndim != 1:
+        raise ValueError(f"Expected q to have shape ({mech.nq},) (one configuration), got {q.shape}.")
+    q = q[None]
+    K, st = _scaled_K(mech, q)
+    K = K[0]
+    _m, nv = K.shape
+    kmax = float(np.max(np.linalg.svd(K, compute_uv=False))) if K.size else 1.0
+    rank = _rank(K, kmax)
+    total = nv - rank
+    N = _null(K, nv)  # admissible motions (scaled coordinates)
+    col = np.where(tree.dof_translational, tree.length, 1.0)
+    na = len(tree.act_dof)
+    locked = N @ _null(N[tree.act_dof], N.shape[1]) if na else N
+    outs = []
+    for b in _output_bodies(mech):
+        Jb = space_jacobian(tree, st, b)[0] / col  # twist per scaled coordinate
+        Jb = Jb * np.array([tree.length] * 3 + [1.0] * 3)[:, None]
+        outs.append(Jb)
+    Jout = np.concatenate(outs) if outs else np.zeros((0, nv))
+    # Jout has unit screws times L: rows of order L, so a motion that moves an output has |Jout v| ~ L|v|
+    idle = locked.shape[1] - _rank(Jout @ locked, tree.length) if locked.shape[1] else 0
+    dof = total - idle
+    n_c = _cut_constraints(mech)
+    gk = nv - n_c
+    # locally constant rank: re-assemble a small step along each admissible direction
+    nearby = []
+    if N.shape[1]:
+        steps = np.concatenate([N.T, -N.T]) * NEIGHBOUR_STEP / col  # back to unscaled coordinates
+        from ._tree import integrate
+
+        qn = integrate(tree, np.repeat(q, steps.shape[0], axis=0), steps)
+        qn, _rc, _, _ = solve_closure(mech, qn, np.arange(nv))
+        for k in range(qn.shape[0]):
+            nearby.append(_rank(_scaled_K(mech, qn[k : k + 1])[0][0], kmax))
+    singular = any(r != rank for r in nearby)
+    if platform is None and len(tree.site_names):
+        platform = tree.body_names[tree.site_body[0]]
+    p_dof = p_rot = p_tw = sm = None
+    if platform is not None:
+        pb = tree.body_index(platform)
+        Jp = space_jacobian(tree, st, pb)[0] / col
+        Tw = Jp @ N
+        Tw[3:] /= tree.length
+        U, s, _ = np.linalg.svd(Tw) if Tw.size else (np.zeros((6, 0)), np.zeros(0), None)
+        p_dof = int(np.sum(s > MOBILITY_RTOL))  # N orthonormal, Tw entries O(1)
+        p_tw = U[:, :p_dof].T
+        p_rot = _rank(p_tw[:, :3], 1.0) if p_dof else 0
+        legs = _serial_legs(mech, st, pb)
+        if legs is not None:
+            # analysis.mobility divides moments by length_scale and wants unit screws after that:
+            # prismatic screws [0; d] are passed as [0; L d]
+            legs = [
+                np.where(np.linalg.norm(c[:, :3], axis=1, keepdims=True) < 1e-12, tree.length * c, c)
+                for c in legs
+            ]
+            sm = screw_mobility.analyze(legs, length_scale=tree.length)
+    act = "exact" if na == dof else ("redundant" if na > dof else "under")
+    return MobilityReport(
+        dof=dof,
+        total_dof=total,
+        idle_dof=idle,
+        locked_dof=int(locked.shape[1]),
+        redundant_constraints=n_c - rank,
+        n_equations=n_c,
+        rank=rank,
+        gruebler_kutzbach=gk,
+        singular=singular,
+        rank_nearby=tuple(nearby),
+        n_actuated=na,
+        actuation=act,
+        platform=platform,
+        platform_dof=p_dof,
+        platform_rotational_dof=p_rot,
+        platform_twists=p_tw,
+        screw_theory=sm,
+        length=tree.length,
+    )

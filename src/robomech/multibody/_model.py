@@ -1,0 +1,604 @@
+"""The description of a mechanism: frozen dataclasses, MuJoCo's model semantics, and a builder.
+
+A mechanism is a spanning tree of bodies (each body's pose in its parent, then its joints applied in
+order, exactly as MuJoCo's ``mj_kinematics``), loop closures (cut joints), joint couplings, actuated
+joints, sites and inertias.  Every vector is stored as a tuple of floats so that descriptions compare
+and hash by value.  Quaternions are MuJoCo's ``[w, x, y, z]``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from robomech._validation import as_array, check_real
+
+__all__ = [
+    "JOINT_TYPES",
+    "Body",
+    "Builder",
+    "Closure",
+    "Coupling",
+    "Inertial",
+    "Joint",
+    "Mechanism",
+    "Site",
+]
+
+JOINT_TYPES = ("hinge", "slide", "ball", "free")
+CLOSURE_KINDS = ("point", "rigid", "revolute")
+# Quaternions and axes given by the user are normalised; a norm below this is not a direction.
+_MIN_NORM = 1e-12
+# A reference configuration "is assembled" (MuJoCo's qpos0 semantics hold for an exported closure)
+# when the two anchors of a closure coincide to this distance relative to the mechanism size:
+# a few hundred ulps of the coordinates.
+ASSEMBLED_RTOL = 1e-10
+
+
+def _vec(x: object, n: int, name: str) -> tuple[float, ...]:
+    a = as_array(x, name)
+    if a.shape != (n,) or not np.all(np.isfinite(a)):
+        raise ValueError(f"Expected {name} to be {n} finite real numbers, got {x!r}.")
+    return tuple(float(v) for v in a)
+
+
+def _unit(x: object, n: int, name: str) -> tuple[float, ...]:
+    v = np.array(_vec(x, n, name))
+    nrm = np.linalg.norm(v)
+    if nrm < _MIN_NORM:
+        raise ValueError(f"Expected {name} to be a non-zero {n}-vector, got {x!r}.")
+    return tuple(float(c) for c in v / nrm)
+
+
+def _name(x: object, what: str) -> str:
+    if not isinstance(x, str) or not x:
+        raise ValueError(f"Expected {what} to be a non-empty string, got {x!r}.")
+    return x
+
+
+@dataclass(frozen=True)
+class Joint:
+    """One joint of a body (MuJoCo semantics, in the body's frame after the joints before it).
+
+    ``hinge``: rotation by ``q - ref`` about ``axis`` through ``pos``; ``slide``: translation by
+    ``q - ref`` along ``axis``; ``ball``: rotation by the unit quaternion ``q`` (4 entries) about
+    ``pos``; ``free``: the body's world pose ``(x, y, z, qw, qx, qy, qz)`` (top-level bodies only).
+    Velocity coordinates (and the columns of every Jacobian over all coordinates) follow MuJoCo's
+    ``qvel``: 1 for hinge and slide, the local angular velocity (3) for a ball, world linear velocity
+    of the body origin then local angular velocity (6) for a free joint.
+    """
+
+    name: str
+    type: str = "hinge"
+    axis: tuple[float, ...] = (0.0, 0.0, 1.0)
+    pos: tuple[float, ...] = (0.0, 0.0, 0.0)
+    ref: float = 0.0
+
+    def __post_init__(self) -> None:
+        _name(self.name, "name (of a Joint)")
+        if not isinstance(self.type, str) or self.type not in JOINT_TYPES:
+            raise ValueError(f"Expected type in {JOINT_TYPES}, got {self.type!r} (joint {self.name!r}).")
+        object.__setattr__(self, "axis", _unit(self.axis, 3, f"axis of joint {self.name!r}"))
+        object.__setattr__(self, "pos", _vec(self.pos, 3, f"pos of joint {self.name!r}"))
+        object.__setattr__(self, "ref", check_real(self.ref, f"ref of joint {self.name!r}"))
+
+    @property
+    def nq(self) -> int:
+        return {"hinge": 1, "slide": 1, "ball": 4, "free": 7}[self.type]
+
+    @property
+    def nv(self) -> int:
+        return {"hinge": 1, "slide": 1, "ball": 3, "free": 6}[self.type]
+
+
+@dataclass(frozen=True)
+class Inertial:
+    """Mass, centre of mass ``pos`` and principal inertia ``diaginertia`` in the frame ``quat`` (body)."""
+
+    mass: float
+    pos: tuple[float, ...] = (0.0, 0.0, 0.0)
+    quat: tuple[float, ...] = (1.0, 0.0, 0.0, 0.0)
+    diaginertia: tuple[float, ...] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "mass", check_real(self.mass, "mass", low=0.0))
+        object.__setattr__(self, "pos", _vec(self.pos, 3, "pos (of an Inertial)"))
+        object.__setattr__(self, "quat", _unit(self.quat, 4, "quat (of an Inertial)"))
+        d = _vec(self.diaginertia, 3, "diaginertia")
+        if min(d) < 0:
+            raise ValueError(f"Expected diaginertia >= 0, got {d}.")
+        object.__setattr__(self, "diaginertia", d)
+
+
+@dataclass(frozen=True)
+class Body:
+    """A body: its pose ``(pos, quat)`` in ``parent`` ("world" for the base) and its joints, in order."""
+
+    name: str
+    parent: str = "world"
+    pos: tuple[float, ...] = (0.0, 0.0, 0.0)
+    quat: tuple[float, ...] = (1.0, 0.0, 0.0, 0.0)
+    joints: tuple[Joint, ...] = ()
+    inertial: Inertial | None = None
+
+    def __post_init__(self) -> None:
+        _name(self.name, "name (of a Body)")
+        if self.name == "world":
+            raise ValueError("Expected name other than 'world' for a Body (the fixed base is implicit).")
+        _name(self.parent, f"parent of body {self.name!r}")
+        object.__setattr__(self, "pos", _vec(self.pos, 3, f"pos of body {self.name!r}"))
+        object.__setattr__(self, "quat", _unit(self.quat, 4, f"quat of body {self.name!r}"))
+        if not isinstance(self.joints, tuple | list):
+            raise ValueError(
+                f"Expected joints of body {self.name!r} to be a tuple of Joint, got {self.joints!r}."
+            )
+        joints = tuple(self.joints)
+        if not all(isinstance(j, Joint) for j in joints):
+            raise ValueError(f"Expected joints of body {self.name!r} to be Joint objects, got {joints!r}.")
+        if any(j.type == "free" for j in joints) and (len(joints) != 1 or self.parent != "world"):
+            raise ValueError(
+                f"Expected a free joint to be the only joint of a top-level body, got body {self.name!r}."
+            )
+        object.__setattr__(self, "joints", joints)
+        if self.inertial is not None and not isinstance(self.inertial, Inertial):
+            raise ValueError(
+                f"Expected inertial of body {self.name!r} to be an Inertial, got {self.inertial!r}."
+            )
+
+
+@dataclass(frozen=True)
+class Site:
+    """A named frame fixed in ``body`` at ``(pos, quat)``: an output of the kinematics."""
+
+    name: str
+    body: str
+    pos: tuple[float, ...] = (0.0, 0.0, 0.0)
+    quat: tuple[float, ...] = (1.0, 0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        _name(self.name, "name (of a Site)")
+        _name(self.body, f"body of site {self.name!r}")
+        object.__setattr__(self, "pos", _vec(self.pos, 3, f"pos of site {self.name!r}"))
+        object.__setattr__(self, "quat", _unit(self.quat, 4, f"quat of site {self.name!r}"))
+
+
+@dataclass(frozen=True)
+class Closure:
+    """A loop closure (cut joint) between ``body1`` and ``body2`` ("world" allowed).
+
+    * ``point`` (MuJoCo ``connect``): point ``anchor1`` of body1 coincides with ``anchor2`` of body2
+      (3 equations; a spherical joint).
+    * ``rigid`` (MuJoCo ``weld``): body2's pose in body1 is ``(relpos, relquat)``; its position rows
+      are measured at ``anchor2`` (body2 frame) as MuJoCo does (6 equations).
+    * ``revolute``: as ``point`` and, in addition, ``axis`` (body1 frame) stays aligned with ``axis2``
+      (body2 frame): a hinge cut joint; 6 equations of rank 5, written as two point closures one
+      characteristic length apart along the axis, which is how MJCF expresses it.
+    """
+
+    name: str
+    kind: str
+    body1: str
+    body2: str
+    anchor1: tuple[float, ...] = (0.0, 0.0, 0.0)
+    anchor2: tuple[float, ...] = (0.0, 0.0, 0.0)
+    relpos: tuple[float, ...] = (0.0, 0.0, 0.0)
+    relquat: tuple[float, ...] = (1.0, 0.0, 0.0, 0.0)
+    axis: tuple[float, ...] = (0.0, 0.0, 1.0)
+    axis2: tuple[float, ...] = (0.0, 0.0, 1.0)
+
+    def __post_init__(self) -> None:
+        _name(self.name, "name (of a Closure)")
+        if not isinstance(self.kind, str) or self.kind not in CLOSURE_KINDS:
+            raise ValueError(f"Expected kind in {CLOSURE_KINDS}, got {self.kind!r} ({self.name!r}).")
+        _name(self.body1, f"body1 of closure {self.name!r}")
+        _name(self.body2, f"body2 of closure {self.name!r}")
+        if self.body1 == self.body2:
+            raise ValueError(
+                f"Expected body2 of closure {self.name!r} to differ from body1, got {self.body1!r} twice."
+            )
+        for f in ("anchor1", "anchor2", "relpos"):
+            object.__setattr__(self, f, _vec(getattr(self, f), 3, f"{f} of closure {self.name!r}"))
+        object.__setattr__(self, "relquat", _unit(self.relquat, 4, f"relquat of closure {self.name!r}"))
+        object.__setattr__(self, "axis", _unit(self.axis, 3, f"axis of closure {self.name!r}"))
+        object.__setattr__(self, "axis2", _unit(self.axis2, 3, f"axis2 of closure {self.name!r}"))
+
+
+@dataclass(frozen=True)
+class Coupling:
+    """MuJoCo's joint equality: ``q1 - ref1 = c0 + c1 x + c2 x^2 + c3 x^3 + c4 x^4`` with ``x = q2 - ref2``.
+
+    ``joint2 = None`` fixes ``joint1`` at ``ref1 + c0``.  Both joints are hinges or slides.
+    """
+
+    name: str
+    joint1: str
+    joint2: str | None = None
+    polycoef: tuple[float, ...] = (0.0, 1.0, 0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        _name(self.name, "name (of a Coupling)")
+        _name(self.joint1, f"joint1 of coupling {self.name!r}")
+        if self.joint2 is not None:
+            _name(self.joint2, f"joint2 of coupling {self.name!r}")
+        object.__setattr__(self, "polycoef", _vec(self.polycoef, 5, f"polycoef of coupling {self.name!r}"))
+
+
+@dataclass(frozen=True)
+class Mechanism:
+    """A closed-chain mechanism: bodies (parents before children), closures, couplings, sites, actuators.
+
+    The bodies are kept in MuJoCo's depth-first order (each body followed by its subtree), whatever
+    the order given, so that ``q`` is exactly the qpos of :func:`to_mjcf`'s model.
+
+    ``actuated`` names hinge or slide joints in actuator order; ``q_act`` are their ``qpos`` entries.
+    The reference configuration ``q0`` is MuJoCo's ``qpos0`` (hinge/slide ``ref``, identity
+    quaternions, a free body's own pose).
+    """
+
+    bodies: tuple[Body, ...]
+    closures: tuple[Closure, ...] = ()
+    couplings: tuple[Coupling, ...] = ()
+    sites: tuple[Site, ...] = ()
+    actuated: tuple[str, ...] = ()
+    gravity: tuple[float, ...] = (0.0, 0.0, -9.81)
+    name: str = "mechanism"
+    # Informative: the units of the quantities the user passes are SI; this is the length used to make
+    # rotations and translations commensurate (residual scaling, conditioning); None: computed.
+    characteristic_length: float | None = field(default=None)
+
+    def __post_init__(self) -> None:
+        for f, typ in (("bodies", Body), ("closures", Closure), ("couplings", Coupling), ("sites", Site)):
+            raw = getattr(self, f)
+            if not isinstance(raw, tuple | list) or not all(isinstance(v, typ) for v in raw):
+                raise ValueError(f"Expected {f} to be a tuple of {typ.__name__} objects, got {raw!r}.")
+            object.__setattr__(self, f, tuple(raw))
+        if not isinstance(self.actuated, tuple | list) or not all(isinstance(a, str) for a in self.actuated):
+            raise ValueError(f"Expected actuated to be a tuple of joint names, got {self.actuated!r}.")
+        object.__setattr__(self, "actuated", tuple(self.actuated))
+        object.__setattr__(self, "gravity", _vec(self.gravity, 3, "gravity"))
+        _name(self.name, "name (of a Mechanism)")
+        if len(self.bodies) == 0:
+            raise ValueError("Expected bodies to hold at least one Body, got none.")
+        object.__setattr__(self, "bodies", _depth_first(self.bodies))
+        seen = {"world"}
+        joints: dict[str, Joint] = {}
+        for b in self.bodies:
+            if b.name in seen:
+                raise ValueError(f"Expected unique body names, got {b.name!r} twice.")
+            if b.parent not in seen:
+                raise ValueError(
+                    f"Expected the parent {b.parent!r} of body {b.name!r} to be 'world' or an earlier body."
+                )
+            seen.add(b.name)
+            for j in b.joints:
+                if j.name in joints:
+                    raise ValueError(f"Expected unique joint names, got {j.name!r} twice.")
+                joints[j.name] = j
+        names = set()
+        for c in (*self.closures, *self.couplings):
+            if c.name in names:
+                raise ValueError(f"Expected unique closure/coupling names, got {c.name!r} twice.")
+            names.add(c.name)
+        for c in self.closures:
+            for bn in (c.body1, c.body2):
+                if bn not in seen:
+                    raise ValueError(f"Closure {c.name!r} names unknown body {bn!r}.")
+        for c in self.couplings:
+            for jn in (c.joint1, c.joint2):
+                if jn is None:
+                    continue
+                if jn not in joints:
+                    raise ValueError(f"Coupling {c.name!r} names unknown joint {jn!r}.")
+                if joints[jn].type not in ("hinge", "slide"):
+                    raise ValueError(f"Expected coupling {c.name!r} to join hinge/slide joints, got {jn!r}.")
+        site_names = set()
+        for s in self.sites:
+            if s.name in site_names:
+                raise ValueError(f"Expected unique site names, got {s.name!r} twice.")
+            site_names.add(s.name)
+            if s.body not in seen:
+                raise ValueError(f"Site {s.name!r} is on unknown body {s.body!r}.")
+        if len(set(self.actuated)) != len(self.actuated):
+            raise ValueError(f"Expected each actuated joint once, got {self.actuated!r}.")
+        for a in self.actuated:
+            if a not in joints:
+                raise ValueError(f"Expected actuated joints among the joints, got unknown {a!r}.")
+            if joints[a].type not in ("hinge", "slide"):
+                raise ValueError(
+                    f"Expected actuated joint {a!r} to be a hinge or slide, got {joints[a].type!r}."
+                )
+        if self.characteristic_length is not None:
+            from robomech._validation import check_positive
+
+            L = check_positive(self.characteristic_length, "characteristic_length")
+            object.__setattr__(self, "characteristic_length", L)
+
+    # -- derived, cached (the dataclass stays frozen: cached_property writes the instance dict) --
+    @cached_property
+    def tree(self):
+        from ._tree import compile_tree
+
+        return compile_tree(self)
+
+    @cached_property
+    def compiled_tables(self):
+        from ._compiled import tables
+
+        return tables(self)
+
+    @cached_property
+    def constraints(self):
+        from ._constraints import compile_constraints
+
+        return compile_constraints(self, self.tree)
+
+    @property
+    def joints(self) -> tuple[Joint, ...]:
+        return tuple(j for b in self.bodies for j in b.joints)
+
+    @property
+    def nq(self) -> int:
+        return self.tree.nq
+
+    @property
+    def nv(self) -> int:
+        return self.tree.nv
+
+    @property
+    def q0(self) -> np.ndarray:
+        """Reference configuration (MuJoCo's qpos0), (nq,)."""
+        return self.tree.q0.copy()
+
+    @property
+    def length(self) -> float:
+        """The characteristic length (m) that makes rotations and translations commensurate."""
+        return self.tree.length
+
+    def site(self, name: str) -> Site:
+        for s in self.sites:
+            if s.name == name:
+                return s
+        raise ValueError(f"Expected a site name among {[s.name for s in self.sites]}, got {name!r}.")
+
+    def joint(self, name: str) -> Joint:
+        for j in self.joints:
+            if j.name == name:
+                return j
+        raise ValueError(f"Expected a joint name among {[j.name for j in self.joints]}, got {name!r}.")
+
+    def qpos_address(self, joint: str) -> int:
+        """Index of the first ``qpos`` entry of ``joint``."""
+        return int(self.tree.jnt_qadr[self.tree.joint_index(joint)])
+
+    def dof_address(self, joint: str) -> int:
+        """Index of the first velocity coordinate (``qvel`` entry) of ``joint``."""
+        return int(self.tree.jnt_dadr[self.tree.joint_index(joint)])
+
+
+def _depth_first(bodies: tuple[Body, ...]) -> tuple[Body, ...]:
+    """Bodies in MuJoCo's order (depth-first, children in the order given), so that ``q`` is its qpos.
+
+    Parents must come before their children in the input (checked afterwards); any body whose parent
+    is unknown is left at the end for that check to name.
+    """
+    children: dict[str, list[Body]] = {}
+    for b in bodies:
+        children.setdefault(b.parent, []).append(b)
+    out: list[Body] = []
+    stack = list(reversed(children.get("world", [])))
+    while stack:
+        b = stack.pop()
+        out.append(b)
+        stack.extend(reversed(children.get(b.name, [])))
+    placed = {id(b) for b in out}
+    return tuple(out) + tuple(b for b in bodies if id(b) not in placed)
+
+
+class Builder:
+    """Assemble a :class:`Mechanism` in Python (no XML), MuJoCo semantics throughout.
+
+    >>> b = Builder("four-bar")
+    >>> b.body("crank", joints=[b.hinge("a", axis=(0, 0, 1))])            # doctest: +SKIP
+    >>> b.connect("loop", "rocker", "coupler", anchor1=(0.3, 0, 0))        # doctest: +SKIP
+    >>> mech = b.build()                                                   # doctest: +SKIP
+
+    The builder only collects descriptions; :meth:`build` returns the frozen, validated mechanism.
+    A closure anchor not given on the second body is computed at the reference configuration
+    (MuJoCo's qpos0 semantics for ``connect`` and ``weld``).
+    """
+
+    def __init__(self, name: str = "mechanism", gravity: Sequence[float] = (0.0, 0.0, -9.81)) -> None:
+        self.name = _name(name, "name (of the mechanism)")
+        self.gravity = _vec(gravity, 3, "gravity")
+        self._bodies: list[Body] = []
+        self._sites: list[Site] = []
+        self._closures: list[tuple] = []
+        self._couplings: list[Coupling] = []
+        self._actuated: list[str] = []
+
+    # joints
+    @staticmethod
+    def hinge(
+        name: str, axis: Sequence[float] = (0, 0, 1), pos: Sequence[float] = (0, 0, 0), ref: float = 0.0
+    ) -> Joint:
+        return Joint(name, "hinge", tuple(axis), tuple(pos), ref)
+
+    @staticmethod
+    def slide(
+        name: str, axis: Sequence[float] = (0, 0, 1), pos: Sequence[float] = (0, 0, 0), ref: float = 0.0
+    ) -> Joint:
+        return Joint(name, "slide", tuple(axis), tuple(pos), ref)
+
+    @staticmethod
+    def ball(name: str, pos: Sequence[float] = (0, 0, 0)) -> Joint:
+        return Joint(name, "ball", (0.0, 0.0, 1.0), tuple(pos))
+
+    @staticmethod
+    def free(name: str) -> Joint:
+        return Joint(name, "free")
+
+    @staticmethod
+    def universal(
+        name: str, axis1: Sequence[float], axis2: Sequence[float], pos: Sequence[float] = (0, 0, 0)
+    ) -> tuple[Joint, Joint]:
+        """A universal joint as two hinges through one point (``name_1`` then ``name_2``)."""
+        return (
+            Joint(f"{name}_1", "hinge", tuple(axis1), tuple(pos)),
+            Joint(f"{name}_2", "hinge", tuple(axis2), tuple(pos)),
+        )
+
+    def helical(
+        self, name: str, axis: Sequence[float], pitch: float, pos: Sequence[float] = (0, 0, 0)
+    ) -> tuple[Joint, Joint]:
+        """A helical joint: hinge ``name_r`` and slide ``name_p`` coupled by ``p = pitch * theta`` (m/rad)."""
+        r = Joint(f"{name}_r", "hinge", tuple(axis), tuple(pos))
+        p = Joint(f"{name}_p", "slide", tuple(axis), tuple(pos))
+        self._couplings.append(Coupling(name, p.name, r.name, (0.0, float(pitch), 0.0, 0.0, 0.0)))
+        return r, p
+
+    # elements
+    def body(
+        self,
+        name: str,
+        parent: str = "world",
+        pos: Sequence[float] = (0, 0, 0),
+        quat: Sequence[float] = (1, 0, 0, 0),
+        joints: Sequence[Joint | tuple[Joint, ...]] = (),
+        inertial: Inertial | None = None,
+    ) -> str:
+        """Add a body (parents before children); ``inertial=None`` lets MJCF export derive it from geoms."""
+        flat: list[Joint] = []
+        for j in joints:
+            flat.extend(j if isinstance(j, tuple) else (j,))
+        self._bodies.append(Body(name, parent, tuple(pos), tuple(quat), tuple(flat), inertial))
+        return name
+
+    def site(
+        self, name: str, body: str, pos: Sequence[float] = (0, 0, 0), quat: Sequence[float] = (1, 0, 0, 0)
+    ) -> str:
+        self._sites.append(Site(name, body, tuple(pos), tuple(quat)))
+        return name
+
+    def connect(
+        self,
+        name: str,
+        body1: str,
+        body2: str,
+        anchor1: Sequence[float],
+        anchor2: Sequence[float] | None = None,
+    ) -> None:
+        """Point closure (MuJoCo ``connect``): ``anchor2`` defaults to the coincident point at q0."""
+        self._closures.append(("point", name, body1, body2, tuple(anchor1), anchor2, None))
+
+    def revolute(
+        self,
+        name: str,
+        body1: str,
+        body2: str,
+        anchor1: Sequence[float],
+        axis: Sequence[float],
+        anchor2: Sequence[float] | None = None,
+    ) -> None:
+        """Hinge closure: as :meth:`connect`, and ``axis`` (body1 frame) fixed in body2."""
+        self._closures.append(("revolute", name, body1, body2, tuple(anchor1), anchor2, tuple(axis)))
+
+    def weld(
+        self,
+        name: str,
+        body1: str,
+        body2: str,
+        relpos: Sequence[float] | None = None,
+        relquat: Sequence[float] | None = None,
+        anchor2: Sequence[float] = (0, 0, 0),
+    ) -> None:
+        """Rigid closure (MuJoCo ``weld``): body2's pose in body1; default: the pose at q0."""
+        rel = (
+            None
+            if relpos is None
+            else (tuple(relpos), tuple(relquat if relquat is not None else (1, 0, 0, 0)))
+        )
+        self._closures.append(("rigid", name, body1, body2, tuple(anchor2), rel, None))
+
+    def couple(self, name: str, joint1: str, joint2: str | None, polycoef: Sequence[float]) -> None:
+        c = tuple(polycoef) + (0.0,) * (5 - len(polycoef))
+        self._couplings.append(Coupling(name, joint1, joint2, c))
+
+    def actuate(self, *joints: str) -> None:
+        self._actuated.extend(joints)
+
+    def build(self) -> Mechanism:
+        # First the tree (no closures) to evaluate reference poses for MuJoCo's qpos0 defaults.
+        tree_only = Mechanism(
+            tuple(self._bodies),
+            (),
+            tuple(self._couplings),
+            tuple(self._sites),
+            tuple(self._actuated),
+            self.gravity,
+            self.name,
+        )
+        from ._tree import body_poses
+
+        T0 = body_poses(tree_only.tree, tree_only.q0[None])[0]
+
+        def pose(body: str) -> np.ndarray:
+            return T0[tree_only.tree.body_index(body)]
+
+        closures = []
+        for kind, name, b1, b2, a, other, axis in self._closures:
+            T1, T2 = pose(b1), pose(b2)
+            if kind in ("point", "revolute"):
+                a1 = np.asarray(a, float)
+                if other is None:
+                    p = T1[:3, :3] @ a1 + T1[:3, 3]
+                    a2 = T2[:3, :3].T @ (p - T2[:3, 3])
+                else:
+                    a2 = np.asarray(other, float)
+                ax1 = np.asarray(axis if axis is not None else (0.0, 0.0, 1.0), float)
+                ax2 = T2[:3, :3].T @ (T1[:3, :3] @ ax1)
+                closures.append(
+                    Closure(name, kind, b1, b2, tuple(a1), tuple(a2), axis=tuple(ax1), axis2=tuple(ax2))
+                )
+            else:
+                if other is None:
+                    T12 = np.linalg.solve(T1, T2)
+                    relpos, relquat = T12[:3, 3], _quat_from_matrix(T12[:3, :3])
+                else:
+                    relpos, relquat = other
+                closures.append(
+                    Closure(
+                        name, "rigid", b1, b2, anchor2=tuple(a), relpos=tuple(relpos), relquat=tuple(relquat)
+                    )
+                )
+        return Mechanism(
+            tuple(self._bodies),
+            tuple(closures),
+            tuple(self._couplings),
+            tuple(self._sites),
+            tuple(self._actuated),
+            self.gravity,
+            self.name,
+        )
+
+
+def _quat_from_matrix(R: np.ndarray) -> np.ndarray:
+    """Unit quaternion [w, x, y, z] (w >= 0) of a rotation matrix (Shepperd's method)."""
+    R = np.asarray(R, float)
+    tr = np.trace(R)
+    if tr > 0:
+        s = 2.0 * np.sqrt(1.0 + tr)
+        q = np.array([0.25 * s, (R[2, 1] - R[1, 2]) / s, (R[0, 2] - R[2, 0]) / s, (R[1, 0] - R[0, 1]) / s])
+    else:
+        i = int(np.argmax(np.diag(R)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * np.sqrt(1.0 + R[i, i] - R[j, j] - R[k, k])
+        q = np.empty(4)
+        q[0] = (R[k, j] - R[j, k]) / s
+        q[1 + i] = 0.25 * s
+        q[1 + j] = (R[j, i] + R[i, j]) / s
+        q[1 + k] = (R[k, i] + R[i, k]) / s
+    q = q / np.linalg.norm(q)
+    return q if q[0] >= 0 else -q
