@@ -3,9 +3,12 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
+DOCS_STAMP := $(VENV)/.installed-docs
 OUT    ?= out
+# A second venv with `pip install .` and no extras: what a user without MuJoCo gets.
+MINIMAL := .venv-minimal
 
-.PHONY: install run test bench verify lint clean
+.PHONY: install run test bench verify lint docs check-minimal clean
 
 install: $(STAMP)
 
@@ -15,8 +18,13 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet -e ".[verify,explore,test]"
 	touch $(STAMP)
 
+$(DOCS_STAMP): $(STAMP)
+	$(BIN)/python -m pip install --quiet -e ".[verify,explore,test,docs]"
+	touch $(DOCS_STAMP)
+
 run: install
 	$(BIN)/robomech reproduce --out $(OUT)
+	$(BIN)/robomech verify --out $(OUT)
 
 test: install
 	$(BIN)/ruff check src tests benchmarks
@@ -31,5 +39,21 @@ bench: install
 lint: install
 	$(BIN)/ruff check src tests benchmarks
 
+# The documentation site; -W: a warning is an error, -n: every cross-reference must resolve.
+docs: $(DOCS_STAMP)
+	$(BIN)/sphinx-build -W --keep-going -n -q -b html docs docs/_build/html
+	@echo "docs: open docs/_build/html/index.html"
+
+# No extras installed: list, the engine-free study and the engine-free checks must exit 0.
+check-minimal:
+	rm -rf $(MINIMAL)
+	$(PYTHON) -m venv $(MINIMAL)
+	$(MINIMAL)/bin/python -m pip install --quiet .
+	! $(MINIMAL)/bin/python -c "import mujoco" 2>/dev/null
+	cd $(MINIMAL) && bin/robomech --version && bin/robomech list
+	cd $(MINIMAL) && bin/robomech reproduce continuum --out minimal-out --quiet
+	cd $(MINIMAL) && bin/robomech verify --quiet
+	rm -rf $(MINIMAL)
+
 clean:
-	rm -rf $(VENV) $(OUT) .pytest_cache .benchmarks build src/*.egg-info
+	rm -rf $(VENV) $(MINIMAL) $(OUT) .pytest_cache .benchmarks build src/*.egg-info docs/_build

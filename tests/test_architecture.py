@@ -42,6 +42,7 @@ ALLOWED = {
         "testing",
     },
     "cli": {"studies", "verify", "explore"},
+    "__main__": {"cli"},  # `python -m robomech`
 }
 INFRASTRUCTURE = {"robomech", "robomech._validation", "robomech._registry", "robomech._numba"}
 ENGINES = {"mujoco", "exudyn", "pinocchio"}

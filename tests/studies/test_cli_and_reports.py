@@ -65,13 +65,6 @@ def test_markdown_table_escapes_pipes_in_headers_and_cells(tmp_path):
         Table("bad", ["a", "b"], [[1]])
 
 
-def test_verify_cli_passes_and_prints_json(capsys):
-    assert main(["verify", "vectored-thrust", "--json"]) == 0
-    out = json.loads(capsys.readouterr().out)
-    assert out["passed"] and all(c["passed"] for c in out["checks"]) and len(out["checks"]) >= 5
-    assert all(c["reason"] for c in out["checks"])  # every tolerance carries its reason
-
-
 def test_verify_cli_exits_nonzero_on_a_failed_check(monkeypatch, capsys):
     from robomech import verify
     from robomech.verify import Check, Tolerance, Verification
@@ -86,3 +79,66 @@ def test_verify_cli_exits_nonzero_on_a_failed_check(monkeypatch, capsys):
     assert main(["verify", "broken"]) == 1
     out = capsys.readouterr().out
     assert "FAIL" in out and "0 passed, 1 failed" in out
+
+
+def test_printed_values_are_shown_as_the_paper_printed_them(tmp_path):
+    from robomech.studies import StudyResult, write_study_report
+    from robomech.studies._core import Printed
+
+    t = comparison_table("t", [("l1", 126.7305, 126.73, "mm"), ("r", "1.50", 1.5, "m"), ("n", 12, 12.0, "")])
+    assert [r[2] for r in t.rows] == [
+        Printed("126.7305", 126.7305),
+        Printed("1.50", 1.5),
+        Printed("12", 12.0),
+    ]
+    paths = write_study_report(StudyResult("x", "X", "src", tables=[t]), tmp_path)
+    md = paths["md"].read_text()
+    assert "| l1 | mm | 126.7305 | 126.73 |" in md and "| r | m | 1.50 | 1.5 |" in md
+    data = json.loads(paths["json"].read_text())
+    assert data["tables"][0]["rows"][0][2] == 126.7305  # a number in JSON, the string beside it
+    assert [0, 2, "126.7305"] in data["tables"][0]["printed"]
+
+
+def test_report_html_is_rendered_markdown_with_contents_back_links_and_alt_text(tmp_path):
+    from robomech.studies import Figure, StudyResult, write_study_report
+
+    res = StudyResult(
+        "x",
+        "X study",
+        "src",
+        summary="**Exact:** the `code` and a list\n\n- one\n- two",
+        tables=[Table("T1", ["a"], [[1.0]])],
+        figures=[Figure(tmp_path / "f.png", "A caption", alt="what the plot shows")],
+        notes=["a *note*"],
+    )
+    page = write_study_report(res, tmp_path)["html"].read_text()
+    assert "<strong>Exact:</strong>" in page and "<code>code</code>" in page and "**" not in page
+    assert '<h2 id="contents">' in page and 'href="#t1"' in page and 'id="t1"' in page
+    assert 'href="../index.html"' in page and '<img alt="what the plot shows" src="f.png"' in page
+    assert "<em>note</em>" in page and "robomech" in page.split("<body>")[0]  # provenance in the page
+    assert "Provenance" in page and "CPUs visible" in page
+
+
+def test_index_is_rebuilt_from_every_results_json_and_shows_verification(tmp_path, monkeypatch, capsys):
+    from robomech import verify
+    from robomech.verify import Check, Tolerance, Verification
+
+    assert main(["reproduce", "demo", "--out", str(tmp_path), "--quiet"]) == 0
+    # a second study folder from another run: reproducing demo again must not hide it
+    other = tmp_path / "other"
+    other.mkdir()
+    data = json.loads((tmp_path / "demo" / "results.json").read_text())
+    (other / "results.json").write_text(json.dumps({**data, "name": "other", "title": "Other"}))
+    assert main(["reproduce", "demo", "--out", str(tmp_path), "--quiet"]) == 0
+    index = (tmp_path / "index.md").read_text()
+    assert "[other](other/report.md)" in index and "[demo](demo/report.md)" in index
+    assert "spherical-leg" in index and "not reproduced yet" in index
+
+    v = Verification("demo", "D", "none", run=lambda: [Check("demo", "x", 0.0, Tolerance(1e-3, "t"))])
+    monkeypatch.setattr(verify, "available_verifications", lambda: {"demo": v})
+    assert main(["verify", "--out", str(tmp_path), "--quiet"]) == 0
+    assert (tmp_path / "verification.json").exists()
+    row = next(line for line in (tmp_path / "index.md").read_text().splitlines() if "[demo]" in line)
+    assert "pass (1 checks)" in row
+    html = (tmp_path / "index.html").read_text()
+    assert 'href="demo/report.html"' in html and "<table>" in html

@@ -75,7 +75,8 @@ def solve(A: object, b: object, *, exact_cond: bool = False, weights: object | N
 
     Each system is factorised as ``[A | b] = Q [R, c; 0, r]`` (unblocked Householder, the algorithm
     of LAPACK's ``dgeqr2``, compiled and run in parallel over the batch: see ``_householder.py``), so
-    ``x = R^-1 c`` and the residual norm is ``|r|``.
+    ``x = R^-1 c`` and the residual norm is ``|r|``.  The first call in a process compiles the kernel
+    (several seconds; cached on disk afterwards).
 
     ``cond`` is the exact 1-norm condition number ``||R||_1 ||R^-1||_1`` of R (within a factor n of
     the 2-norm condition number of A) unless ``exact_cond=True``, which computes the 2-norm one from
@@ -85,6 +86,34 @@ def solve(A: object, b: object, *, exact_cond: bool = False, weights: object | N
     ``weights (..., m)`` (finite, ``>= 0``, broadcasting with the stack) makes it weighted least squares,
     ``min Σ_i w_i (A x - b)_i²``, solved as the ordinary problem on rows scaled by ``sqrt(w_i)``;
     ``residual_norm`` and ``cond`` are then those of the weighted system.
+
+    Parameters
+    ----------
+    A : array_like, shape (..., m, n)
+        Coefficient matrices, ``m >= n`` (any consistent units).
+    b : array_like, shape (..., m)
+        Right-hand sides; batch dimensions broadcast with those of ``A``.
+    exact_cond : bool, optional
+        Report the 2-norm condition number (from the SVD of R) instead of the 1-norm one of R.
+    weights : array_like, shape (..., m), optional
+        Row weights ``w_i >= 0`` (finite) for weighted least squares; default unweighted.
+
+    Returns
+    -------
+    LstsqResult
+        ``x (..., n)``, ``residual_norm (...)``, ``rank (...)``, ``cond (...)``, ``full_rank (...)``,
+        ``ok (...)``: per system; a non-finite system gives ``ok`` False and NaN in ``x`` without
+        affecting the others.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> A = np.array([[[1.0, 0.0], [0.0, 1.0], [1.0, 1.0]], [[1.0, 2.0], [2.0, 4.0], [3.0, 6.0]]])
+    >>> r = solve(A, np.array([[1.0, 2.0, 3.0], [1.0, 2.0, 3.0]]))
+    >>> r.x[0].round(12), bool(r.full_rank[0])          # a consistent full-rank system
+    (array([1., 2.]), True)
+    >>> int(r.rank[1]), bool(r.full_rank[1]), bool(r.ok[1])   # rank 1: minimum-norm solution, flagged
+    (1, False, True)
     """
     from ._householder import householder_lstsq
 
@@ -129,7 +158,22 @@ def solve(A: object, b: object, *, exact_cond: bool = False, weights: object | N
 
 
 def rank_cond_limit(m: int, n: int) -> float:
-    """Condition number above which a system counts as rank deficient: ``1 / (10 max(m, n) eps)``."""
+    """Condition number above which a system counts as rank deficient: ``1 / (10 max(m, n) eps)``.
+
+    Parameters
+    ----------
+    m, n : int
+        Rows and columns of the systems.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> f"{rank_cond_limit(30, 11):.3e}"
+    '1.501e+13'
+    """
     m = check_int(m, "m", low=1)
     n = check_int(n, "n", low=1)
     return 1.0 / (RANK_RTOL_FACTOR * max(m, n) * np.finfo(float).eps)
@@ -140,6 +184,25 @@ def solve_normal_equations(A: object, b: object) -> LstsqResult:
 
     Accuracy degrades like ``cond(A)^2 eps``; a numerically singular ``A^T A`` is flagged as not
     full rank (x is then the minimum-norm solution of the normal equations).
+
+    Parameters
+    ----------
+    A : array_like, shape (..., m, n)
+        Coefficient matrices, ``m >= n``.
+    b : array_like, shape (..., m)
+        Right-hand sides; batch dimensions broadcast.
+
+    Returns
+    -------
+    LstsqResult
+        As :func:`solve`; ``cond`` is the 2-norm condition number of ``A`` from the normal matrix.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> A = np.array([[1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
+    >>> solve_normal_equations(A, np.array([1.0, 2.0, 3.0])).x.round(12)
+    array([1., 2.])
     """
     A, b = _validate(A, b)
     m, n = A.shape[-2:]

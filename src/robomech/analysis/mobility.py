@@ -68,7 +68,30 @@ def _check_tol(tol: object) -> float:
 
 
 def reciprocal_basis(screws: object, *, tol: float = RANK_RTOL) -> np.ndarray:
-    """Basis (k, 6) of the screws (axis-moment order) reciprocal to every row of ``screws (m, 6)``."""
+    """Basis of the screws (axis-moment order ``[s; s0]``) reciprocal to every row of ``screws``.
+
+    Parameters
+    ----------
+    screws : array_like, shape (m, 6)
+        Screws ``[s; s0]`` (e.g. joint twists), moments of order one (scale lengths first).
+    tol : float, optional
+        Relative rank tolerance on the singular values (default ``RANK_RTOL``).
+
+    Returns
+    -------
+    ndarray, shape (k, 6)
+        Orthonormal rows ``r`` with ``reciprocal_product(r, s) = 0`` for every row ``s``;
+        ``k = 6 - rank(screws)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.spatial import reciprocal_product
+    >>> S = np.array([[0.0, 0, 1, 0, 0, 0]])            # a revolute joint on the z axis
+    >>> R = reciprocal_basis(S)
+    >>> R.shape, bool(np.allclose(reciprocal_product(R, S), 0.0))
+    ((5, 6), True)
+    """
     S = as_array(screws, "screws", (None, 6))
     tol = _check_tol(tol)
     if S.ndim != 2:
@@ -77,7 +100,29 @@ def reciprocal_basis(screws: object, *, tol: float = RANK_RTOL) -> np.ndarray:
 
 
 def constraint_wrenches(twists: object, *, tol: float = RANK_RTOL) -> np.ndarray:
-    """Basis (k, 6) of the wrenches ``[m; f]`` that do no work on any row of ``twists (m, 6)``."""
+    """Basis of the wrenches ``[m; f]`` that do no work on any row of ``twists``.
+
+    Parameters
+    ----------
+    twists : array_like, shape (m, 6)
+        Twists ``[w; v]`` a chain allows its end (its joint screws), moments of order one.
+    tol : float, optional
+        Relative rank tolerance (default ``RANK_RTOL``).
+
+    Returns
+    -------
+    ndarray, shape (k, 6)
+        Wrenches ``W`` with ``virtual_power(W, V) = 0`` for every allowed twist ``V``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.spatial import virtual_power
+    >>> V = np.array([[0.0, 0, 1, 0, 0, 0]])            # spin about z
+    >>> W = constraint_wrenches(V)
+    >>> W.shape, bool(np.allclose(virtual_power(W, V), 0.0))
+    ((5, 6), True)
+    """
     S = as_array(twists, "twists", (None, 6))
     tol = _check_tol(tol)
     if S.ndim != 2:
@@ -132,9 +177,50 @@ def _intersection_dim(bases: Sequence[np.ndarray], tol: float) -> int:
 def analyze(chains: Sequence[object], *, length_scale: float = 1.0, tol: float = RANK_RTOL) -> MobilityResult:
     """Platform mobility from each chain's unit joint screws (``[w; v]``; ``[0; d]`` for prismatic).
 
-    ``length_scale`` divides the moment parts so that the screws are of order one (e.g. the
-    mechanism's radius in the units used).  The Grübler–Kutzbach counts assume each chain is a serial
-    chain of one-DOF joints from base to platform (a universal joint is two screws, a spherical three).
+    The constraint wrenches of each chain are the wrenches reciprocal to its joint screws; the
+    platform's twists are those reciprocal to the union of all chains' constraints.  ``length_scale``
+    divides the moment parts so that the screws are of order one (e.g. the mechanism's radius in the
+    units used).  The Grübler–Kutzbach counts assume each chain is a serial chain of one-DOF joints from
+    base to platform (a universal joint is two screws, a spherical three).
+
+    Parameters
+    ----------
+    chains : sequence of array_like, each shape (n_i, 6)
+        Joint screws of each chain from base to platform, in one frame, at one configuration.
+    length_scale : float, optional
+        Length unit of the moment parts (same unit as the screws' points); default 1.
+    tol : float, optional
+        Relative rank tolerance of the screw systems (default ``RANK_RTOL``).
+
+    Returns
+    -------
+    MobilityResult
+        ``dof``; ``platform_twists (dof, 6)`` and ``constraint_wrenches (k, 6)`` bases;
+        ``rotational_dof``/``translational_dof``; common and redundant constraint counts; the
+        Grübler–Kutzbach and modified Grübler–Kutzbach counts for comparison; ``singular`` (with a
+        ``warning`` text) where the screw-theory DOF and the modified count disagree, i.e. a singular
+        configuration where ``dof`` holds at this instant only.
+
+    Raises
+    ------
+    ValueError
+        If a chain is not an ``(n_i, 6)`` array of unit screws (e.g. passed transposed), or
+        ``length_scale`` / ``tol`` are out of range.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.spatial import screw_from_axis
+    >>> z = np.array([0.0, 0.0, 1.0])
+    >>> four_bar = [
+    ...     screw_from_axis(np.stack([z, z]), np.array([[0.0, 0, 0], [0.3, 1.0, 0]])),
+    ...     screw_from_axis(np.stack([z, z]), np.array([[2.0, 0, 0], [1.6, 1.2, 0]])),
+    ... ]
+    >>> m = analyze(four_bar)
+    >>> m.dof, m.gruebler_kutzbach, m.modified_gruebler_kutzbach   # G-K fails: planar is over-constrained
+    (1, -2, 1)
+    >>> m.singular
+    False
     """
     if isinstance(chains, np.ndarray) or not isinstance(chains, Sequence) or isinstance(chains, str):
         raise ValueError(

@@ -1,119 +1,124 @@
-"""The ``robomech`` command: ``list``, ``reproduce`` and ``verify``."""
+"""The ``robomech`` command (also ``python -m robomech``).
+
+Subcommands are discovered: every module ``robomech/cli/<module>.py`` that defines
+``COMMAND = Command(...)`` (see :class:`robomech.cli._core.Command`) becomes ``robomech NAME``.
+
+Exit codes
+----------
+0
+    Success; every check that ran passed (checks skipped for a missing extra do not fail).
+1
+    A verification check ran and failed.
+2
+    Usage or input error (unknown name, bad ``--out``, bad arguments).
+3
+    Internal error (a bug in robomech: please report it; ``--traceback`` shows where).
+130
+    Interrupted (Ctrl-C); completed study folders are kept, the interrupted one is discarded.
+"""
 
 from __future__ import annotations
 
 import argparse
-import json
 import sys
-import time
-from collections.abc import Sequence
-from pathlib import Path
+import traceback
+from collections.abc import Callable, Sequence
 
-__all__ = ["main"]
+from robomech._registry import discover
 
+from ._core import EXIT_INTERNAL, EXIT_INTERRUPTED, EXIT_USAGE, CliError, Command
 
-def _cmd_list(args: argparse.Namespace) -> int:
-    from robomech.studies import available_studies
-    from robomech.verify import available_verifications
-
-    print("studies (robomech reproduce NAME):")
-    for name, study in available_studies().items():
-        print(f"  {name:<20} {study.title}")
-    print("verifications (robomech verify NAME):")
-    for name, v in available_verifications().items():
-        print(f"  {name:<20} {v.title} [{v.engine}]")
-    return 0
+__all__ = ["Command", "available_commands", "build_parser", "main"]
 
 
-def _cmd_reproduce(args: argparse.Namespace) -> int:
-    from robomech.studies import Progress, available_studies, write_index, write_study_report
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose description may be computed when help is shown (listing names)."""
 
-    studies = available_studies()
-    names = args.studies or list(studies)
-    unknown = [n for n in names if n not in studies]
-    if unknown:
-        print(
-            f"robomech: unknown study {', '.join(map(repr, unknown))}; "
-            f"valid studies are: {', '.join(studies)}",
-            file=sys.stderr,
-        )
-        return 2
-    out_root = Path(args.out)
-    out_root.mkdir(parents=True, exist_ok=True)
-    entries = []
-    summary = []
-    for name in names:
-        study = studies[name]
-        progress = Progress(prefix=f"{name}: ", enabled=not args.quiet)
-        progress.step(f"start — {study.title}")
-        t0 = time.perf_counter()
-        result = study.run(out_root / name, progress)
-        seconds = time.perf_counter() - t0
-        paths = write_study_report(result, out_root / name)
-        progress.step(f"done in {seconds:.1f} s → {paths['md']}")
-        entries.append((result, seconds))
-        summary.append(
-            {"study": name, "seconds": seconds, "report": str(paths["md"]), "json": str(paths["json"])}
-        )
-    index = write_index(out_root, entries)
-    if args.json:
-        print(json.dumps({"index": str(index), "studies": summary}, indent=2))
-    else:
-        print(f"report index: {index} (and {index.with_suffix('.html')})")
-    return 0
+    lazy_description: Callable[[], str] | None = None
+
+    def format_help(self) -> str:
+        if self.lazy_description is not None:
+            self.description = self.lazy_description()
+            self.lazy_description = None
+        return super().format_help()
 
 
-def _cmd_verify(args: argparse.Namespace) -> int:
-    from robomech.verify import available_verifications, run_verifications
+def available_commands() -> dict[str, Command]:
+    """Every registered subcommand by name."""
+    return discover(__name__, __path__, "COMMAND", Command)
 
-    available = available_verifications()
-    unknown = [n for n in args.mechanisms if n not in available]
-    if unknown:
-        print(
-            f"robomech: unknown mechanism {', '.join(map(repr, unknown))}; "
-            f"valid ones are: {', '.join(available)}",
-            file=sys.stderr,
-        )
-        return 2
-    report = run_verifications(args.mechanisms)
-    if args.json:
-        print(json.dumps({"passed": report.passed, "checks": [c.as_dict() for c in report.checks]}, indent=2))
-    else:
-        print(report.table())
-    return 0 if report.passed else 1
+
+def _version() -> str:
+    from robomech import __version__
+
+    return __version__
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
-        prog="robomech", description="Kinematics, dynamics and verification of robot mechanisms."
+    """The ``robomech`` argument parser with every registered subcommand."""
+    p = _Parser(
+        prog="robomech",
+        description="Kinematics, dynamics and verification of robot mechanisms.",
+        epilog="exit codes: 0 ok, 1 a check failed, 2 usage or input error, 3 internal error, "
+        "130 interrupted. `robomech COMMAND --help` lists the names each command accepts.",
     )
-    sub = p.add_subparsers(dest="command", required=True)
-
-    sp = sub.add_parser("list", help="list the registered studies and verifications")
-    sp.set_defaults(func=_cmd_list)
-
-    sp = sub.add_parser("reproduce", help="regenerate papers' tables and figures as reports")
-    sp.add_argument("studies", nargs="*", metavar="STUDY", help="studies to run (default: all)")
-    sp.add_argument("--out", default="out", help="output folder (default: out)")
-    sp.add_argument("--json", action="store_true", help="print a JSON summary instead of text")
-    sp.add_argument("--quiet", action="store_true", help="no progress lines")
-    sp.set_defaults(func=_cmd_reproduce)
-
-    sp = sub.add_parser("verify", help="check models against an independent engine; non-zero exit on failure")
-    sp.add_argument("mechanisms", nargs="*", metavar="MECHANISM", help="mechanisms to verify (default: all)")
-    sp.add_argument("--json", action="store_true", help="print JSON instead of a table")
-    sp.set_defaults(func=_cmd_verify)
-
-    from ._sweep import register as register_sweep  # robomech.explore: docs/explore.md
-
-    register_sweep(sub)
+    p.add_argument("--version", action="version", version=f"robomech {_version()}")
+    p.add_argument("--traceback", action="store_true", help="on an internal error, show the traceback")
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Parser)
+    for name, cmd in available_commands().items():
+        sp = sub.add_parser(name, help=cmd.help, description=cmd.help)
+        if callable(cmd.description):
+            sp.lazy_description = cmd.description
+        elif cmd.description:
+            sp.description = cmd.description
+        sp.formatter_class = argparse.RawDescriptionHelpFormatter
+        cmd.add_arguments(sp)
+        sp.set_defaults(func=cmd.run)
     return p
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
-    return int(args.func(args))
+    """Run ``robomech`` with ``argv`` (default: ``sys.argv[1:]``) and return the exit code.
 
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments after ``robomech``.
 
-if __name__ == "__main__":  # pragma: no cover
-    raise SystemExit(main())
+    Returns
+    -------
+    int
+        0 ok, 1 a check failed, 2 usage or input error, 3 internal error, 130 interrupted.
+
+    Examples
+    --------
+    >>> main(["verify", "no-such-mechanism"])  # the message goes to stderr
+    2
+    """
+    try:
+        parser = build_parser()
+        args = parser.parse_args(argv)  # exits 2 on a usage error, 0 after --help/--version
+    except KeyboardInterrupt:
+        print("robomech: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    try:
+        return int(args.func(args))
+    except CliError as e:
+        print(f"robomech {args.command}: {e}", file=sys.stderr)
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        print(f"robomech {args.command}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:  # `robomech verify | head`: the reader left, not an error of ours
+        sys.stderr.close()
+        return 0
+    except Exception as e:  # the last line of defence: an exit code, not a traceback
+        if args.traceback:
+            traceback.print_exc()
+        print(
+            f"robomech {args.command}: internal error: {type(e).__name__}: {e}\n"
+            "This is a bug in robomech; please report it with the output of `robomech --traceback "
+            f"{args.command} ...`.",
+            file=sys.stderr,
+        )
+        return EXIT_INTERNAL

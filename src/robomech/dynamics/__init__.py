@@ -36,9 +36,28 @@ __all__ = [
 def spatial_inertia(mass: object, com: object, inertia_com: object) -> np.ndarray:
     """6x6 spatial inertia about a body frame's origin for twists ``[w; v]``.
 
-    ``com (..., 3)`` is the centre of mass in the body frame and ``inertia_com (..., 3, 3)`` the
-    rotational inertia about it, in body axes:
-    ``G = [[I_c - m hat(c)^2, m hat(c)], [-m hat(c), m I]]``.
+    ``G = [[I_c - m hat(c)^2, m hat(c)], [-m hat(c), m I]]``, so that the body's kinetic energy is
+    ``0.5 V^T G V`` and its momentum ``G V`` (``[angular; linear]``, about the frame origin).
+
+    Parameters
+    ----------
+    mass : float or array_like, shape (...)
+        Mass (kg), ``>= 0``.
+    com : array_like, shape (..., 3)
+        Centre of mass in the body frame (m).
+    inertia_com : array_like, shape (..., 3, 3)
+        Rotational inertia about the centre of mass, body axes (kg m^2).
+
+    Returns
+    -------
+    ndarray, shape (..., 6, 6)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> G = spatial_inertia(2.0, [0.5, 0.0, 0.0], np.diag([0.01, 0.02, 0.02]))
+    >>> float(G[2, 2])          # I_zz about the origin: 0.02 + 2 * 0.5**2 (parallel axes)
+    0.52
     """
     m = as_array(mass, "mass")
     c = as_array(com, "com", (3,))
@@ -72,13 +91,57 @@ def _rates(x: object, name: str, J: np.ndarray) -> np.ndarray:
 
 
 def mass_matrix(G: np.ndarray, J: np.ndarray) -> np.ndarray:
-    """``M = sum_b J_b^T G_b J_b`` for ``G (..., B, 6, 6)`` and ``J (..., B, 6, n)``."""
+    """Joint-space mass matrix ``M = sum_b J_b^T G_b J_b``.
+
+    Parameters
+    ----------
+    G : array_like, shape (..., B, 6, 6)
+        Spatial inertia of each body in its body frame (:func:`spatial_inertia`).
+    J : array_like, shape (..., B, 6, n)
+        Body Jacobian of each body (body frame, ``[w; v]``), mapping the n independent coordinates.
+
+    Returns
+    -------
+    ndarray, shape (..., n, n)
+        Symmetric, in kg m^2 (revolute) / kg (prismatic) units.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> G = spatial_inertia(2.0, [0.5, 0.0, 0.0], np.diag([0.01, 0.02, 0.02]))[None]  # one body (B = 1)
+    >>> J = np.zeros((1, 6, 1)); J[0, 2, 0] = 1.0; J[0, 4, 0] = 0.0   # a link spinning about its z axis
+    >>> mass_matrix(G, J)
+    array([[0.52]])
+    """
     G, J = _bodies(G, J)
     return np.einsum("...bia,...bij,...bjc->...ac", J, G, J)
 
 
 def kinetic_energy(G: np.ndarray, J: np.ndarray, qd: np.ndarray) -> np.ndarray:
-    """``0.5 qd^T M qd`` (...)."""
+    """Kinetic energy ``0.5 qd^T M qd`` of the bodies.
+
+    Parameters
+    ----------
+    G : array_like, shape (..., B, 6, 6)
+        Spatial inertias (body frames).
+    J : array_like, shape (..., B, 6, n)
+        Body Jacobians.
+    qd : array_like, shape (..., n)
+        Generalized rates (rad/s or m/s).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Energy (J).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> G = spatial_inertia(2.0, [0.5, 0.0, 0.0], np.diag([0.01, 0.02, 0.02]))[None]  # one body (B = 1)
+    >>> J = np.zeros((1, 6, 1)); J[0, 2, 0] = 1.0; J[0, 4, 0] = 0.0   # a link spinning about its z axis
+    >>> float(kinetic_energy(G, J, np.array([2.0])))   # 0.5 * 0.52 * 2**2
+    1.04
+    """
     G, J = _bodies(G, J)
     qd = _rates(qd, "qd", J)
     V = np.einsum("...bij,...j->...bi", J, qd)
@@ -104,13 +167,43 @@ def inverse_dynamics(
     gravity_body: np.ndarray | None = None,
     external_wrench_body: np.ndarray | None = None,
 ) -> DynamicsTerms:
-    """Generalized forces for the motion (q, qd, qdd) of bodies with body Jacobians ``J``.
+    """Generalized forces for the motion ``(q, qd, qdd)`` of bodies with body Jacobians ``J``.
 
-    ``Jdot (..., B, 6, n)`` is the time derivative of ``J`` along ``qd`` (see
-    :func:`robomech.kinematics.jacobian_derivative`), ``gravity_body (..., B, 3)`` the gravity
-    acceleration vector expressed in each body frame, and ``external_wrench_body (..., B, 6)`` a wrench
-    ``[m; f]`` applied to each body about its frame origin (body axes).  The external wrench enters
-    with a minus sign: tau is what the joints must supply.
+    ``tau = sum_b J_b^T ( G_b (J_b qdd + Jdot_b qd - g_b) - ad(V_b)^T G_b V_b ) - sum_b J_b^T W_b``:
+    Lagrange's equations in matrix form (module docstring), exact for any holonomic mechanism once
+    ``J`` maps its independent coordinates.
+
+    Parameters
+    ----------
+    G : array_like, shape (..., B, 6, 6)
+        Spatial inertia of each body in its body frame.
+    J : array_like, shape (..., B, 6, n)
+        Body Jacobians at q (body frames, ``[w; v]``).
+    Jdot : array_like, shape (..., B, 6, n)
+        Time derivative of ``J`` along ``qd`` (:func:`robomech.kinematics.jacobian_derivative`).
+    qd, qdd : array_like, shape (..., n)
+        Generalized rates and accelerations.
+    gravity_body : array_like, shape (..., B, 3), optional
+        Gravity acceleration expressed in each body frame (m/s^2), e.g. ``R_b^T [0, 0, -9.81]``.
+    external_wrench_body : array_like, shape (..., B, 6), optional
+        Wrench ``[m; f]`` applied to each body about its frame origin (body axes, N m and N); it
+        enters with a minus sign: ``tau`` is what the joints must supply.
+
+    Returns
+    -------
+    DynamicsTerms
+        ``tau (..., n)`` and its parts: ``M (..., n, n)``, ``velocity_terms``, ``gravity_terms``
+        (the latter includes the external wrenches), with ``tau = M qdd + velocity + gravity``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> G = spatial_inertia(2.0, [0.5, 0.0, 0.0], np.diag([0.01, 0.02, 0.02]))[None]  # one body (B = 1)
+    >>> J = np.zeros((1, 6, 1)); J[0, 2, 0] = 1.0; J[0, 4, 0] = 0.0   # a link spinning about its z axis
+    >>> Jdot = np.zeros_like(J)
+    >>> terms = inverse_dynamics(G, J, Jdot, qd=np.array([0.0]), qdd=np.array([3.0]))
+    >>> terms.tau.round(12)      # 0.52 kg m^2 * 3 rad/s^2
+    array([1.56])
     """
     G, J = _bodies(G, J)
     Jdot = as_array(Jdot, "Jdot", (None, 6, J.shape[-1]))
@@ -140,10 +233,27 @@ def inverse_dynamics(
 
 
 def static_torques(J: object, wrench: object) -> np.ndarray:
-    """Virtual work: generalized forces balancing ``wrench`` applied where ``J`` maps q-rates to the twist.
+    """Virtual work: generalized forces ``tau = J^T w`` that balance a wrench where ``J`` maps q-rates.
 
-    ``tau = J^T w`` for ``J (..., 6, n)``, ``w (..., 6)`` (or any matching m-vector, e.g. a force with a
-    3xn translational Jacobian).
+    Parameters
+    ----------
+    J : array_like, shape (..., m, n)
+        Jacobian from generalized rates to the twist (m = 6) or velocity (e.g. m = 3) where the wrench
+        acts, in the frame of ``wrench``.
+    wrench : array_like, shape (..., m)
+        Wrench ``[m; f]`` (N m, N), or a force (N) for a 3 x n translational Jacobian.
+
+    Returns
+    -------
+    ndarray, shape (..., n)
+        ``J^T w`` (N m or N), the generalized forces equivalent to ``wrench`` by virtual work.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> J = np.array([[0.0], [1.0], [0.0]])     # a 1 m link at q = 0: tip velocity (0, 1, 0) per rad/s
+    >>> static_torques(J, np.array([0.0, -10.0, 0.0]))
+    array([-10.])
     """
     J = as_array(J, "J", (None, None))
     w = as_array(wrench, "wrench", (J.shape[-2],))
@@ -156,11 +266,35 @@ def actuator_forces(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Actuator forces ``f`` with ``J_act^T f = tau_q`` of minimum norm, and the residual per sample.
 
-    ``J_act (..., k, n)`` maps generalized rates to the k actuator rates (k >= n; k > n is redundant
-    actuation, resolved here by the minimum-norm rule).  Returns ``(f (..., k), residual (...))``; a
-    residual well above rounding flags a configuration where the actuators cannot balance ``tau_q``
-    (an actuation singularity).  A sample with a non-finite entry gets NaN forces and a NaN residual
-    and never reaches LAPACK (an SVD of an inf matrix does not return).
+    ``J_act`` maps generalized rates to the k actuator rates (k >= n; k > n is redundant actuation,
+    resolved here by the minimum-norm rule).  A residual well above rounding flags a configuration
+    where the actuators cannot balance ``tau_q`` (an actuation singularity).  A sample with a
+    non-finite entry gets NaN forces and a NaN residual and never reaches LAPACK (an SVD of an inf
+    matrix does not return).
+
+    Parameters
+    ----------
+    J_act : array_like, shape (..., k, n)
+        Actuator Jacobian (actuator rates per generalized rate).
+    tau_q : array_like, shape (..., n)
+        Generalized forces to balance (N m or N).
+    rcond : float, optional
+        Relative cut-off of the pseudo-inverse (default 1e-12), after scaling each system to unit size.
+
+    Returns
+    -------
+    f : ndarray, shape (..., k)
+        Actuator forces (N or N m).
+    residual : ndarray, shape (...)
+        ``|J_act^T f - tau_q|``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> J_act = np.array([[1.0], [1.0]])             # two actuators driving one coordinate
+    >>> f, res = actuator_forces(J_act, np.array([4.0]))
+    >>> f.round(12), float(res.round(12))          # shared equally (minimum norm)
+    (array([2., 2.]), 0.0)
     """
     J_act = as_array(J_act, "J_act", (None, None), finite=False)
     if J_act.shape[-2] < J_act.shape[-1]:

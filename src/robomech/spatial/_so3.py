@@ -19,7 +19,25 @@ ROTATION_ATOL = 1e-5
 
 
 def hat(w: np.ndarray) -> np.ndarray:
-    """Skew-symmetric matrix of ``w`` (..., 3) -> (..., 3, 3), so that ``hat(a) @ b == cross(a, b)``."""
+    """Skew-symmetric matrix of a 3-vector, so that ``hat(a) @ b == cross(a, b)``.
+
+    Parameters
+    ----------
+    w : array_like, shape (..., 3)
+        Vectors (any unit; an angular velocity in rad/s gives ``hat(w)`` in rad/s).
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        ``[[0, -w3, w2], [w3, 0, -w1], [-w2, w1, 0]]`` for each vector.
+
+    Examples
+    --------
+    >>> hat([1.0, 2.0, 3.0])
+    array([[ 0., -3.,  2.],
+           [ 3.,  0., -1.],
+           [-2.,  1.,  0.]])
+    """
     w = as_array(w, "w", (3,))
     return _hat(w)
 
@@ -37,7 +55,22 @@ def _hat(w: np.ndarray) -> np.ndarray:
 
 
 def vee(W: np.ndarray) -> np.ndarray:
-    """Inverse of :func:`hat` (uses the antisymmetric part): (..., 3, 3) -> (..., 3)."""
+    """Inverse of :func:`hat`: the vector of a skew-symmetric matrix.
+
+    Parameters
+    ----------
+    W : array_like, shape (..., 3, 3)
+        Matrices; only their antisymmetric part ``(W - W^T) / 2`` is used.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+
+    Examples
+    --------
+    >>> vee(hat([1.0, 2.0, 3.0]))
+    array([1., 2., 3.])
+    """
     W = as_array(W, "W", (3, 3))
     return _vee(W)
 
@@ -60,7 +93,31 @@ def _series_coeffs(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarra
 
 
 def exp_so3(w: np.ndarray) -> np.ndarray:
-    """Rotation matrix ``exp(hat(w))`` of the rotation vector ``w`` (..., 3) (Rodrigues)."""
+    """Rotation matrix ``exp(hat(w))`` of a rotation vector (Rodrigues' formula).
+
+    Parameters
+    ----------
+    w : array_like, shape (..., 3)
+        Rotation vectors: unit axis times angle (rad).  Accurate for all angles, including 0 (Taylor
+        series below ``SMALL_ANGLE``).
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        ``R_AB`` for a frame B rotated by ``w`` (expressed in A) from A.
+
+    See Also
+    --------
+    log_so3 : the inverse, angle in [0, pi].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> exp_so3([0.0, 0.0, np.pi / 2]).round(12)
+    array([[ 0., -1.,  0.],
+           [ 1.,  0.,  0.],
+           [ 0.,  0.,  1.]])
+    """
     return _exp_so3(as_array(w, "w", (3,)))
 
 
@@ -72,12 +129,33 @@ def _exp_so3(w: np.ndarray) -> np.ndarray:
 
 
 def log_so3(R: np.ndarray) -> np.ndarray:
-    """Rotation vector of ``R`` (..., 3, 3) with angle in [0, pi]; accurate near 0 and near pi.
+    """Rotation vector of a rotation matrix, angle in [0, pi]; accurate near 0 and near pi.
 
     The angle comes from ``atan2(|axis part|, cos part)``, accurate everywhere.  Near 0 the axis is
     the antisymmetric part scaled by its series; for angles above pi/2 it is read from the symmetric
     part ``(R + R^T)/2 - cos t I = (1 - cos t) u u^T`` (the antisymmetric part vanishes at pi), with
     the sign taken from the antisymmetric part.
+
+    Parameters
+    ----------
+    R : array_like, shape (..., 3, 3)
+        Rotation matrices (``R^T R = I`` and ``det R = 1`` within ``ROTATION_ATOL``).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Axis times angle (rad), with ``exp_so3(log_so3(R)) == R``.
+
+    Raises
+    ------
+    ValueError
+        If ``R`` is not a batch of rotation matrices.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> log_so3(exp_so3([0.3, -0.2, 0.1])).round(12)
+    array([ 0.3, -0.2,  0.1])
     """
     R = as_array(R, "R", (3, 3))
     err = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-2, -1), initial=0.0)
@@ -121,6 +199,23 @@ def sincos(angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     within 2.3e-16 of ``np.sin``/``np.cos`` (relative for small angles; tests), and on this project's
     machines about 3.5x faster than the two calls, whose float64 kernels are not vectorised
     (docs/performance.md).  Finite at odd multiples of pi, where ``t`` is ~1e16: ``c = -1``.
+
+    Parameters
+    ----------
+    angle : array_like, shape (...)
+        Angles (rad).
+
+    Returns
+    -------
+    s, c : ndarray, shape (...)
+        Sine and cosine.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> s, c = sincos(np.array([0.0, np.pi / 2]))
+    >>> s.round(12), c.round(12)
+    (array([0., 1.]), array([1., 0.]))
     """
     return _sincos(as_array(angle, "angle"))
 
@@ -146,15 +241,65 @@ def _rot(angle: np.ndarray, i: int, j: int) -> np.ndarray:
 
 
 def rot_x(angle: np.ndarray) -> np.ndarray:
-    """Rotation about x by ``angle`` (...,) -> (..., 3, 3)."""
+    """Active right-handed rotation about x.
+
+    Parameters
+    ----------
+    angle : array_like, shape (...)
+        Rotation angles (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> (rot_x(np.pi / 2) @ [0.0, 1.0, 0.0]).round(12)
+    array([0., 0., 1.])
+    """
     return _rot(angle, 1, 2)
 
 
 def rot_y(angle: np.ndarray) -> np.ndarray:
-    """Rotation about y by ``angle`` (...,) -> (..., 3, 3)."""
+    """Active right-handed rotation about y.
+
+    Parameters
+    ----------
+    angle : array_like, shape (...)
+        Rotation angles (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> (rot_y(np.pi / 2) @ [0.0, 0.0, 1.0]).round(12)
+    array([1., 0., 0.])
+    """
     return _rot(angle, 2, 0)
 
 
 def rot_z(angle: np.ndarray) -> np.ndarray:
-    """Rotation about z by ``angle`` (...,) -> (..., 3, 3)."""
+    """Active right-handed rotation about z.
+
+    Parameters
+    ----------
+    angle : array_like, shape (...)
+        Rotation angles (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rot_z(np.array([0.0, np.pi / 2])).shape
+    (2, 3, 3)
+    >>> (rot_z(np.pi / 2) @ [1.0, 0.0, 0.0]).round(12)
+    array([0., 1., 0.])
+    """
     return _rot(angle, 0, 1)

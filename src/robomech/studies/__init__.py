@@ -31,6 +31,7 @@ def available_studies() -> dict[str, Study]:
 
 
 def get_study(name: str) -> Study:
+    """The registered study ``name``; ``ValueError`` listing the valid names otherwise."""
     studies = available_studies()
     if not isinstance(name, str) or name not in studies:
         raise ValueError(

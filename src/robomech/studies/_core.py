@@ -22,6 +22,7 @@ import numpy as np
 
 __all__ = [
     "Figure",
+    "Printed",
     "Progress",
     "Study",
     "StudyResult",
@@ -52,10 +53,42 @@ class Table:
 
 @dataclass(frozen=True)
 class Figure:
-    """A PNG written by the study into its output folder."""
+    """A PNG written by the study into its output folder; ``alt`` (default: the caption) for readers."""
 
     path: Path
     caption: str
+    alt: str = ""
+
+
+@dataclass(frozen=True)
+class Printed:
+    """A value as the paper printed it: ``text`` is shown verbatim, ``value`` is used for arithmetic.
+
+    Examples
+    --------
+    >>> Printed.of(126.7305).text, Printed.of("1.50").text, Printed.of("1.50").value
+    ('126.7305', '1.50', 1.5)
+    """
+
+    text: str
+    value: float
+
+    @classmethod
+    def of(cls, printed: str | float) -> Printed:
+        if isinstance(printed, Printed):
+            return printed
+        if isinstance(printed, str):
+            return cls(printed.strip(), float(printed))
+        if isinstance(printed, int | np.integer):
+            return cls(str(int(printed)), float(printed))
+        # repr is the shortest string that round-trips: the literal as typed from the paper
+        return cls(repr(float(printed)), float(printed))
+
+    def __float__(self) -> float:
+        return self.value
+
+    def __str__(self) -> str:
+        return self.text
 
 
 @dataclass
@@ -74,22 +107,27 @@ class StudyResult:
 
 @dataclass(frozen=True)
 class Study:
+    """A registered paper reproduction: ``run(out_dir, progress)`` returns a :class:`StudyResult`."""
+
     name: str
     title: str
     source: str
     run: Callable[[Path, Progress], StudyResult]
+    # optional modules the run needs (e.g. ("mujoco",)); missing ones skip it with the extra to install
+    requires: tuple[str, ...] = ()
 
 
 def comparison_table(
     title: str,
-    rows: Iterable[tuple[str, float | None, float, str]],
+    rows: Iterable[tuple[str, str | float | None, float, str]],
     *,
     note: str = "",
 ) -> Table:
     """Printed value, robomech's value and their difference side by side.
 
     ``rows`` are ``(quantity, printed, robomech, unit)``; ``printed`` may be ``None`` where the paper
-    gives no number.
+    gives no number.  The printed value is shown exactly as given (a string such as ``"1.50"`` keeps
+    its digits; a float is shown by its shortest round-trip form, i.e. as typed from the paper).
     """
     if not isinstance(title, str):
         raise ValueError(f"Expected title to be a str, got {type(title).__name__}.")
@@ -99,7 +137,16 @@ def comparison_table(
     for i, row in enumerate(rows):
         if not isinstance(row, tuple | list) or len(row) != 4:
             raise ValueError(f"Expected rows[{i}] to be (quantity, printed, robomech, unit), got {row!r}.")
+        if isinstance(row[1], str | Printed):  # the paper's digits as printed, e.g. "1.50"
+            try:
+                float(str(row[1]))
+            except ValueError:
+                raise ValueError(
+                    f"Expected rows[{i}] printed value to be a number or its printed text, got {row[1]!r}."
+                ) from None
         for value, what in ((row[1], "printed"), (row[2], "robomech")):
+            if isinstance(value, str | Printed) and what == "printed":
+                continue
             if (value is not None or what == "robomech") and (
                 isinstance(value, bool) or not isinstance(value, numbers.Real)
             ):
@@ -109,10 +156,11 @@ def comparison_table(
         if printed is None or not math.isfinite(float(printed)):
             out.append([quantity, unit, "—", ours, "—", "—"])
             continue
-        diff = float(ours) - float(printed)
+        p = Printed.of(printed)
+        diff = float(ours) - p.value
         # relative difference is undefined against a printed zero: shown as a dash, not inf
-        rel = abs(diff) / abs(float(printed)) if float(printed) != 0 else "—"
-        out.append([quantity, unit, float(printed), float(ours), diff, rel])
+        rel = abs(diff) / abs(p.value) if p.value != 0 else "—"
+        out.append([quantity, unit, p, float(ours), diff, rel])
     return Table(
         title=title,
         columns=["quantity", "unit", "paper (printed)", "robomech", "difference", "relative"],
@@ -143,20 +191,3 @@ class Progress:
             if i % every == 0:
                 self.step(f"{label} {i + 1}/{n}")
             yield item
-
-
-def to_jsonable(obj: Any) -> Any:
-    """Numpy arrays and scalars to plain JSON types (NaN/inf become strings, JSON has none)."""
-    if isinstance(obj, dict):
-        return {str(k): to_jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [to_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return to_jsonable(obj.tolist())
-    if isinstance(obj, np.generic):
-        return to_jsonable(obj.item())
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return str(obj)
-    if isinstance(obj, Path):
-        return str(obj)
-    return obj

@@ -1,23 +1,55 @@
-"""Writing a study's report (Markdown, HTML, JSON) and the index that links them."""
+"""Writing a study's report (Markdown, HTML, JSON) and the index that links every study in a folder.
+
+``report.md`` is the source: Markdown written from the :class:`StudyResult` (summary and notes are
+Markdown as the studies write them).  ``report.html`` is that Markdown rendered by the ``markdown``
+library (tables, table of contents, anchors) inside the Jinja2 template ``templates/page.html``.
+``results.json`` is strict JSON (no NaN) and carries the provenance; the index is rebuilt from every
+``*/results.json`` in the output folder, so reproducing one study never hides another.
+"""
 
 from __future__ import annotations
 
-import html
+import datetime as _dt
 import json
 import math
 import os
-from collections.abc import Sequence
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
 from robomech._validation import check_params, check_real
+from robomech.verify._core import dumps_json
 
-from ._core import StudyResult, Table, to_jsonable
+from ._core import Printed, Progress, Study, StudyResult, Table
 
-__all__ = ["format_cell", "write_index", "write_study_report"]
+__all__ = [
+    "INDEX_NAME",
+    "VERIFICATION_FILE",
+    "format_cell",
+    "provenance",
+    "publish_study",
+    "remove_stale_temporaries",
+    "render_html",
+    "write_index",
+    "write_study_report",
+    "write_verification",
+]
+
+INDEX_NAME = "index"
+# `robomech verify --out DIR` writes the checks here; the index shows each mechanism's status from it.
+VERIFICATION_FILE = "verification.json"
+_TMP_PREFIX = ".robomech-tmp-"
 
 
 def format_cell(value: Any) -> str:
+    """Text of one table cell: paper values verbatim, floats to 6 significant digits, bools yes/no."""
+    if isinstance(value, Printed):
+        return value.text
     if isinstance(value, bool):
         return "yes" if value else "no"
     if isinstance(value, int):
@@ -34,36 +66,197 @@ def format_cell(value: Any) -> str:
     return str(value)
 
 
-def _md_table(t: Table) -> str:
-    lines = [f"### {t.title}", ""]
-    lines.append("| " + " | ".join(str(c).replace("|", "\\|") for c in t.columns) + " |")
-    lines.append("|" + "|".join("---" for _ in t.columns) + "|")
-    for row in t.rows:
-        lines.append("| " + " | ".join(format_cell(c).replace("|", "\\|") for c in row) + " |")
+# ---- provenance -------------------------------------------------------------------------------------
+
+
+def _git_commit() -> str | None:
+    """The commit of the source tree robomech runs from, ``-dirty`` if modified; None outside git."""
+    here = Path(__file__).resolve().parent
+    try:
+        out = subprocess.run(
+            ["git", "-C", str(here), "rev-parse", "HEAD"], capture_output=True, text=True, timeout=5
+        )
+        if out.returncode != 0:
+            return None
+        commit = out.stdout.strip()
+        dirty = subprocess.run(
+            ["git", "-C", str(here), "status", "--porcelain", "--untracked-files=no"],
+            capture_output=True,
+            text=True,
+            timeout=5,
+        )
+        return commit + ("-dirty" if dirty.returncode == 0 and dirty.stdout.strip() else "")
+    except (OSError, subprocess.SubprocessError):
+        return None
+
+
+def provenance() -> dict[str, Any]:
+    """Who made a result: robomech version, git commit (if run from a checkout), UTC date, machine."""
+    import numpy
+
+    from robomech import __version__
+
+    versions = {"python": platform.python_version(), "numpy": numpy.__version__}
+    if "mujoco" in sys.modules:
+        versions["mujoco"] = getattr(sys.modules["mujoco"], "__version__", "?")
+    return {
+        "robomech": __version__,
+        "git_commit": _git_commit(),
+        "date_utc": _dt.datetime.now(_dt.UTC).replace(microsecond=0).isoformat(),
+        "machine": {
+            "platform": platform.platform(),
+            "processor": platform.machine(),
+            "cpus_visible": len(os.sched_getaffinity(0))
+            if hasattr(os, "sched_getaffinity")
+            else os.cpu_count(),
+        },
+        "versions": versions,
+    }
+
+
+def _provenance_line(p: Mapping[str, Any]) -> str:
+    commit = p.get("git_commit") or "not a git checkout"
+    m = p.get("machine", {})
+    return (
+        f"robomech {p.get('robomech', '?')} · commit `{commit}` · {p.get('date_utc', '?')} · "
+        f"{m.get('platform', '?')}, {m.get('cpus_visible', '?')} CPUs visible · "
+        + ", ".join(f"{k} {v}" for k, v in p.get("versions", {}).items())
+    )
+
+
+# ---- Markdown ---------------------------------------------------------------------------------------
+
+
+def _slug(text: str, seen: dict[str, int]) -> str:
+    from markdown.extensions.toc import slugify_unicode
+
+    base = slugify_unicode(text, "-") or "section"
+    n = seen.get(base, 0)
+    seen[base] = n + 1
+    return base if n == 0 else f"{base}_{n}"  # the toc extension's rule for repeated titles
+
+
+def _cell_md(value: Any) -> str:
+    return format_cell(value).replace("|", "\\|").replace("\n", " ")
+
+
+def _numeric(t: Table, j: int) -> bool:
+    cells = [row[j] for row in t.rows if row[j] not in ("—", "", None)]
+    return bool(cells) and all(
+        isinstance(c, int | float | Printed) and not isinstance(c, bool) for c in cells
+    )
+
+
+def _short(text: str, limit: int = 70) -> str:
+    text = " ".join(text.split())
+    if len(text) <= limit:
+        return text
+    return text[: text.rfind(" ", 0, limit)].rstrip(",;:") + " …"
+
+
+def _md_table(t: Table) -> list[str]:
+    lines = ["| " + " | ".join(str(c).replace("|", "\\|") for c in t.columns) + " |"]
+    # alignment in the Markdown itself (GitHub and the HTML agree): a column of numbers to the right
+    lines.append("|" + "|".join("---:" if _numeric(t, j) else ":---" for j in range(len(t.columns))) + "|")
+    lines += ["| " + " | ".join(_cell_md(c) for c in row) + " |" for row in t.rows]
     if t.note:
         lines += ["", t.note]
-    return "\n".join(lines) + "\n"
+    return lines
 
 
-def _html_table(t: Table) -> str:
-    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in t.columns)
-    body = "".join(
-        "<tr>" + "".join(f"<td>{html.escape(format_cell(c))}</td>" for c in row) + "</tr>" for row in t.rows
+def _report_markdown(result: StudyResult, prov: Mapping[str, Any], ext: str) -> str:
+    """The report as Markdown; ``ext`` (``md`` or ``html``) is the suffix of the links between pages."""
+    seen: dict[str, int] = {}
+    _slug(result.title, seen)
+    contents_id = _slug("Contents", seen)
+    back = f"[↑ contents](#{contents_id}) · [all studies](../{INDEX_NAME}.{ext})"
+    sections: list[tuple[str, str, list[str]]] = []  # (level, title, lines)
+    if result.summary:
+        sections.append(("##", "Summary", [result.summary.strip()]))
+    if result.tables:
+        sections.append(("##", "Tables", []))
+        for t in result.tables:
+            sections.append(("###", t.title, _md_table(t)))
+    if result.figures:
+        sections.append(("##", "Figures", []))
+        for k, f in enumerate(result.figures, 1):
+            alt = (f.alt or f.caption).replace("[", "(").replace("]", ")").replace("\n", " ")
+            lines = [f"![{alt}]({f.path.name})", "", f"*Figure {k}:* {f.caption}"]
+            sections.append(("###", f"Figure {k}: {_short(f.caption)}", lines))
+    if result.notes:
+        sections.append(("##", "Notes", [f"- {n}" for n in result.notes]))
+
+    md = [f"# {result.title}", "", f"[← all studies](../{INDEX_NAME}.{ext})", ""]
+    md += [f"*Source:* {result.source}", "", f"*Provenance:* {_provenance_line(prov)}", ""]
+    md += ["## Contents", ""]
+    ids = [_slug(title, seen) for _, title, _ in sections]
+    for (level, title, _), sid in zip(sections, ids, strict=True):
+        indent = "    " if level == "###" else ""
+        md.append(f"{indent}- [{title.replace('[', '(').replace(']', ')')}](#{sid})")
+    md.append("")
+    for level, title, lines in sections:
+        md += [f"{level} {title}", ""]
+        if lines:
+            md += [*lines, "", back, ""]
+    return "\n".join(md)
+
+
+def render_html(markdown_text: str, title: str) -> str:
+    """A full HTML page: ``markdown_text`` rendered by the ``markdown`` library in the page template."""
+    import jinja2
+    import markdown
+    from markdown.extensions.toc import slugify_unicode
+
+    from robomech import __version__
+
+    body = markdown.markdown(
+        markdown_text,
+        extensions=["tables", "toc", "sane_lists"],
+        extension_configs={"toc": {"slugify": slugify_unicode}},
+        output_format="html",
     )
-    note = f"<p class='note'>{html.escape(t.note)}</p>" if t.note else ""
-    return f"<h3>{html.escape(t.title)}</h3><table><tr>{head}</tr>{body}</table>{note}"
+    env = jinja2.Environment(
+        loader=jinja2.PackageLoader("robomech.studies", "templates"),
+        autoescape=jinja2.select_autoescape(["html"]),
+    )
+    return env.get_template("page.html").render(
+        title=title, body=jinja2.utils.markupsafe.Markup(body), version=__version__
+    )
 
 
-_CSS = (
-    "body{font-family:sans-serif;max-width:1100px;margin:2em auto;line-height:1.45}"
-    "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #bbb;padding:3px 8px;"
-    "text-align:right}th{background:#eee}td:first-child{text-align:left}img{max-width:100%}"
-    ".note{color:#555;font-size:90%}pre{white-space:pre-wrap}"
-)
+def _payload(result: StudyResult, prov: Mapping[str, Any], seconds: float | None) -> dict[str, Any]:
+    def cell(c: Any) -> Any:
+        return c.value if isinstance(c, Printed) else c
 
-
-def _paragraphs_html(text: str) -> str:
-    return "".join(f"<p>{html.escape(p.strip())}</p>" for p in text.split("\n\n") if p.strip())
+    return {
+        "name": result.name,
+        "title": result.title,
+        "source": result.source,
+        "seconds": seconds,
+        "provenance": dict(prov),
+        "summary": result.summary,
+        "tables": [
+            {
+                "title": t.title,
+                "columns": list(t.columns),
+                "rows": [[cell(c) for c in row] for row in t.rows],
+                # the paper's strings for the cells that were printed values (row, column) -> text
+                "printed": [
+                    [i, j, c.text]
+                    for i, row in enumerate(t.rows)
+                    for j, c in enumerate(row)
+                    if isinstance(c, Printed)
+                ],
+                "note": t.note,
+            }
+            for t in result.tables
+        ],
+        "figures": [
+            {"file": f.path.name, "caption": f.caption, "alt": f.alt or f.caption} for f in result.figures
+        ],
+        "notes": result.notes,
+        "data": result.data,
+    }
 
 
 def _as_path(p: object, name: str) -> Path:
@@ -72,87 +265,245 @@ def _as_path(p: object, name: str) -> Path:
     return Path(p)
 
 
-def write_study_report(result: StudyResult, out_dir: Path) -> dict[str, Path]:
-    """Write ``report.md``, ``report.html`` and ``results.json`` into ``out_dir``."""
+def write_study_report(
+    result: StudyResult, out_dir: Path, *, seconds: float | None = None, prov: Mapping[str, Any] | None = None
+) -> dict[str, Path]:
+    """Write ``report.md``, ``report.html`` and ``results.json`` (strict JSON) into ``out_dir``.
+
+    Parameters
+    ----------
+    result : StudyResult
+        What the study returned.
+    out_dir : path
+        The study's folder (created if needed); its figures are already there.
+    seconds : float, optional
+        Run time of the study (s), recorded in ``results.json`` and shown in the index.
+    prov : mapping, optional
+        Provenance to record (default: :func:`provenance` of this process).
+
+    Returns
+    -------
+    dict
+        Paths ``md``, ``html`` and ``json`` of the three files.
+    """
     check_params(result, StudyResult, "result")
     out_dir = _as_path(out_dir, "out_dir")
+    if seconds is not None:
+        seconds = check_real(seconds, "seconds", low=0.0)
+    if prov is not None and not isinstance(prov, Mapping):
+        raise ValueError(f"Expected prov to be a mapping (see provenance()), got {type(prov).__name__}.")
     out_dir.mkdir(parents=True, exist_ok=True)
-    md = [f"# {result.title}", "", f"*Source:* {result.source}", ""]
-    if result.summary:
-        md += [result.summary.strip(), ""]
-    for t in result.tables:
-        md.append(_md_table(t))
-    for f in result.figures:
-        md += [f"![{f.caption}]({f.path.name})", "", f"*{f.caption}*", ""]
-    if result.notes:
-        md += ["## Notes", ""] + [f"- {n}" for n in result.notes] + [""]
-    (out_dir / "report.md").write_text("\n".join(md))
-
-    parts = [f"<h1>{html.escape(result.title)}</h1><p><i>Source:</i> {html.escape(result.source)}</p>"]
-    parts.append(_paragraphs_html(result.summary))
-    parts += [_html_table(t) for t in result.tables]
-    parts += [
-        f"<figure><img src='{html.escape(f.path.name)}'><figcaption>{html.escape(f.caption)}</figcaption>"
-        "</figure>"
-        for f in result.figures
-    ]
-    if result.notes:
-        parts.append(
-            "<h2>Notes</h2><ul>" + "".join(f"<li>{html.escape(n)}</li>" for n in result.notes) + "</ul>"
-        )
+    prov = provenance() if prov is None else prov
+    text = dumps_json(_payload(result, prov, seconds))  # first: a non-JSON value fails before any write
+    (out_dir / "report.md").write_text(_report_markdown(result, prov, "md"), encoding="utf-8")
     (out_dir / "report.html").write_text(
-        f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(result.title)}</title>"
-        f"<style>{_CSS}</style></head><body>{''.join(parts)}</body></html>"
+        render_html(_report_markdown(result, prov, "html"), result.title), encoding="utf-8"
     )
-
-    payload = {
-        "name": result.name,
-        "title": result.title,
-        "source": result.source,
-        "summary": result.summary,
-        "tables": [
-            {"title": t.title, "columns": list(t.columns), "rows": t.rows, "note": t.note}
-            for t in result.tables
-        ],
-        "figures": [{"file": f.path.name, "caption": f.caption} for f in result.figures],
-        "notes": result.notes,
-        "data": result.data,
-    }
-    (out_dir / "results.json").write_text(json.dumps(to_jsonable(payload), indent=2))
+    (out_dir / "results.json").write_text(text, encoding="utf-8")
     return {"md": out_dir / "report.md", "html": out_dir / "report.html", "json": out_dir / "results.json"}
 
 
-def write_index(out_root: Path, entries: Sequence[tuple[StudyResult, float]]) -> Path:
-    """``index.md`` and ``index.html`` linking every study report, with run times."""
+# ---- atomic publication -----------------------------------------------------------------------------
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _atomic_write(path: Path, text: str) -> None:
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=_TMP_PREFIX)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp's 0600 is for the temporary, not the result
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def remove_stale_temporaries(out_root: Path) -> None:
+    """Remove the temporary folders an earlier, killed run left behind (only robomech's own)."""
+    for p in out_root.glob(_TMP_PREFIX + "*"):
+        if p.is_dir():
+            shutil.rmtree(p, ignore_errors=True)
+        else:
+            p.unlink(missing_ok=True)
+
+
+def publish_study(
+    study: Study,
+    out_root: Path,
+    progress: Progress,
+    clock: Callable[[], float] | None = None,
+) -> dict[str, Any]:
+    """Run ``study`` in a temporary folder under ``out_root`` and move it to ``out_root/<name>``.
+
+    The folder of a study is therefore either the complete previous run or the complete new one,
+    never a mix, also when the run is interrupted (the temporary folder is removed).
+
+    Returns
+    -------
+    dict
+        ``study``, ``seconds``, and the paths ``report`` (Markdown), ``html`` and ``json``.
+    """
+    import time
+
+    clock = clock or time.perf_counter
+    tmp = Path(tempfile.mkdtemp(dir=out_root, prefix=f"{_TMP_PREFIX}{study.name}-"))
+    final = out_root / study.name
+    old = None
+    try:
+        t0 = clock()
+        result = study.run(tmp, progress)
+        seconds = clock() - t0
+        write_study_report(result, tmp, seconds=seconds)
+        if final.exists():
+            old = Path(tempfile.mkdtemp(dir=out_root, prefix=f"{_TMP_PREFIX}{study.name}-old-"))
+            os.replace(final, old / "previous")
+        os.chmod(tmp, 0o777 & ~_umask())  # mkdtemp's 0700 is for the temporary, not the result
+        os.replace(tmp, final)
+    finally:
+        if tmp.exists():
+            shutil.rmtree(tmp, ignore_errors=True)
+        if old is not None:
+            if not final.exists() and (old / "previous").exists():  # never lose the previous run
+                os.replace(old / "previous", final)
+            shutil.rmtree(old, ignore_errors=True)
+    return {
+        "study": study.name,
+        "seconds": seconds,
+        "report": final / "report.md",
+        "html": final / "report.html",
+        "json": final / "results.json",
+    }
+
+
+# ---- index ------------------------------------------------------------------------------------------
+
+
+def _read_results(out_root: Path) -> list[dict[str, Any]]:
+    found = []
+    for path in sorted(out_root.glob("*/results.json")):
+        if path.parent.name.startswith("."):
+            continue
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue  # not ours or unreadable: the index lists what it can read
+        if isinstance(data, dict) and data.get("name") == path.parent.name:
+            found.append(data)
+    return found
+
+
+def _verification_status(out_root: Path) -> tuple[dict[str, str], str | None]:
+    path = out_root / VERIFICATION_FILE
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return {}, None
+    status: dict[str, list[bool]] = {}
+    for c in data.get("checks", []):
+        status.setdefault(str(c.get("mechanism")), []).append(bool(c.get("passed")))
+    out = {
+        m: (f"pass ({len(v)} checks)" if all(v) else f"FAIL ({v.count(False)} of {len(v)} checks)")
+        for m, v in status.items()
+    }
+    for s in data.get("skipped", []):
+        out[str(s.get("mechanism"))] = f"skipped: {s.get('reason')}"
+    return out, (data.get("provenance") or {}).get("date_utc")
+
+
+def write_index(
+    out_root: Path,
+    studies: Mapping[str, Study] | None = None,
+    skipped: Iterable[tuple[str, str]] = (),
+) -> Path:
+    """Rebuild ``index.md`` and ``index.html`` from every ``*/results.json`` in ``out_root``.
+
+    Parameters
+    ----------
+    out_root : Path
+        The output folder of ``robomech reproduce``.
+    studies : mapping, optional
+        Registered studies by name; those without results are listed as not reproduced.
+    skipped : iterable of (name, reason)
+        Studies skipped in this run (e.g. the engine is not installed), listed with the reason.
+
+    Returns
+    -------
+    Path
+        ``out_root / "index.md"`` (``index.html`` beside it).
+    """
     out_root = _as_path(out_root, "out_root")
-    if not isinstance(entries, Sequence) or isinstance(entries, str):
-        raise ValueError(f"Expected entries to be a sequence of (StudyResult, seconds), got {entries!r}.")
-    for i, entry in enumerate(entries):
-        if not (isinstance(entry, tuple) and len(entry) == 2 and isinstance(entry[0], StudyResult)):
-            raise ValueError(f"Expected entries[{i}] to be a (StudyResult, seconds) pair, got {entry!r}.")
-        check_real(entry[1], f"entries[{i}] seconds", low=0.0)
-    md = [
-        "# robomech — paper reproductions",
+    if studies is not None and not (
+        isinstance(studies, Mapping) and all(isinstance(v, Study) for v in studies.values())
+    ):
+        raise ValueError(f"Expected studies to be a mapping name -> Study (or None), got {studies!r}.")
+    if isinstance(skipped, str | bytes) or not isinstance(skipped, Iterable):
+        raise ValueError(f"Expected skipped to be (name, reason) pairs, got {skipped!r}.")
+    skipped = list(skipped)
+    for i, pair in enumerate(skipped):
+        if not (isinstance(pair, tuple) and len(pair) == 2 and all(isinstance(x, str) for x in pair)):
+            raise ValueError(f"Expected skipped[{i}] to be a (name, reason) pair of str, got {pair!r}.")
+    if not out_root.is_dir():
+        raise ValueError(f"Expected out_root to be an existing folder, got {str(out_root)!r}.")
+    results = _read_results(out_root)
+    verified, verified_at = _verification_status(out_root)
+    skipped_by_name = dict(skipped)
+    md = ["# robomech — paper reproductions", ""]
+    md += [
+        "Each row is one study folder; a study's folder is always one complete run (its date and "
+        "provenance are in the row). Verification status comes from `robomech verify --out "
+        f"{out_root.name}`" + (f" (run {verified_at})." if verified_at else " (not run yet)."),
         "",
-        "| study | title | figures | tables | time (s) |",
-        "|---|---|---|---|---|",
+        "| study | title | verification | figures | tables | time (s) | run (UTC) | robomech | commit |",
+        "|:---|:---|:---|---:|---:|---:|:---|:---|:---|",
     ]
-    rows_html = []
-    for res, seconds in entries:
+    for r in results:
+        p = r.get("provenance") or {}
+        secs = r.get("seconds")
+        full = str(p.get("git_commit") or "—")
+        commit = full[:12] + ("-dirty" if full.endswith("-dirty") else "")
         md.append(
-            f"| [{res.name}]({res.name}/report.md) | {res.title} | {len(res.figures)} | {len(res.tables)} | "
-            f"{seconds:.1f} |"
+            "| [{n}]({n}/report.{{ext}}) | {t} | {v} | {f} | {tb} | {s} | {d} | {ver} | `{c}` |".format(
+                n=r["name"],
+                t=str(r.get("title", "")).replace("|", "\\|"),
+                v=verified.get(r["name"], "—"),
+                f=len(r.get("figures", [])),
+                tb=len(r.get("tables", [])),
+                s=f"{secs:.1f}" if isinstance(secs, int | float) else "—",
+                d=str(p.get("date_utc", "—")).replace("T", " ").removesuffix("+00:00"),
+                ver=p.get("robomech", "—"),
+                c=commit,
+            )
         )
-        rows_html.append(
-            f"<tr><td><a href='{html.escape(res.name)}/report.html'>{html.escape(res.name)}</a></td>"
-            f"<td>{html.escape(res.title)}</td><td>{len(res.figures)}</td><td>{len(res.tables)}</td>"
-            f"<td>{seconds:.1f}</td></tr>"
-        )
-    (out_root / "index.md").write_text("\n".join(md) + "\n")
-    (out_root / "index.html").write_text(
-        "<!doctype html><html><head><meta charset='utf-8'><title>robomech reproductions</title>"
-        f"<style>{_CSS}</style></head><body><h1>robomech — paper reproductions</h1><table>"
-        "<tr><th>study</th><th>title</th><th>figures</th><th>tables</th><th>time (s)</th></tr>"
-        f"{''.join(rows_html)}</table></body></html>"
+    present = {r["name"] for r in results}
+    missing = [
+        (n, skipped_by_name.get(n) or "not reproduced yet: `robomech reproduce " + n + "`")
+        for n in (studies or {})
+        if n not in present
+    ]
+    missing += [
+        (n, why) for n, why in skipped_by_name.items() if n not in present and n not in (studies or {})
+    ]
+    if missing:
+        md += ["", "## Not in this folder", ""] + [f"- **{n}** — {why}" for n, why in missing]
+    md.append("")
+    template = "\n".join(md)
+    index_md = out_root / f"{INDEX_NAME}.md"
+    _atomic_write(index_md, template.replace("{ext}", "md"))
+    _atomic_write(
+        out_root / f"{INDEX_NAME}.html",
+        render_html(template.replace("{ext}", "html"), "robomech — paper reproductions"),
     )
-    return out_root / "index.md"
+    return index_md
+
+
+def write_verification(out_root: Path, report_dict: Mapping[str, Any]) -> Path:
+    """Save a verification report (``VerificationReport.as_dict()``) with provenance for the index."""
+    path = out_root / VERIFICATION_FILE
+    _atomic_write(path, dumps_json({**report_dict, "provenance": provenance()}))
+    return path

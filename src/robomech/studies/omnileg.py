@@ -635,4 +635,5 @@ STUDY = Study(
     title="Paper 2: OmniLeg serial-parallel leg",
     source="Xu et al., China Mechanical Engineering 36(4), 2025",
     run=run,
+    requires=("mujoco",),  # the engine overlays (robomech.verify); skipped without robomech[verify]
 )

@@ -342,8 +342,8 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
                 ],
             ],
             note=f"All {int(np.sum(big.valid))} of {N_THROUGHPUT} systems full rank; median cond "
-            f"{float(np.median(big.cond)):.1f} (1-norm of R). Same machine, same run; 2 shared cores. The "
-            "solve is robomech's compiled batched Householder QR (docs/performance.md); the rest is the "
+            f"{float(np.median(big.cond)):.1f} (1-norm of R). Same machine and run (see provenance). "
+            "The solve is robomech's compiled batched Householder QR (docs/performance.md); the rest is the "
             "assembly of A0 and J.",
         )
     )
@@ -563,4 +563,5 @@ STUDY = Study(
     title="Paper 4: skid-steer exploration robot velocity kinematics",
     source="Shang, Qiu, Yang (2012), China Mechanical Engineering 23(2)",
     run=run,
+    requires=("mujoco",),  # the contact-physics comparison; skipped without robomech[verify]
 )

@@ -66,4 +66,5 @@ STUDY = Study(
     title="Design exploration: small sweeps on a local Dask cluster",
     source="robomech.explore",
     run=run,
+    requires=("distributed", "zarr"),  # the explore extra; skipped without robomech[explore]
 )

@@ -509,4 +509,5 @@ STUDY = Study(
     title="Paper 5: vectored-thrust spherical mechanism",
     source="Robot 38(6), 2016",
     run=run,
+    requires=("mujoco",),  # the engine overlays (robomech.verify); skipped without robomech[verify]
 )

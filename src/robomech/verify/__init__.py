@@ -1,24 +1,38 @@
 """Independent verification of every mechanism model (the role ADAMS plays in the papers).
 
 Modules ``robomech/verify/<module>.py`` define ``VERIFICATION``; they are discovered by name so that a
-mechanism's verification needs no edit elsewhere.  Engines are imported inside those modules only.
+mechanism's verification needs no edit elsewhere.  Engines are imported inside those modules only, on
+first use; a verification whose ``requires`` are not installed is skipped with the extra to install.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
 
-from robomech._registry import discover
+from robomech._registry import discover, skip_reason
 
-from ._core import Check, Tolerance, Verification, VerificationReport
+from ._core import (
+    Check,
+    EngineUnavailable,
+    Tolerance,
+    Verification,
+    VerificationReport,
+    dumps_json,
+    optional_module,
+    to_jsonable,
+)
 
 __all__ = [
     "Check",
+    "EngineUnavailable",
     "Tolerance",
     "Verification",
     "VerificationReport",
     "available_verifications",
+    "dumps_json",
+    "optional_module",
     "run_verifications",
+    "to_jsonable",
 ]
 
 
@@ -28,7 +42,24 @@ def available_verifications() -> dict[str, Verification]:
 
 
 def run_verifications(names: Iterable[str] | None = None) -> VerificationReport:
-    """Run the named verifications (all when ``names`` is empty or None)."""
+    """Run the named verifications (all when ``names`` is empty or None).
+
+    Parameters
+    ----------
+    names : iterable of str, optional
+        Mechanism names as listed by :func:`available_verifications`.
+
+    Returns
+    -------
+    VerificationReport
+        ``checks`` of every verification that ran; ``skipped`` lists ``(name, reason)`` for those
+        whose optional engine is not installed (``reason`` names the extra, e.g. ``robomech[verify]``).
+
+    Raises
+    ------
+    ValueError
+        If a name is not a registered verification.
+    """
     available = available_verifications()
     if isinstance(names, str) or not (names is None or isinstance(names, Iterable)):
         raise ValueError(f"Expected names to be a list of mechanism names or None, got {names!r}.")
@@ -41,5 +72,9 @@ def run_verifications(names: Iterable[str] | None = None) -> VerificationReport:
         )
     report = VerificationReport()
     for n in names:
+        reason = skip_reason(available[n].requires)
+        if reason is not None:
+            report.skipped.append((n, reason))
+            continue
         report.checks.extend(available[n].run())
     return report

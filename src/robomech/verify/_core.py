@@ -3,19 +3,138 @@
 A module ``robomech/verify/<module>.py`` defines ``VERIFICATION = Verification(name=..., run=...)``;
 ``run()`` returns a list of :class:`Check`.  Each check names the quantity, the maximum error found,
 the tolerance and *why* that tolerance (engine constraint stiffness, step size, model fidelity).
-This layer is the only one that imports a multibody engine.
+This layer is the only one that imports a multibody engine, and only on first use
+(:func:`optional_module`): a verification that needs one declares it in ``requires`` and is skipped,
+with the extra to install, where it is missing.
 """
 
 from __future__ import annotations
 
+import importlib
+import json
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
+from types import ModuleType
 from typing import Any
 
+import numpy as np
+
+from robomech._registry import EXTRAS
 from robomech._validation import check_bool, check_positive
 
-__all__ = ["Check", "Tolerance", "Verification", "VerificationReport"]
+__all__ = [
+    "Check",
+    "EngineUnavailable",
+    "Tolerance",
+    "Verification",
+    "VerificationReport",
+    "dumps_json",
+    "optional_module",
+    "to_jsonable",
+]
+
+
+class EngineUnavailable(ImportError):
+    """An optional engine is needed but not installed; the message names the extra to install."""
+
+
+class _OptionalModule:
+    """A module imported on first attribute access, so that importing its user costs nothing."""
+
+    def __init__(self, name: str) -> None:
+        self._name = name
+        self._module: ModuleType | None = None
+
+    def __getattr__(self, attr: str) -> Any:
+        if attr.startswith("__") and attr.endswith("__"):
+            raise AttributeError(attr)  # keep copy/pickle/inspect probes from importing the engine
+        if self._module is None:
+            try:
+                self._module = importlib.import_module(self._name)
+            except ImportError as e:
+                extra = EXTRAS.get(self._name, self._name)
+                raise EngineUnavailable(
+                    f"{self._name} is not installed; install it with: pip install 'robomech[{extra}]'"
+                ) from e
+        return getattr(self._module, attr)
+
+    def __repr__(self) -> str:
+        state = "imported" if self._module is not None else "not yet imported"
+        return f"<optional module {self._name!r} ({state})>"
+
+
+def optional_module(name: str) -> Any:
+    """A stand-in for ``import name`` that imports on first use.
+
+    Parameters
+    ----------
+    name : str
+        Top-level module name, e.g. ``"mujoco"``.
+
+    Returns
+    -------
+    module-like
+        Attribute access imports the module; if it is absent, :class:`EngineUnavailable` (an
+        ``ImportError``) names the robomech extra that installs it.
+
+    Examples
+    --------
+    >>> m = optional_module("no_such_engine_xyz")
+    >>> m.step
+    Traceback (most recent call last):
+    ...
+    robomech.verify._core.EngineUnavailable: no_such_engine_xyz is not installed; ...
+    """
+    if not isinstance(name, str) or not name.isidentifier():
+        raise ValueError(f"Expected name to be a module name such as 'mujoco', got {name!r}.")
+    return _OptionalModule(name)
+
+
+def to_jsonable(obj: Any) -> Any:
+    """Plain JSON types from numpy arrays and scalars, paths, tuples and dataclass-free containers.
+
+    Non-finite floats become ``None`` (JSON ``null``): strict JSON has no NaN or infinity.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> to_jsonable({"ok": np.bool_(True), "x": np.float64(0.5), "v": np.array([1.0, np.nan])})
+    {'ok': True, 'x': 0.5, 'v': [1.0, None]}
+    """
+    if isinstance(obj, dict):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple | set | frozenset):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray | np.generic):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, bool | int | str) or obj is None:
+        return obj
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, Path):
+        return str(obj)
+    if isinstance(obj, complex):
+        raise ValueError(f"Expected obj to hold real values only (JSON has no complex), got {obj!r}.")
+    raise ValueError(
+        f"Expected obj to hold JSON-representable values (dict, list, str, number, bool, None, numpy), "
+        f"got {type(obj).__name__}: {obj!r}."
+    )
+
+
+def dumps_json(obj: Any, *, indent: int | None = 2) -> str:
+    """Strict JSON text (``allow_nan=False``) of :func:`to_jsonable` of ``obj``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> dumps_json({"passed": np.bool_(False), "error": float("inf")}, indent=None)
+    '{"passed": false, "error": null}'
+    """
+    if indent is not None and (isinstance(indent, bool) or not isinstance(indent, int) or indent < 0):
+        raise ValueError(f"Expected indent to be None or a non-negative int, got {indent!r}.")
+    return json.dumps(to_jsonable(obj), indent=indent, allow_nan=False, ensure_ascii=False)
 
 
 @dataclass(frozen=True)
@@ -46,15 +165,17 @@ class Check:
         return math.isfinite(self.max_error) and self.max_error <= self.tolerance.value
 
     def as_dict(self) -> dict[str, Any]:
+        """Plain Python types only (numpy scalars converted; a non-finite error becomes None)."""
+        err = float(self.max_error)
         return {
-            "mechanism": self.mechanism,
-            "quantity": self.quantity,
-            "max_error": self.max_error,
-            "tolerance": self.tolerance.value,
-            "relative": self.tolerance.relative,
-            "reason": self.tolerance.reason,
-            "passed": self.passed,
-            "detail": self.detail,
+            "mechanism": str(self.mechanism),
+            "quantity": str(self.quantity),
+            "max_error": err if math.isfinite(err) else None,
+            "tolerance": float(self.tolerance.value),
+            "relative": bool(self.tolerance.relative),
+            "reason": str(self.tolerance.reason),
+            "passed": bool(self.passed),
+            "detail": str(self.detail),
         }
 
 
@@ -64,15 +185,27 @@ class Verification:
     title: str
     engine: str
     run: Callable[[], Sequence[Check]]
+    # optional modules the run needs (e.g. ("mujoco",)); missing ones skip it with the extra to install
+    requires: tuple[str, ...] = ()
 
 
 @dataclass
 class VerificationReport:
     checks: list[Check] = field(default_factory=list)
+    # (mechanism, reason) of verifications that could not run here, e.g. the engine is not installed
+    skipped: list[tuple[str, str]] = field(default_factory=list)
 
     @property
     def passed(self) -> bool:
+        """Every check that ran passed (skipped verifications are listed, not failed)."""
         return all(c.passed for c in self.checks)
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "passed": self.passed,
+            "checks": [c.as_dict() for c in self.checks],
+            "skipped": [{"mechanism": n, "reason": r} for n, r in self.skipped],
+        }
 
     def table(self) -> str:
         wq = max([len("quantity"), *(len(c.quantity) for c in self.checks)])
@@ -86,5 +219,7 @@ class VerificationReport:
                 f"{c.tolerance.value:>11.1e}{kind:4}  {'pass' if c.passed else 'FAIL'}"
             )
         n_fail = sum(not c.passed for c in self.checks)
-        lines.append(f"{len(self.checks) - n_fail} passed, {n_fail} failed")
+        lines += [f"skipped: {n} — {r}" for n, r in self.skipped]
+        tail = f", {len(self.skipped)} skipped" if self.skipped else ""
+        lines.append(f"{len(self.checks) - n_fail} passed, {n_fail} failed{tail}")
         return "\n".join(lines)

@@ -22,14 +22,19 @@ Checks (each a :class:`Check` with a named tolerance):
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import mujoco
 import numpy as np
 
 import robomech.mechanisms.omnileg as ol
 from robomech._validation import as_array, broadcast_batch, check_params
 
-from ._core import Check, Tolerance, Verification
+from ._core import Check, Tolerance, Verification, optional_module
+
+if TYPE_CHECKING:
+    import mujoco
+else:  # imported on first use: discovering this module must not need the optional engine
+    mujoco = optional_module("mujoco")
 
 __all__ = ["VERIFICATION", "EngineModel", "build_mjcf", "build_model", "engine_inverse_dynamics", "run"]
 
@@ -365,5 +370,6 @@ VERIFICATION = Verification(
     name="omnileg",
     title="Paper 2: OmniLeg vs MuJoCo (closure, foot kinematics, torques, forward simulation)",
     engine="MuJoCo",
+    requires=("mujoco",),
     run=run,
 )

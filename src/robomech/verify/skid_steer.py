@@ -421,4 +421,5 @@ VERIFICATION = Verification(
     engine="kinematic rigid-body simulation (transform chains + Newton contact) and MuJoCo (MjSpec model, "
     "wheel-ground friction, height field)",
     run=run_checks,
+    requires=("mujoco",),  # the contact-physics checks; skipped without robomech[verify]
 )

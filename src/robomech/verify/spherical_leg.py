@@ -24,15 +24,20 @@ Checks (the role ADAMS plays in the paper):
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
-import mujoco
 import numpy as np
 
 from robomech._validation import as_array, check_params, check_positive
 from robomech.mechanisms import spherical_leg as sl
 from robomech.spatial import exp_so3
 
-from ._core import Check, Tolerance, Verification
+from ._core import Check, Tolerance, Verification, optional_module
+
+if TYPE_CHECKING:
+    import mujoco
+else:  # imported on first use: discovering this module must not need the optional engine
+    mujoco = optional_module("mujoco")
 
 __all__ = ["VERIFICATION", "build_model", "inverse_dynamics_engine", "run_checks", "study_overlays"]
 
@@ -424,6 +429,7 @@ def study_overlays(leg: sl.SphericalLeg) -> dict:
 VERIFICATION = Verification(
     name="spherical-leg",
     title="Paper 1 spherical parallel leg vs a MuJoCo model of the same mechanism",
-    engine=f"MuJoCo {mujoco.__version__}",
+    engine="MuJoCo",
+    requires=("mujoco",),
     run=run_checks,
 )

@@ -32,21 +32,22 @@ SPECS = {
         args={"title": "t", "rows": [("a", 1.0, 1.1, "m"), ("b", None, 2.0, "s")], "note": ""},
         options={
             "title": (None, 1),
-            "rows": (None, "abc", [("a", 1.0)], [("a", "1.0", 1.1, "m")], [("a", 1.0, None, "m")]),
+            "rows": (None, "abc", [("a", 1.0)], [("a", "one", 1.1, "m")], [("a", 1.0, None, "m")]),
         },
     ),
     P + "write_study_report": Spec(
-        args={"result": RESULT, "out_dir": _HERE},
+        args={"result": RESULT, "out_dir": _HERE, "seconds": 1.5},
         params=("result",),
-        options={"out_dir": (None, "", 1)},
+        options={"out_dir": (None, "", 1), "seconds": (float("nan"), -1.0, "1", True)},
         call=_in_tmp(studies.write_study_report, "out_dir"),
         finite_result=False,
     ),
     P + "write_index": Spec(
-        args={"out_root": _HERE, "entries": [(RESULT, 1.5)]},
+        args={"out_root": _HERE, "studies": None, "skipped": [("omnileg", "install robomech[verify]")]},
         options={
-            "out_root": (None, "", 1),
-            "entries": (None, "abc", [RESULT], [(RESULT, float("nan"))], [(None, 1.0)], [(RESULT, -1.0)]),
+            "out_root": (None, "", 1, "/no/such/folder/robomech"),
+            "studies": ("abc", {"demo": None}, [1]),
+            "skipped": (None, "abc", [("a",)], [(1, "r")], [["a", "b"]]),
         },
         call=_in_tmp(studies.write_index, "out_root"),
     ),

@@ -1,0 +1,5 @@
+"""``python -m robomech``: the ``robomech`` command."""
+
+from robomech.cli import main
+
+raise SystemExit(main())

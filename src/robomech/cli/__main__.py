@@ -1,0 +1,5 @@
+"""``python -m robomech.cli``."""
+
+from robomech.cli import main
+
+raise SystemExit(main())

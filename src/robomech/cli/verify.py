@@ -1,0 +1,78 @@
+"""``robomech verify``: every model against an independent engine or higher-fidelity model."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ._core import EXIT_CHECK_FAILED, EXIT_OK, CliError, Command, announce_compiles, output_folder
+
+
+def _description() -> str:
+    from robomech._registry import skip_reason
+    from robomech.verify import available_verifications
+
+    lines = ["Check the models against an independent engine; exit 1 if a check fails.", "", "mechanisms:"]
+    for n, v in available_verifications().items():
+        why = skip_reason(v.requires)
+        lines.append(f"  {n:<18} {v.title}" + (f" [skipped: {why}]" if why else ""))
+    return "\n".join(lines)
+
+
+def _add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("mechanisms", nargs="*", metavar="MECHANISM", help="mechanisms to verify (default: all)")
+    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    p.add_argument(
+        "--out",
+        default=None,
+        metavar="DIR",
+        help="also save the checks to DIR/verification.json (the report index shows them)",
+    )
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+
+
+def _run(args: argparse.Namespace) -> int:
+    from robomech._registry import skip_reason
+    from robomech.verify import VerificationReport, available_verifications, dumps_json
+
+    out = output_folder(args.out) if args.out is not None else None
+    available = available_verifications()
+    unknown = [n for n in args.mechanisms if n not in available]
+    if unknown:
+        raise CliError(
+            f"unknown mechanism {', '.join(map(repr, unknown))}; valid ones are: {', '.join(available)}"
+        )
+    for n in args.mechanisms:  # asked for by name: not running it is an error, not a skip
+        why = skip_reason(available[n].requires)
+        if why:
+            raise CliError(f"{n} cannot run here: {why}")
+    announce_compiles(enabled=not args.quiet)
+    report = VerificationReport()
+    for n in args.mechanisms or list(available):
+        v = available[n]
+        why = skip_reason(v.requires)
+        if why:
+            report.skipped.append((n, why))
+            if not args.quiet:
+                print(f"verify: {n} skipped — {why}", file=sys.stderr, flush=True)
+            continue
+        if not args.quiet:
+            print(f"verify: {n} — {v.title} ...", file=sys.stderr, flush=True)
+        report.checks.extend(v.run())
+    if out is not None:
+        from robomech.studies import available_studies, write_index
+        from robomech.studies._report import write_verification
+
+        write_verification(out, report.as_dict())
+        write_index(out, available_studies())
+    print(dumps_json(report.as_dict()) if args.json else report.table())
+    return EXIT_OK if report.passed else EXIT_CHECK_FAILED
+
+
+COMMAND = Command(
+    name="verify",
+    help="check models against an independent engine; exit 1 on a failed check",
+    add_arguments=_add_arguments,
+    run=_run,
+    description=_description,
+)
