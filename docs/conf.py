@@ -57,3 +57,9 @@ def _escape_bars(app, what, name, obj, options, lines):
 
 def setup(app):
     app.connect("autodoc-process-docstring", _escape_bars)
+
+
+# No intersphinx (this project builds offline): references into the standard library and
+# unparsed generic annotations cannot resolve, and are the only nitpicks ignored.
+nitpick_ignore = [("py:class", "collections.abc.Mapping")]
+nitpick_ignore_regex = [("py:class", r"'?(list|dict|tuple)\[.*")]

@@ -8,7 +8,7 @@ For chain i with unit joint screws ``S_i (n_i, 6)`` expressed in one frame at on
 * the platform's constraint system is the union (span of all chains' constraints), and its twist
   system is the reciprocal of that union; ``dof = 6 - rank(union)``.
 
-Numerical ranks use the SVD with a relative tolerance :data:`RANK_RTOL`; screws mix angular (1) and
+Numerical ranks use the SVD with a relative tolerance ``RANK_RTOL``; screws mix angular (1) and
 length units, so express them in a length unit in which the mechanism's size is of order one, or
 pass ``length_scale``.
 """

@@ -37,7 +37,7 @@ EXIT_INTERRUPTED = 130  # SIGINT (128 + 2), the shell convention
 
 
 class CliError(Exception):
-    """A usage or input error: printed as one line on stderr, exit code :data:`EXIT_USAGE`."""
+    """A usage or input error: printed as one line on stderr, exit code ``EXIT_USAGE``."""
 
 
 @dataclass(frozen=True)
@@ -53,7 +53,7 @@ class Command:
     add_arguments : callable
         ``add_arguments(parser)`` adds the subcommand's arguments to its ``argparse`` parser.
     run : callable
-        ``run(args) -> int`` returns the exit code; raise :class:`CliError` for a usage error.
+        ``run(args) -> int`` returns the exit code; raise ``CliError`` for a usage error.
     description : str, optional
         Longer text for ``robomech NAME --help``; may be a callable returning it (evaluated when the
         parser is built, e.g. to list the registered names).
@@ -87,7 +87,7 @@ class Command:
 
 
 def output_folder(value: str) -> Path:
-    """An ``--out`` folder that exists (created if needed) and is writable, or a :class:`CliError`.
+    """An ``--out`` folder that exists (created if needed) and is writable, or a ``CliError``.
 
     Rejects an empty path (it would silently mean the current directory), an existing non-folder, a
     path under a file, and a folder where a file cannot be created.

@@ -405,7 +405,7 @@ class Builder:
     >>> b.connect("loop", "rocker", "coupler", anchor1=(0.3, 0, 0))        # doctest: +SKIP
     >>> mech = b.build()                                                   # doctest: +SKIP
 
-    The builder only collects descriptions; :meth:`build` returns the frozen, validated mechanism.
+    The builder only collects descriptions; ``Builder.build()`` returns the frozen, validated mechanism.
     A closure anchor not given on the second body is computed at the reference configuration
     (MuJoCo's qpos0 semantics for ``connect`` and ``weld``).
     """

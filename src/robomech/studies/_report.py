@@ -279,7 +279,7 @@ def write_study_report(
     seconds : float, optional
         Run time of the study (s), recorded in ``results.json`` and shown in the index.
     prov : mapping, optional
-        Provenance to record (default: :func:`provenance` of this process).
+        Provenance to record (default: ``provenance()`` of this process).
 
     Returns
     -------

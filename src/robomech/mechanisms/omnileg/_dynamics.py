@@ -316,7 +316,7 @@ def inverse_dynamics(
     """Motor torques (α, β, γ order) for the motion (q, q̇, q̈), optionally with a force on the foot.
 
     All inputs ``(..., 3)`` broadcast.  ``foot_force (..., 3)`` (N, hip frame) is
-    :data:`FOOT_FORCE_CONVENTION`: the external force applied *to* the foot (as a force applied to the
+    ``FOOT_FORCE_CONVENTION``: the external force applied *to* the foot (as a force applied to the
     foot body in a multibody simulation); it enters as ``-Jᵀ F`` (= :func:`static_torques`).  Paper 2,
     eqs. (49)-(50) add ``+Jᵀ F_f``, i.e. read F_f as the force the foot delivers: pass ``-F_f``.
 
@@ -380,7 +380,7 @@ def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]
 def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
     """Motor torques ``τ = -Jᵀ F`` (..., 3), N·m, holding the leg still against a foot force, gravity aside.
 
-    ``force (..., 3)`` (N, hip frame) is :data:`FOOT_FORCE_CONVENTION`: the force applied *to* the foot,
+    ``force (..., 3)`` (N, hip frame) is ``FOOT_FORCE_CONVENTION``: the force applied *to* the foot,
     the same as ``inverse_dynamics(foot_force=F)``, whose ``foot_terms`` these torques are.  paper 2,
     eq. (50): τ = Jᵀ F_f with F_f the force the foot delivers, F_f = -F.
     """
@@ -392,7 +392,7 @@ def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
 
 @dataclass(frozen=True)
 class FootForceResult:
-    """Foot force ``(..., 3)`` (N, applied to the foot: :data:`FOOT_FORCE_CONVENTION`) from motor torques.
+    """Foot force ``(..., 3)`` (N, applied to the foot: ``FOOT_FORCE_CONVENTION``) from motor torques.
 
     ``singular`` marks samples with ``sigma_min / sigma_max < SINGULAR_RCOND`` (γ ≈ 0): there the force is
     the damped least-squares estimate (its component along the lost direction is not determined by the

@@ -247,7 +247,7 @@ class ForceDistribution:
     ``sigma_min`` (...) m/rad: the conditioning measure, the smallest singular value of J (minimum-norm
     rule) or of the driven legs' 2x2 block (the lever arm through which the legs act; 0 where singular
     or non-finite); ``rcond`` (...) its ratio to the largest.  ``valid`` (...) is False where
-    ``sigma_min < sigma_min_bound`` (default :data:`ACTUATION_SIGMA_MIN`, an actuation singularity or its
+    ``sigma_min < sigma_min_bound`` (default ``ACTUATION_SIGMA_MIN``, an actuation singularity or its
     neighbourhood): there f is NaN if the solve is numerically singular (``rcond`` below
     ``ACTUATION_SINGULAR_RTOL``), else the exact but physically meaningless value."""
 
@@ -269,8 +269,8 @@ def distribute_forces(
 
     ``driven_legs=None``: minimum-norm forces ``f = J (J^T J)^-1 tau`` (all three legs share the load,
     no internal preload). ``driven_legs=(i, j)``: only those two legs act (paper 1's choice is
-    :data:`PAPER_DRIVEN_LEGS`, legs 1 and 3), the third carries no force.  ``sigma_min_bound`` (m/rad,
-    >= 0): the lever arm below which a sample is flagged (see :data:`ACTUATION_SIGMA_MIN`).
+    ``PAPER_DRIVEN_LEGS``, legs 1 and 3), the third carries no force.  ``sigma_min_bound`` (m/rad,
+    >= 0): the lever arm below which a sample is flagged (see ``ACTUATION_SIGMA_MIN``).
     """
     J = as_array(J, "J", (3, 2), finite=False)
     t = as_array(tau, "tau", (2,), finite=False)
