@@ -19,6 +19,8 @@ def test_continuum_verification_passes():
     report = run_verifications(["continuum"])
     assert report.passed, report.table()
     assert any("library CC statics" in c.quantity for c in report.checks)
+    assert sum("disk reference" in c.quantity for c in report.checks) == 3
+    assert len(report.checks) >= 9
 
 
 def test_check_has_teeth_a_wrong_stiffness_in_the_library_model_fails():
@@ -47,3 +49,25 @@ def test_error_table_is_physical():
     assert np.all(np.diff(lateral, axis=1) > 0) and np.all(np.diff(axial, axis=1) > 0)
     # and is not small: at 0.2 N the constant-curvature tip is off by millimetres on this slender core
     assert np.min(t.position_error[:, 3]) > 1e-3
+
+
+def test_convergence_table_small_slice():
+    """Two cases of the docs' convergence table (the full one: benchmarks/continuum_reference.py):
+    two segments at 15 N and 120° (the old reference failed at 5 N), loaded and unloaded."""
+    from robomech.verify.continuum import convergence_table
+
+    t = convergence_table((2,), (15.0,), (120.0,))
+    assert t.taut.all() and t.converged.all() and t.loaded_converged.all()
+    assert np.nanmax(t.tip_error) < 1e-9 * 0.18  # unloaded: the CC arcs are exact
+    assert "✓" in t.markdown()
+
+
+def test_one_paper_robot():
+    """Issue 16: TendonRod.paper() and ContinuumRobot.paper() are one parameter set."""
+    from robomech.verify._cosserat import TendonRod
+
+    a, b = TendonRod.paper(), rod_for(ContinuumRobot.paper())
+    assert a.segment_lengths == b.segment_lengths and a.tendon_radius == b.tendon_radius
+    assert a.tendon_angle == b.tendon_angle and a.tendon_segment == b.tendon_segment
+    assert np.isclose(a.bending_stiffness, b.bending_stiffness, rtol=1e-14)
+    assert np.isclose(a.torsional_stiffness, b.torsional_stiffness, rtol=1e-14)

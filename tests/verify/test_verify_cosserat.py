@@ -239,8 +239,10 @@ ORTHO_TOL = 1e-7
 
 @settings(max_examples=20, deadline=None)
 @given(
-    tau=st.lists(st.floats(0.0, 12.0), min_size=3, max_size=3),
-    force=st.lists(st.floats(-0.4, 0.4), min_size=3, max_size=3),
+    # ranges for the paper robot's 0.8 mm core (EI = 1.2e-3 N m², 4 mm holes; 0-12 N and 0.4 N were
+    # chosen for the former 1.0 mm core, 2.8x less bend per newton)
+    tau=st.lists(st.floats(0.0, 4.5), min_size=3, max_size=3),
+    force=st.lists(st.floats(-0.15, 0.15), min_size=3, max_size=3),
     moment=st.lists(st.floats(-0.01, 0.01), min_size=3, max_size=3),
 )
 def test_property_random_spatial_loads_balance(rod: TendonRod, tau, force, moment) -> None:
@@ -375,19 +377,89 @@ def test_bad_inputs_raise(rod: TendonRod) -> None:
         elastica_cantilever_tip(1e-3, 0.1, 0.0)
 
 
-def test_excessive_tension_is_flagged_not_raised(rod: TendonRod) -> None:
-    """A tension whose cable 'straightening' load rivals the rod stiffness is a per-case flag."""
-    big = cz.MAX_CONTRACTION * 2 * rod.bending_stiffness / rod.tendon_radius[0] ** 2
-    sol = solve_static(rod, [[1.0, 0.0, 0.0], [big, 0.0, 0.0]])
+STRAIN_FP_TOL = 1e-12
+"""Newton strain solve vs a plain fixed-point iteration (the solver used before) where the latter
+contracts (Σ τ r² / EI ≈ 0.1): both converge to round-off of O(1) nondimensional strains."""
+
+
+def _fixed_point_strains(nd, k, tau, R, M, F, iterations=200):
+    """Independent fixed point u ← K⁻¹(Rᵀ M - Σ τ r × t(u, v)), v ← e3 + S (Rᵀ F - Σ τ t) (the solver
+    before Newton), valid while it contracts."""
+    active = nd.seg >= k
+    r, t = nd.r[active], tau[active]
+    mb0, nb0 = np.einsum("jim,jm->im", R, M), np.einsum("jim,j->im", R, F)
+    u, v = mb0 / nd.kbt[:, None], np.broadcast_to(np.array([0.0, 0.0, 1.0])[:, None], mb0.shape).copy()
+    for _ in range(iterations):
+        b = v[None] + np.cross(u.T[None], r[:, None, :]).transpose(0, 2, 1)
+        that = b / np.linalg.norm(b, axis=1, keepdims=True)
+        pm = np.einsum("a,aim->im", t, np.cross(r[:, None, :], that.transpose(0, 2, 1)).transpose(0, 2, 1))
+        pf = np.einsum("a,aim->im", t, that)
+        u = (mb0 - pm) / nd.kbt[:, None]
+        v = np.array([0.0, 0.0, 1.0])[:, None] + (nb0 - pf) * nd.kse_inv[:, None]
+    return u, v
+
+
+def test_newton_strains_equal_fixed_point_where_it_contracts(rod: TendonRod) -> None:
+    nd = cz._nondim(rod)
+    rng = np.random.default_rng(4)
+    m = 7
+    # random rotations (QR of Gaussian matrices) and composite moments; contraction ~0.1
+    R = np.stack([np.linalg.qr(rng.normal(size=(3, 3)))[0] for _ in range(m)], -1)
+    R *= np.sign(np.linalg.det(np.moveaxis(R, -1, 0)))[None, None, :]
+    M = rng.normal(scale=0.5, size=(3, m))
+    F = rng.normal(scale=0.5, size=3)
+    ratio = rod.tendon_radius[0] ** 2 / rod.bending_stiffness
+    tau = np.array([0.04, 0.03, 0.03]) / ratio * rod.bending_stiffness / rod.length**2  # Σ τ r²/EI = 0.1
+    tau = tau * rod.length**2 / rod.bending_stiffness  # nondimensional
+    u, v, _, _ = cz._strains(nd, 0, tau, R, M, F)
+    u_fp, v_fp = _fixed_point_strains(nd, 0, tau, R, M, F)
+    assert np.max(np.abs(u - u_fp)) < STRAIN_FP_TOL and np.max(np.abs(v - v_fp)) < STRAIN_FP_TOL
+
+
+@pytest.mark.parametrize("n_segments, tension", [(1, 15.0), (2, 10.0)])
+def test_high_tension_converges_to_the_arc(n_segments: int, tension: float) -> None:
+    """Σ τ r² / EI > 1 (the old fixed point diverged beyond ~0.3): still the exact unloaded arcs."""
+    ei, L, r = 1.2e-3, 0.09, 4e-3
+    n_t = 3 * n_segments
+    ang = tuple(2 * math.pi * j / 3 + (j // 3) * math.pi / 3 for j in range(n_t))
+    rod = TendonRod(
+        segment_lengths=(L,) * n_segments,
+        bending_stiffness=ei,
+        torsional_stiffness=ei / 1.33,
+        axial_stiffness=None,
+        shear_stiffness=None,
+        tendon_radius=(r,) * n_t,
+        tendon_angle=ang,
+        tendon_segment=tuple(j // 3 for j in range(n_t)),
+    )
+    tau = np.full(n_t, tension)
+    tau[0] += 3.0  # extra pull on cable 1: bends every segment the cable passes through
+    sol = solve_static(rod, tau)
+    assert sol.converged and sol.load_fraction == 1.0 and sol.contraction > 0.5  # old limit: 0.5
+    nd = cz._nondim(rod)
+    u = cz._cc_unloaded_curvature(nd, tau * rod.length**2 / ei) / rod.length
+    T = np.eye(4)
+    for k in range(n_segments):
+        T = T @ constant_curvature_transform(u[k], L)
+    assert np.max(np.abs(sol.T_tip[:3, 3] - T[:3, 3])) / (n_segments * L) < ARC_TOL_REL
+
+
+def test_non_convergence_is_a_finite_per_case_flag(rod: TendonRod, monkeypatch) -> None:
+    """A case the BVP cannot resolve (mesh capped far too low) is flagged with the load fraction it
+    reached; its outputs are finite and the other case in the batch is unaffected."""
+    monkeypatch.setattr(cz, "BVP_MAX_NODES_PER_SEGMENT", 30)
+    hard = [9.0, 0.0, 0.0]
+    sol = solve_static(rod, [[0.0, 0.0, 0.0], hard], [[0.0, 0.0, 0.0], [2.0, 0.0, -2.0]])
     assert sol.converged[0] and not sol.converged[1]
-    assert sol.contraction[1] > cz.MAX_CONTRACTION
+    assert sol.load_fraction[1] < 1.0
+    assert np.all(np.isfinite(sol.position[1])) and np.all(np.isfinite(sol.T_tip))
 
 
 # ---------------------------------------------------------------------------------------------- verify
-def test_verification_module_passes_and_is_registered() -> None:
+def test_verification_module_is_registered() -> None:
+    """Registered under its name; running it (~1 min of Cosserat and disk solves) is
+    tests/verify/test_verify_continuum.py::test_continuum_verification_passes (once, not twice)."""
     from robomech.verify import available_verifications
 
     v = available_verifications()["continuum"]
-    checks = v.run()
-    assert len(checks) >= 4
-    assert all(c.passed for c in checks), [c.as_dict() for c in checks if not c.passed]
+    assert v.name == "continuum" and callable(v.run)

@@ -39,7 +39,13 @@ def _psi_model(default):
 
 SPECS = {
     P + "IK_TOLERANCE": CONSTANT,
-    **exempt("DriveResult FrictionEstimate IKResult SimulationResult TensionResult", RESULT_TYPE, P),
+    P + "IDENTIFY_MU_MAX": CONSTANT,
+    **exempt(
+        "DriveResult FrictionEstimate IKResult PoseFrictionEstimate SimulationResult TensionHistory "
+        "TensionResult",
+        RESULT_TYPE,
+        P,
+    ),
     P + "ContinuumRobot": Spec(
         args={"n_segments": 1, "segment_length": 0.09, "friction": (0.2, 0.3, 0.25), "pretension": 5.0},
         options={
@@ -146,5 +152,27 @@ SPECS = {
         arrays={"wrap": 1, "t_in": 1, "t_out": 1, "direction": 1},
         wrong_shapes={"wrap": ((3, 9),), "t_in": ((3, 9),), "t_out": ((3, 9),), "direction": ((3, 9),)},
         options={"sigma_t": tuple(v for v in BAD_POSITIVE if v is not None)},
+    ),
+    P + "stick_slip_tensions": Spec(
+        args={
+            "robot": ROBOT,
+            "psi": np.array([[0.8, 0.0], [1.2, 0.0], [1.0, 0.0]]),
+            "t_act": np.array([[5.0, 5.0, 5.0], [9.0, 4.0, 4.0], [7.0, 5.0, 5.0]]),
+        },
+        arrays={"psi": 1, "t_act": 1},
+        params=("robot",),
+    ),
+    P + "identify_friction_from_pose": Spec(
+        args={
+            "robot": ROBOT,
+            "psi": np.array([[0.8, 0.0], [1.2, 0.0], [1.0, 2.1]]),
+            "t_act": np.array([[8.0, 4.0, 4.0], [9.0, 3.0, 3.0], [4.0, 7.0, 4.0]]),
+            "direction": np.array([[1.0, -1.0, -1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0]]),
+            "sigma_t": 0.05,
+            "model": "chord",
+        },
+        arrays={"psi": 1, "t_act": 1, "direction": 1},
+        params=("robot",),
+        options={"sigma_t": tuple(v for v in BAD_POSITIVE if v is not None), "model": BAD_MODEL},
     ),
 }

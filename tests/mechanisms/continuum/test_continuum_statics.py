@@ -128,9 +128,9 @@ def test_friction_factors_direction():
     psi = [1.2, 0.0]
     pull = C.friction_factors(PAPER, psi, [1, 1, 1])
     pay = C.friction_factors(PAPER, psi, [-1, -1, -1])
-    stick = C.friction_factors(PAPER, psi, [0, 0, 0])
+    none = C.friction_factors(PAPER, psi, None)  # frictionless model (sticking is refused, see below)
     assert np.all(np.diff(pull, axis=-1) < 0) and np.all(np.diff(pay, axis=-1) > 0)
-    assert np.all(stick == 1.0)
+    assert np.all(none == 1.0)
     total = 1.2 - 1.2 / (2 * PAPER.disks_per_segment)
     assert np.abs(pull[:, -1] - np.exp(-PAPER.friction_array * total)).max() < 1e-14
     with pytest.raises(ValueError, match="direction"):
@@ -139,7 +139,7 @@ def test_friction_factors_direction():
 
 def test_batched_equals_per_sample():
     psi = psi_batch(TWO, seed=6, batch=4)
-    d = np.random.default_rng(0).choice([-1.0, 0.0, 1.0], size=(4, 6))
+    d = np.random.default_rng(0).choice([-1.0, 1.0], size=(4, 6))
     W = np.random.default_rng(1).normal(scale=0.05, size=(4, 6))
     a = C.cable_tensions(TWO, psi, wrench=W, direction=d).tension
     b = np.stack([C.cable_tensions(TWO, psi[i], wrench=W[i], direction=d[i]).tension for i in range(4)])
@@ -153,3 +153,23 @@ def test_bad_input():
         C.cable_tensions(PAPER, [0.1, 0.0], pretension=-1.0)
     with pytest.raises(ValueError, match="psi"):
         C.cable_tensions(PAPER, [np.nan, 0.0])
+
+
+def test_sticking_direction_is_refused_not_frictionless():
+    """Issue 14, defect 6: direction 0 (eq. (19)'s stuck branch) used to return the frictionless tension
+    silently; without a stick-slip model it is a clear error for cables with friction."""
+    import pytest
+
+    from robomech.mechanisms import continuum as C
+
+    robot = C.ContinuumRobot.paper()
+    psi = np.array([0.8, 0.3])
+    with pytest.raises(ValueError, match="direction"):
+        C.cable_tensions(robot, psi, direction=[1.0, 0.0, -1.0])
+    with pytest.raises(ValueError, match="direction"):
+        C.friction_factors(robot, psi, [0.5, -1.0, -1.0])
+    # frictionless cables may stick (nothing is undetermined), and None stays the frictionless model
+    free = C.ContinuumRobot(friction=(0.0, 0.0, 0.0))
+    a = C.cable_tensions(free, psi, direction=[0.0, 0.0, 0.0]).tension
+    b = C.cable_tensions(robot, psi).tension
+    assert np.allclose(a, b, rtol=0, atol=1e-12)

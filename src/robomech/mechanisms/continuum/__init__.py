@@ -15,13 +15,16 @@ from ._compensation import (
 )
 from ._friction import (
     FrictionEstimate,
+    TensionHistory,
     capstan_coefficient,
     capstan_tension_ratio,
     classical_capstan_ratio,
     friction_factors,
     identify_friction,
+    stick_slip_tensions,
     wrap_angles,
 )
+from ._identification import IDENTIFY_MU_MAX, PoseFrictionEstimate, identify_friction_from_pose
 from ._kinematics import (
     IK_TOLERANCE,
     IKResult,
@@ -46,12 +49,15 @@ from ._statics import (
 )
 
 __all__ = [
+    "IDENTIFY_MU_MAX",
     "IK_TOLERANCE",
     "ContinuumRobot",
     "DriveResult",
     "FrictionEstimate",
     "IKResult",
+    "PoseFrictionEstimate",
     "SimulationResult",
+    "TensionHistory",
     "TensionResult",
     "cable_elongation",
     "cable_jacobian",
@@ -68,11 +74,13 @@ __all__ = [
     "forward_kinematics",
     "friction_factors",
     "identify_friction",
+    "identify_friction_from_pose",
     "inverse_kinematics",
     "segment_transform",
     "simulate",
     "span_jacobian",
     "span_lengths",
+    "stick_slip_tensions",
     "theoretical_drive",
     "tip_jacobian",
     "tip_position",

@@ -21,11 +21,13 @@ __all__ = [
     "CAPSTAN_MAX_STEPS",
     "CAPSTAN_STABILITY",
     "FrictionEstimate",
+    "TensionHistory",
     "capstan_coefficient",
     "capstan_tension_ratio",
     "classical_capstan_ratio",
     "friction_factors",
     "identify_friction",
+    "stick_slip_tensions",
     "wrap_angles",
 ]
 
@@ -65,9 +67,15 @@ def _as_direction(robot: ContinuumRobot, direction: object | None, batch: tuple[
     if direction is None:
         return np.zeros((*batch, robot.n_cables))
     d = as_array(direction, "direction", (robot.n_cables,))
-    if np.any(np.abs(d) > 1.0):
+    # paper 3, eq. (19): the stuck branch (q_dot = 0) keeps the previous tension, which needs a stick-slip
+    # model with memory; it is not implemented, so a sticking cable with friction is refused instead of
+    # silently getting the frictionless tension (issue 14, defect 6).  0 is accepted where mu = 0.
+    sliding = (d == 1.0) | (d == -1.0)
+    if np.any(~sliding & (robot.friction_array > 0.0)):
         raise ValueError(
-            "Expected direction in [-1, 1] (+1: cable pulled in, -1: paid out), got larger values."
+            "Expected direction +1 (pulled in) or -1 (paid out) for every cable with friction, got other "
+            "values (0 = sticking: eq. (19)'s stick-slip branch is not modelled; pass direction=None for "
+            "the frictionless model)."
         )
     return d
 
@@ -84,8 +92,8 @@ def friction_factors(robot: ContinuumRobot, psi: object, direction: object | Non
     """Tension of every span relative to the cable's tension at the base plate, ``(..., 3 n, n N)``.
 
     ``direction (..., 3 n)``: +1 where the cable slides toward the actuator (pulled in), -1 where it is
-    paid out, 0 where it sticks (no friction is transmitted; the tension is then undetermined within
-    the friction band and the frictionless value is returned).
+    paid out; ``None``: frictionless.  0 (sticking, eq. (19)'s stuck branch) raises ValueError for a cable
+    with friction: its tension is undetermined within the friction band without a stick-slip memory.
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -316,3 +324,92 @@ def identify_friction(
     chi2 = np.sum(w * (y - mu[..., None] * x) ** 2, axis=-1) / dof
     std = np.sqrt(1.0 / sxx) if sigma_t is not None else np.sqrt(chi2 / sxx)
     return FrictionEstimate(mu=mu, std=std, chi2_per_dof=chi2, n_used=n_used)
+
+
+# ---- stick-slip with memory (eq. (19)) --------------------------------------------------------------
+@dataclass(frozen=True)
+class TensionHistory:
+    """Span tensions of every cable over a history (time axis first, batch shape ``...``).
+
+    ``span_tension (n_t, ..., 3 n, n N)`` (N, zero beyond a cable's termination disk); ``state
+    (n_t, ..., 3 n, n N)`` per hole (the hole where each span starts): +1 sliding with the cable pulled
+    in (span at its lower friction bound), -1 sliding paid out (upper bound), 0 stuck (tension kept from
+    the previous step, strictly within the bounds); ``distal (n_t, ..., 3 n)`` tension of the last span.
+    """
+
+    span_tension: np.ndarray
+    state: np.ndarray
+    distal: np.ndarray
+
+
+def stick_slip_tensions(
+    robot: ContinuumRobot, psi: object, t_act: object, *, initial: object | None = None
+) -> TensionHistory:
+    """Paper 3, eq. (19) with memory: span tensions along the disks for a history of actuator tensions.
+
+    ``psi (n_t, ..., 2 n)`` the pose at every step (wrap angles from :func:`wrap_angles`), ``t_act
+    (n_t, ..., 3 n)`` actuator-side tensions (N, > 0: a slack cable has no friction state).  Starting
+    from ``initial (..., 3 n, n N)`` span tensions (default: every span at the first actuator tension,
+    i.e. the cable laid in without friction history), every step goes from the actuator to the tip: the
+    span beyond hole k keeps its previous tension where that lies within the Coulomb-capstan bounds
+    ``[T_{k-1} exp(-mu eta_k), T_{k-1} exp(mu eta_k)]`` of its new proximal neighbour (stuck, eq. (19)'s
+    q_dot = 0 branch T(t^-1)), else it slides and takes the bound (eq. (19)'s q_dot != 0 branch, with the
+    physical sign of departure 4).  Loading and unloading therefore give hysteresis loops; the result is
+    path-dependent.  This is the rigid-cable (inextensible) limit of a tendon-through-holes model: the
+    tension change travels from the actuator; cable stretch does not feed back on the sliding.
+    """
+    check_params(robot, ContinuumRobot, "robot")
+    p = as_array(psi, "psi", (None, 2 * robot.n_segments))
+    t = as_array(t_act, "t_act", (None, robot.n_cables))
+    if p.ndim < 2 or t.ndim < 2:
+        raise ValueError(
+            f"Expected psi (n_t, ..., {2 * robot.n_segments}) and t_act (n_t, ..., {robot.n_cables}) with a "
+            "leading time axis."
+        )
+    if p.shape[0] != t.shape[0] or p.shape[0] < 1:
+        raise ValueError(
+            f"Expected psi and t_act with one common time length >= 1, got {p.shape[0]} and {t.shape[0]}."
+        )
+    if np.any(t <= 0.0):
+        raise ValueError(
+            "Expected t_act > 0 at every step (a cable at or below zero tension is slack and has no friction "
+            f"state), got min {t.min()!r} N."
+        )
+    theta, beta = _split(robot, p)
+    eta = _wrap(robot, theta, beta)  # (n_t, ..., 3n, nN)
+    n_t = p.shape[0]
+    batch = np.broadcast_shapes(eta.shape[1:-2], t.shape[1:-1])
+    eta = np.broadcast_to(eta, (n_t, *batch, *eta.shape[-2:]))
+    t = np.broadcast_to(t, (n_t, *batch, robot.n_cables))
+    n_spans = robot.disks_per_segment * (robot.cable_segment + 1)
+    active = np.arange(robot.n_segments * robot.disks_per_segment)[None, :] < n_spans[:, None]
+    mu = robot.friction_array[:, None]
+    if initial is None:
+        prev = np.where(active, t[0][..., None], 0.0)
+    else:
+        prev = as_array(initial, "initial", active.shape)
+        if np.any(prev[..., active] <= 0.0):
+            raise ValueError("Expected initial span tensions > 0 on every active span.")
+        prev = np.where(active, np.broadcast_to(prev, (*batch, *active.shape)), 0.0)
+    out = np.zeros((n_t, *batch, *active.shape))
+    state = np.zeros(out.shape, dtype=int)
+    K = active.shape[-1]
+    for i in range(n_t):  # time steps (a history is sequential), vectorised over batch and cables
+        cur = np.empty_like(prev)
+        proximal = t[i]
+        for k in range(K):  # holes from the actuator to the tip
+            lo = proximal * np.exp(-mu[:, 0] * eta[i][..., k])
+            hi = proximal * np.exp(mu[:, 0] * eta[i][..., k])
+            old = prev[..., k]
+            # paper 3, eq. (19): stuck (q_dot = 0) keeps T(t^-1); the print gives no criterion for
+            # sticking: here a span sticks while within the Coulomb-capstan bounds, else slides at them
+            new = np.clip(old, lo, hi)
+            state[i][..., k] = np.where(old < lo, 1, np.where(old > hi, -1, 0))
+            cur[..., k] = np.where(active[:, k], new, 0.0)
+            state[i][..., k] = np.where(active[:, k], state[i][..., k], 0)
+            proximal = np.where(active[:, k], new, proximal)
+        out[i] = cur
+        prev = cur
+    last = n_spans - 1
+    distal = np.take_along_axis(out, np.broadcast_to(last[:, None], (*out.shape[:-1], 1)), axis=-1)[..., 0]
+    return TensionHistory(span_tension=out, state=state, distal=distal)
