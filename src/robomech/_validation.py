@@ -25,6 +25,7 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 
 __all__ = [
+    "MAX_MAGNITUDE",
     "as_array",
     "broadcast_batch",
     "check_bool",
@@ -44,6 +45,12 @@ __all__ = [
 # datetime kinds are not numbers at all.
 _REAL_KINDS = frozenset("iuf")
 
+# Largest magnitude accepted where a finite number is required.  Models multiply up to a few inputs
+# together (squares of lengths, cubes in Jacobian products, rates squared times inertias): with
+# |x| <= 1e100 a product of three stays below 1e300 < 1.8e308, so float64 cannot overflow to inf
+# silently.  No physical quantity in SI units of these mechanisms comes near 1e100.
+MAX_MAGNITUDE = 1e100
+
 
 def _shape_text(tail: Sequence[int | None]) -> str:
     parts = ["..."] + ["n" if d is None else str(d) for d in tail]
@@ -61,15 +68,17 @@ def as_array(
     name: str,
     tail: Sequence[int | None] = (),
     *,
-    finite: bool = True,
+    finite: bool | str = True,
     min_ndim: int | None = None,
 ) -> np.ndarray:
     """Return ``x`` as a float64 array whose trailing dimensions are ``tail``.
 
     Only real numbers are accepted (integer or float dtypes); complex, bool, str and object inputs
     (including ``None`` and ragged lists) raise.  ``None`` in ``tail`` accepts any length.
-    ``finite=True`` rejects NaN and infinity; a model that prefers to flag such samples per sample
-    passes ``finite=False`` and masks them itself (see ``finite_samples``).
+    ``finite=True`` rejects NaN, infinity and magnitudes above :data:`MAX_MAGNITUDE`; a model that
+    prefers to flag such samples per sample passes ``finite=False`` and masks them itself (see
+    ``finite_samples``), or ``finite="mask"``, which also turns every magnitude above
+    :data:`MAX_MAGNITUDE` (and inf) into NaN, for models that mask NaN samples.
     """
     if x is None or isinstance(x, str | bytes):
         raise ValueError(f"Expected {name} to be an array of real numbers, got {type(x).__name__}.")
@@ -88,18 +97,35 @@ def as_array(
         d is not None and a.shape[a.ndim - len(tail) + i] != d for i, d in enumerate(tail)
     ):
         raise ValueError(f"Expected {name} to have shape {_shape_text(tail)}, got {a.shape}.")
-    if finite and not np.all(np.isfinite(a)):
-        bad = int(np.size(a) - np.count_nonzero(np.isfinite(a)))
-        raise ValueError(f"Expected {name} to be finite, got {bad} non-finite value(s).")
+    if finite == "mask":
+        return usable(a)
+    if finite:
+        if not np.all(np.isfinite(a)):
+            bad = int(np.size(a) - np.count_nonzero(np.isfinite(a)))
+            raise ValueError(f"Expected {name} to be finite, got {bad} non-finite value(s).")
+        if a.size and np.max(np.abs(a)) > MAX_MAGNITUDE:
+            raise ValueError(
+                f"Expected {name} to have magnitudes <= {MAX_MAGNITUDE:g} (float64 products overflow "
+                f"beyond), got {float(np.max(np.abs(a))):.3g}."
+            )
     return a
 
 
 def finite_samples(a: np.ndarray, n_core: int) -> np.ndarray:
-    """Per-sample finiteness: ``all(isfinite)`` over the last ``n_core`` axes of ``a``."""
-    f = np.isfinite(a)
+    """Per-sample usability: every entry finite and within :data:`MAX_MAGNITUDE`, over the last
+    ``n_core`` axes of ``a`` (the mask a model applies before its kernels)."""
+    with np.errstate(invalid="ignore"):
+        f = np.abs(a) <= MAX_MAGNITUDE  # False for NaN and inf too
     if n_core:
         f = f.all(axis=tuple(range(a.ndim - n_core, a.ndim)))
     return np.asarray(f)
+
+
+def usable(a: np.ndarray) -> np.ndarray:
+    """``a`` with every entry that is not finite or exceeds :data:`MAX_MAGNITUDE` replaced by NaN, for
+    models that mask non-finite samples themselves (``as_array(..., finite=False)``)."""
+    with np.errstate(invalid="ignore"):
+        return np.where(np.abs(a) <= MAX_MAGNITUDE, a, np.nan)
 
 
 def check_finite(a: np.ndarray, name: str) -> None:
@@ -140,6 +166,8 @@ def check_real(
     v = _scalar(value, name)
     if math.isnan(v) or (finite and not math.isfinite(v)):
         raise ValueError(f"Expected {name} to be a finite real number, got {value!r}.")
+    if finite and abs(v) > MAX_MAGNITUDE:
+        raise ValueError(f"Expected {name} to have magnitude <= {MAX_MAGNITUDE:g}, got {value!r}.")
     if low is not None and (v < low or (low_open and v == low)):
         raise ValueError(f"Expected {name} {'>' if low_open else '>='} {low}, got {value!r}.")
     if high is not None and (v > high or (high_open and v == high)):
@@ -150,7 +178,7 @@ def check_real(
 def check_positive(value: object, name: str, *, allow_zero: bool = False) -> float:
     """Validate one positive (or non-negative) finite real scalar; return it as a float."""
     v = _scalar(value, name)
-    ok = math.isfinite(v) and (v >= 0.0 if allow_zero else v > 0.0)
+    ok = math.isfinite(v) and abs(v) <= MAX_MAGNITUDE and (v >= 0.0 if allow_zero else v > 0.0)
     if not ok:
         rel = ">= 0" if allow_zero else "> 0"
         raise ValueError(f"Expected {name} {rel} and finite, got {value!r}.")

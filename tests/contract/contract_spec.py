@@ -53,6 +53,8 @@ class Spec:
     ``finite_result``  the good call's result must be finite wherever ``mask`` is true (or everywhere
                  without ``mask``); False for functions whose good output may be inf by design.
     ``slow``     mark the good call and its bad calls ``pytest.mark.slow``.
+    ``empty_batch``  the good call with every array argument cut to an empty leading batch must
+                 return (empty results), not raise; False where an array's leading axis is no batch.
     ``good_elsewhere``  for a call that takes minutes (a whole engine verification): the test file
                  that runs the good call; the contract suite then makes only the bad calls.
     """
@@ -68,6 +70,7 @@ class Spec:
     finite_result: bool = True
     slow: bool = False
     good_elsewhere: str = ""
+    empty_batch: bool = True
 
     def __post_init__(self) -> None:
         if self.good_elsewhere and (self.masked or self.mask is not None):

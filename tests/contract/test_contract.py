@@ -135,7 +135,11 @@ def _expect_value_error(name: str, spec: Spec, args: dict[str, Any], arg: str, w
     assert "xpected" in msg, f"{name}({arg}={what}): say what was expected and what was got; got: {msg}"
 
 
-def _check_masked(name: str, spec: Spec, arg: str, args: dict[str, Any], flat_index: int) -> None:
+def _check_masked(
+    name: str, spec: Spec, arg: str, args: dict[str, Any], flat_index: int, must_mask: bool = True
+) -> None:
+    """NaN/inf at one sample: masked there, the other samples unchanged.  A finite but huge value
+    (``must_mask=False``) may instead be used, as long as nothing under a true mask overflows."""
     good = _good(name, spec)
     a = np.asarray(spec.args[arg], dtype=float)
     core = spec.arrays[arg]
@@ -149,7 +153,8 @@ def _check_masked(name: str, spec: Spec, arg: str, args: dict[str, Any], flat_in
         f"mask, it has {batch}"
     )
     sample = flat_index // core_size
-    assert not mask.reshape(-1)[sample], f"{name}: non-finite {arg} at sample {sample} is not masked"
+    if must_mask:
+        assert not mask.reshape(-1)[sample], f"{name}: non-finite {arg} at sample {sample} is not masked"
     _check_finite_where_valid(name, spec, res)
     keep = np.ones(mask.size, dtype=bool)
     keep[sample] = False
@@ -171,7 +176,7 @@ def _check_masked(name: str, spec: Spec, arg: str, args: dict[str, Any], flat_in
 def _variants(name: str, spec: Spec, arg: str) -> list[tuple[str, Any]]:
     a = np.array(spec.args[arg], dtype=float)
     out = []
-    for label, val in (("nan", np.nan), ("inf", np.inf), ("-inf", -np.inf)):
+    for label, val in (("nan", np.nan), ("inf", np.inf), ("-inf", -np.inf), ("1e300", 1e300)):
         b = a.copy()
         b.flat[0] = val
         out.append((label, b))
@@ -244,8 +249,8 @@ def test_bad_array(name, arg, variant):
     spec = ACTIVE[name]
     value = dict(_variants(name, spec, arg))[variant]
     args = {**spec.args, arg: value}
-    if arg in spec.masked and variant in ("nan", "inf", "-inf"):
-        _check_masked(name, spec, arg, args, 0)
+    if arg in spec.masked and variant in ("nan", "inf", "-inf", "1e300"):
+        _check_masked(name, spec, arg, args, 0, must_mask=variant != "1e300")
     else:
         _expect_value_error(name, spec, args, arg, variant)
 
@@ -260,22 +265,67 @@ def test_bad_array(name, arg, variant):
     ],
 )
 def test_bad_element_anywhere(name, arg):
-    """Hypothesis: a non-finite value at any element of any array argument."""
+    """Hypothesis: a non-finite or overflowing (1e300) value at any element of any array argument."""
     spec = ACTIVE[name]
     a = np.array(spec.args[arg], dtype=float)
 
     @settings(max_examples=4, deadline=None, database=None)
-    @given(k=st.integers(0, a.size - 1), v=st.sampled_from([np.nan, np.inf, -np.inf]))
+    @given(k=st.integers(0, a.size - 1), v=st.sampled_from([np.nan, np.inf, -np.inf, 1e300, -1e300]))
     def check(k, v):
         b = a.copy()
         b.flat[k] = v
         args = {**spec.args, arg: b}
         if arg in spec.masked:
-            _check_masked(name, spec, arg, args, k)
+            _check_masked(name, spec, arg, args, k, must_mask=not np.isfinite(v))
         else:
             _expect_value_error(name, spec, args, arg, f"non-finite at flat index {k}")
 
     check()
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(n, marks=[pytest.mark.slow] if s.slow else [])
+        for n, s in sorted(ACTIVE.items())
+        if s.arrays
+        and s.empty_batch
+        and not s.good_elsewhere
+        and all(np.ndim(s.args[a]) > core for a, core in s.arrays.items())
+    ],
+)
+def test_empty_batch(name):
+    """A batch of zero samples is a batch: empty results, no exception."""
+    spec = ACTIVE[name]
+    args = {**spec.args, **{a: np.asarray(spec.args[a], dtype=float)[:0] for a in spec.arrays}}
+    res = _call(name, spec, args)
+    if spec.mask is not None:
+        assert _mask_of(spec, res).size == 0, f"{name}: an empty batch gave a non-empty mask"
+
+
+def _dataclass_specs():
+    out = []
+    for n, s in sorted(ACTIVE.items()):
+        target = _target(n, s)
+        if inspect.isclass(target) and dataclasses.is_dataclass(target):
+            out.append(n)
+    return out
+
+
+@pytest.mark.parametrize("name", _dataclass_specs())
+def test_dataclass_fields_are_stored_as_plain_numbers(name):
+    """A parameter dataclass stores validated Python floats/ints, whatever real type it was given
+    (``SphericalLeg(R=np.float32(0.075)).R`` is a float), so equality and hashing see values."""
+    spec = ACTIVE[name]
+    numeric = {
+        k: (np.int64(v) if isinstance(v, int) else np.float32(v))
+        for k, v in spec.args.items()
+        if isinstance(v, int | float) and not isinstance(v, bool)
+    }
+    obj = _call(name, spec, {**spec.args, **numeric})
+    for k in numeric:
+        v = getattr(obj, k)
+        assert type(v) in (float, int), f"{name}.{k} stored as {type(v).__name__}, expected a plain float/int"
 
 
 # --- parameter objects and options ----------------------------------------------------------------

@@ -157,3 +157,51 @@ def test_continuum_integer_fields_reject_bools_and_capstan_rejects_n_zero():
         c.ContinuumRobot(n_segments=True)
     with pytest.raises(ValueError, match="n"):
         c.capstan_coefficient(np.array([2.0]), 1.0, 0.0)
+
+
+def test_lstsq_docs_name_the_compiled_kernel_and_the_one_norm_condition_number():
+    """Defect 7: the solver is robomech's compiled Householder kernel, and cond is the 1-norm one of R."""
+    from robomech.analysis import lstsq
+
+    assert "compiled" in lstsq.__doc__ and "(LAPACK)" not in lstsq.__doc__.splitlines()[0]
+    assert "1-norm" in lstsq.LstsqResult.__doc__ and "||R||_1 ||R^-1||_1" in lstsq.LstsqResult.__doc__
+
+
+def test_jacobian_derivative_and_trajectory_validate_their_input():
+    from robomech import trajectory
+    from robomech.kinematics import jacobian_derivative
+
+    with pytest.raises(ValueError, match="qd"):
+        jacobian_derivative(np.zeros((6, 3, 3)), np.zeros(4))
+    with pytest.raises(ValueError, match="H"):
+        jacobian_derivative(np.full((6, 3, 3), np.nan), np.zeros(3))
+    with pytest.raises(ValueError, match="amplitude"):
+        trajectory.sinusoid(np.zeros(3), np.nan, 1.0)
+    with pytest.raises(ValueError, match="end"):
+        trajectory.quintic(np.zeros(3), 1.0, 0.0, "1")
+
+
+def test_dynamics_kernels_reject_non_finite_input():
+    from robomech import dynamics
+
+    G = np.broadcast_to(np.eye(6), (2, 6, 6))
+    J = np.ones((2, 6, 3))
+    J[0, 0, 0] = np.nan
+    with pytest.raises(ValueError, match="J"):
+        dynamics.mass_matrix(G, J)
+
+
+def test_values_beyond_max_magnitude_are_rejected_or_masked_never_overflowed():
+    """1e300 in a finite input overflowed to inf inside the models (squares, products): now a
+    ValueError where a number is required, a false mask where the model flags samples."""
+    from robomech._validation import MAX_MAGNITUDE
+    from robomech.mechanisms import spherical_leg as sl
+
+    leg = sl.SphericalLeg.paper()
+    with pytest.raises(ValueError, match="alpha"):
+        sl.inverse_kinematics(leg, np.array([0.1, 1e300]), 0.0)
+    lengths = sl.inverse_kinematics(leg, np.array([0.1, 0.2]), 0.0).lengths
+    lengths[1, 0] = 1e300
+    fk = sl.forward_kinematics(leg, lengths)
+    assert fk.valid[0] and not fk.valid[1]
+    assert MAX_MAGNITUDE**3 < np.finfo(float).max

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from robomech._validation import check_choice, check_int, check_positive, check_real
+from robomech._validation import check_choice, check_int, check_positive, check_real, coerce_int_fields
 
 __all__ = ["DesignStudy", "Metric", "Objective", "Variable", "with_variables"]
 
@@ -184,9 +184,8 @@ class DesignStudy:
         for o in self.objectives:
             if o.metric not in names:
                 raise ValueError(f"Expected objectives to name metrics among {names}, got {o.metric!r}.")
-        check_int(self.poses_per_design, "poses_per_design", low=1)
-        check_int(self.default_chunk, "default_chunk", low=1)
-        check_int(self.default_designs, "default_designs", low=1)
+        # stored as plain ints (a NumPy integer would survive into JSON reports and equality)
+        coerce_int_fields(self, ("poses_per_design", "default_chunk", "default_designs"), low=1)
         check_choice(self.default_sampler, "default_sampler", ("sobol", "lhs", "grid", "random"))
         if not isinstance(self.parameters, Mapping):
             raise ValueError(f"Expected parameters to be a mapping, got {type(self.parameters).__name__}.")

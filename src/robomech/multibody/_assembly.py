@@ -272,7 +272,7 @@ def inverse_kinematics(
     if not isinstance(site, str):
         raise ValueError(f"Expected site to be a site name (str), got {type(site).__name__}.")
     si = tree.site_index(site)
-    T = as_array(T_target, "T_target", (4, 4), finite=False)
+    T = as_array(T_target, "T_target", (4, 4), finite="mask")  # beyond 1e100: masked like NaN
     w = np.ones(6) if weights is None else as_array(weights, "weights", (6,))
     if w.ndim != 1 or np.any(w < 0) or not np.any(w > 0):
         raise ValueError(f"Expected weights to be 6 non-negative numbers, not all zero, got {w!r}.")

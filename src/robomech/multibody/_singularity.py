@@ -177,7 +177,7 @@ def singularity_map(
     if (q_act is None) == (T is None):
         raise ValueError("Expected exactly one of q_act (input grid) or T (output grid).")
     if q_act is not None:
-        qa = as_array(q_act, "q_act", (len(mech.actuated),), finite=False)
+        qa = as_array(q_act, "q_act", (len(mech.actuated),), finite="mask")  # beyond 1e100: masked like NaN
         r = forward_kinematics(mech, qa, guess, steps=steps)
         ok = r.converged
     else:

@@ -94,5 +94,6 @@ SPECS = {
         arrays={"ranges": 1},
         wrong_shapes={"ranges": ((2, 3),)},
         options={"n": (*BAD_INT, 1, [3]), "ranges": ([(1.0, 0.0)], [])},
+        empty_batch=False,  # ranges (d, 2) lists coordinates, not samples
     ),
 }

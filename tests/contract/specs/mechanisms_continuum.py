@@ -161,6 +161,7 @@ SPECS = {
         },
         arrays={"psi": 1, "t_act": 1},
         params=("robot",),
+        empty_batch=False,  # the leading axis is time: a history needs a first step
     ),
     P + "identify_friction_from_pose": Spec(
         args={
@@ -174,5 +175,6 @@ SPECS = {
         arrays={"psi": 1, "t_act": 1, "direction": 1},
         params=("robot",),
         options={"sigma_t": tuple(v for v in BAD_POSITIVE if v is not None), "model": BAD_MODEL},
+        empty_batch=False,  # the leading axis lists measurements of one fit (m >= 1 required)
     ),
 }

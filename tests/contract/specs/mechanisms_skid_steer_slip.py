@@ -126,6 +126,7 @@ SPECS = {
         params=("encoder",),
         options={"dt": BAD_POSITIVE},
         wrong_shapes={"radii": ((2, 3),)},
+        empty_batch=False,  # radii (k,) are one side's wheels, not samples
     ),
     P + "planar_ekf": Spec(
         args={

@@ -37,7 +37,7 @@ SPECS = {
     P + "reciprocal_product": Spec(args={"S1": V2, "S2": V2[::-1]}, arrays={"S1": 1, "S2": 1}),
     P + "virtual_power": Spec(args={"W": V2, "V": V2[::-1]}, arrays={"W": 1, "V": 1}),
     P + "screw_from_axis": Spec(
-        args={"axis": W2, "point": W2[::-1], "pitch": np.array([0.0, 0.1])},
+        args={"axis": W2, "point": W2[::-1], "pitch": 0.1},
         arrays={"axis": 1, "point": 1},
         options={"pitch": (np.nan, None, "0.1", 1j)},
     ),

@@ -44,7 +44,7 @@ SIM_FD_STEP = 6e-6
 
 
 def _lengths_and_factors(robot, theta, beta, direction, model):
-    psi = np.stack([theta, beta], -1).reshape(*theta.shape[:-1], -1)
+    psi = np.stack([theta, beta], -1).reshape(*theta.shape[:-1], 2 * theta.shape[-1])
     ell = span_lengths(robot, psi, model)  # (..., 3n, nN)
     P = _factors(robot, _wrap(robot, theta, beta), direction)
     return ell, P
@@ -86,7 +86,7 @@ def theoretical_drive(robot: ContinuumRobot, psi: object, model: CableModel = "a
     """Cable pulled in by each actuator for a rigid, frictionless robot: q = -(L(psi) - L(0))."""
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
-    psi_a = np.stack([theta, beta], -1).reshape(*theta.shape[:-1], -1)
+    psi_a = np.stack([theta, beta], -1).reshape(*theta.shape[:-1], 2 * theta.shape[-1])
     return -(span_lengths(robot, psi_a, model).sum(axis=-1) - _l0(robot, model))
 
 
@@ -118,7 +118,7 @@ def compensated_drive(
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
-    psi_a = np.stack([theta, beta], -1).reshape(*theta.shape[:-1], -1)
+    psi_a = np.stack([theta, beta], -1).reshape(*theta.shape[:-1], 2 * theta.shape[-1])
     tr: TensionResult = cable_tensions(robot, psi_a, wrench=wrench, direction=direction, model=model)
     q = theoretical_drive(robot, psi_a, model)
     delta = cable_elongation(robot, psi_a, tr.tension, direction, model)

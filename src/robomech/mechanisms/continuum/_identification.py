@@ -62,9 +62,9 @@ def identify_friction_from_pose(
     p = as_array(psi, "psi", (2 * robot.n_segments,))
     t = as_array(t_act, "t_act", (n_c,))
     d = as_array(direction, "direction", (n_c,))
-    if p.ndim != 2 or t.shape != (p.shape[0], n_c) or d.shape != t.shape:
+    if p.ndim != 2 or p.shape[0] < 1 or t.shape != (p.shape[0], n_c) or d.shape != t.shape:
         raise ValueError(
-            f"Expected psi (m, {2 * robot.n_segments}), t_act and direction (m, {n_c}) with one m, got "
+            f"Expected psi (m, {2 * robot.n_segments}), t_act and direction (m, {n_c}) with one m >= 1, got "
             f"{p.shape}, {t.shape}, {d.shape}."
         )
     if np.any((d != 1.0) & (d != -1.0)):

@@ -250,7 +250,7 @@ def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
     flagged (``exists`` false), not raised.
     """
     check_params(leg, OmniLeg, "leg")
-    p = as_array(p_foot, "p_foot", (3,), finite=False)
+    p = as_array(p_foot, "p_foot", (3,), finite="mask")  # NaN, inf, beyond 1e100: masked
     pf = p.reshape(-1, 3)
     n = pf.shape[0]
     q = np.empty((n, 3))

@@ -93,8 +93,8 @@ def icr_velocity(model: ICRModel, v_right: object, v_left: object) -> PlanarVelo
     Non-finite speeds (encoder drop-outs) are flagged per sample by ``valid``.
     """
     check_params(model, ICRModel, "model")
-    vr = as_array(v_right, "v_right", finite=False)
-    vl = as_array(v_left, "v_left", finite=False)
+    vr = as_array(v_right, "v_right", finite="mask")
+    vl = as_array(v_left, "v_left", finite="mask")
     try:
         vr, vl = np.broadcast_arrays(vr, vl)
     except ValueError as exc:
@@ -169,13 +169,14 @@ def identify_icr(
 
     Equations per sample: ``-r y_right = v_right - v_x``, ``-r y_left = v_left - v_x``, ``-r x_icr = v_y``.
     ``weights (N,)`` (``>= 0``) weight each sample's three equations (e.g. ``1/σ²`` of that sample).
-    Samples with any non-finite value (drop-outs) are not used and are reported in ``used`` (nothing is
+    Samples with any non-finite value (drop-outs; also magnitudes beyond ``_validation.MAX_MAGNITUDE``,
+    which would overflow the products) are not used and are reported in ``used`` (nothing is
     dropped silently).  Straight driving carries no information (its rows are zero); a data set without
     turning is reported ``identifiable = False``.
     """
-    vr = as_array(v_right, "v_right", finite=False)
-    vl = as_array(v_left, "v_left", finite=False)
-    V = as_array(body_velocity, "body_velocity", (3,), finite=False)
+    vr = as_array(v_right, "v_right", finite="mask")
+    vl = as_array(v_left, "v_left", finite="mask")
+    V = as_array(body_velocity, "body_velocity", (3,), finite="mask")
     if vr.ndim != 1:
         raise ValueError(f"Expected v_right to have shape (N,), got {vr.shape}.")
     if vl.shape != vr.shape:

@@ -130,7 +130,7 @@ def encoder_rates(model: EncoderModel, wheel_rate: object, dt: float, seed: obje
     out = np.full(w.shape, np.nan)
     out[1:] = np.diff(counts, axis=0) * q / h
     valid = np.ones(w.shape[0], dtype=bool)
-    valid[0] = False
+    valid[:1] = False  # (an empty history has no first sample)
     return EncoderReadings(rate=out, valid=valid)
 
 
@@ -257,7 +257,7 @@ def planar_ekf(
         (v_left, "v_left", oks["encoder_ok"]),
         (gyro_z, "gyro_z", oks["gyro_ok"]),
     ):
-        arr = as_array(a, name, finite=False)
+        arr = as_array(a, name, finite="mask")  # beyond MAX_MAGNITUDE counts as non-finite
         if arr.shape != (n,):
             raise ValueError(
                 f"Expected {name} to have shape ({n},) like t (one sample rate for all histories), "

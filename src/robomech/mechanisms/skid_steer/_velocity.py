@@ -195,8 +195,8 @@ def body_velocity(
     ``residual_norm`` is then the weighted (dimensionless) residual.
     """
     check_params(robot, ExplorationRobot, "robot")
-    q = as_array(state, "state", (CONFIG_SIZE,), finite=False)
-    m = as_array(measured, "measured", (MEASURED_SIZE,), finite=False)
+    q = as_array(state, "state", (CONFIG_SIZE,), finite="mask")  # NaN, inf, beyond 1e100: drop-outs
+    m = as_array(measured, "measured", (MEASURED_SIZE,), finite="mask")
     if solver not in ("qr", "normal_equations"):
         raise ValueError(f"Expected solver 'qr' or 'normal_equations', got {solver!r}.")
     check_bool(exact_cond, "exact_cond")

@@ -224,7 +224,7 @@ def forward_kinematics(
     branch = check_int(branch, "branch", low=0, high=1)
     paper_as_printed = check_bool(paper_as_printed, "paper_as_printed")
     L = as_array(lengths, "lengths", (3,), finite=False)
-    shape = L.shape[:-1]
+    L, shape = as_array(L, "lengths", finite="mask"), L.shape[:-1]  # beyond 1e100: masked like NaN
     n = int(np.prod(shape, dtype=int))
     if paper_as_printed:
         from ._as_printed import forward_as_printed
