@@ -566,16 +566,19 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
 
 
 def _run_chunked(fn, n: int, arrays: list[np.ndarray], **kw) -> dict[str, np.ndarray]:
-    parts = [fn(*(a[i : i + CHUNK] for a in arrays), **kw) for i in range(0, max(n, 1), CHUNK)]
-    if n == 0:
-        return {k: v[:0] for k, v in parts[0].items()}
+    # overflow in a sample (inputs of 1e300) is flagged by its mask, not warned about
+    with np.errstate(all="ignore"):
+        if n == 0:  # an empty batch: evaluate one dummy sample for the result shapes, return none of it
+            part = fn(*(np.zeros((1, *a.shape[1:])) for a in arrays), **kw)
+            return {k: v[:0] for k, v in part.items()}
+        parts = [fn(*(a[i : i + CHUNK] for a in arrays), **kw) for i in range(0, n, CHUNK)]
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
 
 
 def _finite_rows(*xs: np.ndarray) -> np.ndarray:
     ok = np.ones(xs[0].shape[0], dtype=bool)
     for x in xs:
-        ok &= np.all(np.isfinite(x.reshape(x.shape[0], -1)), axis=-1)
+        ok &= np.all(np.isfinite(x.reshape(x.shape[0], int(np.prod(x.shape[1:])))), axis=-1)
     return ok
 
 
@@ -605,6 +608,11 @@ def _sanitize(mech, flat: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray
 
 
 def _shape(d: dict, batch, ok: np.ndarray, nan_keys) -> dict:
+    # a sample whose results overflowed (inputs of 1e300, say) is not valid
+    for v in d.values():
+        v = np.asarray(v)
+        if v.dtype.kind == "f" and v.shape[:1] == ok.shape:
+            ok = ok & np.all(np.isfinite(v.reshape(v.shape[0], int(np.prod(v.shape[1:])))), axis=-1)
     res = {}
     for k, v in d.items():
         v = np.array(v)
@@ -735,7 +743,10 @@ def site_wrench(
     tree = mech.tree
     L = tree.length
     out = {k: [] for k in ("wrench", "residual", "sigma_min", "cond", "valid")}
-    for i in range(0, max(qf.shape[0], 1), CHUNK):
+    empty = qf.shape[0] == 0
+    if empty:  # one dummy sample for the result shapes (sliced away below)
+        qf, tf = tree.q0[None], np.zeros((1, na))
+    for i in range(0, qf.shape[0], CHUNK):
         qc, tc = qf[i : i + CHUNK], tf[i : i + CHUNK]
         n = qc.shape[0]
         z = np.zeros((n, na))
@@ -758,7 +769,7 @@ def site_wrench(
         valid = st["valid"] & (cond <= SINGULAR_COND) & np.all(np.isfinite(W), axis=-1)
         for k, v in zip(out, (W, res, smin, cond, valid), strict=True):
             out[k].append(v)
-    d = {k: np.concatenate(v) for k, v in out.items()}
+    d = {k: np.concatenate(v)[: 0 if empty else None] for k, v in out.items()}
     d = _shape(d, batch, ok, ("wrench",))
     return SiteWrenchResult(**d)
 
@@ -894,6 +905,9 @@ def energy(mech: Mechanism, q: object, qd: object) -> tuple[np.ndarray, np.ndarr
 # Integrator tolerances for solve_ivp (DOP853): relative 1e-10 and absolute 1e-12 (rad, m, rad/s) keep the
 # local error far below the closure tolerance between two projections.
 SIM_RTOL = 1e-10
+# Largest |entry| of an initial state (rad, m, rad/s, m/s) accepted by simulate: far beyond any
+# mechanism, far below overflow of the squares in the energy (1e300 overflows).
+MAX_STATE = 1e100
 SIM_ATOL = 1e-12
 
 
@@ -1035,8 +1049,9 @@ def simulate(
     )
     q0f, qa0 = flat[0], flat[1]
     for x, nm in ((q0f, "q0"), (qa0, "qd_act0")):
-        if not np.all(np.isfinite(x)):
-            raise ValueError(f"Expected {nm} to be finite, got NaN or inf.")
+        # an initial state is simulated, not masked: it must be finite and of physical size
+        if not np.all(np.isfinite(x)) or np.any(np.abs(x) > MAX_STATE):
+            raise ValueError(f"Expected {nm} finite with |value| <= {MAX_STATE:g}, got NaN, inf or more.")
     q0f = normalize_quaternions(tree, q0f)
     N = q0f.shape[0]
     # the initial rates of every coordinate: qd = G qd_act0 (idle motions at rest)

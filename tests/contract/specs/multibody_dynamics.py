@@ -14,7 +14,7 @@ QA = np.array([[0.2], [-0.4], [0.6]])
 Q = mb.forward_kinematics(MECH, QA).q  # (3, 3)
 QD = np.array([[1.0], [-0.5], [0.3]])
 QDD = np.array([[0.2], [0.1], [-1.0]])
-W = np.array([[0.0, 0.0, 0.1, 1.0, -2.0, 0.0]] * 3)
+W = np.array([0.0, 0.0, 0.1, 1.0, -2.0, 0.0])  # one wrench, broadcast (the empty-batch check)
 BAD_WRENCHES = ("x", {"no_such_site": np.zeros(6)}, {"coupler_point": np.full(6, np.nan)}, [np.zeros(6)])
 BAD_WEIGHTS = ("x", np.array([-1.0]), np.array([0.0]), np.array([1.0, 1.0]), np.array([np.nan]))
 
