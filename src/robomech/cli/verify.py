@@ -20,7 +20,7 @@ def _description() -> str:
 
 
 def _add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("mechanisms", nargs="*", metavar="MECHANISM", help="mechanisms to verify (default: all)")
+    p.add_argument("mechanisms", nargs="*", metavar="MECHANISM", help="mechanisms, MJCF files (default: all)")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument(
         "--out",
@@ -34,21 +34,29 @@ def _add_arguments(p: argparse.ArgumentParser) -> None:
 def _run(args: argparse.Namespace) -> int:
     from robomech._registry import skip_reason
     from robomech.verify import VerificationReport, available_verifications, dumps_json
+    from robomech.verify._generic import run_generic, split_targets
 
     out = output_folder(args.out) if args.out is not None else None
     available = available_verifications()
-    unknown = [n for n in args.mechanisms if n not in available]
+    # MJCF paths and gallery / description names get the generic engine checks (issue 13)
+    names, generic = split_targets(args.mechanisms, available)
+    unknown = [n for n in names if n not in available]
     if unknown:
         raise CliError(
             f"unknown mechanism {', '.join(map(repr, unknown))}; valid ones are: {', '.join(available)}"
+            ", a gallery mechanism or an MJCF file"
         )
-    for n in args.mechanisms:  # asked for by name: not running it is an error, not a skip
+    for n in names:  # asked for by name: not running it is an error, not a skip
         why = skip_reason(available[n].requires)
         if why:
             raise CliError(f"{n} cannot run here: {why}")
     announce_compiles(enabled=not args.quiet)
     report = VerificationReport()
-    for n in args.mechanisms or list(available):
+    try:
+        report.checks.extend(run_generic(generic))
+    except ValueError as exc:
+        raise CliError(str(exc)) from exc
+    for n in names or ([] if generic else list(available)):
         v = available[n]
         why = skip_reason(v.requires)
         if why:

@@ -10,6 +10,16 @@ in the body frame.  This is exact for any holonomic mechanism once the closure i
 ``J_b`` maps the independent coordinates q (a parallel mechanism's platform angles, say) to each
 body's twist: the constraint forces do no virtual work and drop out.  Actuator forces then follow by
 virtual work from the actuator Jacobian (:func:`actuator_forces`).
+
+The same equations about each body's centre of mass, in world axes (:func:`com_inverse_dynamics`,
+used by :mod:`robomech.multibody` for any described mechanism): with ``[w_b; c_b'] = J_b qd`` the
+angular velocity and the centre-of-mass velocity of body b (MuJoCo's ``mj_jacSite`` quantities at the
+centre of mass), ``I_b`` its world-frame rotational inertia about the centre of mass and ``m_b`` its
+mass,
+
+    tau = sum_b J_b^T [ I_b wd_b + w_b x I_b w_b ;  m_b (c_b'' - g) ],   [wd_b; c_b''] = J_b qdd + Jdot_b qd,
+
+which is Newton's and Euler's equations of each body projected onto the coordinates (virtual power).
 """
 
 from __future__ import annotations
@@ -25,11 +35,14 @@ from robomech.spatial._so3 import _hat as hat
 __all__ = [
     "DynamicsTerms",
     "actuator_forces",
+    "com_inverse_dynamics",
+    "com_kinetic_energy",
     "inverse_dynamics",
     "kinetic_energy",
     "mass_matrix",
     "spatial_inertia",
     "static_torques",
+    "world_inertia",
 ]
 
 
@@ -319,3 +332,100 @@ def actuator_forces(
         resid[good] = np.linalg.norm(np.einsum("...ij,...j->...i", JTg, fg) - tg, axis=-1) * scale[good]
         f[good] = fg
     return f, resid
+
+
+def world_inertia(R: object, inertia: object) -> np.ndarray:
+    """Rotational inertia in world axes ``R I R^T`` of a body at orientation ``R (..., 3, 3)``.
+
+    ``inertia (..., 3, 3)`` is the inertia about the centre of mass in body axes (a principal
+    inertia ``diag(d)`` in a frame ``R_i`` of the body is ``R_i diag(d) R_i^T``).
+    """
+    R = as_array(R, "R", (3, 3))
+    Ic = as_array(inertia, "inertia", (3, 3))
+    return R @ Ic @ np.swapaxes(R, -1, -2)
+
+
+def com_inverse_dynamics(
+    mass: object,
+    inertia: object,
+    J: object,
+    Jdot_qd: object,
+    qd: object,
+    qdd: object,
+    gravity: object = (0.0, 0.0, -9.81),
+) -> DynamicsTerms:
+    """Generalized forces from centre-of-mass Jacobians in world axes (Newton-Euler per body, projected).
+
+    ``mass (..., B)``; ``inertia (..., B, 3, 3)`` world-axes inertia about each centre of mass
+    (:func:`world_inertia`); ``J (..., B, 6, n)`` maps ``qd`` to ``[w; c']`` of each body (angular
+    velocity, centre-of-mass velocity, world axes); ``Jdot_qd (..., B, 6)`` is ``Jdot qd`` (the
+    velocity-product accelerations ``[wd; c'']`` at ``qdd = 0``); ``gravity (..., 3)`` the gravity
+    acceleration (m/s^2).  Returns ``tau = M qdd + velocity_terms + gravity_terms`` with
+    ``M = sum_b J_b^T diag(I_b, m_b 1) J_b``.
+    """
+    m = as_array(mass, "mass", (None,))
+    B = m.shape[-1]
+    qd = as_array(qd, "qd", (None,))
+    n = qd.shape[-1]
+    # shapes are checked against mass (B bodies) and qd (n coordinates): a mismatch names both
+    I = as_array(inertia, "inertia (B from mass)", (B, 3, 3))
+    J = as_array(J, "J (B from mass, n from qd)", (B, 6, n))
+    a0 = as_array(Jdot_qd, "Jdot_qd (B from mass)", (B, 6))
+    qdd = as_array(qdd, "qdd (n from qd)", (n,))
+    g = as_array(gravity, "gravity", (3,))
+    if np.any(m < 0):
+        raise ValueError(f"Expected mass >= 0, got min {float(np.min(m))}.")
+    return _com_terms(m, I, J, a0, qd, qdd, g)
+
+
+def _com_terms(m, I, J, a0, qd, qdd, g) -> DynamicsTerms:
+    """Kernel of :func:`com_inverse_dynamics` (inputs trusted, broadcast as documented).
+
+    Products over the bodies are one matmul per sample on the stacked ``(3B, n)`` Jacobians; the 3x3
+    products per body are written out elementwise (batched matmul of many tiny matrices is slow).
+    """
+    batch = np.broadcast_shapes(m.shape[:-1], I.shape[:-3], J.shape[:-3], a0.shape[:-2], qd.shape[:-1])
+    B, n = J.shape[-3], J.shape[-1]
+    J = np.broadcast_to(J, (*batch, B, 6, n))
+    I = np.broadcast_to(I, (*batch, B, 3, 3))
+    m = np.broadcast_to(m, (*batch, B))
+    Jw, Jv = J[..., :3, :], J[..., 3:, :]
+
+    def i_times(x):  # I_b x_b for x (..., B, 3, k)
+        return (
+            I[..., :, 0, None] * x[..., 0:1, :]
+            + I[..., :, 1, None] * x[..., 1:2, :]
+            + I[..., :, 2, None] * x[..., 2:3, :]
+        )
+
+    def stack(x):  # (..., B, 3, k) -> (..., 3B, k)
+        return x.reshape(*x.shape[:-3], 3 * B, x.shape[-1])
+
+    Jws, Jvs = stack(Jw), stack(Jv)
+    w = (Jws @ qd[..., :, None]).reshape(*batch, B, 3)
+    Iw = np.sum(I * w[..., None, :], axis=-1)
+    mom = np.sum(I * a0[..., None, :3], axis=-1) + np.cross(w, Iw)
+    frc = m[..., None] * a0[..., 3:]
+    rhs = np.concatenate([mom, frc], axis=-1)  # (..., B, 6)
+    vel = (np.swapaxes(J.reshape(*batch, 6 * B, n), -1, -2) @ rhs.reshape(*batch, 6 * B, 1))[..., 0]
+    M = np.swapaxes(Jws, -1, -2) @ stack(i_times(Jw)) + np.swapaxes(Jvs, -1, -2) @ stack(
+        m[..., None, None] * Jv
+    )
+    grav = -np.sum(m[..., None, None] * Jv, axis=-3).swapaxes(-1, -2) @ g[..., :, None]
+    grav = grav[..., 0]
+    tau = (M @ qdd[..., None])[..., 0] + vel + grav
+    return DynamicsTerms(tau=tau, M=M, velocity_terms=vel, gravity_terms=grav)
+
+
+def com_kinetic_energy(mass: object, inertia: object, J: object, qd: object) -> np.ndarray:
+    """``0.5 sum_b (w_b . I_b w_b + m_b |c'_b|^2)`` with ``[w_b; c'_b] = J_b qd`` (...)."""
+    m = as_array(mass, "mass", (None,))
+    B = m.shape[-1]
+    qd = as_array(qd, "qd", (None,))
+    I = as_array(inertia, "inertia (B from mass)", (B, 3, 3))
+    J = as_array(J, "J (B from mass, n from qd)", (B, 6, qd.shape[-1]))
+    if np.any(m < 0):
+        raise ValueError(f"Expected mass >= 0, got min {float(np.min(m))}.")
+    V = np.einsum("...bin,...n->...bi", J, qd)
+    w, v = V[..., :3], V[..., 3:]
+    return 0.5 * (np.einsum("...bi,...bij,...bj->...", w, I, w) + np.einsum("...b,...bi,...bi->...", m, v, v))

@@ -37,6 +37,8 @@ are the compiled arrays, cached on the frozen mechanism:
   :func:`constraint_residual`, :func:`constraint_jacobian`, :func:`constraint_jacobian_rate`;
 * ``G = ∂qd/∂qd_act (…, nv, n_act)`` and ``∂G/∂q_act``: :func:`influence` (``_influence._influence_flat``
   for flat batches, returning the state, K, G, dG and the screw rates together);
+* dynamics (issue 13, ``_dynamics``): :func:`inverse_dynamics`, :func:`statics`, :func:`site_wrench`,
+  :func:`forward_dynamics`, :func:`simulate`, :func:`energy` (docs/dynamics.md);
 * ``_tree.integrate(tree, q, dv)``: ``q ⊕ dv`` on the configuration manifold (``mj_integratePos``).
 """
 
@@ -45,6 +47,19 @@ from __future__ import annotations
 from . import gallery
 from ._assembly import CONVERGED_RTOL, FKResult, IKResult, forward_kinematics, inverse_kinematics
 from ._draw import body_segments, draw
+from ._dynamics import (
+    ForwardDynamicsResult,
+    InverseDynamicsResult,
+    SimulationResult,
+    SiteWrenchResult,
+    StaticsResult,
+    energy,
+    forward_dynamics,
+    inverse_dynamics,
+    simulate,
+    site_wrench,
+    statics,
+)
 from ._influence import (
     Influence,
     constraint_jacobian,
@@ -67,30 +82,41 @@ __all__ = [
     "Closure",
     "Coupling",
     "FKResult",
+    "ForwardDynamicsResult",
     "IKResult",
     "Inertial",
     "Influence",
+    "InverseDynamicsResult",
     "Joint",
     "Mechanism",
     "MobilityReport",
+    "SimulationResult",
     "SingularityMapResult",
     "SingularityResult",
     "Site",
+    "SiteWrenchResult",
+    "StaticsResult",
     "body_segments",
     "constraint_jacobian",
     "constraint_jacobian_rate",
     "constraint_residual",
     "draw",
+    "energy",
+    "forward_dynamics",
     "forward_kinematics",
     "from_mjcf",
     "gallery",
     "influence",
+    "inverse_dynamics",
     "inverse_kinematics",
     "mobility",
+    "simulate",
     "singularities",
     "singularity_map",
     "site_hessian",
     "site_jacobian",
     "site_pose",
+    "site_wrench",
+    "statics",
     "to_mjcf",
 ]

@@ -1,0 +1,1110 @@
+"""Closed-chain dynamics in actuator space for any described mechanism (issue 13).
+
+The spanning tree's rigid-body dynamics (Newton-Euler of every body about its centre of mass,
+:func:`robomech.dynamics.com_inverse_dynamics`) over the tree's velocity coordinates ``qd (nv)``,
+
+    M(q) qdd + c(q, qd) + g(q) = E tau + J_s^T W + K^T lambda,
+
+is projected onto the admissible motions ``qd = G qd_act`` (``G`` the first-order influence
+coefficients, :func:`~robomech.multibody.influence`; ``qdd = G qdd_act + Gdot qd_act``).  Because
+``K G = 0`` the closure forces ``K^T lambda`` drop out, and because the actuated rows of ``G`` are the
+identity ``G^T E = I``:
+
+    tau = G^T (M qdd + c + g - J_s^T W) = M_a qdd_act + c_a + g_a + e_a,     M_a = G^T M G.
+
+``W`` are external wrenches ``[m; f]`` (world axes, moment about the site point) applied *to* the
+mechanism at sites; ``e_a = -G^T J_s^T W`` is their share.  ``G`` is the minimum-norm choice for idle
+motions (a link spinning about its own axis): idle motions are prescribed at rest, as in MuJoCo's
+least-squares projection.
+
+Redundant actuation (more actuators than degrees of freedom; paper 1's three legs on a 2-DOF
+platform): only rates ``qd_act`` in the consistent subspace ``range(N_c)``, ``N_c = null(K G)``, are
+admissible, and virtual work fixes only ``N_c^T tau = N_c^T tau_G``.  The rule that picks ``tau`` is
+stated and selectable: ``weights=None`` the minimum-norm forces (``tau = N_c N_c^T tau_G``, no
+internal preload), ``weights = w (n_act,) >= 0`` the forces minimising ``sum tau_i^2 / w_i`` (an actuator
+with ``w_i = 0`` carries nothing: paper 1's "two legs driven" rule is ``w = (1, 0, 1)``):
+``tau = W N_c (N_c^T W N_c)^-1 N_c^T tau_G``, ``W = diag(w)``.
+
+Forward dynamics works on the tree coordinates with the closure as a constraint (idle motions
+included, as the engine has them): ``qdd = qdd_p + u``, ``K qdd_p = -Kdot qd`` (minimum norm), ``u`` in
+``null(K)`` from ``P (M u - f) = 0`` with ``P = I - K^+ K``.  :func:`simulate` integrates ``(q, qd)`` with
+``scipy.integrate.solve_ivp`` and projects back onto the constraint manifold (positions by the
+closure Newton iteration, velocities onto ``null(K)``) at every output time.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomech._validation import as_array, check_bool
+from robomech.dynamics import _com_terms
+
+from ._assembly import check_mechanism, check_q, solve_closure
+from ._constraints import jacobian
+from ._influence import PASSIVE_RANK_RTOL, _pinv
+from ._model import Mechanism
+from ._tree import (
+    frame_jacobian,
+    kinematics,
+    normalize_quaternions,
+    quat_mul,
+    quat_to_matrix,
+)
+
+__all__ = [
+    "ADMISSIBLE_RTOL",
+    "SINGULAR_COND",
+    "ForwardDynamicsResult",
+    "InverseDynamicsResult",
+    "SimulationResult",
+    "SiteWrenchResult",
+    "StaticsResult",
+    "energy",
+    "forward_dynamics",
+    "inverse_dynamics",
+    "simulate",
+    "site_wrench",
+    "statics",
+]
+
+# A configuration is flagged singular when the passive block K_p of the constraint Jacobian has a
+# condition number above SINGULAR_COND (or lost rank against the reference configuration): actuator
+# forces grow like cond, and the closure is only solved to CONVERGED_RTOL = 1e-10 relative, so beyond
+# 1e6 the forces would carry relative errors of order 1e-4 from the geometry alone — and they are
+# physically unbounded as cond -> inf.  Such samples get valid = False and NaN forces.
+SINGULAR_COND = 1e6
+# The prescribed motion must be admissible: |K qd| and |K qdd + Kdot qd| below ADMISSIBLE_RTOL times
+# their scale (L |qd|, L (|qdd| + |qd|^2)).  Rounding leaves ~1e-15; an inconsistent rate of a
+# redundantly actuated mechanism (or a rank drop) gives O(1).
+ADMISSIBLE_RTOL = 1e-8
+# ... and below RATE_FLOOR (1/s, 1/s^2) of motion the scale is RATE_FLOOR: at rest the test is absolute
+# (1e-8 L per s^2), not relative to zero.
+RATE_FLOOR = 1.0
+# Rank decisions on K G (redundant actuation) and on the forward-dynamics matrices: singular values
+# below this fraction of the largest are zero (the same reasoning as PASSIVE_RANK_RTOL).
+RANK_RTOL = PASSIVE_RANK_RTOL
+# Samples per block in the batched kernels: bounds the (N, bodies, 6, nv) temporaries to ~100 MB.
+CHUNK = 2048
+
+
+# ----------------------------------------------------------------------------- cached mechanism data
+def _mv(A: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Batched matrix-vector product ``A (N, i, j) x (N, j) -> (N, i)`` (matmul, BLAS)."""
+    return (A @ x[..., None])[..., 0]
+
+
+def _cache(mech: Mechanism, key: str, make: Callable[[], object]) -> object:
+    d = mech.__dict__  # frozen dataclass: cached_property writes here too
+    if key not in d:
+        d[key] = make()
+    return d[key]
+
+
+@dataclass(frozen=True)
+class _Bodies:
+    idx: np.ndarray  # (B,) tree body indices with mass or inertia
+    mass: np.ndarray  # (B,)
+    com: np.ndarray  # (B, 3) body frame
+    inertia: np.ndarray  # (B, 3, 3) about the com, body axes
+
+
+def _bodies(mech: Mechanism) -> _Bodies:
+    def make() -> _Bodies:
+        idx, m, c, inn = [], [], [], []
+        for i, b in enumerate(mech.bodies, start=1):
+            if b.inertial is None:
+                continue
+            it = b.inertial
+            if it.mass == 0 and max(it.diaginertia) == 0:
+                continue
+            Ri = quat_to_matrix(np.asarray(it.quat))
+            idx.append(i)
+            m.append(it.mass)
+            c.append(it.pos)
+            inn.append(Ri @ np.diag(it.diaginertia) @ Ri.T)
+        return _Bodies(
+            np.array(idx, dtype=int),
+            np.array(m, float),
+            np.array(c, float).reshape(-1, 3),
+            np.array(inn, float).reshape(-1, 3, 3),
+        )
+
+    return _cache(mech, "_dyn_bodies", make)
+
+
+def _reference(mech: Mechanism) -> tuple[int, int]:
+    """(passive rank of K at the reference configuration, mobility DOF)."""
+    return _reference3(mech)[:2]
+
+
+def _rank_K(mech: Mechanism) -> int:
+    """Generic rank of the full constraint Jacobian K (nv minus every instantaneous motion, idle included)."""
+    return _reference3(mech)[2]
+
+
+def _pinv_rank(K: np.ndarray, r: int) -> tuple[np.ndarray, np.ndarray]:
+    """Pseudo-inverse of ``K (N, m, n)`` truncated to the mechanism's generic rank ``r``, and the ratio
+    ``s_1 / s_r`` (N,).  A fixed rank rather than a tolerance: between two projections a simulated state
+    is ~1e-12 off the manifold, which lifts the zero singular values of an over-constrained closure
+    (Bennett, planar loops in 3-D) to ~1e-12 — a tolerance would then invert them."""
+    N, m, n = K.shape
+    if r == 0 or m == 0:
+        return np.zeros((N, n, m)), np.ones(N)
+    U, s, Vt = np.linalg.svd(K, full_matrices=False)
+    sr = s[:, r - 1]
+    ok = sr > 0
+    sinv = np.zeros_like(s)
+    sinv[:, :r] = 1.0 / np.where(ok[:, None], s[:, :r], 1.0)
+    P = np.einsum("nji,nj,nkj->nik", Vt, sinv, U)
+    return P, np.where(ok, s[:, 0] / np.where(ok, sr, 1.0), np.inf)
+
+
+# Below this 1-norm condition estimate of K_p the Gram-matrix inverse (with one refinement step) is used;
+# above it the sample is recomputed with the SVD pseudo-inverse (exact rank decision).  The Gram matrix
+# squares the condition number: at 1e4, 1e8 * eps ~ 1e-8 before refinement, ~1e-12 after it.
+GRAM_COND_MAX = 1e4
+# Above this condition estimate the Gram inverse is refined once (below it cond^2 eps < 1e-12).
+GRAM_REFINE_COND = 1e2
+
+
+def _passive_inverse(Kp: np.ndarray, rank0: int):
+    """Pseudo-inverse of the passive block ``Kp (N, m, n)`` with (rank, sigma_min, cond) per sample.
+
+    Fast path where the generic rank is ``min(m, n)`` (no idle motion *and* redundant rows at once):
+    ``Kp^T (Kp Kp^T)^-1`` (wide) or ``(Kp^T Kp)^-1 Kp^T`` (tall) from a batched inverse, refined once
+    (``P += P (I - Kp P)`` / ``P += (I - P Kp) P``); ``cond`` is then the 1-norm estimate
+    ``sqrt(||Gram||_1 ||Gram^-1||_1)`` (within a factor sqrt(rank) of the 2-norm one) and ``sigma_min``
+    ``1 / sqrt(||Gram^-1||_1)`` (a lower bound within rank^(1/4)).  Samples above GRAM_COND_MAX, and
+    mechanisms without the fast path, get the SVD pseudo-inverse of the multibody layer.
+    """
+    N, m, n = Kp.shape
+    if m == 0 or n == 0 or rank0 != min(m, n):
+        return _pinv(Kp)
+    wide = m <= n
+    KT = Kp.swapaxes(-1, -2)
+    Gm = Kp @ KT if wide else KT @ Kp
+    with np.errstate(all="ignore"):
+        try:
+            Gi = np.linalg.inv(Gm)
+        except np.linalg.LinAlgError:
+            return _pinv(Kp)
+        P = KT @ Gi if wide else Gi @ KT
+        ni = np.linalg.norm(Gi, 1, axis=(-2, -1))
+        cond = np.sqrt(np.linalg.norm(Gm, 1, axis=(-2, -1)) * ni)
+        smin = 1.0 / np.sqrt(ni)
+        # refine where the Gram matrix's squared conditioning could show: cond^2 eps > 1e-12
+        r = np.flatnonzero(~(cond <= GRAM_REFINE_COND))
+        if r.size:
+            Pr, Kr = P[r], Kp[r]
+            P[r] = Pr + Pr @ (np.eye(m) - Kr @ Pr) if wide else Pr + (np.eye(n) - Pr @ Kr) @ Pr
+    rank = np.full(N, rank0)
+    bad = ~(np.isfinite(cond) & (cond <= GRAM_COND_MAX) & np.all(np.isfinite(P), axis=(-1, -2)))
+    if np.any(bad):
+        Pb, rb, sb, cb = _pinv(Kp[bad])
+        P[bad], rank[bad], smin[bad], cond[bad] = Pb, rb, sb, cb
+    return P, rank, smin, cond
+
+
+def _reference3(mech: Mechanism) -> tuple[int, int, int]:
+    def make() -> tuple[int, int, int]:
+        from ._mobility import mobility
+
+        tree = mech.tree
+        pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
+        mob = mobility(mech)
+        # the passive block has full column rank but for the idle motions (computed, not taken from q0,
+        # which may itself be singular); K's generic rank leaves the DOF and the idle motions free
+        return len(pas) - int(mob.idle_dof), int(mob.dof), int(tree.nv - mob.dof - mob.idle_dof)
+
+    return _cache(mech, "_dyn_reference", make)
+
+
+# ----------------------------------------------------------------------------- tree kernels
+def _com_jacobians(tree, state, bd: _Bodies, qd: np.ndarray | None, Sd: np.ndarray | None):
+    """Centre-of-mass points (N, B, 3), Jacobians (N, B, 6, nv) and ``Jdot qd`` (N, B, 6)."""
+    T = state.T[:, bd.idx]
+    p = (T[..., :3, :3] @ bd.com[:, :, None])[..., 0] + T[..., :3, 3]
+    S = state.S
+    A = tree.A[bd.idx]  # (B, nv)
+    Sw, Sv = S[..., :3], S[..., 3:]
+    Jw = Sw[:, None] * A[None, :, :, None]  # (N, B, nv, 3)
+    Jv = (Sv[:, None] + np.cross(Sw[:, None], p[:, :, None])) * A[None, :, :, None]
+    J = np.concatenate([Jw, Jv], axis=-1).swapaxes(-1, -2)
+    a0 = None
+    if qd is not None:
+        V = A @ (S * qd[..., None])
+        Vd = A @ (Sd * qd[..., None])
+        w = V[..., :3]
+        pd = V[..., 3:] + np.cross(w, p)
+        a0 = np.concatenate([Vd[..., :3], Vd[..., 3:] + np.cross(Vd[..., :3], p) + np.cross(w, pd)], axis=-1)
+    return p, J, a0
+
+
+def _cross_rows(a: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``a_col x p`` for every column of ``a (..., 3, k)`` with ``p (..., 3)`` (component arithmetic:
+    np.cross on broadcast blocks moves axes and is several times slower here)."""
+    x, y, z = p[..., 0, None], p[..., 1, None], p[..., 2, None]
+    a0, a1, a2 = a[..., 0, :], a[..., 1, :], a[..., 2, :]
+    return np.stack([a1 * z - a2 * y, a2 * x - a0 * z, a0 * y - a1 * x], axis=-2)
+
+
+def _com_projected(tree, state, bd: _Bodies, qd, Sd, G, extra_qdd):
+    """Centre-of-mass Jacobians through G, ``J_b G (N, B, 6, na)``, and the accelerations
+    ``Jdot_b qd + J_b extra_qdd (N, B, 6)`` — without the (N, B, 6, nv) Jacobians' cross products."""
+    T = state.T[:, bd.idx]
+    p = (T[..., :3, :3] @ bd.com[:, :, None])[..., 0] + T[..., :3, 3]
+    S = state.S
+    A = tree.A[bd.idx]  # (B, nv)
+    SG = np.empty((S.shape[0], len(bd.idx), 6, G.shape[-1]))  # (N, B, 6, na): sum over b's path of S_k G_k
+    St = S.swapaxes(-1, -2)
+    for i, b in enumerate(bd.idx):
+        c = _path(tree, b)
+        SG[:, i] = St[:, :, c] @ G[:, c]
+    JG = np.concatenate([SG[..., :3, :], SG[..., 3:, :] + _cross_rows(SG[..., :3, :], p)], axis=-2)
+    V = A @ (S * qd[..., None])
+    Vd = A @ (Sd * qd[..., None] + S * extra_qdd[..., None])
+    w = V[..., :3]
+    pd = V[..., 3:] + np.cross(w, p)
+    a0 = np.concatenate([Vd[..., :3], Vd[..., 3:] + np.cross(Vd[..., :3], p) + np.cross(w, pd)], axis=-1)
+    return JG, a0
+
+
+def _screw_rates(tree, state, qd: np.ndarray) -> np.ndarray:
+    """``_tree.screw_rates`` for flat ``qd (N, nv)`` with the carrier twists by matmul (the 3-operand
+    einsum there runs as a naive loop): ``dS_k = [w_c x w_k; w_c x v_k - w_k x v_c]``."""
+    S = state.S
+    Vc = tree.C @ (S * qd[..., None])
+    wc, vc = Vc[..., :3], Vc[..., 3:]
+    ws, vs = S[..., :3], S[..., 3:]
+    return np.concatenate([np.cross(wc, ws), np.cross(wc, vs) - np.cross(ws, vc)], axis=-1)
+
+
+def _path(tree, b: int) -> np.ndarray:
+    """Indices of the velocity coordinates that move body ``b`` (cached on the compiled tree)."""
+    cache = tree.__dict__.setdefault("_dyn_paths", {})
+    if b not in cache:
+        cache[b] = np.flatnonzero(tree.A[b])
+    return cache[b]
+
+
+def _constraint_matrix(mech: Mechanism, state, q: np.ndarray) -> np.ndarray:
+    """``K (N, m, nv)`` as ``_constraints.jacobian`` builds it (same rows, same order), with the point
+    rows' cross products in component arithmetic (the dynamics' hot path; tested equal)."""
+    from ._constraints import _poly
+
+    tree, cs = mech.tree, mech.constraints
+    N, nv = q.shape[0], tree.nv
+    S = state.S
+    w = S[..., :3]
+    w0, w1, w2 = w[..., 0], w[..., 1], w[..., 2]
+    v = S[..., 3:]
+    L = tree.length
+    out = []
+    for kind, d in cs.blocks:
+        if kind == "point":
+            b1, x1, b2, x2 = d
+            rows = np.zeros((N, 3, nv))
+            for b, x, sign in ((b1, x1, 1.0), (b2, x2, -1.0)):
+                if b == 0:
+                    continue
+                p = (state.T[:, b] @ x)[:, :3]
+                c = _path(tree, b)  # only the coordinates that move body b (a loop touches few)
+                p0, p1, p2 = p[:, 0, None], p[:, 1, None], p[:, 2, None]
+                a0, a1, a2 = w0[:, c], w1[:, c], w2[:, c]
+                rows[:, 0, c] += sign * (v[:, c, 0] + a1 * p2 - a2 * p1)
+                rows[:, 1, c] += sign * (v[:, c, 1] + a2 * p0 - a0 * p2)
+                rows[:, 2, c] += sign * (v[:, c, 2] + a0 * p1 - a1 * p0)
+            out.append(rows)
+        elif kind == "rot":
+            b1, _, b2 = d
+            out.append(L * w.swapaxes(-1, -2) * (tree.A[b2] - tree.A[b1]))
+        else:
+            d1, _, _, d2, q2, ref2, c, sc = d
+            row = np.zeros((N, 1, nv))
+            row[:, 0, d1] = sc
+            if d2 >= 0:
+                row[:, 0, d2] -= sc * _poly(c, q[:, q2] - ref2)[1]
+            out.append(row)
+    return np.concatenate(out, axis=-2) if out else np.zeros((N, 0, nv))
+
+
+def _kdot_qd(mech: Mechanism, state, q: np.ndarray, qd: np.ndarray, Sd: np.ndarray) -> np.ndarray:
+    """``Kdot qd (N, m)`` directly (the closure rows' velocity-product accelerations), block by block as
+    ``_constraints.jacobian_rate`` builds ``Kdot``, without forming the (N, m, nv) matrix: a point row is
+    the difference of the two anchors' ``dVd_v + dVd_w x p + w x pdot`` (``Vd = sum_k A Sd_k qd_k``), a
+    rotation row ``L (Vd_w2 - Vd_w1)``, a coupling row ``-s poly''(x) qd2^2``."""
+    from ._constraints import _poly
+
+    tree, cs = mech.tree, mech.constraints
+    V = tree.A @ (state.S * qd[..., None])
+    Vd = tree.A @ (Sd * qd[..., None])
+    L = tree.length
+    out = []
+    for kind, d in cs.blocks:
+        if kind == "point":
+            b1, x1, b2, x2 = d
+            acc = []
+            for b, x in ((b1, x1), (b2, x2)):
+                pt = (state.T[:, b] @ x)[:, :3]
+                w = V[:, b, :3]
+                pd = V[:, b, 3:] + np.cross(w, pt)
+                acc.append(Vd[:, b, 3:] + np.cross(Vd[:, b, :3], pt) + np.cross(w, pd))
+            out.append(acc[0] - acc[1])
+        elif kind == "rot":
+            b1, _, b2 = d
+            out.append(L * (Vd[:, b2, :3] - Vd[:, b1, :3]))
+        else:
+            _d1, _, _, d2, q2, ref2, c, sc = d
+            row = np.zeros((q.shape[0], 1))
+            if d2 >= 0:
+                row[:, 0] = -sc * _poly(c, q[:, q2] - ref2)[2] * qd[:, d2] ** 2
+            out.append(row)
+    return np.concatenate(out, axis=-1) if out else np.zeros((q.shape[0], 0))
+
+
+def _tree_terms(mech: Mechanism, state, qd, Sd, qdd, gravity: bool = True):
+    """Tree dynamics ``M (N, nv, nv)``, velocity terms, gravity terms (N, nv) at ``qdd`` (DynamicsTerms)."""
+    tree = mech.tree
+    bd = _bodies(mech)
+    N = state.T.shape[0]
+    R = state.T[:, bd.idx, :3, :3]
+    Iw = R @ bd.inertia @ R.swapaxes(-1, -2)
+    _, J, a0 = _com_jacobians(tree, state, bd, qd, Sd)
+    g = np.asarray(mech.gravity) if gravity else np.zeros(3)
+    m = np.broadcast_to(bd.mass, (N, len(bd.mass)))
+    return _com_terms(m, Iw, J, a0, qd, qdd, np.broadcast_to(g, (N, 3)))
+
+
+def _energy_flat(mech: Mechanism, q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    tree = mech.tree
+    bd = _bodies(mech)
+    st = kinematics(tree, q)
+    p, J, _ = _com_jacobians(tree, st, bd, None, None)
+    V = np.einsum("nbik,nk->nbi", J, qd)
+    R = st.T[:, bd.idx, :3, :3]
+    Iw = R @ bd.inertia @ R.swapaxes(-1, -2)
+    w, v = V[..., :3], V[..., 3:]
+    T = 0.5 * (np.einsum("nbi,nbij,nbj->n", w, Iw, w) + np.einsum("b,nbi,nbi->n", bd.mass, v, v))
+    U = -np.einsum("b,nbi,i->n", bd.mass, p, np.asarray(mech.gravity))
+    return T, U
+
+
+def _site_terms(mech: Mechanism, state, wrenches: dict[int, np.ndarray]) -> np.ndarray:
+    """``-sum_s J_s^T W_s`` (N, nv) for wrenches ``W_s (N, 6)`` applied to the mechanism at sites."""
+    tree = mech.tree
+    out = np.zeros((state.T.shape[0], tree.nv))
+    for si, W in wrenches.items():
+        b = tree.site_body[si]
+        p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
+        Js = frame_jacobian(tree, state, b, p)
+        out -= np.einsum("nik,ni->nk", Js, W)
+    return out
+
+
+# ----------------------------------------------------------------------------- validation helpers
+def _check_wrenches(mech: Mechanism, wrenches: object) -> dict[int, np.ndarray]:
+    if wrenches is None:
+        return {}
+    if not isinstance(wrenches, Mapping):
+        raise ValueError(
+            f"Expected wrenches to be a mapping site name -> (..., 6) wrench, got {type(wrenches).__name__}."
+        )
+    out = {}
+    for name, W in wrenches.items():
+        if not isinstance(name, str) or name not in mech.tree.site_names:
+            raise ValueError(
+                f"Expected wrenches keys to be site names among {list(mech.tree.site_names)}, got {name!r}."
+            )
+        out[mech.tree.site_index(name)] = as_array(W, f"wrenches[{name!r}]", (6,))
+    return out
+
+
+def _check_weights(mech: Mechanism, weights: object) -> np.ndarray | None:
+    if weights is None:
+        return None
+    na = len(mech.actuated)
+    w = as_array(weights, "weights", (na,))
+    if w.shape != (na,) or np.any(w < 0) or not np.any(w > 0):
+        raise ValueError(f"Expected weights to be {na} non-negative numbers, not all zero, got {weights!r}.")
+    return w
+
+
+def _fully_actuated(mech: Mechanism) -> tuple[int, int]:
+    rank0, dof = _reference(mech)
+    na = len(mech.actuated)
+    if na < dof or na == 0:
+        raise ValueError(
+            f"Expected mech to be actuated in every degree of freedom (dof {dof}), "
+            f"got {na} actuated joint(s); inverse dynamics needs the actuators to determine the motion."
+        )
+    return rank0, dof
+
+
+# ----------------------------------------------------------------------------- inverse dynamics
+@dataclass(frozen=True)
+class InverseDynamicsResult:
+    """``tau = M_a qdd_act + velocity_terms + gravity_terms + external_terms`` per sample.
+
+    ``tau (..., n_act)`` generalized force at each actuated joint (N m or N, no gear);
+    ``M_a (..., n_act, n_act)`` the mass matrix in actuator space (``G^T M G``; with redundant actuation
+    the distributed ``Pi G^T M G``, ``Pi`` the stated rule's projector); ``velocity_terms``,
+    ``gravity_terms``, ``external_terms (..., n_act)`` (the last: site wrenches).  ``qd``, ``qdd``
+    ``(..., nv)`` every tree coordinate's rate and acceleration.  ``cond`` the condition number of the
+    passive constraint block (grows without bound at a type II / parallel singularity), ``sigma_min``
+    its smallest kept singular value (m), ``admissibility`` the closure error of the prescribed motion
+    (relative), ``valid`` False at a singular configuration, an inadmissible motion or a non-finite
+    input — forces NaN there.
+    """
+
+    tau: np.ndarray
+    M_a: np.ndarray
+    velocity_terms: np.ndarray
+    gravity_terms: np.ndarray
+    external_terms: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    cond: np.ndarray
+    sigma_min: np.ndarray
+    admissibility: np.ndarray
+    valid: np.ndarray
+
+
+def _projector(mech, K, G, dof, w):
+    """Redundant actuation: the rule's projector Pi (N, na, na); False where null(K G) is not ``dof``-wide."""
+    N, _, na = G.shape
+    KG = (K @ G) / mech.tree.length
+    s_full = np.zeros((N, na))
+    if KG.shape[1]:
+        _, s, Vt = np.linalg.svd(KG, full_matrices=True)
+        s_full[:, : s.shape[1]] = s[:, :na]
+    else:
+        Vt = np.broadcast_to(np.eye(na), (N, na, na))
+    # singular values ascending over the right singular vectors: the last `dof` rows of Vt span null(KG)
+    Nc = Vt[:, na - dof :].swapaxes(-1, -2)  # (N, na, dof)
+    top = np.maximum(np.max(s_full, axis=-1), 1.0)
+    gap_ok = np.all(s_full[:, na - dof :] <= RANK_RTOL * 1e2 * top[:, None], axis=-1)
+    if dof < na:
+        gap_ok &= s_full[:, na - dof - 1] > RANK_RTOL * 1e2 * top
+    if w is None:
+        Pi = Nc @ Nc.swapaxes(-1, -2)
+    else:
+        WN = w[:, None] * Nc
+        A = Nc.swapaxes(-1, -2) @ WN
+        ok = np.linalg.cond(A) < 1.0 / RANK_RTOL
+        A = np.where(ok[:, None, None], A, np.eye(dof))
+        Pi = WN @ np.linalg.solve(A, Nc.swapaxes(-1, -2))
+        gap_ok &= ok
+    return Pi, gap_ok
+
+
+def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
+    tree = mech.tree
+    rank0, dof = _reference(mech)
+    na = len(tree.act_dof)
+    act = tree.act_dof
+    pas = np.setdiff1d(np.arange(tree.nv), act)
+    N = q.shape[0]
+    state = kinematics(tree, q)
+    K = _constraint_matrix(mech, state, q)
+    P, rank, smin, cond = _passive_inverse(K[..., pas], rank0)
+    G = np.zeros((N, tree.nv, na))
+    G[:, act, np.arange(na)] = 1.0
+    G[:, pas] = -P @ K[..., act]
+    qd = _mv(G, qd_a)
+    Sd = _screw_rates(tree, state, qd)
+    kdq = _kdot_qd(mech, state, q, qd, Sd)
+    qdd = _mv(G, qdd_a)
+    qdd[:, pas] -= _mv(P, kdq)
+    # Project each body's Jacobian through G first (6 x n_act instead of 6 x nv): the tree mass matrix is
+    # never formed.  The convective acceleration J (qdd - G qdd_act) joins the velocity-product terms.
+    bd = _bodies(mech)
+    R = state.T[:, bd.idx, :3, :3]
+    Iw = R @ bd.inertia @ R.swapaxes(-1, -2)
+    conv = qdd - _mv(G, qdd_a)
+    JG, a0 = _com_projected(tree, state, bd, qd, Sd, G, conv)
+    gv = np.asarray(mech.gravity) if gravity else np.zeros(3)
+    terms = _com_terms(np.broadcast_to(bd.mass, (N, len(bd.mass))), Iw, JG, a0, qd_a, qdd_a, gv[None])
+    ext = _site_terms(mech, state, wr)
+    GT = G.swapaxes(-1, -2)
+    M_a = terms.M
+    vel = terms.velocity_terms
+    grav = terms.gravity_terms
+    ex = _mv(GT, ext)
+    ok = np.ones(N, dtype=bool)
+    if na > dof or weights is not None:
+        Pi, ok = _projector(mech, K, G, dof, weights)
+        M_a = Pi @ M_a
+        vel, grav, ex = (_mv(Pi, x) for x in (vel, grav, ex))
+    tau = _mv(M_a, qdd_a) + vel + grav + ex
+    L = tree.length
+    sv = np.max(np.abs(qd), axis=-1) if tree.nv else np.zeros(N)
+    sa = np.max(np.abs(qdd), axis=-1) + sv * sv if tree.nv else np.zeros(N)
+    if K.shape[1]:
+        e1 = np.max(np.abs(_mv(K, qd)), axis=-1) / (L * np.maximum(sv, RATE_FLOOR))
+        e2 = np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
+        adm = np.maximum(e1, e2)
+    else:
+        adm = np.zeros(N)
+    fin = np.all(np.isfinite(tau), axis=-1) & np.all(np.isfinite(M_a), axis=(-1, -2))
+    valid = ok & fin & (rank >= rank0) & (cond <= SINGULAR_COND) & (adm <= ADMISSIBLE_RTOL)
+    return dict(
+        tau=tau,
+        M_a=M_a,
+        velocity_terms=vel,
+        gravity_terms=grav,
+        external_terms=ex,
+        qd=qd,
+        qdd=qdd,
+        cond=cond,
+        sigma_min=smin,
+        admissibility=adm,
+        valid=valid,
+    )
+
+
+def _run_chunked(fn, n: int, arrays: list[np.ndarray], **kw) -> dict[str, np.ndarray]:
+    # overflow in a sample (inputs of 1e300) is flagged by its mask, not warned about
+    with np.errstate(all="ignore"):
+        if n == 0:  # an empty batch: evaluate one dummy sample for the result shapes, return none of it
+            part = fn(*(np.zeros((1, *a.shape[1:])) for a in arrays), **kw)
+            return {k: v[:0] for k, v in part.items()}
+        parts = [fn(*(a[i : i + CHUNK] for a in arrays), **kw) for i in range(0, n, CHUNK)]
+    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+
+
+def _finite_rows(*xs: np.ndarray) -> np.ndarray:
+    ok = np.ones(xs[0].shape[0], dtype=bool)
+    for x in xs:
+        ok &= np.all(np.isfinite(x.reshape(x.shape[0], int(np.prod(x.shape[1:])))), axis=-1)
+    return ok
+
+
+def _broadcast(mech, q, others: list[tuple[object, str, int]], qname: str = "q"):
+    """Validate ``q`` (non-finite allowed: masked) and the others (..., n); broadcast, flatten."""
+    qv = as_array(q, qname, (mech.nq,), finite=False)
+    for a in mech.tree.quat_adr:
+        n = np.linalg.norm(qv[..., a : a + 4], axis=-1)
+        if np.any(np.isfinite(n) & (n < 1e-9)):
+            raise ValueError(f"Expected the quaternion {qname}[..., {a}:{a + 4}] to be non-zero.")
+    arrs = [as_array(x, name, (n,), finite=False) for x, name, n in others]
+    batch = np.broadcast_shapes(qv.shape[:-1], *(a.shape[:-1] for a in arrs))
+    flat = [np.broadcast_to(qv, (*batch, mech.nq)).reshape(-1, mech.nq)]
+    flat += [np.broadcast_to(a, (*batch, a.shape[-1])).reshape(-1, a.shape[-1]) for a in arrs]
+    return batch, flat
+
+
+def _sanitize(mech, flat: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray]]:
+    ok = _finite_rows(*flat)
+    out = []
+    for i, a in enumerate(flat):
+        a = np.array(a, dtype=float)
+        a[~ok] = mech.tree.q0 if i == 0 else 0.0
+        out.append(a)
+    out[0] = normalize_quaternions(mech.tree, out[0])
+    return ok, out
+
+
+def _shape(d: dict, batch, ok: np.ndarray, nan_keys) -> dict:
+    # a sample whose results overflowed (inputs of 1e300, say) is not valid
+    for v in d.values():
+        v = np.asarray(v)
+        if v.dtype.kind == "f" and v.shape[:1] == ok.shape:
+            ok = ok & np.all(np.isfinite(v.reshape(v.shape[0], int(np.prod(v.shape[1:])))), axis=-1)
+    res = {}
+    for k, v in d.items():
+        v = np.array(v)
+        if k == "valid":
+            v = v & ok
+        elif k in nan_keys:
+            bad = ~(d["valid"] & ok)
+            v = np.where(bad.reshape(-1, *(1,) * (v.ndim - 1)), np.nan, v)
+        elif v.dtype.kind == "f":
+            v = np.where(ok.reshape(-1, *(1,) * (v.ndim - 1)), v, np.nan)
+        res[k] = np.reshape(v, (*batch, *v.shape[1:]))
+    return res
+
+
+_FORCE_KEYS = ("tau", "M_a", "velocity_terms", "gravity_terms", "external_terms")
+
+
+def inverse_dynamics(
+    mech: Mechanism,
+    q: object,
+    qd_act: object,
+    qdd_act: object,
+    *,
+    wrenches: Mapping[str, object] | None = None,
+    weights: object = None,
+    gravity: bool = True,
+) -> InverseDynamicsResult:
+    """Actuator forces for the motion ``(q, qd_act, qdd_act)`` of any described closed chain.
+
+    ``q (..., nq)`` an assembled configuration (from :func:`forward_kinematics` /
+    :func:`inverse_kinematics`), ``qd_act``, ``qdd_act (..., n_act)`` the actuated joints' rates and
+    accelerations in actuator order; ``wrenches`` maps site names to wrenches ``[m; f] (..., 6)``
+    applied *to* the mechanism at the site (world axes, moment about the site point); gravity from
+    ``mech.gravity`` (MJCF ``<option gravity>``) unless ``gravity=False``.  ``weights (n_act,)``: the
+    redundant-actuation rule (module docstring; default minimum norm).  Actuator ``gear`` is not
+    applied: ``tau`` is the generalized force at each actuated joint.  Batched over any leading shape;
+    non-finite samples and singular configurations give ``valid = False`` and NaN forces.
+    """
+    mech = check_mechanism(mech)
+    _fully_actuated(mech)
+    gravity = check_bool(gravity, "gravity")
+    w = _check_weights(mech, weights)
+    na = len(mech.actuated)
+    wr = _check_wrenches(mech, wrenches)
+    names = list(wr)
+    batch, flat = _broadcast(
+        mech,
+        q,
+        [(qd_act, "qd_act", na), (qdd_act, "qdd_act", na)]
+        + [(wr[s], f"wrenches[{mech.tree.site_names[s]!r}]", 6) for s in names],
+    )
+    ok, flat = _sanitize(mech, flat)
+    n = flat[0].shape[0]
+
+    def fn(qf, qdf, qddf, *ws, **kw):
+        return _inverse_flat(mech, qf, qdf, qddf, dict(zip(names, ws, strict=True)), w, gravity)
+
+    d = _run_chunked(fn, n, flat)
+    return InverseDynamicsResult(**_shape(d, batch, ok, _FORCE_KEYS))
+
+
+# ----------------------------------------------------------------------------- statics
+@dataclass(frozen=True)
+class StaticsResult:
+    """Actuator forces ``tau (..., n_act)`` holding the mechanism at rest against the site wrenches and
+    gravity (virtual work: ``tau = -G^T (J_s^T W - g)``), its parts, the passive-block ``cond`` and
+    ``valid`` (False at a singular configuration; forces NaN there)."""
+
+    tau: np.ndarray
+    gravity_terms: np.ndarray
+    external_terms: np.ndarray
+    cond: np.ndarray
+    valid: np.ndarray
+
+
+def statics(
+    mech: Mechanism,
+    q: object,
+    *,
+    wrenches: Mapping[str, object] | None = None,
+    weights: object = None,
+    gravity: bool = True,
+) -> StaticsResult:
+    """Actuator forces balancing ``wrenches`` (applied to the mechanism at sites) and gravity at rest.
+
+    The same virtual-work projection as :func:`inverse_dynamics` at ``qd = qdd = 0``.
+    """
+    mech = check_mechanism(mech)
+    q = as_array(q, "q", (mech.nq,), finite=False)
+    z = np.zeros(len(mech.actuated))
+    r = inverse_dynamics(mech, q, z, z, wrenches=wrenches, weights=weights, gravity=gravity)
+    return StaticsResult(r.tau, r.gravity_terms, r.external_terms, r.cond, r.valid)
+
+
+@dataclass(frozen=True)
+class SiteWrenchResult:
+    """The wrench ``[m; f] (..., 6)`` the mechanism exerts on its environment at a site under actuator
+    forces ``tau`` (at rest): the least-squares solution of ``J^T W = tau - g_a`` (rotation rows scaled by
+    the characteristic length, so that N m and N are compared as N).  ``residual (...)`` the part of
+    ``tau`` the site cannot transmit (N m or N; non-zero when the actuators preload internally or
+    n_act > 6), ``sigma_min`` the smallest singular value of ``J`` (rotation rows times L, m; zero at an
+    output singularity where the site cannot resist some wrench), ``cond``, ``valid``.  With
+    ``n_act < 6`` the wrench components the structure carries (``null(J^T)``) are not determined by the
+    actuators and are returned as zero (minimum norm)."""
+
+    wrench: np.ndarray
+    residual: np.ndarray
+    sigma_min: np.ndarray
+    cond: np.ndarray
+    valid: np.ndarray
+
+
+def site_wrench(
+    mech: Mechanism, q: object, site: str, tau: object, *, gravity: bool = True
+) -> SiteWrenchResult:
+    """Inverse static map: the site wrench produced by actuator forces ``tau (..., n_act)`` at ``q``."""
+    from ._influence import _influence_flat
+
+    mech = check_mechanism(mech)
+    if not isinstance(site, str):
+        raise ValueError(f"Expected site to be a site name (str), got {type(site).__name__}.")
+    si = mech.tree.site_index(site)
+    gravity = check_bool(gravity, "gravity")
+    _fully_actuated(mech)
+    na = len(mech.actuated)
+    batch, flat = _broadcast(mech, q, [(tau, "tau", na)])
+    ok, (qf, tf) = _sanitize(mech, flat)
+    tree = mech.tree
+    L = tree.length
+    out = {k: [] for k in ("wrench", "residual", "sigma_min", "cond", "valid")}
+    empty = qf.shape[0] == 0
+    if empty:  # one dummy sample for the result shapes (sliced away below)
+        qf, tf = tree.q0[None], np.zeros((1, na))
+    for i in range(0, qf.shape[0], CHUNK):
+        qc, tc = qf[i : i + CHUNK], tf[i : i + CHUNK]
+        n = qc.shape[0]
+        z = np.zeros((n, na))
+        st = _inverse_flat(mech, qc, z, z, {}, None, gravity)
+        state, _, G, _, _, _ = _influence_flat(mech, qc, False)
+        b = tree.site_body[si]
+        p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
+        J = frame_jacobian(tree, state, b, p) @ G  # (n, 6, na)
+        Js = np.concatenate([J[:, :3] * L, J[:, 3:]], axis=1)
+        U, s, Vt = np.linalg.svd(Js, full_matrices=False)
+        smax = s[:, :1]
+        keep = s > RANK_RTOL * np.maximum(smax, 1e-300)
+        sinv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
+        rhs = tc - st["gravity_terms"]
+        Ws = np.einsum("nik,nk,nkj,nj->ni", U, sinv, Vt, rhs)  # (J_s^T)^+ rhs
+        W = np.concatenate([Ws[:, :3] * L, Ws[:, 3:]], axis=1)
+        res = np.linalg.norm(np.einsum("nik,ni->nk", J, W) - rhs, axis=-1)
+        smin = s[:, -1] if na <= 6 else s[:, 5]
+        cond = smax[:, 0] / np.maximum(smin, 1e-300)
+        valid = st["valid"] & (cond <= SINGULAR_COND) & np.all(np.isfinite(W), axis=-1)
+        for k, v in zip(out, (W, res, smin, cond, valid), strict=True):
+            out[k].append(v)
+    d = {k: np.concatenate(v)[: 0 if empty else None] for k, v in out.items()}
+    d = _shape(d, batch, ok, ("wrench",))
+    return SiteWrenchResult(**d)
+
+
+# ----------------------------------------------------------------------------- forward dynamics
+def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
+    """Tree accelerations ``qdd (N, nv)`` under actuator forces with the closure enforced, and a
+    conditioning measure of the constrained mass matrix (N,)."""
+    tree = mech.tree
+    N = q.shape[0]
+    nv = tree.nv
+    state = kinematics(tree, q)
+    K = _constraint_matrix(mech, state, q)
+    Sd = _screw_rates(tree, state, qd)
+    kdq = _kdot_qd(mech, state, q, qd, Sd)
+    terms = _tree_terms(mech, state, qd, Sd, np.zeros_like(qd), gravity)
+    f = -terms.velocity_terms - terms.gravity_terms
+    if wr:
+        f = f - _site_terms(mech, state, wr)
+    f[:, tree.act_dof] += tau_a
+    if K.shape[1]:
+        Kp, _ = _pinv_rank(K, _rank_K(mech))  # (N, nv, m)
+        qdd_p = -_mv(Kp, kdq)
+        Pn = np.eye(nv) - Kp @ K
+    else:
+        qdd_p = np.zeros((N, nv))
+        Pn = np.broadcast_to(np.eye(nv), (N, nv, nv))
+    M = terms.M
+    Mc = Pn @ M @ Pn + (np.eye(nv) - Pn)
+    rhs = _mv(Pn, f - _mv(M, qdd_p))
+    if want_cond:
+        s = np.linalg.svd(Mc, compute_uv=False)
+        cond = s[:, 0] / np.maximum(s[:, -1], 1e-300)
+    else:
+        cond = np.ones(N)
+    try:
+        u = np.linalg.solve(Mc, rhs[..., None])[..., 0]
+    except np.linalg.LinAlgError:  # a massless motion somewhere in the batch: minimum-norm there
+        u = _mv(np.linalg.pinv(Mc, rcond=RANK_RTOL), rhs)
+    return qdd_p + u, cond, K, kdq
+
+
+@dataclass(frozen=True)
+class ForwardDynamicsResult:
+    """``qdd_act (..., n_act)`` and every tree coordinate's ``qdd (..., nv)`` under the actuator forces;
+    ``cond`` the condition number of the constrained mass matrix (large: a nearly massless motion),
+    ``admissibility`` the closure error of the resulting acceleration (relative), ``valid``."""
+
+    qdd_act: np.ndarray
+    qdd: np.ndarray
+    qd: np.ndarray
+    cond: np.ndarray
+    admissibility: np.ndarray
+    valid: np.ndarray
+
+
+def forward_dynamics(
+    mech: Mechanism,
+    q: object,
+    qd_act: object,
+    tau: object,
+    *,
+    wrenches: Mapping[str, object] | None = None,
+    gravity: bool = True,
+) -> ForwardDynamicsResult:
+    """Accelerations under actuator forces ``tau (..., n_act)`` at ``(q, qd_act)`` (idle motions at rest).
+
+    The inverse of :func:`inverse_dynamics`: ``forward_dynamics(mech, q, qd, inverse_dynamics(mech, q,
+    qd, qdd).tau).qdd_act == qdd`` wherever both are valid (idle motions decoupled).
+    """
+    mech = check_mechanism(mech)
+    _fully_actuated(mech)
+    gravity = check_bool(gravity, "gravity")
+    na = len(mech.actuated)
+    wr = _check_wrenches(mech, wrenches)
+    names = list(wr)
+    batch, flat = _broadcast(
+        mech,
+        q,
+        [(qd_act, "qd_act", na), (tau, "tau", na)]
+        + [(wr[s], f"wrenches[{mech.tree.site_names[s]!r}]", 6) for s in names],
+    )
+    ok, flat = _sanitize(mech, flat)
+    rank0, _ = _reference(mech)
+    tree = mech.tree
+    pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
+
+    def fn(qf, qdf, tf, *ws):
+        state = kinematics(tree, qf)
+        K = jacobian(mech.constraints, tree, state, qf)
+        P, rank, _, cK = _pinv(K[..., pas])
+        qd = np.zeros((qf.shape[0], tree.nv))
+        qd[:, tree.act_dof] = qdf
+        qd[:, pas] = -np.einsum("nij,njk,nk->ni", P, K[..., tree.act_dof], qdf)
+        qdd, cond, K, kdq = _forward_full(
+            mech, qf, qd, tf, dict(zip(names, ws, strict=True)), gravity, want_cond=True
+        )
+        L = tree.length
+        sa = np.max(np.abs(qdd), axis=-1) + np.max(np.abs(qd), axis=-1) ** 2 if tree.nv else 0.0
+        adm = (
+            np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
+            if K.shape[1]
+            else np.zeros(qf.shape[0])
+        )
+        valid = (
+            (rank >= rank0)
+            & (cK <= SINGULAR_COND)
+            & (cond < 1.0 / RANK_RTOL)
+            & (adm <= ADMISSIBLE_RTOL)
+            & np.all(np.isfinite(qdd), axis=-1)
+        )
+        return dict(qdd_act=qdd[:, tree.act_dof], qdd=qdd, qd=qd, cond=cond, admissibility=adm, valid=valid)
+
+    d = _run_chunked(fn, flat[0].shape[0], flat)
+    return ForwardDynamicsResult(**_shape(d, batch, ok, ("qdd_act", "qdd")))
+
+
+# ----------------------------------------------------------------------------- energy
+def energy(mech: Mechanism, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
+    """Kinetic and potential energy ``(T, U) (...)`` (J) at ``q (..., nq)`` with every coordinate's rate
+    ``qd (..., nv)`` (``U = -sum m g . c``, zero at the world origin)."""
+    mech = check_mechanism(mech)
+    q = check_q(mech, q)
+    qd = as_array(qd, "qd", (mech.nv,))
+    batch = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1])
+    qf = np.broadcast_to(q, (*batch, mech.nq)).reshape(-1, mech.nq)
+    qdf = np.broadcast_to(qd, (*batch, mech.nv)).reshape(-1, mech.nv)
+    T, U = _energy_flat(mech, qf, qdf)
+    return np.reshape(T, batch), np.reshape(U, batch)
+
+
+# ----------------------------------------------------------------------------- simulation
+# Integrator tolerances for solve_ivp (DOP853): relative 1e-10 and absolute 1e-12 (rad, m, rad/s) keep the
+# local error far below the closure tolerance between two projections.
+SIM_RTOL = 1e-10
+# Largest |entry| of an initial state (rad, m, rad/s, m/s) accepted by simulate: far beyond any
+# mechanism, far below overflow of the squares in the energy (1e300 overflows).
+MAX_STATE = 1e100
+SIM_ATOL = 1e-12
+
+
+def _qpos_rate(tree, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """``dq/dt (N, nq)`` from the velocity coordinates (quaternion rates from local angular velocity)."""
+    out = np.zeros_like(q)
+    for k in range(len(tree.jnt_names)):
+        typ, qa, da = tree.jnt_type[k], tree.jnt_qadr[k], tree.jnt_dadr[k]
+        if typ <= 1:
+            out[:, qa] = qd[:, da]
+        elif typ == 2:
+            w = np.concatenate([np.zeros((q.shape[0], 1)), qd[:, da : da + 3]], axis=-1)
+            out[:, qa : qa + 4] = 0.5 * quat_mul(q[:, qa : qa + 4], w)
+        else:
+            out[:, qa : qa + 3] = qd[:, da : da + 3]
+            w = np.concatenate([np.zeros((q.shape[0], 1)), qd[:, da + 3 : da + 6]], axis=-1)
+            out[:, qa + 3 : qa + 7] = 0.5 * quat_mul(q[:, qa + 3 : qa + 7], w)
+    return out
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """A simulated motion, batch ``...`` of initial conditions, ``nt`` output times.
+
+    ``t (nt,)``; ``q (..., nt, nq)``, ``qd (..., nt, nv)``, ``q_act``, ``qd_act (..., nt, n_act)``;
+    ``kinetic``, ``potential`` (J) and ``work`` (the actuators' work since t0, J) ``(..., nt)``;
+    ``energy_drift (...)`` = max over t of ``|T + U - W - (T + U)(t0)|`` (J) and ``energy_drift_rel``
+    the same divided by the largest of ``T``, ``|U - U(t0)|`` and ``W`` over the motion;
+    ``closure (..., nt)`` the closure residual after projection (m); ``success (...)`` the integration
+    succeeded, every state is finite and every closure below CONVERGED_RTOL * L.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    q_act: np.ndarray
+    qd_act: np.ndarray
+    kinetic: np.ndarray
+    potential: np.ndarray
+    work: np.ndarray
+    energy_drift: np.ndarray
+    energy_drift_rel: np.ndarray
+    closure: np.ndarray
+    success: np.ndarray
+
+
+def _project(mech, q, qd):
+    """Back onto the manifold: positions by the closure Newton iteration (all coordinates), velocities
+    onto ``null(K)`` (minimum-norm correction)."""
+    tree = mech.tree
+    q, rc, _, _ = solve_closure(mech, q, np.arange(tree.nv))
+    st = kinematics(tree, q)
+    K = jacobian(mech.constraints, tree, st, q)
+    if K.shape[1]:
+        Kp, _ = _pinv_rank(K, _rank_K(mech))
+        qd = qd - np.einsum("nij,njk,nk->ni", Kp, K, qd)
+    return q, qd, rc
+
+
+def _simulate_flat(mech, q0, qd0, t, tau_fn, gravity):
+    from scipy.integrate import solve_ivp
+
+    tree = mech.tree
+    N, nq, nv = q0.shape[0], tree.nq, tree.nv
+    na = len(tree.act_dof)
+
+    def unpack(y):
+        Y = y.reshape(N, nq + nv + 1)
+        return Y[:, :nq], Y[:, nq : nq + nv], Y[:, -1]
+
+    def forces(tt, q, qd):
+        if tau_fn is None:
+            return np.zeros((N, na))
+        return np.broadcast_to(np.asarray(tau_fn(tt, q, qd), float), (N, na))
+
+    def rhs(tt, y):
+        q, qd, _ = unpack(y)
+        qn = normalize_quaternions(tree, q) if tree.quat_adr else q
+        tau = forces(tt, qn, qd)
+        qdd, _, _, _ = _forward_full(mech, qn, qd, tau, None, gravity)
+        power = np.sum(tau * qd[:, tree.act_dof], axis=-1)
+        return np.concatenate([_qpos_rate(tree, qn, qd), qdd, power[:, None]], axis=-1).ravel()
+
+    nt = len(t)
+    Q = np.empty((N, nt, nq))
+    QD = np.empty((N, nt, nv))
+    W = np.zeros((N, nt))
+    RC = np.zeros((N, nt))
+    q, qd, rc = _project(mech, q0, qd0)
+    Q[:, 0], QD[:, 0], RC[:, 0] = q, qd, rc
+    ok = True
+    for i in range(1, nt):
+        y0 = np.concatenate([q, qd, W[:, i - 1 : i]], axis=-1).ravel()
+        sol = solve_ivp(rhs, (t[i - 1], t[i]), y0, method="DOP853", rtol=SIM_RTOL, atol=SIM_ATOL)
+        if not sol.success or not np.all(np.isfinite(sol.y[:, -1])):
+            ok = False
+            Q[:, i:], QD[:, i:], W[:, i:], RC[:, i:] = np.nan, np.nan, np.nan, np.inf
+            break
+        q, qd, w = unpack(sol.y[:, -1])
+        q, qd, rc = _project(mech, normalize_quaternions(tree, q), qd)
+        Q[:, i], QD[:, i], W[:, i], RC[:, i] = q, qd, w, rc
+    return Q, QD, W, RC, ok
+
+
+def simulate(
+    mech: Mechanism,
+    q0: object,
+    qd_act0: object,
+    t: object,
+    *,
+    tau: object = None,
+    gravity: bool = True,
+) -> SimulationResult:
+    """Integrate the closed chain from ``(q0 (..., nq), qd_act0 (..., n_act))`` to the output times ``t``.
+
+    ``tau`` the actuator forces: None (passive motion), an array ``(..., n_act)`` held constant, or a
+    callable ``tau(t, q (N, nq), qd (N, nv)) -> (N, n_act)`` over the flattened batch.  The state is
+    every tree coordinate (idle motions included) integrated by ``scipy.integrate.solve_ivp`` (DOP853,
+    ``SIM_RTOL = 1e-10``, ``SIM_ATOL = 1e-12``) between consecutive output times, projected back onto the
+    constraint manifold at each of them.  Batched over initial conditions (one ODE system; a batch
+    whose integration fails is retried sample by sample so that one bad sample does not spoil the rest).
+    """
+    mech = check_mechanism(mech)
+    _fully_actuated(mech)
+    gravity = check_bool(gravity, "gravity")
+    tree = mech.tree
+    na = len(mech.actuated)
+    t = as_array(t, "t", (None,))
+    if t.ndim != 1 or t.shape[0] < 2 or np.any(np.diff(t) <= 0):
+        raise ValueError(f"Expected t to be increasing output times (at least 2), got shape {t.shape}.")
+    tau_arr = None
+    if tau is not None and not callable(tau):
+        tau_arr = as_array(tau, "tau", (na,))
+    batch, flat = _broadcast(
+        mech,
+        q0,
+        [(qd_act0, "qd_act0", na)] + ([(tau_arr, "tau", na)] if tau_arr is not None else []),
+        qname="q0",
+    )
+    q0f, qa0 = flat[0], flat[1]
+    for x, nm in ((q0f, "q0"), (qa0, "qd_act0")):
+        # an initial state is simulated, not masked: it must be finite and of physical size
+        if not np.all(np.isfinite(x)) or np.any(np.abs(x) > MAX_STATE):
+            raise ValueError(f"Expected {nm} finite with |value| <= {MAX_STATE:g}, got NaN, inf or more.")
+    q0f = normalize_quaternions(tree, q0f)
+    N = q0f.shape[0]
+    # the initial rates of every coordinate: qd = G qd_act0 (idle motions at rest)
+    from ._influence import _influence_flat
+
+    _, _, G, _, _, _ = _influence_flat(mech, q0f, False)
+    qd0 = _mv(G, qa0)
+    if tau_arr is not None:
+        tv = flat[2]
+
+        def tau_fn(tt, q, qd, tv=tv):
+            return tv if q.shape[0] == tv.shape[0] else tv[: q.shape[0]]
+    else:
+        tau_fn = tau
+    Q, QD, W, RC, ok = _simulate_flat(mech, q0f, qd0, t, tau_fn, gravity)
+    success = np.full(N, ok)
+    if not ok and N > 1:
+        for i in range(N):
+            fn_i = None
+            if tau_arr is not None:
+                fn_i = lambda tt, q, qd, v=flat[2][i : i + 1]: v  # noqa: E731
+            elif tau is not None:
+                fn_i = lambda tt, q, qd, i=i: np.asarray(tau(tt, q, qd), float).reshape(-1, na)[:1]  # noqa: E731
+            Qi, QDi, Wi, RCi, oki = _simulate_flat(mech, q0f[i : i + 1], qd0[i : i + 1], t, fn_i, gravity)
+            Q[i], QD[i], W[i], RC[i], success[i] = Qi[0], QDi[0], Wi[0], RCi[0], oki
+    from ._assembly import CONVERGED_RTOL
+
+    nt = len(t)
+    Tk, U = _energy_flat(mech, np.nan_to_num(Q.reshape(-1, tree.nq)), np.nan_to_num(QD.reshape(-1, tree.nv)))
+    Tk, U = Tk.reshape(N, nt), U.reshape(N, nt)
+    E = Tk + U - W
+    drift = np.max(np.abs(E - E[:, :1]), axis=-1)
+    scale = np.maximum.reduce([np.max(Tk, -1), np.max(np.abs(U - U[:, :1]), -1), np.max(np.abs(W), -1)])
+    rel = drift / np.maximum(scale, 1e-300)
+    success &= np.all(np.isfinite(Q), axis=(-1, -2)) & np.all(RC <= CONVERGED_RTOL * tree.length, axis=-1)
+    bad = ~success
+    drift = np.where(bad, np.nan, drift)
+    rel = np.where(bad, np.nan, rel)
+
+    def rs(x, *tail):
+        return np.reshape(x, (*batch, *tail))
+
+    return SimulationResult(
+        t=t.copy(),
+        q=rs(Q, nt, tree.nq),
+        qd=rs(QD, nt, tree.nv),
+        q_act=rs(Q[..., tree.act_qadr], nt, na),
+        qd_act=rs(QD[..., tree.act_dof], nt, na),
+        kinetic=rs(Tk, nt),
+        potential=rs(U, nt),
+        work=rs(W, nt),
+        energy_drift=rs(drift),
+        energy_drift_rel=rs(rel),
+        closure=rs(RC, nt),
+        success=rs(success),
+    )

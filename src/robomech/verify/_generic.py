@@ -1,0 +1,438 @@
+"""Automatic verification of any described mechanism against MuJoCo built from the same description.
+
+For a :class:`~robomech.multibody.Mechanism` (from an MJCF file or the Builder) the engine model is
+``mb.to_mjcf(mech)`` — the same bodies, joints, inertias and closures — and every check compares the
+multibody layer with the engine's *own* computations along a smooth trajectory of the actuated joints
+(each moves by ``q_act0 + a_i sin(w_i t + phi_i)``):
+
+* closure: the engine's equality violation ``efc_pos`` at the assembled configurations;
+* velocities: ``efc_J qd = 0`` for the rates ``qd = G qd_act``, and every site's ``[w; v]``
+  (``mj_objectVelocity``) against ``site_jacobian @ qd_act``;
+* accelerations: every site's acceleration (``mj_rnePostConstraint`` + ``mj_objectAcceleration`` with
+  the engine's ``qacc`` set to the multibody ``qdd``) against ``J qdd_act + H qd_act qd_act``;
+* inverse dynamics: the engine's tree dynamics ``M qdd + c + g`` (``mj_rne``) projected through the
+  engine's constraint Jacobian ``efc_J`` (actuator forces ``tau`` with ``N^T (E tau - f) = 0``,
+  ``N = null(efc_J)``, least squares, minimum norm) against :func:`~robomech.multibody.inverse_dynamics`;
+* power balance: ``tau . qd_act`` against ``dE/dt`` of the engine's own energy (``mj_energyPos`` +
+  ``mj_energyVel``), differentiated along the trajectory by a five-point stencil;
+* forward simulation: :func:`~robomech.multibody.simulate` from the trajectory's first state, passive
+  (gravity only), against MuJoCo's RK4 integration with stiff equality constraints; and the energy
+  drift of the multibody simulation.
+
+MuJoCo is imported inside the functions (the engine is the optional ``verify`` extra).  Joint damping,
+armature, springs, limits and contacts are not part of a multibody description and are absent from
+the exported engine model too, so both sides model the same rigid mechanism.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+from ._core import Check, Tolerance, VerificationReport
+
+__all__ = [
+    "check_mechanism",
+    "describe",
+    "engine_inverse_dynamics",
+    "engine_model",
+    "run_generic",
+    "split_targets",
+    "trajectory",
+    "verify_file",
+]
+
+# Geometry evaluated by two codes from the same numbers: agreement to rounding of O(L) positions through
+# a few dozen transforms, relative to the characteristic length (closure: FK converges to 1e-10 L, and
+# in practice to ~1e-15 L).
+TOL_CLOSURE = Tolerance(1e-9, "closure solved to 1e-10 L (CONVERGED_RTOL); engine rounding", relative=True)
+TOL_VELOCITY = Tolerance(1e-9, "exact first-order influence coefficients; rounding only", relative=True)
+TOL_ACCELERATION = Tolerance(1e-8, "exact second-order influence coefficients; rounding only", relative=True)
+# Both inverse dynamics are exact rigid-body models of the same bodies (acceptance: 1e-8 relative).
+TOL_TORQUE = Tolerance(1e-8, "exact tree dynamics + the engine's own constraint projection", relative=True)
+# Five-point stencil with step H_POWER: truncation h^4 w^5 E / 30 ~ 1e-11 (w <= 10 rad/s on the test
+# trajectory), rounding of E (~1e-15 through the assembly) / h ~ 1e-11.
+TOL_POWER = Tolerance(1e-8, "dE/dt by a 5-point stencil (h = 0.2 ms): ~1e-11 relative error", relative=True)
+H_POWER = 2e-4
+# Forward simulation: the engine's equality constraints are soft; with a stiff setting (time constant
+# 0.5 ms, impedance 0.9999) and RK4 steps of 0.1 ms the engine tracks the exact constrained motion to
+# ~3e-5 over T_SIM (measured on the gallery); the multibody integration (DOP853, rtol 1e-10) to ~1e-9.
+SIM_TIMESTEP = 1e-4
+SIM_SOLREF = "0.0005 1"
+SIM_SOLIMP = "0.9999 0.9999 0.001 0.5 2"
+T_SIM = 0.3
+TOL_SIM = Tolerance(1e-3, "soft engine constraints (0.5 ms, 0.9999) and 0.1 ms RK4 steps", relative=True)
+TOL_DRIFT = Tolerance(
+    1e-7,
+    "DOP853 at rtol 1e-10 with projection onto the manifold; relative to the energy exchanged",
+    relative=True,
+)
+# Every test configuration must assemble: the error is the fraction that failed (any failure >= 1/N_TRAJ).
+TOL_ASSEMBLY = Tolerance(1e-12, "every sample must assemble (FK converged); error = fraction failed")
+# Trajectory: N_TRAJ samples over T_TRAJ seconds, amplitudes AMP rad (AMP L for slides).
+N_TRAJ = 12
+T_TRAJ = 1.0
+AMP = 0.15
+# Null-space rank decision on the engine's efc_J (equality rows, length units): as in the multibody layer.
+ENGINE_RANK_RTOL = 1e-10
+
+
+def engine_model(mech, *, simulation: bool = False):
+    """MuJoCo model of ``mech`` from ``mb.to_mjcf``; ``simulation=True`` sets the stiff equality
+    constraints and the RK4 step used by the forward-simulation check."""
+    import mujoco
+
+    from robomech import multibody as mb
+
+    xml = mb.to_mjcf(mech)
+    if simulation:
+        root = ET.fromstring(xml)
+        opt = root.find("option")
+        if opt is None:
+            opt = ET.SubElement(root, "option")
+        opt.set("timestep", repr(SIM_TIMESTEP))
+        opt.set("integrator", "RK4")
+        eq = root.find("equality")
+        for e in [] if eq is None else list(eq):
+            e.set("solref", SIM_SOLREF)
+            e.set("solimp", SIM_SOLIMP)
+        xml = ET.tostring(root, encoding="unicode")
+    return mujoco.MjModel.from_xml_string(xml)
+
+
+def _efc_equality(m, d) -> np.ndarray:
+    import mujoco
+
+    eq = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+    if d.nefc == 0:
+        return np.zeros((0, m.nv))
+    if mujoco.mj_isSparse(m):
+        J = np.zeros((d.nefc, m.nv))
+        mujoco.mju_sparse2dense(J, d.efc_J, d.efc_J_rownnz, d.efc_J_rowadr, d.efc_J_colind)
+    else:
+        J = np.array(d.efc_J)[: d.nefc * m.nv].reshape(d.nefc, m.nv)
+    return J[eq]
+
+
+def trajectory(mech, n: int = N_TRAJ, t_end: float = T_TRAJ, seed: int = 0):
+    """``t, q_act, qd_act, qdd_act`` of the smooth test motion around the reference configuration."""
+    rng = np.random.default_rng(seed)
+    tree = mech.tree
+    na = len(mech.actuated)
+    scale = np.where(tree.dof_translational[tree.act_dof], tree.length, 1.0)
+    a = AMP * scale * rng.uniform(0.5, 1.0, na)
+    w = 2 * np.pi * rng.uniform(0.5, 1.5, na)
+    ph = rng.uniform(0, 2 * np.pi, na)
+    t = np.linspace(0.0, t_end, n)
+
+    def at(tt):
+        tt = np.asarray(tt, float)[..., None]
+        s = np.sin(w * tt + ph) - np.sin(ph)
+        return tree.q0[tree.act_qadr] + a * s, a * w * np.cos(w * tt + ph), -a * w * w * np.sin(w * tt + ph)
+
+    return t, at
+
+
+def _assemble_along(mech, qa: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """FK along a sequence of inputs, each from the previous solution (continuation keeps the branch)."""
+    from robomech import multibody as mb
+
+    q = np.empty((len(qa), mech.nq))
+    conv = np.empty(len(qa), dtype=bool)
+    guess = None
+    for i, x in enumerate(qa):
+        r = mb.forward_kinematics(mech, x, guess=guess, steps=1 if guess is not None else 4)
+        q[i], conv[i] = r.q, r.converged
+        guess = r.q if r.converged else guess
+    return q, conv
+
+
+def engine_inverse_dynamics(m, d, mech, q, qd, qdd) -> np.ndarray:
+    """Actuator forces from the engine: ``mj_rne`` tree dynamics projected through its ``efc_J``."""
+    import mujoco
+
+    d.qpos[:] = q
+    d.qvel[:] = qd
+    mujoco.mj_forward(m, d)
+    d.qacc[:] = qdd
+    f = np.zeros(m.nv)
+    mujoco.mj_rne(m, d, 1, f)
+    Jc = _efc_equality(m, d)
+    if Jc.shape[0]:
+        _, s, Vt = np.linalg.svd(Jc)
+        r = int(np.sum(s > ENGINE_RANK_RTOL * max(s[0], 1e-300)))
+        Nn = Vt[r:].T
+    else:
+        Nn = np.eye(m.nv)
+    E = np.zeros((m.nv, len(mech.actuated)))
+    E[mech.tree.act_dof, np.arange(len(mech.actuated))] = 1.0
+    return np.linalg.lstsq(Nn.T @ E, Nn.T @ f, rcond=None)[0]
+
+
+def _rel(err: float, scale: float) -> float:
+    return float(err / scale) if scale > 0 else float(err)
+
+
+def check_mechanism(mech, name: str | None = None, *, simulate: bool = True) -> list[Check]:
+    """Every check of this module for ``mech`` (the rows of the ``robomech verify`` table)."""
+    import mujoco
+
+    from robomech import multibody as mb
+
+    name = name or mech.name
+    inferred = [b.name for b in mech.bodies if b.inertial is None]
+    if inferred:
+        # to_mjcf lets MuJoCo derive these bodies' inertia from their visual geoms; verify the mechanism
+        # as exported, with those inertias on both sides (read back from the engine's compiled model)
+        mech = mb.from_mjcf(mb.to_mjcf(mech))
+    tree = mech.tree
+    L = tree.length
+    checks: list[Check] = []
+    drv = _driver(mech)  # redundant actuation: a consistent motion is driven through `dof` actuators
+    t, at = trajectory(drv)
+    qa, qda, qdda = at(t)
+    q, conv = _assemble_along(drv, qa)
+    checks.append(
+        Check(
+            name,
+            "assembly along the test trajectory",
+            float(np.mean(~conv)),  # the fraction that failed (finite: --json stays strict JSON)
+            TOL_ASSEMBLY,
+            f"{int(conv.sum())}/{len(conv)} converged"
+            + (f"; inertia of {len(inferred)} bodies from the exported geoms" if inferred else ""),
+        )
+    )
+    q, qa, qda, qdda = q[conv], qa[conv], qda[conv], qdda[conv]
+    if not len(q):
+        return checks
+    if drv is not mech:  # every actuator's rates along the driven (consistent) motion
+        rd = mb.inverse_dynamics(drv, q, qda, qdda)
+        qa, qda, qdda = q[:, tree.act_qadr], rd.qd[:, tree.act_dof], rd.qdd[:, tree.act_dof]
+    inv = mb.inverse_dynamics(mech, q, qda, qdda)
+    m = engine_model(mech)
+    d = mujoco.MjData(m)
+    closure = vel = acc = 0.0
+    vscale = ascale = 0.0
+    tau_e = np.zeros_like(inv.tau)
+    g = np.asarray(mech.gravity)
+    sites = [s.name for s in mech.sites]
+    J = {s: mb.site_jacobian(mech, q, s) for s in sites}
+    H = {s: mb.site_hessian(mech, q, s) for s in sites}
+    adm = 0.0
+    for i in range(len(q)):
+        d.qpos[:] = q[i]
+        d.qvel[:] = inv.qd[i]
+        mujoco.mj_forward(m, d)
+        eq = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+        if np.any(eq):
+            closure = max(closure, float(np.max(np.abs(d.efc_pos[eq]))))
+            Jc = _efc_equality(m, d)
+            adm = max(adm, float(np.max(np.abs(Jc @ inv.qd[i]))))
+        d.qacc[:] = inv.qdd[i]
+        mujoco.mj_rnePostConstraint(m, d)
+        for s in sites:
+            sid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, s)
+            v6 = np.zeros(6)
+            mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_SITE, sid, v6, 0)
+            a6 = np.zeros(6)
+            mujoco.mj_objectAcceleration(m, d, mujoco.mjtObj.mjOBJ_SITE, sid, a6, 0)
+            a6[3:] += g  # the engine's accelerations include -g (an accelerometer's reading)
+            mine_v = J[s][i] @ qda[i]
+            mine_a = J[s][i] @ qdda[i] + np.einsum("ijk,j,k->i", H[s][i], qda[i], qda[i])
+            wv = np.array([L, L, L, 1, 1, 1])
+            vel = max(vel, float(np.max(np.abs((mine_v - v6) * wv))))
+            acc = max(acc, float(np.max(np.abs((mine_a - a6) * wv))))
+            vscale = max(vscale, float(np.max(np.abs(mine_v * wv))))
+            ascale = max(ascale, float(np.max(np.abs(mine_a * wv))))
+        tau_e[i] = engine_inverse_dynamics(m, d, mech, q[i], inv.qd[i], inv.qdd[i])
+    qdscale = L * max(float(np.max(np.abs(inv.qd))), 1e-300)
+    checks += [
+        Check(name, "closure (engine efc_pos)", closure / L, TOL_CLOSURE, "max |efc_pos| / L"),
+        Check(name, "admissible velocity (engine efc_J qd)", adm / qdscale, TOL_VELOCITY, "/ (L max|qd|)"),
+    ]
+    if sites:
+        checks += [
+            Check(name, "site velocities", _rel(vel, vscale), TOL_VELOCITY, "J qd_act vs mj_objectVelocity"),
+            Check(
+                name, "site accelerations", _rel(acc, ascale), TOL_ACCELERATION, "J qdd + H qd qd vs engine"
+            ),
+        ]
+    tscale = float(np.max(np.abs(tau_e)))
+    checks.append(
+        Check(
+            name,
+            "inverse dynamics (mj_rne through efc_J)",
+            _rel(float(np.nanmax(np.abs(inv.tau - tau_e))), tscale) if inv.valid.all() else 1.0,
+            TOL_TORQUE,
+            f"max |tau| {tscale:.3g}; {int(inv.valid.sum())}/{len(inv.valid)} valid",
+        )
+    )
+    checks.append(_power_check(drv, name, m, d, at, t[conv], q, inv.tau, inv.qd[:, tree.act_dof]))
+    if simulate:
+        checks += _simulation_checks(mech, name, q[0], qda[0])
+    return checks
+
+
+def _engine_energy(m, d, q, qd) -> float:
+    import mujoco
+
+    d.qpos[:] = q
+    d.qvel[:] = qd
+    mujoco.mj_forward(m, d)
+    mujoco.mj_energyPos(m, d)
+    mujoco.mj_energyVel(m, d)
+    return float(d.energy[0] + d.energy[1])
+
+
+def _driver(mech):
+    """``mech``, or for redundant actuation the same mechanism driven by the first subset of ``dof``
+    actuators that determines its motion (to generate consistent test motions)."""
+    from itertools import combinations
+
+    from robomech import multibody as mb
+
+    dof = mb.mobility(mech).dof
+    if len(mech.actuated) <= dof:
+        return mech
+    for sub in combinations(mech.actuated, dof):
+        drv = dataclasses.replace(mech, actuated=sub)
+        if mb.mobility(drv).dof == dof and mb.influence(drv, drv.q0, second_order=False).consistency < 1e-9:
+            return drv
+    return mech
+
+
+def _power_check(mech, name, m, d, at, t, q, tau, qd_act) -> Check:
+    """``tau . qd_act`` (every actuator's force and rate) against dE/dt of the engine's energy along the
+    motion driven through ``mech``'s actuators (``at``)."""
+    import mujoco
+
+    from robomech import multibody as mb
+
+    m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
+    h = H_POWER
+    err = 0.0
+    scale = 0.0
+    for i, ti in enumerate(t):
+        qa, qda, qdda = at(ti + h * np.arange(-2, 3))
+        fk = mb.forward_kinematics(mech, qa, guess=q[i])
+        r = mb.inverse_dynamics(mech, fk.q, qda, qdda)
+        E = np.array([_engine_energy(m, d, fk.q[k], r.qd[k]) for k in range(5)])
+        dE = (E[0] - 8 * E[1] + 8 * E[3] - E[4]) / (12 * h)
+        P = float(tau[i] @ qd_act[i])
+        err = max(err, abs(P - dE))
+        scale = max(scale, abs(P), abs(dE))
+    return Check(name, "power balance tau.qd = dE/dt (engine energy)", _rel(err, scale), TOL_POWER, "")
+
+
+def _simulation_checks(mech, name, q0, qd_act0) -> list[Check]:
+    import mujoco
+
+    from robomech import multibody as mb
+
+    t = np.linspace(0.0, T_SIM, 7)
+    sim = mb.simulate(mech, q0, qd_act0, t)
+    m = engine_model(mech, simulation=True)
+    d = mujoco.MjData(m)
+    G = mb.influence(mech, q0, second_order=False).G
+    d.qpos[:] = q0
+    d.qvel[:] = G @ qd_act0
+    mujoco.mj_forward(m, d)
+    out = [d.qpos[mech.tree.act_qadr].copy()]
+    for k in range(1, len(t)):
+        while d.time < t[k] - 0.5 * SIM_TIMESTEP:
+            mujoco.mj_step(m, d)
+        out.append(d.qpos[mech.tree.act_qadr].copy())
+    eng = np.array(out)
+    if not bool(sim.success):
+        return [Check(name, "forward simulation vs engine", 1.0, TOL_SIM, "integration failed (error: 1)")]
+    tree = mech.tree
+    scale = np.where(tree.dof_translational[tree.act_dof], 1.0 / tree.length, 1.0)
+    err = float(np.max(np.abs((sim.q_act - eng) * scale)))
+    moved = float(np.max(np.abs((sim.q_act - sim.q_act[0]) * scale)))
+    return [
+        Check(
+            name,
+            f"forward simulation vs engine ({T_SIM} s, passive)",
+            _rel(err, max(moved, 1e-3)),
+            TOL_SIM,
+            f"max |q_act - engine| {err:.2e} (rad, slides / L) for a motion of {moved:.3g}",
+        ),
+        Check(
+            name,
+            "energy drift of the simulation",
+            float(sim.energy_drift_rel),
+            TOL_DRIFT,
+            f"{float(sim.energy_drift):.2e} J",
+        ),
+    ]
+
+
+def verify_file(path: str | Path) -> VerificationReport:
+    """``robomech verify path/to/model.xml``: every check of :func:`check_mechanism` on a user's MJCF."""
+    from robomech import multibody as mb
+
+    mech = mb.from_mjcf(Path(path))
+    report = VerificationReport()
+    report.checks.extend(check_mechanism(mech, Path(path).stem))
+    return report
+
+
+def split_targets(targets, available) -> tuple[list[str], list[str]]:
+    """``robomech verify`` arguments: (registered names and unknown words, generic targets).
+
+    Generic targets are MJCF paths and gallery / paper-description names that are not registered
+    verifications; they get :func:`check_mechanism`."""
+    from robomech import multibody as mb
+
+    described = set(_paper()) | set(mb.gallery.NAMES)
+    def is_generic(a: str) -> bool:
+        return a not in available and (a in described or a.endswith(".xml") or Path(a).is_file())
+
+    generic = [a for a in targets if is_generic(a)]
+    return [a for a in targets if a not in generic], generic
+
+
+def run_generic(targets) -> list[Check]:
+    """The generic checks of each target (MJCF path, gallery or description name); ValueError if one
+    cannot be read."""
+    checks: list[Check] = []
+    for t in targets:
+        try:
+            mech = describe(t)
+        except OSError as exc:
+            raise ValueError(f"cannot read {t!r}: {exc}") from exc
+        checks.extend(check_mechanism(mech, Path(t).stem if t.endswith(".xml") else f"{t} (generic)"))
+    return checks
+
+
+def _paper() -> dict:
+    from robomech.mechanisms import omnileg as ol
+    from robomech.mechanisms import spherical_leg as sl
+    from robomech.mechanisms import vectored_thrust as vt
+
+    return {
+        "spherical-leg": lambda: sl.to_multibody(sl.SphericalLeg.paper()),
+        "omnileg": lambda: ol.to_multibody(ol.OmniLeg.paper()),
+        "vectored-thrust": lambda: vt.to_multibody(vt.VectoredThruster.paper()),
+    }
+
+
+def describe(target: str):
+    """The mechanism named by ``target`` (``robomech export``): a paper mechanism with a description
+    (its ``to_multibody`` at the paper's parameters), a gallery name or an MJCF path."""
+    from robomech import multibody as mb
+
+    paper = _paper()
+    if target in paper:
+        return paper[target]()
+    if target in mb.gallery.NAMES:
+        return mb.gallery.load(target)
+    if target.endswith(".xml") or Path(target).is_file():
+        return mb.from_mjcf(Path(target))
+    raise ValueError(
+        f"Expected MECHANISM among {sorted(paper)} or the gallery {list(mb.gallery.NAMES)}, "
+        f"or an MJCF file, got {target!r}."
+    )
