@@ -1,7 +1,7 @@
 """Bad-input specs of robomech.mechanisms.omnileg (paper 2)."""
 
 import numpy as np
-from contract_spec import BAD_INT, BAD_POSITIVE, BAD_REAL, CONSTANT, RESULT_TYPE, Spec, exempt
+from contract_spec import BAD_BOOL, BAD_INT, BAD_POSITIVE, BAD_REAL, CONSTANT, RESULT_TYPE, Spec, exempt
 
 from robomech.mechanisms import omnileg as ol
 
@@ -60,9 +60,10 @@ SPECS = {
     P + "static_torques": _leg(q=Q, force=QD),
     P + "joint_motion": _leg(q=Q, qd=QD, qdd=QDD),
     P + "inverse_dynamics": Spec(
-        args={"leg": LEG, "q": Q, "qd": QD, "qdd": QDD, "foot_force": QD},
+        args={"leg": LEG, "q": Q, "qd": QD, "qdd": QDD, "foot_force": QD, "paper_as_printed": False},
         arrays={"q": 1, "qd": 1, "qdd": 1, "foot_force": 1},
         params=("leg",),
+        options={"paper_as_printed": BAD_BOOL},
     ),
     P + "foot_force_from_torques": Spec(
         args={"leg": LEG, "q": Q, "tau": QD},

@@ -67,12 +67,12 @@ SPECS = {
         args={"leg": LEG, "alpha": A, "beta": B}, arrays={"alpha": 0, "beta": 0}, params=("leg",)
     ),
     P + "forward_kinematics": Spec(
-        args={"leg": LEG, "lengths": LENGTHS, "branch": 0},
+        args={"leg": LEG, "lengths": LENGTHS, "branch": 0, "paper_as_printed": False},
         arrays={"lengths": 1},
         masked=("lengths",),
         mask="valid",
         params=("leg",),
-        options={"branch": (2, -1, 0.5, None, "0", True)},
+        options={"branch": (2, -1, 0.5, None, "0", True), "paper_as_printed": BAD_BOOL},
     ),
     P + "platform_rotation": Spec(args={"alpha": A, "beta": B}, arrays={"alpha": 0, "beta": 0}),
     P + "jacobian": Spec(
@@ -104,11 +104,11 @@ SPECS = {
         args={"leg": LEG, "q": Q, "qd": QD}, arrays={"q": 1, "qd": 1}, params=("leg",)
     ),
     P + "distribute_forces": Spec(
-        args={"J": J, "tau": QD, "driven_legs": None},
+        args={"J": J, "tau": QD, "driven_legs": None, "sigma_min_bound": sl.ACTUATION_SIGMA_MIN},
         arrays={"J": 2, "tau": 1},
         masked=("J", "tau"),
         mask="valid",
-        options={"driven_legs": BAD_LEGS},
+        options={"driven_legs": BAD_LEGS, "sigma_min_bound": BAD_NONNEGATIVE},
     ),
     P + "inverse_dynamics": Spec(
         args={
