@@ -384,6 +384,17 @@ def _run() -> list[Check]:
     ]
 
 
+def _grid_markdown(n_segments, pretension, bend_deg, cell) -> str:
+    """A segments x pretension (rows) by bend angle (columns) Markdown table; ``cell(i, j, k)``."""
+    head = "| segments | pretension (N) | " + " | ".join(f"{b:g}°" for b in bend_deg) + " |"
+    lines = [head, "|---|---|" + "---|" * len(bend_deg)]
+    for i, n in enumerate(n_segments):
+        for j, t in enumerate(pretension):
+            cells = [cell(i, j, k) for k in range(len(bend_deg))]
+            lines.append(f"| {n} | {t:g} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 @dataclasses.dataclass(frozen=True)
 class CCErrorTable:
     """Constant-curvature modelling error vs bend angle and tip load (paper robot, one segment)."""
@@ -460,20 +471,13 @@ class ConvergenceTable:
     seconds: np.ndarray
 
     def markdown(self) -> str:
-        head = "| segments | pretension (N) | " + " | ".join(f"{b:g}°" for b in self.bend_deg) + " |"
-        lines = [head, "|---|---|" + "---|" * len(self.bend_deg)]
-        for i, n in enumerate(self.n_segments):
-            for j, t in enumerate(self.pretension):
-                cells = []
-                for k in range(len(self.bend_deg)):
-                    a = "✓" if self.converged[i, j, k] else f"✗ (λ={self.load_fraction[i, j, k]:.2f})"
-                    b = "✓" if self.loaded_converged[i, j, k] else "✗"
-                    err = (
-                        f"{1e3 * self.tip_error[i, j, k]:.0e} mm" if self.taut[i, j, k] else "slack, clipped"
-                    )
-                    cells.append(f"{a} {err} / loaded {b} ({self.seconds[i, j, k]:.1f} s)")
-                lines.append(f"| {n} | {t:g} | " + " | ".join(cells) + " |")
-        return "\n".join(lines)
+        def cell(i: int, j: int, k: int) -> str:
+            a = "✓" if self.converged[i, j, k] else f"✗ (λ={self.load_fraction[i, j, k]:.2f})"
+            b = "✓" if self.loaded_converged[i, j, k] else "✗"
+            err = f"{1e3 * self.tip_error[i, j, k]:.0e} mm" if self.taut[i, j, k] else "slack, clipped"
+            return f"{a} {err} / loaded {b} ({self.seconds[i, j, k]:.1f} s)"
+
+        return _grid_markdown(self.n_segments, self.pretension, self.bend_deg, cell)
 
 
 def convergence_table(
@@ -538,21 +542,15 @@ class DiskAgreementTable:
     valid: np.ndarray
 
     def markdown(self) -> str:
-        head = "| segments | pretension (N) | " + " | ".join(f"{b:g}°" for b in self.bend_deg) + " |"
-        lines = [head, "|---|---|" + "---|" * len(self.bend_deg)]
-        for i, n in enumerate(self.n_segments):
-            for j, t in enumerate(self.pretension):
-                cells = []
-                for k in range(len(self.bend_deg)):
-                    if not self.valid[i, j, k]:
-                        cells.append("slack / not converged")
-                        continue
-                    cells.append(
-                        f"{1e3 * self.chord_error[i, j, k]:.2f} / {1e3 * self.arc_error[i, j, k]:.2f} mm, "
-                        f"{1e6 * self.elongation_error[i, j, k]:.1f} µm"
-                    )
-                lines.append(f"| {n} | {t:g} | " + " | ".join(cells) + " |")
-        return "\n".join(lines)
+        def cell(i: int, j: int, k: int) -> str:
+            if not self.valid[i, j, k]:
+                return "slack / not converged"
+            return (
+                f"{1e3 * self.chord_error[i, j, k]:.2f} / {1e3 * self.arc_error[i, j, k]:.2f} mm, "
+                f"{1e6 * self.elongation_error[i, j, k]:.1f} µm"
+            )
+
+        return _grid_markdown(self.n_segments, self.pretension, self.bend_deg, cell)
 
 
 def disk_agreement_table(
