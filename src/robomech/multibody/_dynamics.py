@@ -596,6 +596,18 @@ def _broadcast(mech, q, others: list[tuple[object, str, int]], qname: str = "q")
     return batch, flat
 
 
+def _site_inputs(mech, q, arrays, wrenches):
+    """Validate the per-sample arrays and the site wrenches, broadcast them with ``q`` and sanitize:
+    ``(site indices of the wrenches, batch shape, per-sample ok mask, flat arrays)``."""
+    wr = _check_wrenches(mech, wrenches)
+    names = list(wr)
+    batch, flat = _broadcast(
+        mech, q, list(arrays) + [(wr[s], f"wrenches[{mech.tree.site_names[s]!r}]", 6) for s in names]
+    )
+    ok, flat = _sanitize(mech, flat)
+    return names, batch, ok, flat
+
+
 def _sanitize(mech, flat: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray]]:
     ok = _finite_rows(*flat)
     out = []
@@ -656,15 +668,8 @@ def inverse_dynamics(
     gravity = check_bool(gravity, "gravity")
     w = _check_weights(mech, weights)
     na = len(mech.actuated)
-    wr = _check_wrenches(mech, wrenches)
-    names = list(wr)
-    batch, flat = _broadcast(
-        mech,
-        q,
-        [(qd_act, "qd_act", na), (qdd_act, "qdd_act", na)]
-        + [(wr[s], f"wrenches[{mech.tree.site_names[s]!r}]", 6) for s in names],
-    )
-    ok, flat = _sanitize(mech, flat)
+    arrays = [(qd_act, "qd_act", na), (qdd_act, "qdd_act", na)]
+    names, batch, ok, flat = _site_inputs(mech, q, arrays, wrenches)
     n = flat[0].shape[0]
 
     def fn(qf, qdf, qddf, *ws, **kw):
@@ -844,15 +849,7 @@ def forward_dynamics(
     _fully_actuated(mech)
     gravity = check_bool(gravity, "gravity")
     na = len(mech.actuated)
-    wr = _check_wrenches(mech, wrenches)
-    names = list(wr)
-    batch, flat = _broadcast(
-        mech,
-        q,
-        [(qd_act, "qd_act", na), (tau, "tau", na)]
-        + [(wr[s], f"wrenches[{mech.tree.site_names[s]!r}]", 6) for s in names],
-    )
-    ok, flat = _sanitize(mech, flat)
+    names, batch, ok, flat = _site_inputs(mech, q, [(qd_act, "qd_act", na), (tau, "tau", na)], wrenches)
     rank0, _ = _reference(mech)
     tree = mech.tree
     pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
