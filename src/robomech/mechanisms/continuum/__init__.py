@@ -6,13 +6,17 @@ See ``docs/mechanisms/continuum.md`` for every assumption and every departure fr
 """
 
 from ._compensation import (
+    COMPENSATION_ITERATIONS,
+    COMPENSATION_STEP_TOL,
     DriveResult,
     SimulationResult,
     cable_elongation,
     compensated_drive,
+    disk_equilibrium,
     simulate,
     theoretical_drive,
 )
+from ._disks import DISK_MAX_ITERATIONS, DISK_TOLERANCE, DiskEquilibrium
 from ._friction import (
     FrictionEstimate,
     TensionHistory,
@@ -49,9 +53,14 @@ from ._statics import (
 )
 
 __all__ = [
+    "COMPENSATION_ITERATIONS",
+    "COMPENSATION_STEP_TOL",
+    "DISK_MAX_ITERATIONS",
+    "DISK_TOLERANCE",
     "IDENTIFY_MU_MAX",
     "IK_TOLERANCE",
     "ContinuumRobot",
+    "DiskEquilibrium",
     "DriveResult",
     "FrictionEstimate",
     "IKResult",
@@ -68,6 +77,7 @@ __all__ = [
     "classical_capstan_ratio",
     "compensated_drive",
     "coupling_moments",
+    "disk_equilibrium",
     "disk_transforms",
     "elastic_energy",
     "elastic_gradient",
