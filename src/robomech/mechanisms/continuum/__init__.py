@@ -28,7 +28,14 @@ from ._friction import (
     stick_slip_tensions,
     wrap_angles,
 )
-from ._identification import IDENTIFY_MU_MAX, PoseFrictionEstimate, identify_friction_from_pose
+from ._identification import (
+    IDENTIFY_MU_MAX,
+    IDENTIFY_STIFFNESS_BOUNDS,
+    PoseFrictionEstimate,
+    TipFrictionEstimate,
+    identify_friction_from_pose,
+    identify_friction_from_tip,
+)
 from ._kinematics import (
     IK_TOLERANCE,
     IKResult,
@@ -58,6 +65,7 @@ __all__ = [
     "DISK_MAX_ITERATIONS",
     "DISK_TOLERANCE",
     "IDENTIFY_MU_MAX",
+    "IDENTIFY_STIFFNESS_BOUNDS",
     "IK_TOLERANCE",
     "ContinuumRobot",
     "DiskEquilibrium",
@@ -68,6 +76,7 @@ __all__ = [
     "SimulationResult",
     "TensionHistory",
     "TensionResult",
+    "TipFrictionEstimate",
     "cable_elongation",
     "cable_jacobian",
     "cable_lengths",
@@ -85,6 +94,7 @@ __all__ = [
     "friction_factors",
     "identify_friction",
     "identify_friction_from_pose",
+    "identify_friction_from_tip",
     "inverse_kinematics",
     "segment_transform",
     "simulate",
