@@ -42,6 +42,8 @@ DISK_BACKTRACKS = 12
 COLUMN_SERIES_BELOW = 0.1
 """Below u = 0.1 the column correction uses its series (-u^4/45 - 2u^6/945; the closed form cancels to
 ~1e-12 relative there, the first omitted term is ~u^8/4725 ~ 2e-12)."""
+COLUMN_PASSES = 8
+"""Fixed-point passes of the column shortening in drive mode (see _state)."""
 DISK_FD_STEP = 6e-6
 """Central-difference step (rad) of the Newton matrix: eps^(1/3) for O(0.1) interval bends."""
 
@@ -155,12 +157,15 @@ def _state(
     ei = robot.bending_stiffness
     # The column shape shortens the interval more than its arc (see _column_shortening): in the cable
     # paths only (the virtual work has it through the stiffness correction below).  In drive mode the
-    # compression is taken from the tensions of the arc paths (one fixed-point pass; the shortening
-    # is ~1e-5 m, its effect on the compression ~1e-2 of it).
-    t_u = load if mode == "tension" else _tension_estimate(robot, ell, P, load)
-    u_path = 0.5 * h * np.sqrt(np.sum(np.maximum(t_u, 0.0)[..., :, None] * P, axis=-2) / ei)
-    ell_path = ell - np.where(act, _column_shortening(th, u_path, h)[..., None, :], 0.0)
-    t_raw = load if mode == "tension" else _tension_estimate(robot, ell_path, P, load)
+    # compression depends on the tensions that depend on the paths: a fixed point (the shortening is
+    # ~1e-5 m, and 1e-5 m of path is ~0.1 N of tension); measured: after 5 passes the drive-mode round
+    # trip is off by 2e-5 N at 80 deg, after COLUMN_PASSES = 8 by 6e-8 N.
+    ell_path, t_raw = ell, load
+    for _ in range(1 if mode == "tension" else COLUMN_PASSES):
+        t_u = load if mode == "tension" else _tension_estimate(robot, ell_path, P, load)
+        u_path = 0.5 * h * np.sqrt(np.sum(np.maximum(t_u, 0.0)[..., :, None] * P, axis=-2) / ei)
+        ell_path = ell - np.where(act, _column_shortening(th, u_path, h)[..., None, :], 0.0)
+        t_raw = load if mode == "tension" else _tension_estimate(robot, ell_path, P, load)
     w = np.maximum(t_raw, 0.0)[..., :, None] * P  # span tensions (a cable cannot push)
     # Beam-column correction: the cables compress the core between two disks by ~sum of the span
     # tensions; the arc's chord shortening in ell already softens the interval to EI (1 - u^2/3),
@@ -240,4 +245,4 @@ def _uniform_k(robot: ContinuumRobot, theta: Array, beta: Array) -> Array:
     N = robot.disks_per_segment
     th = np.repeat(theta / N, N, axis=-1)
     be = np.repeat(beta, N, axis=-1)
-    return np.stack([th * np.cos(be), th * np.sin(be)], -1).reshape(*th.shape, 2).reshape(*th.shape[:-1], -1)
+    return np.stack([th * np.cos(be), th * np.sin(be)], -1).reshape(*th.shape[:-1], 2 * th.shape[-1])
