@@ -26,6 +26,7 @@ from robomech.mechanisms.continuum import (
     forward_kinematics,
     segment_transform,
 )
+from robomech.mechanisms.continuum._kinematics import CableModel
 from robomech.spatial import log_so3
 
 from ._core import Check, Tolerance, Verification
@@ -88,8 +89,8 @@ def _arc_check(rigid: TendonRod) -> Check:
     for deg in _BEND_DEG:
         tau = ei * math.radians(deg) / (L * r)
         cases += [(tau, 0.0, 0.0), (0.0, tau, 0.0), (tau, 0.5 * tau, 0.0)]
-    tau = np.array(cases)
-    sol = solve_static(rigid, tau)
+    taus = np.array(cases)
+    sol = solve_static(rigid, taus)
     u = np.einsum("ba,ai->bi", tau, np.cross([0.0, 0.0, 1.0], rigid.tendon_offsets))[:, :2] / ei
     T = constant_curvature_transform(u, L)
     err = np.max(np.abs(sol.T_tip[..., :3, 3] - T[..., :3, 3]), axis=-1) / L
@@ -262,7 +263,7 @@ def library_disk_error(
     psi: object,
     direction: object | None = None,
     *,
-    model: str = "chord",
+    model: CableModel = "chord",
     reference: DiskRobot | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Library statics (cable model ``model``, disk friction in the sliding ``direction``) against the
@@ -270,7 +271,11 @@ def library_disk_error(
     the reference (default :func:`disk_robot_for` the robot) with the same sliding directions; returns
     ``(tip position error (B,) m, elongation error (B,) m (max over cables), taut, converged)``."""
     psi = np.atleast_2d(np.asarray(psi, dtype=float))
-    d = None if direction is None else np.broadcast_to(direction, (psi.shape[0], robot.n_cables))
+    d = (
+        None
+        if direction is None
+        else np.broadcast_to(np.asarray(direction, float), (psi.shape[0], robot.n_cables))
+    )
     reference = disk_robot_for(robot) if reference is None else reference
     tens = cable_tensions(robot, psi, direction=d, model=model)
     pos = np.full(psi.shape[0], np.nan)
@@ -666,11 +671,11 @@ def identification_from_reference(
     robot = ContinuumRobot.paper() if robot is None else robot
     bends = np.arange(40.0, 90.1, 5.0) if bends_deg is None else np.asarray(bends_deg, float)
     rng = np.random.default_rng(seed)
-    psi, dirs = [], []
+    psis, dirs = [], []
     for k, b in enumerate(np.radians([0.0, 120.0, 240.0])):
-        psi.append(np.stack([np.radians(bends), np.full(bends.size, b)], -1))
+        psis.append(np.stack([np.radians(bends), np.full(bends.size, b)], -1))
         dirs.append(np.where(np.arange(3) == k, 1.0, -1.0) * np.ones((bends.size, 1)))
-    psi, d = np.concatenate(psi), np.concatenate(dirs)
+    psi, d = np.concatenate(psis), np.concatenate(dirs)
     t = cable_tensions(robot, psi, direction=d).tension
     sol = solve_disk_robot(disk_robot_for(robot), tension=t, direction=d)
     tip = sol.T_tip[:, :3, 3] + rng.normal(0.0, IDENT_TRACKER_NOISE, (psi.shape[0], 3))

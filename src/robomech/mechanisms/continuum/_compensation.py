@@ -64,7 +64,7 @@ def _lengths_and_factors(robot, theta, beta, direction, model):
     return ell, P
 
 
-def _l0(robot: ContinuumRobot, model: str) -> np.ndarray:
+def _l0(robot: ContinuumRobot, model: CableModel) -> np.ndarray:
     return span_lengths(robot, np.zeros(2 * robot.n_segments), model).sum(axis=-1)
 
 
