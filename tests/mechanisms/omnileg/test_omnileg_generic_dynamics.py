@@ -86,7 +86,11 @@ def test_joint_names_and_values_are_the_analytic_tree():
 def test_body_frames_and_mass_centres_are_the_analytic_ones():
     rng = np.random.default_rng(3)
     q = np.column_stack(
-        [rng.uniform(-1, 1, 12) * LEG.alpha_max, rng.uniform(-1, 1, 12) * LEG.beta_max, rng.uniform(0, 1.4, 12)]
+        [
+            rng.uniform(-1, 1, 12) * LEG.alpha_max,
+            rng.uniform(-1, 1, 12) * LEG.beta_max,
+            rng.uniform(0, 1.4, 12),
+        ]
     )
     fk = mb.forward_kinematics(MECH, q, steps=4)
     assert fk.converged.all()
@@ -130,7 +134,9 @@ def test_generic_equals_analytic_for_other_parameters():
     """Other dimensions, inertias (an off-diagonal foot inertia and an offset mass centre) and gravity."""
     foot = LEG.bodies["foot"]
     c, s = np.cos(0.4), np.sin(0.4)
-    R = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]) @ np.array([[c, -s, 0.0], [s, c, 0.0], [0, 0, 1]])
+    R = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]) @ np.array(
+        [[c, -s, 0.0], [s, c, 0.0], [0, 0, 1]]
+    )
     I = R @ np.array(foot.inertia) @ R.T  # a full (non-diagonal) inertia tensor
     leg = dataclasses.replace(
         LEG,
@@ -155,7 +161,7 @@ def test_the_comparison_has_teeth():
 
 
 def test_paper_drive_is_not_the_described_drive():
-    """paper 2, eqs. (26)-(31): the simplified drive differs from the exact double Cardan (and the generic)."""
+    """paper 2, eqs. (26)-(31): the simplified drive differs from the exact double Cardan described."""
     _, prof, _ = _eq52(13)
     fk = mb.forward_kinematics(MECH, prof.q, steps=4)
     gen = mb.inverse_dynamics(MECH, fk.q, prof.qd, prof.qdd)

@@ -215,7 +215,7 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
                 pos=Rc_world.T @ (foot_origin - (C + Rc @ np.array([0.0, 0.0, L4]))),
                 quat=_quat(Rc_world.T),
                 # the foot turns by γ relative to coupler 1 (qpos = γ, as joint_motion)
-                joints=[b.hinge("foot", axis=S[:, 0], pos=E, ref=g0)],
+                joints=[b.hinge("foot", axis=tuple(S[:, 0]), pos=tuple(E), ref=g0)],
                 inertial=inertial("foot", "foot"),
             )
         else:
