@@ -110,7 +110,7 @@ def test_engine_tells_the_exact_drive_from_the_papers_simplification(engine):
     prof = ol.joint_trajectory_eq52(t)
     F = np.where((t <= 1.0)[:, None], vo.FIG11_FORCE, 0.0)
     tau_pp = ol.inverse_dynamics(LEG, prof.q, prof.qd, prof.qdd, foot_force=F, paper_as_printed=True).tau
-    assert np.abs(tau_pp - tau_en).max() / np.abs(tau_en).max() > 3 * vo.TOL_TORQUE.value
+    assert np.abs(tau_pp - tau_en).max() / np.abs(tau_en).max() > 100 * vo.TOL_TORQUE.value
 
 
 def test_engine_from_a_perturbed_leg_fails_the_torque_check():
