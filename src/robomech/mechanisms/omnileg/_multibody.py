@@ -144,7 +144,9 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
         else:
             b.revolute(f"theta{c}4", kc, "knee_plate", anchor1=(0.0, 0.0, 0.0), axis=w[3])
     # drive (paper 2, Fig. 7): input shaft about Z0 turned by γ, U joint A4 at O0, rod A4B4, U joint B4
-    # at O0', output shaft about Z0' in the knee plate; every frame is Rz(γ) at α = β = 0
+    # at O0', output shaft about Z0' in the knee plate; every frame is Rz(γ) at α = β = 0.
+    # paper 2, eqs. (26)-(31): the paper decouples the drive's spin from the thigh motion; here the
+    # closure solves the double Cardan exactly (as the analytic model does, docs departure 9).
     Rg0 = _quat(_rz(g0))
     b.body(
         "drive_shaft_in",
