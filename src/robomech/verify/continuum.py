@@ -91,7 +91,7 @@ def _arc_check(rigid: TendonRod) -> Check:
         cases += [(tau, 0.0, 0.0), (0.0, tau, 0.0), (tau, 0.5 * tau, 0.0)]
     taus = np.array(cases)
     sol = solve_static(rigid, taus)
-    u = np.einsum("ba,ai->bi", tau, np.cross([0.0, 0.0, 1.0], rigid.tendon_offsets))[:, :2] / ei
+    u = np.einsum("ba,ai->bi", taus, np.cross([0.0, 0.0, 1.0], rigid.tendon_offsets))[:, :2] / ei
     T = constant_curvature_transform(u, L)
     err = np.max(np.abs(sol.T_tip[..., :3, 3] - T[..., :3, 3]), axis=-1) / L
     err = np.maximum(err, np.max(np.abs(sol.T_tip[..., :3, :3] - T[..., :3, :3]), axis=(-1, -2)))
