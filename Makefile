@@ -8,7 +8,7 @@ OUT    ?= out
 # A second venv with `pip install .` and no extras: what a user without MuJoCo gets.
 MINIMAL := .venv-minimal
 
-.PHONY: install run test bench verify lint docs check-minimal clean
+.PHONY: install run test bench verify lint typecheck docs check-minimal clean
 
 install: $(STAMP)
 
@@ -39,6 +39,10 @@ bench: install
 lint: install
 	$(BIN)/ruff check src tests benchmarks
 
+# Static types: numpy.typing annotations checked by mypy over src/robomech (pyproject [tool.mypy]; ~1 min cold).
+typecheck: install
+	$(BIN)/mypy
+
 # The documentation site; -W: a warning is an error, -n: every cross-reference must resolve.
 docs: $(DOCS_STAMP)
 	$(BIN)/sphinx-build -W --keep-going -n -q -b html docs docs/_build/html
@@ -56,4 +60,4 @@ check-minimal:
 	rm -rf $(MINIMAL)
 
 clean:
-	rm -rf $(VENV) $(MINIMAL) $(OUT) .pytest_cache .benchmarks build src/*.egg-info docs/_build
+	rm -rf $(VENV) $(MINIMAL) $(OUT) .mypy_cache .pytest_cache .benchmarks build src/*.egg-info docs/_build

@@ -27,6 +27,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, broadcast_batch, check_positive, finite_samples
 from robomech.spatial._se3 import ad
@@ -46,7 +47,7 @@ __all__ = [
 ]
 
 
-def spatial_inertia(mass: object, com: object, inertia_com: object) -> np.ndarray:
+def spatial_inertia(mass: ArrayLike, com: ArrayLike, inertia_com: ArrayLike) -> np.ndarray:
     """6x6 spatial inertia about a body frame's origin for twists ``[w; v]``.
 
     ``G = [[I_c - m hat(c)^2, m hat(c)], [-m hat(c), m I]]``, so that the body's kinetic energy is
@@ -89,14 +90,14 @@ def spatial_inertia(mass: object, com: object, inertia_com: object) -> np.ndarra
     return G
 
 
-def _bodies(G: object, J: object) -> tuple[np.ndarray, np.ndarray]:
+def _bodies(G: ArrayLike, J: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     G = as_array(G, "G", (None, 6, 6))
     J = as_array(J, "J", (None, 6, None))
     broadcast_batch((G, 2, "G"), (J, 2, "J"))
     return G, J
 
 
-def _rates(x: object, name: str, J: np.ndarray) -> np.ndarray:
+def _rates(x: ArrayLike, name: str, J: np.ndarray) -> np.ndarray:
     """A generalized-coordinate vector (..., n) matching ``J (..., B, 6, n)``; its batch excludes B."""
     a = as_array(x, name, (J.shape[-1],), min_ndim=1)
     broadcast_batch((J, 3, "J"), (a, 1, name))
@@ -245,7 +246,7 @@ def inverse_dynamics(
     return DynamicsTerms(tau=tau, M=M, velocity_terms=vel, gravity_terms=grav)
 
 
-def static_torques(J: object, wrench: object) -> np.ndarray:
+def static_torques(J: ArrayLike, wrench: ArrayLike) -> np.ndarray:
     """Virtual work: generalized forces ``tau = J^T w`` that balance a wrench where ``J`` maps q-rates.
 
     Parameters
@@ -275,7 +276,7 @@ def static_torques(J: object, wrench: object) -> np.ndarray:
 
 
 def actuator_forces(
-    J_act: object, tau_q: object, *, rcond: float | None = None
+    J_act: ArrayLike, tau_q: ArrayLike, *, rcond: float | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """Actuator forces ``f`` with ``J_act^T f = tau_q`` of minimum norm, and the residual per sample.
 
@@ -334,7 +335,7 @@ def actuator_forces(
     return f, resid
 
 
-def world_inertia(R: object, inertia: object) -> np.ndarray:
+def world_inertia(R: ArrayLike, inertia: ArrayLike) -> np.ndarray:
     """Rotational inertia in world axes ``R I R^T`` of a body at orientation ``R (..., 3, 3)``.
 
     ``inertia (..., 3, 3)`` is the inertia about the centre of mass in body axes (a principal
@@ -346,13 +347,13 @@ def world_inertia(R: object, inertia: object) -> np.ndarray:
 
 
 def com_inverse_dynamics(
-    mass: object,
-    inertia: object,
-    J: object,
-    Jdot_qd: object,
-    qd: object,
-    qdd: object,
-    gravity: object = (0.0, 0.0, -9.81),
+    mass: ArrayLike,
+    inertia: ArrayLike,
+    J: ArrayLike,
+    Jdot_qd: ArrayLike,
+    qd: ArrayLike,
+    qdd: ArrayLike,
+    gravity: ArrayLike = (0.0, 0.0, -9.81),
 ) -> DynamicsTerms:
     """Generalized forces from centre-of-mass Jacobians in world axes (Newton-Euler per body, projected).
 
@@ -417,7 +418,7 @@ def _com_terms(m, I, J, a0, qd, qdd, g) -> DynamicsTerms:
     return DynamicsTerms(tau=tau, M=M, velocity_terms=vel, gravity_terms=grav)
 
 
-def com_kinetic_energy(mass: object, inertia: object, J: object, qd: object) -> np.ndarray:
+def com_kinetic_energy(mass: ArrayLike, inertia: ArrayLike, J: ArrayLike, qd: ArrayLike) -> np.ndarray:
     """``0.5 sum_b (w_b . I_b w_b + m_b |c'_b|^2)`` with ``[w_b; c'_b] = J_b qd`` (...)."""
     m = as_array(mass, "mass", (None,))
     B = m.shape[-1]

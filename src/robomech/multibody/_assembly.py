@@ -13,12 +13,13 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, check_int
 
 from ._constraints import jacobian, residual
 from ._model import Mechanism
-from ._tree import frame_jacobian, integrate, kinematics, normalize_quaternions
+from ._tree import TreeState, frame_jacobian, integrate, kinematics, normalize_quaternions
 
 __all__ = [
     "CONVERGED_RTOL",
@@ -63,7 +64,7 @@ def check_mechanism(mech: object) -> Mechanism:
     return mech
 
 
-def check_q(mech: Mechanism, q: object, name: str = "q") -> np.ndarray:
+def check_q(mech: Mechanism, q: ArrayLike, name: str = "q") -> np.ndarray:
     """``q (..., nq)`` finite, quaternions non-zero; returns it with quaternions normalised."""
     q = as_array(q, name, (mech.nq,))
     for a in mech.tree.quat_adr:
@@ -79,7 +80,7 @@ def solve_closure(
     mech: Mechanism,
     q: np.ndarray,
     free: np.ndarray,
-    extra: Callable[[object, np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None,
+    extra: Callable[[TreeState, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None,
     max_iter: int = MAX_ITER,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """LM on the closure rows (plus ``extra(state, q, idx) -> (r, J)`` rows) over the coordinates ``free``.
@@ -184,7 +185,7 @@ class IKResult:
     iterations: np.ndarray
 
 
-def _guess(mech: Mechanism, guess: object, batch: tuple[int, ...]) -> np.ndarray:
+def _guess(mech: Mechanism, guess: ArrayLike | None, batch: tuple[int, ...]) -> np.ndarray:
     if guess is None:
         return np.broadcast_to(mech.tree.q0, (*batch, mech.nq))
     g = as_array(guess, "guess", (mech.nq,))
@@ -194,7 +195,9 @@ def _guess(mech: Mechanism, guess: object, batch: tuple[int, ...]) -> np.ndarray
     return normalize_quaternions(mech.tree, g)
 
 
-def forward_kinematics(mech: Mechanism, q_act: object, guess: object = None, *, steps: int = 1) -> FKResult:
+def forward_kinematics(
+    mech: Mechanism, q_act: ArrayLike, guess: ArrayLike | None = None, *, steps: int = 1
+) -> FKResult:
     """Assemble the mechanism at the actuated coordinates ``q_act (..., n_act)`` (actuator order).
 
     The passive coordinates start from ``guess (..., nq)`` (default the reference configuration
@@ -253,10 +256,10 @@ def _site_error(tree, state, site: int, T_target: np.ndarray, w: np.ndarray):
 def inverse_kinematics(
     mech: Mechanism,
     site: str,
-    T_target: object,
-    guess: object = None,
+    T_target: ArrayLike,
+    guess: ArrayLike | None = None,
     *,
-    weights: object = None,
+    weights: ArrayLike | None = None,
     steps: int = 1,
 ) -> IKResult:
     """Configuration(s) that put ``site`` at ``T_target (..., 4, 4)`` (world) with the loops closed.
@@ -302,7 +305,9 @@ def inverse_kinematics(
         else:
             Ts = _interp_pose(start, Tf, s / steps)
 
-        def extra(state, qs, idx, Ts=Ts):
+        def extra(
+            state: TreeState, qs: np.ndarray, idx: np.ndarray, Ts: np.ndarray = Ts
+        ) -> tuple[np.ndarray, np.ndarray]:
             return _site_error(tree, state, si, Ts[idx], w)
 
         q, rc, _, it = solve_closure(mech, q, free, extra)

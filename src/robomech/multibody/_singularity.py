@@ -27,11 +27,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, check_int, check_positive, check_real
 from robomech.analysis import workspace
 
-from ._assembly import check_mechanism, check_q, forward_kinematics, inverse_kinematics
+from ._assembly import FKResult, IKResult, check_mechanism, check_q, forward_kinematics, inverse_kinematics
 from ._influence import _influence_flat
 from ._mobility import mobility
 from ._model import Mechanism
@@ -66,10 +67,10 @@ def _kth(s: np.ndarray, k: int) -> np.ndarray:
 
 def singularities(
     mech: Mechanism,
-    q: object,
+    q: ArrayLike,
     site: str,
     *,
-    reference: object = None,
+    reference: ArrayLike | None = None,
     length: float | None = None,
     rtol: float = workspace.SINGULAR_RTOL,
 ) -> SingularityResult:
@@ -157,11 +158,11 @@ def singularity_map(
     mech: Mechanism,
     site: str,
     *,
-    q_act: object = None,
-    T: object = None,
-    guess: object = None,
+    q_act: ArrayLike | None = None,
+    T: ArrayLike | None = None,
+    guess: ArrayLike | None = None,
     steps: int = 4,
-    ik_weights: object = None,
+    ik_weights: ArrayLike | None = None,
     length: float | None = None,
 ) -> SingularityMapResult:
     """Workspace / dexterity / singularity maps over a grid of inputs ``q_act (..., n_act)`` (FK) or
@@ -176,13 +177,14 @@ def singularity_map(
         check_positive(length, "length")
     if (q_act is None) == (T is None):
         raise ValueError("Expected exactly one of q_act (input grid) or T (output grid).")
+    r: FKResult | IKResult
     if q_act is not None:
         qa = as_array(q_act, "q_act", (len(mech.actuated),), finite="mask")  # beyond 1e100: masked like NaN
         r = forward_kinematics(mech, qa, guess, steps=steps)
-        ok = r.converged
     else:
+        assert T is not None  # exactly one of q_act and T (checked above)
         r = inverse_kinematics(mech, site, T, guess, weights=ik_weights, steps=steps)
-        ok = r.converged
+    ok = r.converged
     q = np.where(ok[..., None], r.q, mech.tree.q0)
     s = singularities(mech, q, site, length=length)
     tree = mech.tree

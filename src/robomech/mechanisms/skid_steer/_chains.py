@@ -14,6 +14,7 @@ and axes parallel to that link's.  At each instant P_w coincides with a frame PÌ
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, check_params
 
@@ -97,7 +98,7 @@ def side_points(robot: ExplorationRobot, q: np.ndarray) -> dict[str, np.ndarray]
     }
 
 
-def _check_config(config: object) -> np.ndarray:
+def _check_config(config: ArrayLike) -> np.ndarray:
     return as_array(config, "config", (CONFIG_SIZE,))
 
 
@@ -112,7 +113,7 @@ def _blocked(kernel, q: np.ndarray, tail: tuple[int, ...]) -> np.ndarray:
     return out.reshape(*batch, *tail)
 
 
-def contact_frames(robot: ExplorationRobot, config: object) -> np.ndarray:
+def contact_frames(robot: ExplorationRobot, config: ArrayLike) -> np.ndarray:
     """Poses ``T_BP`` of the six contact frames in the body frame: ``(..., 6, 4, 4)``, order ``WHEELS``."""
     check_params(robot, ExplorationRobot, "robot")
     q = _check_config(config)
@@ -178,7 +179,7 @@ def _linear_columns(robot: ExplorationRobot, q: np.ndarray) -> tuple[np.ndarray,
     return p, alpha, G
 
 
-def wheel_jacobians(robot: ExplorationRobot, config: object) -> np.ndarray:
+def wheel_jacobians(robot: ExplorationRobot, config: ArrayLike) -> np.ndarray:
     """Space Jacobians of the contact frames relative to the body: ``(..., 6, 6, 4)``.
 
     ``J[..., w, :, j]`` is the twist ``[Ï‰; v]`` (in B, ``v`` the velocity of the point at B's origin)

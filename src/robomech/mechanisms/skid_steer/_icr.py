@@ -21,6 +21,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, check_params, check_positive, coerce_float_fields
 from robomech.analysis import lstsq
@@ -87,7 +88,7 @@ class PlanarVelocity:
     valid: np.ndarray
 
 
-def icr_velocity(model: ICRModel, v_right: object, v_left: object) -> PlanarVelocity:
+def icr_velocity(model: ICRModel, v_right: ArrayLike, v_left: ArrayLike) -> PlanarVelocity:
     """Body velocity predicted by the ICR model from the right and left track (encoder) speeds (m/s).
 
     Non-finite speeds (encoder drop-outs) are flagged per sample by ``valid``.
@@ -130,7 +131,7 @@ class TrackSpeeds:
     valid: np.ndarray
 
 
-def encoder_track_speeds(robot: ExplorationRobot, wheel_rate: object) -> TrackSpeeds:
+def encoder_track_speeds(robot: ExplorationRobot, wheel_rate: ArrayLike) -> TrackSpeeds:
     """No-slip track speeds from the wheel spin rates ``(..., 6)`` (rad/s): the mean rim speed
     ``r_w φ̇_w`` of each side's three wheels.  A sample with a non-finite wheel rate is flagged."""
     radii = wheel_radii(robot)
@@ -162,7 +163,7 @@ class ICRIdentification:
 
 
 def identify_icr(
-    v_right: object, v_left: object, body_velocity: object, *, weights: object | None = None
+    v_right: ArrayLike, v_left: ArrayLike, body_velocity: ArrayLike, *, weights: ArrayLike | None = None
 ) -> ICRIdentification:
     """Identify ``(y_right, y_left, x_icr)`` from track speeds ``(N,)`` and measured planar body
     velocities ``(N, 3)`` = ``(v_x, v_y, r)`` by linear least squares (``analysis.lstsq``).
@@ -228,7 +229,7 @@ class WheelSlip:
 
 
 def wheel_slip(
-    robot: ExplorationRobot, wheel_rate: object, body_velocity: object, config: object | None = None
+    robot: ExplorationRobot, wheel_rate: ArrayLike, body_velocity: ArrayLike, config: ArrayLike | None = None
 ) -> WheelSlip:
     """Slip of each wheel from its spin rate ``(..., 6)`` (rad/s) and the planar body velocity
     ``(..., 3)`` = ``(v_x, v_y, r)``; contacts at ``config (..., 8)`` (default: zero joint angles with

@@ -18,6 +18,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import (
     as_array,
@@ -111,7 +112,7 @@ class EncoderReadings:
     valid: np.ndarray
 
 
-def encoder_rates(model: EncoderModel, wheel_rate: object, dt: float, seed: object = 0) -> EncoderReadings:
+def encoder_rates(model: EncoderModel, wheel_rate: ArrayLike, dt: float, seed: object = 0) -> EncoderReadings:
     """Measured spin rates from true rates ``(N, 6)`` sampled every ``dt`` s.
 
     The true angle is integrated by the trapezoidal rule from a random initial phase (``seed``: an int
@@ -135,7 +136,7 @@ def encoder_rates(model: EncoderModel, wheel_rate: object, dt: float, seed: obje
 
 
 def imu_measurements(
-    model: ImuModel, angular_velocity: object, specific_force: object, dt: float, seed: object = 0
+    model: ImuModel, angular_velocity: ArrayLike, specific_force: ArrayLike, dt: float, seed: object = 0
 ) -> tuple[np.ndarray, np.ndarray]:
     """Gyro and accelerometer readings ``(N, 3)`` each from true body-axis values ``(N, 3)``."""
     check_params(model, ImuModel, "model")
@@ -151,7 +152,7 @@ def imu_measurements(
     return gyro, acc
 
 
-def track_speed_sigma(encoder: EncoderModel, radii: object, dt: float) -> float:
+def track_speed_sigma(encoder: EncoderModel, radii: ArrayLike, dt: float) -> float:
     """Standard deviation of a side's encoder track speed (mean of its wheels' rim speeds, m/s).
 
     ``radii``: the side's wheel radii (m); the wheels' quantisation errors are independent.
@@ -179,7 +180,7 @@ class EKFResult:
     gyro_used: np.ndarray
 
 
-def _check_times(t: object) -> np.ndarray:
+def _check_times(t: ArrayLike) -> np.ndarray:
     ta = as_array(t, "t", (None,))
     if ta.ndim != 1 or ta.size < 2:
         raise ValueError(f"Expected t to have shape (N,) with N >= 2, got {ta.shape}.")
@@ -192,10 +193,10 @@ def _check_times(t: object) -> np.ndarray:
 
 
 def planar_ekf(
-    t: object,
-    v_right: object,
-    v_left: object,
-    gyro_z: object,
+    t: ArrayLike,
+    v_right: ArrayLike,
+    v_left: ArrayLike,
+    gyro_z: ArrayLike,
     icr: ICRModel,
     *,
     sigma_track: float,
@@ -204,12 +205,12 @@ def planar_ekf(
     accel_psd: float = 0.5,
     yaw_accel_psd: float = 2.0,
     bias_psd: float = 1e-8,
-    initial_pose: object = (0.0, 0.0, 0.0),
+    initial_pose: ArrayLike = (0.0, 0.0, 0.0),
     initial_bias_sigma: float = 0.01,
     icr_sigma: float = 0.0,
     icr_psd: float = 0.0,
-    encoder_ok: object | None = None,
-    gyro_ok: object | None = None,
+    encoder_ok: ArrayLike | None = None,
+    gyro_ok: ArrayLike | None = None,
 ) -> EKFResult:
     """Extended Kalman filter for planar odometry: encoders through the ICR model, and a gyro.
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, broadcast_batch, check_positive
 from robomech.spatial import exp_se3
@@ -45,7 +46,7 @@ class SkidSteerTurn:
     turning: np.ndarray
 
 
-def skid_steer_turn(v_right: object, v_left: object, track_width: float) -> SkidSteerTurn:
+def skid_steer_turn(v_right: ArrayLike, v_left: ArrayLike, track_width: float) -> SkidSteerTurn:
     """Yaw rate, speed and turning radius of the body centre from the right (``v1``) and left (``v2``)
     track speeds (m/s), for tracks ``track_width`` (m) apart, assuming no longitudinal slip.
 
@@ -66,7 +67,7 @@ def skid_steer_turn(v_right: object, v_left: object, track_width: float) -> Skid
     return SkidSteerTurn(yaw_rate=diff / S, forward_speed=0.5 * total, radius=radius, turning=turning)
 
 
-def wheel_lateral_velocity(yaw_rate: object, wheel_x: object, icr_x: object = 0.0) -> np.ndarray:
+def wheel_lateral_velocity(yaw_rate: ArrayLike, wheel_x: ArrayLike, icr_x: ArrayLike = 0.0) -> np.ndarray:
     """Lateral (body y) sliding velocity of a contact at body ``x = wheel_x`` (m) of a body turning at
     ``yaw_rate`` about a centre of rotation at longitudinal position ``icr_x`` (m): ``r (x_w - x_icr)``.
 
@@ -88,7 +89,9 @@ class LateralSlip:
     valid: np.ndarray
 
 
-def paper_lateral_slip(v_outer: object, wheelbase: float, radius: object, track_width: float) -> LateralSlip:
+def paper_lateral_slip(
+    v_outer: ArrayLike, wheelbase: float, radius: ArrayLike, track_width: float
+) -> LateralSlip:
     """paper 4, Sec. 1.2: ``v_Y = v_X L / (2 R_s + S)``, magnitude of the lateral slip of an outer
     wheel a distance ``L/2`` ahead of or behind the centre of rotation, with ``R_s`` the radius of the
     body centre (not of the inner wheel, as printed).
@@ -108,7 +111,7 @@ def paper_lateral_slip(v_outer: object, wheelbase: float, radius: object, track_
     return LateralSlip(lateral_speed=np.where(valid, out, np.nan), valid=valid)
 
 
-def dead_reckoning(twists: object, dt: float, T0: object | None = None) -> np.ndarray:
+def dead_reckoning(twists: ArrayLike, dt: float, T0: ArrayLike | None = None) -> np.ndarray:
     """Body poses ``T_GB (..., N, 4, 4)`` from body twists ``[ω; v]`` ``(..., N, 6)`` sampled every ``dt`` s.
 
     Between samples the twist is taken as the mean of its end values (second order in ``dt``):

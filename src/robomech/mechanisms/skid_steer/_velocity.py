@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, broadcast_batch, check_bool, check_params
 from robomech.analysis import lstsq
@@ -54,7 +55,7 @@ ASSEMBLY_CHUNK = 256
 _PASSIVE = ((5, 6, 9), (7, 8, 10))
 
 
-def assemble(robot: ExplorationRobot, config: object) -> tuple[np.ndarray, np.ndarray]:
+def assemble(robot: ExplorationRobot, config: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """``A0 (..., 30, 11)`` and ``J (..., 30, 22)`` of the composite system at ``config (..., 8)``."""
     check_params(robot, ExplorationRobot, "robot")
     q = as_array(config, "config", (CONFIG_SIZE,))
@@ -119,7 +120,7 @@ def _assemble(robot: ExplorationRobot, q: np.ndarray) -> tuple[np.ndarray, np.nd
 
 
 def wheel_measurements(
-    robot: ExplorationRobot, config: object, twist: object, config_rate: object
+    robot: ExplorationRobot, config: ArrayLike, twist: ArrayLike, config_rate: ArrayLike
 ) -> np.ndarray:
     """Exact measurements ``q̇ (..., 22)`` of a known motion (the forward velocity map).
 
@@ -172,12 +173,12 @@ class BodyVelocity:
 
 def body_velocity(
     robot: ExplorationRobot,
-    state: object,
-    measured: object,
+    state: ArrayLike,
+    measured: ArrayLike,
     *,
     solver: Literal["qr", "normal_equations"] = "qr",
     exact_cond: bool = False,
-    measurement_sigma: object | None = None,
+    measurement_sigma: ArrayLike | None = None,
 ) -> BodyVelocity:
     """Body twist and passive joint rates from wheel and rocker measurements, per sample.
 
