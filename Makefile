@@ -27,7 +27,7 @@ run: install
 	$(BIN)/robomech verify --out $(OUT)
 
 test: install
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks examples docs/conf.py
 	$(BIN)/python -m pytest -q
 
 verify: install
@@ -37,7 +37,7 @@ bench: install
 	$(BIN)/python benchmarks/run.py
 
 lint: install
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks examples docs/conf.py
 
 # Static types: numpy.typing annotations checked by mypy over src/robomech (pyproject [tool.mypy]; ~1 min cold).
 typecheck: install

@@ -135,7 +135,7 @@ def singularity_map(J: ArrayLike, *, rtol: float = SINGULAR_RTOL) -> Singularity
         Jacobians, e.g. a model's Jacobian evaluated on a :func:`grid`.
     rtol : float, optional
         A Jacobian is singular when ``sigma_min / sigma_max < rtol`` (``0 < rtol <= 1``); default
-        :data:`SINGULAR_RTOL` = 1e-8.
+        ``SINGULAR_RTOL`` = 1e-8.
 
     Returns
     -------
