@@ -114,7 +114,27 @@ def _blocked(kernel, q: np.ndarray, tail: tuple[int, ...]) -> np.ndarray:
 
 
 def contact_frames(robot: ExplorationRobot, config: ArrayLike) -> np.ndarray:
-    """Poses ``T_BP`` of the six contact frames in the body frame: ``(..., 6, 4, 4)``, order ``WHEELS``."""
+    """Poses ``T_BP`` of the six contact frames in the body frame: ``(..., 6, 4, 4)``, order ``WHEELS``.
+
+    Parameters
+    ----------
+    robot : ExplorationRobot
+        The robot's geometry (m), e.g. ``ExplorationRobot.paper()``.
+    config : array_like, shape (..., 8)
+        Joint configuration: per side ``SIDE_JOINTS`` (rocker, bogie and slide coordinates; rad, m).
+
+    Returns
+    -------
+    ndarray, shape (..., 6, 4, 4)
+        ``T_BP`` of each wheel's contact frame in the body frame B, wheels in ``WHEELS`` order.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> robot = ExplorationRobot.paper()
+    >>> contact_frames(robot, np.zeros(8)).shape
+    (6, 4, 4)
+    """
     check_params(robot, ExplorationRobot, "robot")
     q = _check_config(config)
     return _blocked(lambda qc: _contact_frames(robot, qc), q, (N_WHEELS, 4, 4))
@@ -185,6 +205,25 @@ def wheel_jacobians(robot: ExplorationRobot, config: ArrayLike) -> np.ndarray:
     ``J[..., w, :, j]`` is the twist ``[ω; v]`` (in B, ``v`` the velocity of the point at B's origin)
     of contact frame ``w`` relative to the body per unit rate of joint ``j`` of its side
     (``SIDE_JOINTS``); joints outside the wheel's chain give zero columns.  ``ω = (0, Σ rates, 0)``.
+
+    Parameters
+    ----------
+    robot : ExplorationRobot
+        The robot's geometry (m).
+    config : array_like, shape (..., 8)
+        Joint configuration (rad, m), ``SIDE_JOINTS`` per side.
+
+    Returns
+    -------
+    ndarray, shape (..., 6, 6, 4)
+        Per wheel (``WHEELS`` order) the 6 x 4 Jacobian of its contact frame relative to B, columns
+        the four joints of its side; twists ``[ω; v]`` in body axes (rad/s, m/s per unit joint rate).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> wheel_jacobians(ExplorationRobot.paper(), np.zeros((5, 8))).shape   # a batch of 5
+    (5, 6, 6, 4)
     """
     check_params(robot, ExplorationRobot, "robot")
     q = _check_config(config)

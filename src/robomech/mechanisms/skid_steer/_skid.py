@@ -53,6 +53,24 @@ def skid_steer_turn(v_right: ArrayLike, v_left: ArrayLike, track_width: float) -
     paper 4, Sec. 1.2: printed ``R_s = (S/2)(v1+v2)/(v1-v2)`` is called the inner wheel's radius; it is
     the radius of the body centre (the inner track runs at ``R_s - S/2``).  Printed ``ω = 2 v_X / L``;
     the yaw rate consistent with the geometry is ``(v1 - v2)/S``.
+
+    Parameters
+    ----------
+    v_right, v_left : array_like, shape (...)
+        Right and left track speeds (m/s); broadcast together.
+    track_width : float
+        Distance between the track centre lines ``S`` (m), ``> 0``.
+
+    Returns
+    -------
+    SkidSteerTurn
+        ``yaw_rate`` (rad/s), ``forward_speed`` (m/s), signed ``radius`` (m) and ``turning``.
+
+    Examples
+    --------
+    >>> t = skid_steer_turn(1.0, 0.5, 0.6)
+    >>> round(float(t.yaw_rate), 12), float(t.forward_speed), round(float(t.radius), 12)  # R = v / r
+    (0.833333333333, 0.75, 0.9)
     """
     v1 = as_array(v_right, "v_right")
     v2 = as_array(v_left, "v_left")
@@ -72,6 +90,26 @@ def wheel_lateral_velocity(yaw_rate: ArrayLike, wheel_x: ArrayLike, icr_x: Array
     ``yaw_rate`` about a centre of rotation at longitudinal position ``icr_x`` (m): ``r (x_w - x_icr)``.
 
     Planar rigid motion: the velocity of point ``p`` is ``r z × (p - p_icr)``, whose y part is this.
+
+    Parameters
+    ----------
+    yaw_rate : array_like, shape (...)
+        Body yaw rate ``r`` (rad/s).
+    wheel_x : array_like, shape (...)
+        Longitudinal position of the contact in body axes (m).
+    icr_x : array_like, shape (...), optional
+        Longitudinal position of the centre of rotation (m), default 0.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Lateral sliding velocity (m/s) of the broadcast shape.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> wheel_lateral_velocity(0.5, np.array([0.3, -0.3]))    # front and rear wheels slide opposite ways
+    array([ 0.15, -0.15])
     """
     r = as_array(yaw_rate, "yaw_rate")
     x = as_array(wheel_x, "wheel_x")
@@ -98,6 +136,28 @@ def paper_lateral_slip(
 
     Samples at the formula's singularity ``2 R + S = 0`` (the centre of rotation on the inner track, which
     is then at rest) are flagged (``valid`` false, NaN) instead of returned as huge or infinite values.
+
+    Parameters
+    ----------
+    v_outer : array_like, shape (...)
+        Speed of the outer track ``v_X`` (m/s).
+    wheelbase : float
+        Distance ``L`` between the front and rear wheels (m), ``> 0``.
+    radius : array_like, shape (...)
+        Turning radius ``R_s`` of the body centre (m).
+    track_width : float
+        Track width ``S`` (m), ``> 0``.
+
+    Returns
+    -------
+    LateralSlip
+        ``lateral_speed`` (m/s) and ``valid`` per sample.
+
+    Examples
+    --------
+    >>> s = paper_lateral_slip(1.0, wheelbase=0.6, radius=2.0, track_width=0.6)
+    >>> round(float(s.lateral_speed), 6)                 # 1.0 * 0.6 / (2 * 2.0 + 0.6)
+    0.130435
     """
     v = as_array(v_outer, "v_outer")
     R = as_array(radius, "radius")
@@ -117,6 +177,28 @@ def dead_reckoning(twists: ArrayLike, dt: float, T0: ArrayLike | None = None) ->
     Between samples the twist is taken as the mean of its end values (second order in ``dt``):
     ``T_{k+1} = T_k exp(dt (V_k + V_{k+1})/2)``.  The running product is evaluated as a parallel prefix
     scan (``log2 N`` batched matrix products), so there is no Python loop over samples.
+
+    Parameters
+    ----------
+    twists : array_like, shape (..., N, 6)
+        Body twists ``[ω; v]`` in body axes (rad/s, m/s), one per sample, ``N >= 1``.
+    dt : float
+        Sample period (s), ``> 0``.
+    T0 : array_like, shape (..., 4, 4), optional
+        Initial pose ``T_GB`` (default the identity).
+
+    Returns
+    -------
+    ndarray, shape (..., N, 4, 4)
+        Poses ``T_GB`` at the sample times (the first is ``T0``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> V = np.tile([0.0, 0.0, 0.5, 1.0, 0.0, 0.0], (3, 1))     # 1 m/s forward turning at 0.5 rad/s
+    >>> T = dead_reckoning(V, 0.1)
+    >>> T.shape, T[-1, :2, 3].round(4)                          # on the arc of radius 2 m after 0.2 s
+    ((3, 4, 4), array([0.1997, 0.01  ]))
     """
     V = as_array(twists, "twists", (None, 6), min_ndim=2)
     h = check_positive(dt, "dt")
