@@ -275,6 +275,27 @@ def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """Poses ``T_0i (..., n, 4, 4)`` of every segment's end frame in the base frame (paper 3, eq. (3)).
 
     The array may be a non-contiguous view (the matrix entries are computed as contiguous planes).
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
+    psi : array_like, shape (..., 2 n)
+        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., n, 4, 4)
+        ``T_0i`` of each segment's end frame in the base frame (m).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> robot = cr.ContinuumRobot.paper()                       # one 0.09 m segment
+    >>> T = cr.forward_kinematics(robot, np.array([np.pi / 2, 0.0]))   # bent 90 deg in the x-z plane
+    >>> T.shape, T[0, :3, 3].round(6)                          # on an arc of radius 0.09 / (pi/2)
+    ((1, 4, 4), array([0.057296, 0.      , 0.057296]))
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split_views(robot, psi)
@@ -282,7 +303,27 @@ def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
 
 
 def tip_position(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """Tip position ``(..., 3)`` in the base frame (m)."""
+    """Tip position ``(..., 3)`` in the base frame (m).
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m).
+    psi : array_like, shape (..., 2 n)
+        Bend and bending-plane angles of the segments (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Tip position in the base frame (m).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> cr.tip_position(cr.ContinuumRobot.paper(), np.zeros(2))     # straight: the segment length on z
+    array([0.  , 0.  , 0.09])
+    """
     check_params(robot, ContinuumRobot, "robot")
     return forward_kinematics(robot, psi)[..., -1, :3, 3]
 
@@ -657,6 +698,26 @@ def inverse_kinematics(robot: ContinuumRobot, p_tip: object) -> IKResult:
     robot's reach (|p| <= n l) that are still not reached are restarted from a small fixed set of other
     shapes (IK_STARTS: segments bent in opposite or crossed planes, different bends); the pose with the
     smallest residual is kept, with its ``converged`` flag.  Targets beyond the reach get one solve only.
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m).
+    p_tip : array_like, shape (..., 3)
+        Tip targets in the base frame (m).
+
+    Returns
+    -------
+    IKResult
+        ``psi (..., 2 n)`` (rad), ``residual`` (m), ``reachable``, ``converged`` and ``iterations``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> ik = cr.inverse_kinematics(cr.ContinuumRobot.paper(), np.array([0.057296, 0.0, 0.057296]))
+    >>> ik.psi.round(4), bool(ik.converged)
+    (array([1.5708, 0.    ]), True)
     """
     check_params(robot, ContinuumRobot, "robot")
     p = as_array(p_tip, "p_tip", (3,))
