@@ -340,6 +340,25 @@ def world_inertia(R: ArrayLike, inertia: ArrayLike) -> np.ndarray:
 
     ``inertia (..., 3, 3)`` is the inertia about the centre of mass in body axes (a principal
     inertia ``diag(d)`` in a frame ``R_i`` of the body is ``R_i diag(d) R_i^T``).
+
+    Parameters
+    ----------
+    R : array_like, shape (..., 3, 3)
+        Body orientations (rotation matrices, body to world).
+    inertia : array_like, shape (..., 3, 3)
+        Inertia about the centre of mass in body axes (kg m²).
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        Inertia about the centre of mass in world axes (kg m²).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> Rz90 = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    >>> np.diag(world_inertia(Rz90, np.diag([1.0, 2.0, 3.0])))    # x and y swap
+    array([2., 1., 3.])
     """
     R = as_array(R, "R", (3, 3))
     Ic = as_array(inertia, "inertia", (3, 3))
@@ -363,6 +382,36 @@ def com_inverse_dynamics(
     velocity-product accelerations ``[wd; c'']`` at ``qdd = 0``); ``gravity (..., 3)`` the gravity
     acceleration (m/s^2).  Returns ``tau = M qdd + velocity_terms + gravity_terms`` with
     ``M = sum_b J_b^T diag(I_b, m_b 1) J_b``.
+
+    Parameters
+    ----------
+    mass : array_like, shape (..., B)
+        Body masses (kg).
+    inertia : array_like, shape (..., B, 3, 3)
+        World-axes inertia about each centre of mass (kg m²).
+    J : array_like, shape (..., B, 6, n)
+        ``[w; c']`` of each body per unit ``qd`` (rad/s, m/s; world axes).
+    Jdot_qd : array_like, shape (..., B, 6)
+        ``Jdot qd``: velocity-product accelerations (rad/s², m/s²).
+    qd, qdd : array_like, shape (..., n)
+        Generalized velocities and accelerations.
+    gravity : array_like, shape (..., 3), optional
+        Gravity acceleration (m/s²), default ``(0, 0, -9.81)``.
+
+    Returns
+    -------
+    DynamicsTerms
+        ``tau``, ``velocity_terms``, ``gravity_terms`` ``(..., n)`` (N or N m) and ``M (..., n, n)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> J = np.zeros((1, 6, 1))
+    >>> J[0, 5, 0] = 1.0                                  # one 2 kg body on a vertical slide
+    >>> r = com_inverse_dynamics(np.array([2.0]), np.zeros((1, 3, 3)), J, np.zeros((1, 6)),
+    ...                          np.array([0.0]), np.array([1.0]))
+    >>> r.tau.round(12), r.gravity_terms.round(12)        # m (qdd + g): 2 (1 + 9.81) N
+    (array([21.62]), array([19.62]))
     """
     m = as_array(mass, "mass", (None,))
     B = m.shape[-1]
@@ -419,7 +468,32 @@ def _com_terms(m, I, J, a0, qd, qdd, g) -> DynamicsTerms:
 
 
 def com_kinetic_energy(mass: ArrayLike, inertia: ArrayLike, J: ArrayLike, qd: ArrayLike) -> np.ndarray:
-    """``0.5 sum_b (w_b . I_b w_b + m_b |c'_b|^2)`` with ``[w_b; c'_b] = J_b qd`` (...)."""
+    """``0.5 sum_b (w_b . I_b w_b + m_b |c'_b|^2)`` with ``[w_b; c'_b] = J_b qd`` (...).
+
+    Parameters
+    ----------
+    mass : array_like, shape (..., B)
+        Body masses (kg).
+    inertia : array_like, shape (..., B, 3, 3)
+        World-axes inertia about each centre of mass (kg m²).
+    J : array_like, shape (..., B, 6, n)
+        ``[w; c']`` of each body per unit ``qd`` (world axes).
+    qd : array_like, shape (..., n)
+        Generalized velocities.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Kinetic energy (J).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> J = np.zeros((1, 6, 1))
+    >>> J[0, 5, 0] = 1.0
+    >>> float(com_kinetic_energy(np.array([2.0]), np.zeros((1, 3, 3)), J, np.array([3.0])))  # m v² / 2
+    9.0
+    """
     m = as_array(mass, "mass", (None,))
     B = m.shape[-1]
     qd = as_array(qd, "qd", (None,))

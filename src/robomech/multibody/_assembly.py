@@ -205,6 +205,31 @@ def forward_kinematics(
     inputs from the guess's values to ``q_act`` in that many equal stages (continuation), which
     keeps the branch over large moves; along a trajectory pass the previous solution as the guess.
     Non-finite inputs give ``converged = False`` and NaN for that sample only.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism (:func:`from_mjcf` or :class:`Builder`).
+    q_act : array_like, shape (..., n_act)
+        Actuated joints' coordinates in actuator order (rad for hinges, m for slides).
+    guess : array_like, shape (..., nq), optional
+        Start of the passive coordinates (default ``mech.q0``); broadcasts with ``q_act``.
+    steps : int, optional
+        Continuation stages from the guess's inputs to ``q_act`` (``>= 1``).
+
+    Returns
+    -------
+    FKResult
+        ``q (..., nq)`` (MuJoCo qpos), ``residual (...)`` (m), ``converged`` and ``iterations``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> fk = mb.forward_kinematics(mech, np.array([[0.2], [np.nan]]))   # a bad sample is only flagged
+    >>> fk.q[0].round(4), fk.converged
+    (array([ 0.2   , -0.196 ,  0.0771]), array([ True, False]))
     """
     mech = check_mechanism(mech)
     tree = mech.tree
@@ -269,6 +294,36 @@ def inverse_kinematics(
     ``(0, 0, 0, 1, 1, 1)`` for a point target).  All coordinates move, from ``guess`` (default
     ``mech.q0``), in least squares; ``steps > 1`` moves the target from the guess's site pose in
     stages (continuation).  A target the mechanism cannot reach leaves ``converged = False``.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    site : str
+        Name of the site to place.
+    T_target : array_like, shape (..., 4, 4)
+        Target world poses of the site (m).
+    guess : array_like, shape (..., nq), optional
+        Start configuration (default ``mech.q0``).
+    weights : array_like, shape (6,), optional
+        Weights of the error rows ``[rot_x, rot_y, rot_z, x, y, z]`` (>= 0; 0 leaves a component free).
+    steps : int, optional
+        Continuation stages (``>= 1``).
+
+    Returns
+    -------
+    IKResult
+        ``q (..., nq)``, ``q_act (..., n_act)``, ``residual`` (m), ``pose_error`` (m) and ``converged``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> T = mb.site_pose(mech, mb.forward_kinematics(mech, np.array([0.2])).q, "coupler_point")
+    >>> ik = mb.inverse_kinematics(mech, "coupler_point", T)
+    >>> ik.q_act.round(10), bool(ik.converged)                          # the crank angle back
+    (array([0.2]), True)
     """
     mech = check_mechanism(mech)
     tree = mech.tree

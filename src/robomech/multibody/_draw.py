@@ -19,7 +19,28 @@ __all__ = ["body_segments", "draw"]
 
 
 def body_segments(mech: Mechanism, q: ArrayLike) -> dict[str, np.ndarray]:
-    """World segments ``(k, 2, 3)`` per body name at one configuration ``q (nq,)`` (the drawing's data)."""
+    """World segments ``(k, 2, 3)`` per body name at one configuration ``q (nq,)`` (the drawing's data).
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (nq,)
+        One configuration.
+
+    Returns
+    -------
+    dict of str to ndarray, shape (k, 2, 3)
+        Per body name, its segments (from the body's joint anchor to its children, closure anchors
+        and sites) in world coordinates (m).
+
+    Examples
+    --------
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> {name: s.shape for name, s in mb.body_segments(mech, mech.q0).items()}
+    {'crank': (1, 2, 3), 'coupler': (2, 2, 3), 'rocker': (1, 2, 3)}
+    """
     mech = check_mechanism(mech)
     q = check_q(mech, q)
     if q.ndim != 1:
@@ -54,7 +75,26 @@ def body_segments(mech: Mechanism, q: ArrayLike) -> dict[str, np.ndarray]:
 def draw(
     mech: Mechanism, q: ArrayLike | None = None, ax=None, *, color: str = "C0", title: str | None = None
 ):
-    """Draw ``mech`` at ``q (nq,)`` (default its reference configuration) on 3-D axes; returns the axes."""
+    """Draw ``mech`` at ``q (nq,)`` (default its reference configuration) on 3-D axes; returns the axes.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (nq,), optional
+        Configuration (default ``mech.q0``).
+    ax : matplotlib Axes3D, optional
+        Axes to draw on (default: new 3-D axes).
+    color : str, optional
+        Matplotlib colour of the segments.
+    title : str, optional
+        Axes title.
+
+    Returns
+    -------
+    matplotlib Axes3D
+        The axes drawn on.
+    """
     import matplotlib.pyplot as plt
 
     mech = check_mechanism(mech)

@@ -80,6 +80,23 @@ def from_mjcf(path_or_xml: str | os.PathLike) -> Mechanism:
     equalities, actuators on tendons, sites or bodies — raise ``ValueError`` naming them.  Inactive
     equalities (``active="false"``) are not constraints of the mechanism and are left out.
     Simulation settings (timestep, solver, contacts, limits, visuals) are ignored.
+
+    Parameters
+    ----------
+    path_or_xml : str or os.PathLike
+        A path to an MJCF file, or MJCF text (a string starting with ``<``).
+
+    Returns
+    -------
+    Mechanism
+        The frozen, validated description (``q`` is MuJoCo's ``qpos``; lengths in m, angles in rad).
+
+    Examples
+    --------
+    >>> from robomech import multibody as mb
+    >>> mech = mb.from_mjcf(mb.gallery.path("four_bar"))
+    >>> mech.actuated, mech.nq, [b.name for b in mech.bodies]
+    (('theta2',), 3, ['crank', 'coupler', 'rocker'])
     """
     if not isinstance(path_or_xml, str | os.PathLike):
         raise ValueError(f"Expected path_or_xml to be a path or MJCF text, got {type(path_or_xml).__name__}.")
@@ -226,6 +243,25 @@ def to_mjcf(mech: Mechanism, *, comment: str | None = None) -> str:
     A ``revolute`` closure is written as two ``connect`` elements ``name`` and ``name/axis`` one
     characteristic length apart along the axis (MJCF has no hinge equality).  ``comment`` is written
     as an XML comment at the top of the model.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    comment : str, optional
+        An XML comment written at the top of the model.
+
+    Returns
+    -------
+    str
+        MJCF text (radians, full-precision floats).
+
+    Examples
+    --------
+    >>> from robomech import multibody as mb
+    >>> xml = mb.to_mjcf(mb.gallery.load("four_bar"))
+    >>> xml.splitlines()[0], mb.from_mjcf(xml).actuated
+    ('<mujoco model="four_bar">', ('theta2',))
     """
     if not isinstance(mech, Mechanism):
         raise ValueError(f"Expected mech to be a robomech.multibody.Mechanism, got {type(mech).__name__}.")

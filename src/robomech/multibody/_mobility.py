@@ -168,6 +168,28 @@ def mobility(mech: Mechanism, q: ArrayLike | None = None, *, platform: str | Non
     ``platform`` (a body name; default the body of the first site, if any) adds the platform's twist
     system, and the screw-theory analysis of :mod:`robomech.analysis.mobility` when the platform is
     carried by serial legs.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (nq,), optional
+        An assembled configuration (default ``mech.q0``).
+    platform : str, optional
+        A body name whose twist system is analysed.
+
+    Returns
+    -------
+    MobilityReport
+        ``dof`` (without idle motions), ``redundant_constraints``, ``gruebler_kutzbach``, ``singular``,
+        the actuation and the platform's twists; ``summary()`` gives one line.
+
+    Examples
+    --------
+    >>> from robomech import multibody as mb
+    >>> m = mb.mobility(mb.gallery.load("four_bar"))
+    >>> m.dof, m.gruebler_kutzbach, m.redundant_constraints      # planar: 1 DOF, spatial count 0
+    (1, 0, 1)
     """
     mech = check_mechanism(mech)
     tree = mech.tree

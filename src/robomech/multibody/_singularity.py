@@ -74,7 +74,38 @@ def singularities(
     length: float | None = None,
     rtol: float = workspace.SINGULAR_RTOL,
 ) -> SingularityResult:
-    """Type I / type II / constraint singularity measures of ``site`` at assembled ``q (..., nq)``."""
+    """Type I / type II / constraint singularity measures of ``site`` at assembled ``q (..., nq)``.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (..., nq)
+        Assembled configurations.
+    site : str
+        The output site.
+    reference : array_like, shape (nq,), optional
+        Configuration for the characteristic length (default ``mech.q0``).
+    length : float, optional
+        Characteristic length L (m) that scales rotations and hinge columns (default ``mech.length``).
+    rtol : float, optional
+        Relative threshold of a singular value below which a type counts as singular.
+
+    Returns
+    -------
+    SingularityResult
+        Per sample: ``sigma_I``, ``sigma_II``, ``sigma_C`` (m), ``cond_*``, the flags ``type_I``,
+        ``type_II``, ``constraint``, ``singular`` and the ``length`` used (m).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> s = mb.singularities(mech, mb.forward_kinematics(mech, np.array([0.2])).q, "coupler_point")
+    >>> bool(s.singular), round(float(s.length), 4)            # a regular pose; L in m
+    (False, 0.4753)
+    """
     mech = check_mechanism(mech)
     tree = mech.tree
     if not isinstance(site, str):
@@ -167,6 +198,40 @@ def singularity_map(
 ) -> SingularityMapResult:
     """Workspace / dexterity / singularity maps over a grid of inputs ``q_act (..., n_act)`` (FK) or
     of site targets ``T (..., 4, 4)`` (IK), e.g. from :func:`robomech.analysis.workspace.grid`.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    site : str
+        The output site.
+    q_act : array_like, shape (..., n_act), optional
+        A grid of inputs (FK); exactly one of ``q_act`` and ``T``.
+    T : array_like, shape (..., 4, 4), optional
+        A grid of site targets (IK).
+    guess : array_like, shape (..., nq), optional
+        Start configuration of the solves.
+    steps : int, optional
+        Continuation stages of each solve.
+    ik_weights : array_like, shape (6,), optional
+        Error-row weights of the IK solves (:func:`inverse_kinematics`).
+    length : float, optional
+        Characteristic length (m).
+
+    Returns
+    -------
+    SingularityMapResult
+        ``q``, ``reachable``, ``singularity`` (:class:`SingularityResult`), ``cond``, ``dexterity`` and
+        ``singular`` over the grid's batch shape.
+
+    Examples
+    --------
+    >>> from robomech import multibody as mb
+    >>> from robomech.analysis import workspace
+    >>> mech = mb.gallery.load("four_bar")
+    >>> smap = mb.singularity_map(mech, "coupler_point", q_act=workspace.grid([(-0.5, 0.5)], 5))
+    >>> smap.reachable.shape, bool(smap.reachable.all())
+    ((5,), True)
     """
     mech = check_mechanism(mech)
     if not isinstance(site, str):
