@@ -5,6 +5,8 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 DOCS_STAMP := $(VENV)/.installed-docs
 OUT    ?= out
+# `make docs REPORTS=out`: the docs show the reports of that `robomech reproduce --out` folder.
+REPORTS ?=
 # A second venv with `pip install .` and no extras: what a user without MuJoCo gets.
 MINIMAL := .venv-minimal
 
@@ -44,8 +46,10 @@ typecheck: install
 	$(BIN)/mypy
 
 # The documentation site; -W: a warning is an error, -n: every cross-reference must resolve.
+# It runs examples/*.py and reproduces the fast studies for their pages (docs/conf.py);
+# `make docs REPORTS=out` shows every report of an earlier `make run` instead.
 docs: $(DOCS_STAMP)
-	$(BIN)/sphinx-build -W --keep-going -n -q -b html docs docs/_build/html
+	ROBOMECH_DOCS_REPORTS=$(REPORTS) $(BIN)/sphinx-build -W --keep-going -n -q -b html docs docs/_build/html
 	@echo "docs: open docs/_build/html/index.html"
 
 # No extras installed: list, the engine-free study and the engine-free checks must exit 0.

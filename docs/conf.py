@@ -59,8 +59,14 @@ def _escape_bars(app, what, name, obj, options, lines):
             lines[i] = "".join(p if k % 2 else p.replace("|", r"\|") for k, p in enumerate(parts))
 
 
+def _generate(app) -> None:
+    _example_outputs()
+    _paper_pages()
+
+
 def setup(app):
     app.connect("autodoc-process-docstring", _escape_bars)
+    app.connect("builder-inited", _generate)  # before the sources (and the papers/* glob) are read
 
 
 # No intersphinx (this project builds offline): references into the standard library and
@@ -106,9 +112,12 @@ def _example_outputs() -> None:
         (out / f"{script.stem}.txt").write_text(run.stdout)
 
 
-# The studies whose reports the site shows, one page per paper (docs/papers.md).  Each is reproduced
-# from this checkout by `robomech reproduce` during the build.
+# The studies whose reports the site shows, one page per study (docs/papers.md).  By default the
+# fast ones are reproduced from this checkout by `robomech reproduce` during the build (seconds each;
+# the others take minutes).  With ROBOMECH_DOCS_REPORTS=DIR (`make docs REPORTS=out` after
+# `make run`) every study folder of an existing `robomech reproduce --out DIR` is shown instead.
 PAPER_STUDIES = ("demo",)
+REPORTS_DIR = os.environ.get("ROBOMECH_DOCS_REPORTS", "")
 PAPERS = ROOT / "docs" / "papers"
 _DROP_LINE = re.compile(r"^\[(← all studies|↑ contents)\]")
 
@@ -132,16 +141,22 @@ def _paper_page(study: str, report_md: str) -> str:
 
 
 def _paper_pages() -> None:
-    reports = BUILD / "reports"
-    subprocess.run(
-        [sys.executable, "-m", "robomech", "reproduce", *PAPER_STUDIES, "--out", str(reports), "--quiet"],
-        env=RUN_ENV,
-        check=True,
-        timeout=RUN_TIMEOUT_S,
-        stdout=subprocess.DEVNULL,  # the "report index: ..." line; errors still reach stderr
-    )
+    if REPORTS_DIR:
+        reports = Path(REPORTS_DIR).resolve()
+        studies = sorted(p.parent.name for p in reports.glob("*/report.md"))
+        if not studies:
+            raise RuntimeError(f"ROBOMECH_DOCS_REPORTS={REPORTS_DIR}: no <study>/report.md in it")
+    else:
+        reports, studies = BUILD / "reports", list(PAPER_STUDIES)
+        subprocess.run(
+            [sys.executable, "-m", "robomech", "reproduce", *studies, "--out", str(reports), "--quiet"],
+            env=RUN_ENV,
+            check=True,
+            timeout=RUN_TIMEOUT_S,
+            stdout=subprocess.DEVNULL,  # the "report index: ..." line; errors still reach stderr
+        )
     shutil.rmtree(PAPERS, ignore_errors=True)
-    for study in PAPER_STUDIES:
+    for study in studies:
         src, dst = reports / study, PAPERS / study
         dst.mkdir(parents=True)
         for f in src.iterdir():
@@ -150,6 +165,3 @@ def _paper_pages() -> None:
         page = _paper_page(study, (src / "report.md").read_text(encoding="utf-8"))
         (dst / "index.md").write_text(page, encoding="utf-8")
 
-
-_example_outputs()
-_paper_pages()

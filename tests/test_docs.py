@@ -44,3 +44,53 @@ def test_docs_extra_installs_the_configured_extensions():
     needed = {"sphinx": "sphinx", "numpydoc": "numpydoc", "myst_parser": "myst-parser"}
     for module, dist in needed.items():
         assert module in conf and any(e.startswith(dist) for e in extras), dist
+
+
+def _conf():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("robomech_docs_conf", DOCS / "conf.py")
+    conf = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(conf)  # generation runs only in Sphinx's builder-inited hook
+    return conf
+
+
+def test_a_paper_page_keeps_the_report_and_drops_its_own_navigation():
+    report = "\n".join(
+        [
+            "# Paper 9: a mechanism",
+            "",
+            "[← all studies](../index.md)",
+            "",
+            "*Source:* a paper",
+            "",
+            "## Contents",
+            "",
+            "- [Tables](#tables)",
+            "",
+            "## Tables",
+            "",
+            "| a | b |",
+            "|:---|---:|",
+            "| x | 1.5 |",
+            "",
+            "[↑ contents](#contents) · [all studies](../index.md)",
+            "",
+            "![alt text](fig1.png)",
+        ]
+    )
+    page = _conf()._paper_page("paper-9", report)
+    assert page.startswith("# Paper 9: a mechanism\n")
+    assert "robomech reproduce paper-9" in page and "{download}`results.json <results.json>`" in page
+    for kept in ("*Source:* a paper", "## Tables", "| x | 1.5 |", "![alt text](fig1.png)"):
+        assert kept in page
+    for dropped in ("../index.md", "## Contents", "#contents", "[Tables](#tables)"):
+        assert dropped not in page
+
+
+def test_the_docs_show_every_example_and_the_paper_pages():
+    conf = (DOCS / "conf.py").read_text()
+    assert "builder-inited" in conf
+    assert "papers/*/index" in (DOCS / "papers.md").read_text()
+    index = (DOCS / "index.md").read_text()
+    assert re.search(r"^papers$", index, re.M) and re.search(r"^examples$", index, re.M)

@@ -112,7 +112,9 @@ class EncoderReadings:
     valid: np.ndarray
 
 
-def encoder_rates(model: EncoderModel, wheel_rate: ArrayLike, dt: float, seed: object = 0) -> EncoderReadings:
+def encoder_rates(
+    model: EncoderModel, wheel_rate: ArrayLike, dt: float, seed: int | np.random.Generator = 0
+) -> EncoderReadings:
     """Measured spin rates from true rates ``(N, 6)`` sampled every ``dt`` s.
 
     The true angle is integrated by the trapezoidal rule from a random initial phase (``seed``: an int
@@ -152,7 +154,11 @@ def encoder_rates(model: EncoderModel, wheel_rate: ArrayLike, dt: float, seed: o
 
 
 def imu_measurements(
-    model: ImuModel, angular_velocity: ArrayLike, specific_force: ArrayLike, dt: float, seed: object = 0
+    model: ImuModel,
+    angular_velocity: ArrayLike,
+    specific_force: ArrayLike,
+    dt: float,
+    seed: int | np.random.Generator = 0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Gyro and accelerometer readings ``(N, 3)`` each from true body-axis values ``(N, 3)``.
 
