@@ -43,7 +43,7 @@ def numerical_jacobian(
 
     Returns
     -------
-    ndarray, shape (..., *out, n)
+    ndarray, shape ``(..., *out, n)``
         ``d f / d x_k`` in the last axis.
 
     Examples
