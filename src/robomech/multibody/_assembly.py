@@ -64,7 +64,7 @@ def check_mechanism(mech: object) -> Mechanism:
     return mech
 
 
-def check_q(mech: Mechanism, q: ArrayLike, name: str = "q") -> np.ndarray:
+def check_q(mech: Mechanism, q: object, name: str = "q") -> np.ndarray:  # a validator: any input
     """``q (..., nq)`` finite, quaternions non-zero; returns it with quaternions normalised."""
     q = as_array(q, name, (mech.nq,))
     for a in mech.tree.quat_adr:
