@@ -276,3 +276,29 @@ def test_cli_interrupt_says_how_to_resume(monkeypatch, tmp_path, capsys):
     monkeypatch.setattr(ex, "run_sweep", interrupted)
     assert main(["sweep", STUDY, "--out", str(tmp_path / "s"), "--quiet"]) == 130
     assert "rerun the same command" in capsys.readouterr().err
+
+
+def test_list_names_the_design_studies_in_text_and_json(capsys, monkeypatch):
+    import json
+
+    from robomech.explore import available_studies
+
+    assert main(["list"]) == 0
+    text = capsys.readouterr().out
+    section = text.split("design studies (robomech sweep NAME --out DIR):\n", 1)[1]
+    lines = {ln.split()[0]: ln for ln in section.splitlines() if ln.startswith("  ")}
+    assert set(lines) == set(available_studies())
+    for name, st in available_studies().items():
+        assert st.title in lines[name] and "skipped" not in lines[name]
+    assert main(["list", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert [d["name"] for d in data["design_studies"]] == list(available_studies())
+    assert all(d["skipped"] is None and d["title"] for d in data["design_studies"])
+    # without the Dask/Zarr extra the design studies are still listed, marked skipped with the reason
+    import robomech._registry as reg
+
+    real = reg.skip_reason
+    monkeypatch.setattr(reg, "skip_reason", lambda req: "no zarr here" if "zarr" in req else real(req))
+    assert main(["list", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert {d["skipped"] for d in data["design_studies"]} == {"no zarr here"}
