@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 from robomech._validation import check_bool, check_choice, check_int, check_positive
 
 from ._sampling import SAMPLERS, chunk_seed, design_matrix
-from ._store import ChunkWriter, open_store, prepare_store
+from ._store import ChunkWriter, open_store, prepare_store, store_array
 from ._study import DesignStudy, Variable, check_variables, with_variables
 
 if TYPE_CHECKING:
@@ -255,7 +255,9 @@ def run_sweep(
     }
     n_chunks = -(-n // chunk)
     g = open_store(Path(out), fp, X)  # raises StoreMismatch before anything is written
-    done = np.zeros(n_chunks, bool) if g is None else np.asarray(g["chunk_done"][:], dtype=bool)
+    done = (
+        np.zeros(n_chunks, bool) if g is None else np.asarray(store_array(g, "chunk_done")[...], dtype=bool)
+    )
     missing = [k for k in range(done.size) if not done[k]]
     t0 = time.perf_counter()
     computed: list[int] = []
@@ -312,10 +314,11 @@ def run_sweep(
 
 
 def _pickle_study(study: DesignStudy) -> bytes:
-    """The study as bytes for the tasks (cloudpickle: a study defined in ``__main__`` travels too)."""
-    import cloudpickle
+    """The study as bytes for the tasks (Dask's pickle, cloudpickle for what plain pickle cannot: a study
+    defined in ``__main__`` travels too)."""
+    from distributed.protocol.pickle import dumps
 
-    return bytes(cloudpickle.dumps(study))
+    return bytes(dumps(study))
 
 
 def check_runtime(

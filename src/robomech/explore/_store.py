@@ -63,7 +63,8 @@ def _meta(g: zarr.Group) -> dict[str, Any]:
     return dict(meta) if isinstance(meta, Mapping) else {}
 
 
-def _array(g: zarr.Group, name: str) -> zarr.Array:
+def store_array(g: zarr.Group, name: str) -> zarr.Array:
+    """Array ``name`` of the store ``g`` (StoreMismatch if it is a group)."""
     import zarr
 
     a = g[name]
@@ -108,7 +109,7 @@ def open_store(
             f"got the store of study {old.get('study')!r} differing in {', '.join(diff)}; "
             "use another --out (nothing was overwritten)."
         )
-    if designs is not None and not np.array_equal(np.asarray(_array(g, "designs")[...]), designs):
+    if designs is not None and not np.array_equal(np.asarray(store_array(g, "designs")[...]), designs):
         raise StoreMismatch(f"The design matrix stored in {str(out)!r} differs from this sweep's.")
     return g
 
