@@ -17,7 +17,7 @@ the same designs) ``--repeats`` times on each cluster, reading back per sweep:
 
 Reported per study (medians over the repeats):
 
-- poses/s = designs x ``poses_per_design`` / T;
+- poses/s = designs x ``poses_per_design`` / T; set-up + tail = T - window (once per sweep);
 - efficiency ``T1 / (2 T2)`` (the acceptance figure) and the steady-state one ``window1 / (2 window2)``;
 - overhead per chunk = (workers x window - sum of chunk work) / chunks: everything per chunk that is not
   the study's computation (scheduling, transfer, the worker's task wrapper, the client's receipt and
@@ -158,9 +158,10 @@ def main() -> int:
     )
     print(
         "| study (chunk) | workers | T (s) | poses/s | efficiency T1/(2 T2) | steady efficiency | "
-        "chunk work (s) | overhead / chunk (ms) | overhead / work | task overhead (ms) | client write (ms) |"
+        "chunk work (s) | overhead / chunk (ms) | overhead / work | task overhead (ms) | client write (ms) | "
+        "set-up + tail (s) |"
     )
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name in names:
         st = get_study(name)
         n = args.chunks * st.default_chunk
@@ -193,7 +194,8 @@ def main() -> int:
                 f"| {name} ({st.default_chunk}) | {workers} | {row['wall_s']:.2f} | "
                 f"{row['poses_per_s']:.3g} | {eff:.2f} | {steady:.2f} | {work:.2f} | {1e3 * over:.0f} | "
                 f"{100 * over / work:.1f} % | "
-                f"{1e3 * row['task_overhead_s']:.1f} | {1e3 * row['client_write_s']:.1f} |",
+                f"{1e3 * row['task_overhead_s']:.1f} | {1e3 * row['client_write_s']:.1f} | "
+                f"{row['wall_s'] - row['window_s']:.2f} |",
                 flush=True,
             )
     if "spherical-leg-synthesis" in names:
