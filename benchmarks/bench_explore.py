@@ -6,7 +6,7 @@ evaluations per second on one core, no Dask).
 ``python benchmarks/bench_explore.py`` (standalone, ~2 min on 2 idle cores): one LocalCluster of 1 and
 one of 2 single-threaded worker processes (``robomech.explore``'s own settings: ``WORKER_ENV``), a warm-up
 sweep per study and worker count, then for each study the *same* sweep (``--chunks`` default-size chunks,
-the same designs) ``--repeats`` times on each cluster, reading back per sweep:
+the same designs) ``--repeats`` times on each cluster, alternating the clusters, reading back per sweep:
 
 - ``T`` the wall time of ``run_sweep`` (store creation and everything else included);
 - the Dask task stream: when each task started and stopped on its worker, so ``window`` is the time
@@ -111,28 +111,38 @@ def _one_sweep(client: Any, name: str, out: Path, n: int) -> dict[str, float]:
     }
 
 
-def _measure(workers: int, names: list[str], chunks: int, repeats: int) -> dict[str, list[dict[str, float]]]:
+def _measure(names: list[str], chunks: int, repeats: int) -> dict[int, dict[str, list[dict[str, float]]]]:
+    """Both clusters stay up; the repeats alternate 1 and 2 workers so that a drifting load on a shared
+    machine biases neither."""
+    from contextlib import ExitStack
+
     from distributed import Client, LocalCluster
 
     runner_mod.ChunkWriter = _TimedWriter  # type: ignore[misc]
-    out: dict[str, list[dict[str, float]]] = {}
-    with (
-        LocalCluster(
-            n_workers=workers, threads_per_worker=1, host="127.0.0.1", dashboard_address="127.0.0.1:0",
-            silence_logs=40, env=runner_mod.WORKER_ENV,
-        ) as cluster,
-        Client(cluster) as client,
-        tempfile.TemporaryDirectory() as d,
-    ):  # fmt: skip
+    out: dict[int, dict[str, list[dict[str, float]]]] = {1: {}, 2: {}}
+    with ExitStack() as stack:
+        d = Path(stack.enter_context(tempfile.TemporaryDirectory()))
+        clients = {}
+        for w in (1, 2):
+            cluster = stack.enter_context(
+                LocalCluster(
+                    n_workers=w, threads_per_worker=1, host="127.0.0.1", dashboard_address="127.0.0.1:0",
+                    silence_logs=40, env=runner_mod.WORKER_ENV,
+                )
+            )  # fmt: skip
+            clients[w] = stack.enter_context(Client(cluster))
         for name in names:
             st = get_study(name)
-            # warm-up: every worker imports robomech and runs its first chunk (first-call costs)
-            run_sweep(st, Path(d) / f"warm-{name}", designs=st.default_chunk * workers, client=client,
-                      progress=False)  # fmt: skip
-            out[name] = [
-                _one_sweep(client, name, Path(d) / f"{name}-{r}", chunks * st.default_chunk)
-                for r in range(repeats)
-            ]
+            for w, client in clients.items():
+                # warm-up: every worker imports robomech and runs its first chunk (first-call costs)
+                run_sweep(st, d / f"warm-{w}-{name}", designs=st.default_chunk * w, client=client,
+                          progress=False)  # fmt: skip
+                out[w][name] = []
+            for r in range(repeats):
+                for w, client in clients.items():
+                    out[w][name].append(
+                        _one_sweep(client, name, d / f"{name}-{w}-{r}", chunks * st.default_chunk)
+                    )
     return out
 
 
@@ -150,7 +160,7 @@ def main() -> int:
     names = [n for n in STUDIES if not args.only or args.only in n]
     t_start = time.perf_counter()
     load = os.getloadavg()[0]
-    res = {w: _measure(w, names, args.chunks, args.repeats) for w in (1, 2)}
+    res = _measure(names, args.chunks, args.repeats)
     rows = []
     print(
         f"\n{args.chunks} chunks per sweep, median of {args.repeats}; load average {load:.1f} at the start, "
