@@ -54,8 +54,8 @@ SPECS = {
     P + "PULLEY_QUAD_NODES": CONSTANT,
     P + "STICK_SLIP_TENSION_FLOOR": CONSTANT,
     **exempt(
-        "DiskEquilibrium DriveResult FrictionEstimate HistoryResult IKResult PoseFrictionEstimate SimulationResult "
-        "TensionHistory TensionResult TipFrictionEstimate",
+        "DiskEquilibrium DriveResult FrictionEstimate HistoryResult IKResult PoseFrictionEstimate "
+        "SimulationResult TensionHistory TensionResult TipFrictionEstimate",
         RESULT_TYPE,
         P,
     ),

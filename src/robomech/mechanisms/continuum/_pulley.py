@@ -52,7 +52,9 @@ class Pulley:
             raise ValueError(f"Expected n in (0, 1] (eq. (25)), got {self.n!r}.")
 
 
-def _kappa(robot: ContinuumRobot, pulley: Pulley, phi: NDArray[np.float64], t_out: NDArray[np.float64]):
+def _kappa(
+    robot: ContinuumRobot, pulley: Pulley, phi: NDArray[np.float64], t_out: NDArray[np.float64]
+) -> NDArray[np.float64]:
     """kappa(phi; t_out) of eq. (32), 1 for a frictionless pulley."""
     if pulley.alpha == 0.0:
         return np.ones(np.broadcast_shapes(np.shape(phi), np.shape(t_out)))
