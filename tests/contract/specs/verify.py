@@ -83,14 +83,16 @@ SPECS = {
         args={"leg": LEG_SL, "timestep": 2e-4}, params=("leg",), options={"timestep": BAD_POSITIVE}
     ),
     P + "spherical_leg.inverse_dynamics_engine": Spec(
-        args={"leg": LEG_SL, "q": _Q2, "qd": 0.1 * _Q2, "qdd": 0.2 * _Q2},
+        args={"leg": LEG_SL, "q": _Q2, "qd": 0.1 * _Q2, "qdd": 0.2 * _Q2, "driven_legs": (0, 2)},
         arrays={"q": 1, "qd": 1, "qdd": 1},
         wrong_shapes={"q": ((2, 3), (2,)), "qd": ((3, 2),), "qdd": ((2, 3),)},
         params=("leg",),
+        options={"driven_legs": ((0, 0), (0, 3), (0,), "ab", 1, (0.5, 1.0), (True, False))},
     ),
     P + "spherical_leg.run_checks": Spec(
-        args={"analytic": LEG_SL},
+        args={"analytic": LEG_SL, "paper_as_printed": False},
         params=("analytic",),
+        options={"paper_as_printed": BAD_BOOL},
         good_elsewhere="tests/verify/test_verify_spherical_leg.py",
     ),
     P + "spherical_leg.study_overlays": Spec(
