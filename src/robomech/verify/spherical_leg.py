@@ -223,7 +223,7 @@ def _engine_states(
 
 def _equality_jacobian(m: mujoco.MjModel, d: mujoco.MjData) -> tuple[Array, Array]:
     rows = np.nonzero(d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY)[0]
-    return np.array(d.efc_J).reshape(-1, m.nv)[rows], np.array(d.efc_pos)[rows]
+    return np.array(d.efc_J)[: d.nefc * m.nv].reshape(d.nefc, m.nv)[rows], np.array(d.efc_pos)[rows]
 
 
 def _null_space(Jc: Array) -> Array:

@@ -110,14 +110,14 @@ SPECS = {
         args={"th": TH, "actuated": False}, params=("th",), options={"actuated": BAD_BOOL}
     ),
     P + "vectored_thrust.engine_trace": Spec(
-        args={"th": TH, "t": _T, "q": _TRAJ[0], "qd": _TRAJ[1], "qdd": _TRAJ[2]},
+        args={"th": TH, "t": _T, "q": _TRAJ[0], "qd": _TRAJ[1], "qdd": _TRAJ[2], "analytic": TH},
         arrays={"t": 0, "q": 1, "qd": 1, "qdd": 1},
         wrong_shapes={"t": ((2,),), "q": ((3, 3), (2, 2))},
-        params=("th",),
+        params=("th", "analytic"),
     ),
     P + "vectored_thrust.run": Spec(
-        args={"th": TH, "omega_dot_model": None},
-        params=("th",),
+        args={"th": TH, "omega_dot_model": None, "analytic": TH},
+        params=("th", "analytic"),
         options={"omega_dot_model": ("model", 1.0)},
         good_elsewhere="tests/verify/test_verify_vectored_thrust.py",
     ),
