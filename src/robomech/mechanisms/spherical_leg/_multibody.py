@@ -6,7 +6,9 @@ three lengths, J, H) to 1e-10.
 
 * central chain 0 (RUR): two hinges at O, ``alpha`` about X then ``beta`` about the turned Y, so the
   platform turns by ``Rx(alpha) Ry(beta)`` about O (paper 1, eq. (1));
-* leg i: a universal joint at A_i (two hinges across the leg), then the upper body sliding along the
+* leg i: a universal joint at A_i (two hinges across the leg: ``u{i}a`` about ``leg.cardan_axes[i]``,
+  fixed in the base, then ``u{i}b`` about the turned axis; the analytic dynamics carries the spin of
+  the leg about its axis that this joint imposes), then the upper body sliding along the
   leg (qpos of ``l{i}`` = length - home length), and a point closure (the upper spherical joint) at
   B_i; legs 1 and 3 also carry the lead screw, spinning about the leg axis at 2 pi / lead per metre of
   stroke (a joint coupling, ``screw_spin``), as the analytic dynamics assumes.
