@@ -416,7 +416,8 @@ def _singular_values_2x2_gram(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 class InverseDynamicsResult:
     """generalized_forces (..., 2) N m on (alpha, beta); leg_forces (..., 3) N (positive extends);
     residual (...) N m of J^T f = tau; valid (...) False at or near an actuation singularity
-    (``sigma_min < ACTUATION_SIGMA_MIN``; forces NaN where the solve is numerically singular);
+    (``sigma_min < ACTUATION_SIGMA_MIN``; forces NaN where the solve is numerically singular) or a
+    gimbal lock of a base universal joint (``CARDAN_LOCK_TOL``);
     sigma_min (...) m/rad and rcond (...) the per-sample conditioning (:class:`ForceDistribution`)."""
 
     generalized_forces: np.ndarray
