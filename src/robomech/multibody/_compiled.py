@@ -1,12 +1,15 @@
-"""Compiled (numba) per-sample kernels for large batches: forward kinematics and site Jacobians.
+"""Compiled (numba) per-sample kernels for large batches: FK, site Jacobians, inverse dynamics.
 
-The same algorithms as the numpy path (``_tree``, ``_constraints``, ``_assembly``, ``_influence``),
-written per sample in one parallel loop over the batch: tree kinematics, closure residual and
+The same algorithms as the numpy path (``_tree``, ``_constraints``, ``_assembly``, ``_influence``,
+``_dynamics``), written per sample in one loop over the batch: tree kinematics, closure residual and
 velocity constraint matrix, the Levenberg–Marquardt assembly with the same damping, step cap and
-stopping rules, and ``G = [I; -K_p^+ K_a]`` with the site's ``[ω; ṗ]`` Jacobian.  A numpy batch pays
-one Python-level operation per body and per closure on arrays of the whole batch; here every sample
-stays in cache.  The tests check that both paths agree to rounding.  This module (and numba) loads
-on the first large call.
+stopping rules, ``G = [I; -K_p^+ K_a]`` with the site's ``[ω; ṗ]`` Jacobian, and the closed-chain
+inverse dynamics of ``_dynamics._inverse_flat`` (:func:`inv_dyn`: passive pseudo-inverse, screw rates,
+``K̇ q̇``, the bodies' Newton–Euler terms through ``G``, site wrenches, the redundant-actuation rule and
+the same validity flags).  A numpy batch pays one Python-level operation per body and per closure on
+arrays of the whole batch; here every sample stays in cache.  The mechanism is passed packed, as the
+named tuples :class:`Tables` and :class:`DynTables`.  The tests check that both paths agree to
+rounding.  This module (and numba) loads on the first large call.
 """
 
 from __future__ import annotations
