@@ -12,9 +12,9 @@ single-threaded); the numpy path is the reference it is tested against.
 * Spherical leg and OmniLeg, generic description vs the analytic model (Kane, Lagrange), both batched
   over 10^5 samples.  Target: the generic model within 3x (speed-up >= 1/3).
 
-The OmniLeg description carries no inertias of its own on this branch: its bodies get the inertias
-MuJoCo derives from the exported visual geometry (``mb.from_mjcf(mb.to_mjcf(mech))``, as ``robomech
-verify`` does), which costs the same per sample as any other inertias (every body massive).
+The OmniLeg description carries the analytic model's inertias; should a body lack one, it gets the
+inertia MuJoCo derives from the exported visual geometry (``mb.from_mjcf(mb.to_mjcf(mech))``, as
+``robomech verify`` does), which costs the same per sample (every body massive).
 
 The 10^5 configurations are 10^3 assembled ones repeated 100 times (assembling 10^5 Delta
 configurations is not the workload; each sample costs the same).
