@@ -201,7 +201,8 @@ def _segment_planes(theta: np.ndarray, beta: np.ndarray, length: np.ndarray | fl
     Pf = P.reshape(16, -1)
     th, be = _flat(theta, shape), _flat(beta, shape)
     scalar_length = np.ndim(length) == 0
-    ln = float(length) if scalar_length else _flat(length, shape)
+    ln_arr = None if scalar_length else _flat(np.asarray(length, dtype=float), shape)
+    ln = float(length) if scalar_length else 0.0
     for k in range(0, th.size, CHUNK):
         c = slice(k, k + CHUNK)
         t = np.ascontiguousarray(th[c])
@@ -226,7 +227,7 @@ def _segment_planes(theta: np.ndarray, beta: np.ndarray, length: np.ndarray | fl
         Pf[10, c] = ct
         # paper 3, eq. (2), written with (1 - cos t)/t and sin t / t so that it is finite at theta = 0
         # (Taylor series on the rare entries below SMALL_ANGLE).
-        lc = ln if scalar_length else ln[c]
+        lc = ln if ln_arr is None else ln_arr[c]
         fc *= lc
         np.multiply(fc, cb, out=Pf[3, c])
         np.multiply(fc, sb, out=Pf[7, c])
@@ -892,8 +893,12 @@ def inverse_kinematics(robot: ContinuumRobot, p_tip: object) -> IKResult:
         idx = idx[r >= IK_TOLERANCE]
     _normalise(theta, beta)
     beta[theta == 0.0] = 0.0  # beta is undefined on a straight segment: 0 by convention
-    psi = psi.reshape(*batch, 2 * n)
-    res, converged, iterations = res.reshape(batch), converged.reshape(batch), iterations.reshape(batch)
+    psi_out: np.ndarray = psi.reshape(*batch, 2 * n)
+    res_out: np.ndarray = res.reshape(batch)
     return IKResult(
-        psi=psi, residual=res, reachable=res < IK_TOLERANCE, converged=converged, iterations=iterations
+        psi=psi_out,
+        residual=res_out,
+        reachable=res_out < IK_TOLERANCE,
+        converged=converged.reshape(batch),
+        iterations=iterations.reshape(batch),
     )
