@@ -48,7 +48,7 @@ BRANCH_TOL = 1e-6
 # Palette of each GIF frame: a wireframe on a white background needs few colours (smaller file).
 GIF_COLOURS = 64
 # Ticks per axis (at most): the labels of a narrow axis must not overlap at 6 pt.
-TICKS = 4
+TICKS = 3
 # Frames sampled (evenly over the motion) to build the GIF's one palette.
 PALETTE_FRAMES = 6
 # Margin around the motion's bounding box, as a fraction of its largest extent.
@@ -378,7 +378,7 @@ def animate(
     # one palette for every frame (from a few frames side by side): a per-frame palette would map the
     # same background grey to different entries from frame to frame (flicker, and a larger file)
     sample = np.concatenate([rgb[k] for k in np.linspace(0, nt - 1, min(nt, PALETTE_FRAMES)).astype(int)], 1)
-    palette = Image.fromarray(sample).quantize(GIF_COLOURS, method=Image.Quantize.MEDIANCUT)
+    palette = Image.fromarray(sample).quantize(GIF_COLOURS, method=Image.Quantize.FASTOCTREE)
     images = [Image.fromarray(f).quantize(palette=palette, dither=Image.Dither.NONE) for f in rgb]
     path = Path(path)
     images[0].save(path, save_all=True, append_images=images[1:], duration=frame_ms(fps), loop=0, disposal=1)
