@@ -20,6 +20,8 @@ N_DYN = 100_000
 N_ALT_KIN = 2000
 N_ALT_DYN = 2000
 N_ALT_ENGINE = 200
+# Generic (robomech.multibody) vs analytic inverse dynamics of the same description (issue 13).
+N_GEN = 10_000
 LEG = ol.OmniLeg.paper()
 
 
@@ -53,6 +55,30 @@ def _engine():
     idx = np.linspace(0, N_DYN - 1, N_ALT_ENGINE).astype(int)
     jm = ol.joint_motion(LEG, q[idx], qd[idx], qdd[idx])
     return vo, vo.build_model(LEG), jm, F[idx]
+
+
+@cache
+def _generic_data():
+    """The description and assembled q of N_GEN samples of eq. (52) (qpos from joint_motion: same joints)."""
+    q, qd, qdd, F = (a[:: N_DYN // N_GEN] for a in _dyn_data())
+    mech = ol.to_multibody(LEG)
+    qpos = np.zeros((len(q), mech.nq))
+    qpos[:, [mech.qpos_address(n) for n in ol.TREE_JOINTS]] = ol.joint_motion(LEG, q, qd, qdd).q
+    W = np.zeros((len(q), 6))
+    W[:, 3:] = F
+    return mech, qpos, q, qd, qdd, F, W
+
+
+def _generic_dyn():
+    from robomech import multibody as mb
+
+    mech, qpos, _, qd, qdd, _, W = _generic_data()
+    return mb.inverse_dynamics(mech, qpos, qd, qdd, wrenches={"foot": W})
+
+
+def _analytic_dyn_gen():
+    _, _, q, qd, qdd, F, _ = _generic_data()
+    return ol.inverse_dynamics(LEG, q, qd, qdd, foot_force=F)
 
 
 def _engine_loop() -> np.ndarray:
@@ -96,4 +122,10 @@ def workloads() -> list[Workload]:
     out.append(Workload(name="omnileg: inverse dynamics (vs own loop)", group="3", run=dyn, n=N_DYN,
                         bytes_moved=dyn_bytes, alternative=dyn_loop, n_alt=N_ALT_DYN,
                         alternative_name="per-sample Python loop", repeats=2))  # fmt: skip
+    # issue 13: "the generic OmniLeg within 3x of the analytic one" (speed-up target 1/3)
+    gen_bytes = N_GEN * f8 * (22 + 3 * 3 + 6 + 3 * 5 + 9)  # qpos, rates, wrench in; τ, parts, M_a out
+    out.append(Workload(name="omnileg: generic inverse dynamics (vs analytic)", group="3", run=_generic_dyn,
+                        n=N_GEN, bytes_moved=gen_bytes, alternative=_analytic_dyn_gen, n_alt=N_GEN,
+                        alternative_name="analytic Lagrange model (batched)", target_speedup=1 / 3,
+                        repeats=2))  # fmt: skip
     return out

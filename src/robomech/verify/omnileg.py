@@ -1,33 +1,41 @@
 """Paper 2 (OmniLeg) against MuJoCo: the engine plays the role of the paper's ADAMS prototype.
 
-The MJCF is generated from the same :class:`OmniLeg` parameters: a spanning tree of 22 hinges
-(``TREE_JOINTS``: chain 1 carrying the knee plate, chains 2 and 3 without their last joint, the double-Cardan
-drive, the shank cranks and couplers, the foot on coupler 1) and the loop closures as MuJoCo equality
-constraints: each cut hinge is two ``connect`` constraints at two points of its axis; the 1:1 bevel gears
-are ``joint`` equalities crank_i = drive_out.  The thigh is over-constrained (the engine's solver handles
-the redundant rows).
+The engine model is the generic export of the leg's description,
+``robomech.multibody.to_mjcf(omnileg.to_multibody(leg))`` (no hand-written MJCF): the 22 bodies with the
+analytic model's inertias, the spanning tree of 22 hinges (``TREE_JOINTS``: chain 1 carrying the knee
+plate, chains 2 and 3 without their last joint, the double-Cardan drive, the shank cranks and couplers,
+the foot on coupler 1), each cut hinge as two ``connect`` constraints on its axis and the 1:1 bevel gears
+as ``joint`` equalities crank_i = drive_out.  :func:`build_mjcf` adds only the engine options of the
+forward simulation (time step, stiff equality constraints).  The thigh is over-constrained (the engine's
+solver handles the redundant rows).
 
-Checks (each a :class:`Check` with a named tolerance):
+Checks of the *analytic* model (``mechanisms/omnileg``, Lagrange) against the engine, each a
+:class:`Check` with a named tolerance:
 
-* kinematics: analytic joint angles in ``qpos`` -> equality-constraint violation ``efc_pos`` and the foot
-  site against eq. (11); analytic joint rates in ``qvel`` -> ``efc_J qvel`` and the foot site velocity
-  against ``J q̇``;
+* kinematics: analytic joint angles (``joint_motion``) in ``qpos`` -> equality-constraint violation
+  ``efc_pos`` and the foot site against eq. (11); analytic joint rates in ``qvel`` -> ``efc_J qvel`` and
+  the foot site velocity against ``J q̇``;
+* energy: analytic kinetic and potential energy against the engine's ``mj_energyPos``/``mj_energyVel``;
 * inverse dynamics: the engine's tree inverse dynamics (``M q̈ + c`` from ``mj_inverse``/``mj_mulM``,
   constraint forces left out) along eq. (52) with Fig. 11's foot force, projected through the
-  constraint Jacobian
-  (``τ_tree = Sᵀ τ + J_cᵀ λ``, least squares) -> motor torques, against the analytic model;
+  constraint Jacobian (``τ_tree = Sᵀ τ + J_cᵀ λ``, least squares) -> motor torques, against the analytic
+  model;
 * forward simulation: the engine driven only by the analytic torques follows eq. (52).
 """
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 import robomech.mechanisms.omnileg as ol
+from robomech import multibody as mb
 from robomech._validation import as_array, broadcast_batch, check_params
+from robomech.trajectory import Profile
 
 from ._core import Check, Tolerance, Verification, optional_module
 
@@ -38,20 +46,24 @@ else:  # imported on first use: discovering this module must not need the option
 
 __all__ = ["VERIFICATION", "EngineModel", "build_mjcf", "build_model", "engine_inverse_dynamics", "run"]
 
+Array = NDArray[np.float64]
+
 MECHANISM = "omnileg"
-# Tree joints driven by the motors, in q = (α, β, γ) order.
+# Tree joints driven by the motors, in q = (α, β, γ) order (the description's actuators).
 ACTUATED_JOINTS = ("theta21", "theta11", "drive_in")
-# Distance between the two connect anchors that replace a cut hinge (m): any non-zero length on the
-# axis works; 20 mm keeps the rows well conditioned against the 0.1 m link scale.
-CONNECT_SPAN = 0.02
+# The foot point (eq. (11)) in the description.
+FOOT_SITE = "foot"
 # Kinematic agreement: analytic joint values satisfy the engine's closure and foot site to rounding.
 TOL_KINEMATICS = Tolerance(1e-12, "pure geometry: rounding of O(0.5 m) positions through 8 joint transforms")
 TOL_VELOCITY = Tolerance(
     1e-12, "pure geometry: rounding of O(1 m/s) velocities through the constraint Jacobian"
 )
-# Inverse dynamics: both sides are exact rigid-body models of the same bodies; only rounding differs.
+# Energy: the same bodies summed by two codes (MuJoCo from its compiled principal inertias).
+TOL_ENERGY = Tolerance(1e-10, "the same 22 rigid bodies; rounding of principal-axis inertias", relative=True)
+# Inverse dynamics: both sides are exact rigid-body models of the same bodies; only rounding differs
+# (measured 6e-15; issue 13's bar 1e-8 relative, was 1e-6 with the hand-written model).
 TOL_TORQUE = Tolerance(
-    1e-6, "exact tree inverse dynamics + least-squares projection; rounding only", relative=True
+    1e-8, "exact tree inverse dynamics + least-squares projection; rounding only", relative=True
 )
 # Forward simulation: MuJoCo's equality constraints are soft.  A stiff setting (time constant 0.5 ms =
 # 5 steps, impedance 0.9999; with the default 2 ms / 0.9-0.95 the gears lag by ~1e-2 rad) and the Euler
@@ -68,149 +80,68 @@ N_CHECK = 120
 FIG11_FORCE = np.array([0.0, -20.0, 20.0])
 
 
-def _quat(R: np.ndarray) -> str:
-    q = np.zeros(4)
-    mujoco.mju_mat2Quat(q, np.ascontiguousarray(R, dtype=float).ravel())
-    return " ".join(f"{v:.17g}" for v in q)
-
-
-def _vec(v) -> str:
-    return " ".join(f"{float(x):.17g}" for x in v)
-
-
-def _inertial(body: ol.RigidBody) -> str:
-    I = body.inertia_matrix
-    full = [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]
-    return f'<inertial pos="{_vec(body.com)}" mass="{body.mass:.17g}" fullinertia="{_vec(full)}"/>'
-
-
-def _kR(k: int) -> np.ndarray:
-    d = 0.5 * np.pi * k
-    c, s = np.cos(d), np.sin(d)
-    return np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # paper 2, eq. (5) as printed (Rz(-δ))
+def _vec(v: ArrayLike) -> str:
+    return " ".join(f"{float(x):.17g}" for x in np.ravel(v))
 
 
 def build_mjcf(leg: ol.OmniLeg) -> str:
-    """MJCF of the whole leg at its home pose (q = 0), from the parameter dataclass."""
+    """MJCF of the whole leg: ``mb.to_mjcf(omnileg.to_multibody(leg))`` plus the simulation options.
+
+    The options (not part of a mechanism description): time step ``SIM_TIMESTEP``, stiff equality
+    constraints ``SIM_SOLREF``/``SIM_SOLIMP``, dense constraint Jacobian, contacts off.
+    """
     check_params(leg, ol.OmniLeg, "leg")
-    b = leg.bodies
-    S = ol.shank_frames(leg)
-    r, h = leg.shank_radius, leg.knee_to_crank
-    hinge = 'limited="false" damping="0" armature="0"'
-    parts = []
-
-    def chain(k: int, with_plate: bool) -> str:
-        A = _kR(k) @ np.array([0.0, leg.L3, 0.0])
-        j = [f"theta{k + 1}{i}" for i in range(1, 5)]
-        inner = ""
-        if with_plate:
-            shank = ""
-            for i in range(3):
-                foot = ""
-                if i == 0:
-                    foot = (
-                        f'<body name="foot" pos="{_vec([-r, 0.0, leg.L4])}" quat="{_quat(S[0].T)}">'
-                        f'<joint name="foot" type="hinge" pos="{_vec(S[0] @ [r, 0, 0])}" '
-                        f'axis="{_vec(S[0][:, 0])}" {hinge}/>'
-                        f"{_inertial(b['foot'])}"
-                        f'<site name="foot_point" pos="0 0 {leg.foot_drop:.17g}" size="0.005"/></body>'
-                    )
-                shank += (
-                    f'<body name="crank_{i + 1}" pos="{_vec(S[i] @ [r, 0.0, h])}" quat="{_quat(S[i])}">'
-                    f'<joint name="crank_{i + 1}" type="hinge" axis="1 0 0" {hinge}/>{_inertial(b["crank"])}'
-                    f'<body name="coupler_{i + 1}" pos="0 0 {leg.L4:.17g}">'
-                    f'<joint name="coupler_{i + 1}" type="hinge" axis="1 0 0" {hinge}/>'
-                    f"{_inertial(b['coupler'])}"
-                    f"{foot}</body></body>"
-                )
-            inner = (
-                f'<body name="knee_plate" pos="0 {-leg.L3:.17g} 0">'
-                f'<joint name="theta14" type="hinge" pos="0 {leg.L3:.17g} 0" axis="0 1 0" {hinge}/>'
-                f"{_inertial(b['knee_plate'])}"
-                f'<body name="drive_shaft_out"><joint name="drive_out" type="hinge" axis="0 0 1" {hinge}/>'
-                f"{_inertial(b['drive_shaft_out'])}</body>{shank}</body>"
-            )
-        return (
-            f'<body name="hip_cross_{k + 1}" pos="{_vec(A)}" quat="{_quat(_kR(k))}">'
-            f'<joint name="{j[0]}" type="hinge" axis="0 1 0" {hinge}/>{_inertial(b["hip_cross"])}'
-            f'<body name="thigh_rod_{k + 1}"><joint name="{j[1]}" type="hinge" axis="1 0 0" {hinge}/>'
-            f"{_inertial(b['thigh_rod'])}"
-            f'<body name="knee_cross_{k + 1}" pos="0 0 {leg.L1:.17g}">'
-            f'<joint name="{j[2]}" type="hinge" axis="1 0 0" {hinge}/>{_inertial(b["knee_cross"])}'
-            f"{inner}</body></body></body>"
-        )
-
-    parts.append(chain(0, True))
-    parts.append(chain(1, False))
-    parts.append(chain(2, False))
-    parts.append(
-        '<body name="drive_shaft_in"><joint name="drive_in" type="hinge" axis="0 0 1" ' + hinge + "/>"
-        f"{_inertial(b['drive_shaft_in'])}"
-        f'<body name="drive_cross_a"><joint name="drive_phi1" type="hinge" axis="0 1 0" {hinge}/>'
-        f"{_inertial(b['drive_cross'])}"
-        f'<body name="drive_rod"><joint name="drive_phi2" type="hinge" axis="1 0 0" {hinge}/>'
-        f"{_inertial(b['drive_rod'])}"
-        f'<body name="drive_cross_b" pos="0 0 {leg.L1:.17g}">'
-        f'<joint name="drive_phi3" type="hinge" axis="1 0 0" {hinge}/>{_inertial(b["drive_cross"])}'
-        "</body></body></body></body>"
-    )
-    d = CONNECT_SPAN
-    eq = []
-    for k in (2, 3):  # chains 2, 3: cut hinge theta_k4 about the cross's local y
-        for a in ((0, 0, 0), (0, d, 0)):
-            eq.append(f'<connect body1="knee_cross_{k}" body2="knee_plate" anchor="{_vec(a)}"/>')
-    for a in ((0, 0, 0), (0, d, 0)):  # drive: cut hinge of cross B4 about its local y (a1)
-        eq.append(f'<connect body1="drive_cross_b" body2="drive_shaft_out" anchor="{_vec(a)}"/>')
-    for i in (2, 3):  # shank: couplers 2, 3 close on the foot at E_i (hinge about local x)
-        for a in ((0, 0, leg.L4), (d, 0, leg.L4)):
-            eq.append(f'<connect body1="coupler_{i}" body2="foot" anchor="{_vec(a)}"/>')
-    for i in (1, 2, 3):  # 1:1 bevel gears
-        eq.append(f'<joint joint1="crank_{i}" joint2="drive_out" polycoef="0 1 0 0 0"/>')
-    return (
-        '<mujoco model="omnileg"><compiler angle="radian" autolimits="false"/>'
-        f'<option gravity="{_vec(leg.gravity)}" timestep="{SIM_TIMESTEP}" jacobian="dense">'
-        '<flag contact="disable"/></option>'
-        f'<default><equality solref="{_vec(SIM_SOLREF)}" solimp="{_vec(SIM_SOLIMP)}"/></default>'
-        f"<worldbody>{''.join(parts)}</worldbody><equality>{''.join(eq)}</equality></mujoco>"
-    )
+    root = ET.fromstring(mb.to_mjcf(ol.to_multibody(leg), comment="robomech verify omnileg"))
+    opt = root.find("option")
+    if opt is None:  # to_mjcf always writes <option gravity=...>; kept robust
+        opt = ET.SubElement(root, "option")
+    opt.set("timestep", repr(SIM_TIMESTEP))
+    opt.set("jacobian", "dense")
+    ET.SubElement(opt, "flag", contact="disable")
+    eq = root.find("equality")
+    for e in [] if eq is None else list(eq):
+        e.set("solref", _vec(SIM_SOLREF))
+        e.set("solimp", _vec(SIM_SOLIMP))
+    return ET.tostring(root, encoding="unicode")
 
 
 @dataclass
 class EngineModel:
     model: mujoco.MjModel
     data: mujoco.MjData
-    qpos_index: np.ndarray  # tree joint i (TREE_JOINTS order) -> qpos address
-    dof_index: np.ndarray  # tree joint i -> dof address (qvel, qacc, forces)
-    actuated: np.ndarray  # dof addresses of (α, β, γ) = (theta21, theta11, drive_in)
+    qpos_index: NDArray[np.intp]  # tree joint i (TREE_JOINTS order) -> qpos address
+    dof_index: NDArray[np.intp]  # tree joint i -> dof address (qvel, qacc, forces)
+    actuated: NDArray[np.intp]  # dof addresses of (α, β, γ) = (theta21, theta11, drive_in)
     foot_site: int
 
 
 def build_model(leg: ol.OmniLeg) -> EngineModel:
+    """The engine model of :func:`build_mjcf` with the address maps of ``TREE_JOINTS`` and the foot site."""
     check_params(leg, ol.OmniLeg, "leg")
     m = mujoco.MjModel.from_xml_string(build_mjcf(leg))
     d = mujoco.MjData(m)
     jid = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n) for n in ol.TREE_JOINTS]
-    qadr = np.array([m.jnt_qposadr[j] for j in jid])
-    dadr = np.array([m.jnt_dofadr[j] for j in jid])
+    qadr = np.array([m.jnt_qposadr[j] for j in jid], dtype=np.intp)
+    dadr = np.array([m.jnt_dofadr[j] for j in jid], dtype=np.intp)
     act = dadr[[ol.TREE_JOINTS.index(n) for n in ACTUATED_JOINTS]]
-    site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "foot_point")
+    site = int(mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, FOOT_SITE))
     return EngineModel(m, d, qadr, dadr, act, site)
 
 
-def _set_state(em: EngineModel, qpos: np.ndarray, qvel: np.ndarray, qacc: np.ndarray | None = None) -> None:
+def _set_state(em: EngineModel, qpos: Array, qvel: Array, qacc: Array | None = None) -> None:
     em.data.qpos[em.qpos_index] = qpos
     em.data.qvel[em.dof_index] = qvel
     if qacc is not None:
         em.data.qacc[em.dof_index] = qacc
 
 
-def _eq_rows(em: EngineModel) -> np.ndarray:
+def _eq_rows(em: EngineModel) -> NDArray[np.intp]:
     return np.flatnonzero(em.data.efc_type[: em.data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
 
 
 def engine_inverse_dynamics(
-    em: EngineModel, jm: ol.JointMotion, foot_force: np.ndarray | None = None
-) -> np.ndarray:
+    em: EngineModel, jm: ol.JointMotion, foot_force: ArrayLike | None = None
+) -> Array:
     """Motor torques (N, 3) from the engine, one sample at a time (the per-sample alternative).
 
     Per sample: ``mj_inverse`` (which also builds the constraint Jacobian ``efc_J``), the tree forces
@@ -222,10 +153,11 @@ def engine_inverse_dynamics(
     check_params(jm, ol.JointMotion, "jm")
     m, d = em.model, em.data
     N = jm.q.shape[0]
+    F: Array | None = None
     if foot_force is not None:
-        foot_force = as_array(foot_force, "foot_force", (3,))
-        broadcast_batch((foot_force, 1, "foot_force"), (jm.q, 1, "jm.q"))
-        foot_force = np.broadcast_to(foot_force, (N, 3))
+        F = as_array(foot_force, "foot_force", (3,))
+        broadcast_batch((F, 1, "foot_force"), (jm.q, 1, "jm.q"))
+        F = np.broadcast_to(F, (N, 3))
     out = np.empty((N, 3))
     nv = m.nv
     S = np.zeros((3, nv))
@@ -239,32 +171,38 @@ def engine_inverse_dynamics(
         Jc = d.efc_J.reshape(-1, nv)[rows]
         mujoco.mj_mulM(m, d, Mqacc, d.qacc)
         tau_tree = Mqacc + d.qfrc_bias
-        if foot_force is not None:
+        if F is not None:
             mujoco.mj_jacSite(m, d, jacp, None, em.foot_site)
-            tau_tree = tau_tree - jacp.T @ foot_force[n]
+            tau_tree = tau_tree - jacp.T @ F[n]
         sol = np.linalg.lstsq(np.vstack([S, Jc]).T, tau_tree, rcond=None)[0]
         out[n] = sol[:3]
     return out
 
 
-def _trajectory(n: int, duration: float = 2.0) -> tuple[np.ndarray, object]:
+def _trajectory(n: int, duration: float = 2.0) -> tuple[Array, Profile]:
     t = np.linspace(0.0, duration, n)
     return t, ol.joint_trajectory_eq52(t)
 
 
-def kinematic_checks(leg: ol.OmniLeg, em: EngineModel) -> list[Check]:
-    rng = np.random.default_rng(7)
-    _, prof = _trajectory(N_CHECK, 6.0)
-    qr = np.stack(
+def _random_states(leg: ol.OmniLeg, n: int, seed: int) -> tuple[Array, Array]:
+    """``n`` random poses inside Table 2's ranges and random rates (rad, rad/s)."""
+    rng = np.random.default_rng(seed)
+    q = np.stack(
         [
-            rng.uniform(-1, 1, 60) * leg.alpha_max,
-            rng.uniform(-1, 1, 60) * leg.beta_max,
-            rng.uniform(leg.gamma_min, leg.gamma_max, 60),
+            rng.uniform(-1, 1, n) * leg.alpha_max,
+            rng.uniform(-1, 1, n) * leg.beta_max,
+            rng.uniform(leg.gamma_min, leg.gamma_max, n),
         ],
         -1,
     )
+    return q, rng.normal(size=q.shape)
+
+
+def kinematic_checks(leg: ol.OmniLeg, em: EngineModel) -> list[Check]:
+    _, prof = _trajectory(N_CHECK, 6.0)
+    qr, qdr = _random_states(leg, 60, 7)
     q = np.concatenate([prof.q, qr])
-    qd = np.concatenate([prof.qd, rng.normal(size=qr.shape)])
+    qd = np.concatenate([prof.qd, qdr])
     jm = ol.joint_motion(leg, q, qd, np.zeros_like(q))
     m, d = em.model, em.data
     closure, foot, cvel, fvel = 0.0, 0.0, 0.0, 0.0
@@ -295,9 +233,35 @@ def kinematic_checks(leg: ol.OmniLeg, em: EngineModel) -> list[Check]:
     ]
 
 
+def energy_error(leg_analytic: ol.OmniLeg, em: EngineModel, n: int = 60) -> float:
+    """Relative max difference of the analytic kinetic + potential energy from the engine's.
+
+    Random poses and rates (``n`` samples); the engine's energy (``mj_energyPos`` + ``mj_energyVel``,
+    potential ``-Σ m gᵀ p``, the analytic model's reference too) at the analytic joint state.  Kinetic
+    and potential energy are compared separately, each relative to its own scale.
+    """
+    check_params(leg_analytic, ol.OmniLeg, "leg_analytic")
+    check_params(em, EngineModel, "em")
+    q, qd = _random_states(leg_analytic, n, 11)
+    T_an, U_an = ol.energy(leg_analytic, q, qd)
+    jm = ol.joint_motion(leg_analytic, q, qd, np.zeros_like(q))
+    m, d = em.model, em.data
+    m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
+    T_en, U_en = np.empty(n), np.empty(n)
+    for k in range(n):
+        _set_state(em, jm.q[k], jm.qd[k])
+        mujoco.mj_forward(m, d)
+        mujoco.mj_energyPos(m, d)
+        mujoco.mj_energyVel(m, d)
+        U_en[k], T_en[k] = d.energy
+    eT = float(np.abs(T_an - T_en).max() / np.abs(T_en).max())
+    eU = float(np.abs(U_an - U_en).max() / np.abs(U_en).max())
+    return max(eT, eU)
+
+
 def torque_error(
     leg_analytic: ol.OmniLeg, em: EngineModel, n: int = N_CHECK
-) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[float, Array, Array, Array]:
     """Relative max torque difference analytic vs engine along eq. (52), 0-2 s, Fig. 11's force in 0-1 s."""
     t, prof = _trajectory(n)
     F = np.where((t <= 1.0)[:, None], FIG11_FORCE, 0.0)
@@ -308,9 +272,7 @@ def torque_error(
     return err, t, tau_an, tau_en
 
 
-def forward_simulation(
-    leg: ol.OmniLeg, em: EngineModel, duration: float = 2.0
-) -> dict[str, np.ndarray | float]:
+def forward_simulation(leg: ol.OmniLeg, em: EngineModel, duration: float = 2.0) -> dict[str, Array | float]:
     """Drive the engine with the analytic torques of eq. (52) (no foot force) and record the drift."""
     m, d = em.model, em.data
     n_steps = round(duration / m.opt.timestep)
@@ -341,6 +303,15 @@ def run() -> list[Check]:
     leg = ol.OmniLeg.paper()
     em = build_model(leg)
     checks = kinematic_checks(leg, em)
+    checks.append(
+        Check(
+            MECHANISM,
+            "kinetic and potential energy vs engine (mj_energy)",
+            energy_error(leg, em),
+            TOL_ENERGY,
+            "60 random states; each energy relative to its scale",
+        )
+    )
     err, *_ = torque_error(leg, em)
     checks.append(
         Check(
@@ -368,7 +339,7 @@ def run() -> list[Check]:
 
 VERIFICATION = Verification(
     name="omnileg",
-    title="Paper 2: OmniLeg vs MuJoCo (closure, foot kinematics, torques, forward simulation)",
+    title="Paper 2: OmniLeg vs MuJoCo (closure, foot kinematics, energy, torques, forward simulation)",
     engine="MuJoCo",
     requires=("mujoco",),
     run=run,

@@ -20,6 +20,8 @@ def _leg(**kw):
 
 
 SPECS = {
+    # the generic description (issue 13): takes only the parameter object
+    P + "to_multibody": Spec(args={"leg": LEG}, params=("leg",)),
     P + "BODY_NAMES": CONSTANT,
     P + "TREE_JOINTS": CONSTANT,
     **exempt(

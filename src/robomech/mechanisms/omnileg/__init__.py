@@ -32,6 +32,7 @@ from ._kinematics import (
     thigh_direction,
     within_limits,
 )
+from ._multibody import to_multibody
 from ._params import BodySet, OmniLeg, RigidBody, default_bodies
 from ._rates import JointRatesResult, joint_rates
 from ._trajectories import (
@@ -99,8 +100,8 @@ __all__ = [
     "static_torques",
     "thigh_closure",
     "thigh_direction",
+    "to_multibody",
     "within_limits",
     "workspace_map",
     "workspace_symmetry",
 ]
-from ._multibody import to_multibody as to_multibody

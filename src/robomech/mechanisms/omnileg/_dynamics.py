@@ -88,7 +88,23 @@ def _body_list() -> list[tuple[str, str]]:
 BODY_NAMES = tuple(name for name, _ in _body_list())
 
 
-Cols = tuple[jt.Jet, jt.Jet, jt.Jet] | None  # the three columns of R_b (None: R_b = I, translation only)
+Cols3 = tuple[jt.Jet, jt.Jet, jt.Jet]  # the three columns of R_b
+Cols = Cols3 | None  # None: R_b = I, translation only
+
+
+def _rotate_cols(S: np.ndarray, cols: Cols3) -> Cols3:
+    """The columns of ``S R`` for a constant rotation ``S`` and the columns of ``R``."""
+    return (jt.rotate_const(S, cols[0]), jt.rotate_const(S, cols[1]), jt.rotate_const(S, cols[2]))
+
+
+def _half_cross_sum(cols: Cols3, part: str) -> np.ndarray:
+    """``½ Σ_j r_j × part(r_j)`` over the columns r_j (``part`` one of "vd", "vdd", "g")."""
+    c0, c1, c2 = cols
+    return 0.5 * (
+        jt.cross3(c0.v, getattr(c0, part))
+        + jt.cross3(c1.v, getattr(c1, part))
+        + jt.cross3(c2.v, getattr(c2, part))
+    )
 
 
 def _poses(
@@ -146,8 +162,8 @@ def _poses(
     for i in range(3):
         C = knee + S[i] @ np.array([leg.shank_radius, 0.0, leg.knee_to_crank])
         D = C + jt.rotate_const(S[i], crank_dir) * leg.L4
-        out.append((tuple(jt.rotate_const(S[i], c) for c in Rx_p), C))
-        out.append((tuple(jt.rotate_const(S[i], c) for c in Rx_m), D))
+        out.append((_rotate_cols(S[i], Rx_p), C))
+        out.append((_rotate_cols(S[i], Rx_m), D))
     foot_origin = knee + jt.stack([zero, zero, cg * (2.0 * leg.L4) + leg.knee_to_crank])
     out.append((None, foot_origin))
     return out
@@ -192,11 +208,12 @@ def _terms(
     pot = np.zeros(N)
     eye = np.broadcast_to(np.eye(3), (N, 3, 3))
     Rs, ps = [], []
-    groups: dict[int, tuple[Cols, np.ndarray]] = {}
-    spun: dict[int, tuple[Cols, np.ndarray]] = {}  # paper_drive: rotations that also spin by γ about Z0
-    by_name: dict[str, Cols] = {}
+    groups: dict[int, tuple[Cols3, np.ndarray]] = {}
+    spun: dict[int, tuple[Cols3, np.ndarray]] = {}  # paper_drive: rotations that also spin by γ about Z0
+    by_name: dict[str, Cols3] = {}  # the rotating bodies' columns
     for (cols, o), (name, key) in zip(_poses(leg, q, qd, qdd), _body_list(), strict=True):
-        by_name[name] = cols
+        if cols is not None:
+            by_name[name] = cols
         body: RigidBody = leg.bodies[key]
         m = body.mass
         c = body.com_vector
@@ -238,9 +255,9 @@ def _terms(
     rot = [(c, i, False) for c, i in groups.values()] + [(c, i, True) for c, i in spun.values()]
     for cols, Iner, spin in rot:
         # ω = ½ Σ_j r_j × ṙ_j, ω̇ = ½ Σ_j r_j × r̈_j, ∂ω/∂q̇_k = ½ Σ_j r_j × ∂r_j/∂q_k  (columns r_j of R)
-        w = 0.5 * sum(jt.cross3(r.v, r.vd) for r in cols)
-        wd = 0.5 * sum(jt.cross3(r.v, r.vdd) for r in cols)
-        Jw = 0.5 * sum(jt.cross3(r.v, r.g) for r in cols)  # (3 q, N, 3 xyz)
+        w = _half_cross_sum(cols, "vd")
+        wd = _half_cross_sum(cols, "vdd")
+        Jw = _half_cross_sum(cols, "g")  # (3 q, N, 3 xyz)
         if spin:  # paper 2, eqs. (26), (29): ω = ω_chain1 + γ̇ Z0, and ω̇ = ω̇_chain1 + γ̈ Z0 (Z0 fixed)
             w = w + qd[:, 2:3] * ez
             wd = wd + qdd[:, 2:3] * ez

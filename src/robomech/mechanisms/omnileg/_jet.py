@@ -14,8 +14,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
-Array = np.ndarray
+Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -80,14 +81,16 @@ class Jet:
         return Jet(*(np.swapaxes(a, -1, -2) for a in (self.v, self.vd, self.vdd, self.g)))
 
 
-def bilinear(a: Jet | Array, b: Jet | Array, op: Callable[[Array, Array], Array]) -> Jet:
+def bilinear(a: Jet | Array | float, b: Jet | Array | float, op: Callable[[Array, Array], Array]) -> Jet:
     """Product rule for any bilinear ``op`` (multiply, matmul, cross) of jets or constants."""
     if not isinstance(a, Jet):
-        a = np.asarray(a, dtype=float)
-        return Jet(op(a, b.v), op(a, b.vd), op(a, b.vdd), op(a, b.g))
+        if not isinstance(b, Jet):
+            raise TypeError("bilinear: expected at least one Jet operand")
+        ca = np.asarray(a, dtype=float)
+        return Jet(op(ca, b.v), op(ca, b.vd), op(ca, b.vdd), op(ca, b.g))
     if not isinstance(b, Jet):
-        b = np.asarray(b, dtype=float)
-        return Jet(op(a.v, b), op(a.vd, b), op(a.vdd, b), op(a.g, b))
+        cb = np.asarray(b, dtype=float)
+        return Jet(op(a.v, cb), op(a.vd, cb), op(a.vdd, cb), op(a.g, cb))
     return Jet(
         op(a.v, b.v),
         op(a.vd, b.v) + op(a.v, b.vd),

@@ -2,106 +2,210 @@
 
 Nothing is derived by hand here: the generic layer assembles the closures and differentiates them,
 and the tests compare the result with the analytic model (eq. (11) FK, the PoE thigh closure, the
-foot J and H) to 1e-10.
+foot J and H, and the Lagrange inverse dynamics of ``_dynamics.py``).
+
+The 22 bodies and 22 tree joints are those of the analytic model (``BODY_NAMES``, ``TREE_JOINTS``),
+with the same names, and every joint's ``qpos`` is the value :func:`joint_motion` gives it:
 
 * Thigh (paper 2, eqs. (1)-(7)): chain k's joints are chain 1's screws (axes y, x at A1 = (0, L3, 0);
   x, y at B1 = (0, L3, L1)) rotated by kR = Rz(-δ), δ = (k-1) π/2, as printed (eq. (5)).  Chain 1's four
   hinges carry the knee plate; chains 2 and 3 keep three hinges in the tree and close on the knee plate
   through their fourth joint (a hinge cut, ``revolute`` closure).  qpos of ``theta{k}{j}`` = θ_kj.
+* Drive (paper 2, Section 3, Fig. 7): the universal-joint coupling G_J1 A4 B4 U_E G_J2.  The input
+  shaft G_J1A4 (``drive_shaft_in``, hinge ``drive_in`` about Z0, motor M3) carries the cross CS_A4
+  (``drive_cross_a``, hinge ``drive_phi1`` about the shaft's yoke arm), the rod A4B4 (``drive_rod``,
+  hinge ``drive_phi2`` about the rod's yoke arm) and the cross CS_B4 at its far end (``drive_cross_b``,
+  hinge ``drive_phi3``); CS_B4 closes on the output shaft B4U_E (``drive_shaft_out``, hinge
+  ``drive_out`` about Z0' in the knee plate) through a hinge cut about the output yoke arm.  At the
+  reference (α = β = 0) the yokes are parallel to the U joints A1, B1 (as the paper sets them up).
+  The output shaft, the cross CS_UE, the shaft U_E G_J2 and the output bevel gear turn as one body
+  about Z0' (the paper's statement after eq. (25)); the 1:1 bevel gears are joint couplings
+  ``crank_i = drive_out``.  The double-Cardan kinematics is exact (solved by the closure), not the
+  paper's simplification of eqs. (26)-(31).
 * Shank (eq. (10), Fig. 4e): each chain C_iD_iE_i is a crank (hinge about its radial axis at C_i,
   ``knee_to_crank`` below O0'), a coupler (hinge at D_i) and the foot (hinge at E_i on chain 1, hinge
-  cuts on chains 2 and 3).  The three cranks turn together (one motor through bevel gears): cranks 2
-  and 3 are coupled to crank 1 (joint couplings).  qpos of ``crank1`` = γ.  The reference
-  configuration is γ = 60° (γ = 0 folds every chain straight, a singular configuration).
-* The double-Cardan drive shaft inside the thigh is not described: it carries γ to the knee with a
-  1:1 ratio (exact, see the analytic model) and changes no position; the dynamics layer may add it.
-* Inertias are not attached (the analytic model's body frames differ; see ``_dynamics.py``).
+  cuts on chains 2 and 3).  The reference configuration is γ = 60° (γ = 0 folds every chain straight,
+  a singular configuration).
+* Inertias (the analytic model's assumptions, ``OmniLeg.bodies``): each body's mass, centre of mass
+  and inertia tensor are given in the analytic model's body frame (``docs/mechanisms/omnileg.md``);
+  here they are rotated into this description's body frame (a constant rotation per body, ``_FRAME``)
+  and written as MuJoCo's principal inertia (``Inertial(mass, pos, quat, diaginertia)``).
 
-``q_act = (α, β, γ)`` in the analytic model's order (actuators θ21, θ11, crank1); the foot site is
-the foot point, whose position is eq. (11).
+``q_act = (α, β, γ)`` in the analytic model's order (actuators ``theta21``, ``theta11``, ``drive_in``);
+the foot site ``foot`` is the foot point, whose position is eq. (11).
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
-from robomech.multibody import Builder, Mechanism
+from robomech._validation import check_params
+from robomech.multibody import Builder, Inertial, Mechanism
+from robomech.multibody._model import _quat_from_matrix
 
-from ._params import OmniLeg
+from ._params import OmniLeg, RigidBody
 
 __all__ = ["REFERENCE_GAMMA", "to_multibody"]
 
 # Reference (qpos0) crank angle: the gait's start FK(0, 0, 60 deg) (docs/mechanisms/omnileg.md).
-REFERENCE_GAMMA = np.deg2rad(60.0)
+REFERENCE_GAMMA = float(np.deg2rad(60.0))
+
+Matrix = NDArray[np.float64]
 
 
-def _kR(k: int) -> np.ndarray:
+def _kR(k: int) -> Matrix:
     d = 0.5 * np.pi * k
     c, s = np.cos(d), np.sin(d)
     return np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # paper 2, eq. (5): Rz(-δ), as printed
 
 
-def _quat(R: np.ndarray) -> tuple[float, ...]:
-    from robomech.multibody._model import _quat_from_matrix
+def _rz(a: float) -> Matrix:
+    return np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
 
-    return tuple(_quat_from_matrix(R))
+
+def _rx(a: float) -> Matrix:
+    return np.array([[1.0, 0.0, 0.0], [0.0, np.cos(a), -np.sin(a)], [0.0, np.sin(a), np.cos(a)]])
+
+
+def _quat(R: Matrix) -> tuple[float, ...]:
+    return tuple(float(v) for v in _quat_from_matrix(R))
+
+
+def _frame(name: str) -> Matrix:
+    """The analytic model's body frame of ``name`` in this description's body frame (constant).
+
+    Every body frame here is parallel to the hip frame at α = β = 0 and moves with its body; the
+    analytic frames (``_dynamics._poses``) of chain k's crosses and rod are chain 1's rotated by kR
+    (their x axis is the carried joint axis x_k, kR e_x); every other analytic frame coincides with
+    the body frame here.  ``test_omnileg_generic_dynamics`` checks R_here(q) _frame = R_analytic(q).
+    """
+    for k in range(3):
+        if name in (f"hip_cross_{k + 1}", f"thigh_rod_{k + 1}", f"knee_cross_{k + 1}"):
+            return _kR(k)
+    return np.eye(3)
+
+
+def _inertial(body: RigidBody, Q: Matrix) -> Inertial:
+    """``body`` (analytic frame) as an :class:`Inertial` of a body whose frame maps the analytic one by Q."""
+    inertia = Q @ body.inertia_matrix @ Q.T
+    inertia = 0.5 * (inertia + inertia.T)
+    d, V = np.linalg.eigh(inertia)
+    if np.linalg.det(V) < 0:  # a proper rotation for the quaternion
+        V[:, 2] = -V[:, 2]
+    return Inertial(
+        body.mass,
+        pos=tuple(float(v) for v in Q @ body.com_vector),
+        quat=_quat(V),
+        diaginertia=tuple(float(max(v, 0.0)) for v in d),
+    )
 
 
 def to_multibody(leg: OmniLeg) -> Mechanism:
-    """The generic description of ``leg`` (an :class:`OmniLeg`); q_act = (α, β, γ)."""
-    if not isinstance(leg, OmniLeg):
-        raise ValueError(f"Expected leg to be an OmniLeg, got {type(leg).__name__}.")
+    """The generic description of ``leg`` (an :class:`OmniLeg`), with its inertias; q_act = (α, β, γ).
+
+    Bodies, joints and inertial parameters are those of the analytic model (module docstring); the
+    exported MJCF (``robomech.multibody.to_mjcf``) is the engine model of ``robomech verify omnileg``.
+    """
+    check_params(leg, OmniLeg, "leg")
     L1, L3, L4 = leg.L1, leg.L3, leg.L4
+    bodies = leg.bodies
+
+    def inertial(name: str, kind: str) -> Inertial:
+        return _inertial(bodies[kind], _frame(name))
+
     b = Builder("omnileg", gravity=leg.gravity)
     w1 = np.array([[0.0, 1, 0], [1, 0, 0], [1, 0, 0], [0, 1, 0]])  # paper 2, eq. (1)
     p1 = np.array([[0.0, L3, 0], [0, L3, 0], [0, L3, L1], [0, L3, L1]])  # eq. (2)
     knee = np.array([0.0, 0.0, L1])  # O0' at the home pose (eq. (3))
+    g0 = REFERENCE_GAMMA
     for k in range(3):
         w, p = w1 @ _kR(k).T, p1 @ _kR(k).T  # eqs. (6), (7)
         c = k + 1
         # every body frame is parallel to the hip frame at the home pose, so qpos = the PoE angles
-        b.body(f"hip_cross{c}", pos=p[0], joints=[b.hinge(f"theta{c}1", axis=w[0])])
-        b.body(f"thigh_rod{c}", f"hip_cross{c}", joints=[b.hinge(f"theta{c}2", axis=w[1])])
-        b.body(f"knee_cross{c}", f"thigh_rod{c}", pos=p[2] - p[0], joints=[b.hinge(f"theta{c}3", axis=w[2])])
+        hc, tr, kc = f"hip_cross_{c}", f"thigh_rod_{c}", f"knee_cross_{c}"
+        b.body(hc, pos=p[0], joints=[b.hinge(f"theta{c}1", axis=w[0])], inertial=inertial(hc, "hip_cross"))
+        b.body(tr, hc, joints=[b.hinge(f"theta{c}2", axis=w[1])], inertial=inertial(tr, "thigh_rod"))
+        b.body(
+            kc,
+            tr,
+            pos=p[2] - p[0],
+            joints=[b.hinge(f"theta{c}3", axis=w[2])],
+            inertial=inertial(kc, "knee_cross"),
+        )
         if k == 0:
             b.body(
                 "knee_plate",
-                "knee_cross1",
+                kc,
                 pos=knee - p[2],
                 joints=[b.hinge("theta14", axis=w[3], pos=p[3] - knee)],
+                inertial=inertial("knee_plate", "knee_plate"),
             )
         else:
-            b.revolute(f"theta{c}4", f"knee_cross{c}", "knee_plate", anchor1=(0.0, 0.0, 0.0), axis=w[3])
+            b.revolute(f"theta{c}4", kc, "knee_plate", anchor1=(0.0, 0.0, 0.0), axis=w[3])
+    # drive (paper 2, Fig. 7): input shaft about Z0 turned by γ, U joint A4 at O0, rod A4B4, U joint B4
+    # at O0', output shaft about Z0' in the knee plate; every frame is Rz(γ) at α = β = 0.
+    # paper 2, eqs. (26)-(31): the paper decouples the drive's spin from the thigh motion; here the
+    # closure solves the double Cardan exactly (as the analytic model does, docs departure 9).
+    Rg0 = _quat(_rz(g0))
+    b.body(
+        "drive_shaft_in",
+        quat=Rg0,
+        joints=[b.hinge("drive_in", axis=(0, 0, 1), ref=g0)],
+        inertial=inertial("drive_shaft_in", "drive_shaft_in"),
+    )
+    b.body(
+        "drive_cross_a",
+        "drive_shaft_in",
+        joints=[b.hinge("drive_phi1", axis=(0, 1, 0))],  # about the shaft's yoke arm a1 = Rz(γ) e_y
+        inertial=inertial("drive_cross_a", "drive_cross"),
+    )
+    b.body(
+        "drive_rod",
+        "drive_cross_a",
+        joints=[b.hinge("drive_phi2", axis=(1, 0, 0))],  # about the rod's yoke arm a2
+        inertial=inertial("drive_rod", "drive_rod"),
+    )
+    b.body(
+        "drive_cross_b",
+        "drive_rod",
+        pos=(0.0, 0.0, L1),
+        joints=[b.hinge("drive_phi3", axis=(1, 0, 0))],  # in-phase yokes: the rod's arm at B4 is a2 too
+        inertial=inertial("drive_cross_b", "drive_cross"),
+    )
+    b.body(
+        "drive_shaft_out",
+        "knee_plate",
+        quat=Rg0,
+        joints=[b.hinge("drive_out", axis=(0, 0, 1), ref=g0)],
+        inertial=inertial("drive_shaft_out", "drive_shaft_out"),
+    )
+    b.revolute("drive_B4", "drive_cross_b", "drive_shaft_out", anchor1=(0.0, 0.0, 0.0), axis=(0, 1, 0))
     # shank: chain i in the plane normal to its radial axis x_i (frame S_i = Rz(ψ_i))
-    g0 = float(REFERENCE_GAMMA)
     psi = leg.shank_azimuth + 2.0 * np.pi * np.arange(3) / 3.0
     e_plane = leg.knee_to_crank + 2.0 * L4 * np.cos(g0)  # depth of the E plane below O0' (eq. (10))
     for i in range(3):
         c = i + 1
-        S = np.array(
-            [[np.cos(psi[i]), -np.sin(psi[i]), 0.0], [np.sin(psi[i]), np.cos(psi[i]), 0.0], [0, 0, 1.0]]
-        )
+        S = _rz(float(psi[i]))
         C = S @ np.array([leg.shank_radius, 0.0, leg.knee_to_crank])
-        Rc = S @ np.array(
-            [[1.0, 0, 0], [0, np.cos(g0), -np.sin(g0)], [0, np.sin(g0), np.cos(g0)]]
-        )  # S_i Rx(γ0)
+        Rc = S @ _rx(g0)
         # crank: z along C_iD_i; coupler: z along D_iE_i at angle -γ, i.e. Rx(-2γ) relative to the crank
         b.body(
-            f"crank{c}",
+            f"crank_{c}",
             "knee_plate",
             pos=C,
             quat=_quat(Rc),
-            joints=[b.hinge(f"crank{c}", axis=(1, 0, 0), ref=g0)],
+            joints=[b.hinge(f"crank_{c}", axis=(1, 0, 0), ref=g0)],
+            inertial=inertial(f"crank_{c}", "crank"),
         )
-        Rrel = np.array(
-            [[1.0, 0, 0], [0, np.cos(2 * g0), np.sin(2 * g0)], [0, -np.sin(2 * g0), np.cos(2 * g0)]]
-        )
+        Rrel = _rx(-2.0 * g0)
         b.body(
-            f"coupler{c}",
-            f"crank{c}",
+            f"coupler_{c}",
+            f"crank_{c}",
             pos=(0.0, 0.0, L4),
             quat=_quat(Rrel),
-            joints=[b.hinge(f"coupler{c}", axis=(1, 0, 0), ref=-2 * g0)],
+            joints=[b.hinge(f"coupler_{c}", axis=(1, 0, 0), ref=-2 * g0)],
+            inertial=inertial(f"coupler_{c}", "coupler"),
         )
         E = S @ np.array([leg.shank_radius, 0.0, 0.0])  # E_i relative to the centre of the E plane
         if i == 0:
@@ -109,14 +213,16 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
             foot_origin = np.array([0.0, 0.0, e_plane])
             b.body(
                 "foot",
-                "coupler1",
+                "coupler_1",
                 pos=Rc_world.T @ (foot_origin - (C + Rc @ np.array([0.0, 0.0, L4]))),
                 quat=_quat(Rc_world.T),
-                joints=[b.hinge("foot", axis=S[:, 0], pos=E, ref=0.0)],
+                # the foot turns by γ relative to coupler 1 (qpos = γ, as joint_motion)
+                joints=[b.hinge("foot", axis=tuple(S[:, 0]), pos=tuple(E), ref=g0)],
+                inertial=inertial("foot", "foot"),
             )
         else:
-            b.revolute(f"E{c}", f"coupler{c}", "foot", anchor1=(0.0, 0.0, L4), axis=(1.0, 0.0, 0.0))
-            b.couple(f"gear{c}", f"crank{c}", "crank1", (0.0, 1.0))
+            b.revolute(f"E{c}", f"coupler_{c}", "foot", anchor1=(0.0, 0.0, L4), axis=(1.0, 0.0, 0.0))
+        b.couple(f"gear_{c}", f"crank_{c}", "drive_out", (0.0, 1.0))  # 1:1 bevel gear
     b.site("foot", "foot", pos=(0.0, 0.0, leg.L5 - leg.knee_to_crank))
-    b.actuate("theta21", "theta11", "crank1")
+    b.actuate("theta21", "theta11", "drive_in")
     return b.build()

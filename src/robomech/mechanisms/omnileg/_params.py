@@ -46,8 +46,8 @@ class RigidBody:
     """
 
     mass: float
-    com: tuple[float, float, float]
-    inertia: tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
+    com: tuple[float, ...]  # 3 floats once validated
+    inertia: tuple[tuple[float, ...], ...]  # 3 x 3 floats once validated
 
     def __post_init__(self) -> None:
         m = _real(self.mass, "RigidBody.mass")
@@ -352,7 +352,7 @@ class OmniLeg:
     @classmethod
     def paper(cls) -> OmniLeg:
         """Table 2 of paper 2 (converted to SI), joint ranges read as magnitudes, default inertias."""
-        return cls(**_PAPER)
+        return cls(L1=_PAPER["L1"], L3=_PAPER["L3"], L4=_PAPER["L4"], L5=_PAPER["L5"])
 
     @property
     def foot_drop(self) -> float:
