@@ -84,7 +84,7 @@ def gait_animation(leg: ol.OmniLeg, out_dir: Path) -> tuple[Animation, dict[str,
     """The leg of ``ol.to_multibody`` stepping through eq. (53)'s swing and stance, as a GIF.
 
     Each frame's joint angles come from the analytic inverse kinematics of the gait's foot point; the
-    generic description is assembled at them (thigh and shank loops closed numerically).  Returns the
+    generic description is assembled at them (thigh, drive and shank loops closed numerically).  Returns the
     animation and the largest distance between the drawn foot site and eq. (53)'s foot point.
     """
     mech = ol.to_multibody(leg)
@@ -100,12 +100,14 @@ def gait_animation(leg: ol.OmniLeg, out_dir: Path) -> tuple[Animation, dict[str,
         "One step of the gait eq. (53) in real time: swing (0–1 s, the foot moves 0.1 m along Y0 while "
         "lifting 0.05 m) and stance (1–2 s, back on the ground). The joint angles are the inverse "
         "kinematics of the foot point; the leg drawn is the generic description ol.to_multibody(leg) "
-        "assembled at them, thigh and shank loops closed numerically. Chain 1 of the thigh, the knee "
-        "plate, the three shank crank-sliders and the foot are blue, thigh chains 2 and 3 green and "
-        "orange; red circles are the loop cuts, black the foot, dotted its path; Z0 points down.",
-        "Animated 3-D wireframe of the OmniLeg hanging from its hip: three thigh rods carry a knee "
-        "plate, below which three crank-slider chains carry the foot; the foot swings forward with a "
-        "small lift and then slides back along a straight line.",
+        "assembled at them, thigh, drive and shank loops closed numerically. Each body is drawn from "
+        "its joint to the points it carries, coloured by the chain it hangs from: thigh chain 1 with "
+        "the knee plate, the three shank crank-sliders and the foot blue, thigh chains 2 and 3 orange "
+        "and green, the double-Cardan drive shaft red; circles are the loop cuts, the black dot the "
+        "foot and the dotted curve its path; Z0 points down.",
+        "Animated 3-D wireframe of the OmniLeg hanging from its hip: three thigh rods and a central "
+        "drive shaft carry a knee plate, below which three crank-slider chains carry the foot; the "
+        "foot swings forward with a small lift and then slides back along a straight line.",
         site="foot",
         fps=ANIMATION_FPS,
         title="paper 2, gait eq. (53)",
@@ -293,7 +295,8 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         axs[0].plot(t_eng, tau_en[:, j], color=col, ls="none", marker="o", mfc="none", ms=3,
                     markevery=4, label=f"{MOTORS[j]} MuJoCo")  # fmt: skip
         axs[1].semilogy(t_eng, np.abs(tau_an_eng[:, j] - tau_en[:, j]) + 1e-18, color=col, label=MOTORS[j])
-        axs[2].plot(sim["t"], np.degrees(sim["q_sim"][:, j] - sim["q_ref"][:, j]), color=col,
+        drift = np.asarray(sim["q_sim"])[:, j] - np.asarray(sim["q_ref"])[:, j]  # dict of arrays and floats
+        axs[2].plot(sim["t"], np.degrees(drift), color=col,
                     ls=("-", "--", "-")[j], label=("α", "β (= α in eq. (52))", "γ")[j])  # fmt: skip
     axs[0].set_ylabel("torque (N·m)")
     axs[0].set_title("Fig. 11 vs engine: analytic torques and MuJoCo inverse dynamics (force in 0–1 s)")
