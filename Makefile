@@ -5,10 +5,12 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 DOCS_STAMP := $(VENV)/.installed-docs
 OUT    ?= out
+# `make docs REPORTS=out`: the docs show the reports of that `robomech reproduce --out` folder.
+REPORTS ?=
 # A second venv with `pip install .` and no extras: what a user without MuJoCo gets.
 MINIMAL := .venv-minimal
 
-.PHONY: install run test bench verify lint docs check-minimal clean
+.PHONY: install run test bench verify lint typecheck docs check-minimal clean
 
 install: $(STAMP)
 
@@ -27,7 +29,7 @@ run: install
 	$(BIN)/robomech verify --out $(OUT)
 
 test: install
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks examples docs/conf.py
 	$(BIN)/python -m pytest -q
 
 verify: install
@@ -37,11 +39,17 @@ bench: install
 	$(BIN)/python benchmarks/run.py
 
 lint: install
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks examples docs/conf.py
+
+# Static types: numpy.typing annotations checked by mypy over src/robomech (pyproject [tool.mypy]; ~1 min cold).
+typecheck: install
+	$(BIN)/mypy
 
 # The documentation site; -W: a warning is an error, -n: every cross-reference must resolve.
+# It runs examples/*.py and reproduces the fast studies for their pages (docs/conf.py);
+# `make docs REPORTS=out` shows every report of an earlier `make run` instead.
 docs: $(DOCS_STAMP)
-	$(BIN)/sphinx-build -W --keep-going -n -q -b html docs docs/_build/html
+	ROBOMECH_DOCS_REPORTS=$(REPORTS) $(BIN)/sphinx-build -W --keep-going -n -q -b html docs docs/_build/html
 	@echo "docs: open docs/_build/html/index.html"
 
 # No extras installed: list, the engine-free study and the engine-free checks must exit 0.
@@ -56,4 +64,4 @@ check-minimal:
 	rm -rf $(MINIMAL)
 
 clean:
-	rm -rf $(VENV) $(MINIMAL) $(OUT) .pytest_cache .benchmarks build src/*.egg-info docs/_build
+	rm -rf $(VENV) $(MINIMAL) $(OUT) .mypy_cache .pytest_cache .benchmarks build src/*.egg-info docs/_build

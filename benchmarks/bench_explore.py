@@ -3,32 +3,54 @@
 ``workloads()`` (for ``run.py``): one default-size chunk of each study evaluated in-process (pose
 evaluations per second on one core, no Dask).
 
-``python benchmarks/bench_explore.py`` (standalone, ~1-2 min on 2 cores): for each study, the same sweep
-on a LocalCluster of 1 and of 2 worker processes (cluster start-up excluded): pose evaluations per second
-and the scaling efficiency ``rate(2) / (2 rate(1))``; the Dask overhead per chunk at the default chunk
-size, ``(wall time x workers - sum of worker chunk times) / chunks`` against the mean chunk work; and the
-extrapolated time of a 10^6-design spherical-leg synthesis per worker.
+``python benchmarks/bench_explore.py`` (standalone, ~2 min on 2 idle cores): one LocalCluster of 1 and
+one of 2 single-threaded worker processes (``robomech.explore``'s own settings: ``WORKER_ENV``), a warm-up
+sweep per study and worker count, then for each study the *same* sweep (``--chunks`` default-size chunks,
+the same designs) ``--repeats`` times on each cluster, alternating the clusters, reading back per sweep:
+
+- ``T`` the wall time of ``run_sweep`` (store creation and everything else included);
+- the Dask task stream: when each task started and stopped on its worker, so ``window`` is the time
+  from the first task's start to the last task's stop (the steady state, without the sweep's one-off
+  set-up: connecting, creating the store, the design matrix) and ``task overhead`` the worker-side time
+  of a task outside the study's code (task duration minus the in-task work timer ``chunk_seconds``);
+- the client's time per chunk in ``ChunkWriter.write`` (the Zarr write of a finished chunk).
+
+Reported per study (medians over the repeats):
+
+- poses/s = designs x ``poses_per_design`` / T; set-up + tail = T - window (once per sweep);
+- efficiency ``T1 / (2 T2)`` (the acceptance figure) and the steady-state one ``window1 / (2 window2)``;
+- overhead per chunk = (workers x window - sum of chunk work) / chunks: everything per chunk that is not
+  the study's computation (scheduling, transfer, the worker's task wrapper, the client's receipt and
+  Zarr write competing for the cores, and the 2-worker load imbalance), as a fraction of the mean chunk
+  work; and its parts, the worker-side task overhead and the client's write time;
+- the 10^6-design spherical-leg synthesis extrapolated from the 1-worker steady throughput.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
+import statistics
 import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any, ClassVar
 
 import numpy as np
 
+from robomech.explore import _runner as runner_mod
 from robomech.explore import design_matrix, get_study, open_results, run_sweep
 from robomech.explore._sampling import chunk_seed
 
 from _harness import Workload
 
 STUDIES = ("spherical-leg-synthesis", "vectored-thrust-tolerance", "omnileg-synthesis")
-# Chunks per worker in the scaling runs: enough for the load to balance, small enough to stay quick.
-CHUNKS_PER_WORKER = 4
+# Default-size chunks per timed sweep: the same designs on 1 and 2 workers (2 chunks per worker).
+CHUNKS = 4
+# Repeats of each timed sweep (medians reported): the machine is shared, single runs vary by +-30 %.
+REPEATS = 3
 SYNTHESIS_DESIGNS = 1_000_000
 
 
@@ -50,88 +72,155 @@ def workloads() -> list[Workload]:
     return out
 
 
-def _sweep(name: str, workers: int, chunks: int) -> dict:
-    from distributed import Client, LocalCluster
+class _TimedWriter(runner_mod.ChunkWriter):
+    """The runner's ChunkWriter, timing each chunk's write (client side)."""
+
+    seconds: ClassVar[list[float]] = []
+
+    def write(self, *args: Any, **kwargs: Any) -> None:
+        t0 = time.perf_counter()
+        super().write(*args, **kwargs)
+        _TimedWriter.seconds.append(time.perf_counter() - t0)
+
+
+def _one_sweep(client: Any, name: str, out: Path, n: int) -> dict[str, float]:
+    from distributed import get_task_stream
 
     st = get_study(name)
-    n = chunks * st.default_chunk
-    with (
-        LocalCluster(
-            n_workers=workers, threads_per_worker=1, host="127.0.0.1", dashboard_address="127.0.0.1:0",
-            silence_logs=40,
-        ) as cluster,
-        Client(cluster) as client,
-        tempfile.TemporaryDirectory() as d,
-    ):  # fmt: skip
-        client.run(lambda: __import__("robomech.explore"))  # imports on the workers: not part of the sweep
-        # warm-up chunk (first-call costs on each worker), then the timed sweep
-        run_sweep(st, Path(d) / "warm", designs=st.default_chunk * workers, client=client, progress=False)
+    _TimedWriter.seconds = []
+    with get_task_stream(client=client) as ts:
         t0 = time.perf_counter()
-        s = run_sweep(st, Path(d) / "s", designs=n, client=client, progress=False)
+        s = run_sweep(st, out, designs=n, client=client, progress=False)
         wall = time.perf_counter() - t0
-        stored = open_results(Path(d) / "s")
-        work = float(np.sum(stored["chunk_seconds"]))
-        cpu = float(np.sum(stored["chunk_cpu_seconds"]))
+    tasks = [t for t in ts.data if str(t["key"]).startswith("_chunk_task")]
+    computes = [ss for t in tasks for ss in t["startstops"] if ss["action"] == "compute"]
+    durations = [ss["stop"] - ss["start"] for t in tasks for ss in t["startstops"]]
+    window = max(ss["stop"] for ss in computes) - min(ss["start"] for ss in computes)
+    stored = open_results(out)
+    work = np.asarray(stored["chunk_seconds"], dtype=float)
+    chunks = s.n_chunks
+    assert len(computes) == chunks and s.computed_designs == n, "a chunk ran twice or not at all"
     return {
-        "study": name,
-        "workers": workers,
-        "designs": n,
-        "chunks": s.n_chunks,
-        "chunk_size": st.default_chunk,
         "wall_s": wall,
-        "work_s": work,
-        "poses_per_s": n * st.poses_per_design / wall,
-        "designs_per_s": n / wall,
-        "overhead_per_chunk_s": (wall * workers - work) / s.n_chunks,
-        "work_per_chunk_s": work / s.n_chunks,
-        "utilisation": work / (wall * workers),  # fraction of worker time spent in chunk work
-        "cpu_per_design_s": cpu / n,  # CPU time of the study's own computation per design
-        "cpu_share": cpu / work,  # CPU time / wall time of the chunks: < 1 when the cores are contended
+        "window_s": window,
+        "work_s": float(work.sum()),
+        "work_per_chunk_s": float(work.mean()),
+        "task_overhead_s": (sum(durations) - float(work.sum())) / chunks,
+        "client_write_s": float(np.mean(_TimedWriter.seconds)),
+        "cpu_s": float(np.sum(stored["chunk_cpu_seconds"])),
     }
 
 
+def _measure(names: list[str], chunks: int, repeats: int) -> dict[int, dict[str, list[dict[str, float]]]]:
+    """Both clusters stay up; the repeats alternate 1 and 2 workers so that a drifting load on a shared
+    machine biases neither."""
+    from contextlib import ExitStack
+
+    from distributed import Client, LocalCluster
+
+    runner_mod.ChunkWriter = _TimedWriter  # type: ignore[misc]
+    out: dict[int, dict[str, list[dict[str, float]]]] = {1: {}, 2: {}}
+    with ExitStack() as stack:
+        d = Path(stack.enter_context(tempfile.TemporaryDirectory()))
+        clients = {}
+        for w in (1, 2):
+            cluster = stack.enter_context(
+                LocalCluster(
+                    n_workers=w, threads_per_worker=1, host="127.0.0.1", dashboard_address="127.0.0.1:0",
+                    silence_logs=40, env=runner_mod.WORKER_ENV,
+                )
+            )  # fmt: skip
+            clients[w] = stack.enter_context(Client(cluster))
+        for name in names:
+            st = get_study(name)
+            for w, client in clients.items():
+                # warm-up: every worker imports robomech and runs its first chunk (first-call costs)
+                run_sweep(st, d / f"warm-{w}-{name}", designs=st.default_chunk * w, client=client,
+                          progress=False)  # fmt: skip
+                out[w][name] = []
+            for r in range(repeats):
+                for w, client in clients.items():
+                    out[w][name].append(
+                        _one_sweep(client, name, d / f"{name}-{w}-{r}", chunks * st.default_chunk)
+                    )
+    return out
+
+
+def _median(runs: list[dict[str, float]], key: str) -> float:
+    return statistics.median(r[key] for r in runs)
+
+
 def main() -> int:
-    p = argparse.ArgumentParser()
-    p.add_argument("--json", default=None)
-    p.add_argument("--only", default=None)
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--json", default=None, help="also write the rows as JSON to this file")
+    p.add_argument("--only", default=None, help="only the studies whose name contains this")
+    p.add_argument("--chunks", type=int, default=CHUNKS, help=f"chunks per timed sweep (default {CHUNKS})")
+    p.add_argument("--repeats", type=int, default=REPEATS, help=f"repeats per sweep (default {REPEATS})")
     args = p.parse_args()
+    names = [n for n in STUDIES if not args.only or args.only in n]
+    t_start = time.perf_counter()
+    load = os.getloadavg()[0]
+    res = _measure(names, args.chunks, args.repeats)
     rows = []
     print(
-        f"{'study':<28} {'workers':>7} {'designs':>7} {'wall s':>7} {'poses/s':>10} {'efficiency':>10} "
-        f"{'chunk work s':>12} {'overhead/chunk s':>16} {'overhead %':>10} {'utilisation':>11} "
-        f"{'cpu share':>9} {'cpu µs/pose':>11} {'free-core eff.':>14}"
+        f"\n{args.chunks} chunks per sweep, median of {args.repeats}; load average {load:.1f} at the start, "
+        f"{os.getloadavg()[0]:.1f} at the end; {os.cpu_count()} cores\n"
     )
-    for name in STUDIES:
-        if args.only and args.only not in name:
-            continue
-        one = _sweep(name, 1, CHUNKS_PER_WORKER)
-        two = _sweep(name, 2, 2 * CHUNKS_PER_WORKER)
-        for r in (one, two):
-            r["efficiency"] = r["poses_per_s"] / (r["workers"] * one["poses_per_s"])
-            # free-core estimate: the same CPU per design and the measured Dask utilisation
-            r["cpu_efficiency"] = (
-                one["cpu_per_design_s"] / r["cpu_per_design_s"] * r["utilisation"] / one["utilisation"]
-            )
-            pct = 100 * r["overhead_per_chunk_s"] / r["work_per_chunk_s"]
+    print(
+        "| study (chunk) | workers | T (s) | poses/s | efficiency T1/(2 T2) | steady efficiency | "
+        "chunk work (s) | overhead / chunk (ms) | overhead / work | task overhead (ms) | client write (ms) | "
+        "set-up + tail (s) |"
+    )
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for name in names:
+        st = get_study(name)
+        n = args.chunks * st.default_chunk
+        one, two = res[1][name], res[2][name]
+        t1, t2 = _median(one, "wall_s"), _median(two, "wall_s")
+        w1, w2 = _median(one, "window_s"), _median(two, "window_s")
+        for workers, runs, eff, steady in ((1, one, 1.0, 1.0), (2, two, t1 / (2 * t2), w1 / (2 * w2))):
+            over = statistics.median((workers * r["window_s"] - r["work_s"]) / args.chunks for r in runs)
+            work = _median(runs, "work_per_chunk_s")
+            row = {
+                "study": name,
+                "chunk_size": st.default_chunk,
+                "workers": workers,
+                "designs": n,
+                "wall_s": _median(runs, "wall_s"),
+                "window_s": _median(runs, "window_s"),
+                "poses_per_s": n * st.poses_per_design / _median(runs, "wall_s"),
+                "efficiency": eff,
+                "steady_efficiency": steady,
+                "work_per_chunk_s": work,
+                "overhead_per_chunk_s": over,
+                "overhead_fraction": over / work,
+                "task_overhead_s": _median(runs, "task_overhead_s"),
+                "client_write_s": _median(runs, "client_write_s"),
+                "cpu_per_design_s": _median(runs, "cpu_s") / n,
+                "runs": runs,
+            }
+            rows.append(row)
             print(
-                f"{name:<28} {r['workers']:>7} {r['designs']:>7} {r['wall_s']:>7.2f} "
-                f"{r['poses_per_s']:>10.3g} {r['efficiency']:>10.2f} {r['work_per_chunk_s']:>12.3f} "
-                f"{r['overhead_per_chunk_s']:>16.4f} "
-                f"{pct:>10.1f} {r['utilisation']:>11.2f} {r['cpu_share']:>9.2f} "
-                f"{r['cpu_per_design_s'] / get_study(name).poses_per_design * 1e6:>11.3f} "
-                f"{r['cpu_efficiency']:>14.2f}",
+                f"| {name} ({st.default_chunk}) | {workers} | {row['wall_s']:.2f} | "
+                f"{row['poses_per_s']:.3g} | {eff:.2f} | {steady:.2f} | {work:.2f} | {1e3 * over:.0f} | "
+                f"{100 * over / work:.1f} % | "
+                f"{1e3 * row['task_overhead_s']:.1f} | {1e3 * row['client_write_s']:.1f} | "
+                f"{row['wall_s'] - row['window_s']:.2f} |",
                 flush=True,
             )
-            rows.append(r)
-        if name == "spherical-leg-synthesis":
-            per_worker = SYNTHESIS_DESIGNS / one["designs_per_s"]
-            two_h = per_worker / 3600 / (2 * two["efficiency"])
-            print(
-                f"  10^6-design spherical-leg synthesis: {per_worker / 3600:.2f} h on 1 worker, "
-                f"{two_h:.2f} h on 2 workers (measured efficiency), {per_worker / 3600 / 64:.3f} h on 64 "
-                "(ideal scaling)",
-                flush=True,
-            )
+    if "spherical-leg-synthesis" in names:
+        st = get_study("spherical-leg-synthesis")
+        n = args.chunks * st.default_chunk
+        steady1 = n / _median(res[1][st.name], "window_s")  # designs/s of one worker, steady state
+        eff2 = _median(res[1][st.name], "window_s") / (2 * _median(res[2][st.name], "window_s"))
+        hours = SYNTHESIS_DESIGNS / steady1 / 3600
+        print(
+            f"\n10^6-design spherical-leg synthesis, from the 1-worker steady throughput ({steady1:.0f} "
+            f"designs/s = {steady1 * st.poses_per_design:.3g} poses/s): {hours:.2f} h on 1 worker, "
+            f"{hours / (2 * eff2):.2f} h on 2 (measured steady efficiency {eff2:.2f}), "
+            f"{60 * hours / 16:.1f} min on 16 and {60 * hours / 64:.1f} min on 64 (ideal scaling)"
+        )
+    print(f"\nbenchmark wall time {time.perf_counter() - t_start:.0f} s")
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=2))
     return 0

@@ -43,13 +43,17 @@ def main(argv: list[str]) -> None:
                         flush=True,
                     )
     if "ident" in which:
-        t0 = time.perf_counter()
-        est, ok = V.identification_from_reference()
-        print(f"mu {est.mu}, std {est.std}, 95% CI low {est.ci_low}, high {est.ci_high}")
-        print(
-            f"residual rms {est.residual_rms:.3f} N, {int(ok.sum())}/{ok.size} reference solves converged, "
-            f"{time.perf_counter() - t0:.0f} s"
-        )
+        for estimator, stiff in (("pose", False), ("tip", False), ("tip", True), ("tip-eiv", False)):
+            t0 = time.perf_counter()
+            est, ok = V.identification_from_reference(estimator=estimator, fit_stiffness=stiff)
+            print(f"{estimator} (stiffness fitted: {stiff}): estimate {est.mu}, std {est.std}")
+            print(f"  95% CI low {est.ci_low}, high {est.ci_high}")
+            print(
+                f"  residual rms {est.residual_rms:.3g}, {int(ok.sum())}/{ok.size} reference solves "
+                "converged, "
+                f"{time.perf_counter() - t0:.0f} s",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

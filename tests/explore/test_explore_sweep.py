@@ -276,3 +276,65 @@ def test_cli_interrupt_says_how_to_resume(monkeypatch, tmp_path, capsys):
     monkeypatch.setattr(ex, "run_sweep", interrupted)
     assert main(["sweep", STUDY, "--out", str(tmp_path / "s"), "--quiet"]) == 130
     assert "rerun the same command" in capsys.readouterr().err
+
+
+def test_list_names_the_design_studies_in_text_and_json(capsys, monkeypatch):
+    import json
+
+    from robomech.explore import available_studies
+
+    assert main(["list"]) == 0
+    text = capsys.readouterr().out
+    section = text.split("design studies (robomech sweep NAME --out DIR):\n", 1)[1]
+    lines = {ln.split()[0]: ln for ln in section.splitlines() if ln.startswith("  ")}
+    assert set(lines) == set(available_studies())
+    for name, st in available_studies().items():
+        assert st.title in lines[name] and "skipped" not in lines[name]
+    assert main(["list", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert [d["name"] for d in data["design_studies"]] == list(available_studies())
+    assert all(d["skipped"] is None and d["title"] for d in data["design_studies"])
+    # without the Dask/Zarr extra the design studies are still listed, marked skipped with the reason
+    import robomech._registry as reg
+
+    real = reg.skip_reason
+    monkeypatch.setattr(reg, "skip_reason", lambda req: "no zarr here" if "zarr" in req else real(req))
+    assert main(["list", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert {d["skipped"] for d in data["design_studies"]} == {"no zarr here"}
+
+
+def test_chunk_writer_writes_rows_then_the_flag_and_refuses_unknown_arrays(tmp_path):
+    from robomech.explore._runner import evaluate_chunk, sweep_fingerprint
+    from robomech.explore._store import ChunkWriter, prepare_store
+
+    st = get_study("vectored-thrust-tolerance")
+    X = design_matrix(st.variables, 8, st.default_sampler, 1, 4)
+    out = tmp_path / "s"
+    prepare_store(out, st, X, 4, sweep_fingerprint(st, 8, st.default_sampler, 1, 4), st.describe())
+    k, res, secs, cpu = evaluate_chunk(st, X[4:], 1, 1)
+    names = ["design_ok", *(m.name for m in st.metrics)]
+    with ChunkWriter(out, names) as w:
+        with pytest.raises(RuntimeError, match="does not hold"):
+            w.write(0, slice(0, 4), {**res, "not_a_metric": res["rms_error"]}, secs, cpu)
+        w.write(k, slice(4, 8), res, secs, cpu)
+    r = open_results(out)
+    assert r["chunk_done"].tolist() == [False, True]  # the refused chunk wrote nothing
+    assert r["chunk_seconds"][1] == secs and r["chunk_cpu_seconds"][1] == cpu
+    assert np.isnan(r["rms_error"][:4]).all()
+    for name, arr in res.items():
+        assert r[name][4:].tobytes() == arr.tobytes(), name
+
+
+@pytest.mark.slow
+def test_local_cluster_workers_are_single_threaded_for_every_threaded_library():
+    import os
+
+    from robomech.explore._runner import WORKER_ENV, dask_client
+
+    with dask_client(workers=1) as c:
+        env = c.run(lambda: {k: os.environ.get(k) for k in WORKER_ENV})
+        assert list(env.values()) == [WORKER_ENV]
+        assert c.scheduler_info()["workers"] and all(
+            w["nthreads"] == 1 for w in c.scheduler_info()["workers"].values()
+        )

@@ -19,7 +19,7 @@ def test_continuum_verification_passes():
     report = run_verifications(["continuum"])
     assert report.passed, report.table()
     assert any("library CC statics" in c.quantity for c in report.checks)
-    assert sum("disk reference" in c.quantity for c in report.checks) == 3
+    assert sum("disk reference" in c.quantity for c in report.checks) == 5
     assert len(report.checks) >= 9
 
 

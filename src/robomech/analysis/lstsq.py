@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, broadcast_batch, check_bool, check_int, finite_samples
 
@@ -47,7 +48,7 @@ class LstsqResult:
     ok: np.ndarray
 
 
-def _validate(A: object, b: object) -> tuple[np.ndarray, np.ndarray]:
+def _validate(A: ArrayLike, b: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     A = as_array(A, "A", (None, None), finite=False)
     m, n = A.shape[-2:]
     if m < n:
@@ -57,7 +58,7 @@ def _validate(A: object, b: object) -> tuple[np.ndarray, np.ndarray]:
     return A, b
 
 
-def _apply_weights(A: np.ndarray, b: np.ndarray, weights: object | None) -> tuple[np.ndarray, np.ndarray]:
+def _apply_weights(A: np.ndarray, b: np.ndarray, weights: ArrayLike | None) -> tuple[np.ndarray, np.ndarray]:
     """Scale the rows of ``A`` and ``b`` by ``sqrt(weights)``: least squares then minimises
     ``Σ_i w_i r_i²`` (weighted least squares; ``w_i = 1/σ_i²`` for independent row errors)."""
     if weights is None:
@@ -70,7 +71,9 @@ def _apply_weights(A: np.ndarray, b: np.ndarray, weights: object | None) -> tupl
     return A * sw[..., :, None], b * sw
 
 
-def solve(A: object, b: object, *, exact_cond: bool = False, weights: object | None = None) -> LstsqResult:
+def solve(
+    A: ArrayLike, b: ArrayLike, *, exact_cond: bool = False, weights: ArrayLike | None = None
+) -> LstsqResult:
     """Least-squares solution of every system in the stack by Householder QR.
 
     Each system is factorised as ``[A | b] = Q [R, c; 0, r]`` (unblocked Householder, the algorithm
@@ -129,6 +132,7 @@ def solve(A: object, b: object, *, exact_cond: bool = False, weights: object | N
     # A finite system can still overflow (entries ~1e200): its solution is then not a number either.
     finite = finite & finite_samples(x, 1) & np.isfinite(resid)
     if exact_cond:
+        assert R is not None  # householder_lstsq returns R when asked (want_R)
         R = np.where(finite[:, None, None], R, np.eye(n))
         sv = np.linalg.svd(R, compute_uv=False)
         cond = np.where(sv[:, -1] > 0, sv[:, 0] / np.where(sv[:, -1] > 0, sv[:, -1], 1.0), np.inf)
@@ -179,7 +183,7 @@ def rank_cond_limit(m: int, n: int) -> float:
     return 1.0 / (RANK_RTOL_FACTOR * max(m, n) * np.finfo(float).eps)
 
 
-def solve_normal_equations(A: object, b: object) -> LstsqResult:
+def solve_normal_equations(A: ArrayLike, b: ArrayLike) -> LstsqResult:
     """Least squares through ``A^T A x = A^T b`` (LU, batched), for comparison with :func:`solve`.
 
     Accuracy degrades like ``cond(A)^2 eps``; a numerically singular ``A^T A`` is flagged as not

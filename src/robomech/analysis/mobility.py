@@ -19,6 +19,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, check_real
 
@@ -67,7 +68,7 @@ def _check_tol(tol: object) -> float:
     return check_real(tol, "tol", low=0.0, high=1.0, low_open=True, high_open=True)
 
 
-def reciprocal_basis(screws: object, *, tol: float = RANK_RTOL) -> np.ndarray:
+def reciprocal_basis(screws: ArrayLike, *, tol: float = RANK_RTOL) -> np.ndarray:
     """Basis of the screws (axis-moment order ``[s; s0]``) reciprocal to every row of ``screws``.
 
     Parameters
@@ -99,7 +100,7 @@ def reciprocal_basis(screws: object, *, tol: float = RANK_RTOL) -> np.ndarray:
     return _null_basis(S @ _DELTA, tol) if S.shape[0] else np.eye(6)
 
 
-def constraint_wrenches(twists: object, *, tol: float = RANK_RTOL) -> np.ndarray:
+def constraint_wrenches(twists: ArrayLike, *, tol: float = RANK_RTOL) -> np.ndarray:
     """Basis of the wrenches ``[m; f]`` that do no work on any row of ``twists``.
 
     Parameters

@@ -10,6 +10,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from robomech._validation import as_array, check_int, check_real, finite_samples
 
@@ -20,8 +21,30 @@ __all__ = ["SingularityMap", "condition_number", "grid", "singularity_map"]
 SINGULAR_RTOL = 1e-8
 
 
-def grid(ranges: Sequence[tuple[float, float]], n: int | Sequence[int]) -> np.ndarray:
-    """Regular grid over ``ranges`` ((lo, hi) per coordinate): ``(n_1, ..., n_d, d)``."""
+def grid(ranges: ArrayLike, n: int | Sequence[int]) -> NDArray[np.float64]:
+    """Regular grid over ``ranges`` ((lo, hi) per coordinate): ``(n_1, ..., n_d, d)``.
+
+    Parameters
+    ----------
+    ranges : array_like, shape (d, 2)
+        ``(lo, hi)`` per coordinate, ``lo < hi``, in the coordinate's unit (m, rad).
+    n : int or sequence of int
+        Points per coordinate (``>= 2``, end points included): one count for all or one per coordinate.
+
+    Returns
+    -------
+    ndarray, shape (n_1, ..., n_d, d)
+        The grid points, ``indexing="ij"`` (the first coordinate varies along the first axis); ready
+        to be passed as a batch to any model.
+
+    Examples
+    --------
+    >>> g = grid([(0.0, 1.0), (-1.0, 1.0)], (2, 3))
+    >>> g.shape
+    (2, 3, 2)
+    >>> g[1, 2]                    # last point of both coordinates
+    array([1., 1.])
+    """
     r = as_array(ranges, "ranges", (2,))
     if r.ndim != 2 or r.shape[0] == 0:
         raise ValueError(f"Expected ranges to have shape (d, 2) with d >= 1 (lo, hi) pairs, got {r.shape}.")
@@ -33,16 +56,36 @@ def grid(ranges: Sequence[tuple[float, float]], n: int | Sequence[int]) -> np.nd
         counts = [check_int(c, "n", low=2) for c in n]
     else:
         counts = [check_int(n, "n", low=2)] * len(r)
-    ranges = r.tolist()
-    axes = [np.linspace(lo, hi, c) for (lo, hi), c in zip(ranges, counts, strict=True)]
+    axes = [np.linspace(lo, hi, c) for (lo, hi), c in zip(r, counts, strict=True)]
     return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1)
 
 
-def condition_number(J: object) -> np.ndarray:
+def condition_number(J: ArrayLike) -> NDArray[np.float64]:
     """2-norm condition number ``sigma_max / sigma_min`` of each Jacobian (inf where singular).
 
     A Jacobian with a non-finite entry gets NaN and is kept away from LAPACK (whose SVD raises for
-    the whole batch on one NaN)."""
+    the whole batch on one NaN).
+
+    Parameters
+    ----------
+    J : array_like, shape (..., m, n)
+        Jacobians (any frame: the condition number does not depend on it, but it does depend on the
+        units of mixed rows, e.g. rad/s and m/s rows of a twist Jacobian).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        ``sigma_max / sigma_min`` (>= 1), ``inf`` where ``sigma_min = 0``, NaN for a non-finite ``J``.
+        An exactly singular matrix usually gives a large finite value (~1e16) from rounding: use
+        :func:`singularity_map` for a singular mask.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> J = np.array([[[2.0, 0.0], [0.0, 1.0]], [[1.0, 0.0], [0.0, np.nan]]])
+    >>> condition_number(J)
+    array([ 2., nan])
+    """
     J = as_array(J, "J", (None, None), finite=False)
     s, finite = _singular_values(J)
     smin = s[..., -1]
@@ -63,14 +106,50 @@ def _singular_values(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass(frozen=True)
 class SingularityMap:
-    cond: np.ndarray  # (...,) condition number
-    dexterity: np.ndarray  # (...,) 1 / cond in [0, 1]
-    singular: np.ndarray  # (...,) bool, cond > 1 / SINGULAR_RTOL
-    sigma_min: np.ndarray  # (...,) smallest singular value (in the Jacobian's units)
+    """Per-Jacobian singularity measures (the result of :func:`singularity_map`).
+
+    Attributes
+    ----------
+    cond : ndarray, shape (...)
+        2-norm condition number ``sigma_max / sigma_min`` (inf where singular or non-finite).
+    dexterity : ndarray, shape (...)
+        ``1 / cond`` in ``[0, 1]`` (0 where singular or non-finite).
+    singular : ndarray of bool, shape (...)
+        ``dexterity < rtol``: singular, or a non-finite Jacobian.
+    sigma_min : ndarray, shape (...)
+        Smallest singular value, in the Jacobian's units; NaN for a non-finite Jacobian.
+    """
+
+    cond: NDArray[np.float64]
+    dexterity: NDArray[np.float64]
+    singular: NDArray[np.bool_]
+    sigma_min: NDArray[np.float64]
 
 
-def singularity_map(J: object, *, rtol: float = SINGULAR_RTOL) -> SingularityMap:
-    """Condition, dexterity and a singular mask for each Jacobian; non-finite Jacobians count as singular."""
+def singularity_map(J: ArrayLike, *, rtol: float = SINGULAR_RTOL) -> SingularityMap:
+    """Condition, dexterity and a singular mask for each Jacobian; non-finite Jacobians count as singular.
+
+    Parameters
+    ----------
+    J : array_like, shape (..., m, n)
+        Jacobians, e.g. a model's Jacobian evaluated on a :func:`grid`.
+    rtol : float, optional
+        A Jacobian is singular when ``sigma_min / sigma_max < rtol`` (``0 < rtol <= 1``); default
+        ``SINGULAR_RTOL`` = 1e-8.
+
+    Returns
+    -------
+    SingularityMap
+        ``cond``, ``dexterity``, ``singular`` and ``sigma_min``, each of shape ``(...)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> J = np.array([[[2.0, 0.0], [0.0, 1.0]], [[1.0, 1.0], [1.0, 1.0]]])   # regular, rank 1
+    >>> m = singularity_map(J)
+    >>> m.dexterity[0], m.singular
+    (np.float64(0.5), array([False,  True]))
+    """
     J = as_array(J, "J", (None, None), finite=False)
     rtol = check_real(rtol, "rtol", low=0.0, high=1.0, low_open=True)
     s, finite = _singular_values(J)

@@ -11,6 +11,9 @@ from typing import Any
 
 from ._core import CliError, Command
 
+# The extras `robomech sweep` needs beyond the core install (`robomech list` reports them too).
+SWEEP_REQUIRES = ("distributed", "zarr")
+
 
 class _OneParser:
     """Stands in for argparse's subparsers so that ``_sweep.register`` fills the parser it is given."""
@@ -35,7 +38,7 @@ def _run(args: argparse.Namespace) -> int:
 
     from ._sweep import _cmd_sweep
 
-    why = skip_reason(("distributed", "zarr"))
+    why = skip_reason(SWEEP_REQUIRES)
     if why:
         raise CliError(f"sweep cannot run here: {why}")
 

@@ -27,6 +27,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, broadcast_batch, check_positive, finite_samples
 from robomech.spatial._se3 import ad
@@ -46,7 +47,7 @@ __all__ = [
 ]
 
 
-def spatial_inertia(mass: object, com: object, inertia_com: object) -> np.ndarray:
+def spatial_inertia(mass: ArrayLike, com: ArrayLike, inertia_com: ArrayLike) -> np.ndarray:
     """6x6 spatial inertia about a body frame's origin for twists ``[w; v]``.
 
     ``G = [[I_c - m hat(c)^2, m hat(c)], [-m hat(c), m I]]``, so that the body's kinetic energy is
@@ -89,14 +90,14 @@ def spatial_inertia(mass: object, com: object, inertia_com: object) -> np.ndarra
     return G
 
 
-def _bodies(G: object, J: object) -> tuple[np.ndarray, np.ndarray]:
+def _bodies(G: ArrayLike, J: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     G = as_array(G, "G", (None, 6, 6))
     J = as_array(J, "J", (None, 6, None))
     broadcast_batch((G, 2, "G"), (J, 2, "J"))
     return G, J
 
 
-def _rates(x: object, name: str, J: np.ndarray) -> np.ndarray:
+def _rates(x: ArrayLike, name: str, J: np.ndarray) -> np.ndarray:
     """A generalized-coordinate vector (..., n) matching ``J (..., B, 6, n)``; its batch excludes B."""
     a = as_array(x, name, (J.shape[-1],), min_ndim=1)
     broadcast_batch((J, 3, "J"), (a, 1, name))
@@ -245,7 +246,7 @@ def inverse_dynamics(
     return DynamicsTerms(tau=tau, M=M, velocity_terms=vel, gravity_terms=grav)
 
 
-def static_torques(J: object, wrench: object) -> np.ndarray:
+def static_torques(J: ArrayLike, wrench: ArrayLike) -> np.ndarray:
     """Virtual work: generalized forces ``tau = J^T w`` that balance a wrench where ``J`` maps q-rates.
 
     Parameters
@@ -275,7 +276,7 @@ def static_torques(J: object, wrench: object) -> np.ndarray:
 
 
 def actuator_forces(
-    J_act: object, tau_q: object, *, rcond: float | None = None
+    J_act: ArrayLike, tau_q: ArrayLike, *, rcond: float | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """Actuator forces ``f`` with ``J_act^T f = tau_q`` of minimum norm, and the residual per sample.
 
@@ -334,11 +335,30 @@ def actuator_forces(
     return f, resid
 
 
-def world_inertia(R: object, inertia: object) -> np.ndarray:
+def world_inertia(R: ArrayLike, inertia: ArrayLike) -> np.ndarray:
     """Rotational inertia in world axes ``R I R^T`` of a body at orientation ``R (..., 3, 3)``.
 
     ``inertia (..., 3, 3)`` is the inertia about the centre of mass in body axes (a principal
     inertia ``diag(d)`` in a frame ``R_i`` of the body is ``R_i diag(d) R_i^T``).
+
+    Parameters
+    ----------
+    R : array_like, shape (..., 3, 3)
+        Body orientations (rotation matrices, body to world).
+    inertia : array_like, shape (..., 3, 3)
+        Inertia about the centre of mass in body axes (kg m²).
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        Inertia about the centre of mass in world axes (kg m²).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> Rz90 = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    >>> np.diag(world_inertia(Rz90, np.diag([1.0, 2.0, 3.0])))    # x and y swap
+    array([2., 1., 3.])
     """
     R = as_array(R, "R", (3, 3))
     Ic = as_array(inertia, "inertia", (3, 3))
@@ -346,13 +366,13 @@ def world_inertia(R: object, inertia: object) -> np.ndarray:
 
 
 def com_inverse_dynamics(
-    mass: object,
-    inertia: object,
-    J: object,
-    Jdot_qd: object,
-    qd: object,
-    qdd: object,
-    gravity: object = (0.0, 0.0, -9.81),
+    mass: ArrayLike,
+    inertia: ArrayLike,
+    J: ArrayLike,
+    Jdot_qd: ArrayLike,
+    qd: ArrayLike,
+    qdd: ArrayLike,
+    gravity: ArrayLike = (0.0, 0.0, -9.81),
 ) -> DynamicsTerms:
     """Generalized forces from centre-of-mass Jacobians in world axes (Newton-Euler per body, projected).
 
@@ -362,6 +382,36 @@ def com_inverse_dynamics(
     velocity-product accelerations ``[wd; c'']`` at ``qdd = 0``); ``gravity (..., 3)`` the gravity
     acceleration (m/s^2).  Returns ``tau = M qdd + velocity_terms + gravity_terms`` with
     ``M = sum_b J_b^T diag(I_b, m_b 1) J_b``.
+
+    Parameters
+    ----------
+    mass : array_like, shape (..., B)
+        Body masses (kg).
+    inertia : array_like, shape (..., B, 3, 3)
+        World-axes inertia about each centre of mass (kg m²).
+    J : array_like, shape (..., B, 6, n)
+        ``[w; c']`` of each body per unit ``qd`` (rad/s, m/s; world axes).
+    Jdot_qd : array_like, shape (..., B, 6)
+        ``Jdot qd``: velocity-product accelerations (rad/s², m/s²).
+    qd, qdd : array_like, shape (..., n)
+        Generalized velocities and accelerations.
+    gravity : array_like, shape (..., 3), optional
+        Gravity acceleration (m/s²), default ``(0, 0, -9.81)``.
+
+    Returns
+    -------
+    DynamicsTerms
+        ``tau``, ``velocity_terms``, ``gravity_terms`` ``(..., n)`` (N or N m) and ``M (..., n, n)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> J = np.zeros((1, 6, 1))
+    >>> J[0, 5, 0] = 1.0                                  # one 2 kg body on a vertical slide
+    >>> r = com_inverse_dynamics(np.array([2.0]), np.zeros((1, 3, 3)), J, np.zeros((1, 6)),
+    ...                          np.array([0.0]), np.array([1.0]))
+    >>> r.tau.round(12), r.gravity_terms.round(12)        # m (qdd + g): 2 (1 + 9.81) N
+    (array([21.62]), array([19.62]))
     """
     m = as_array(mass, "mass", (None,))
     B = m.shape[-1]
@@ -417,8 +467,33 @@ def _com_terms(m, I, J, a0, qd, qdd, g) -> DynamicsTerms:
     return DynamicsTerms(tau=tau, M=M, velocity_terms=vel, gravity_terms=grav)
 
 
-def com_kinetic_energy(mass: object, inertia: object, J: object, qd: object) -> np.ndarray:
-    """``0.5 sum_b (w_b . I_b w_b + m_b |c'_b|^2)`` with ``[w_b; c'_b] = J_b qd`` (...)."""
+def com_kinetic_energy(mass: ArrayLike, inertia: ArrayLike, J: ArrayLike, qd: ArrayLike) -> np.ndarray:
+    """``0.5 sum_b (w_b . I_b w_b + m_b |c'_b|^2)`` with ``[w_b; c'_b] = J_b qd`` (...).
+
+    Parameters
+    ----------
+    mass : array_like, shape (..., B)
+        Body masses (kg).
+    inertia : array_like, shape (..., B, 3, 3)
+        World-axes inertia about each centre of mass (kg m²).
+    J : array_like, shape (..., B, 6, n)
+        ``[w; c']`` of each body per unit ``qd`` (world axes).
+    qd : array_like, shape (..., n)
+        Generalized velocities.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Kinetic energy (J).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> J = np.zeros((1, 6, 1))
+    >>> J[0, 5, 0] = 1.0
+    >>> float(com_kinetic_energy(np.array([2.0]), np.zeros((1, 3, 3)), J, np.array([3.0])))  # m v² / 2
+    9.0
+    """
     m = as_array(mass, "mass", (None,))
     B = m.shape[-1]
     qd = as_array(qd, "qd", (None,))

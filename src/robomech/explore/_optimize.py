@@ -30,7 +30,7 @@ from ._runner import (
     robomech_version,
     sweep_fingerprint,
 )
-from ._store import open_store, prepare_store
+from ._store import open_store, prepare_store, store_array
 from ._study import DesignStudy, Variable, check_variables, with_variables
 
 __all__ = ["optimize_nsga2"]
@@ -98,9 +98,12 @@ def optimize_nsga2(
         if X.shape[0] > P:  # pymoo's NSGA-II proposes n_offsprings = pop_size rows per generation
             raise RuntimeError(f"NSGA-II proposed {X.shape[0]} rows, more than the population {P}")
         rows = slice(k * P, k * P + X.shape[0])
-        if bool(g["chunk_done"][k]) and np.array_equal(g["designs"][rows], X):
+        if bool(store_array(g, "chunk_done")[k]) and np.array_equal(
+            np.asarray(store_array(g, "designs")[rows]), X
+        ):
             res = {
-                name: np.asarray(g[name][rows]) for name in ["design_ok", *(m.name for m in study.metrics)]
+                name: np.asarray(store_array(g, name)[rows])
+                for name in ["design_ok", *(m.name for m in study.metrics)]
             }
         else:
             futures = [
@@ -109,10 +112,10 @@ def optimize_nsga2(
             ]
             parts = [f.result()[1] for f in futures]  # in order: deterministic regardless of workers
             res = {name: np.concatenate([p[name] for p in parts]) for name in parts[0]}
-            g["designs"][rows] = X
+            store_array(g, "designs")[rows] = X
             for name, arr in res.items():
-                g[name][rows] = arr
-            g["chunk_done"][k] = True
+                store_array(g, name)[rows] = arr
+            store_array(g, "chunk_done")[k] = True
             computed.append(k)
         bar.update(X.shape[0])
         return res

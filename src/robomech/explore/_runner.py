@@ -11,23 +11,29 @@ elsewhere.
 
 from __future__ import annotations
 
+import functools
 import importlib.metadata
 import os
+import pickle
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from robomech._validation import check_bool, check_choice, check_int, check_positive
 
 from ._sampling import SAMPLERS, chunk_seed, design_matrix
-from ._store import open_store, prepare_store
+from ._store import ChunkWriter, open_store, prepare_store, store_array
 from ._study import DesignStudy, Variable, check_variables, with_variables
+
+if TYPE_CHECKING:
+    from distributed import Client
 
 __all__ = ["SchedulerUnreachable", "SweepSummary", "evaluate_chunk", "run_sweep"]
 
@@ -35,6 +41,14 @@ __all__ = ["SchedulerUnreachable", "SweepSummary", "evaluate_chunk", "run_sweep"
 CONNECT_TIMEOUT = 10.0
 # Retries of a chunk whose task raised (a worker dying is handled by the scheduler, not by these).
 TASK_RETRIES = 2
+# Environment of the LocalCluster's worker processes: one thread per process for every threaded library
+# (OpenMP, MKL, OpenBLAS, numba), so K single-threaded workers use K cores and never oversubscribe them.
+WORKER_ENV = {
+    "OMP_NUM_THREADS": "1",
+    "MKL_NUM_THREADS": "1",
+    "OPENBLAS_NUM_THREADS": "1",
+    "NUMBA_NUM_THREADS": "1",
+}
 
 
 class SchedulerUnreachable(ValueError):
@@ -80,15 +94,34 @@ def robomech_version() -> str:
         return robomech.__version__
 
 
-def evaluate_chunk(study: DesignStudy, rows: np.ndarray, seed: int, chunk: int):
+ChunkResult = tuple[int, dict[str, NDArray[Any]], float, float]
+
+
+def evaluate_chunk(study: DesignStudy, rows: NDArray[np.float64], seed: int, chunk: int) -> ChunkResult:
     """One task: the metrics of chunk ``chunk``'s design rows, and the wall and CPU seconds it took."""
     t0, c0 = time.perf_counter(), time.process_time()
     res = study.evaluate_rows(rows, chunk_seed(seed, chunk))
     return chunk, res, time.perf_counter() - t0, time.process_time() - c0
 
 
+@functools.lru_cache(maxsize=4)
+def _study_from_bytes(blob: bytes) -> DesignStudy:
+    """The study of a sweep, unpickled once per worker process (a sweep's tasks share one blob)."""
+    study = pickle.loads(blob)
+    if not isinstance(study, DesignStudy):  # only the client's own cloudpickle of a DesignStudy
+        raise TypeError(f"expected a pickled DesignStudy, got {type(study).__name__}")
+    return study
+
+
+def _chunk_task(blob: bytes, rows: NDArray[np.float64], seed: int, chunk: int) -> ChunkResult:
+    """The Dask task of a sweep: :func:`evaluate_chunk` on the study pickled once by the client."""
+    return evaluate_chunk(_study_from_bytes(blob), rows, seed, chunk)
+
+
 @contextmanager
-def dask_client(scheduler: str | None = None, workers: int | None = None, timeout: float = CONNECT_TIMEOUT):
+def dask_client(
+    scheduler: str | None = None, workers: int | None = None, timeout: float = CONNECT_TIMEOUT
+) -> Iterator[Client]:
     """A ``distributed.Client``: to ``scheduler`` if given, else to a new LocalCluster (closed after)."""
     from distributed import Client, LocalCluster
 
@@ -117,6 +150,7 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, timeou
         host="127.0.0.1",
         dashboard_address="127.0.0.1:0",  # loopback, any free port (None would mean :8787 on every interface)
         silence_logs=40,
+        env=WORKER_ENV,  # passed to each worker's Nanny: set before the worker process imports numpy
     )
     client = Client(cluster)
     try:
@@ -129,7 +163,7 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, timeou
 class _Bar:
     """One progress line on stderr: designs done, rate, time left."""
 
-    def __init__(self, label: str, total: int, enabled: bool, stream=None) -> None:
+    def __init__(self, label: str, total: int, enabled: bool, stream: IO[str] | None = None) -> None:
         self.label, self.total, self.enabled = label, total, enabled
         self.stream = stream if stream is not None else sys.stderr
         self.t0 = time.perf_counter()
@@ -180,12 +214,12 @@ def plan(
         raise ValueError(f"Expected study to be a DesignStudy, got {type(study).__name__}.")
     variables = check_variables(variables)
     study = with_variables(study, variables) if variables else study
-    sampler = study.default_sampler if sampler is None else check_choice(sampler, "sampler", SAMPLERS)
+    method = study.default_sampler if sampler is None else str(check_choice(sampler, "sampler", SAMPLERS))
     chunk = study.default_chunk if chunk_size is None else check_int(chunk_size, "chunk_size", low=1)
     n = study.default_designs if designs is None else check_int(designs, "designs", low=1)
     seed = check_int(seed, "seed", low=0)
-    X = design_matrix(study.variables, n, sampler, int(seed), chunk)
-    return study, X, sampler, chunk
+    X = design_matrix(study.variables, n, method, int(seed), chunk)
+    return study, X, method, chunk
 
 
 def run_sweep(
@@ -221,7 +255,9 @@ def run_sweep(
     }
     n_chunks = -(-n // chunk)
     g = open_store(Path(out), fp, X)  # raises StoreMismatch before anything is written
-    done = np.zeros(n_chunks, bool) if g is None else np.asarray(g["chunk_done"][:], dtype=bool)
+    done = (
+        np.zeros(n_chunks, bool) if g is None else np.asarray(store_array(g, "chunk_done")[...], dtype=bool)
+    )
     missing = [k for k in range(done.size) if not done[k]]
     t0 = time.perf_counter()
     computed: list[int] = []
@@ -236,10 +272,11 @@ def run_sweep(
             if g is None:
                 g = prepare_store(Path(out), study, X, chunk, fp, info)
             n_workers = len(c.scheduler_info().get("workers", {}))
+            blob = _pickle_study(study)  # once per sweep, not once per task
             futures = [
                 c.submit(
-                    evaluate_chunk,
-                    study,
+                    _chunk_task,
+                    blob,
                     X[k * chunk : (k + 1) * chunk],
                     int(seed),
                     k,
@@ -249,18 +286,15 @@ def run_sweep(
                 for k in missing
             ]
             try:
-                for fut in as_completed(futures):
-                    k, res, secs, cpu = fut.result()
-                    rows = slice(k * chunk, min((k + 1) * chunk, n))
-                    for name, arr in res.items():
-                        g[name][rows] = arr
-                    g["chunk_seconds"][k] = secs
-                    g["chunk_cpu_seconds"][k] = cpu
-                    g["chunk_done"][k] = True  # last: the chunk's rows are all written
-                    computed.append(k)
-                    bar.update(rows.stop - rows.start)
-                    if on_chunk is not None:
-                        on_chunk(k)
+                with ChunkWriter(Path(out), ["design_ok", *(m.name for m in study.metrics)]) as writer:
+                    for fut in as_completed(futures):
+                        k, res, secs, cpu = fut.result()
+                        rows = slice(k * chunk, min((k + 1) * chunk, n))
+                        writer.write(k, rows, res, secs, cpu)  # chunk_done[k] last
+                        computed.append(k)
+                        bar.update(rows.stop - rows.start)
+                        if on_chunk is not None:
+                            on_chunk(k)
             finally:
                 for fut in futures:
                     if not fut.done():
@@ -279,7 +313,22 @@ def run_sweep(
     )
 
 
-def check_runtime(out, scheduler, workers, progress, connect_timeout, on_chunk=None) -> Path:
+def _pickle_study(study: DesignStudy) -> bytes:
+    """The study as bytes for the tasks (Dask's pickle, cloudpickle for what plain pickle cannot: a study
+    defined in ``__main__`` travels too)."""
+    from distributed.protocol.pickle import dumps
+
+    return bytes(dumps(study))
+
+
+def check_runtime(
+    out: object,
+    scheduler: object,
+    workers: object,
+    progress: object,
+    connect_timeout: object,
+    on_chunk: object = None,
+) -> Path:
     """Validate the execution options shared by run_sweep and optimize_nsga2; return ``out`` as a Path."""
     if not isinstance(out, str | Path) or str(out) == "":
         raise ValueError(f"Expected out to be a directory path (str or Path), got {out!r}.")
@@ -295,5 +344,5 @@ def check_runtime(out, scheduler, workers, progress, connect_timeout, on_chunk=N
 
 
 @contextmanager
-def _existing(client):
+def _existing(client: Client) -> Iterator[Client]:
     yield client

@@ -104,6 +104,6 @@ STUDY = DesignStudy(
     ),
     poses_per_design=TASK_GRID**2 + round(FIG5B_DURATION / FIG5B_STEP) + 1,
     default_sampler="sobol",
-    default_chunk=256,
+    default_chunk=512,  # ~1.5 s of work per task on one core (docs/performance.md)
     default_designs=1024,
 )

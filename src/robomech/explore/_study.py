@@ -76,7 +76,12 @@ class Variable:
         return self.sigma * norm.ppf(u)
 
     def as_dict(self) -> dict[str, Any]:
-        d = {"name": self.name, "kind": self.kind, "unit": self.unit, "description": self.description}
+        d: dict[str, Any] = {
+            "name": self.name,
+            "kind": self.kind,
+            "unit": self.unit,
+            "description": self.description,
+        }
         if self.kind == "range":
             d.update(low=self.low, high=self.high)
         else:

@@ -7,6 +7,7 @@ Shapes: ``screws (n, 6)`` (or broadcastable ``(..., n, 6)``), ``q (..., n)``, ``
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, broadcast_batch
 from robomech.spatial._se3 import _exp_se3, ad, adjoint
@@ -21,7 +22,7 @@ __all__ = [
 ]
 
 
-def _check(screws: object, q: object, name: str = "screws") -> tuple[np.ndarray, np.ndarray]:
+def _check(screws: ArrayLike, q: ArrayLike, name: str = "screws") -> tuple[np.ndarray, np.ndarray]:
     S = as_array(screws, name, (None, 6))
     qa = as_array(q, "q", (None,), min_ndim=1)
     if qa.shape[-1] != S.shape[-2]:
@@ -35,7 +36,7 @@ def _joint_exps(S: np.ndarray, q: np.ndarray) -> np.ndarray:
     return _exp_se3(S * q[..., None])
 
 
-def poe_fk(M: object, screws: object, q: object) -> np.ndarray:
+def poe_fk(M: ArrayLike, screws: ArrayLike, q: ArrayLike) -> np.ndarray:
     """Forward kinematics by the space-form product of exponentials, ``T = exp([S1]q1) ... exp([Sn]qn) M``.
 
     Parameters
@@ -79,7 +80,7 @@ def poe_fk(M: object, screws: object, q: object) -> np.ndarray:
     return T @ M
 
 
-def jacobian_space(screws: object, q: object) -> np.ndarray:
+def jacobian_space(screws: ArrayLike, q: ArrayLike) -> np.ndarray:
     """Space Jacobian ``J_s``: column i is ``Ad(exp([S1]q1)...exp([S_{i-1}]q_{i-1})) S_i``.
 
     ``J_s(q) @ qd`` is the end frame's space twist ``[w; v]`` (``v``: the velocity of the body point at
@@ -122,7 +123,7 @@ def jacobian_space(screws: object, q: object) -> np.ndarray:
     return J
 
 
-def jacobian_body(body_screws: object, q: object) -> np.ndarray:
+def jacobian_body(body_screws: ArrayLike, q: ArrayLike) -> np.ndarray:
     """Body Jacobian ``J_b`` from body screw axes (``T = M exp([B1]q1)...exp([Bn]qn)``).
 
     Column i is ``Ad(exp(-[Bn]qn)...exp(-[B_{i+1}]q_{i+1})) B_i``; ``J_b @ qd`` is the end frame's body
@@ -165,7 +166,7 @@ def jacobian_body(body_screws: object, q: object) -> np.ndarray:
     return J
 
 
-def hessian_space(screws: object, q: object) -> np.ndarray:
+def hessian_space(screws: ArrayLike, q: ArrayLike) -> np.ndarray:
     """Second-order influence coefficients of the space Jacobian, ``H[..., i, j, k] = dJ[i, j]/dq_k``.
 
     ``dJ_j/dq_k = ad(J_k) J_j`` for ``k < j`` and 0 otherwise (column j moves only with the joints
@@ -210,7 +211,7 @@ def hessian_space(screws: object, q: object) -> np.ndarray:
     return H
 
 
-def hessian_body(body_screws: object, q: object) -> np.ndarray:
+def hessian_body(body_screws: ArrayLike, q: ArrayLike) -> np.ndarray:
     """Second-order influence coefficients of the body Jacobian, ``H[..., i, j, k] = dJb[i, j]/dq_k``.
 
     ``dJb_j/dq_k = ad(Jb_j) Jb_k`` for ``k > j`` and 0 otherwise (column j moves only with the joints

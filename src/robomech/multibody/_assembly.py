@@ -13,12 +13,13 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, check_int
 
 from ._constraints import jacobian, residual
 from ._model import Mechanism
-from ._tree import frame_jacobian, integrate, kinematics, normalize_quaternions
+from ._tree import TreeState, frame_jacobian, integrate, kinematics, normalize_quaternions
 
 __all__ = [
     "CONVERGED_RTOL",
@@ -63,7 +64,7 @@ def check_mechanism(mech: object) -> Mechanism:
     return mech
 
 
-def check_q(mech: Mechanism, q: object, name: str = "q") -> np.ndarray:
+def check_q(mech: Mechanism, q: object, name: str = "q") -> np.ndarray:  # a validator: any input
     """``q (..., nq)`` finite, quaternions non-zero; returns it with quaternions normalised."""
     q = as_array(q, name, (mech.nq,))
     for a in mech.tree.quat_adr:
@@ -79,7 +80,7 @@ def solve_closure(
     mech: Mechanism,
     q: np.ndarray,
     free: np.ndarray,
-    extra: Callable[[object, np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None,
+    extra: Callable[[TreeState, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None,
     max_iter: int = MAX_ITER,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """LM on the closure rows (plus ``extra(state, q, idx) -> (r, J)`` rows) over the coordinates ``free``.
@@ -184,7 +185,7 @@ class IKResult:
     iterations: np.ndarray
 
 
-def _guess(mech: Mechanism, guess: object, batch: tuple[int, ...]) -> np.ndarray:
+def _guess(mech: Mechanism, guess: ArrayLike | None, batch: tuple[int, ...]) -> np.ndarray:
     if guess is None:
         return np.broadcast_to(mech.tree.q0, (*batch, mech.nq))
     g = as_array(guess, "guess", (mech.nq,))
@@ -194,7 +195,9 @@ def _guess(mech: Mechanism, guess: object, batch: tuple[int, ...]) -> np.ndarray
     return normalize_quaternions(mech.tree, g)
 
 
-def forward_kinematics(mech: Mechanism, q_act: object, guess: object = None, *, steps: int = 1) -> FKResult:
+def forward_kinematics(
+    mech: Mechanism, q_act: ArrayLike, guess: ArrayLike | None = None, *, steps: int = 1
+) -> FKResult:
     """Assemble the mechanism at the actuated coordinates ``q_act (..., n_act)`` (actuator order).
 
     The passive coordinates start from ``guess (..., nq)`` (default the reference configuration
@@ -202,6 +205,31 @@ def forward_kinematics(mech: Mechanism, q_act: object, guess: object = None, *, 
     inputs from the guess's values to ``q_act`` in that many equal stages (continuation), which
     keeps the branch over large moves; along a trajectory pass the previous solution as the guess.
     Non-finite inputs give ``converged = False`` and NaN for that sample only.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism (:func:`from_mjcf` or :class:`Builder`).
+    q_act : array_like, shape (..., n_act)
+        Actuated joints' coordinates in actuator order (rad for hinges, m for slides).
+    guess : array_like, shape (..., nq), optional
+        Start of the passive coordinates (default ``mech.q0``); broadcasts with ``q_act``.
+    steps : int, optional
+        Continuation stages from the guess's inputs to ``q_act`` (``>= 1``).
+
+    Returns
+    -------
+    FKResult
+        ``q (..., nq)`` (MuJoCo qpos), ``residual (...)`` (m), ``converged`` and ``iterations``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> fk = mb.forward_kinematics(mech, np.array([[0.2], [np.nan]]))   # a bad sample is only flagged
+    >>> fk.q[0].round(4), fk.converged
+    (array([ 0.2   , -0.196 ,  0.0771]), array([ True, False]))
     """
     mech = check_mechanism(mech)
     tree = mech.tree
@@ -253,10 +281,10 @@ def _site_error(tree, state, site: int, T_target: np.ndarray, w: np.ndarray):
 def inverse_kinematics(
     mech: Mechanism,
     site: str,
-    T_target: object,
-    guess: object = None,
+    T_target: ArrayLike,
+    guess: ArrayLike | None = None,
     *,
-    weights: object = None,
+    weights: ArrayLike | None = None,
     steps: int = 1,
 ) -> IKResult:
     """Configuration(s) that put ``site`` at ``T_target (..., 4, 4)`` (world) with the loops closed.
@@ -266,6 +294,36 @@ def inverse_kinematics(
     ``(0, 0, 0, 1, 1, 1)`` for a point target).  All coordinates move, from ``guess`` (default
     ``mech.q0``), in least squares; ``steps > 1`` moves the target from the guess's site pose in
     stages (continuation).  A target the mechanism cannot reach leaves ``converged = False``.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    site : str
+        Name of the site to place.
+    T_target : array_like, shape (..., 4, 4)
+        Target world poses of the site (m).
+    guess : array_like, shape (..., nq), optional
+        Start configuration (default ``mech.q0``).
+    weights : array_like, shape (6,), optional
+        Weights of the error rows ``[rot_x, rot_y, rot_z, x, y, z]`` (>= 0; 0 leaves a component free).
+    steps : int, optional
+        Continuation stages (``>= 1``).
+
+    Returns
+    -------
+    IKResult
+        ``q (..., nq)``, ``q_act (..., n_act)``, ``residual`` (m), ``pose_error`` (m) and ``converged``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> T = mb.site_pose(mech, mb.forward_kinematics(mech, np.array([0.2])).q, "coupler_point")
+    >>> ik = mb.inverse_kinematics(mech, "coupler_point", T)
+    >>> ik.q_act.round(10), bool(ik.converged)                          # the crank angle back
+    (array([0.2]), True)
     """
     mech = check_mechanism(mech)
     tree = mech.tree
@@ -302,7 +360,9 @@ def inverse_kinematics(
         else:
             Ts = _interp_pose(start, Tf, s / steps)
 
-        def extra(state, qs, idx, Ts=Ts):
+        def extra(
+            state: TreeState, qs: np.ndarray, idx: np.ndarray, Ts: np.ndarray = Ts
+        ) -> tuple[np.ndarray, np.ndarray]:
             return _site_error(tree, state, si, Ts[idx], w)
 
         q, rc, _, it = solve_closure(mech, q, free, extra)

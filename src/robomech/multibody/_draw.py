@@ -9,6 +9,7 @@ only module of the layer that uses matplotlib (docs/architecture.md explains the
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._assembly import check_mechanism, check_q
 from ._model import Mechanism
@@ -17,8 +18,29 @@ from ._tree import body_poses
 __all__ = ["body_segments", "draw"]
 
 
-def body_segments(mech: Mechanism, q: object) -> dict[str, np.ndarray]:
-    """World segments ``(k, 2, 3)`` per body name at one configuration ``q (nq,)`` (the drawing's data)."""
+def body_segments(mech: Mechanism, q: ArrayLike) -> dict[str, np.ndarray]:
+    """World segments ``(k, 2, 3)`` per body name at one configuration ``q (nq,)`` (the drawing's data).
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (nq,)
+        One configuration.
+
+    Returns
+    -------
+    dict of str to ndarray, shape (k, 2, 3)
+        Per body name, its segments (from the body's joint anchor to its children, closure anchors
+        and sites) in world coordinates (m).
+
+    Examples
+    --------
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> {name: s.shape for name, s in mb.body_segments(mech, mech.q0).items()}
+    {'crank': (1, 2, 3), 'coupler': (2, 2, 3), 'rocker': (1, 2, 3)}
+    """
     mech = check_mechanism(mech)
     q = check_q(mech, q)
     if q.ndim != 1:
@@ -30,9 +52,9 @@ def body_segments(mech: Mechanism, q: object) -> dict[str, np.ndarray]:
         return T[b, :3, :3] @ np.asarray(x, float) + T[b, :3, 3]
 
     pts: dict[int, list[np.ndarray]] = {i: [] for i in range(len(tree.body_names))}
-    for i, b in enumerate(mech.bodies, start=1):
-        pts[i].insert(0, world(i, b.joints[0].pos) if b.joints else T[i, :3, 3])
-        anchor = world(i, b.joints[0].pos) if b.joints else T[i, :3, 3]
+    for i, body in enumerate(mech.bodies, start=1):
+        pts[i].insert(0, world(i, body.joints[0].pos) if body.joints else T[i, :3, 3])
+        anchor = world(i, body.joints[0].pos) if body.joints else T[i, :3, 3]
         pts[int(tree.parent[i])].append(anchor)
     for c in mech.closures:
         b1, b2 = tree.body_index(c.body1), tree.body_index(c.body2)
@@ -50,8 +72,29 @@ def body_segments(mech: Mechanism, q: object) -> dict[str, np.ndarray]:
     return out
 
 
-def draw(mech: Mechanism, q: object = None, ax=None, *, color: str = "C0", title: str | None = None):
-    """Draw ``mech`` at ``q (nq,)`` (default its reference configuration) on 3-D axes; returns the axes."""
+def draw(
+    mech: Mechanism, q: ArrayLike | None = None, ax=None, *, color: str = "C0", title: str | None = None
+):
+    """Draw ``mech`` at ``q (nq,)`` (default its reference configuration) on 3-D axes; returns the axes.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (nq,), optional
+        Configuration (default ``mech.q0``).
+    ax : matplotlib Axes3D, optional
+        Axes to draw on (default: new 3-D axes).
+    color : str, optional
+        Matplotlib colour of the segments.
+    title : str, optional
+        Axes title.
+
+    Returns
+    -------
+    matplotlib Axes3D
+        The axes drawn on.
+    """
     import matplotlib.pyplot as plt
 
     mech = check_mechanism(mech)

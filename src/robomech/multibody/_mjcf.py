@@ -80,6 +80,23 @@ def from_mjcf(path_or_xml: str | os.PathLike) -> Mechanism:
     equalities, actuators on tendons, sites or bodies — raise ``ValueError`` naming them.  Inactive
     equalities (``active="false"``) are not constraints of the mechanism and are left out.
     Simulation settings (timestep, solver, contacts, limits, visuals) are ignored.
+
+    Parameters
+    ----------
+    path_or_xml : str or os.PathLike
+        A path to an MJCF file, or MJCF text (a string starting with ``<``).
+
+    Returns
+    -------
+    Mechanism
+        The frozen, validated description (``q`` is MuJoCo's ``qpos``; lengths in m, angles in rad).
+
+    Examples
+    --------
+    >>> from robomech import multibody as mb
+    >>> mech = mb.from_mjcf(mb.gallery.path("four_bar"))
+    >>> mech.actuated, mech.nq, [b.name for b in mech.bodies]
+    (('theta2',), 3, ['crank', 'coupler', 'rocker'])
     """
     if not isinstance(path_or_xml, str | os.PathLike):
         raise ValueError(f"Expected path_or_xml to be a path or MJCF text, got {type(path_or_xml).__name__}.")
@@ -134,10 +151,11 @@ def from_mjcf(path_or_xml: str | os.PathLike) -> Mechanism:
     for e in range(m.neq):
         if not m.eq_active0[e]:
             continue
-        typ, o1, o2, d = int(m.eq_type[e]), int(m.eq_obj1id[e]), int(m.eq_obj2id[e]), np.array(m.eq_data[e])
+        eq_typ, o1, o2 = int(m.eq_type[e]), int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
+        d = np.array(m.eq_data[e])
         name = m.eq(e).name or f"equality{e}"
         sites_form = int(m.eq_objtype[e]) == site_t
-        if typ == int(eq.mjEQ_CONNECT):
+        if eq_typ == int(eq.mjEQ_CONNECT):
             if sites_form:
                 closures.append(
                     Closure(
@@ -153,7 +171,7 @@ def from_mjcf(path_or_xml: str | os.PathLike) -> Mechanism:
                 closures.append(
                     Closure(name, "point", body_names[o1], body_names[o2], tuple(d[0:3]), tuple(d[3:6]))
                 )
-        elif typ == int(eq.mjEQ_WELD):
+        elif eq_typ == int(eq.mjEQ_WELD):
             if sites_form:
                 # MuJoCo's site weld: the two site frames coincide.
                 T1 = np.eye(4)
@@ -187,10 +205,10 @@ def from_mjcf(path_or_xml: str | os.PathLike) -> Mechanism:
                         relquat=tuple(d[6:10]),
                     )
                 )
-        elif typ == int(eq.mjEQ_JOINT):
+        elif eq_typ == int(eq.mjEQ_JOINT):
             couplings.append(Coupling(name, jnt_names[o1], jnt_names[o2] if o2 >= 0 else None, tuple(d[0:5])))
         else:
-            kind = {int(getattr(eq, k)): k for k in dir(eq) if k.startswith("mjEQ_")}.get(typ, str(typ))
+            kind = {int(getattr(eq, k)): k for k in dir(eq) if k.startswith("mjEQ_")}.get(eq_typ, str(eq_typ))
             raise ValueError(f"Unsupported MJCF equality for robomech.multibody: {kind} ({name!r}).")
     actuated = []
     for a in range(m.nu):
@@ -225,6 +243,25 @@ def to_mjcf(mech: Mechanism, *, comment: str | None = None) -> str:
     A ``revolute`` closure is written as two ``connect`` elements ``name`` and ``name/axis`` one
     characteristic length apart along the axis (MJCF has no hinge equality).  ``comment`` is written
     as an XML comment at the top of the model.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    comment : str, optional
+        An XML comment written at the top of the model.
+
+    Returns
+    -------
+    str
+        MJCF text (radians, full-precision floats).
+
+    Examples
+    --------
+    >>> from robomech import multibody as mb
+    >>> xml = mb.to_mjcf(mb.gallery.load("four_bar"))
+    >>> xml.splitlines()[0], mb.from_mjcf(xml).actuated
+    ('<mujoco model="four_bar">', ('theta2',))
     """
     if not isinstance(mech, Mechanism):
         raise ValueError(f"Expected mech to be a robomech.multibody.Mechanism, got {type(mech).__name__}.")
@@ -292,11 +329,11 @@ def to_mjcf(mech: Mechanism, *, comment: str | None = None) -> str:
                 relpose=_f([*p1, *c.relquat]),
                 anchor=_f(c.anchor2),
             )
-    for c in mech.couplings:
-        attrs = {"name": c.name, "joint1": c.joint1, "polycoef": _f(c.polycoef)}
-        if c.joint2 is not None:
-            attrs["joint2"] = c.joint2
-        ET.SubElement(equality, "joint", **attrs)
+    for cp in mech.couplings:
+        attrs = {"name": cp.name, "joint1": cp.joint1, "polycoef": _f(cp.polycoef)}
+        if cp.joint2 is not None:
+            attrs["joint2"] = cp.joint2
+        ET.SubElement(equality, "joint", attrs)
 
     def add_geoms(el: ET.Element, name: str) -> None:
         pts = [p for p in targets[name] if np.linalg.norm(p) > 1e-9 * L]
@@ -306,8 +343,8 @@ def to_mjcf(mech: Mechanism, *, comment: str | None = None) -> str:
             ET.SubElement(el, "geom", type="capsule", fromto=_f([0, 0, 0, *p]), size=_f(radius))
 
     add_geoms(world, "world")
-    for s, p in aux_sites.get("world", []):
-        ET.SubElement(world, "site", name=s, pos=_f(p))
+    for sname, p in aux_sites.get("world", []):
+        ET.SubElement(world, "site", name=sname, pos=_f(p))
     for b in mech.bodies:
         el = ET.SubElement(elems[b.parent], "body", name=b.name, pos=_f(b.pos), quat=_f(b.quat))
         elems[b.name] = el
@@ -322,10 +359,10 @@ def to_mjcf(mech: Mechanism, *, comment: str | None = None) -> str:
                 attrs.update(axis=_f(j.axis), pos=_f(j.pos), ref=_f(j.ref))
             elif j.type == "ball":
                 attrs.update(pos=_f(j.pos))
-            ET.SubElement(el, "joint", **attrs)
+            ET.SubElement(el, "joint", attrs)
         add_geoms(el, b.name)
-        for s, p in aux_sites.get(b.name, []):
-            ET.SubElement(el, "site", name=s, pos=_f(p))
+        for sname, p in aux_sites.get(b.name, []):
+            ET.SubElement(el, "site", name=sname, pos=_f(p))
     for s in mech.sites:
         ET.SubElement(elems[s.body], "site", name=s.name, pos=_f(s.pos), quat=_f(s.quat))
     if len(equality):

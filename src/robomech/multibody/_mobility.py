@@ -27,13 +27,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech.analysis import mobility as screw_mobility
 
 from ._assembly import check_mechanism, check_q, solve_closure
 from ._constraints import jacobian
 from ._model import Mechanism
-from ._tree import kinematics, space_jacobian
+from ._tree import TreeState, kinematics, space_jacobian
 
 __all__ = ["MOBILITY_RTOL", "NEIGHBOUR_STEP", "MobilityReport", "mobility"]
 
@@ -80,7 +81,7 @@ class MobilityReport:
         return s
 
 
-def _scaled_K(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, object]:
+def _scaled_K(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, TreeState]:
     tree = mech.tree
     st = kinematics(tree, q)
     K = jacobian(mech.constraints, tree, st, q)
@@ -161,12 +162,34 @@ def _cut_constraints(mech: Mechanism) -> int:
     return n + sum({1: 3, 2: 5}.get(k, 6) for k in pairs.values())
 
 
-def mobility(mech: Mechanism, q: object = None, *, platform: str | None = None) -> MobilityReport:
+def mobility(mech: Mechanism, q: ArrayLike | None = None, *, platform: str | None = None) -> MobilityReport:
     """Mobility at one assembled configuration ``q (nq,)`` (default the reference configuration).
 
     ``platform`` (a body name; default the body of the first site, if any) adds the platform's twist
     system, and the screw-theory analysis of :mod:`robomech.analysis.mobility` when the platform is
     carried by serial legs.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (nq,), optional
+        An assembled configuration (default ``mech.q0``).
+    platform : str, optional
+        A body name whose twist system is analysed.
+
+    Returns
+    -------
+    MobilityReport
+        ``dof`` (without idle motions), ``redundant_constraints``, ``gruebler_kutzbach``, ``singular``,
+        the actuation and the platform's twists; ``summary()`` gives one line.
+
+    Examples
+    --------
+    >>> from robomech import multibody as mb
+    >>> m = mb.mobility(mb.gallery.load("four_bar"))
+    >>> m.dof, m.gruebler_kutzbach, m.redundant_constraints      # planar: 1 DOF, spatial count 0
+    (1, 0, 1)
     """
     mech = check_mechanism(mech)
     tree = mech.tree

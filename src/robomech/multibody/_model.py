@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
+from numpy.typing import NDArray
 
 from robomech._validation import as_array, check_real
 
@@ -36,6 +37,9 @@ _MIN_NORM = 1e-12
 # when the two anchors of a closure coincide to this distance relative to the mechanism size:
 # a few hundred ulps of the coordinates.
 ASSEMBLED_RTOL = 1e-10
+
+# A point, axis or quaternion given to the Builder: a sequence of floats or a float64 array.
+Vector = Sequence[float] | NDArray[np.float64]
 
 
 def _vec(x: object, n: int, name: str) -> tuple[float, ...]:
@@ -277,23 +281,23 @@ class Mechanism:
                 if j.name in joints:
                     raise ValueError(f"Expected unique joint names, got {j.name!r} twice.")
                 joints[j.name] = j
-        names = set()
-        for c in (*self.closures, *self.couplings):
-            if c.name in names:
-                raise ValueError(f"Expected unique closure/coupling names, got {c.name!r} twice.")
-            names.add(c.name)
+        names: set[str] = set()
+        for cname in (*(c.name for c in self.closures), *(cp.name for cp in self.couplings)):
+            if cname in names:
+                raise ValueError(f"Expected unique closure/coupling names, got {cname!r} twice.")
+            names.add(cname)
         for c in self.closures:
             for bn in (c.body1, c.body2):
                 if bn not in seen:
                     raise ValueError(f"Closure {c.name!r} names unknown body {bn!r}.")
-        for c in self.couplings:
-            for jn in (c.joint1, c.joint2):
+        for cp in self.couplings:
+            for jn in (cp.joint1, cp.joint2):
                 if jn is None:
                     continue
                 if jn not in joints:
-                    raise ValueError(f"Coupling {c.name!r} names unknown joint {jn!r}.")
+                    raise ValueError(f"Coupling {cp.name!r} names unknown joint {jn!r}.")
                 if joints[jn].type not in ("hinge", "slide"):
-                    raise ValueError(f"Expected coupling {c.name!r} to join hinge/slide joints, got {jn!r}.")
+                    raise ValueError(f"Expected coupling {cp.name!r} to join hinge/slide joints, got {jn!r}.")
         site_names = set()
         for s in self.sites:
             if s.name in site_names:
@@ -410,7 +414,7 @@ class Builder:
     (MuJoCo's qpos0 semantics for ``connect`` and ``weld``).
     """
 
-    def __init__(self, name: str = "mechanism", gravity: Sequence[float] = (0.0, 0.0, -9.81)) -> None:
+    def __init__(self, name: str = "mechanism", gravity: Vector = (0.0, 0.0, -9.81)) -> None:
         self.name = _name(name, "name (of the mechanism)")
         self.gravity = _vec(gravity, 3, "gravity")
         self._bodies: list[Body] = []
@@ -422,18 +426,18 @@ class Builder:
     # joints
     @staticmethod
     def hinge(
-        name: str, axis: Sequence[float] = (0, 0, 1), pos: Sequence[float] = (0, 0, 0), ref: float = 0.0
+        name: str, axis: Vector = (0, 0, 1), pos: Vector = (0, 0, 0), ref: float = 0.0
     ) -> Joint:
         return Joint(name, "hinge", tuple(axis), tuple(pos), ref)
 
     @staticmethod
     def slide(
-        name: str, axis: Sequence[float] = (0, 0, 1), pos: Sequence[float] = (0, 0, 0), ref: float = 0.0
+        name: str, axis: Vector = (0, 0, 1), pos: Vector = (0, 0, 0), ref: float = 0.0
     ) -> Joint:
         return Joint(name, "slide", tuple(axis), tuple(pos), ref)
 
     @staticmethod
-    def ball(name: str, pos: Sequence[float] = (0, 0, 0)) -> Joint:
+    def ball(name: str, pos: Vector = (0, 0, 0)) -> Joint:
         return Joint(name, "ball", (0.0, 0.0, 1.0), tuple(pos))
 
     @staticmethod
@@ -442,7 +446,7 @@ class Builder:
 
     @staticmethod
     def universal(
-        name: str, axis1: Sequence[float], axis2: Sequence[float], pos: Sequence[float] = (0, 0, 0)
+        name: str, axis1: Vector, axis2: Vector, pos: Vector = (0, 0, 0)
     ) -> tuple[Joint, Joint]:
         """A universal joint as two hinges through one point (``name_1`` then ``name_2``)."""
         return (
@@ -451,7 +455,7 @@ class Builder:
         )
 
     def helical(
-        self, name: str, axis: Sequence[float], pitch: float, pos: Sequence[float] = (0, 0, 0)
+        self, name: str, axis: Vector, pitch: float, pos: Vector = (0, 0, 0)
     ) -> tuple[Joint, Joint]:
         """A helical joint: hinge ``name_r`` and slide ``name_p`` coupled by ``p = pitch * theta`` (m/rad)."""
         r = Joint(f"{name}_r", "hinge", tuple(axis), tuple(pos))
@@ -464,8 +468,8 @@ class Builder:
         self,
         name: str,
         parent: str = "world",
-        pos: Sequence[float] = (0, 0, 0),
-        quat: Sequence[float] = (1, 0, 0, 0),
+        pos: Vector = (0, 0, 0),
+        quat: Vector = (1, 0, 0, 0),
         joints: Sequence[Joint | tuple[Joint, ...]] = (),
         inertial: Inertial | None = None,
     ) -> str:
@@ -477,7 +481,7 @@ class Builder:
         return name
 
     def site(
-        self, name: str, body: str, pos: Sequence[float] = (0, 0, 0), quat: Sequence[float] = (1, 0, 0, 0)
+        self, name: str, body: str, pos: Vector = (0, 0, 0), quat: Vector = (1, 0, 0, 0)
     ) -> str:
         self._sites.append(Site(name, body, tuple(pos), tuple(quat)))
         return name
@@ -487,8 +491,8 @@ class Builder:
         name: str,
         body1: str,
         body2: str,
-        anchor1: Sequence[float],
-        anchor2: Sequence[float] | None = None,
+        anchor1: Vector,
+        anchor2: Vector | None = None,
     ) -> None:
         """Point closure (MuJoCo ``connect``): ``anchor2`` defaults to the coincident point at q0."""
         self._closures.append(("point", name, body1, body2, tuple(anchor1), anchor2, None))
@@ -498,9 +502,9 @@ class Builder:
         name: str,
         body1: str,
         body2: str,
-        anchor1: Sequence[float],
-        axis: Sequence[float],
-        anchor2: Sequence[float] | None = None,
+        anchor1: Vector,
+        axis: Vector,
+        anchor2: Vector | None = None,
     ) -> None:
         """Hinge closure: as :meth:`connect`, and ``axis`` (body1 frame) fixed in body2."""
         self._closures.append(("revolute", name, body1, body2, tuple(anchor1), anchor2, tuple(axis)))
@@ -510,9 +514,9 @@ class Builder:
         name: str,
         body1: str,
         body2: str,
-        relpos: Sequence[float] | None = None,
-        relquat: Sequence[float] | None = None,
-        anchor2: Sequence[float] = (0, 0, 0),
+        relpos: Vector | None = None,
+        relquat: Vector | None = None,
+        anchor2: Vector = (0, 0, 0),
     ) -> None:
         """Rigid closure (MuJoCo ``weld``): body2's pose in body1; default: the pose at q0."""
         rel = (
@@ -522,7 +526,7 @@ class Builder:
         )
         self._closures.append(("rigid", name, body1, body2, tuple(anchor2), rel, None))
 
-    def couple(self, name: str, joint1: str, joint2: str | None, polycoef: Sequence[float]) -> None:
+    def couple(self, name: str, joint1: str, joint2: str | None, polycoef: Vector) -> None:
         c = tuple(polycoef) + (0.0,) * (5 - len(polycoef))
         self._couplings.append(Coupling(name, joint1, joint2, c))
 

@@ -27,11 +27,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, check_int, check_positive, check_real
 from robomech.analysis import workspace
 
-from ._assembly import check_mechanism, check_q, forward_kinematics, inverse_kinematics
+from ._assembly import FKResult, IKResult, check_mechanism, check_q, forward_kinematics, inverse_kinematics
 from ._influence import _influence_flat
 from ._mobility import mobility
 from ._model import Mechanism
@@ -66,14 +67,45 @@ def _kth(s: np.ndarray, k: int) -> np.ndarray:
 
 def singularities(
     mech: Mechanism,
-    q: object,
+    q: ArrayLike,
     site: str,
     *,
-    reference: object = None,
+    reference: ArrayLike | None = None,
     length: float | None = None,
     rtol: float = workspace.SINGULAR_RTOL,
 ) -> SingularityResult:
-    """Type I / type II / constraint singularity measures of ``site`` at assembled ``q (..., nq)``."""
+    """Type I / type II / constraint singularity measures of ``site`` at assembled ``q (..., nq)``.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (..., nq)
+        Assembled configurations.
+    site : str
+        The output site.
+    reference : array_like, shape (nq,), optional
+        Configuration for the characteristic length (default ``mech.q0``).
+    length : float, optional
+        Characteristic length L (m) that scales rotations and hinge columns (default ``mech.length``).
+    rtol : float, optional
+        Relative threshold of a singular value below which a type counts as singular.
+
+    Returns
+    -------
+    SingularityResult
+        Per sample: ``sigma_I``, ``sigma_II``, ``sigma_C`` (m), ``cond_*``, the flags ``type_I``,
+        ``type_II``, ``constraint``, ``singular`` and the ``length`` used (m).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> s = mb.singularities(mech, mb.forward_kinematics(mech, np.array([0.2])).q, "coupler_point")
+    >>> bool(s.singular), round(float(s.length), 4)            # a regular pose; L in m
+    (False, 0.4753)
+    """
     mech = check_mechanism(mech)
     tree = mech.tree
     if not isinstance(site, str):
@@ -157,15 +189,49 @@ def singularity_map(
     mech: Mechanism,
     site: str,
     *,
-    q_act: object = None,
-    T: object = None,
-    guess: object = None,
+    q_act: ArrayLike | None = None,
+    T: ArrayLike | None = None,
+    guess: ArrayLike | None = None,
     steps: int = 4,
-    ik_weights: object = None,
+    ik_weights: ArrayLike | None = None,
     length: float | None = None,
 ) -> SingularityMapResult:
     """Workspace / dexterity / singularity maps over a grid of inputs ``q_act (..., n_act)`` (FK) or
     of site targets ``T (..., 4, 4)`` (IK), e.g. from :func:`robomech.analysis.workspace.grid`.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    site : str
+        The output site.
+    q_act : array_like, shape (..., n_act), optional
+        A grid of inputs (FK); exactly one of ``q_act`` and ``T``.
+    T : array_like, shape (..., 4, 4), optional
+        A grid of site targets (IK).
+    guess : array_like, shape (..., nq), optional
+        Start configuration of the solves.
+    steps : int, optional
+        Continuation stages of each solve.
+    ik_weights : array_like, shape (6,), optional
+        Error-row weights of the IK solves (:func:`inverse_kinematics`).
+    length : float, optional
+        Characteristic length (m).
+
+    Returns
+    -------
+    SingularityMapResult
+        ``q``, ``reachable``, ``singularity`` (:class:`SingularityResult`), ``cond``, ``dexterity`` and
+        ``singular`` over the grid's batch shape.
+
+    Examples
+    --------
+    >>> from robomech import multibody as mb
+    >>> from robomech.analysis import workspace
+    >>> mech = mb.gallery.load("four_bar")
+    >>> smap = mb.singularity_map(mech, "coupler_point", q_act=workspace.grid([(-0.5, 0.5)], 5))
+    >>> smap.reachable.shape, bool(smap.reachable.all())
+    ((5,), True)
     """
     mech = check_mechanism(mech)
     if not isinstance(site, str):
@@ -176,13 +242,14 @@ def singularity_map(
         check_positive(length, "length")
     if (q_act is None) == (T is None):
         raise ValueError("Expected exactly one of q_act (input grid) or T (output grid).")
+    r: FKResult | IKResult
     if q_act is not None:
         qa = as_array(q_act, "q_act", (len(mech.actuated),), finite="mask")  # beyond 1e100: masked like NaN
         r = forward_kinematics(mech, qa, guess, steps=steps)
-        ok = r.converged
     else:
+        assert T is not None  # exactly one of q_act and T (checked above)
         r = inverse_kinematics(mech, site, T, guess, weights=ik_weights, steps=steps)
-        ok = r.converged
+    ok = r.converged
     q = np.where(ok[..., None], r.q, mech.tree.q0)
     s = singularities(mech, q, site, length=length)
     tree = mech.tree

@@ -167,7 +167,15 @@ def compile_tree(mech) -> Tree:
     nb = len(names)
     parent = np.zeros(nb, dtype=int)
     T_off = np.tile(np.eye(4), (nb, 1, 1))
-    jn, jt, jb, jq, jd, jp, ja, jr, bj = [], [], [], [], [], [], [], [], [[] for _ in range(nb)]
+    jn: list[str] = []
+    jt: list[int] = []
+    jb: list[int] = []
+    jq: list[int] = []
+    jd: list[int] = []
+    jp: list[np.ndarray] = []
+    ja: list[np.ndarray] = []
+    jr: list[float] = []
+    bj: list[list[int]] = [[] for _ in range(nb)]
     q0: list[float] = []
     nq = nv = 0
     dof_body: list[int] = []
@@ -295,7 +303,8 @@ def _kin(tree: Tree, q: np.ndarray, screws: bool) -> TreeState:
     nb = len(tree.body_names)
     T = np.empty((N, nb, 4, 4))
     T[:, 0] = np.eye(4)
-    S = np.zeros((N, tree.nv, 6)) if screws else None
+    # Without screws S is an empty (N, 0, 6) placeholder that is never written (only poses wanted).
+    S = np.zeros((N, tree.nv if screws else 0, 6))
     for b in range(1, nb):
         Tb = T[:, tree.parent[b]] @ tree.T_off[b]
         for k in tree.body_jnts[b]:

@@ -201,7 +201,7 @@ def compare(
                 "contact": run.in_contact.mean(axis=0),
                 "on_terrain": bool(run.on_terrain.all()),
                 "chi_own": own.model.track_width_factor(robot.track_width)
-                if own.identifiable
+                if own.identifiable and own.model is not None
                 else float("nan"),
                 "yaw_rms": {e: float(np.sqrt(np.mean((y - yaw_true) ** 2))) for e, y in est_yaw.items()},
                 "drift_per_m": {
@@ -231,7 +231,7 @@ def _wls_rows(robot: ss.ExplorationRobot, run: EngineRun, name: str, rng: np.ran
         sig[6:9] *= scale_rear  # right rear wheel (WHEELS order), x/y/z
         sig[15:18] *= scale_rear  # left rear wheel
         meas = run.measured + rng.normal(size=run.measured.shape) * sig
-        out = [name, label]
+        out: list[object] = [name, label]
         for weights in (None, sig):
             bv = ss.body_velocity(robot, run.config, meas, measurement_sigma=weights)
             e = bv.twist - run.twist

@@ -73,7 +73,7 @@ def _conditioning_sweep(robot: ExplorationRobot) -> list[list[object]]:
     V = rng.uniform(-0.3, 0.3, size=(n, 6))
     qd = rng.uniform(-0.3, 0.3, size=(n, 8))
     qd[:, 4] = -qd[:, 0]
-    rows = []
+    rows: list[list[object]] = []
     for offset in (6.8e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8):
         r = dataclasses.replace(robot, side_link_hinge_offset=offset)
         m = wheel_measurements(r, q, V, qd)

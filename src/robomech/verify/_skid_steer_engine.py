@@ -23,6 +23,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from robomech._validation import as_array, check_params, check_positive, coerce_float_fields
 from robomech.mechanisms.skid_steer import WHEELS, ExplorationRobot, wheel_radii
@@ -86,8 +87,9 @@ class Terrain:
     def is_flat(self) -> bool:
         return len(self.amplitude) == 0
 
-    def height(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        z = np.zeros(np.broadcast_shapes(np.shape(x), np.shape(y)))
+    def height(self, x: ArrayLike, y: ArrayLike) -> NDArray[np.float64]:
+        x, y = np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)
+        z = np.zeros(np.broadcast_shapes(x.shape, y.shape))
         for a, kx, ky, ph in zip(self.amplitude, self.kx, self.ky, self.phase, strict=True):
             z = z + a * np.sin(kx * x + ky * y + ph)
         return z
@@ -344,7 +346,7 @@ class EngineRun:
 
 def simulate_engine(
     robot: ExplorationRobot,
-    track_speeds: object,
+    track_speeds: ArrayLike,
     duration: float,
     *,
     terrain: Terrain | None = None,

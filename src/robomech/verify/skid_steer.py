@@ -354,7 +354,7 @@ def identify_from_runs(robot: ExplorationRobot, runs) -> ICRModel:
         parts.append((vr, vl, planar_twist(u)[sl]))
     vr, vl, V = (np.concatenate(x) for x in zip(*parts, strict=True))
     ident = identify_icr(vr, vl, V)
-    if not ident.identifiable:
+    if not ident.identifiable or ident.model is None:
         raise RuntimeError("ICR identification data carry no turning (internal manoeuvre set is wrong).")
     return ident.model
 

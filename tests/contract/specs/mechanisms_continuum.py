@@ -2,6 +2,7 @@
 
 import numpy as np
 from contract_spec import (
+    BAD_BOOL,
     BAD_INT,
     BAD_NONNEGATIVE,
     BAD_POSITIVE,
@@ -22,6 +23,8 @@ DIRECTION = np.ones((3, 3))
 Q = c.compensated_drive(ROBOT, PSI).q
 BAD_MODEL = ("helix", None, 1)
 _W = np.abs(np.random.default_rng(0).normal(size=(3, 8)))
+_T3 = np.array([[8.0, 4.0, 4.0], [9.0, 3.0, 3.0], [4.0, 7.0, 4.0]])
+_D3 = np.array([[1.0, -1.0, -1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0]])
 
 
 def _psi(**extra):
@@ -40,9 +43,14 @@ def _psi_model(default):
 SPECS = {
     P + "IK_TOLERANCE": CONSTANT,
     P + "IDENTIFY_MU_MAX": CONSTANT,
+    P + "IDENTIFY_STIFFNESS_BOUNDS": CONSTANT,
+    P + "COMPENSATION_ITERATIONS": CONSTANT,
+    P + "COMPENSATION_STEP_TOL": CONSTANT,
+    P + "DISK_MAX_ITERATIONS": CONSTANT,
+    P + "DISK_TOLERANCE": CONSTANT,
     **exempt(
-        "DriveResult FrictionEstimate IKResult PoseFrictionEstimate SimulationResult TensionHistory "
-        "TensionResult",
+        "DiskEquilibrium DriveResult FrictionEstimate IKResult PoseFrictionEstimate SimulationResult "
+        "TensionHistory TensionResult TipFrictionEstimate",
         RESULT_TYPE,
         P,
     ),
@@ -115,11 +123,12 @@ SPECS = {
             "direction": DIRECTION,
             "wrench": np.zeros((3, 6)),
             "model": "chord",
+            "method": "paper",
         },
         arrays={"psi": 1, "direction": 1, "wrench": 1},
         params=("robot",),
         mask="taut",
-        options={"model": BAD_MODEL},
+        options={"model": BAD_MODEL, "method": ("segment", None, 1)},
     ),
     P + "simulate": Spec(
         args={"robot": ROBOT, "q": Q, "direction": DIRECTION, "model": "chord"},
@@ -162,6 +171,28 @@ SPECS = {
         arrays={"psi": 1, "t_act": 1},
         params=("robot",),
         empty_batch=False,  # the leading axis is time: a history needs a first step
+    ),
+    P + "disk_equilibrium": Spec(
+        args={"robot": ROBOT, "tension": TENSION, "direction": DIRECTION, "initial": PSI},
+        arrays={"tension": 1, "direction": 1, "initial": 1},
+        params=("robot",),
+        mask="converged",
+        options={"tension": (-np.ones(3),)},
+    ),
+    P + "identify_friction_from_tip": Spec(
+        args={
+            "robot": ROBOT,
+            "tip": c.disk_equilibrium(ROBOT, tension=_T3, direction=_D3).tip,
+            "t_act": _T3,
+            "direction": _D3,
+            "fit_stiffness": False,
+            "sigma_t": 0.05,
+            "sigma_tip": 2e-5,
+        },
+        arrays={"tip": 1, "t_act": 1, "direction": 1},
+        params=("robot",),
+        options={"fit_stiffness": BAD_BOOL, "sigma_t": (0.0, -1.0, "a"), "sigma_tip": (0.0, -1.0, "a")},
+        empty_batch=False,  # the leading axis lists measurements of one fit (m >= 1 required)
     ),
     P + "identify_friction_from_pose": Spec(
         args={

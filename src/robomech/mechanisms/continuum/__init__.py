@@ -6,13 +6,17 @@ See ``docs/mechanisms/continuum.md`` for every assumption and every departure fr
 """
 
 from ._compensation import (
+    COMPENSATION_ITERATIONS,
+    COMPENSATION_STEP_TOL,
     DriveResult,
     SimulationResult,
     cable_elongation,
     compensated_drive,
+    disk_equilibrium,
     simulate,
     theoretical_drive,
 )
+from ._disks import DISK_MAX_ITERATIONS, DISK_TOLERANCE, DiskEquilibrium
 from ._friction import (
     FrictionEstimate,
     TensionHistory,
@@ -24,7 +28,14 @@ from ._friction import (
     stick_slip_tensions,
     wrap_angles,
 )
-from ._identification import IDENTIFY_MU_MAX, PoseFrictionEstimate, identify_friction_from_pose
+from ._identification import (
+    IDENTIFY_MU_MAX,
+    IDENTIFY_STIFFNESS_BOUNDS,
+    PoseFrictionEstimate,
+    TipFrictionEstimate,
+    identify_friction_from_pose,
+    identify_friction_from_tip,
+)
 from ._kinematics import (
     IK_TOLERANCE,
     IKResult,
@@ -49,9 +60,15 @@ from ._statics import (
 )
 
 __all__ = [
+    "COMPENSATION_ITERATIONS",
+    "COMPENSATION_STEP_TOL",
+    "DISK_MAX_ITERATIONS",
+    "DISK_TOLERANCE",
     "IDENTIFY_MU_MAX",
+    "IDENTIFY_STIFFNESS_BOUNDS",
     "IK_TOLERANCE",
     "ContinuumRobot",
+    "DiskEquilibrium",
     "DriveResult",
     "FrictionEstimate",
     "IKResult",
@@ -59,6 +76,7 @@ __all__ = [
     "SimulationResult",
     "TensionHistory",
     "TensionResult",
+    "TipFrictionEstimate",
     "cable_elongation",
     "cable_jacobian",
     "cable_lengths",
@@ -68,6 +86,7 @@ __all__ = [
     "classical_capstan_ratio",
     "compensated_drive",
     "coupling_moments",
+    "disk_equilibrium",
     "disk_transforms",
     "elastic_energy",
     "elastic_gradient",
@@ -75,6 +94,7 @@ __all__ = [
     "friction_factors",
     "identify_friction",
     "identify_friction_from_pose",
+    "identify_friction_from_tip",
     "inverse_kinematics",
     "segment_transform",
     "simulate",

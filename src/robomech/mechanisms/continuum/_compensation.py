@@ -8,17 +8,21 @@ elongation delta to it).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
-from robomech._validation import as_array, check_params
+from robomech._validation import as_array, check_choice, check_params
 
+from ._disks import DiskEquilibrium, _solve, _uniform_k
 from ._friction import _as_direction, _factors, _wrap
-from ._kinematics import CableModel, _segment_spans, _split, span_lengths
+from ._kinematics import CableModel, _fk, _segment_spans, _split, span_lengths
 from ._params import ContinuumRobot
 from ._statics import TensionResult, cable_tensions
 
 __all__ = [
+    "COMPENSATION_ITERATIONS",
+    "COMPENSATION_STEP_TOL",
     "SIM_BACKTRACKS",
     "SIM_FD_STEP",
     "SIM_MAX_ITERATIONS",
@@ -27,6 +31,7 @@ __all__ = [
     "SimulationResult",
     "cable_elongation",
     "compensated_drive",
+    "disk_equilibrium",
     "simulate",
     "theoretical_drive",
 ]
@@ -41,6 +46,15 @@ SIM_MAX_ITERATIONS = 40
 SIM_BACKTRACKS = 12
 # Central-difference step (rad) for the 2n x 2n Newton matrix: eps^(1/3) for O(1) curvature.
 SIM_FD_STEP = 6e-6
+# compensated_drive(method="disk"): Gauss-Newton on the commanded pose psi' (bending vectors), stopped
+# when the step is below 1e-10 rad (the segment ends then sit at their least-squares point to ~1e-11 m;
+# the residual itself is not 0: a 2n-parameter family cannot hit 3n coordinates exactly) ...
+COMPENSATION_STEP_TOL = 1e-10
+# ... or after 12 iterations (3-5 are needed from psi' = psi; the Jacobian is a central difference).
+COMPENSATION_ITERATIONS = 12
+COMPENSATION_FD_STEP = 1e-6  # rad, central difference of the segment ends in psi'
+
+CompensationMethod = Literal["paper", "disk"]
 
 
 def _lengths_and_factors(robot, theta, beta, direction, model):
@@ -50,7 +64,7 @@ def _lengths_and_factors(robot, theta, beta, direction, model):
     return ell, P
 
 
-def _l0(robot: ContinuumRobot, model: str) -> np.ndarray:
+def _l0(robot: ContinuumRobot, model: CableModel) -> np.ndarray:
     return span_lengths(robot, np.zeros(2 * robot.n_segments), model).sum(axis=-1)
 
 
@@ -110,15 +124,37 @@ def compensated_drive(
     *,
     model: CableModel = "chord",
     wrench: object | None = None,
+    method: CompensationMethod = "paper",
 ) -> DriveResult:
     """Feed-forward drive for pose ``psi (..., 2 n)``: q~ = q + delta (paper 3, eq. (37), Fig. 10).
 
-    The tensions come from :func:`cable_tensions` (virtual work, friction along the disks in the sliding
-    ``direction``, pretension in the null space), the elongation from :func:`cable_elongation`.
+    ``method="paper"``: the tensions come from :func:`cable_tensions` (virtual work, friction along the
+    disks in the sliding ``direction``, pretension in the null space), the elongation from
+    :func:`cable_elongation`, q~ = q + delta.
+
+    ``method="disk"`` (issue 16; not in the paper): the drive that puts the segment ends of the
+    disk-wise constant-curvature model (:func:`disk_equilibrium`: one arc per disk interval, so the
+    curvature can fall from disk to disk under friction) on the commanded ones.  A pose psi' is sought
+    (Gauss-Newton, least squares over the 3 n end coordinates) whose library tensions
+    (:func:`cable_tensions` at psi', same pretension rule) hold the disk-wise robot with its segment ends
+    at those of psi; q~ is the drive of that equilibrium (chord lengths and cable stretch included), and
+    ``delta = q~ - q``.  Chord cables only (``model="chord"``), no ``wrench``.
     """
     check_params(robot, ContinuumRobot, "robot")
+    check_choice(method, "method", ("paper", "disk"))
     theta, beta = _split(robot, psi)
     psi_a = np.stack([theta, beta], -1).reshape(*theta.shape[:-1], 2 * theta.shape[-1])
+    if method == "disk":
+        if model != "chord":
+            raise ValueError(f"Expected model='chord' with method='disk' (chord spans), got {model!r}.")
+        if wrench is not None:
+            raise ValueError("Expected wrench=None with method='disk' (no tip load in the disk-wise model).")
+        d = _as_direction(robot, direction, theta.shape[:-1])
+        q = theoretical_drive(robot, psi_a, "chord")
+        eq = _disk_compensation(robot, theta, beta, d)
+        return DriveResult(
+            q=q, delta=eq.drive - q, q_compensated=eq.drive, tension=eq.tension, taut=eq.taut & eq.converged
+        )
     tr: TensionResult = cable_tensions(robot, psi_a, wrench=wrench, direction=direction, model=model)
     q = theoretical_drive(robot, psi_a, model)
     delta = cable_elongation(robot, psi_a, tr.tension, direction, model)
@@ -247,3 +283,94 @@ def simulate(
         residual=res,
         iterations=iterations,
     )
+
+
+# ---- disk-wise constant curvature (issue 16) ----------------------------------------------------
+def _ends_of(robot: ContinuumRobot, eq: DiskEquilibrium) -> np.ndarray:
+    N = robot.disks_per_segment
+    return eq.disk_T[..., N::N, :3, 3].reshape(*eq.tip.shape[:-1], 3 * robot.n_segments)
+
+
+def _psi_from_u(u: np.ndarray) -> np.ndarray:
+    th, be = _k_to_psi(u)
+    return np.stack([th, be], -1).reshape(u.shape)
+
+
+def _disk_at(robot: ContinuumRobot, u: np.ndarray, d: np.ndarray) -> DiskEquilibrium:
+    """Disk-wise equilibrium under the library's tensions for the commanded pose with bending vectors u."""
+    psi = _psi_from_u(u)
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        t = cable_tensions(robot, np.nan_to_num(psi), direction=d).tension
+    th, be = psi[..., 0::2], psi[..., 1::2]
+    return _solve(robot, _uniform_k(robot, th, be), t, d, "tension")
+
+
+def _disk_compensation(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray, d: np.ndarray):
+    n = robot.n_segments
+    target = _fk(robot, theta, beta)[..., :3, 3].reshape(*theta.shape[:-1], 3 * n)
+    u = np.stack([theta * np.cos(beta), theta * np.sin(beta)], -1).reshape(*theta.shape[:-1], 2 * n)
+    done = np.zeros(theta.shape[:-1], dtype=bool)
+    eye = np.eye(2 * n)
+    for _ in range(COMPENSATION_ITERATIONS):
+        e = _ends_of(robot, _disk_at(robot, u, d)) - target
+        cols = [
+            (
+                _ends_of(robot, _disk_at(robot, u + COMPENSATION_FD_STEP * v, d))
+                - _ends_of(robot, _disk_at(robot, u - COMPENSATION_FD_STEP * v, d))
+            )
+            / (2.0 * COMPENSATION_FD_STEP)
+            for v in eye
+        ]
+        Jm = np.nan_to_num(np.stack(cols, -1))
+        step = np.einsum("...ij,...j->...i", np.linalg.pinv(Jm), np.nan_to_num(e))
+        u = np.where(done[..., None], u, u - step)
+        done = done | (np.max(np.abs(step), axis=-1) < COMPENSATION_STEP_TOL)
+        if np.all(done):
+            break
+    return _disk_at(robot, u, d)
+
+
+def disk_equilibrium(
+    robot: ContinuumRobot,
+    *,
+    tension: object | None = None,
+    drive: object | None = None,
+    direction: object | None = None,
+    initial: object | None = None,
+) -> DiskEquilibrium:
+    """Equilibrium of the disk-wise constant-curvature robot: one arc per disk interval (issue 16).
+
+    Exactly one of ``tension (..., 3 n)`` (actuator-side tensions, N, >= 0) and ``drive (..., 3 n)``
+    (cable pulled in since the straight pretensioned pose, m; elastic cables, slack ones flagged).
+    ``direction (..., 3 n)`` the sliding direction of every cable (+1 pulled in, -1 paid out; None
+    frictionless), ``initial (..., 2 n)`` a segment pose to start from (default: the straight robot).
+    Chord spans, wrap angles, capstan friction and cable stretch as in the segment model; the
+    curvature may differ from interval to interval.  See :class:`DiskEquilibrium` and
+    ``docs/mechanisms/continuum.md``.
+    """
+    check_params(robot, ContinuumRobot, "robot")
+    if (tension is None) == (drive is None):
+        raise ValueError("Expected exactly one of tension and drive, got both or neither.")
+    if tension is not None:
+        load = as_array(tension, "tension", (robot.n_cables,))
+        if np.any(load < 0.0):
+            raise ValueError(f"Expected tension >= 0 (a cable cannot push), got min {float(load.min())!r}.")
+        mode: Literal["tension", "drive"] = "tension"
+    else:
+        load = as_array(drive, "drive", (robot.n_cables,))
+        mode = "drive"
+    batch = load.shape[:-1]
+    if initial is not None:
+        th0, be0 = _split(robot, initial, "initial")
+        batch = np.broadcast_shapes(batch, th0.shape[:-1])
+    else:
+        th0 = np.zeros((*batch, robot.n_segments))
+        be0 = np.zeros_like(th0)
+    d = _as_direction(robot, direction, batch)
+    batch = np.broadcast_shapes(batch, d.shape[:-1])
+    k0 = np.broadcast_to(
+        _uniform_k(robot, th0, be0), (*batch, 2 * robot.n_segments * robot.disks_per_segment)
+    )
+    load = np.broadcast_to(load, (*batch, robot.n_cables))
+    d = np.broadcast_to(d, (*batch, robot.n_cables))
+    return _solve(robot, k0, load, d, mode)

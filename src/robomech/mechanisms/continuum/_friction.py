@@ -34,7 +34,11 @@ __all__ = [
 
 # ---- wrap angles and the capstan transfer along the disks -----------------------------------------
 def _wrap(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray) -> np.ndarray:
-    T = _disk_T(robot, theta, beta)  # (..., 1 + nN, 4, 4)
+    return _wrap_from_disks(robot, _disk_T(robot, theta, beta))
+
+
+def _wrap_from_disks(robot: ContinuumRobot, T: np.ndarray) -> np.ndarray:
+    """Wrap angles (..., 3n, nN) from the base plate and disk poses T (..., 1 + nN, 4, 4)."""
     r, sig = robot.hole_radius, robot.hole_angles
     holes_local = np.stack([r * np.cos(sig), r * np.sin(sig), np.zeros_like(sig)], -1)  # (3n, 3)
     holes = np.einsum("...kab,cb->...cka", T[..., :3, :3], holes_local) + T[..., None, :, :3, 3]

@@ -9,13 +9,20 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from robomech._validation import as_array, check_params, check_positive
+from robomech._validation import as_array, check_bool, check_params, check_positive
 
 from ._kinematics import CableModel
 from ._params import ContinuumRobot
 from ._statics import cable_tensions
 
-__all__ = ["IDENTIFY_MU_MAX", "PoseFrictionEstimate", "identify_friction_from_pose"]
+__all__ = [
+    "IDENTIFY_MU_MAX",
+    "IDENTIFY_STIFFNESS_BOUNDS",
+    "PoseFrictionEstimate",
+    "TipFrictionEstimate",
+    "identify_friction_from_pose",
+    "identify_friction_from_tip",
+]
 
 IDENTIFY_MU_MAX = 2.0
 """Upper bound of the fitted μ (Coulomb coefficients of polymer cable on aluminium are 0.1-0.6; the bound
@@ -103,4 +110,158 @@ def identify_friction_from_pose(
         residual_rms=float(np.sqrt(np.mean(sol.fun**2))),
         identifiable=identifiable,
         success=bool(sol.success),
+    )
+
+
+IDENTIFY_STIFFNESS_BOUNDS = (0.25, 4.0)
+"""Bounds of the fitted core-stiffness factor EI / EI_robot (the modulus of NiTi spans 40-75 GPa and the
+core diameter is not printed: a factor 4 either way covers any plausible core)."""
+
+
+@dataclass(frozen=True)
+class TipFrictionEstimate:
+    """Output-error fit of the disk-wise model to tracked tips (issue 16).
+
+    ``mu (3 n,)`` friction per cable, ``stiffness_scale`` the fitted EI / EI_robot (1.0 if not fitted);
+    ``std``, ``ci_low``, ``ci_high`` for ``[*mu, stiffness_scale]`` (the last entry only if fitted):
+    linearised covariance s² (JᵀJ)⁻¹ with s² the residual variance of the tip fit (model error
+    included, not only the tracker noise); ``residual_rms`` (m) of the tip; ``identifiable`` per
+    parameter; ``success`` of the solver and every disk-wise equilibrium converged."""
+
+    mu: np.ndarray
+    stiffness_scale: float
+    std: np.ndarray
+    ci_low: np.ndarray
+    ci_high: np.ndarray
+    residual_rms: float
+    identifiable: np.ndarray
+    success: bool
+
+
+def identify_friction_from_tip(
+    robot: ContinuumRobot,
+    tip: object,
+    t_act: object,
+    direction: object,
+    *,
+    fit_stiffness: bool = False,
+    initial: object | None = None,
+    sigma_t: float | None = None,
+    sigma_tip: float | None = None,
+) -> TipFrictionEstimate:
+    """Friction coefficients (and optionally the core stiffness) from tracked tips (issue 16).
+
+    Measurements: ``tip (m, 3)`` tracked tip positions (m), ``t_act (m, 3 n)`` actuator-side tensions
+    (load cells, N), ``direction (m, 3 n)`` the sliding direction (±1).  Model: the disk-wise
+    constant-curvature robot (:func:`disk_equilibrium`: one arc per disk interval, capstan friction at
+    every hole) carrying the measured tensions; ``scipy.optimize.least_squares`` minimises the tip
+    residual over μ (0 ≤ μ ≤ ``IDENTIFY_MU_MAX``) and, if ``fit_stiffness``, the factor EI / EI_robot
+    (within ``IDENTIFY_STIFFNESS_BOUNDS``).  ``initial (m, 2 n)``: segment poses to start the
+    equilibria from (e.g. IK of the tips; default straight).
+
+    With ``sigma_t`` (load-cell noise, N) and ``sigma_tip`` (tracker noise, m) the fit is errors in
+    variables: the true tensions are unknowns too, residuals ``(t - t_act)/sigma_t`` and
+    ``(tip(t) - tip)/sigma_tip`` (the measured tensions are noisy inputs of the model; an output-error
+    fit that takes them as exact biases the stiffness factor and μ with it: measured on reference data,
+    EI +5 %, μ −15 %).  The covariance then uses s² = 1 (the stated noise levels); without them s²
+    is the residual variance of the tip fit.
+
+    Departure from paper 3, eq. (38): the paper fits the model tensions at the measured pose to the
+    measured tensions (an inverse-model residual, its constant-curvature pose taken from the tip).
+    Under friction the shape is not one arc per segment, and that fit absorbs the shape error into μ
+    (−25 % on reference data); here the forward model predicts the tip from the measured tensions
+    (output error), which needs no pose inversion.
+    """
+    from ._compensation import disk_equilibrium
+
+    check_params(robot, ContinuumRobot, "robot")
+    n_c = robot.n_cables
+    p = as_array(tip, "tip", (3,))
+    t = as_array(t_act, "t_act", (n_c,))
+    d = as_array(direction, "direction", (n_c,))
+    if p.ndim != 2 or p.shape[0] < 1 or t.shape != (p.shape[0], n_c) or d.shape != t.shape:
+        raise ValueError(
+            f"Expected tip (m, 3), t_act and direction (m, {n_c}) with one m >= 1, got "
+            f"{p.shape}, {t.shape}, {d.shape}."
+        )
+    if np.any((d != 1.0) & (d != -1.0)):
+        raise ValueError("Expected direction entries +1 or -1 (a sliding cable), got others.")
+    if np.any(t <= 0.0):
+        raise ValueError("Expected t_act > 0 (a slack cable carries no friction information).")
+    fit = check_bool(fit_stiffness, "fit_stiffness")
+    init = None if initial is None else as_array(initial, "initial", (2 * robot.n_segments,))
+    if init is not None and init.shape != (p.shape[0], 2 * robot.n_segments):
+        raise ValueError(f"Expected initial ({p.shape[0]}, {2 * robot.n_segments}), got {init.shape}.")
+    if (sigma_t is None) != (sigma_tip is None):
+        raise ValueError("Expected both sigma_t and sigma_tip (errors in variables) or neither, got one.")
+    eiv = sigma_t is not None
+    if eiv:
+        sig_t = check_positive(sigma_t, "sigma_t")
+        sig_p = check_positive(sigma_tip, "sigma_tip")
+    state = {"ok": True}
+
+    def robot_of(x: np.ndarray) -> ContinuumRobot:
+        mod = robot.core_modulus * (float(x[n_c]) if fit else 1.0)
+        return dataclasses.replace(robot, friction=tuple(float(m) for m in x[:n_c]), core_modulus=mod)
+
+    k_par = n_c + int(fit)
+    m = p.shape[0]
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        tt = x[k_par:].reshape(m, n_c) if eiv else t
+        eq = disk_equilibrium(robot_of(x), tension=np.maximum(tt, 0.0), direction=d, initial=init)
+        state["ok"] = bool(np.all(eq.converged))
+        r = np.nan_to_num((eq.tip - p).ravel(), nan=1.0)
+        if not eiv:
+            return r
+        return np.concatenate([r / sig_p, (tt - t).ravel() / sig_t])
+
+    x0 = np.clip(robot.friction_array, 0.0, IDENTIFY_MU_MAX)
+    lo, hi = np.zeros(n_c), np.full(n_c, IDENTIFY_MU_MAX)
+    if fit:
+        x0 = np.append(x0, 1.0)
+        lo, hi = np.append(lo, IDENTIFY_STIFFNESS_BOUNDS[0]), np.append(hi, IDENTIFY_STIFFNESS_BOUNDS[1])
+    x0 = np.clip(x0, lo + 1e-9, hi - 1e-9)
+    sparsity = None
+    if eiv:
+        # the tip of measurement i depends on the parameters and on its own tensions only
+        x0 = np.concatenate([x0, t.ravel()])
+        lo, hi = np.concatenate([lo, np.zeros(t.size)]), np.concatenate([hi, np.full(t.size, np.inf)])
+        sparsity = np.zeros((3 * m + t.size, k_par + t.size), dtype=bool)
+        sparsity[: 3 * m, :k_par] = True
+        for i in range(m):
+            sparsity[3 * i : 3 * i + 3, k_par + n_c * i : k_par + n_c * (i + 1)] = True
+        sparsity[3 * m :, k_par:] = np.eye(t.size, dtype=bool)
+    sol = least_squares(
+        residual,
+        x0,
+        bounds=(lo, hi),
+        x_scale=np.concatenate([np.full(k_par, 0.1), np.full(x0.size - k_par, 0.1)]),
+        diff_step=1e-6,
+        jac_sparsity=sparsity,
+        method="trf",
+    )
+    residual(sol.x)  # the final state's convergence
+    J = sol.jac.toarray() if hasattr(sol.jac, "toarray") else np.asarray(sol.jac)
+    dof = max(J.shape[0] - J.shape[1], 1)
+    s2 = 1.0 if eiv else float(np.sum(sol.fun**2)) / dof
+    identifiable = np.linalg.norm(J, axis=0) > 0.0
+    k = J.shape[1]
+    cov = np.full((k, k), np.inf)
+    idx = np.flatnonzero(identifiable)
+    if idx.size:
+        Ji = J[:, idx]
+        cov[np.ix_(idx, idx)] = s2 * np.linalg.pinv(Ji.T @ Ji)
+    std = np.sqrt(np.diag(cov))[:k_par]
+    xp = sol.x[:k_par]
+    tip_res = sol.fun[: 3 * m] * (sig_p if eiv else 1.0)
+    return TipFrictionEstimate(
+        mu=sol.x[:n_c],
+        stiffness_scale=float(sol.x[n_c]) if fit else 1.0,
+        std=std,
+        ci_low=xp - _Z95 * std,
+        ci_high=xp + _Z95 * std,
+        residual_rms=float(np.sqrt(np.mean(tip_res**2))),
+        identifiable=identifiable[:k_par],
+        success=bool(sol.success) and state["ok"],
     )

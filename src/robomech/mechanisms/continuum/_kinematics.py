@@ -201,7 +201,8 @@ def _segment_planes(theta: np.ndarray, beta: np.ndarray, length: np.ndarray | fl
     Pf = P.reshape(16, -1)
     th, be = _flat(theta, shape), _flat(beta, shape)
     scalar_length = np.ndim(length) == 0
-    ln = float(length) if scalar_length else _flat(length, shape)
+    ln_arr = None if scalar_length else _flat(np.asarray(length, dtype=float), shape)
+    ln = float(length) if scalar_length else 0.0
     for k in range(0, th.size, CHUNK):
         c = slice(k, k + CHUNK)
         t = np.ascontiguousarray(th[c])
@@ -226,7 +227,7 @@ def _segment_planes(theta: np.ndarray, beta: np.ndarray, length: np.ndarray | fl
         Pf[10, c] = ct
         # paper 3, eq. (2), written with (1 - cos t)/t and sin t / t so that it is finite at theta = 0
         # (Taylor series on the rare entries below SMALL_ANGLE).
-        lc = ln if scalar_length else ln[c]
+        lc = ln if ln_arr is None else ln_arr[c]
         fc *= lc
         np.multiply(fc, cb, out=Pf[3, c])
         np.multiply(fc, sb, out=Pf[7, c])
@@ -241,6 +242,27 @@ def segment_transform(theta: object, beta: object, length: object) -> np.ndarray
 
     ``theta`` bend angle (rad), ``beta`` bending-plane angle (rad), ``length`` arc length (m); all
     broadcast.  Rotation ``Rz(beta) Ry(theta) Rz(-beta)``; exact and finite at ``theta = 0`` (series).
+
+    Parameters
+    ----------
+    theta : array_like, shape (...)
+        Bend angle (rad).
+    beta : array_like, shape (...)
+        Bending-plane angle about the base z axis (rad).
+    length : array_like, shape (...)
+        Arc length of the segment (m).
+
+    Returns
+    -------
+    ndarray, shape (..., 4, 4)
+        ``T`` of the segment's end frame in its base frame (m).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> T = segment_transform(np.pi / 2, 0.0, 0.09)          # a quarter circle of radius 0.0573 m
+    >>> T[:3, 3].round(4), T[:3, 2].round(12) + 0.0         # end point; the end tangent is +x
+    (array([0.0573, 0.    , 0.0573]), array([1., 0., 0.]))
     """
     t = as_array(theta, "theta")
     b = as_array(beta, "beta")
@@ -275,6 +297,27 @@ def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """Poses ``T_0i (..., n, 4, 4)`` of every segment's end frame in the base frame (paper 3, eq. (3)).
 
     The array may be a non-contiguous view (the matrix entries are computed as contiguous planes).
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
+    psi : array_like, shape (..., 2 n)
+        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., n, 4, 4)
+        ``T_0i`` of each segment's end frame in the base frame (m).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> robot = cr.ContinuumRobot.paper()                       # one 0.09 m segment
+    >>> T = cr.forward_kinematics(robot, np.array([np.pi / 2, 0.0]))   # bent 90 deg in the x-z plane
+    >>> T.shape, T[0, :3, 3].round(6)                          # on an arc of radius 0.09 / (pi/2)
+    ((1, 4, 4), array([0.057296, 0.      , 0.057296]))
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split_views(robot, psi)
@@ -282,7 +325,27 @@ def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
 
 
 def tip_position(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """Tip position ``(..., 3)`` in the base frame (m)."""
+    """Tip position ``(..., 3)`` in the base frame (m).
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m).
+    psi : array_like, shape (..., 2 n)
+        Bend and bending-plane angles of the segments (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Tip position in the base frame (m).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> cr.tip_position(cr.ContinuumRobot.paper(), np.zeros(2))     # straight: the segment length on z
+    array([0.  , 0.  , 0.09])
+    """
     check_params(robot, ContinuumRobot, "robot")
     return forward_kinematics(robot, psi)[..., -1, :3, 3]
 
@@ -351,6 +414,26 @@ def tip_jacobian(robot: ContinuumRobot, psi: object) -> np.ndarray:
 
     ``omega`` is the tip frame's angular velocity and ``v_tip`` the velocity of the tip point (paper 3,
     eq. (6): J_xomega stacked on J_xv, angular first as in robomech's twists).
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m).
+    psi : array_like, shape (..., 2 n)
+        Bend and bending-plane angles of the segments (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 6, 2 n)
+        ``[omega; v_tip]`` per unit ``psi_dot`` (rad/s, m/s), base frame.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> J = cr.tip_jacobian(cr.ContinuumRobot.paper(), np.array([np.pi / 2, 0.0]))
+    >>> J.shape, J[:3, 0].round(12) + 0.0          # bending turns the tip about the base y axis
+    ((6, 2), array([0., 1., 0.]))
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split_views(robot, psi)
@@ -358,7 +441,27 @@ def tip_jacobian(robot: ContinuumRobot, psi: object) -> np.ndarray:
 
 
 def disk_transforms(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """Poses of the base plate and of every disk, ``(..., 1 + n N, 4, 4)``, in the base frame."""
+    """Poses of the base plate and of every disk, ``(..., 1 + n N, 4, 4)``, in the base frame.
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m).
+    psi : array_like, shape (..., 2 n)
+        Bend and bending-plane angles of the segments (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 1 + n N, 4, 4)
+        The base plate, then the N disks of each segment, in the base frame (m).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> cr.disk_transforms(cr.ContinuumRobot.paper(), np.zeros(2)).shape     # base + 5 disks
+    (6, 4, 4)
+    """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     return _disk_T(robot, theta, beta)
@@ -426,7 +529,29 @@ def _active(robot: ContinuumRobot) -> np.ndarray:
 
 
 def span_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "chord") -> np.ndarray:
-    """Length of every cable span ``(..., 3 n, n N)`` (zero beyond the cable's termination disk)."""
+    """Length of every cable span ``(..., 3 n, n N)`` (zero beyond the cable's termination disk).
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m).
+    psi : array_like, shape (..., 2 n)
+        Bend and bending-plane angles of the segments (rad).
+    model : {"chord", "arc"}, optional
+        Cable path model.
+
+    Returns
+    -------
+    ndarray, shape (..., 3 n, n N)
+        Length of each cable's span between consecutive disks (m).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> cr.span_lengths(cr.ContinuumRobot.paper(), np.zeros(2))[0]   # straight: 0.09 m / 5 disks
+    array([0.018, 0.018, 0.018, 0.018, 0.018])
+    """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     ell, _, _ = _segment_spans(robot, theta, beta, model)
@@ -434,7 +559,22 @@ def span_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "chord"
 
 
 def span_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "chord") -> np.ndarray:
-    """``d span / d psi``: ``(..., 3 n, n N, 2 n)``."""
+    """``d span / d psi``: ``(..., 3 n, n N, 2 n)``.
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m).
+    psi : array_like, shape (..., 2 n)
+        Bend and bending-plane angles of the segments (rad).
+    model : {"chord", "arc"}, optional
+        Cable path model.
+
+    Returns
+    -------
+    ndarray, shape (..., 3 n, n N, 2 n)
+        ``d span / d psi`` (m/rad).
+    """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     return _span_jac(robot, theta, beta, model)
@@ -457,6 +597,28 @@ def cable_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "arc")
 
     ``model="arc"`` is paper 3, eq. (4) (cable parallel to the core); ``model="chord"`` takes straight
     cable spans between the holes of consecutive disks (what a real cable does).
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m).
+    psi : array_like, shape (..., 2 n)
+        Bend and bending-plane angles of the segments (rad).
+    model : {"arc", "chord"}, optional
+        Cable path model (see above).
+
+    Returns
+    -------
+    ndarray, shape (..., 3 n)
+        Cable lengths (m), cable ``3 i + j`` of segment i.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> robot = cr.ContinuumRobot.paper()                    # holes at r = 4 mm, 0 and ±120 deg
+    >>> cr.cable_lengths(robot, np.array([np.pi / 2, 0.0])).round(6)   # L - theta r cos(beta - phi_j)
+    array([0.083717, 0.093142, 0.093142])
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -465,7 +627,31 @@ def cable_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "arc")
 
 
 def cable_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "arc") -> np.ndarray:
-    """``J_qpsi = d cable_lengths / d psi``, ``(..., 3 n, 2 n)`` (paper 3, eq. (5) for one segment)."""
+    """``J_qpsi = d cable_lengths / d psi``, ``(..., 3 n, 2 n)`` (paper 3, eq. (5) for one segment).
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m).
+    psi : array_like, shape (..., 2 n)
+        Bend and bending-plane angles of the segments (rad).
+    model : {"arc", "chord"}, optional
+        Cable path model.
+
+    Returns
+    -------
+    ndarray, shape (..., 3 n, 2 n)
+        ``d l / d psi`` (m/rad).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> cr.cable_jacobian(cr.ContinuumRobot.paper(), np.array([np.pi / 2, 0.0])).round(5)
+    array([[-0.004  ,  0.     ],
+           [ 0.002  , -0.00544],
+           [ 0.002  ,  0.00544]])
+    """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     return _span_jac(robot, theta, beta, model).sum(axis=-2)
@@ -657,6 +843,26 @@ def inverse_kinematics(robot: ContinuumRobot, p_tip: object) -> IKResult:
     robot's reach (|p| <= n l) that are still not reached are restarted from a small fixed set of other
     shapes (IK_STARTS: segments bent in opposite or crossed planes, different bends); the pose with the
     smallest residual is kept, with its ``converged`` flag.  Targets beyond the reach get one solve only.
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m).
+    p_tip : array_like, shape (..., 3)
+        Tip targets in the base frame (m).
+
+    Returns
+    -------
+    IKResult
+        ``psi (..., 2 n)`` (rad), ``residual`` (m), ``reachable``, ``converged`` and ``iterations``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> ik = cr.inverse_kinematics(cr.ContinuumRobot.paper(), np.array([0.057296, 0.0, 0.057296]))
+    >>> ik.psi.round(4), bool(ik.converged)
+    (array([1.5708, 0.    ]), True)
     """
     check_params(robot, ContinuumRobot, "robot")
     p = as_array(p_tip, "p_tip", (3,))
@@ -687,8 +893,12 @@ def inverse_kinematics(robot: ContinuumRobot, p_tip: object) -> IKResult:
         idx = idx[r >= IK_TOLERANCE]
     _normalise(theta, beta)
     beta[theta == 0.0] = 0.0  # beta is undefined on a straight segment: 0 by convention
-    psi = psi.reshape(*batch, 2 * n)
-    res, converged, iterations = res.reshape(batch), converged.reshape(batch), iterations.reshape(batch)
+    psi_out: np.ndarray = psi.reshape(*batch, 2 * n)
+    res_out: np.ndarray = res.reshape(batch)
     return IKResult(
-        psi=psi, residual=res, reachable=res < IK_TOLERANCE, converged=converged, iterations=iterations
+        psi=psi_out,
+        residual=res_out,
+        reachable=res_out < IK_TOLERANCE,
+        converged=converged.reshape(batch),
+        iterations=iterations.reshape(batch),
     )

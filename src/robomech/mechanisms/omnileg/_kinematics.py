@@ -83,6 +83,25 @@ def forward_kinematics(leg: OmniLeg, q: object) -> np.ndarray:
     """Foot position ``p_F`` in the hip frame (..., 3), metres, from ``q = (α, β, γ)`` (..., 3), rad.
 
     Exactly paper 2, eq. (11) (Z0 toward the foot).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m), e.g. ``OmniLeg.paper()``.
+    q : array_like, shape (..., 3)
+        Joint angles ``(α, β, γ)`` (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Foot position ``p_F`` in the hip frame (m).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import omnileg as ol
+    >>> ol.forward_kinematics(ol.OmniLeg.paper(), np.array([0.1, 0.2, 0.8])).round(5)
+    array([ 0.02966, -0.01468,  0.43868])
     """
     check_params(leg, OmniLeg, "leg")
     q = _q(q)
@@ -143,6 +162,27 @@ def jacobian(leg: OmniLeg, q: object) -> np.ndarray:
 
     With w = (sβ cα, -cβ sα, cβ cα), N = |w| and u = w/N (module docstring):
     ``∂p/∂(α, β) = L1 (I - u uᵀ) ∂w/∂(α, β) / N``, ``∂p/∂γ = (0, 0, -2 L4 sin γ)``.
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m).
+    q : array_like, shape (..., 3)
+        Joint angles ``(α, β, γ)`` (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        ``∂p_F,i/∂q_j`` (m/rad), hip frame.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import omnileg as ol
+    >>> ol.jacobian(ol.OmniLeg.paper(), np.array([0.1, 0.2, 0.8])).round(4)
+    array([[-0.0029,  0.1464,  0.    ],
+           [-0.1464,  0.0029,  0.    ],
+           [-0.0141, -0.0294, -0.1363]])
     """
     check_params(leg, OmniLeg, "leg")
     q = _q(q)
@@ -248,6 +288,28 @@ def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
     eq. (11)); γ = arccos((P_z - L5 - s) / (2 L4)) (printed with only s divided by 2 L4), where
     ``s = sqrt(L1² - P_x² - P_y²)`` is the depth of the knee below O0.  Non-finite input samples are
     flagged (``exists`` false), not raised.
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m).
+    p_foot : array_like, shape (..., 3)
+        Foot positions in the hip frame (m).
+
+    Returns
+    -------
+    IKResult
+        ``q (..., 3)`` joint angles (rad), ``exists``, ``within_limits`` and ``reachable`` per sample.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import omnileg as ol
+    >>> leg = ol.OmniLeg.paper()
+    >>> p = ol.forward_kinematics(leg, np.array([0.1, 0.2, 0.8]))
+    >>> ik = ol.inverse_kinematics(leg, p)
+    >>> ik.q.round(12), bool(ik.reachable)                      # the round trip
+    (array([0.1, 0.2, 0.8]), True)
     """
     check_params(leg, OmniLeg, "leg")
     p = as_array(p_foot, "p_foot", (3,), finite="mask")  # NaN, inf, beyond 1e100: masked

@@ -14,6 +14,7 @@ and axes parallel to that link's.  At each instant P_w coincides with a frame P�
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, check_params
 
@@ -97,7 +98,7 @@ def side_points(robot: ExplorationRobot, q: np.ndarray) -> dict[str, np.ndarray]
     }
 
 
-def _check_config(config: object) -> np.ndarray:
+def _check_config(config: ArrayLike) -> np.ndarray:
     return as_array(config, "config", (CONFIG_SIZE,))
 
 
@@ -112,8 +113,28 @@ def _blocked(kernel, q: np.ndarray, tail: tuple[int, ...]) -> np.ndarray:
     return out.reshape(*batch, *tail)
 
 
-def contact_frames(robot: ExplorationRobot, config: object) -> np.ndarray:
-    """Poses ``T_BP`` of the six contact frames in the body frame: ``(..., 6, 4, 4)``, order ``WHEELS``."""
+def contact_frames(robot: ExplorationRobot, config: ArrayLike) -> np.ndarray:
+    """Poses ``T_BP`` of the six contact frames in the body frame: ``(..., 6, 4, 4)``, order ``WHEELS``.
+
+    Parameters
+    ----------
+    robot : ExplorationRobot
+        The robot's geometry (m), e.g. ``ExplorationRobot.paper()``.
+    config : array_like, shape (..., 8)
+        Joint configuration: per side ``SIDE_JOINTS`` (rocker, bogie and slide coordinates; rad, m).
+
+    Returns
+    -------
+    ndarray, shape (..., 6, 4, 4)
+        ``T_BP`` of each wheel's contact frame in the body frame B, wheels in ``WHEELS`` order.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> robot = ExplorationRobot.paper()
+    >>> contact_frames(robot, np.zeros(8)).shape
+    (6, 4, 4)
+    """
     check_params(robot, ExplorationRobot, "robot")
     q = _check_config(config)
     return _blocked(lambda qc: _contact_frames(robot, qc), q, (N_WHEELS, 4, 4))
@@ -178,12 +199,31 @@ def _linear_columns(robot: ExplorationRobot, q: np.ndarray) -> tuple[np.ndarray,
     return p, alpha, G
 
 
-def wheel_jacobians(robot: ExplorationRobot, config: object) -> np.ndarray:
+def wheel_jacobians(robot: ExplorationRobot, config: ArrayLike) -> np.ndarray:
     """Space Jacobians of the contact frames relative to the body: ``(..., 6, 6, 4)``.
 
     ``J[..., w, :, j]`` is the twist ``[ω; v]`` (in B, ``v`` the velocity of the point at B's origin)
     of contact frame ``w`` relative to the body per unit rate of joint ``j`` of its side
     (``SIDE_JOINTS``); joints outside the wheel's chain give zero columns.  ``ω = (0, Σ rates, 0)``.
+
+    Parameters
+    ----------
+    robot : ExplorationRobot
+        The robot's geometry (m).
+    config : array_like, shape (..., 8)
+        Joint configuration (rad, m), ``SIDE_JOINTS`` per side.
+
+    Returns
+    -------
+    ndarray, shape (..., 6, 6, 4)
+        Per wheel (``WHEELS`` order) the 6 x 4 Jacobian of its contact frame relative to B, columns
+        the four joints of its side; twists ``[ω; v]`` in body axes (rad/s, m/s per unit joint rate).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> wheel_jacobians(ExplorationRobot.paper(), np.zeros((5, 8))).shape   # a batch of 5
+    (5, 6, 6, 4)
     """
     check_params(robot, ExplorationRobot, "robot")
     q = _check_config(config)

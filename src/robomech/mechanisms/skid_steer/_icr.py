@@ -21,6 +21,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, check_params, check_positive, coerce_float_fields
 from robomech.analysis import lstsq
@@ -87,10 +88,29 @@ class PlanarVelocity:
     valid: np.ndarray
 
 
-def icr_velocity(model: ICRModel, v_right: object, v_left: object) -> PlanarVelocity:
+def icr_velocity(model: ICRModel, v_right: ArrayLike, v_left: ArrayLike) -> PlanarVelocity:
     """Body velocity predicted by the ICR model from the right and left track (encoder) speeds (m/s).
 
     Non-finite speeds (encoder drop-outs) are flagged per sample by ``valid``.
+
+    Parameters
+    ----------
+    model : ICRModel
+        Track ICR positions (m, body axes).
+    v_right, v_left : array_like, shape (...)
+        Track speeds (m/s); broadcast together.
+
+    Returns
+    -------
+    PlanarVelocity
+        Planar body velocity ``(v_x, v_y, r)`` (m/s, m/s, rad/s) and ``valid`` per sample.
+
+    Examples
+    --------
+    >>> icr = ICRModel.no_slip(0.5)                  # ICRs on the track lines, 0.5 m apart
+    >>> v = icr_velocity(icr, 1.0, 0.5)
+    >>> float(v.yaw_rate), float(v.v_x), abs(float(v.v_y))   # (v_r - v_l) / S, mean speed, no side slip
+    (1.0, 0.75, 0.0)
     """
     check_params(model, ICRModel, "model")
     vr = as_array(v_right, "v_right", finite="mask")
@@ -115,7 +135,23 @@ def icr_velocity(model: ICRModel, v_right: object, v_left: object) -> PlanarVelo
 
 
 def wheel_radii(robot: ExplorationRobot) -> np.ndarray:
-    """Rolling radius of each wheel in ``WHEELS`` order (m): road wheels, then the rear wheel, per side."""
+    """Rolling radius of each wheel in ``WHEELS`` order (m): road wheels, then the rear wheel, per side.
+
+    Parameters
+    ----------
+    robot : ExplorationRobot
+        The robot's geometry.
+
+    Returns
+    -------
+    ndarray, shape (6,)
+        Rolling radii (m), ``WHEELS`` order.
+
+    Examples
+    --------
+    >>> wheel_radii(ExplorationRobot.paper())
+    array([0.05, 0.05, 0.1 , 0.05, 0.05, 0.1 ])
+    """
     check_params(robot, ExplorationRobot, "robot")
     return np.array([robot.road_wheel_radius if "road" in w else robot.rear_wheel_radius for w in WHEELS])
 
@@ -130,9 +166,30 @@ class TrackSpeeds:
     valid: np.ndarray
 
 
-def encoder_track_speeds(robot: ExplorationRobot, wheel_rate: object) -> TrackSpeeds:
+def encoder_track_speeds(robot: ExplorationRobot, wheel_rate: ArrayLike) -> TrackSpeeds:
     """No-slip track speeds from the wheel spin rates ``(..., 6)`` (rad/s): the mean rim speed
-    ``r_w φ̇_w`` of each side's three wheels.  A sample with a non-finite wheel rate is flagged."""
+    ``r_w φ̇_w`` of each side's three wheels.  A sample with a non-finite wheel rate is flagged.
+
+    Parameters
+    ----------
+    robot : ExplorationRobot
+        The robot's geometry (wheel radii, m).
+    wheel_rate : array_like, shape (..., 6)
+        Wheel spin rates (rad/s), ``WHEELS`` order.
+
+    Returns
+    -------
+    TrackSpeeds
+        ``right``, ``left`` (m/s) and ``valid``, each of shape ``(...)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> robot = ExplorationRobot.paper()
+    >>> ts = encoder_track_speeds(robot, np.array([10.0, 10.0, 5.0, 8.0, 8.0, 4.0]))   # rad/s
+    >>> round(float(ts.right), 12), round(float(ts.left), 12)          # rim speeds r * rate (m/s)
+    (0.5, 0.4)
+    """
     radii = wheel_radii(robot)
     w = as_array(wheel_rate, "wheel_rate", (N_WHEELS,), finite=False)
     valid = np.all(np.isfinite(w), axis=-1)
@@ -162,7 +219,7 @@ class ICRIdentification:
 
 
 def identify_icr(
-    v_right: object, v_left: object, body_velocity: object, *, weights: object | None = None
+    v_right: ArrayLike, v_left: ArrayLike, body_velocity: ArrayLike, *, weights: ArrayLike | None = None
 ) -> ICRIdentification:
     """Identify ``(y_right, y_left, x_icr)`` from track speeds ``(N,)`` and measured planar body
     velocities ``(N, 3)`` = ``(v_x, v_y, r)`` by linear least squares (``analysis.lstsq``).
@@ -173,6 +230,32 @@ def identify_icr(
     which would overflow the products) are not used and are reported in ``used`` (nothing is
     dropped silently).  Straight driving carries no information (its rows are zero); a data set without
     turning is reported ``identifiable = False``.
+
+    Parameters
+    ----------
+    v_right, v_left : array_like, shape (N,)
+        Track (encoder) speeds (m/s).
+    body_velocity : array_like, shape (N, 3)
+        Measured planar body velocities ``(v_x, v_y, r)`` (m/s, m/s, rad/s).
+    weights : array_like, shape (N,), optional
+        Per-sample weights (``>= 0``).
+
+    Returns
+    -------
+    ICRIdentification
+        The identified ``model`` (or ``None``), ``residual_rms (3,)`` (m/s), ``used (N,)``,
+        ``n_used``, ``cond`` and ``identifiable``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> true = ICRModel(y_left=0.3, y_right=-0.32, x_icr=0.02)
+    >>> r = np.array([0.2, -0.4, 0.5, 0.1])                          # yaw rates (rad/s)
+    >>> vx = np.array([0.5, 0.3, 0.2, 0.4])
+    >>> V = np.stack([vx, -r * true.x_icr, r], axis=-1)
+    >>> ident = identify_icr(vx - r * true.y_right, vx - r * true.y_left, V)
+    >>> ident.identifiable, np.round([ident.model.y_left, ident.model.y_right, ident.model.x_icr], 12)
+    (True, array([ 0.3 , -0.32,  0.02]))
     """
     vr = as_array(v_right, "v_right", finite="mask")
     vl = as_array(v_left, "v_left", finite="mask")
@@ -228,11 +311,37 @@ class WheelSlip:
 
 
 def wheel_slip(
-    robot: ExplorationRobot, wheel_rate: object, body_velocity: object, config: object | None = None
+    robot: ExplorationRobot, wheel_rate: ArrayLike, body_velocity: ArrayLike, config: ArrayLike | None = None
 ) -> WheelSlip:
     """Slip of each wheel from its spin rate ``(..., 6)`` (rad/s) and the planar body velocity
     ``(..., 3)`` = ``(v_x, v_y, r)``; contacts at ``config (..., 8)`` (default: zero joint angles with
-    the nominal slides), planar rigid motion: contact ``(x, y)`` moves at ``(v_x - r y, v_y + r x)``."""
+    the nominal slides), planar rigid motion: contact ``(x, y)`` moves at ``(v_x - r y, v_y + r x)``.
+
+    Parameters
+    ----------
+    robot : ExplorationRobot
+        The robot's geometry (m).
+    wheel_rate : array_like, shape (..., 6)
+        Wheel spin rates (rad/s), ``WHEELS`` order.
+    body_velocity : array_like, shape (..., 3)
+        Planar body velocity ``(v_x, v_y, r)`` (m/s, m/s, rad/s).
+    config : array_like, shape (..., 8), optional
+        Joint configuration for the contact positions (rad, m).
+
+    Returns
+    -------
+    WheelSlip
+        Per wheel ``(..., 6)``: the slip ``ratio``, the ``lateral_velocity`` (m/s) and ``valid``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> robot = ExplorationRobot.paper()
+    >>> rate = 0.5 / wheel_radii(robot)                     # every rim at 0.5 m/s
+    >>> s = wheel_slip(robot, rate, np.array([0.5, 0.0, 0.0]))   # straight at 0.5 m/s: no slip
+    >>> np.abs(s.ratio).max() < 1e-12, bool(s.valid.all())
+    (np.True_, True)
+    """
     radii = wheel_radii(robot)
     w = as_array(wheel_rate, "wheel_rate", (N_WHEELS,), finite=False)
     V = as_array(body_velocity, "body_velocity", (3,))

@@ -18,6 +18,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import (
     as_array,
@@ -111,11 +112,29 @@ class EncoderReadings:
     valid: np.ndarray
 
 
-def encoder_rates(model: EncoderModel, wheel_rate: object, dt: float, seed: object = 0) -> EncoderReadings:
+def encoder_rates(
+    model: EncoderModel, wheel_rate: ArrayLike, dt: float, seed: int | np.random.Generator = 0
+) -> EncoderReadings:
     """Measured spin rates from true rates ``(N, 6)`` sampled every ``dt`` s.
 
     The true angle is integrated by the trapezoidal rule from a random initial phase (``seed``: an int
     or a ``numpy.random.Generator``), counted, and differenced; the first sample has no reading.
+
+    Parameters
+    ----------
+    model : EncoderModel
+        Encoder resolution.
+    wheel_rate : array_like, shape (N, 6)
+        True wheel spin rates (rad/s).
+    dt : float
+        Sample period (s), ``> 0``.
+    seed : int or numpy.random.Generator, optional
+        Random initial phase of the counters.
+
+    Returns
+    -------
+    EncoderReadings
+        ``rate (N, 6)`` measured rates (rad/s; NaN in the first sample) and ``valid (N,)``.
     """
     check_params(model, EncoderModel, "model")
     w = as_array(wheel_rate, "wheel_rate", (None, N_WHEELS), min_ndim=2)
@@ -135,9 +154,32 @@ def encoder_rates(model: EncoderModel, wheel_rate: object, dt: float, seed: obje
 
 
 def imu_measurements(
-    model: ImuModel, angular_velocity: object, specific_force: object, dt: float, seed: object = 0
+    model: ImuModel,
+    angular_velocity: ArrayLike,
+    specific_force: ArrayLike,
+    dt: float,
+    seed: int | np.random.Generator = 0,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Gyro and accelerometer readings ``(N, 3)`` each from true body-axis values ``(N, 3)``."""
+    """Gyro and accelerometer readings ``(N, 3)`` each from true body-axis values ``(N, 3)``.
+
+    Parameters
+    ----------
+    model : ImuModel
+        Noise densities and biases of the gyro and the accelerometer.
+    angular_velocity : array_like, shape (N, 3)
+        True body angular velocity (rad/s, body axes).
+    specific_force : array_like, shape (N, 3)
+        True specific force (m/s², body axes).
+    dt : float
+        Sample period (s), ``> 0``.
+    seed : int or numpy.random.Generator, optional
+        Random state of the noise.
+
+    Returns
+    -------
+    gyro, accel : ndarray, shape (N, 3)
+        Gyro (rad/s) and accelerometer (m/s²) readings.
+    """
     check_params(model, ImuModel, "model")
     w = as_array(angular_velocity, "angular_velocity", (3,))
     a = as_array(specific_force, "specific_force", (3,))
@@ -151,10 +193,24 @@ def imu_measurements(
     return gyro, acc
 
 
-def track_speed_sigma(encoder: EncoderModel, radii: object, dt: float) -> float:
+def track_speed_sigma(encoder: EncoderModel, radii: ArrayLike, dt: float) -> float:
     """Standard deviation of a side's encoder track speed (mean of its wheels' rim speeds, m/s).
 
     ``radii``: the side's wheel radii (m); the wheels' quantisation errors are independent.
+
+    Parameters
+    ----------
+    encoder : EncoderModel
+        Encoder resolution.
+    radii : array_like, shape (k,)
+        The side's wheel radii (m).
+    dt : float
+        Sample period (s), ``> 0``.
+
+    Returns
+    -------
+    float
+        Standard deviation of the side's track speed (m/s).
     """
     check_params(encoder, EncoderModel, "encoder")
     r = as_array(radii, "radii", (None,))
@@ -179,7 +235,7 @@ class EKFResult:
     gyro_used: np.ndarray
 
 
-def _check_times(t: object) -> np.ndarray:
+def _check_times(t: ArrayLike) -> np.ndarray:
     ta = as_array(t, "t", (None,))
     if ta.ndim != 1 or ta.size < 2:
         raise ValueError(f"Expected t to have shape (N,) with N >= 2, got {ta.shape}.")
@@ -192,10 +248,10 @@ def _check_times(t: object) -> np.ndarray:
 
 
 def planar_ekf(
-    t: object,
-    v_right: object,
-    v_left: object,
-    gyro_z: object,
+    t: ArrayLike,
+    v_right: ArrayLike,
+    v_left: ArrayLike,
+    gyro_z: ArrayLike,
     icr: ICRModel,
     *,
     sigma_track: float,
@@ -204,12 +260,12 @@ def planar_ekf(
     accel_psd: float = 0.5,
     yaw_accel_psd: float = 2.0,
     bias_psd: float = 1e-8,
-    initial_pose: object = (0.0, 0.0, 0.0),
+    initial_pose: ArrayLike = (0.0, 0.0, 0.0),
     initial_bias_sigma: float = 0.01,
     icr_sigma: float = 0.0,
     icr_psd: float = 0.0,
-    encoder_ok: object | None = None,
-    gyro_ok: object | None = None,
+    encoder_ok: ArrayLike | None = None,
+    gyro_ok: ArrayLike | None = None,
 ) -> EKFResult:
     """Extended Kalman filter for planar odometry: encoders through the ICR model, and a gyro.
 
@@ -233,6 +289,36 @@ def planar_ekf(
     ``gyro_ok`` (bool ``(N,)``, default all true) mark the samples with a reading; the values there must
     be finite (a NaN elsewhere raises: nothing is skipped silently), the others are ignored, and
     ``encoder_used`` / ``gyro_used`` report what entered.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Uniform sample times (s).
+    v_right, v_left : array_like, shape (N,)
+        Encoder track speeds (m/s).
+    gyro_z : array_like, shape (N,)
+        Gyro yaw-rate readings (rad/s).
+    icr : ICRModel
+        Initial track ICRs (m).
+    sigma_track, sigma_gyro : float
+        Measurement noise of a track speed (m/s) and of the gyro (rad/s).
+    sigma_model : float, optional
+        Extra per-side model noise (m/s).
+    accel_psd, yaw_accel_psd, bias_psd : float, optional
+        Random-walk spectral densities (m²/s³, rad²/s³, rad²/s³).
+    initial_pose : array_like, shape (3,), optional
+        ``(x, y, ψ)`` at ``t[0]`` (m, m, rad).
+    initial_bias_sigma : float, optional
+        Initial 1σ of the gyro bias (rad/s).
+    icr_sigma, icr_psd : float, optional
+        Initial 1σ (m) and random-walk density (m²/s) of the track ICRs (0: fixed).
+    encoder_ok, gyro_ok : array_like of bool, shape (N,), optional
+        Samples with a reading (default all).
+
+    Returns
+    -------
+    EKFResult
+        State and covariance histories and the samples used.
     """
     ta = _check_times(t)
     n = ta.size

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, broadcast_batch, check_positive
 from robomech.spatial import exp_se3
@@ -45,13 +46,31 @@ class SkidSteerTurn:
     turning: np.ndarray
 
 
-def skid_steer_turn(v_right: object, v_left: object, track_width: float) -> SkidSteerTurn:
+def skid_steer_turn(v_right: ArrayLike, v_left: ArrayLike, track_width: float) -> SkidSteerTurn:
     """Yaw rate, speed and turning radius of the body centre from the right (``v1``) and left (``v2``)
     track speeds (m/s), for tracks ``track_width`` (m) apart, assuming no longitudinal slip.
 
     paper 4, Sec. 1.2: printed ``R_s = (S/2)(v1+v2)/(v1-v2)`` is called the inner wheel's radius; it is
     the radius of the body centre (the inner track runs at ``R_s - S/2``).  Printed ``ω = 2 v_X / L``;
     the yaw rate consistent with the geometry is ``(v1 - v2)/S``.
+
+    Parameters
+    ----------
+    v_right, v_left : array_like, shape (...)
+        Right and left track speeds (m/s); broadcast together.
+    track_width : float
+        Distance between the track centre lines ``S`` (m), ``> 0``.
+
+    Returns
+    -------
+    SkidSteerTurn
+        ``yaw_rate`` (rad/s), ``forward_speed`` (m/s), signed ``radius`` (m) and ``turning``.
+
+    Examples
+    --------
+    >>> t = skid_steer_turn(1.0, 0.5, 0.6)
+    >>> round(float(t.yaw_rate), 12), float(t.forward_speed), round(float(t.radius), 12)  # R = v / r
+    (0.833333333333, 0.75, 0.9)
     """
     v1 = as_array(v_right, "v_right")
     v2 = as_array(v_left, "v_left")
@@ -66,11 +85,31 @@ def skid_steer_turn(v_right: object, v_left: object, track_width: float) -> Skid
     return SkidSteerTurn(yaw_rate=diff / S, forward_speed=0.5 * total, radius=radius, turning=turning)
 
 
-def wheel_lateral_velocity(yaw_rate: object, wheel_x: object, icr_x: object = 0.0) -> np.ndarray:
+def wheel_lateral_velocity(yaw_rate: ArrayLike, wheel_x: ArrayLike, icr_x: ArrayLike = 0.0) -> np.ndarray:
     """Lateral (body y) sliding velocity of a contact at body ``x = wheel_x`` (m) of a body turning at
     ``yaw_rate`` about a centre of rotation at longitudinal position ``icr_x`` (m): ``r (x_w - x_icr)``.
 
     Planar rigid motion: the velocity of point ``p`` is ``r z × (p - p_icr)``, whose y part is this.
+
+    Parameters
+    ----------
+    yaw_rate : array_like, shape (...)
+        Body yaw rate ``r`` (rad/s).
+    wheel_x : array_like, shape (...)
+        Longitudinal position of the contact in body axes (m).
+    icr_x : array_like, shape (...), optional
+        Longitudinal position of the centre of rotation (m), default 0.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Lateral sliding velocity (m/s) of the broadcast shape.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> wheel_lateral_velocity(0.5, np.array([0.3, -0.3]))    # front and rear wheels slide opposite ways
+    array([ 0.15, -0.15])
     """
     r = as_array(yaw_rate, "yaw_rate")
     x = as_array(wheel_x, "wheel_x")
@@ -88,13 +127,37 @@ class LateralSlip:
     valid: np.ndarray
 
 
-def paper_lateral_slip(v_outer: object, wheelbase: float, radius: object, track_width: float) -> LateralSlip:
+def paper_lateral_slip(
+    v_outer: ArrayLike, wheelbase: float, radius: ArrayLike, track_width: float
+) -> LateralSlip:
     """paper 4, Sec. 1.2: ``v_Y = v_X L / (2 R_s + S)``, magnitude of the lateral slip of an outer
     wheel a distance ``L/2`` ahead of or behind the centre of rotation, with ``R_s`` the radius of the
     body centre (not of the inner wheel, as printed).
 
     Samples at the formula's singularity ``2 R + S = 0`` (the centre of rotation on the inner track, which
     is then at rest) are flagged (``valid`` false, NaN) instead of returned as huge or infinite values.
+
+    Parameters
+    ----------
+    v_outer : array_like, shape (...)
+        Speed of the outer track ``v_X`` (m/s).
+    wheelbase : float
+        Distance ``L`` between the front and rear wheels (m), ``> 0``.
+    radius : array_like, shape (...)
+        Turning radius ``R_s`` of the body centre (m).
+    track_width : float
+        Track width ``S`` (m), ``> 0``.
+
+    Returns
+    -------
+    LateralSlip
+        ``lateral_speed`` (m/s) and ``valid`` per sample.
+
+    Examples
+    --------
+    >>> s = paper_lateral_slip(1.0, wheelbase=0.6, radius=2.0, track_width=0.6)
+    >>> round(float(s.lateral_speed), 6)                 # 1.0 * 0.6 / (2 * 2.0 + 0.6)
+    0.130435
     """
     v = as_array(v_outer, "v_outer")
     R = as_array(radius, "radius")
@@ -108,12 +171,34 @@ def paper_lateral_slip(v_outer: object, wheelbase: float, radius: object, track_
     return LateralSlip(lateral_speed=np.where(valid, out, np.nan), valid=valid)
 
 
-def dead_reckoning(twists: object, dt: float, T0: object | None = None) -> np.ndarray:
+def dead_reckoning(twists: ArrayLike, dt: float, T0: ArrayLike | None = None) -> np.ndarray:
     """Body poses ``T_GB (..., N, 4, 4)`` from body twists ``[ω; v]`` ``(..., N, 6)`` sampled every ``dt`` s.
 
     Between samples the twist is taken as the mean of its end values (second order in ``dt``):
     ``T_{k+1} = T_k exp(dt (V_k + V_{k+1})/2)``.  The running product is evaluated as a parallel prefix
     scan (``log2 N`` batched matrix products), so there is no Python loop over samples.
+
+    Parameters
+    ----------
+    twists : array_like, shape (..., N, 6)
+        Body twists ``[ω; v]`` in body axes (rad/s, m/s), one per sample, ``N >= 1``.
+    dt : float
+        Sample period (s), ``> 0``.
+    T0 : array_like, shape (..., 4, 4), optional
+        Initial pose ``T_GB`` (default the identity).
+
+    Returns
+    -------
+    ndarray, shape (..., N, 4, 4)
+        Poses ``T_GB`` at the sample times (the first is ``T0``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> V = np.tile([0.0, 0.0, 0.5, 1.0, 0.0, 0.0], (3, 1))     # 1 m/s forward turning at 0.5 rad/s
+    >>> T = dead_reckoning(V, 0.1)
+    >>> T.shape, T[-1, :2, 3].round(4)                          # on the arc of radius 2 m after 0.2 s
+    ((3, 4, 4), array([0.1997, 0.01  ]))
     """
     V = as_array(twists, "twists", (None, 6), min_ndim=2)
     h = check_positive(dt, "dt")

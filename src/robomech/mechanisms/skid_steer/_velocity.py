@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, broadcast_batch, check_bool, check_params
 from robomech.analysis import lstsq
@@ -54,8 +55,30 @@ ASSEMBLY_CHUNK = 256
 _PASSIVE = ((5, 6, 9), (7, 8, 10))
 
 
-def assemble(robot: ExplorationRobot, config: object) -> tuple[np.ndarray, np.ndarray]:
-    """``A0 (..., 30, 11)`` and ``J (..., 30, 22)`` of the composite system at ``config (..., 8)``."""
+def assemble(robot: ExplorationRobot, config: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """``A0 (..., 30, 11)`` and ``J (..., 30, 22)`` of the composite system at ``config (..., 8)``.
+
+    Parameters
+    ----------
+    robot : ExplorationRobot
+        The robot's geometry (m).
+    config : array_like, shape (..., 8)
+        Joint configuration (rad, m).
+
+    Returns
+    -------
+    A0 : ndarray, shape (..., 30, 11)
+        Coefficients of the unknowns ``ṗ`` (body twist and passive joint rates, paper order).
+    J : ndarray, shape (..., 30, 22)
+        Coefficients of the measured vector ``q̇`` (wheel spin rates, rocker rates, gyro): ``A0 ṗ = J q̇``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> A0, J = assemble(ExplorationRobot.paper(), np.zeros(8))
+    >>> A0.shape, J.shape
+    ((30, 11), (30, 22))
+    """
     check_params(robot, ExplorationRobot, "robot")
     q = as_array(config, "config", (CONFIG_SIZE,))
     batch = q.shape[:-1]
@@ -119,7 +142,7 @@ def _assemble(robot: ExplorationRobot, q: np.ndarray) -> tuple[np.ndarray, np.nd
 
 
 def wheel_measurements(
-    robot: ExplorationRobot, config: object, twist: object, config_rate: object
+    robot: ExplorationRobot, config: ArrayLike, twist: ArrayLike, config_rate: ArrayLike
 ) -> np.ndarray:
     """Exact measurements ``q̇ (..., 22)`` of a known motion (the forward velocity map).
 
@@ -127,6 +150,31 @@ def wheel_measurements(
     velocity of the body centre); ``config_rate (..., 8)`` the joint rates.  :func:`body_velocity`
     recovers everything from these except that it reports ``ω_BY = (ω1 + ω2)/2``, which is the true
     pitch rate only when the differential holds (``θ̇2 = -θ̇1``).
+
+    Parameters
+    ----------
+    robot : ExplorationRobot
+        The robot's geometry (m).
+    config : array_like, shape (..., 8)
+        Joint configuration (rad, m).
+    twist : array_like, shape (..., 6)
+        Body twist ``[ω_B; v_B]`` relative to the ground, body axes (rad/s, m/s).
+    config_rate : array_like, shape (..., 8)
+        Joint rates (rad/s, m/s).
+
+    Returns
+    -------
+    ndarray, shape (..., 22)
+        The measured vector (module docstring): wheel spin rates, rocker rates and the gyro.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> robot = ExplorationRobot.paper()
+    >>> twist = np.array([0.0, 0.0, 0.2, 0.5, 0.0, 0.0])    # 0.5 m/s forward, turning at 0.2 rad/s
+    >>> m = wheel_measurements(robot, np.zeros(8), twist, np.zeros(8))
+    >>> body_velocity(robot, np.zeros(8), m).twist.round(12) + 0.0   # recovered exactly
+    array([0. , 0. , 0.2, 0.5, 0. , 0. ])
     """
     check_params(robot, ExplorationRobot, "robot")
     q = as_array(config, "config", (CONFIG_SIZE,))
@@ -172,12 +220,12 @@ class BodyVelocity:
 
 def body_velocity(
     robot: ExplorationRobot,
-    state: object,
-    measured: object,
+    state: ArrayLike,
+    measured: ArrayLike,
     *,
     solver: Literal["qr", "normal_equations"] = "qr",
     exact_cond: bool = False,
-    measurement_sigma: object | None = None,
+    measurement_sigma: ArrayLike | None = None,
 ) -> BodyVelocity:
     """Body twist and passive joint rates from wheel and rocker measurements, per sample.
 
@@ -193,6 +241,37 @@ def body_velocity(
     ``1 / Σ_j J_ij² σ_j²``, the inverse variance of its right-hand side.  The rows' correlations (the
     gyro appears in all six wheels' angular rows) are neglected: a diagonal weighting, not full GLS.
     ``residual_norm`` is then the weighted (dimensionless) residual.
+
+    Parameters
+    ----------
+    robot : ExplorationRobot
+        The robot's geometry (m).
+    state : array_like, shape (..., 8)
+        Joint configuration (rad, m).
+    measured : array_like, shape (..., 22)
+        Measured vector (rad/s; module docstring); non-finite samples are flagged, not raised.
+    solver : {"qr", "normal_equations"}, optional
+        Householder QR (default) or the normal equations (for comparison).
+    exact_cond : bool, optional
+        Report the 2-norm condition number (QR only).
+    measurement_sigma : array_like, shape (..., 22), optional
+        Standard deviations (> 0) of the measured vector for weighted least squares (QR only).
+
+    Returns
+    -------
+    BodyVelocity
+        ``twist (..., 6)`` ``[ω_B; v_B]`` (rad/s, m/s, body axes), ``config_rate (..., 8)``,
+        ``unknowns (..., 11)``, ``residual_norm``, ``cond`` and ``valid`` per sample.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> robot = ExplorationRobot.paper()
+    >>> m = wheel_measurements(robot, np.zeros(8), np.array([0, 0, 0, 0.5, 0, 0]), np.zeros(8))
+    >>> m = np.stack([m, np.full(22, np.nan)])                # a drop-out in the second sample
+    >>> bv = body_velocity(robot, np.zeros(8), m)
+    >>> bv.twist[0, 3].round(12), bv.valid
+    (np.float64(0.5), array([ True, False]))
     """
     check_params(robot, ExplorationRobot, "robot")
     q = as_array(state, "state", (CONFIG_SIZE,), finite="mask")  # NaN, inf, beyond 1e100: drop-outs

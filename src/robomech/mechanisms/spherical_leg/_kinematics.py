@@ -142,6 +142,26 @@ def inverse_kinematics(leg: SphericalLeg, alpha: object, beta: object) -> Invers
     """Leg lengths (paper 1, eq. (4)) for platform angles ``alpha``, ``beta`` (rad, broadcast).
 
     Every finite (alpha, beta) has a solution; non-finite angles raise ``ValueError``.
+
+    Parameters
+    ----------
+    leg : SphericalLeg
+        The leg's geometry (m).
+    alpha, beta : array_like, shape (...)
+        Platform angles (rad); broadcast together.
+
+    Returns
+    -------
+    InverseKinematicsResult
+        ``lengths (..., 3)`` (m), ``unit_vectors (..., 3, 3)`` (leg directions, base frame),
+        ``platform_points (..., 3, 3)`` (m, base frame), ``base_points (3, 3)`` and
+        ``within_limits (..., 3)`` (the actuator stroke).
+
+    Examples
+    --------
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> sl.inverse_kinematics(sl.SphericalLeg.paper(), 0.1, 0.05).lengths.round(5)   # m
+    array([0.10621, 0.11305, 0.11637])
     """
     check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
@@ -219,6 +239,33 @@ def forward_kinematics(
     with its lost square, Ferrari with the misprinted resolvent, α = arctan(2a); ``_as_printed.py``),
     for comparison only: its ``residual`` shows how far the printed α is from assembling the lengths
     (``branch`` is then ignored: the print keeps the real root in (-π/2, π/2) that fits l3 best).
+
+    Parameters
+    ----------
+    leg : SphericalLeg
+        The leg's geometry (m), e.g. ``SphericalLeg.paper()``.
+    lengths : array_like, shape (..., 3)
+        Leg lengths ``(l1, l2, l3)`` (m).
+    branch : {0, 1}, optional
+        Assembly branch of alpha (0: the one containing alpha = 0).
+    paper_as_printed : bool, optional
+        Run paper 1's printed pipeline instead (for comparison only).
+
+    Returns
+    -------
+    ForwardKinematicsResult
+        ``alpha``, ``beta`` (rad, about the platform's rotation axes), ``residual`` (m), ``valid``
+        and ``converged``, each of shape ``(...)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> leg = sl.SphericalLeg.paper()
+    >>> ik = sl.inverse_kinematics(leg, np.array([0.0, 0.1]), 0.05)       # two poses (rad)
+    >>> fk = sl.forward_kinematics(leg, ik.lengths)                       # and back
+    >>> fk.alpha.round(12) + 0.0, fk.beta.round(12), fk.valid
+    (array([0. , 0.1]), array([0.05, 0.05]), array([ True,  True]))
     """
     check_params(leg, SphericalLeg, "leg")
     branch = check_int(branch, "branch", low=0, high=1)
@@ -513,7 +560,28 @@ def _fit_beta_cs(
 
 
 def jacobian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
-    """``J[..., i, j] = d l_i / d (alpha, beta)_j`` -> (..., 3, 2) in m/rad."""
+    """``J[..., i, j] = d l_i / d (alpha, beta)_j`` -> (..., 3, 2) in m/rad.
+
+    Parameters
+    ----------
+    leg : SphericalLeg
+        The leg's geometry (m).
+    alpha, beta : array_like, shape (...)
+        Platform angles (rad); broadcast together.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 2)
+        ``d l_i / d(alpha, beta)_j`` (m/rad).
+
+    Examples
+    --------
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> sl.jacobian(sl.SphericalLeg.paper(), 0.1, 0.05).round(4)
+    array([[ 0.    , -0.0695],
+           [ 0.    ,  0.0673],
+           [ 0.066 , -0.0003]])
+    """
     check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
     J = np.empty((a.size, 3, 2))

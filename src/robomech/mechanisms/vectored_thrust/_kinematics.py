@@ -407,6 +407,27 @@ def forward_kinematics(th: VectoredThruster, q: object) -> FKResult:
     Paper 5, eqs. (11)-(12), with eq. (12)'s sin(phi1) corrected to sin(phi2).  Singular inputs
     (``|s22 x s12| <= SINGULAR_TOL``) give NaN outputs with ``valid`` False.  The link-interference
     limit (Section 4.1 (2)) is evaluated by :func:`link_clearance` and ``workspace_map``.
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry (m), e.g. ``VectoredThruster.paper()``.
+    q : array_like, shape (..., 2)
+        Inputs ``(q1, q2)`` (rad).
+
+    Returns
+    -------
+    FKResult
+        ``axis (..., 3)`` unit propeller axis and ``tip (..., 3)`` (m), base frame; ``tilt`` (rad);
+        ``valid``, ``in_range``, ``tilt_ok`` and ``within_limits``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import vectored_thrust as vt
+    >>> fk = vt.forward_kinematics(vt.VectoredThruster.paper(), np.array([0.3, 0.2]))
+    >>> fk.axis.round(5), bool(fk.valid)
+    (array([ 0.18442, -0.3719 ,  0.90977]), True)
     """
     check_params(th, VectoredThruster, "th")
     return _chunked(_fk, th, _q(q))
@@ -501,6 +522,27 @@ def inverse_kinematics(th: VectoredThruster, s: object) -> IKResult:
     Per-sample masks: ``solved`` (an assembly exists: |s| > 0, the closure has a root), ``in_range``,
     ``tilt_ok`` (universal joint); ``valid`` is all of them.  The link-interference limit is checked
     on the inputs by :func:`link_clearance` / ``workspace_map``.
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry (m).
+    s : array_like, shape (..., 3)
+        Desired propeller direction (base frame; any positive multiple).
+
+    Returns
+    -------
+    IKResult
+        ``q (..., 2)`` inputs (rad) and the masks ``solved``, ``in_range``, ``tilt_ok``, ``valid``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import vectored_thrust as vt
+    >>> th = vt.VectoredThruster.paper()
+    >>> ik = vt.inverse_kinematics(th, vt.forward_kinematics(th, np.array([0.3, 0.2])).axis)
+    >>> ik.q.round(12), bool(ik.valid)                         # the round trip
+    (array([0.3, 0.2]), True)
     """
     check_params(th, VectoredThruster, "th")
     return _chunked(_ik, th, as_array(s, "s", (3,)))
@@ -606,6 +648,28 @@ def jacobian(th: VectoredThruster, q: object) -> JacobianResult:
 
     ``omega`` is the angular velocity of the platform carrying the propeller shaft (the propeller's
     own spin about s0 excluded).  NaN with ``valid`` False at singular inputs.
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry (m).
+    q : array_like, shape (..., 2)
+        Inputs ``(q1, q2)`` (rad).
+
+    Returns
+    -------
+    JacobianResult
+        ``J (..., 3, 2)`` (rad/s per rad/s, base frame), ``valid`` (not singular) and ``distance``
+        ``|s22 x s12|`` (0 at the singularity).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import vectored_thrust as vt
+    >>> vt.jacobian(vt.VectoredThruster.paper(), np.array([0.3, 0.2])).J.round(4) + 0.0
+    array([[ 1.2266,  0.5366],
+           [ 0.    ,  1.    ],
+           [-0.2486, -0.1088]])
     """
     check_params(th, VectoredThruster, "th")
     return _chunked(_jacobian, th, _q(q))
