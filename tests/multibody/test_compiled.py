@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from robomech import multibody as mb
 from robomech.mechanisms import spherical_leg as sl
@@ -62,3 +64,177 @@ def test_compiled_masks_bad_samples():
     assert not fk.converged[5] and not fk.converged[7]
     assert fk.converged[np.r_[0:5, 6, 8:N]].all()
     assert np.all(np.isnan(fk.q[5])) and np.all(np.isfinite(fk.q[7]))
+
+
+# ----------------------------------------------------------------------------- inverse dynamics
+# The compiled inverse dynamics (_compiled.inv_dyn) against the numpy path (_dynamics._inverse_flat),
+# the reference: the same formulas with a different operation order, and the passive pseudo-inverse
+# from a Cholesky (compiled) instead of an LU (numpy) Gram inverse, refined alike.  Forces agree to
+# rounding amplified by the passive block's conditioning (cond ~1e2..3e4 here: cond * eps <= 1e-11).
+ID_RTOL = 1e-11
+# cond and sigma_min are 1-norm estimates from the Gram inverse, whose rounding is ~cond^2 eps
+# (6e-8 at the spherical leg's cond 2.6e4) before any refinement (the estimate is not refined).
+COND_RTOL = 1e-6
+# admissibility is a rounding-level residual (~1e-15); its two evaluations agree in absolute terms.
+ADM_ATOL = 1e-12
+_ID_KEYS = ("tau", "M_a", "velocity_terms", "gravity_terms", "external_terms", "qd", "qdd")
+
+
+class _numpy_path:
+    """Context: every multibody batch runs the numpy path (the reference)."""
+
+    def __enter__(self):
+        self.old = _assembly.COMPILED_MIN
+        _assembly.COMPILED_MIN = 10**9
+
+    def __exit__(self, *exc):
+        _assembly.COMPILED_MIN = self.old
+
+
+class _compiled_path:
+    """Context: every inverse-dynamics batch, however small, runs the compiled kernel."""
+
+    def __enter__(self):
+        self.old = _assembly.COMPILED_MIN
+        _assembly.COMPILED_MIN = 1
+
+    def __exit__(self, *exc):
+        _assembly.COMPILED_MIN = self.old
+
+
+def _assert_same(fast, slow):
+    assert np.array_equal(fast.valid, slow.valid)
+    v = slow.valid
+    for k in _ID_KEYS:
+        a, b = getattr(fast, k), getattr(slow, k)
+        assert np.array_equal(np.isnan(a), np.isnan(b)), k
+        scale = max(1.0, float(np.nanmax(np.abs(b[v])))) if v.any() else 1.0
+        assert np.nanmax(np.abs(a - b), initial=0.0) <= ID_RTOL * scale, k
+    for k in ("cond", "sigma_min"):
+        a, b = getattr(fast, k)[v], getattr(slow, k)[v]
+        assert np.all(np.abs(a - b) <= COND_RTOL * np.abs(b)), k
+    fin = np.isfinite(slow.admissibility)
+    assert np.array_equal(fin, np.isfinite(fast.admissibility))
+    assert np.max(np.abs(fast.admissibility[fin] - slow.admissibility[fin]), initial=0.0) <= ADM_ATOL
+
+
+def _mechanism(name):
+    if name == "spherical_leg":  # actuated by the three legs: redundant (3 actuators, 2 DOF)
+        return sl.to_multibody(sl.SphericalLeg.paper())
+    if name == "spherical_leg_angles":
+        return sl.to_multibody(sl.SphericalLeg.paper(), actuate="platform")
+    return mb.gallery.load(name)
+
+
+def _states(mech, n_conf, n, seed, amp=0.08):
+    """n samples over n_conf assembled configurations (numpy FK), random rates of the actuators.
+
+    The redundantly actuated spherical leg gets consistent leg rates: those of a random platform
+    motion of its angle-actuated twin (same bodies and coordinates), ``qd_legs = G[legs] u`` and
+    ``qdd_legs = G[legs] u' + dG[legs] u u``."""
+    rng = np.random.default_rng(seed)
+    tree = mech.tree
+    if mech.name.startswith("spherical") and len(mech.actuated) == 3:
+        twin = _mechanism("spherical_leg_angles")
+        assert twin.nq == mech.nq and twin.nv == mech.nv
+        q, u, ud = _states(twin, n_conf, n, seed)
+        with _numpy_path():
+            infl = mb.influence(twin, q)
+        legs = tree.act_dof
+        qd = np.einsum("nij,nj->ni", infl.G[:, legs], u)
+        qdd = np.einsum("nij,nj->ni", infl.G[:, legs], ud) + np.einsum(
+            "nijk,nj,nk->ni", infl.dG[:, legs], u, u
+        )
+        return q, qd, qdd
+    with _numpy_path():
+        if mech.name.startswith("spherical"):
+            qa = rng.uniform(-0.4, 0.4, (n_conf, 2))
+        else:
+            scale = np.where(tree.dof_translational[tree.act_dof], mech.length, 1.0)
+            qa = mech.q0[tree.act_qadr] + amp * scale * rng.uniform(-1, 1, (n_conf, len(mech.actuated)))
+        fk = mb.forward_kinematics(mech, qa, steps=2)
+    q = fk.q[fk.converged]
+    assert q.shape[0] > 0
+    q = q[rng.integers(0, q.shape[0], n)]
+    na = len(mech.actuated)
+    return q, rng.normal(size=(n, na)), rng.normal(size=(n, na))
+
+
+def _both(mech, q, qd, qdd, **kw):
+    with _compiled_path():
+        fast = mb.inverse_dynamics(mech, q, qd, qdd, **kw)
+    with _numpy_path():
+        slow = mb.inverse_dynamics(mech, q, qd, qdd, **kw)
+    return fast, slow
+
+
+_GALLERY = ["four_bar", "bennett", "planar_3rrr", "delta", "rps_3", "stewart"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", [*_GALLERY, "spherical_leg", "spherical_leg_angles"])
+def test_compiled_inverse_dynamics_equals_numpy(name):
+    mech = _mechanism(name)
+    q, qd, qdd = _states(mech, 8, _assembly.COMPILED_MIN, seed=11)
+    site = mech.sites[0].name
+    W = np.random.default_rng(12).normal(size=(q.shape[0], 6))
+    fast, slow = _both(mech, q, qd, qdd, wrenches={site: W})
+    assert slow.valid.mean() > 0.9  # the comparison is about valid forces
+    _assert_same(fast, slow)
+    # the default dispatch (>= COMPILED_MIN samples) is the compiled kernel
+    default = mb.inverse_dynamics(mech, q, qd, qdd, wrenches={site: W})
+    assert np.array_equal(default.tau, fast.tau, equal_nan=True)
+
+
+@pytest.mark.slow
+@settings(max_examples=30, deadline=None)
+@given(
+    name=st.sampled_from([*_GALLERY, "spherical_leg"]),
+    seed=st.integers(0, 2**31),
+    gravity=st.booleans(),
+    wrench=st.booleans(),
+    bad=st.sampled_from(["none", "nan", "huge", "inconsistent"]),
+)
+def test_property_compiled_inverse_dynamics_equals_numpy(name, seed, gravity, wrench, bad):
+    """Random assembled states of any gallery mechanism (and the redundant spherical leg): the compiled
+    kernel gives the numpy path's forces and the same flags, also for a bad sample in the batch."""
+    mech = _mechanism(name)
+    q, qd, qdd = _states(mech, 3, 6, seed)
+    kw = {"gravity": gravity}
+    if wrench:
+        kw["wrenches"] = {mech.sites[-1].name: np.random.default_rng(seed).normal(size=(6, 6))}
+    if bad == "nan":
+        qdd[2, 0] = np.nan
+    elif bad == "huge":
+        qd[2] = 1e300  # overflows inside: flagged, forces NaN
+    elif bad == "inconsistent":
+        qd[2, -1] += 1.0  # not a motion of the mechanism unless every rate is free
+    fast, slow = _both(mech, q, qd, qdd, **kw)
+    _assert_same(fast, slow)
+    if bad in ("nan", "huge"):
+        assert not fast.valid[2]
+
+
+@pytest.mark.slow
+def test_compiled_redundant_weights_and_singular_flags():
+    """Paper 1's weighting rule and a type II singularity, compiled as in numpy."""
+    mech = _mechanism("spherical_leg")
+    q, qd, qdd = _states(mech, 4, 8, seed=3)
+    for w in ([1.0, 0.0, 1.0], [1.0, 2.0, 3.0]):
+        fast, slow = _both(mech, q, qd, qdd, weights=w)
+        assert fast.valid.all()
+        _assert_same(fast, slow)
+    b = mb.Builder("toggle", gravity=(0, -9.81, 0))
+    inertial = mb.Inertial(1.0, (0.1, 0.0, 0.0), diaginertia=(0.01,) * 3)
+    b.body("crank", joints=[b.hinge("a")], inertial=inertial)
+    b.body("coupler", parent="crank", pos=(0, 1, 0), joints=[b.hinge("b")], inertial=inertial)
+    b.body("rocker", pos=(2, 0, 0), joints=[b.hinge("c")], inertial=inertial)
+    b.connect("C", "coupler", "rocker", anchor1=(1.0, -0.5, 0.0))  # B, C, D collinear at q0
+    b.actuate("a")
+    toggle = b.build()
+    with _numpy_path():
+        fk = mb.forward_kinematics(toggle, [-0.05], guess=toggle.q0)
+    q = np.stack([toggle.q0, fk.q])
+    fast, slow = _both(toggle, q, [[0.0], [0.3]], [[0.0], [0.1]])
+    assert fast.valid.tolist() == [False, True]
+    _assert_same(fast, slow)

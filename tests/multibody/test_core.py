@@ -356,3 +356,20 @@ def test_property_four_bar_closes_and_G_is_admissible(x, rate):
     G = mb.influence(FOUR_BAR, fk.q, second_order=False).G
     K = mb.constraint_jacobian(FOUR_BAR, fk.q)
     assert np.max(np.abs(K @ G @ np.array([rate]))) < CLOSED_FORM_TOL * max(1.0, abs(rate))
+
+
+def test_quat_from_matrix_refuses_a_frame_that_is_not_a_rotation():
+    # A non-orthogonal frame was once projected silently onto some rotation (leg 3 of the spherical
+    # leg got undocumented joint axes); a reflection or a skewed matrix must be refused by name.
+    from robomech.multibody._model import _quat_from_matrix
+
+    c, s = np.cos(0.3), np.sin(0.3)
+    R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    q = _quat_from_matrix(R)
+    assert np.isclose(q[0], np.cos(0.15)) and np.isclose(q[3], np.sin(0.15))
+    skewed = R.copy()
+    skewed[:, 1] = [0.2, 0.9, 0.1]
+    with pytest.raises(ValueError, match="proper rotation"):
+        _quat_from_matrix(skewed)
+    with pytest.raises(ValueError, match="proper rotation"):
+        _quat_from_matrix(np.diag([1.0, 1.0, -1.0]))

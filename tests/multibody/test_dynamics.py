@@ -258,3 +258,15 @@ def test_unbatched_calls_return_unbatched_results():
     assert mb.forward_dynamics(FOUR_BAR, q, [0.1], [0.2]).qdd_act.shape == (1,)
     sim = mb.simulate(FOUR_BAR, q, [1.0], [0.0, 0.01])
     assert sim.q.shape == (2, FOUR_BAR.nq) and sim.success.shape == ()
+
+
+def test_site_wrench_of_overflowing_forces_is_flagged_quietly():
+    """Forces of 1e300 overflow in the residual norm: the sample is flagged, with no RuntimeWarning."""
+    import warnings
+
+    q = mb.forward_kinematics(FOUR_BAR, [[0.2], [0.3]]).q
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        r = mb.site_wrench(FOUR_BAR, q, "coupler_point", [[1e300], [0.1]])
+    assert r.valid.tolist() == [False, True]
+    assert np.all(np.isnan(r.wrench[0])) and np.all(np.isfinite(r.wrench[1]))

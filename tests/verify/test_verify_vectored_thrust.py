@@ -51,8 +51,35 @@ def test_teeth_printed_eq12_fails_against_engine_tip() -> None:
     assert np.abs(tr.tip_analytic - tr.tip_engine).max() < 1e-15
 
 
-def test_mjcf_is_built_from_the_parameters() -> None:
+def test_mjcf_is_the_generic_export_of_the_description() -> None:
     import dataclasses
 
-    xml = vv.build_mjcf(dataclasses.replace(TH, propeller_arm=0.12))
-    assert 'name="tip" pos="0 0 0.12"' in xml
+    import mujoco
+
+    from robomech import multibody as mb
+
+    th = dataclasses.replace(TH, propeller_arm=0.12)
+    xml = vv.build_mjcf(th)
+    assert 'name="propeller" pos="0.0 0.0 0.12"' in xml
+    m = mujoco.MjModel.from_xml_string(xml)
+    mech = vt.to_multibody(th)
+    names = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(m.njnt)]
+    assert names == [j.name for b in mech.bodies for j in b.joints]
+    assert m.nu == 0 and m.neq == 2  # the s13 hinge: two connects along its axis (mb.to_mjcf)
+    assert mujoco.MjModel.from_xml_string(vv.build_mjcf(th, actuated=True)).nu == 2
+    # the same bodies, joints and closures as the description read back
+    back = mb.from_mjcf(xml)
+    assert [b.name for b in back.bodies] == [b.name for b in mech.bodies]
+
+
+def test_teeth_a_perturbed_parameter_fails() -> None:
+    import dataclasses
+
+    arc = {c.quantity: c for c in vv.run(TH, analytic=dataclasses.replace(TH, arc_angle=TH.arc_angle + 1e-3))}
+    assert not arc["loop closure |efc_pos| (s13 hinge as 2 connects), m"].passed
+    assert not arc["platform orientation, RRR tree (rel)"].passed
+    assert not arc["angular velocity, RRR tree (rel)"].passed
+    assert not arc["angular acceleration, RRR tree (rel)"].passed
+    arm = {c.quantity: c for c in vv.run(TH, analytic=dataclasses.replace(TH, propeller_arm=0.08008))}
+    assert not arm["propeller tip position (rel)"].passed
+    assert arm["platform orientation (rel)"].passed  # the arm length changes no orientation

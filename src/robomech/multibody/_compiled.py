@@ -1,57 +1,74 @@
-"""Compiled (numba) per-sample kernels for large batches: forward kinematics and site Jacobians.
+"""Compiled (numba) per-sample kernels for large batches: FK, site Jacobians, inverse dynamics.
 
-The same algorithms as the numpy path (``_tree``, ``_constraints``, ``_assembly``, ``_influence``),
-written per sample in one parallel loop over the batch: tree kinematics, closure residual and
+The same algorithms as the numpy path (``_tree``, ``_constraints``, ``_assembly``, ``_influence``,
+``_dynamics``), written per sample in one loop over the batch: tree kinematics, closure residual and
 velocity constraint matrix, the Levenberg–Marquardt assembly with the same damping, step cap and
-stopping rules, and ``G = [I; -K_p^+ K_a]`` with the site's ``[ω; ṗ]`` Jacobian.  A numpy batch pays
-one Python-level operation per body and per closure on arrays of the whole batch; here every sample
-stays in cache.  The tests check that both paths agree to rounding.  This module (and numba) loads
-on the first large call.
+stopping rules, ``G = [I; -K_p^+ K_a]`` with the site's ``[ω; ṗ]`` Jacobian, and the closed-chain
+inverse dynamics of ``_dynamics._inverse_flat`` (:func:`inv_dyn`: passive pseudo-inverse, screw rates,
+``K̇ q̇``, the bodies' Newton–Euler terms through ``G``, site wrenches, the redundant-actuation rule and
+the same validity flags).  A numpy batch pays one Python-level operation per body and per closure on
+arrays of the whole batch; here every sample stays in cache.  The mechanism is passed packed, as the
+named tuples :class:`Tables` and :class:`DynTables`.  The tests check that both paths agree to
+rounding.  This module (and numba) loads on the first large call.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import NDArray
 
 from robomech._numba import import_numba
 
 from ._assembly import COMPILED_MIN, MAX_ITER, MAX_STEP, MU_MAX, MU_MIN, MU_START, STOP_RTOL
 from ._influence import PASSIVE_RANK_RTOL
+from ._model import Mechanism
 
-__all__ = ["COMPILED_MIN", "Tables", "compiled_fk", "compiled_site_jacobian", "tables"]
+__all__ = [
+    "COMPILED_MIN",
+    "DynTables",
+    "Tables",
+    "compiled_fk",
+    "compiled_site_jacobian",
+    "inv_dyn",
+    "tables",
+]
 
 # this module is imported on the first large batch only; the kernel cache lives in robomech's cache dir
 numba = import_numba()
 
 
-@dataclass(frozen=True, eq=False)
-class Tables:
-    parent: np.ndarray
-    T_off: np.ndarray
-    body_j0: np.ndarray  # (nb + 1,) joints of body b are body_j0[b]:body_j0[b + 1]
-    jtype: np.ndarray
-    jqadr: np.ndarray
-    jdadr: np.ndarray
-    jpos: np.ndarray
-    jaxis: np.ndarray
-    jref: np.ndarray
-    A: np.ndarray
-    dof_tr: np.ndarray
+class Tables(NamedTuple):
+    """The mechanism packed for the kernels (one argument instead of ~20 arrays; numba types it as a
+    named tuple, so the kernels read ``t.parent``, ``t.A``, ...).  Built once per mechanism
+    (``Mechanism.compiled_tables``)."""
+
+    parent: NDArray[np.int64]
+    T_off: NDArray[np.float64]
+    j0: NDArray[np.int64]  # (nb + 1,) joints of body b are j0[b]:j0[b + 1]
+    jtype: NDArray[np.int64]
+    jqadr: NDArray[np.int64]
+    jdadr: NDArray[np.int64]
+    jpos: NDArray[np.float64]
+    jaxis: NDArray[np.float64]
+    jref: NDArray[np.float64]
+    A: NDArray[np.float64]  # (nb, nv) coordinate k moves body b
+    C: NDArray[np.float64]  # (nv, nv) coordinate j moves the carrier frame of coordinate k
+    dof_tr: NDArray[np.bool_]
     # closure rows
-    pp: np.ndarray  # (np, 3) int: b1, b2, first row
-    px: np.ndarray  # (np, 2, 3) local points
-    rr: np.ndarray  # (nr, 3) int: b1, b2, first row
-    rR: np.ndarray  # (nr, 3, 3)
-    cc: np.ndarray  # (nc, 5) int: d1, q1, d2, q2, row
-    cf: np.ndarray  # (nc, 8) float: ref1, ref2, c0..c4, scale
-    geom_row: np.ndarray  # (m,) bool
+    pp: NDArray[np.int64]  # (np, 3) int: b1, b2, first row
+    px: NDArray[np.float64]  # (np, 2, 3) local points
+    rr: NDArray[np.int64]  # (nr, 3) int: b1, b2, first row
+    rR: NDArray[np.float64]  # (nr, 3, 3)
+    cc: NDArray[np.int64]  # (nc, 5) int: d1, q1, d2, q2, row
+    cf: NDArray[np.float64]  # (nc, 8) float: ref1, ref2, c0..c4, scale
+    geom_row: NDArray[np.bool_]  # (m,) bool
     m: int
     L: float
 
 
-def tables(mech) -> Tables:
+def tables(mech: Mechanism) -> Tables:
     tree, cs = mech.tree, mech.constraints
     nb = len(tree.body_names)
     j0 = np.zeros(nb + 1, dtype=np.int64)
@@ -78,7 +95,7 @@ def tables(mech) -> Tables:
     return Tables(
         parent=tree.parent.astype(np.int64),
         T_off=np.ascontiguousarray(tree.T_off),
-        body_j0=j0,
+        j0=j0,
         jtype=tree.jnt_type.astype(np.int64),
         jqadr=tree.jnt_qadr.astype(np.int64),
         jdadr=tree.jnt_dadr.astype(np.int64),
@@ -86,6 +103,7 @@ def tables(mech) -> Tables:
         jaxis=np.ascontiguousarray(tree.jnt_axis),
         jref=tree.jnt_ref.astype(float),
         A=np.ascontiguousarray(tree.A),
+        C=np.ascontiguousarray(tree.C),
         dof_tr=tree.dof_translational.astype(np.bool_),
         pp=np.array(pp, dtype=np.int64).reshape(-1, 3),
         px=np.array(px, dtype=float).reshape(-1, 2, 3),
@@ -96,29 +114,6 @@ def tables(mech) -> Tables:
         geom_row=np.array([k != "coupling" for k in cs.row_kind], dtype=np.bool_),
         m=cs.m,
         L=float(tree.length),
-    )
-
-
-def _args(t: Tables) -> tuple:
-    return (
-        t.parent,
-        t.T_off,
-        t.body_j0,
-        t.jtype,
-        t.jqadr,
-        t.jdadr,
-        t.jpos,
-        t.jaxis,
-        t.jref,
-        t.A,
-        t.pp,
-        t.px,
-        t.rr,
-        t.rR,
-        t.cc,
-        t.cf,
-        t.m,
-        t.L,
     )
 
 
@@ -144,7 +139,10 @@ def quat_mat(w, x, y, z, R):  # pragma: no cover - compiled
 
 
 @_nj
-def kin(q, parent, T_off, j0, jtype, jqadr, jdadr, jpos, jaxis, jref, T, S):  # pragma: no cover
+def kin(q, t, T, S):  # pragma: no cover
+    """Body poses ``T (nb, 4, 4)`` and coordinate space screws ``S (nv, 6)`` at ``q`` (``_tree._kin``)."""
+    parent, T_off, j0, jtype, jqadr, jdadr = t.parent, t.T_off, t.j0, t.jtype, t.jqadr, t.jdadr
+    jpos, jaxis, jref = t.jpos, t.jaxis, t.jref
     nb = parent.shape[0]
     for i in range(4):
         for j in range(4):
@@ -253,7 +251,9 @@ def point_rows(T, S, A, b, x, sign, row, K, r, with_jac):  # pragma: no cover
 
 
 @_nj
-def resjac(q, T, S, A, pp, px, rr, rR, cc, cf, L, r, K, with_jac):  # pragma: no cover
+def resjac(q, t, T, S, r, K, with_jac):  # pragma: no cover
+    """Closure residual ``r (m)`` and, with ``with_jac``, the velocity constraint matrix ``K (m, nv)``."""
+    A, pp, px, rr, rR, cc, cf, L = t.A, t.pp, t.px, t.rr, t.rR, t.cc, t.cf, t.L
     r[:] = 0.0
     if with_jac:
         K[:, :] = 0.0
@@ -358,42 +358,13 @@ def integrate(q, dv, jtype, jqadr, jdadr, out):  # pragma: no cover
 
 
 @numba.njit(cache=True, error_model="numpy")
-def fk(
-    Q,
-    free,
-    wstep,
-    geom_row,
-    parent,
-    T_off,
-    j0,
-    jtype,
-    jqadr,
-    jdadr,
-    jpos,
-    jaxis,
-    jref,
-    A,
-    pp,
-    px,
-    rr,
-    rR,
-    cc,
-    cf,
-    m,
-    L,
-    max_iter,
-    stop2,
-    mu0,
-    mu_min,
-    mu_max,
-    max_step,
-    rc_out,
-    it_out,
-):  # pragma: no cover
+def fk(Q, free, wstep, t, max_iter, stop2, mu0, mu_min, mu_max, max_step, rc_out, it_out):  # pragma: no cover
     N, nq = Q.shape
-    nb = parent.shape[0]
-    nv = A.shape[1]
+    nb = t.parent.shape[0]
+    nv = t.A.shape[1]
     nf = free.shape[0]
+    m, geom_row = t.m, t.geom_row
+    jtype, jqadr, jdadr = t.jtype, t.jqadr, t.jdadr
     for n in numba.prange(N):
         q = Q[n].copy()
         T = np.empty((nb, 4, 4))
@@ -408,8 +379,8 @@ def fk(
         g = np.empty(nf)
         dx = np.empty(nf)
         geo = np.zeros(nf, dtype=np.bool_)
-        kin(q, parent, T_off, j0, jtype, jqadr, jdadr, jpos, jaxis, jref, T, S)
-        resjac(q, T, S, A, pp, px, rr, rR, cc, cf, L, r, K, True)
+        kin(q, t, T, S)
+        resjac(q, t, T, S, r, K, True)
         cost = 0.0
         for i in range(m):
             cost += r[i] * r[i]
@@ -453,8 +424,8 @@ def fk(
             for a in range(nf):
                 dv[free[a]] = -dx[a] * f
             integrate(q, dv, jtype, jqadr, jdadr, qt)
-            kin(qt, parent, T_off, j0, jtype, jqadr, jdadr, jpos, jaxis, jref, T, S)
-            resjac(qt, T, S, A, pp, px, rr, rR, cc, cf, L, rt, Kt, True)
+            kin(qt, t, T, S)
+            resjac(qt, t, T, S, rt, Kt, True)
             ct = 0.0
             for i in range(m):
                 ct += rt[i] * rt[i]
@@ -478,35 +449,10 @@ def fk(
 
 
 @numba.njit(cache=True, error_model="numpy")
-def site_jac(
-    Q,
-    act,
-    pas,
-    sb,
-    Tsite,
-    parent,
-    T_off,
-    j0,
-    jtype,
-    jqadr,
-    jdadr,
-    jpos,
-    jaxis,
-    jref,
-    A,
-    pp,
-    px,
-    rr,
-    rR,
-    cc,
-    cf,
-    m,
-    L,
-    rtol,
-    J_out,
-):  # pragma: no cover
+def site_jac(Q, act, pas, sb, Tsite, t, rtol, J_out):  # pragma: no cover
     N = Q.shape[0]
-    nb = parent.shape[0]
+    nb = t.parent.shape[0]
+    A, m = t.A, t.m
     nv = A.shape[1]
     na, npas = act.shape[0], pas.shape[0]
     for n in numba.prange(N):
@@ -515,8 +461,8 @@ def site_jac(
         S = np.zeros((nv, 6))
         r = np.empty(m)
         K = np.empty((m, nv))
-        kin(q, parent, T_off, j0, jtype, jqadr, jdadr, jpos, jaxis, jref, T, S)
-        resjac(q, T, S, A, pp, px, rr, rR, cc, cf, L, r, K, True)
+        kin(q, t, T, S)
+        resjac(q, t, T, S, r, K, True)
         G = np.zeros((nv, na))
         for j in range(na):
             G[act[j], j] = 1.0
@@ -589,6 +535,571 @@ def site_jac(
                         J_out[n, i, j] += col[i] * g
 
 
+# ----------------------------------------------------------------------------- inverse dynamics
+class DynTables(NamedTuple):
+    """What the inverse-dynamics kernel needs beyond :class:`Tables` (built once per mechanism)."""
+
+    bidx: NDArray[np.int64]  # (B,) bodies with mass or inertia
+    mass: NDArray[np.float64]  # (B,)
+    com: NDArray[np.float64]  # (B, 3) body frame
+    inertia: NDArray[np.float64]  # (B, 3, 3) about the com, body axes
+    act: NDArray[np.int64]  # (na,) actuated velocity coordinates
+    pas: NDArray[np.int64]  # (npas,) the others
+    rank0: int  # generic rank of K_p
+    dof: int  # mobility
+    gram_cond_max: float  # _dynamics.GRAM_COND_MAX
+    gram_refine_cond: float  # _dynamics.GRAM_REFINE_COND
+    gram_refine2_cond: float  # _dynamics.GRAM_REFINE2_COND
+    pinv_rtol: float  # _influence.PASSIVE_RANK_RTOL
+    rank_rtol: float  # _dynamics.RANK_RTOL
+    singular_cond: float  # _dynamics.SINGULAR_COND
+    admissible_rtol: float  # _dynamics.ADMISSIBLE_RTOL
+    rate_floor: float  # _dynamics.RATE_FLOOR
+
+
+@_nj
+def _cross_into(a0, a1, a2, b0, b1, b2, out, o):  # pragma: no cover - compiled
+    out[o] = a1 * b2 - a2 * b1
+    out[o + 1] = a2 * b0 - a0 * b2
+    out[o + 2] = a0 * b1 - a1 * b0
+
+
+@_nj
+def _all_finite(x):  # pragma: no cover - compiled
+    for v in x.ravel():
+        if not np.isfinite(v):
+            return False
+    return True
+
+
+@_nj
+def _amax_abs(x):  # pragma: no cover - compiled
+    """max |x| with NaN propagated (as numpy's max); 0 for an empty x."""
+    out = 0.0
+    for v in x:
+        a = abs(v)
+        if a != a:
+            return np.nan
+        if a > out:
+            out = a
+    return out
+
+
+@_nj
+def svd_pinv(Kp, rtol, P):  # pragma: no cover - compiled
+    """``_influence._pinv`` for one matrix: P (n, m) and (rank, smallest kept singular value, cond)."""
+    m, n = Kp.shape
+    if not _all_finite(Kp):  # LAPACK refuses it; the sample is flagged (rank 0)
+        P[:, :] = np.nan
+        return 0, np.inf, np.inf
+    U, s, Vt = np.linalg.svd(np.ascontiguousarray(Kp), full_matrices=False)
+    cut = rtol * s[0]
+    rank = 0
+    smin = np.inf
+    P[:, :] = 0.0
+    for c in range(s.shape[0]):
+        if s[c] > cut:
+            rank += 1
+            smin = min(smin, s[c])
+            inv = 1.0 / s[c]
+            for i in range(n):
+                f = Vt[c, i] * inv
+                for j in range(m):
+                    P[i, j] += f * U[j, c]
+    cond = s[0] / (smin if np.isfinite(smin) else 1.0) if rank > 0 else np.inf
+    return rank, smin, cond
+
+
+@_nj
+def passive_inverse(Kp, d, Gi, P):  # pragma: no cover - compiled
+    """``_dynamics._passive_inverse`` for one sample: (mode, rank, sigma_min, cond).
+
+    Gram path (mode 1 wide, 2 tall) where the generic rank is min(m, n): ``P = Kp^T (Kp Kp^T)^-1`` or
+    ``(Kp^T Kp)^-1 Kp^T``, with the Gram inverse ``Gi`` by Cholesky (numpy's path: LU; equal to rounding)
+    and ``cond`` the same 1-norm estimate ``sqrt(||Gram||_1 ||Gi||_1)``; P is applied to vectors by
+    :func:`passive_solve` (refined as the numpy path is).  Mode 0: the SVD pseudo-inverse ``P``
+    (``_influence._pinv``), also beyond ``gram_cond_max``.
+    """
+    m, n = Kp.shape
+    if m == 0 or n == 0:
+        P[:, :] = 0.0
+        return 0, 0, np.inf, 1.0
+    if d.rank0 == min(m, n):
+        wide = m <= n
+        k = m if wide else n
+        Gm = np.empty((k, k))
+        if wide:
+            for i in range(m):
+                for j in range(i + 1):
+                    acc = 0.0
+                    for c in range(n):
+                        acc += Kp[i, c] * Kp[j, c]
+                    Gm[i, j] = acc
+                    Gm[j, i] = acc
+        else:
+            for i in range(n):
+                for j in range(i + 1):
+                    acc = 0.0
+                    for r in range(m):
+                        acc += Kp[r, i] * Kp[r, j]
+                    Gm[i, j] = acc
+                    Gm[j, i] = acc
+        Lc = Gm.copy()
+        chol_factor(Lc)
+        # Gi = L^-T L^-1: the lower-triangular inverse by forward substitution, then the product
+        Li = np.zeros((k, k))
+        for j in range(k):
+            Li[j, j] = 1.0 / Lc[j, j]
+            for i in range(j + 1, k):
+                acc = 0.0
+                for c in range(j, i):
+                    acc += Lc[i, c] * Li[c, j]
+                Li[i, j] = -acc / Lc[i, i]
+        for i in range(k):
+            for j in range(i + 1):
+                acc = 0.0
+                for c in range(i, k):
+                    acc += Li[c, i] * Li[c, j]
+                Gi[i, j] = acc
+                Gi[j, i] = acc
+        n1 = 0.0
+        n1i = 0.0
+        nan = False
+        for j in range(k):
+            s1 = 0.0
+            s2 = 0.0
+            for i in range(k):
+                s1 += abs(Gm[i, j])
+                s2 += abs(Gi[i, j])
+            nan = nan or s1 != s1 or s2 != s2
+            n1 = max(n1, s1)
+            n1i = max(n1i, s2)
+        cond = np.sqrt(n1 * n1i) if not nan else np.nan
+        smin = 1.0 / np.sqrt(n1i) if not nan else np.nan
+        if np.isfinite(cond) and cond <= d.gram_cond_max:
+            return (1 if wide else 2), d.rank0, smin, cond
+    rank, smin, cond = svd_pinv(Kp, d.pinv_rtol, P)
+    return 0, rank, smin, cond
+
+
+@_nj
+def _gram_apply(Kp, Gi, mode, b, x, tmp):  # pragma: no cover - compiled
+    """x = P b with the Gram pseudo-inverse (mode 1: Kp^T (Gi b); mode 2: Gi (Kp^T b))."""
+    m, n = Kp.shape
+    if mode == 1:
+        for i in range(m):
+            acc = 0.0
+            for c in range(m):
+                acc += Gi[i, c] * b[c]
+            tmp[i] = acc
+        for j in range(n):
+            acc = 0.0
+            for i in range(m):
+                acc += Kp[i, j] * tmp[i]
+            x[j] = acc
+    else:
+        for j in range(n):
+            acc = 0.0
+            for i in range(m):
+                acc += Kp[i, j] * b[i]
+            tmp[j] = acc
+        for i in range(n):
+            acc = 0.0
+            for c in range(n):
+                acc += Gi[i, c] * tmp[c]
+            x[i] = acc
+
+
+@_nj
+def passive_solve(Kp, Gi, P, mode, nref, b, x, res, dx, tmp):  # pragma: no cover - compiled
+    """``x = P b`` for the pseudo-inverse of :func:`passive_inverse`.  The numpy path refines the matrix,
+    ``P_{k+1} = P_k + P0 (I - Kp P_k)``; applied to b that is ``x += P0 (b - Kp x)``, done here per
+    right-hand side ``nref`` times."""
+    m, n = Kp.shape
+    if mode == 0:
+        for i in range(n):
+            acc = 0.0
+            for c in range(m):
+                acc += P[i, c] * b[c]
+            x[i] = acc
+        return
+    _gram_apply(Kp, Gi, mode, b, x, tmp)
+    for _ in range(nref):
+        for i in range(m):
+            acc = b[i]
+            for c in range(n):
+                acc -= Kp[i, c] * x[c]
+            res[i] = acc
+        _gram_apply(Kp, Gi, mode, res, dx, tmp)
+        for i in range(n):
+            x[i] += dx[i]
+
+
+@numba.njit(cache=True, error_model="numpy")
+def inv_dyn(
+    Q,
+    QD,
+    QDD,
+    W,
+    wsb,
+    wT,
+    gv,
+    wts,
+    t,
+    d,
+    tau_o,
+    Ma_o,
+    vel_o,
+    grav_o,
+    ex_o,
+    qd_o,
+    qdd_o,
+    cond_o,
+    smin_o,
+    adm_o,
+    valid_o,
+):  # pragma: no cover - compiled
+    """``_dynamics._inverse_flat`` per sample (same formulas; see there for the derivation)."""
+    N = Q.shape[0]
+    nb = t.parent.shape[0]
+    A, C, m, L = t.A, t.C, t.m, t.L
+    nv = A.shape[1]
+    act, pas = d.act, d.pas
+    na, npas = act.shape[0], pas.shape[0]
+    B = d.bidx.shape[0]
+    nw = wsb.shape[0]
+    dof = d.dof
+    redundant = na > dof or wts.shape[0] > 0
+    ps = np.empty(3)
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    r = np.empty(m)
+    K = np.empty((m, nv))
+    Kp = np.empty((m, npas))
+    P = np.empty((npas, m))
+    Gi = np.empty((min(m, npas), min(m, npas)))
+    bm = np.empty(m)
+    xp = np.empty(npas)
+    dxp = np.empty(npas)
+    res = np.empty(m)
+    tmpk = np.empty(max(m, npas))
+    G = np.empty((nv, na))
+    qd = np.empty(nv)
+    qdd = np.empty(nv)
+    conv = np.empty(nv)
+    Sd = np.empty((nv, 6))
+    V = np.empty((nb, 6))  # body twists (space, [w; v at the origin])
+    Vd = np.empty((nb, 6))  # sum_k A Sd_k qd_k
+    Vc = np.empty((nb, 6))  # sum_k A S_k conv_k
+    kdq = np.empty(m)
+    SG = np.empty((6, na))
+    JG = np.empty((6, na))
+    a0 = np.empty(6)
+    rhs = np.empty(6)
+    Iw = np.empty((3, 3))
+    IJ = np.empty((3, na))
+    wb = np.empty(3)
+    Iwb = np.empty(3)
+    Ma = np.empty((na, na))
+    vel = np.empty(na)
+    grav = np.empty(na)
+    ex = np.empty(na)
+    ext = np.empty(nv)
+    KG = np.empty((m, na))
+    tmpm = np.empty(m)
+    for n in range(N):
+        q = Q[n]
+        qa = QD[n]
+        qdda = QDD[n]
+        kin(q, t, T, S)
+        resjac(q, t, T, S, r, K, True)
+        for i in range(m):
+            for j in range(npas):
+                Kp[i, j] = K[i, pas[j]]
+        mode, rank, smin, cond = passive_inverse(Kp, d, Gi, P)
+        # refinement steps as numpy (NaN cond refines too, and is then recomputed by the SVD)
+        nref = (0 if cond <= d.gram_refine_cond else 1) + (0 if cond <= d.gram_refine2_cond else 1)
+        # G = [I; -P K_a]
+        G[:, :] = 0.0
+        for j in range(na):
+            G[act[j], j] = 1.0
+            for i in range(m):
+                bm[i] = K[i, act[j]]
+            passive_solve(Kp, Gi, P, mode, nref, bm, xp, res, dxp, tmpk)
+            for i in range(npas):
+                G[pas[i], j] = -xp[i]
+        for k in range(nv):
+            acc = 0.0
+            acc2 = 0.0
+            for j in range(na):
+                acc += G[k, j] * qa[j]
+                acc2 += G[k, j] * qdda[j]
+            qd[k] = acc
+            qdd[k] = acc2
+        # screw rates dS_k = [w_c x w_k; w_c x v_k - w_k x v_c], V_c the carrier twist of coordinate k
+        for k in range(nv):
+            c0 = c1 = c2 = c3 = c4 = c5 = 0.0
+            for j in range(nv):
+                if C[k, j] != 0.0:
+                    f = C[k, j] * qd[j]
+                    c0 += f * S[j, 0]
+                    c1 += f * S[j, 1]
+                    c2 += f * S[j, 2]
+                    c3 += f * S[j, 3]
+                    c4 += f * S[j, 4]
+                    c5 += f * S[j, 5]
+            w0, w1, w2, v0, v1, v2 = S[k, 0], S[k, 1], S[k, 2], S[k, 3], S[k, 4], S[k, 5]
+            Sd[k, 0] = c1 * w2 - c2 * w1
+            Sd[k, 1] = c2 * w0 - c0 * w2
+            Sd[k, 2] = c0 * w1 - c1 * w0
+            Sd[k, 3] = (c1 * v2 - c2 * v1) - (w1 * c5 - w2 * c4)
+            Sd[k, 4] = (c2 * v0 - c0 * v2) - (w2 * c3 - w0 * c5)
+            Sd[k, 5] = (c0 * v1 - c1 * v0) - (w0 * c4 - w1 * c3)
+        for b in range(nb):
+            for i in range(6):
+                acc = 0.0
+                acc2 = 0.0
+                for k in range(nv):
+                    if A[b, k] != 0.0:
+                        acc += A[b, k] * S[k, i] * qd[k]
+                        acc2 += A[b, k] * Sd[k, i] * qd[k]
+                V[b, i] = acc
+                Vd[b, i] = acc2
+        # Kdot qd, block by block (_dynamics._kdot_qd)
+        for i in range(t.pp.shape[0]):
+            row = t.pp[i, 2]
+            for c in range(3):
+                kdq[row + c] = 0.0
+            for side in range(2):
+                b = t.pp[i, side]
+                x = t.px[i, side]
+                sign = 1.0 if side == 0 else -1.0
+                p0 = T[b, 0, 3] + T[b, 0, 0] * x[0] + T[b, 0, 1] * x[1] + T[b, 0, 2] * x[2]
+                p1 = T[b, 1, 3] + T[b, 1, 0] * x[0] + T[b, 1, 1] * x[1] + T[b, 1, 2] * x[2]
+                p2 = T[b, 2, 3] + T[b, 2, 0] * x[0] + T[b, 2, 1] * x[1] + T[b, 2, 2] * x[2]
+                w0, w1, w2 = V[b, 0], V[b, 1], V[b, 2]
+                pd0 = V[b, 3] + w1 * p2 - w2 * p1
+                pd1 = V[b, 4] + w2 * p0 - w0 * p2
+                pd2 = V[b, 5] + w0 * p1 - w1 * p0
+                e0, e1, e2 = Vd[b, 0], Vd[b, 1], Vd[b, 2]
+                kdq[row] += sign * (Vd[b, 3] + (e1 * p2 - e2 * p1) + (w1 * pd2 - w2 * pd1))
+                kdq[row + 1] += sign * (Vd[b, 4] + (e2 * p0 - e0 * p2) + (w2 * pd0 - w0 * pd2))
+                kdq[row + 2] += sign * (Vd[b, 5] + (e0 * p1 - e1 * p0) + (w0 * pd1 - w1 * pd0))
+        for i in range(t.rr.shape[0]):
+            b1, b2, row = t.rr[i, 0], t.rr[i, 1], t.rr[i, 2]
+            for c in range(3):
+                kdq[row + c] = L * (Vd[b2, c] - Vd[b1, c])
+        for i in range(t.cc.shape[0]):
+            d2, q2, row = t.cc[i, 2], t.cc[i, 3], t.cc[i, 4]
+            if d2 >= 0:
+                x = q[q2] - t.cf[i, 1]
+                dd = 2 * t.cf[i, 4] + x * (6 * t.cf[i, 5] + x * 12 * t.cf[i, 6])
+                kdq[row] = -t.cf[i, 7] * dd * qd[d2] ** 2
+            else:
+                kdq[row] = 0.0
+        # qdd = G qdd_act - [0; P kdq]; the convective part conv = qdd - G qdd_act
+        conv[:] = 0.0
+        passive_solve(Kp, Gi, P, mode, nref, kdq, xp, res, dxp, tmpk)
+        for i in range(npas):
+            conv[pas[i]] = -xp[i]
+            qdd[pas[i]] -= xp[i]
+        for b in range(nb):
+            for i in range(6):
+                acc = 0.0
+                for k in range(nv):
+                    if A[b, k] != 0.0 and conv[k] != 0.0:
+                        acc += A[b, k] * S[k, i] * conv[k]
+                Vc[b, i] = acc
+        # bodies: J_b G, accelerations, Newton-Euler about the com (robomech.dynamics._com_terms)
+        Ma[:, :] = 0.0
+        vel[:] = 0.0
+        grav[:] = 0.0
+        for ib in range(B):
+            b = d.bidx[ib]
+            cx = d.com[ib]
+            p0 = T[b, 0, 3] + T[b, 0, 0] * cx[0] + T[b, 0, 1] * cx[1] + T[b, 0, 2] * cx[2]
+            p1 = T[b, 1, 3] + T[b, 1, 0] * cx[0] + T[b, 1, 1] * cx[1] + T[b, 1, 2] * cx[2]
+            p2 = T[b, 2, 3] + T[b, 2, 0] * cx[0] + T[b, 2, 1] * cx[1] + T[b, 2, 2] * cx[2]
+            Ib = d.inertia[ib]
+            for i in range(3):  # R I R^T
+                for j in range(3):
+                    acc = 0.0
+                    for u in range(3):
+                        ru = 0.0
+                        for v in range(3):
+                            ru += Ib[u, v] * T[b, j, v]
+                        acc += T[b, i, u] * ru
+                    Iw[i, j] = acc
+            SG[:, :] = 0.0
+            for k in range(nv):
+                if A[b, k] != 0.0:
+                    for j in range(na):
+                        g = G[k, j]
+                        if g != 0.0:
+                            for i in range(6):
+                                SG[i, j] += S[k, i] * g
+            for j in range(na):
+                s0, s1, s2 = SG[0, j], SG[1, j], SG[2, j]
+                JG[0, j], JG[1, j], JG[2, j] = s0, s1, s2
+                JG[3, j] = SG[3, j] + (s1 * p2 - s2 * p1)
+                JG[4, j] = SG[4, j] + (s2 * p0 - s0 * p2)
+                JG[5, j] = SG[5, j] + (s0 * p1 - s1 * p0)
+            w0, w1, w2 = V[b, 0], V[b, 1], V[b, 2]
+            pd0 = V[b, 3] + w1 * p2 - w2 * p1
+            pd1 = V[b, 4] + w2 * p0 - w0 * p2
+            pd2 = V[b, 5] + w0 * p1 - w1 * p0
+            e0, e1, e2 = Vd[b, 0] + Vc[b, 0], Vd[b, 1] + Vc[b, 1], Vd[b, 2] + Vc[b, 2]
+            a0[0], a0[1], a0[2] = e0, e1, e2
+            a0[3] = Vd[b, 3] + Vc[b, 3] + (e1 * p2 - e2 * p1) + (w1 * pd2 - w2 * pd1)
+            a0[4] = Vd[b, 4] + Vc[b, 4] + (e2 * p0 - e0 * p2) + (w2 * pd0 - w0 * pd2)
+            a0[5] = Vd[b, 5] + Vc[b, 5] + (e0 * p1 - e1 * p0) + (w0 * pd1 - w1 * pd0)
+            for i in range(3):  # the angular velocity J_w G qd_act, as _com_terms has it
+                acc = 0.0
+                for j in range(na):
+                    acc += JG[i, j] * qa[j]
+                wb[i] = acc
+            for i in range(3):
+                Iwb[i] = Iw[i, 0] * wb[0] + Iw[i, 1] * wb[1] + Iw[i, 2] * wb[2]
+            mb = d.mass[ib]
+            for i in range(3):
+                rhs[i] = Iw[i, 0] * a0[0] + Iw[i, 1] * a0[1] + Iw[i, 2] * a0[2]
+                rhs[3 + i] = mb * a0[3 + i]
+            rhs[0] += wb[1] * Iwb[2] - wb[2] * Iwb[1]
+            rhs[1] += wb[2] * Iwb[0] - wb[0] * Iwb[2]
+            rhs[2] += wb[0] * Iwb[1] - wb[1] * Iwb[0]
+            for i in range(3):
+                for j in range(na):
+                    IJ[i, j] = Iw[i, 0] * JG[0, j] + Iw[i, 1] * JG[1, j] + Iw[i, 2] * JG[2, j]
+            for j in range(na):
+                acc = 0.0
+                for i in range(6):
+                    acc += JG[i, j] * rhs[i]
+                vel[j] += acc
+                grav[j] -= mb * (JG[3, j] * gv[0] + JG[4, j] * gv[1] + JG[5, j] * gv[2])
+                for c in range(na):
+                    Ma[j, c] += (
+                        JG[0, j] * IJ[0, c]
+                        + JG[1, j] * IJ[1, c]
+                        + JG[2, j] * IJ[2, c]
+                        + mb * (JG[3, j] * JG[3, c] + JG[4, j] * JG[4, c] + JG[5, j] * JG[5, c])
+                    )
+        # site wrenches: ex = -G^T sum_s J_s^T W_s
+        ext[:] = 0.0
+        for s in range(nw):
+            b = wsb[s]
+            Ts = wT[s]
+            for i in range(3):
+                ps[i] = T[b, i, 3] + T[b, i, 0] * Ts[0, 3] + T[b, i, 1] * Ts[1, 3] + T[b, i, 2] * Ts[2, 3]
+            Wn = W[n, s]
+            for k in range(nv):
+                if A[b, k] != 0.0:
+                    w0, w1, w2 = S[k, 0], S[k, 1], S[k, 2]
+                    ext[k] -= (
+                        w0 * Wn[0]
+                        + w1 * Wn[1]
+                        + w2 * Wn[2]
+                        + (S[k, 3] + w1 * ps[2] - w2 * ps[1]) * Wn[3]
+                        + (S[k, 4] + w2 * ps[0] - w0 * ps[2]) * Wn[4]
+                        + (S[k, 5] + w0 * ps[1] - w1 * ps[0]) * Wn[5]
+                    )
+        for j in range(na):
+            acc = 0.0
+            for k in range(nv):
+                acc += G[k, j] * ext[k]
+            ex[j] = acc
+        ok = True
+        if redundant:  # _dynamics._projector
+            for i in range(m):
+                for j in range(na):
+                    acc = 0.0
+                    for k in range(nv):
+                        acc += K[i, k] * G[k, j]
+                    KG[i, j] = acc / L
+            sf = np.zeros(na)
+            if m > 0 and _all_finite(KG):
+                _, sv, Vt_ = np.linalg.svd(KG, full_matrices=True)
+                Vt = np.ascontiguousarray(Vt_)
+                for i in range(min(sv.shape[0], na)):
+                    sf[i] = sv[i]
+            elif m > 0:
+                Vt = np.eye(na)
+                sf[:] = np.nan
+            else:
+                Vt = np.eye(na)
+            Nc = np.ascontiguousarray(Vt[na - dof :].T)  # (na, dof) spans null(K G)
+            top = 1.0
+            for i in range(na):
+                if not sf[i] <= top:
+                    top = sf[i] if sf[i] == sf[i] else np.nan
+            thr = d.rank_rtol * 1e2 * top
+            for i in range(na - dof, na):
+                if not sf[i] <= thr:
+                    ok = False
+            if dof < na and not sf[na - dof - 1] > thr:
+                ok = False
+            if wts.shape[0] == 0:
+                Pi = Nc @ Nc.T
+            else:
+                WN = np.empty((na, dof))
+                for i in range(na):
+                    for j in range(dof):
+                        WN[i, j] = wts[i] * Nc[i, j]
+                Aw = Nc.T @ WN
+                if _all_finite(Aw):
+                    sa = np.linalg.svd(Aw, full_matrices=False)[1]
+                    cw = sa[0] / sa[-1] if sa[-1] > 0 else np.inf
+                else:
+                    cw = np.nan
+                if not cw < 1.0 / d.rank_rtol:
+                    ok = False
+                    Aw = np.eye(dof)
+                Pi = WN @ np.linalg.solve(Aw, np.ascontiguousarray(Nc.T))
+            Ma[:, :] = Pi @ Ma
+            vel[:] = Pi @ vel
+            grav[:] = Pi @ grav
+            ex[:] = Pi @ ex
+        fin = True
+        for j in range(na):
+            acc = vel[j] + grav[j] + ex[j]
+            s_ = 0.0
+            for c in range(na):
+                s_ += Ma[j, c] * qdda[c]
+                if not np.isfinite(Ma[j, c]):
+                    fin = False
+            tau_o[n, j] = s_ + acc
+            if not np.isfinite(tau_o[n, j]):
+                fin = False
+        # admissibility of the prescribed motion
+        adm = 0.0
+        if m > 0:
+            sv_ = _amax_abs(qd)
+            sa_ = _amax_abs(qdd) + sv_ * sv_
+            for i in range(m):
+                acc = 0.0
+                acc2 = kdq[i]
+                for k in range(nv):
+                    acc += K[i, k] * qd[k]
+                    acc2 += K[i, k] * qdd[k]
+                tmpm[i] = acc
+                r[i] = acc2
+            e1 = _amax_abs(tmpm) / (L * max(sv_, d.rate_floor))
+            e2 = _amax_abs(r) / (L * max(sa_, d.rate_floor))
+            if e1 != e1 or e2 != e2 or sv_ != sv_ or sa_ != sa_:
+                adm = np.nan
+            else:
+                adm = max(e1, e2)
+        Ma_o[n] = Ma
+        vel_o[n] = vel
+        grav_o[n] = grav
+        ex_o[n] = ex
+        qd_o[n] = qd
+        qdd_o[n] = qdd
+        cond_o[n] = cond
+        smin_o[n] = smin
+        adm_o[n] = adm
+        valid_o[n] = ok and fin and rank >= d.rank0 and cond <= d.singular_cond and adm <= d.admissible_rtol
+
+
 def _kernels():
     return fk, site_jac
 
@@ -606,8 +1117,7 @@ def compiled_fk(mech, q: np.ndarray, free: np.ndarray) -> tuple[np.ndarray, np.n
         Q,
         free.astype(np.int64),
         wstep,
-        t.geom_row,
-        *_args(t),
+        t,
         MAX_ITER,
         (STOP_RTOL * t.L) ** 2,
         MU_START,
@@ -635,7 +1145,7 @@ def compiled_site_jacobian(mech, q: np.ndarray, site: int) -> np.ndarray:
         pas,
         int(tree.site_body[site]),
         np.ascontiguousarray(tree.T_site[site]),
-        *_args(t),
+        t,
         PASSIVE_RANK_RTOL,
         J,
     )

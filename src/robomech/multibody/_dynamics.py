@@ -36,6 +36,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 
@@ -91,16 +92,20 @@ CHUNK = 2048
 
 
 # ----------------------------------------------------------------------------- cached mechanism data
+_T = TypeVar("_T")
+
+
 def _mv(A: np.ndarray, x: np.ndarray) -> np.ndarray:
     """Batched matrix-vector product ``A (N, i, j) x (N, j) -> (N, i)`` (matmul, BLAS)."""
     return (A @ x[..., None])[..., 0]
 
 
-def _cache(mech: Mechanism, key: str, make: Callable[[], object]) -> object:
+def _cache(mech: Mechanism, key: str, make: Callable[[], _T]) -> _T:
     d = mech.__dict__  # frozen dataclass: cached_property writes here too
     if key not in d:
         d[key] = make()
-    return d[key]
+    out: _T = d[key]
+    return out
 
 
 @dataclass(frozen=True)
@@ -162,23 +167,29 @@ def _pinv_rank(K: np.ndarray, r: int) -> tuple[np.ndarray, np.ndarray]:
     return P, np.where(ok, s[:, 0] / np.where(ok, sr, 1.0), np.inf)
 
 
-# Below this 1-norm condition estimate of K_p the Gram-matrix inverse (with one refinement step) is used;
-# above it the sample is recomputed with the SVD pseudo-inverse (exact rank decision).  The Gram matrix
-# squares the condition number: at 1e4, 1e8 * eps ~ 1e-8 before refinement, ~1e-12 after it.
-GRAM_COND_MAX = 1e4
-# Above this condition estimate the Gram inverse is refined once (below it cond^2 eps < 1e-12).
+# Below this 1-norm condition estimate of K_p the Gram-matrix inverse (with refinement) is used; above it
+# the sample is recomputed with the SVD pseudo-inverse (exact rank decision).  The Gram matrix squares
+# the condition number: its inverse carries ~cond^2 eps relative error, and each refinement step
+# (x += P0 (b - K_p x)) multiplies the error by ~cond^2 eps again.  SINGULAR_COND: beyond it the sample
+# is invalid anyway, and the estimate bounds the 2-norm condition number from above (within sqrt(rank)),
+# so a sample judged by the estimate is never wrongly valid.
+GRAM_COND_MAX = SINGULAR_COND
+# Refinement steps: one above GRAM_REFINE_COND (below it cond^2 eps < 1e-12), two above
+# GRAM_REFINE2_COND (at cond 1e6: 1e-4 -> 1e-8 -> 1e-12, below the inherent cond eps ~ 1e-10).
 GRAM_REFINE_COND = 1e2
+GRAM_REFINE2_COND = 1e4
 
 
 def _passive_inverse(Kp: np.ndarray, rank0: int):
     """Pseudo-inverse of the passive block ``Kp (N, m, n)`` with (rank, sigma_min, cond) per sample.
 
     Fast path where the generic rank is ``min(m, n)`` (no idle motion *and* redundant rows at once):
-    ``Kp^T (Kp Kp^T)^-1`` (wide) or ``(Kp^T Kp)^-1 Kp^T`` (tall) from a batched inverse, refined once
-    (``P += P (I - Kp P)`` / ``P += (I - P Kp) P``); ``cond`` is then the 1-norm estimate
-    ``sqrt(||Gram||_1 ||Gram^-1||_1)`` (within a factor sqrt(rank) of the 2-norm one) and ``sigma_min``
-    ``1 / sqrt(||Gram^-1||_1)`` (a lower bound within rank^(1/4)).  Samples above GRAM_COND_MAX, and
-    mechanisms without the fast path, get the SVD pseudo-inverse of the multibody layer.
+    ``P0 = Kp^T (Kp Kp^T)^-1`` (wide) or ``(Kp^T Kp)^-1 Kp^T`` (tall) from a batched inverse, refined
+    ``P_{k+1} = P_k + P0 (I - Kp P_k)`` (once above GRAM_REFINE_COND, twice above GRAM_REFINE2_COND:
+    iterative refinement of the normal equations, for wide and tall alike); ``cond`` is then the 1-norm
+    estimate ``sqrt(||Gram||_1 ||Gram^-1||_1)`` (between the 2-norm one and sqrt(rank) times it) and
+    ``sigma_min`` ``1 / sqrt(||Gram^-1||_1)`` (a lower bound within rank^(1/4)).  Samples above
+    GRAM_COND_MAX, and mechanisms without the fast path, get the SVD pseudo-inverse of the multibody layer.
     """
     N, m, n = Kp.shape
     if m == 0 or n == 0 or rank0 != min(m, n):
@@ -196,10 +207,11 @@ def _passive_inverse(Kp: np.ndarray, rank0: int):
         cond = np.sqrt(np.linalg.norm(Gm, 1, axis=(-2, -1)) * ni)
         smin = 1.0 / np.sqrt(ni)
         # refine where the Gram matrix's squared conditioning could show: cond^2 eps > 1e-12
-        r = np.flatnonzero(~(cond <= GRAM_REFINE_COND))
-        if r.size:
-            Pr, Kr = P[r], Kp[r]
-            P[r] = Pr + Pr @ (np.eye(m) - Kr @ Pr) if wide else Pr + (np.eye(n) - Pr @ Kr) @ Pr
+        for lim in (GRAM_REFINE_COND, GRAM_REFINE2_COND):
+            r = np.flatnonzero(~(cond <= lim))
+            if r.size:
+                P0 = KT[r] @ Gi[r] if wide else Gi[r] @ KT[r]
+                P[r] = P[r] + P0 @ (np.eye(m) - Kp[r] @ P[r])
     rank = np.full(N, rank0)
     bad = ~(np.isfinite(cond) & (cond <= GRAM_COND_MAX) & np.all(np.isfinite(P), axis=(-1, -2)))
     if np.any(bad):
@@ -565,6 +577,85 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
     )
 
 
+def _dyn_tables(mech: Mechanism):
+    """The compiled kernel's per-mechanism tables (``_compiled.DynTables``), built once."""
+
+    def make():
+        from ._compiled import DynTables
+
+        tree = mech.tree
+        bd = _bodies(mech)
+        rank0, dof = _reference(mech)
+        act = tree.act_dof.astype(np.int64)
+        return DynTables(
+            bidx=bd.idx.astype(np.int64),
+            mass=np.ascontiguousarray(bd.mass, dtype=float),
+            com=np.ascontiguousarray(bd.com, dtype=float),
+            inertia=np.ascontiguousarray(bd.inertia, dtype=float),
+            act=act,
+            pas=np.setdiff1d(np.arange(tree.nv), act).astype(np.int64),
+            rank0=int(rank0),
+            dof=int(dof),
+            gram_cond_max=float(GRAM_COND_MAX),
+            gram_refine_cond=float(GRAM_REFINE_COND),
+            gram_refine2_cond=float(GRAM_REFINE2_COND),
+            pinv_rtol=float(PASSIVE_RANK_RTOL),
+            rank_rtol=float(RANK_RTOL),
+            singular_cond=float(SINGULAR_COND),
+            admissible_rtol=float(ADMISSIBLE_RTOL),
+            rate_floor=float(RATE_FLOOR),
+        )
+
+    return _cache(mech, "_dyn_compiled_tables", make)
+
+
+def _inverse_compiled(mech, q, qd_a, qdd_a, wr, weights, gravity=True) -> dict[str, np.ndarray]:
+    """:func:`_inverse_flat` by the compiled per-sample kernel (``_compiled.inv_dyn``): same formulas,
+    same flags; the tests check both paths agree to rounding."""
+    from ._compiled import inv_dyn
+
+    tree = mech.tree
+    t = mech.compiled_tables
+    d = _dyn_tables(mech)
+    N, nv, na = q.shape[0], tree.nv, len(tree.act_dof)
+    sites = list(wr)
+    W = np.zeros((N, len(sites), 6))
+    for i, si in enumerate(sites):
+        W[:, i] = wr[si]
+    wsb = np.array([tree.site_body[si] for si in sites], dtype=np.int64)
+    wT = np.ascontiguousarray(np.array([tree.T_site[si] for si in sites], dtype=float).reshape(-1, 4, 4))
+    gv = np.asarray(mech.gravity, dtype=float) if gravity else np.zeros(3)
+    wts = np.zeros(0) if weights is None else np.ascontiguousarray(weights, dtype=float)
+    out = dict(
+        tau=np.empty((N, na)),
+        M_a=np.empty((N, na, na)),
+        velocity_terms=np.empty((N, na)),
+        gravity_terms=np.empty((N, na)),
+        external_terms=np.empty((N, na)),
+        qd=np.empty((N, nv)),
+        qdd=np.empty((N, nv)),
+        cond=np.empty(N),
+        sigma_min=np.empty(N),
+        admissibility=np.empty(N),
+        valid=np.empty(N, dtype=np.bool_),
+    )
+    f = np.ascontiguousarray
+    inv_dyn(
+        f(q, dtype=float),
+        f(qd_a, dtype=float),
+        f(qdd_a, dtype=float),
+        W,
+        wsb,
+        wT,
+        gv,
+        wts,
+        t,
+        d,
+        *out.values(),
+    )
+    return out
+
+
 def _run_chunked(fn, n: int, arrays: list[np.ndarray], **kw) -> dict[str, np.ndarray]:
     # overflow in a sample (inputs of 1e300) is flagged by its mask, not warned about
     with np.errstate(all="ignore"):
@@ -675,7 +766,14 @@ def inverse_dynamics(
     def fn(qf, qdf, qddf, *ws, **kw):
         return _inverse_flat(mech, qf, qdf, qddf, dict(zip(names, ws, strict=True)), w, gravity)
 
-    d = _run_chunked(fn, n, flat)
+    from . import _assembly
+
+    if n >= _assembly.COMPILED_MIN:  # same formulas, compiled per sample (_compiled.inv_dyn)
+        d = _inverse_compiled(
+            mech, flat[0], flat[1], flat[2], dict(zip(names, flat[3:], strict=True)), w, gravity
+        )
+    else:
+        d = _run_chunked(fn, n, flat)
     return InverseDynamicsResult(**_shape(d, batch, ok, _FORCE_KEYS))
 
 
@@ -747,33 +845,36 @@ def site_wrench(
     ok, (qf, tf) = _sanitize(mech, flat)
     tree = mech.tree
     L = tree.length
-    out = {k: [] for k in ("wrench", "residual", "sigma_min", "cond", "valid")}
+    out: dict[str, list[np.ndarray]] = {k: [] for k in ("wrench", "residual", "sigma_min", "cond", "valid")}
     empty = qf.shape[0] == 0
     if empty:  # one dummy sample for the result shapes (sliced away below)
         qf, tf = tree.q0[None], np.zeros((1, na))
-    for i in range(0, qf.shape[0], CHUNK):
-        qc, tc = qf[i : i + CHUNK], tf[i : i + CHUNK]
-        n = qc.shape[0]
-        z = np.zeros((n, na))
-        st = _inverse_flat(mech, qc, z, z, {}, None, gravity)
-        state, _, G, _, _, _ = _influence_flat(mech, qc, False)
-        b = tree.site_body[si]
-        p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
-        J = frame_jacobian(tree, state, b, p) @ G  # (n, 6, na)
-        Js = np.concatenate([J[:, :3] * L, J[:, 3:]], axis=1)
-        U, s, Vt = np.linalg.svd(Js, full_matrices=False)
-        smax = s[:, :1]
-        keep = s > RANK_RTOL * np.maximum(smax, 1e-300)
-        sinv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
-        rhs = tc - st["gravity_terms"]
-        Ws = np.einsum("nik,nk,nkj,nj->ni", U, sinv, Vt, rhs)  # (J_s^T)^+ rhs
-        W = np.concatenate([Ws[:, :3] * L, Ws[:, 3:]], axis=1)
-        res = np.linalg.norm(np.einsum("nik,ni->nk", J, W) - rhs, axis=-1)
-        smin = s[:, -1] if na <= 6 else s[:, 5]
-        cond = smax[:, 0] / np.maximum(smin, 1e-300)
-        valid = st["valid"] & (cond <= SINGULAR_COND) & np.all(np.isfinite(W), axis=-1)
-        for k, v in zip(out, (W, res, smin, cond, valid), strict=True):
-            out[k].append(v)
+    # forces of 1e300 overflow in the products and norms: such a sample is flagged (not finite -> not
+    # valid, in _shape), quietly, as in inverse_dynamics
+    with np.errstate(all="ignore"):
+        for i in range(0, qf.shape[0], CHUNK):
+            qc, tc = qf[i : i + CHUNK], tf[i : i + CHUNK]
+            n = qc.shape[0]
+            z = np.zeros((n, na))
+            st = _inverse_flat(mech, qc, z, z, {}, None, gravity)
+            state, _, G, _, _, _ = _influence_flat(mech, qc, False)
+            b = tree.site_body[si]
+            p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
+            J = frame_jacobian(tree, state, b, p) @ G  # (n, 6, na)
+            Js = np.concatenate([J[:, :3] * L, J[:, 3:]], axis=1)
+            U, s, Vt = np.linalg.svd(Js, full_matrices=False)
+            smax = s[:, :1]
+            keep = s > RANK_RTOL * np.maximum(smax, 1e-300)
+            sinv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
+            rhs = tc - st["gravity_terms"]
+            Ws = np.einsum("nik,nk,nkj,nj->ni", U, sinv, Vt, rhs)  # (J_s^T)^+ rhs
+            W = np.concatenate([Ws[:, :3] * L, Ws[:, 3:]], axis=1)
+            res = np.linalg.norm(np.einsum("nik,ni->nk", J, W) - rhs, axis=-1)
+            smin = s[:, -1] if na <= 6 else s[:, 5]
+            cond = smax[:, 0] / np.maximum(smin, 1e-300)
+            valid = st["valid"] & (cond <= SINGULAR_COND) & np.all(np.isfinite(W), axis=-1)
+            for k, v in zip(out, (W, res, smin, cond, valid), strict=True):
+                out[k].append(v)
     d = {k: np.concatenate(v)[: 0 if empty else None] for k, v in out.items()}
     d = _shape(d, batch, ok, ("wrench",))
     return SiteWrenchResult(**d)
@@ -1056,13 +1157,16 @@ def simulate(
 
     _, _, G, _, _, _ = _influence_flat(mech, q0f, False)
     qd0 = _mv(G, qa0)
+    tau_fn: Callable[..., object] | None
     if tau_arr is not None:
         tv = flat[2]
 
-        def tau_fn(tt, q, qd, tv=tv):
+        def _held(tt, q, qd, tv=tv):
             return tv if q.shape[0] == tv.shape[0] else tv[: q.shape[0]]
+
+        tau_fn = _held
     else:
-        tau_fn = tau
+        tau_fn = tau if callable(tau) else None
     Q, QD, W, RC, ok = _simulate_flat(mech, q0f, qd0, t, tau_fn, gravity)
     success = np.full(N, ok)
     if not ok and N > 1:
@@ -1070,8 +1174,8 @@ def simulate(
             fn_i = None
             if tau_arr is not None:
                 fn_i = lambda tt, q, qd, v=flat[2][i : i + 1]: v  # noqa: E731
-            elif tau is not None:
-                fn_i = lambda tt, q, qd, i=i: np.asarray(tau(tt, q, qd), float).reshape(-1, na)[:1]  # noqa: E731
+            elif callable(tau):
+                fn_i = lambda tt, q, qd, i=i: np.asarray(tau(tt, q, qd), dtype=float).reshape(-1, na)[:1]  # noqa: E731
             Qi, QDi, Wi, RCi, oki = _simulate_flat(mech, q0f[i : i + 1], qd0[i : i + 1], t, fn_i, gravity)
             Q[i], QD[i], W[i], RC[i], success[i] = Qi[0], QDi[0], Wi[0], RCi[0], oki
     from ._assembly import CONVERGED_RTOL

@@ -588,9 +588,28 @@ class Builder:
         )
 
 
+# A rotation matrix must satisfy R^T R = I and det R = +1 to this tolerance: composed transforms are
+# orthonormal to ~1e-15, a matrix typed with 7 significant digits to ~1e-7; a wrong frame (a
+# non-orthogonal or reflected matrix, e.g. a swapped axis) is off by O(1).
+ROTATION_TOL = 1e-6
+
+
 def _quat_from_matrix(R: np.ndarray) -> np.ndarray:
-    """Unit quaternion [w, x, y, z] (w >= 0) of a rotation matrix (Shepperd's method)."""
+    """Unit quaternion [w, x, y, z] (w >= 0) of a rotation matrix (Shepperd's method).
+
+    Raises ``ValueError`` when ``R`` is not a proper rotation (a silently projected non-orthogonal
+    frame once gave a joint undocumented axes).
+    """
     R = np.asarray(R, float)
+    if R.shape != (3, 3) or not np.all(np.isfinite(R)):
+        raise ValueError(f"rotation matrix: expected a finite (3, 3) array, got shape {R.shape}")
+    orth = float(np.max(np.abs(R.T @ R - np.eye(3))))
+    det = float(np.linalg.det(R))
+    if orth > ROTATION_TOL or abs(det - 1.0) > ROTATION_TOL:
+        raise ValueError(
+            f"rotation matrix: expected a proper rotation (R^T R = I within {ROTATION_TOL:g}, det R = +1), "
+            f"got max |R^T R - I| = {orth:.3g}, det R = {det:.6g}"
+        )
     tr = np.trace(R)
     if tr > 0:
         s = 2.0 * np.sqrt(1.0 + tr)

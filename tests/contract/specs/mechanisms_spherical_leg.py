@@ -95,13 +95,29 @@ SPECS = {
         mask="reachable",
     ),
     P + "generalized_forces": Spec(
-        args={"leg": LEG, "q": Q, "qd": QD, "qdd": QDD, "platform_wrench": np.zeros((3, 6))},
+        args={
+            "leg": LEG,
+            "q": Q,
+            "qd": QD,
+            "qdd": QDD,
+            "platform_wrench": np.zeros((3, 6)),
+            "paper_as_printed": False,
+        },
         arrays={"q": 1, "qd": 1, "qdd": 1, "platform_wrench": 1},
         params=("leg",),
+        options={"paper_as_printed": BAD_BOOL},
     ),
-    P + "mass_matrix": Spec(args={"leg": LEG, "q": Q}, arrays={"q": 1}, params=("leg",)),
+    P + "mass_matrix": Spec(
+        args={"leg": LEG, "q": Q, "paper_as_printed": False},
+        arrays={"q": 1},
+        params=("leg",),
+        options={"paper_as_printed": BAD_BOOL},
+    ),
     P + "mechanical_energy": Spec(
-        args={"leg": LEG, "q": Q, "qd": QD}, arrays={"q": 1, "qd": 1}, params=("leg",)
+        args={"leg": LEG, "q": Q, "qd": QD, "paper_as_printed": False},
+        arrays={"q": 1, "qd": 1},
+        params=("leg",),
+        options={"paper_as_printed": BAD_BOOL},
     ),
     P + "distribute_forces": Spec(
         args={"J": J, "tau": QD, "driven_legs": None, "sigma_min_bound": sl.ACTUATION_SIGMA_MIN},
@@ -118,11 +134,12 @@ SPECS = {
             "qdd": QDD,
             "platform_wrench": np.zeros((3, 6)),
             "driven_legs": (0, 2),
+            "paper_as_printed": False,
         },
         arrays={"q": 1, "qd": 1, "qdd": 1, "platform_wrench": 1},
         params=("leg",),
         mask="valid",
-        options={"driven_legs": BAD_LEGS},
+        options={"driven_legs": BAD_LEGS, "paper_as_printed": BAD_BOOL},
     ),
     P + "sway": Spec(
         args={"t": np.array([0.0, 1.0, 2.0]), "about": "x", "beta0": 0.1},

@@ -15,6 +15,8 @@ LENGTHS = sl.inverse_kinematics(LEG, _A, 0.2).lengths  # a 4-sample trajectory (
 
 SPECS = {
     P + "ACTUATION_SIGMA_MIN": CONSTANT,
+    # issue 13: the base universal joints' spin, and the former model without it on request
+    P + "CARDAN_LOCK_TOL": CONSTANT,
     P + "BranchTrack": RESULT_TYPE,
     P + "track_branches": Spec(
         args={"leg": LEG, "lengths": LENGTHS, "branch": 0},
@@ -26,3 +28,4 @@ SPECS = {
         wrong_shapes={"lengths": ((3,),)},
     ),
 }
+

@@ -83,14 +83,16 @@ SPECS = {
         args={"leg": LEG_SL, "timestep": 2e-4}, params=("leg",), options={"timestep": BAD_POSITIVE}
     ),
     P + "spherical_leg.inverse_dynamics_engine": Spec(
-        args={"leg": LEG_SL, "q": _Q2, "qd": 0.1 * _Q2, "qdd": 0.2 * _Q2},
+        args={"leg": LEG_SL, "q": _Q2, "qd": 0.1 * _Q2, "qdd": 0.2 * _Q2, "driven_legs": (0, 2)},
         arrays={"q": 1, "qd": 1, "qdd": 1},
         wrong_shapes={"q": ((2, 3), (2,)), "qd": ((3, 2),), "qdd": ((2, 3),)},
         params=("leg",),
+        options={"driven_legs": ((0, 0), (0, 3), (0,), "ab", 1, (0.5, 1.0), (True, False))},
     ),
     P + "spherical_leg.run_checks": Spec(
-        args={"analytic": LEG_SL},
+        args={"analytic": LEG_SL, "paper_as_printed": False},
         params=("analytic",),
+        options={"paper_as_printed": BAD_BOOL},
         good_elsewhere="tests/verify/test_verify_spherical_leg.py",
     ),
     P + "spherical_leg.study_overlays": Spec(
@@ -108,14 +110,14 @@ SPECS = {
         args={"th": TH, "actuated": False}, params=("th",), options={"actuated": BAD_BOOL}
     ),
     P + "vectored_thrust.engine_trace": Spec(
-        args={"th": TH, "t": _T, "q": _TRAJ[0], "qd": _TRAJ[1], "qdd": _TRAJ[2]},
+        args={"th": TH, "t": _T, "q": _TRAJ[0], "qd": _TRAJ[1], "qdd": _TRAJ[2], "analytic": TH},
         arrays={"t": 0, "q": 1, "qd": 1, "qdd": 1},
         wrong_shapes={"t": ((2,),), "q": ((3, 3), (2, 2))},
-        params=("th",),
+        params=("th", "analytic"),
     ),
     P + "vectored_thrust.run": Spec(
-        args={"th": TH, "omega_dot_model": None},
-        params=("th",),
+        args={"th": TH, "omega_dot_model": None, "analytic": TH},
+        params=("th", "analytic"),
         options={"omega_dot_model": ("model", 1.0)},
         good_elsewhere="tests/verify/test_verify_vectored_thrust.py",
     ),

@@ -20,14 +20,14 @@ def _trajectory(t: np.ndarray):
     return q, qd, qdd
 
 
-@pytest.mark.parametrize("spin", [True, False])
-def test_power_of_generalized_forces_equals_rate_of_energy(spin):
+@pytest.mark.parametrize(("spin", "printed"), [(True, False), (False, False), (True, True), (False, True)])
+def test_power_of_generalized_forces_equals_rate_of_energy(spin, printed):
     leg = replace(LEG, screw_spin=spin)
     t = np.linspace(0.0, 4.0, 8001)
     dt = t[1] - t[0]
     q, qd, qdd = _trajectory(t)
-    tau = sl.generalized_forces(leg, q, qd, qdd)
-    T, V = sl.mechanical_energy(leg, q, qd)
+    tau = sl.generalized_forces(leg, q, qd, qdd, paper_as_printed=printed)
+    T, V = sl.mechanical_energy(leg, q, qd, paper_as_printed=printed)
     E = T + V
     # fourth-order central difference in time: error ~ dt^4 E^(5) ~ 1e-13 of the power scale
     dE = (E[:-4] - 8 * E[1:-3] + 8 * E[3:-1] - E[4:]) / (12 * dt)
@@ -38,15 +38,19 @@ def test_power_of_generalized_forces_equals_rate_of_energy(spin):
     assert np.max(np.abs(np.sum(bad * qd, -1)[2:-2] - dE)) > 1e-3 * np.max(np.abs(P))
 
 
-def test_kane_equals_lagrange_from_the_energy_function():
-    """Without screw spin every body's motion is holonomic: tau = d/dt dL/dqd - dL/dq (by differences)."""
-    leg = replace(LEG, screw_spin=False)
+@pytest.mark.parametrize(("spin", "printed"), [(True, False), (False, False), (False, True)])
+def test_kane_equals_lagrange_from_the_energy_function(spin, printed):
+    """With universal joints at the base every body's orientation is a function of q (the screw's spin
+    angle too), so the motion is holonomic: tau = d/dt dL/dqd - dL/dq (by differences).  The former
+    model (``paper_as_printed``: legs that do not spin) is holonomic only without the screw spin (a
+    screw spinning relative to a non-spinning sleeve is not)."""
+    leg = replace(LEG, screw_spin=spin)
     t = np.linspace(0.5, 0.7, 5)
     h = 1e-5
     q, qd, qdd = _trajectory(t)
 
     def lagrangian(qq, qqd):
-        T, V = sl.mechanical_energy(leg, qq, qqd)
+        T, V = sl.mechanical_energy(leg, qq, qqd, paper_as_printed=printed)
         return T - V
 
     dL_dq = numerical_jacobian(lambda x: lagrangian(x, qd), q)
@@ -58,7 +62,7 @@ def test_kane_equals_lagrange_from_the_energy_function():
 
     dp = (p_at(t + h) - p_at(t - h)) / (2 * h)
     tau_lagrange = dp - dL_dq
-    tau = sl.generalized_forces(leg, q, qd, qdd)
+    tau = sl.generalized_forces(leg, q, qd, qdd, paper_as_printed=printed)
     assert np.max(np.abs(tau - tau_lagrange)) < 1e-5 * np.max(np.abs(tau))
 
 
@@ -141,6 +145,8 @@ def test_batched_equals_per_sample_and_bad_input():
         sl.inverse_dynamics(LEG, np.zeros((20, 3)), qd, qdd)
     with pytest.raises(ValueError, match="platform_wrench"):
         sl.inverse_dynamics(LEG, q, qd, qdd, platform_wrench=np.zeros(3))
+    with pytest.raises(ValueError, match="paper_as_printed"):
+        sl.inverse_dynamics(LEG, q, qd, qdd, paper_as_printed="yes")
 
 
 @pytest.mark.parametrize(

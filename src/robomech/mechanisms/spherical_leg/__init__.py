@@ -9,6 +9,7 @@ redundant-actuation force distribution, and workspace/singularity maps.  See
 
 from ._dynamics import (
     ACTUATION_SIGMA_MIN,
+    CARDAN_LOCK_TOL,
     PAPER_DRIVEN_LEGS,
     ForceDistribution,
     InverseDynamicsResult,
@@ -37,6 +38,7 @@ from ._workspace import WorkspaceMap, workspace_map
 
 __all__ = [
     "ACTUATION_SIGMA_MIN",
+    "CARDAN_LOCK_TOL",
     "PAPER_DRIVEN_LEGS",
     "BranchTrack",
     "ForceDistribution",

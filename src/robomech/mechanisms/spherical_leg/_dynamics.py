@@ -13,10 +13,18 @@ closure is solved): with each body's centre-of-mass velocity ``v_b = Pv_b qd`` a
 
 Bodies: the platform (rotating about O), and per leg a lower body (centre of mass fixed on the leg
 axis at half its length from A_i) and an upper body (centre of mass at half its length from B_i). The
-leg bodies are inertially axisymmetric and do not spin about the leg axis (the S-P-S motion of an
-axisymmetric leg), except the lead screws of legs 1 and 3, which spin at ``2 pi ldot / lead``
-(helical joint) when ``leg.screw_spin`` is set.  Leg forces f (positive = extending the leg) satisfy
-``J^T f = tau`` (virtual work, power f . ldot): three legs drive two coordinates, so a rule picks f.
+leg bodies are inertially axisymmetric.  Each leg hangs on a universal (Cardan) joint at A_i (first
+axis ``a_i = leg.cardan_axes[i]`` fixed in the base, second axis across the leg): the joint forces
+both bodies of the leg to spin about the leg axis s at
+
+    sigma = w . s = sin(u_b) du_a/dt = (a . s) (a . (s x sdot)) / (1 - (a . s)^2)
+
+(u_a about a, u_b about the turned second axis; ``_cardan_spin``), and the lead screws of legs 1
+and 3 spin at ``2 pi ldot / lead`` more (helical joint) when ``leg.screw_spin`` is set.  Paper 1's
+leg energy, eq. (23), has no spin about the leg axis at all; ``paper_as_printed=True`` drops the
+Cardan spin (the model before issue 13), for comparison only.  Leg forces f (positive = extending
+the leg) satisfy ``J^T f = tau`` (virtual work, power f . ldot): three legs drive two coordinates,
+so a rule picks f.
 """
 
 from __future__ import annotations
@@ -24,14 +32,16 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
+from numpy.typing import NDArray
 
-from robomech._validation import as_array, check_int, check_params, check_real, finite_samples
+from robomech._validation import as_array, check_bool, check_int, check_params, check_real, finite_samples
 
 from ._kinematics import LENGTH_FLOOR, _rotation
 from ._params import SphericalLeg
 
 __all__ = [
     "ACTUATION_SIGMA_MIN",
+    "CARDAN_LOCK_TOL",
     "PAPER_DRIVEN_LEGS",
     "ForceDistribution",
     "InverseDynamicsResult",
@@ -58,6 +68,13 @@ ACTUATION_SINGULAR_RTOL = 1e-8
 # Samples below it are flagged (valid False) with their finite forces kept for inspection; before issue
 # 14 only the 1e-8 ratio flagged, which let ~1e8 N through as valid 1e-6 rad from the singular curve.
 ACTUATION_SIGMA_MIN = 1e-3
+# Gimbal lock of a base universal joint: the leg along the joint's fixed axis, 1 - (a . s)^2 = 0, where
+# the spin sigma = (a . s)(a . (s x sdot)) / (1 - (a . s)^2) is unbounded (the joint cannot follow).
+# Below this value of 1 - (a . s)^2 (the leg within 1.8 deg of the axis, spin gain > 1000 rad per rad
+# of swing) a sample of inverse_dynamics is flagged, and the formula's denominator is floored there
+# (finite values, flagged).  The paper's motions stay above 0.036 (Fig. 5(a), leg 3 at alpha = -60 deg;
+# Fig. 5(b) 0.17, 5(c) 0.38): lock needs a leg lying along its joint's horizontal axis.
+CARDAN_LOCK_TOL = 1e-3
 
 
 @dataclass(frozen=True)
@@ -77,9 +94,42 @@ class _Motion:
     ldd: np.ndarray
     Jl: np.ndarray  # (..., 3, 2) dl/dq
     Ps: np.ndarray  # (..., 3, 3, 2) d(sdot)/d(qd)
+    sig: np.ndarray  # (..., 3) spin of each leg about its axis imposed by the base universal joint
+    sigd: np.ndarray  # (..., 3) its rate
+    Psig: np.ndarray  # (..., 3, 2) d(sig)/d(qd)
+    lock: np.ndarray  # (...,) a base universal joint at or near gimbal lock (CARDAN_LOCK_TOL)
 
 
-def _motion(leg: SphericalLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> _Motion:
+def _cardan_spin(
+    a: np.ndarray, s: np.ndarray, sd: np.ndarray, sdd: np.ndarray, Ps: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Spin ``w . s`` of a body on a universal joint with fixed first axis ``a (3 legs, 3)``.
+
+    Derivation (independent of the multibody layer): in a frame with ``a`` as its y axis the leg is
+    ``s = Ry(u_a) (cos u_b, sin u_b, 0)`` and ``w = du_a a + du_b b`` with ``b`` perpendicular to
+    ``a`` and to ``s``, so ``w . s = du_a (a . s) = du_a sin u_b``.  With ``c = a . s = sin u_b`` and
+    ``du_a = (a . (s x sdot)) / (1 - c^2)`` (the rate of ``u_a = atan2(-s_z, s_x)``):
+    ``sigma = kappa . sdot``, ``kappa = f(c) (a x s)``, ``f(c) = c / (1 - c^2)``.  Returns sigma,
+    its time derivative ``kappa . sddot + kappa_dot . sdot``, its partial velocities ``kappa . Ps``
+    and the gimbal-lock mask (``1 - c^2 < CARDAN_LOCK_TOL``, denominator floored there)."""
+    c = np.sum(a * s, -1)
+    den = 1.0 - c * c
+    lock = den < CARDAN_LOCK_TOL
+    den = np.maximum(den, CARDAN_LOCK_TOL)
+    f = c / den
+    df = (1.0 + c * c) / (den * den)  # f'(c)
+    axs = np.cross(a, s)
+    kappa = f[..., None] * axs
+    kappa_d = (df * np.sum(a * sd, -1))[..., None] * axs + f[..., None] * np.cross(a, sd)
+    sig = np.sum(kappa * sd, -1)
+    sigd = np.sum(kappa * sdd, -1) + np.sum(kappa_d * sd, -1)
+    Psig = np.einsum("...li,...lik->...lk", kappa, Ps)
+    return sig, sigd, Psig, np.any(lock, axis=-1)
+
+
+def _motion(
+    leg: SphericalLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, cardan: bool = True
+) -> _Motion:
     a, b = q[..., 0], q[..., 1]
     sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
     Rp = _rotation(sa, ca, sb, cb)
@@ -109,7 +159,13 @@ def _motion(leg: SphericalLeg, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -
     U = np.swapaxes(U, -1, -2)  # (..., legs, 3, k)
     Jl = np.einsum("...li,...lik->...lk", s, U)
     Ps = (U - s[..., :, None] * Jl[..., None, :]) / l[..., None, None]
-    return _Motion(E, w, dw, p, Rp, s, sd, sdd, l, ld, ldd, Jl, Ps)
+    if cardan:
+        sig, sigd, Psig, lock = _cardan_spin(leg.cardan_axes, s, sd, sdd, Ps)
+    else:
+        # paper 1, eq. (23): the leg's energy has only its swing (no spin about the leg axis); a base
+        # universal joint imposes the spin sigma (_cardan_spin) -- kept here only for paper_as_printed
+        sig, sigd, Psig, lock = np.zeros_like(l), np.zeros_like(l), np.zeros_like(Jl), np.zeros(a.shape, bool)
+    return _Motion(E, w, dw, p, Rp, s, sd, sdd, l, ld, ldd, Jl, Ps, sig, sigd, Psig, lock)
 
 
 _NO_QDD = object()
@@ -160,48 +216,61 @@ def _generalized(leg: SphericalLeg, m: _Motion, wrench: np.ndarray | None) -> np
             d = np.array([0.5 * bd.length for bd in bodies])
             acc = d[:, None] * m.sdd
             Pv = d[:, None, None] * m.Ps
-            Ia = np.array([bd.axial_inertia for bd in bodies])
-            sig, sigd = k * m.ld, k * m.ldd
-            # screw spin sigma s: n = It dwL + Ia (dsigma s + sigma sdot) (axisymmetric body)
-            n = It[:, None] * dwL + Ia[:, None] * (sigd[..., None] * m.s + sig[..., None] * m.sd)
-            Pw = PwL + k[:, None, None] * sJ
+            # spin about s: the Cardan's sigma plus, on legs 1 and 3, the screw's own 2 pi ldot / lead
+            sig, sigd, Psig = m.sig + k * m.ld, m.sigd + k * m.ldd, m.Psig + k[:, None] * m.Jl
         else:
             d = m.l - np.array([0.5 * bd.length for bd in bodies])
             acc = m.ldd[..., None] * m.s + 2 * m.ld[..., None] * m.sd + d[..., None] * m.sdd
             Pv = sJ + d[..., None, None] * m.Ps
-            n = It[:, None] * dwL  # w x (I w) = 0: w is perpendicular to the symmetry axis
-            Pw = PwL
+            sig, sigd, Psig = m.sig, m.sigd, m.Psig  # the Cardan's spin only
+        Ia = np.array([bd.axial_inertia for bd in bodies])
+        # w = s x sdot + sig s; axisymmetric body: n = d/dt(It s x sdot + Ia sig s)
+        #   = It s x sddot + Ia (dsig s + sig sdot)   (its gyroscopic part w x I w is inside)
+        n = It[:, None] * dwL + Ia[:, None] * (sigd[..., None] * m.s + sig[..., None] * m.sd)
+        Pw = PwL + m.s[..., :, None] * Psig[..., None, :]
         F = mass[:, None] * (acc - g)
         tau = tau + np.einsum("...lik,...li->...k", Pv, F) + np.einsum("...lik,...li->...k", Pw, n)
     return tau
 
 
 def generalized_forces(
-    leg: SphericalLeg, q: object, qd: object, qdd: object, *, platform_wrench: object | None = None
-) -> np.ndarray:
+    leg: SphericalLeg,
+    q: object,
+    qd: object,
+    qdd: object,
+    *,
+    platform_wrench: object | None = None,
+    paper_as_printed: bool = False,
+) -> NDArray[np.float64]:
     """Generalized forces on q = (alpha, beta) (N m) for the motion (q, qd, qdd), each (..., 2).
 
     ``platform_wrench (..., 6)``: external wrench ``[m_O; f]`` on the platform, base frame, moment
-    about O (conventions); tau is what the actuators must supply.
+    about O (conventions); tau is what the actuators must supply.  ``paper_as_printed``: see
+    :func:`inverse_dynamics`.  Near a gimbal lock of a base universal joint (``CARDAN_LOCK_TOL``, far
+    outside the paper's motions) the values are finite but meaningless: :func:`inverse_dynamics` flags
+    them.
     """
     check_params(leg, SphericalLeg, "leg")
     qa, qda, qdda = _check_state(q, qd, qdd)
     w = None if platform_wrench is None else as_array(platform_wrench, "platform_wrench", (6,))
-    return _generalized(leg, _motion(leg, qa, qda, qdda), w)
+    cardan = not check_bool(paper_as_printed, "paper_as_printed")
+    return _generalized(leg, _motion(leg, qa, qda, qdda, cardan), w)
 
 
-def mass_matrix(leg: SphericalLeg, q: object) -> np.ndarray:
-    """Mass matrix M(q) (..., 2, 2) of the coordinates (alpha, beta): tau = M qdd + c(q, qd) + g(q)."""
+def mass_matrix(leg: SphericalLeg, q: object, *, paper_as_printed: bool = False) -> NDArray[np.float64]:
+    """Mass matrix M(q) (..., 2, 2) of the coordinates (alpha, beta): tau = M qdd + c(q, qd) + g(q).
+
+    ``paper_as_printed``: see :func:`inverse_dynamics`."""
     check_params(leg, SphericalLeg, "leg")
     qa = as_array(q, "q", (2,))
+    cardan = not check_bool(paper_as_printed, "paper_as_printed")
     zero_g = _replace_gravity(leg)
     cols = []
     for j in range(2):
         e = np.zeros(2)
         e[j] = 1.0
-        cols.append(
-            _generalized(zero_g, _motion(zero_g, qa, np.zeros_like(qa), np.broadcast_to(e, qa.shape)), None)
-        )
+        mo = _motion(zero_g, qa, np.zeros_like(qa), np.broadcast_to(e, qa.shape), cardan)
+        cols.append(_generalized(zero_g, mo, None))
     return np.stack(cols, -1)
 
 
@@ -209,11 +278,16 @@ def _replace_gravity(leg: SphericalLeg) -> SphericalLeg:
     return replace(leg, gravity=(0.0, 0.0, 0.0))
 
 
-def mechanical_energy(leg: SphericalLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
-    """Kinetic and potential energy (J) of platform and legs, each (...); potential zero at O."""
+def mechanical_energy(
+    leg: SphericalLeg, q: object, qd: object, *, paper_as_printed: bool = False
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Kinetic and potential energy (J) of platform and legs, each (...); potential zero at O.
+
+    ``paper_as_printed``: see :func:`inverse_dynamics`."""
     check_params(leg, SphericalLeg, "leg")
     qa, qda = _check_state(q, qd)
-    m = _motion(leg, qa, qda, np.zeros_like(qa))
+    cardan = not check_bool(paper_as_printed, "paper_as_printed")
+    m = _motion(leg, qa, qda, np.zeros_like(qa), cardan)
     g = np.asarray(leg.gravity)
     vp = np.cross(m.w, m.p)
     Iw = m.Rp @ leg.platform_inertia @ np.swapaxes(m.Rp, -1, -2)
@@ -221,20 +295,20 @@ def mechanical_energy(leg: SphericalLeg, q: object, qd: object) -> tuple[np.ndar
     V = -leg.platform_mass * (m.p @ g)
     wL2 = np.sum(np.cross(m.s, m.sd) ** 2, -1)  # (..., legs)
     A = leg.base_points
-    sig = leg.spin_ratio * m.ld
     for pos, bodies in (("lower", leg.lower), ("upper", leg.upper)):
         mass = np.array([bd.mass for bd in bodies])
         It = np.array([bd.transverse_inertia for bd in bodies])
+        Ia = np.array([bd.axial_inertia for bd in bodies])
         if pos == "lower":
             d = np.array([0.5 * bd.length for bd in bodies])
             v = d[:, None] * m.sd
-            Ia = np.array([bd.axial_inertia for bd in bodies])
-            T = T + 0.5 * np.sum(Ia * sig * sig, -1)
+            sig = m.sig + leg.spin_ratio * m.ld  # Cardan spin + the screw's own
         else:
             d = m.l - np.array([0.5 * bd.length for bd in bodies])
             v = m.ld[..., None] * m.s + d[..., None] * m.sd
+            sig = m.sig
         c = A + d[..., None] * m.s
-        T = T + 0.5 * np.sum(mass * np.sum(v * v, -1) + It * wL2, -1)
+        T = T + 0.5 * np.sum(mass * np.sum(v * v, -1) + It * wL2 + Ia * sig * sig, -1)
         V = V - np.sum(mass * (c @ g), -1)
     return T, V
 
@@ -342,7 +416,8 @@ def _singular_values_2x2_gram(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 class InverseDynamicsResult:
     """generalized_forces (..., 2) N m on (alpha, beta); leg_forces (..., 3) N (positive extends);
     residual (...) N m of J^T f = tau; valid (...) False at or near an actuation singularity
-    (``sigma_min < ACTUATION_SIGMA_MIN``; forces NaN where the solve is numerically singular);
+    (``sigma_min < ACTUATION_SIGMA_MIN``; forces NaN where the solve is numerically singular) or a
+    gimbal lock of a base universal joint (``CARDAN_LOCK_TOL``);
     sigma_min (...) m/rad and rcond (...) the per-sample conditioning (:class:`ForceDistribution`)."""
 
     generalized_forces: np.ndarray
@@ -361,16 +436,23 @@ def inverse_dynamics(
     *,
     platform_wrench: object | None = None,
     driven_legs: tuple[int, int] | None = None,
+    paper_as_printed: bool = False,
 ) -> InverseDynamicsResult:
     """Generalized forces and leg actuator forces for the platform motion (q, qd, qdd), each (..., 2).
 
     q = (alpha, beta) rad; ``platform_wrench (..., 6)`` ``[m_O; f]`` on the platform (base frame, moment
     about O); ``driven_legs`` selects the force distribution (see :func:`distribute_forces`).
+    ``valid`` is also False where a base universal joint is at or near gimbal lock
+    (``CARDAN_LOCK_TOL``).  ``paper_as_printed=True``: without the spin of the legs about their own
+    axes that the base universal joints impose (paper 1, eq. (23), and this module before issue 13),
+    for comparison only; the lead-screw spin still follows ``leg.screw_spin``.
     """
     check_params(leg, SphericalLeg, "leg")
     qa, qda, qdda = _check_state(q, qd, qdd)
     w = None if platform_wrench is None else as_array(platform_wrench, "platform_wrench", (6,))
-    m = _motion(leg, qa, qda, qdda)
+    cardan = not check_bool(paper_as_printed, "paper_as_printed")
+    m = _motion(leg, qa, qda, qdda, cardan)
     tau = _generalized(leg, m, w)
     dist = distribute_forces(m.Jl, tau, driven_legs)
-    return InverseDynamicsResult(tau, dist.forces, dist.residual, dist.valid, dist.sigma_min, dist.rcond)
+    valid = dist.valid & ~m.lock
+    return InverseDynamicsResult(tau, dist.forces, dist.residual, valid, dist.sigma_min, dist.rcond)

@@ -6,7 +6,9 @@ three lengths, J, H) to 1e-10.
 
 * central chain 0 (RUR): two hinges at O, ``alpha`` about X then ``beta`` about the turned Y, so the
   platform turns by ``Rx(alpha) Ry(beta)`` about O (paper 1, eq. (1));
-* leg i: a universal joint at A_i (two hinges across the leg), then the upper body sliding along the
+* leg i: a universal joint at A_i (two hinges across the leg: ``u{i}a`` about ``leg.cardan_axes[i]``,
+  fixed in the base, then ``u{i}b`` about the turned axis; the analytic dynamics carries the spin of
+  the leg about its axis that this joint imposes), then the upper body sliding along the
   leg (qpos of ``l{i}`` = length - home length), and a point closure (the upper spherical joint) at
   B_i; legs 1 and 3 also carry the lead screw, spinning about the leg axis at 2 pi / lead per metre of
   stroke (a joint coupling, ``screw_spin``), as the analytic dynamics assumes.
@@ -56,8 +58,7 @@ def to_multibody(leg: SphericalLeg, actuate: str = "legs") -> Mechanism:
         v = B[i] - A[i]
         l0 = float(np.linalg.norm(v))
         x = v / l0
-        y = np.cross((0.0, 0.0, 1.0), x) if abs(x[2]) < 0.9 else np.array([0.0, 1.0, 0.0])
-        y /= np.linalg.norm(y)
+        y = leg.cardan_axes[i]  # the U joint's base-fixed axis (horizontal, across the leg at home)
         R = np.column_stack([x, y, np.cross(x, y)])  # x along the leg; U axes y, z across it
         k = i + 1
         lo, up = leg.lower[i], leg.upper[i]

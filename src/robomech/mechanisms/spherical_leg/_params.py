@@ -162,6 +162,27 @@ class SphericalLeg:
         return np.diag([m * (a * a + t * t) / 12.0, m * (a * a + t * t) / 12.0, m * (2 * a * a) / 12.0])
 
     @property
+    def cardan_axes(self) -> np.ndarray:
+        """First (base-fixed) axis ``a_i`` of the universal joint at A_i, (3, 3) rows = legs 1..3.
+
+        The paper gives no U-joint axis directions (assumption, docs/mechanisms/spherical_leg.md): the
+        first axis is horizontal and perpendicular to the leg at the home pose, ``a_i = Z x s_i(0)``
+        normalised, i.e. tangent to the base circle (for a leg within ~6 deg of vertical at home,
+        ``R`` close to ``r``: ``Y`` made perpendicular to the leg); the second axis turns with it and
+        is perpendicular to both ``a_i`` and the leg.  This fixes the spin of each leg about its own
+        axis, ``w . s = sin(u_b) du_a/dt`` (the dynamics).
+        """
+        u = self.platform_points_home - self.base_points
+        x = u / np.linalg.norm(u, axis=-1, keepdims=True)
+        out = np.empty((3, 3))
+        for i in range(3):
+            y = np.cross((0.0, 0.0, 1.0), x[i])
+            if np.linalg.norm(y) < 0.1:  # nearly vertical leg: the horizontal direction is ill-defined
+                y = np.array([0.0, 1.0, 0.0]) - x[i, 1] * x[i]
+            out[i] = y / np.linalg.norm(y)
+        return out
+
+    @property
     def spin_ratio(self) -> np.ndarray:
         """Screw spin rate per unit leg rate (rad/m) per leg: 2 pi / lead for legs 1, 3; 0 for leg 2."""
         k = 2.0 * math.pi / self.screw_lead if self.screw_spin else 0.0

@@ -109,7 +109,8 @@ def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> Br
         seg = np.zeros(idx.size, dtype=np.int8)
         start = 0
         M = idx.size
-        for k in cand:  # positions in idx
+        cand_list: list[int] = [int(x) for x in cand]
+        for k in cand_list:  # positions in idx
             seg[start:k] = cur
             # the motion before the meeting (samples k-3 .. k-1; the meeting sample itself may already
             # lie on the other side) extrapolated to k, k+1, k+2; keep the continuation that fits it

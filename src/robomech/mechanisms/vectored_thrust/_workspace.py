@@ -121,7 +121,8 @@ def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = 
         n1, n2 = (check_int(k, "n", low=2) for k in n)
     else:
         n1 = n2 = check_int(n, "n", low=2)
-    g1, g2 = np.linspace(*lim[0], n1), np.linspace(*lim[1], n2)
+    g1 = np.linspace(float(lim[0, 0]), float(lim[0, 1]), n1)
+    g2 = np.linspace(float(lim[1, 0]), float(lim[1, 1]), n2)
     return np.stack(np.meshgrid(g1, g2, indexing="ij"), axis=-1)
 
 
