@@ -22,6 +22,8 @@ TENSION = c.cable_tensions(ROBOT, PSI).tension
 DIRECTION = np.ones((3, 3))
 Q = c.compensated_drive(ROBOT, PSI).q
 BAD_MODEL = ("helix", None, 1)
+PULLEY = c.Pulley(radius=0.005, wrap=1.5, alpha=0.15, n=1.0)
+BAD_PULLEY = ("pulley", 1, ROBOT)
 _W = np.abs(np.random.default_rng(0).normal(size=(3, 8)))
 _T3 = np.array([[8.0, 4.0, 4.0], [9.0, 3.0, 3.0], [4.0, 7.0, 4.0]])
 _D3 = np.array([[1.0, -1.0, -1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0]])
@@ -48,9 +50,12 @@ SPECS = {
     P + "COMPENSATION_STEP_TOL": CONSTANT,
     P + "DISK_MAX_ITERATIONS": CONSTANT,
     P + "DISK_TOLERANCE": CONSTANT,
+    P + "PULLEY_FIXED_POINT_ITERATIONS": CONSTANT,
+    P + "PULLEY_QUAD_NODES": CONSTANT,
+    P + "STICK_SLIP_TENSION_FLOOR": CONSTANT,
     **exempt(
-        "DiskEquilibrium DriveResult FrictionEstimate IKResult PoseFrictionEstimate SimulationResult "
-        "TensionHistory TensionResult TipFrictionEstimate",
+        "DiskEquilibrium DriveResult FrictionEstimate HistoryResult IKResult PoseFrictionEstimate "
+        "SimulationResult TensionHistory TensionResult TipFrictionEstimate",
         RESULT_TYPE,
         P,
     ),
@@ -124,18 +129,36 @@ SPECS = {
             "wrench": np.zeros((3, 6)),
             "model": "chord",
             "method": "paper",
+            "pulley": PULLEY,
         },
         arrays={"psi": 1, "direction": 1, "wrench": 1},
         params=("robot",),
         mask="taut",
-        options={"model": BAD_MODEL, "method": ("segment", None, 1)},
+        options={"model": BAD_MODEL, "method": ("segment", None, 1), "pulley": BAD_PULLEY},
     ),
     P + "simulate": Spec(
-        args={"robot": ROBOT, "q": Q, "direction": DIRECTION, "model": "chord"},
+        args={"robot": ROBOT, "q": Q, "direction": DIRECTION, "model": "chord", "pulley": PULLEY},
         arrays={"q": 1, "direction": 1},
         params=("robot",),
         mask="converged",
-        options={"model": BAD_MODEL},
+        options={"model": BAD_MODEL, "pulley": BAD_PULLEY},
+    ),
+    P + "simulate_history": Spec(
+        args={"robot": ROBOT, "q": Q, "times": np.array([0.0, 0.5, 1.0]), "model": "chord", "pulley": PULLEY},
+        arrays={"q": 1, "times": 0},
+        wrong_shapes={"q": ((3, 4),), "times": ((2,), (3, 1))},
+        params=("robot",),
+        options={"model": BAD_MODEL, "pulley": BAD_PULLEY, "times": (np.array([0.0, 1.0, 0.5]),)},
+        empty_batch=False,  # the leading axis is time: a history needs a first step
+    ),
+    P + "Pulley": Spec(
+        args={"radius": 0.005, "wrap": 1.5, "alpha": 0.15, "n": 1.0},
+        options={
+            "radius": BAD_POSITIVE,
+            "wrap": BAD_NONNEGATIVE,
+            "alpha": BAD_NONNEGATIVE,
+            "n": (*BAD_POSITIVE, 1.5),
+        },
     ),
     P + "capstan_coefficient": Spec(
         args={"rho": np.array([2.0, 3.0]), "alpha": 1.0, "n": 0.5},

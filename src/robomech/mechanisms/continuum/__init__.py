@@ -8,12 +8,15 @@ See ``docs/mechanisms/continuum.md`` for every assumption and every departure fr
 from ._compensation import (
     COMPENSATION_ITERATIONS,
     COMPENSATION_STEP_TOL,
+    STICK_SLIP_TENSION_FLOOR,
     DriveResult,
+    HistoryResult,
     SimulationResult,
     cable_elongation,
     compensated_drive,
     disk_equilibrium,
     simulate,
+    simulate_history,
     theoretical_drive,
 )
 from ._disks import DISK_MAX_ITERATIONS, DISK_TOLERANCE, DiskEquilibrium
@@ -51,6 +54,7 @@ from ._kinematics import (
     tip_position,
 )
 from ._params import ContinuumRobot
+from ._pulley import PULLEY_FIXED_POINT_ITERATIONS, PULLEY_QUAD_NODES, Pulley
 from ._statics import (
     TensionResult,
     cable_tensions,
@@ -67,12 +71,17 @@ __all__ = [
     "IDENTIFY_MU_MAX",
     "IDENTIFY_STIFFNESS_BOUNDS",
     "IK_TOLERANCE",
+    "PULLEY_FIXED_POINT_ITERATIONS",
+    "PULLEY_QUAD_NODES",
+    "STICK_SLIP_TENSION_FLOOR",
     "ContinuumRobot",
     "DiskEquilibrium",
     "DriveResult",
     "FrictionEstimate",
+    "HistoryResult",
     "IKResult",
     "PoseFrictionEstimate",
+    "Pulley",
     "SimulationResult",
     "TensionHistory",
     "TensionResult",
@@ -98,6 +107,7 @@ __all__ = [
     "inverse_kinematics",
     "segment_transform",
     "simulate",
+    "simulate_history",
     "span_jacobian",
     "span_lengths",
     "stick_slip_tensions",

@@ -15,9 +15,10 @@ import numpy as np
 from robomech._validation import as_array, check_choice, check_params
 
 from ._disks import DiskEquilibrium, _solve, _uniform_k
-from ._friction import _as_direction, _factors, _wrap
+from ._friction import _as_direction, _factors, _wrap, stick_slip_tensions
 from ._kinematics import CableModel, _fk, _segment_spans, _split, span_lengths
 from ._params import ContinuumRobot
+from ._pulley import PULLEY_FIXED_POINT_ITERATIONS, Pulley, pulley_chain, pulley_stretch
 from ._statics import TensionResult, cable_tensions
 
 __all__ = [
@@ -27,12 +28,15 @@ __all__ = [
     "SIM_FD_STEP",
     "SIM_MAX_ITERATIONS",
     "SIM_TOLERANCE",
+    "STICK_SLIP_TENSION_FLOOR",
     "DriveResult",
+    "HistoryResult",
     "SimulationResult",
     "cable_elongation",
     "compensated_drive",
     "disk_equilibrium",
     "simulate",
+    "simulate_history",
     "theoretical_drive",
 ]
 
@@ -53,6 +57,10 @@ COMPENSATION_STEP_TOL = 1e-10
 # ... or after 12 iterations (3-5 are needed from psi' = psi; the Jacobian is a central difference).
 COMPENSATION_ITERATIONS = 12
 COMPENSATION_FD_STEP = 1e-6  # rad, central difference of the segment ends in psi'
+
+# simulate_history: a slack cable (tension 0) has no friction state; stick_slip_tensions is fed this
+# floor (N, far below any working tension) and the sample is flagged (taut false).
+STICK_SLIP_TENSION_FLOOR = 1e-9
 
 CompensationMethod = Literal["paper", "disk"]
 
@@ -108,13 +116,17 @@ def theoretical_drive(robot: ContinuumRobot, psi: object, model: CableModel = "a
 class DriveResult:
     """Compensated drive (batch shape ``...``): ``q`` theoretical, ``delta`` elongation, ``q_compensated``
     = q + delta (paper 3, eq. (37)), the model ``tension`` behind delta, and ``taut`` (all cables in
-    tension; where false the compensation is not meaningful)."""
+    tension; where false the compensation is not meaningful).  ``actuator_tension`` is the tension at the
+    actuator, beyond the pulley (equal to ``tension`` without a ``pulley``), ``delta_pulley`` the part of
+    ``delta`` stretched over the pulley wrap (0 without one)."""
 
     q: np.ndarray
     delta: np.ndarray
     q_compensated: np.ndarray
     tension: np.ndarray
     taut: np.ndarray
+    actuator_tension: np.ndarray
+    delta_pulley: np.ndarray
 
 
 def compensated_drive(
@@ -125,6 +137,7 @@ def compensated_drive(
     model: CableModel = "chord",
     wrench: object | None = None,
     method: CompensationMethod = "paper",
+    pulley: Pulley | None = None,
 ) -> DriveResult:
     """Feed-forward drive for pose ``psi (..., 2 n)``: q~ = q + delta (paper 3, eq. (37), Fig. 10).
 
@@ -139,9 +152,16 @@ def compensated_drive(
     (:func:`cable_tensions` at psi', same pretension rule) hold the disk-wise robot with its segment ends
     at those of psi; q~ is the drive of that equilibrium (chord lengths and cable stretch included), and
     ``delta = q~ - q``.  Chord cables only (``model="chord"``), no ``wrench``.
+
+    ``pulley`` (issue 16, eqs. (29)-(35)): the guide pulley at every actuator.  The tension entering the
+    robot is the model tension above; the actuator side differs by the improved-capstan ratio kappa
+    (eq. (32), in the cable's sliding ``direction``), and the cable wrapped over the pulley stretches by
+    delta_c (eq. (34)), which is added to delta.  None (default): no pulley, today's drive exactly.
     """
     check_params(robot, ContinuumRobot, "robot")
     check_choice(method, "method", ("paper", "disk"))
+    if pulley is not None:
+        check_params(pulley, Pulley, "pulley")
     theta, beta = _split(robot, psi)
     psi_a = np.stack([theta, beta], -1).reshape(*theta.shape[:-1], 2 * theta.shape[-1])
     if method == "disk":
@@ -152,13 +172,37 @@ def compensated_drive(
         d = _as_direction(robot, direction, theta.shape[:-1])
         q = theoretical_drive(robot, psi_a, "chord")
         eq = _disk_compensation(robot, theta, beta, d)
+        delta, tension, taut = eq.drive - q, eq.tension, eq.taut & eq.converged
+    else:
+        tr: TensionResult = cable_tensions(robot, psi_a, wrench=wrench, direction=direction, model=model)
+        q = theoretical_drive(robot, psi_a, model)
+        delta = cable_elongation(robot, psi_a, tr.tension, direction, model)
+        tension, taut = tr.tension, tr.taut
+    if pulley is None:
         return DriveResult(
-            q=q, delta=eq.drive - q, q_compensated=eq.drive, tension=eq.tension, taut=eq.taut & eq.converged
+            q=q,
+            delta=delta,
+            q_compensated=q + delta,
+            tension=tension,
+            taut=taut,
+            actuator_tension=tension,
+            delta_pulley=np.zeros_like(delta),
         )
-    tr: TensionResult = cable_tensions(robot, psi_a, wrench=wrench, direction=direction, model=model)
-    q = theoretical_drive(robot, psi_a, model)
-    delta = cable_elongation(robot, psi_a, tr.tension, direction, model)
-    return DriveResult(q=q, delta=delta, q_compensated=q + delta, tension=tr.tension, taut=tr.taut)
+    d = np.broadcast_to(_as_direction(robot, direction, theta.shape[:-1]), tension.shape)
+    with np.errstate(invalid="ignore", over="ignore"):
+        t_act, d_c = pulley_stretch(robot, pulley, np.nan_to_num(tension), d)
+    ok = taut & np.all(np.isfinite(tension) & (tension > 0.0), axis=-1)
+    t_act = np.where(ok[..., None], t_act, np.nan)
+    d_c = np.where(ok[..., None], d_c, np.nan)
+    return DriveResult(
+        q=q,
+        delta=delta + d_c,
+        q_compensated=q + delta + d_c,
+        tension=tension,
+        taut=ok,
+        actuator_tension=t_act,
+        delta_pulley=d_c,
+    )
 
 
 # ---- the simulated robot --------------------------------------------------------------------------
@@ -167,7 +211,8 @@ class SimulationResult:
     """Quasi-static equilibrium of the simulated robot under a drive (batch shape ``...``).
 
     ``psi (..., 2 n)`` pose, ``tension (..., 3 n)`` at the base plate, ``taut`` no cable went slack,
-    ``converged`` Newton met ``SIM_TOLERANCE``, ``residual`` generalized-force residual (N m).
+    ``converged`` Newton met ``SIM_TOLERANCE``, ``residual`` generalized-force residual (N m),
+    ``actuator_tension`` beyond the pulley (= ``tension`` without one).
     """
 
     psi: np.ndarray
@@ -176,6 +221,7 @@ class SimulationResult:
     converged: np.ndarray
     residual: np.ndarray
     iterations: np.ndarray
+    actuator_tension: np.ndarray
 
 
 def _k_to_psi(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -183,7 +229,7 @@ def _k_to_psi(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.hypot(kx, ky), np.arctan2(ky, kx)
 
 
-def _sim_residual(robot, k, q, d, model):
+def _sim_residual(robot, k, q, d, model, pulley=None):
     """Generalized force in bending-vector coordinates k_i = theta_i (cos beta_i, sin beta_i)."""
     theta, beta = _k_to_psi(k)
     ell, P = _lengths_and_factors(robot, theta, beta, d, model)
@@ -192,6 +238,18 @@ def _sim_residual(robot, k, q, d, model):
     # Compatibility: the cable's geometric path equals its unstretched length (pulled in by q) plus its
     # stretch; solved for the base tension, linear in it.  A cable cannot push: tension clipped at 0.
     t_raw = (ea * (L - L0 + q) + T0 * (Lf + L0)) / (Lf + np.sum(P * ell, axis=-1))
+    if pulley is not None and pulley.wrap > 0.0:
+        # The wrap adds R (int T dphi' - T0 phi) / (E A) (eq. (34)); int T dphi' = t g(t), g constant for
+        # n = 1 (one pass exact), slowly varying for n < 1 (fixed point from the pulley-free tension).
+        R = pulley.radius + 0.5 * robot.cable_diameter
+        num = ea * (L - L0 + q) + T0 * (Lf + L0 + R * pulley.wrap)
+        den = Lf + np.sum(P * ell, axis=-1)
+        iters = 1 if pulley.n == 1.0 else PULLEY_FIXED_POINT_ITERATIONS
+        t_lvl = np.maximum(t_raw, T0 if T0 > 0.0 else 1.0)
+        for _ in range(iters):
+            _, integral = pulley_chain(robot, pulley, t_lvl, d)
+            t_raw = num / (den + R * integral / t_lvl)
+            t_lvl = np.maximum(t_raw, np.finfo(float).tiny)
     t = np.maximum(t_raw, 0.0)
     # Virtual work of the span tensions, with d/dbeta divided by theta (finite at the straight pose):
     # d/dk = d/dtheta (cos b, sin b) + (d/dbeta)/theta (-sin b, cos b).
@@ -216,6 +274,7 @@ def simulate(
     *,
     model: CableModel = "chord",
     initial: object | None = None,
+    pulley: Pulley | None = None,
 ) -> SimulationResult:
     """Equilibrium pose of a robot whose actuators have pulled in ``q (..., 3 n)`` (m): a simulated robot.
 
@@ -223,8 +282,12 @@ def simulate(
     free length and the spans; Coulomb friction at every hole in the sliding ``direction``; cables that
     would push go slack (tension 0, ``taut`` false).  Solved by Newton in bending-vector coordinates
     (smooth through the straight pose), starting from ``initial`` psi or the rigid-cable arc solution.
+    ``pulley``: the guide pulley at every actuator (eqs. (29)-(34)): its wrapped cable stretches with the
+    improved-capstan tension profile; ``actuator_tension`` is the tension beyond it.  None: no pulley.
     """
     check_params(robot, ContinuumRobot, "robot")
+    if pulley is not None:
+        check_params(pulley, Pulley, "pulley")
     qa = as_array(q, "q", (robot.n_cables,))
     batch = qa.shape[:-1]
     d = _as_direction(robot, direction, batch)
@@ -244,7 +307,7 @@ def simulate(
     iterations = np.zeros(batch, dtype=int)
     eye = np.eye(2 * n)
     for _ in range(SIM_MAX_ITERATIONS):  # Newton iterations over the whole batch
-        F, _ = _sim_residual(robot, k, qa, d, model)
+        F, _ = _sim_residual(robot, k, qa, d, model, pulley)
         converged = np.linalg.norm(F, axis=-1) < SIM_TOLERANCE
         if np.all(converged):
             break
@@ -252,7 +315,10 @@ def simulate(
         for j in range(2 * n):
             e = SIM_FD_STEP * eye[j]
             cols.append(
-                (_sim_residual(robot, k + e, qa, d, model)[0] - _sim_residual(robot, k - e, qa, d, model)[0])
+                (
+                    _sim_residual(robot, k + e, qa, d, model, pulley)[0]
+                    - _sim_residual(robot, k - e, qa, d, model, pulley)[0]
+                )
                 / (2 * SIM_FD_STEP)
             )
         Jm = np.stack(cols, -1)
@@ -263,7 +329,7 @@ def simulate(
         f0 = np.linalg.norm(F, axis=-1)
         scale = np.ones(batch)
         for _ in range(SIM_BACKTRACKS):
-            F_try, _ = _sim_residual(robot, k - scale[..., None] * step, qa, d, model)
+            F_try, _ = _sim_residual(robot, k - scale[..., None] * step, qa, d, model, pulley)
             trial = np.linalg.norm(F_try, axis=-1)
             worse = (trial >= f0) & ~converged
             if not np.any(worse):
@@ -271,17 +337,123 @@ def simulate(
             scale = np.where(worse, 0.5 * scale, scale)
         k = np.where(converged[..., None], k, k - scale[..., None] * step)
         iterations = iterations + ~converged
-    F, t_raw = _sim_residual(robot, k, qa, d, model)
+    F, t_raw = _sim_residual(robot, k, qa, d, model, pulley)
     res = np.linalg.norm(F, axis=-1)
     theta, beta = _k_to_psi(k)
     psi = np.stack([theta, beta], -1).reshape(*batch, 2 * n)
+    tension = np.maximum(t_raw, 0.0)
+    if pulley is None:
+        t_act = tension
+    else:
+        t_act = np.where(
+            t_raw > 0.0, pulley_chain(robot, pulley, tension, np.broadcast_to(d, tension.shape))[0], 0.0
+        )
     return SimulationResult(
         psi=psi,
-        tension=np.maximum(t_raw, 0.0),
+        tension=tension,
         taut=np.all(t_raw >= 0.0, axis=-1),
         converged=res < SIM_TOLERANCE,
         residual=res,
         iterations=iterations,
+        actuator_tension=t_act,
+    )
+
+
+@dataclass(frozen=True)
+class HistoryResult:
+    """Quasi-static response to a history of drives (time axis first, batch shape ``...``).
+
+    ``psi (n_t, ..., 2 n)``, ``tension (n_t, ..., 3 n)`` at the base plate, ``actuator_tension`` beyond
+    the pulley, ``direction (n_t, ..., 3 n)`` the sliding direction every cable had at each step (its
+    last nonzero drive increment: a cable whose drive stops keeps sliding-state memory), ``span_tension``
+    and ``state (n_t, ..., 3 n, n N)`` the stick-slip span tensions with memory (:func:`stick_slip_tensions`
+    fed with the base tensions), ``taut``, ``converged``, ``residual`` per sample, ``valid`` = taut and
+    converged.
+    """
+
+    psi: np.ndarray
+    tension: np.ndarray
+    actuator_tension: np.ndarray
+    direction: np.ndarray
+    span_tension: np.ndarray
+    state: np.ndarray
+    taut: np.ndarray
+    converged: np.ndarray
+    residual: np.ndarray
+    valid: np.ndarray
+
+
+def simulate_history(
+    robot: ContinuumRobot,
+    q: object,
+    *,
+    times: object | None = None,
+    model: CableModel = "chord",
+    pulley: Pulley | None = None,
+) -> HistoryResult:
+    """The simulated robot driven through a history ``q (n_t, ..., 3 n)`` (m, leading time axis).
+
+    Path-dependent (issue 16, paper 3 eq. (19) with memory): from the straight pretensioned pose
+    (q = 0), every cable slides in the direction of its drive increment q_i - q_{i-1} (+1 pulled in,
+    -1 paid out); where its increment is 0 it keeps its last direction (the friction state of its
+    last slip; +1 before it ever moved).  Each step is :func:`simulate` with that direction, started
+    from the previous pose.  Loading and unloading the same drive therefore meet the friction bounds
+    from opposite sides: hysteresis.  The span tensions with memory along the disks follow from
+    :func:`stick_slip_tensions`.  ``times (n_t,)`` optional strictly increasing time stamps (s): the
+    quasi-static model does not use them beyond the check (rate-independent friction).
+    Cables that would push are flagged per sample (``taut`` false), not raised.
+    """
+    check_params(robot, ContinuumRobot, "robot")
+    if pulley is not None:
+        check_params(pulley, Pulley, "pulley")
+    check_choice(model, "model", ("arc", "chord"))
+    qa = as_array(q, "q", (None, robot.n_cables))
+    if qa.ndim < 2 or qa.shape[0] < 1:
+        raise ValueError(
+            f"Expected q (n_t, ..., {robot.n_cables}) with a leading time axis of length >= 1, got shape "
+            f"{qa.shape}."
+        )
+    n_t = qa.shape[0]
+    if times is not None:
+        ts = as_array(times, "times", (None,))
+        if ts.shape != (n_t,):
+            raise ValueError(f"Expected times of shape ({n_t},) (one per drive sample), got {ts.shape}.")
+        if np.any(np.diff(ts) <= 0.0):
+            raise ValueError("Expected times strictly increasing, got a non-monotone history.")
+    batch = qa.shape[1:-1]
+    d = np.ones((*batch, robot.n_cables))
+    prev_q = np.zeros((*batch, robot.n_cables))
+    psi_prev: np.ndarray | None = None
+    rows = []
+    dirs = []
+    for i in range(n_t):  # a history is sequential
+        dq = qa[i] - prev_q
+        d = np.where(dq > 0.0, 1.0, np.where(dq < 0.0, -1.0, d))
+        r = simulate(robot, qa[i], d, model=model, initial=psi_prev, pulley=pulley)
+        rows.append(r)
+        dirs.append(d)
+        # the next step starts from this pose where it is usable, else from the straight pose
+        good = np.all(np.isfinite(r.psi), axis=-1, keepdims=True)
+        psi_prev = np.where(good, r.psi, 0.0)
+        prev_q = qa[i]
+    psi = np.stack([r.psi for r in rows])
+    tension = np.stack([r.tension for r in rows])
+    taut = np.stack([r.taut for r in rows])
+    conv = np.stack([r.converged for r in rows])
+    # stick_slip_tensions needs T > 0: a slack cable gets a floor value, its sample is flagged not taut
+    floor = np.maximum(tension, STICK_SLIP_TENSION_FLOOR)
+    hist = stick_slip_tensions(robot, np.nan_to_num(psi), np.nan_to_num(floor, nan=STICK_SLIP_TENSION_FLOOR))
+    return HistoryResult(
+        psi=psi,
+        tension=tension,
+        actuator_tension=np.stack([r.actuator_tension for r in rows]),
+        direction=np.stack(dirs),
+        span_tension=hist.span_tension,
+        state=hist.state,
+        taut=taut,
+        converged=conv,
+        residual=np.stack([r.residual for r in rows]),
+        valid=taut & conv,
     )
 
 
