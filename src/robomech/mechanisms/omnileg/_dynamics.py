@@ -435,7 +435,8 @@ def inverse_dynamics(
 def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
     """Joint-space inertia matrix ``M(q) (..., 3, 3)`` (kg m²), symmetric positive definite.
 
-    Paper 2, eqs. (32)-(46) (with the exact double-Cardan drive, see the module docstring).
+    The M(η) of paper 2, eq. (46), from the kinetic energies of eq. (44) (with the exact double-Cardan
+    drive, see the module docstring).
 
     Parameters
     ----------
@@ -469,6 +470,8 @@ def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
 
 def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
     """``G(q) = ∂V/∂q`` (..., 3), N·m: the torques holding the leg still against gravity.
+
+    The G(η) of paper 2, eq. (46), with the potential ``-m gᵀ p`` (eq. (44) prints ``m g P``).
 
     Parameters
     ----------
