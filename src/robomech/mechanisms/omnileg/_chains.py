@@ -54,7 +54,27 @@ def _kR(k: int) -> np.ndarray:
 
 
 def chain_screws(leg: OmniLeg) -> tuple[np.ndarray, np.ndarray]:
-    """Space screws of the three UU chains at the home pose, (3, 4, 6), and their home pose M (4, 4)."""
+    """Space screws of the three UU chains at the home pose, (3, 4, 6), and their home pose M (4, 4).
+
+    Paper 2, eqs. (1)-(7): chain 1's screws rotated by ``kR`` (eq. (5)) for chains 2 and 3.
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m).
+
+    Returns
+    -------
+    S : ndarray, shape (3, 4, 6)
+        Screw ``[ω; v]`` (space frame O0; v in m) of joint i of chain k as ``S[k, i]``.
+    M : ndarray, shape (4, 4)
+        Home pose ``T_O0 O0'`` of the knee plate (eq. (3)).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg`.
+    """
     check_params(leg, OmniLeg, "leg")
     w1 = np.array([[0.0, 1, 0], [1, 0, 0], [1, 0, 0], [0, 1, 0]])  # paper 2, eq. (1)
     p1 = np.array([[0.0, leg.L3, 0], [0, leg.L3, 0], [0, leg.L3, leg.L1], [0, leg.L3, leg.L1]])  # eq. (2)
@@ -72,6 +92,25 @@ class ThighClosure:
     knee-plate pose O0' in O0 (chain 1's PoE); ``residual`` the largest closure twist |log(T_k T_1^-1)|;
     ``converged`` the Gauss-Newton flag; ``rotation_error`` the angle of the knee plate's rotation (rad);
     ``translation_only`` = converged and rotation_error <= TRANSLATION_ONLY_TOL.
+
+    Attributes
+    ----------
+    theta : ndarray, shape (..., 3, 4)
+        Joint angles of the three chains (rad), ``theta[..., k, i] = θ_{k+1, i+1}``.
+    T_knee : ndarray, shape (..., 4, 4)
+        Knee-plate pose ``T_O0 O0'`` (m).
+    residual : ndarray, shape (...)
+        Largest component of the closure twists ``log(T_k T_1^-1)`` (rad or m).
+    converged : ndarray of bool, shape (...)
+        The Gauss-Newton solve converged.
+    rotation_error : ndarray, shape (...)
+        Rotation angle of the knee plate (rad); zero for an exact closure.
+    translation_only : ndarray of bool, shape (...)
+        ``converged & (rotation_error <= TRANSLATION_ONLY_TOL)``.
+    iterations : int
+        Gauss-Newton iterations used, summed over the continuation stages.
+    knee : ndarray, shape (..., 3)
+        Knee point O0' in O0 (m), the translation of ``T_knee``.
     """
 
     theta: np.ndarray
@@ -100,6 +139,31 @@ def thigh_closure(leg: OmniLeg, alpha: object, beta: object) -> ThighClosure:
     Gauss-Newton from the home pose: with ``J_k`` the space Jacobian of chain k, a passive step
     ``dθ`` must satisfy ``J_1 dθ_1 - J_k dθ_k = log(T_k T_1^-1)`` (k = 2, 3), a 12 x 10 least-squares
     system solved per sample by batched Householder QR.
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m).
+    alpha, beta : array_like, shape (...)
+        Active angles α = θ21 and β = θ11 (rad); broadcast together.
+
+    Returns
+    -------
+    ThighClosure
+        All twelve joint angles ``theta`` (..., 3, 4), the knee pose ``T_knee`` (..., 4, 4), the
+        ``residual``, ``converged``, ``rotation_error`` and ``translation_only`` per sample.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg`, ``alpha``/``beta`` is not a finite real array, or their
+        shapes do not broadcast.
+
+    Examples
+    --------
+    >>> c = thigh_closure(OmniLeg.paper(), 0.3, -0.2)
+    >>> bool(c.converged), bool(c.translation_only), c.theta.shape
+    (True, True, (3, 4))
     """
     check_params(leg, OmniLeg, "leg")
     a = as_array(alpha, "alpha")
@@ -166,6 +230,19 @@ class ShankResult:
     plane below the C plane (m); ``coupler_angle (...)`` the coupler's angle from Z0' (rad, sign opposite
     to the crank); ``delta_L2 (...)`` the shank shortening 2 L4 - slider (eq. (10)); ``valid (...)``
     false (and D, E, slider NaN) where |γ| >= π/2, where the chain folds flat.
+
+    Attributes
+    ----------
+    C, D, E : ndarray, shape (..., 3, 3)
+        Joint points of chains i = 1..3 as ``C[..., i - 1, :]`` (m, knee-plate frame).
+    slider : ndarray, shape (...)
+        Depth of the E plane below the C plane (m).
+    coupler_angle : ndarray, shape (...)
+        Coupler angle from Z0' (rad).
+    delta_L2 : ndarray, shape (...)
+        Shank shortening ``2 L4 - slider`` (m).
+    valid : ndarray of bool, shape (...)
+        ``|γ| < π/2``.
     """
 
     C: np.ndarray
@@ -178,7 +255,25 @@ class ShankResult:
 
 
 def shank_frames(leg: OmniLeg) -> np.ndarray:
-    """Rotations S_i (3, 3, 3) of the shank chain frames: x radial outward along the C_i axis, z = Z0'."""
+    """Rotations S_i (3, 3, 3) of the shank chain frames: x radial outward along the C_i axis, z = Z0'.
+
+    Chain i's frame is turned by ``shank_azimuth + 2π (i - 1)/3`` about Z0'.
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (``shank_azimuth``, rad).
+
+    Returns
+    -------
+    ndarray, shape (3, 3, 3)
+        ``S[i - 1]``: rotation of chain i's frame in the knee-plate frame.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg`.
+    """
     check_params(leg, OmniLeg, "leg")
     psi = leg.shank_azimuth + 2.0 * np.pi * np.arange(3) / 3.0
     c, s = np.cos(psi), np.sin(psi)
@@ -194,6 +289,30 @@ def shank_crank_slider(leg: OmniLeg, gamma: object) -> ShankResult:
 
     Crank C_iD_i turns by γ about the radial axis X_Ci; the slider position below C_i is the crank-slider
     law ``s = r cos γ + sqrt(l² - (r sin γ)²)`` with r = l = L4, i.e. 2 L4 cos γ (eq. (10)).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m).
+    gamma : array_like, shape (...)
+        Crank angle γ (rad); samples with ``|γ| >= π/2`` are flagged, not raised.
+
+    Returns
+    -------
+    ShankResult
+        Joint points ``C, D, E`` (..., 3, 3) m, ``slider``, ``coupler_angle``, ``delta_L2`` and ``valid``.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg` or ``gamma`` is not a finite real array.
+
+    Examples
+    --------
+    >>> leg = OmniLeg.paper()
+    >>> r = shank_crank_slider(leg, 0.0)
+    >>> bool(np.isclose(r.slider, 2 * leg.L4)), bool(r.valid)
+    (True, True)
     """
     check_params(leg, OmniLeg, "leg")
     g_in = as_array(gamma, "gamma")

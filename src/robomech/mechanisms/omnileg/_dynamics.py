@@ -301,7 +301,27 @@ def _flat(*arrays: np.ndarray) -> tuple[tuple[int, ...], list[np.ndarray]]:
 
 
 def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
-    """Body rotations ``R_b (..., 22, 3, 3)`` (in the hip frame) and mass centres ``p_b (..., 22, 3)`` (m)."""
+    """Body rotations ``R_b (..., 22, 3, 3)`` (in the hip frame) and mass centres ``p_b (..., 22, 3)`` (m).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        Leg geometry and body inertias.
+    q : array_like, shape (..., 3)
+        Joint coordinates ``(α, β, γ)`` (rad).
+
+    Returns
+    -------
+    R : ndarray, shape (..., 22, 3, 3)
+        Rotation of each body (hip frame), in the order of ``BODY_NAMES``.
+    p : ndarray, shape (..., 22, 3)
+        Mass centre of each body (m, hip frame), in the order of ``BODY_NAMES``.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg` or ``q`` is not a finite real array of shape (..., 3).
+    """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
@@ -312,7 +332,21 @@ def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass(frozen=True)
 class DynamicsResult:
-    """``tau = M q̈ + velocity_terms + gravity_terms + foot_terms`` (each (..., 3), N·m; M (..., 3, 3))."""
+    """``tau = M q̈ + velocity_terms + gravity_terms + foot_terms`` (each (..., 3), N·m; M (..., 3, 3)).
+
+    Attributes
+    ----------
+    tau : ndarray, shape (..., 3)
+        Motor torques (N·m), α, β, γ order.
+    M : ndarray, shape (..., 3, 3)
+        Joint-space inertia matrix (kg m²).
+    velocity_terms : ndarray, shape (..., 3)
+        Coriolis and centrifugal torques ``V(q, q̇)`` (N·m).
+    gravity_terms : ndarray, shape (..., 3)
+        Gravity torques ``G(q)`` (N·m).
+    foot_terms : ndarray, shape (..., 3)
+        Torques ``-Jᵀ F`` of the foot force (N·m); zero when no foot force was given.
+    """
 
     tau: np.ndarray
     M: np.ndarray
@@ -341,6 +375,38 @@ def inverse_dynamics(
     (26)-(31): the crosses CS_A4, CS_B4 and the rod A4B4 turn like chain 1's cross CS_A1, rod A1B1, cross
     CS_B1 plus an independent spin γ̇ about Z0), for comparison only: the difference is the error the
     paper's theory carries against its ADAMS model.
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        Leg geometry, body inertias and gravity (hip frame).
+    q, qd, qdd : array_like, shape (..., 3)
+        Joint coordinates (rad), rates (rad/s) and accelerations (rad/s²); broadcast together.
+    foot_force : array_like, shape (..., 3), optional
+        Force applied to the foot (N, hip frame); ``None`` (default) means no external force.
+    paper_as_printed : bool, optional
+        Use paper 2's simplified Cardan drive (eqs. (26)-(31)) instead of the exact one (default False).
+
+    Returns
+    -------
+    DynamicsResult
+        ``tau`` (..., 3) N·m, the inertia matrix ``M`` (..., 3, 3) kg m², and the ``velocity_terms``,
+        ``gravity_terms`` and ``foot_terms`` (each (..., 3), N·m) that sum with ``M q̈`` to ``tau``.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3),
+        the shapes do not broadcast, or ``paper_as_printed`` is not a bool.
+
+    Examples
+    --------
+    >>> leg = OmniLeg.paper()
+    >>> r = inverse_dynamics(leg, [[0.1, 0.2, 1.0]] * 4, np.zeros(3), np.zeros(3))
+    >>> r.tau.shape, r.M.shape
+    ((4, 3), (4, 3, 3))
+    >>> bool(np.allclose(r.tau, r.gravity_terms))   # at rest only gravity acts
+    True
     """
     check_params(leg, OmniLeg, "leg")
     paper_as_printed = check_bool(paper_as_printed, "paper_as_printed")
@@ -367,7 +433,34 @@ def inverse_dynamics(
 
 
 def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
-    """Joint-space inertia matrix ``M(q) (..., 3, 3)`` (kg m²), symmetric positive definite."""
+    """Joint-space inertia matrix ``M(q) (..., 3, 3)`` (kg m²), symmetric positive definite.
+
+    The M(η) of paper 2, eq. (46), from the kinetic energies of eq. (44) (with the exact double-Cardan
+    drive, see the module docstring).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        Leg geometry and body inertias.
+    q : array_like, shape (..., 3)
+        Joint coordinates ``(α, β, γ)`` (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        ``M(q)`` (kg m² on the diagonal; α, β, γ order), the kinetic energy being ``½ q̇ᵀ M q̇``.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg` or ``q`` is not a finite real array of shape (..., 3).
+
+    Examples
+    --------
+    >>> M = mass_matrix(OmniLeg.paper(), [0.1, 0.2, 1.0])
+    >>> M.shape, bool(np.allclose(M, M.T)), bool(np.all(np.linalg.eigvalsh(M) > 0))
+    ((3, 3), True, True)
+    """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
@@ -376,7 +469,27 @@ def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
 
 
 def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
-    """``G(q) = ∂V/∂q`` (..., 3), N·m: the torques holding the leg still against gravity."""
+    """``G(q) = ∂V/∂q`` (..., 3), N·m: the torques holding the leg still against gravity.
+
+    The G(η) of paper 2, eq. (46), with the potential ``-m gᵀ p`` (eq. (44) prints ``m g P``).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        Leg geometry, body masses and gravity (hip frame).
+    q : array_like, shape (..., 3)
+        Joint coordinates ``(α, β, γ)`` (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Gravity torques (N·m), α, β, γ order (``gravity_terms`` of :func:`inverse_dynamics`).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg` or ``q`` is not a finite real array of shape (..., 3).
+    """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
@@ -385,7 +498,31 @@ def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
 
 
 def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
-    """Kinetic ``½ q̇ᵀ M q̇`` and potential ``-Σ m_b gᵀ p_b`` energy (J), each (...)."""
+    """Kinetic ``½ q̇ᵀ M q̇`` and potential ``-Σ m_b gᵀ p_b`` energy (J), each (...).
+
+    The potential is the scalar ``-m gᵀ p`` with the hip origin as datum (paper 2, eq. (44) prints
+    ``m g P``).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        Leg geometry, body inertias and gravity (hip frame).
+    q, qd : array_like, shape (..., 3)
+        Joint coordinates (rad) and rates (rad/s); broadcast together.
+
+    Returns
+    -------
+    kinetic : ndarray, shape (...)
+        Kinetic energy (J).
+    potential : ndarray, shape (...)
+        Potential energy (J).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3), or
+        the shapes do not broadcast.
+    """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     qd = as_array(qd, "qd", (3,))
@@ -400,6 +537,34 @@ def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
     ``force (..., 3)`` (N, hip frame) is ``FOOT_FORCE_CONVENTION``: the force applied *to* the foot,
     the same as ``inverse_dynamics(foot_force=F)``, whose ``foot_terms`` these torques are.  paper 2,
     eq. (50): τ = Jᵀ F_f with F_f the force the foot delivers, F_f = -F.
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        Leg geometry.
+    q : array_like, shape (..., 3)
+        Joint coordinates ``(α, β, γ)`` (rad).
+    force : array_like, shape (..., 3)
+        Force applied to the foot (N, hip frame); broadcasts with ``q``.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Motor torques (N·m), α, β, γ order.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3), or
+        the shapes do not broadcast.
+
+    Examples
+    --------
+    >>> leg = OmniLeg.paper()
+    >>> tau = static_torques(leg, [0.1, 0.2, 1.0], [0.0, 0.0, -10.0])
+    >>> f = foot_force_from_torques(leg, [0.1, 0.2, 1.0], tau)
+    >>> bool(np.allclose(f.force, [0.0, 0.0, -10.0]))
+    True
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -414,6 +579,17 @@ class FootForceResult:
     ``singular`` marks samples with ``sigma_min / sigma_max < SINGULAR_RCOND`` (γ ≈ 0): there the force is
     the damped least-squares estimate (its component along the lost direction is not determined by the
     torques) and ``residual = |-Jᵀ F - τ|`` is no longer zero.
+
+    Attributes
+    ----------
+    force : ndarray, shape (..., 3)
+        Force applied to the foot (N, hip frame).
+    singular : ndarray of bool, shape (...)
+        True where the foot Jacobian is near singular (``rcond < SINGULAR_RCOND``).
+    rcond : ndarray, shape (...)
+        ``sigma_min / sigma_max`` of the foot Jacobian (dimensionless).
+    residual : ndarray, shape (...)
+        ``|-Jᵀ F - τ|`` (N·m).
     """
 
     force: np.ndarray
@@ -432,6 +608,26 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     their weak directions damped: ``F = Σ c_i u_i (v_iᵀ τ)`` with ``c_i = 1/σ_i`` where
     ``σ_i >= SINGULAR_RCOND σ_max`` and ``c_i = σ_i / (σ_i² + λ²)``, ``λ = DAMPING_RELATIVE σ_max``, otherwise
     (selectively damped least squares: the well-determined components stay exact).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        Leg geometry.
+    q : array_like, shape (..., 3)
+        Joint coordinates ``(α, β, γ)`` (rad).
+    tau : array_like, shape (..., 3)
+        Motor torques (N·m), α, β, γ order; broadcasts with ``q``.
+
+    Returns
+    -------
+    FootForceResult
+        ``force`` (..., 3) N, the ``singular`` mask, ``rcond`` and ``residual`` (N·m), each (...).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3), or
+        the shapes do not broadcast.
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))

@@ -34,7 +34,17 @@ TREE_JOINTS = (
 
 @dataclass(frozen=True)
 class JointMotion:
-    """Angles, rates and accelerations of the tree joints ``TREE_JOINTS`` (..., 22), rad-based units."""
+    """Angles, rates and accelerations of the tree joints ``TREE_JOINTS`` (..., 22), rad-based units.
+
+    Attributes
+    ----------
+    q : ndarray, shape (..., 22)
+        Joint angles (rad), in the order of ``TREE_JOINTS``.
+    qd : ndarray, shape (..., 22)
+        Joint rates (rad/s).
+    qdd : ndarray, shape (..., 22)
+        Joint accelerations (rad/s²).
+    """
 
     q: np.ndarray
     qd: np.ndarray
@@ -48,6 +58,30 @@ def joint_motion(leg: OmniLeg, q: object, qd: object, qdd: object) -> JointMotio
     θ23 = -θ22; θ31 = -β, θ32 = -θ12, θ33 = θ12 (the closure, eqs. (8), (12)).  Drive: with the rod
     direction u, the shaft arm a1 = Rz(γ) e_y and the rod arm a2 = (a1 × u)/|a1 × u|,
     φ1 = atan2((Rz(γ) e_x)·(a2 × a1), (Rz(γ) e_x)·a2), φ2 = atan2((a2 × a1)·(u × a2), a1·(u × a2)).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry.
+    q, qd, qdd : array_like, shape (..., 3)
+        Angles (rad), rates (rad/s) and accelerations (rad/s²) of ``(α, β, γ)``; broadcast together.
+
+    Returns
+    -------
+    JointMotion
+        ``q``, ``qd``, ``qdd`` of the 22 tree joints, each (..., 22).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3), or
+        the shapes do not broadcast.
+
+    Examples
+    --------
+    >>> m = joint_motion(OmniLeg.paper(), [0.1, 0.2, 0.8], np.zeros(3), np.zeros(3))
+    >>> m.q.shape, float(m.q[TREE_JOINTS.index("crank_1")])
+    ((22,), 0.8)
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))

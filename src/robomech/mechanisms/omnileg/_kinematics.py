@@ -72,6 +72,26 @@ def thigh_direction(alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
 
     Written as ``w / |w|`` with ``w = (sin β cos α, -cos β sin α, cos β cos α)`` (module docstring): the
     printed tangent form mirrors the pose for |α| or |β| > 90°.
+
+    Parameters
+    ----------
+    alpha, beta : array_like, shape (...)
+        Active thigh angles α (about X0) and β (about Y0), rad; broadcast together.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Unit thigh direction in the hip frame (dimensionless).
+
+    Raises
+    ------
+    ValueError
+        If ``alpha`` or ``beta`` is not a finite real array, or they do not broadcast.
+
+    Examples
+    --------
+    >>> thigh_direction(0.0, 0.0)
+    array([ 0., -0.,  1.])
     """
     a, b = as_array(alpha, "alpha"), as_array(beta, "beta")
     ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
@@ -130,6 +150,25 @@ def passive_angles(leg: OmniLeg, alpha: object, beta: object) -> tuple[np.ndarra
     θ22 = -arctan(tan β cos α).  Written as atan2(sin α cos β, cos α) and -atan2(sin β cos α, cos β):
     equal for |α|, |β| < 90°, and continuous beyond, where the arctan form mirrors (module docstring;
     the closure's angles agree modulo 2π).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry.
+    alpha, beta : array_like, shape (...)
+        Active thigh angles (rad); broadcast together.
+
+    Returns
+    -------
+    theta12 : ndarray, shape (...)
+        Passive angle of chain 1's second U-joint axis (rad).
+    theta22 : ndarray, shape (...)
+        Passive angle of chain 2's second U-joint axis (rad).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg`, or ``alpha``/``beta`` is not a finite real array.
     """
     check_params(leg, OmniLeg, "leg")
     a = as_array(alpha, "alpha")
@@ -203,7 +242,28 @@ def jacobian(leg: OmniLeg, q: object) -> np.ndarray:
 
 
 def hessian(leg: OmniLeg, q: object) -> np.ndarray:
-    """Second-order influence coefficients ``H[..., i, j, k] = ∂²p_F,i/∂q_j∂q_k`` (..., 3, 3, 3)."""
+    """Second-order influence coefficients ``H[..., i, j, k] = ∂²p_F,i/∂q_j∂q_k`` (..., 3, 3, 3).
+
+    The derivative of :func:`jacobian` (paper 2, eq. (14)); ``a_F = J q̈ + q̇ᵀ H q̇``.
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m).
+    q : array_like, shape (..., 3)
+        Joint angles ``(α, β, γ)`` (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3, 3)
+        ``∂²p_F,i/∂q_j∂q_k`` (m/rad²), hip frame; symmetric in ``j, k``.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg` or an array is not a finite real array of shape (..., 3)
+        (or the shapes do not broadcast).
+    """
     check_params(leg, OmniLeg, "leg")
     q = _q(q)
     u, N, W, W2 = _dw(q)
@@ -227,14 +287,65 @@ def hessian(leg: OmniLeg, q: object) -> np.ndarray:
 
 
 def foot_velocity(leg: OmniLeg, q: object, qd: object) -> np.ndarray:
-    """``v_F = J q̇`` (..., 3), m/s."""
+    """``v_F = J q̇`` (..., 3), m/s: the foot velocity (paper 2, eq. (14)).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m).
+    q : array_like, shape (..., 3)
+        Joint angles ``(α, β, γ)`` (rad).
+    qd : array_like, shape (..., 3)
+        Joint rates (rad/s); broadcasts with ``q``.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Foot velocity in the hip frame (m/s).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg` or an array is not a finite real array of shape (..., 3)
+        (or the shapes do not broadcast).
+
+    Examples
+    --------
+    >>> leg = OmniLeg.paper()
+    >>> v = foot_velocity(leg, [0.1, 0.2, 0.8], [0.0, 0.0, 1.0])   # γ̇ only: the foot moves along Z0
+    >>> v.round(4)
+    array([ 0.    ,  0.    , -0.1363])
+    """
     check_params(leg, OmniLeg, "leg")
     qd = as_array(qd, "qd", (3,))
     return np.einsum("...ij,...j->...i", jacobian(leg, q), qd)
 
 
 def foot_acceleration(leg: OmniLeg, q: object, qd: object, qdd: object) -> np.ndarray:
-    """``a_F = J q̈ + q̇ᵀ H q̇`` (..., 3), m/s² (the foot does not rotate, Section 2)."""
+    """``a_F = J q̈ + q̇ᵀ H q̇`` (..., 3), m/s² (the foot does not rotate, Section 2).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m).
+    q : array_like, shape (..., 3)
+        Joint angles ``(α, β, γ)`` (rad).
+    qd : array_like, shape (..., 3)
+        Joint rates (rad/s).
+    qdd : array_like, shape (..., 3)
+        Joint accelerations (rad/s²); all three broadcast together.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Foot acceleration in the hip frame (m/s²).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg` or an array is not a finite real array of shape (..., 3)
+        (or the shapes do not broadcast).
+    """
     check_params(leg, OmniLeg, "leg")
     qd = as_array(qd, "qd", (3,))
     qdd = as_array(qdd, "qdd", (3,))
@@ -244,7 +355,31 @@ def foot_acceleration(leg: OmniLeg, q: object, qd: object, qdd: object) -> np.nd
 
 
 def within_limits(leg: OmniLeg, q: object) -> np.ndarray:
-    """Per-sample mask: |α| ≤ α_max, |β| ≤ β_max, γ_min ≤ γ ≤ γ_max (Table 2 as magnitudes)."""
+    """Per-sample mask: |α| ≤ α_max, |β| ≤ β_max, γ_min ≤ γ ≤ γ_max (Table 2 as magnitudes).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg and its joint limits (rad).
+    q : array_like, shape (..., 3)
+        Joint angles ``(α, β, γ)`` (rad); non-finite samples give False.
+
+    Returns
+    -------
+    ndarray of bool, shape (...)
+        True where every joint is within its range (inclusive, up to ``LIMIT_SLACK``).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg` or ``q`` is not a real array of shape (..., 3).
+
+    Examples
+    --------
+    >>> leg = OmniLeg.paper()
+    >>> within_limits(leg, [[0.1, 0.2, 0.8], [0.1, 0.2, 2.0]])
+    array([ True, False])
+    """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,), finite=False)
     with np.errstate(invalid="ignore"):
@@ -264,6 +399,23 @@ class IKResult:
     L1 from Z0 horizontally, or deeper/shallower than the shank can reach).  ``within_limits`` checks the
     joint ranges; ``reachable = exists & within_limits``.  ``residual`` is ``|FK(q) - p|`` (m, NaN where
     no solution exists), a diagnostic computed on first access (it costs a forward kinematics).
+
+    Attributes
+    ----------
+    q : ndarray, shape (..., 3)
+        Joint angles ``(α, β, γ)`` (rad), branch γ ≥ 0; NaN where no solution exists.
+    exists : ndarray of bool, shape (...)
+        A real solution exists.
+    within_limits : ndarray of bool, shape (...)
+        The solution is within the joint ranges.
+    reachable : ndarray of bool, shape (...)
+        ``exists & within_limits``.
+    leg : OmniLeg
+        The leg solved for.
+    p_foot : ndarray, shape (..., 3)
+        The requested foot positions (m, hip frame).
+    residual : ndarray, shape (...)
+        ``|FK(q) - p_foot|`` (m), NaN where no solution exists (computed on first access).
     """
 
     q: np.ndarray

@@ -106,6 +106,22 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
 
     Bodies, joints and inertial parameters are those of the analytic model (module docstring); the
     exported MJCF (``robomech.multibody.to_mjcf``) is the engine model of ``robomech verify omnileg``.
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m), inertias and gravity (hip frame).
+
+    Returns
+    -------
+    Mechanism
+        The spanning tree of ``TREE_JOINTS`` with its bodies and inertials, the loop closures, and the
+        actuated coordinates ``(α, β, γ)``.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg`.
     """
     check_params(leg, OmniLeg, "leg")
     L1, L3, L4 = leg.L1, leg.L3, leg.L4

@@ -43,6 +43,28 @@ class RigidBody:
 
     ``mass`` in kg; ``com (3,)`` the centre of mass in the body frame (m); ``inertia (3, 3)`` the
     rotational inertia about the centre of mass in body axes (kg m^2).
+
+    Parameters
+    ----------
+    mass : float
+        Mass (kg), > 0.
+    com : array_like, shape (3,)
+        Centre of mass in the body frame (m); stored as a tuple of 3 floats.
+    inertia : array_like, shape (3, 3)
+        Inertia about the centre of mass in body axes (kg m²): symmetric, positive semidefinite, its
+        principal moments obeying the triangle inequality; stored as nested tuples.
+
+    Attributes
+    ----------
+    inertia_matrix : ndarray, shape (3, 3)
+        ``inertia`` as an array (kg m²).
+    com_vector : ndarray, shape (3,)
+        ``com`` as an array (m).
+
+    Raises
+    ------
+    ValueError
+        If a field is not finite, the mass is not positive, or the inertia is not a valid inertia matrix.
     """
 
     mass: float
@@ -128,6 +150,32 @@ def default_bodies(L1: float, L3: float, L4: float, L5: float, knee_to_crank: fl
     an 8 mm aluminium disk of radius L3 + 15 mm with 150 g of gears and bearings; cranks and couplers
     aluminium bars 12 x 6 mm of length L4 (the crank also carrying a 25 g bevel gear at C); foot a
     100 g aluminium pad with a 10 mm aluminium rod from the E plane down to the foot point.
+
+    Parameters
+    ----------
+    L1, L3, L4, L5 : float
+        Thigh rod length, U-joint radius, shank link length and knee height (m), each > 0 (see
+        :class:`OmniLeg`).
+    knee_to_crank : float
+        Depth of the crank joints C_i below the knee point O0' (m).
+
+    Returns
+    -------
+    dict of str to RigidBody
+        The 11 body kinds (``hip_cross``, ``thigh_rod``, ``knee_cross``, ``knee_plate``,
+        ``drive_shaft_in``, ``drive_cross``, ``drive_rod``, ``drive_shaft_out``, ``crank``, ``coupler``,
+        ``foot``) and their inertial parameters.
+
+    Raises
+    ------
+    ValueError
+        If a length is not a positive finite real number or ``knee_to_crank`` is not a finite real.
+
+    Examples
+    --------
+    >>> b = default_bodies(0.15, 0.075, 0.095, 0.16, 0.03)
+    >>> len(b), bool(b["foot"].mass > 0)
+    (11, True)
     """
     L1, L3, L4, L5 = (check_positive(v, n) for v, n in ((L1, "L1"), (L3, "L3"), (L4, "L4"), (L5, "L5")))
     knee_to_crank = check_real(knee_to_crank, "knee_to_crank")
@@ -219,6 +267,18 @@ class BodySet(Mapping):
     :func:`default_bodies` derives from the leg's dimensions, and are derived again whenever the leg is
     rebuilt (``dataclasses.replace(leg, L1=...)`` passes this mapping back to ``OmniLeg``, which keeps
     only its explicit entries).  Two sets compare equal when all 11 bodies are equal.
+
+    Parameters
+    ----------
+    bodies : Mapping
+        Body kind -> :class:`RigidBody` for all 11 kinds.
+    explicit : frozenset of str
+        The kinds given explicitly by the user.
+
+    Attributes
+    ----------
+    explicit : frozenset of str
+        Body kinds given explicitly (not derived from the dimensions).
     """
 
     __slots__ = ("_bodies", "_explicit")
@@ -270,6 +330,49 @@ class OmniLeg:
     (a mapping of some body kinds to :class:`RigidBody`); every other body is derived from the
     dimensions by :func:`default_bodies`, and is derived again when a dimension changes
     (``dataclasses.replace``).  ``leg.bodies`` is the full :class:`BodySet`; equality compares it.
+
+    Parameters
+    ----------
+    L1 : float
+        Thigh rod length A_iB_i (m), > 0 (Table 2: 0.15 m).
+    L3 : float
+        Distance of the U joints A_i, B_i from the plate centres O0, O0' (m), > 0.
+    L4 : float
+        Shank link length C_iD_i = D_iE_i (m), > 0.
+    L5 : float
+        Knee height (m), > 0: the constant part of the foot depth below O0' (eq. (11)).
+    alpha_max, beta_max : float, optional
+        Joint range magnitudes of α and β (rad), in (0, π/2); default 65°.
+    gamma_min, gamma_max : float, optional
+        Range of the crank angle γ (rad), ``-π/2 < gamma_min < gamma_max < π/2``; default 0 and 85°.
+    knee_to_crank : float, optional
+        Depth of the C_i joints below O0' (m), in [0, L5]; default 0.03 m.
+    shank_radius : float, optional
+        Radius of the C_i and E_i circles (m), > 0; default 0.025 m.
+    shank_azimuth : float, optional
+        Angle of chain C1D1E1 from X0 (rad); default π/2.
+    gravity : array_like, shape (3,), optional
+        Gravity acceleration in the hip frame (m/s²); default ``(0, 0, 9.80665)`` (Z0 down).
+    bodies : Mapping, optional
+        Explicit :class:`RigidBody` overrides by body kind (keys from ``BODY_FIELDS``); the others are
+        :func:`default_bodies`.  Stored as a :class:`BodySet` of all 11 kinds.
+
+    Attributes
+    ----------
+    foot_drop : float
+        Depth of the foot point below the E_i plane, ``L5 - knee_to_crank`` (m).
+
+    Raises
+    ------
+    ValueError
+        If a field is out of its range, not finite, or ``bodies`` has an unknown key or a value that is
+        not a :class:`RigidBody`.
+
+    Examples
+    --------
+    >>> leg = OmniLeg.paper()
+    >>> leg.L1, len(leg.bodies), round(leg.foot_drop, 3)
+    (0.15, 11, 0.13)
     """
 
     L1: float

@@ -35,6 +35,23 @@ class JointRatesResult:
     (γ ≈ 0): there the weak direction is damped, so the solution is the damped least-squares one and
     ``velocity_residual = |J q̇ - ṗ|`` (m/s) and ``acceleration_residual = |J q̈ + q̇ᵀHq̇ - p̈|`` (m/s²)
     are no longer zero; ``valid = ~singular`` and every value finite.
+
+    Attributes
+    ----------
+    qd : ndarray, shape (..., 3)
+        Joint rates (rad/s).
+    qdd : ndarray, shape (..., 3)
+        Joint accelerations (rad/s²); NaN if no foot acceleration was given.
+    rcond : ndarray, shape (...)
+        ``sigma_min / sigma_max`` of the foot Jacobian (dimensionless).
+    singular : ndarray of bool, shape (...)
+        ``rcond < SINGULAR_RCOND``: the solution is the damped least-squares one.
+    velocity_residual : ndarray, shape (...)
+        ``|J q̇ - ṗ|`` (m/s).
+    acceleration_residual : ndarray, shape (...)
+        ``|J q̈ + q̇ᵀ H q̇ - p̈|`` (m/s²); NaN if no foot acceleration was given.
+    valid : ndarray of bool, shape (...)
+        Not singular and every value finite.
     """
 
     qd: np.ndarray
@@ -68,6 +85,41 @@ def joint_rates(
     sigma_max) damps the directions with ``sigma < SINGULAR_RCOND sigma_max``: ``c = σ / (σ² + λ²)``,
     ``λ = damping sigma_max`` (selectively damped least squares: the well-determined components stay
     exact).  ``damping = 0`` drops the weak directions (truncated pseudo-inverse).
+
+    Paper 2, eq. (47)'s inverse of the foot Jacobian (eq. (14)), regularised at the singularity γ = 0.
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m).
+    q : array_like, shape (..., 3)
+        Joint angles ``(α, β, γ)`` (rad).
+    foot_velocity : array_like, shape (..., 3)
+        Foot velocity ``ṗ`` in the hip frame (m/s).
+    foot_acceleration : array_like, shape (..., 3), optional
+        Foot acceleration ``p̈`` in the hip frame (m/s²); ``None`` (default) leaves ``qdd`` NaN.
+    damping : float, optional
+        Damping of the weak directions relative to sigma_max (>= 0; default ``DEFAULT_DAMPING``).
+
+    Returns
+    -------
+    JointRatesResult
+        ``qd`` (rad/s) and ``qdd`` (rad/s²), each (..., 3); ``rcond``, ``singular``, the velocity and
+        acceleration residuals and ``valid``, each (...).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3),
+        the batch shapes do not broadcast, or ``damping`` is negative or not a finite real number.
+
+    Examples
+    --------
+    >>> leg = OmniLeg.paper()
+    >>> q = np.array([0.1, 0.2, 0.8])
+    >>> r = joint_rates(leg, q, jacobian(leg, q) @ [0.3, -0.2, 0.5])   # ṗ of a known q̇
+    >>> r.qd.round(12), bool(r.valid)
+    (array([ 0.3, -0.2,  0.5]), True)
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))

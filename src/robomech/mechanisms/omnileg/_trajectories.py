@@ -46,7 +46,25 @@ GAIT_STRIDE, GAIT_HEIGHT, GAIT_LATERAL, GAIT_PERIOD = 0.1, 0.05, 0.0, 1.0
 
 
 def start_point(leg: OmniLeg) -> np.ndarray:
-    """Foot start point ``FK(0, 0, START_GAMMA)`` (3,), m."""
+    """Foot start point ``FK(0, 0, START_GAMMA)`` (3,), m.
+
+    The start of the foot trajectories of eqs. (51) and (53) (the paper gives none; module docstring).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m).
+
+    Returns
+    -------
+    ndarray, shape (3,)
+        Foot position in the hip frame (m).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg`.
+    """
     check_params(leg, OmniLeg, "leg")
     return forward_kinematics(leg, np.array([0.0, 0.0, START_GAMMA]))
 
@@ -58,7 +76,36 @@ def _lift(p0: np.ndarray, x: Profile, y: Profile, z: Profile) -> Profile:
 
 
 def foot_trajectory_eq51(leg: OmniLeg, t: object) -> Profile:
-    """Foot position, velocity, acceleration (..., 3) of eq. (51) at times ``t`` (...), 0 <= t <= 5 s."""
+    """Foot position, velocity, acceleration (..., 3) of eq. (51) at times ``t`` (...), 0 <= t <= 5 s.
+
+    Paper 2, eq. (51): X rises by 0.1 m over T/2 and returns, Y rises by 0.1 m over T, Z lifts 0.05 m
+    and returns, T = ``EQ51_PERIOD``; added to :func:`start_point`, Z against Z0.
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m).
+    t : array_like, shape (...)
+        Times (s), in ``[0, EQ51_PERIOD]``.
+
+    Returns
+    -------
+    Profile
+        ``q`` foot position (m), ``qd`` velocity (m/s), ``qdd`` acceleration (m/s²), each (..., 3), hip
+        frame.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg` or ``t`` is not a finite real array.
+
+    Examples
+    --------
+    >>> leg = OmniLeg.paper()
+    >>> f = foot_trajectory_eq51(leg, np.linspace(0.0, 5.0, 11))
+    >>> f.q.shape, bool(np.allclose(f.q[0], start_point(leg)))
+    ((11, 3), True)
+    """
     check_params(leg, OmniLeg, "leg")
     t = as_array(t, "t")
     half = EQ51_PERIOD / 2
@@ -77,6 +124,28 @@ def joint_trajectory_eq52(t: object) -> Profile:
 
     Note: γ < 0 for 3 s < t < 6 s, outside Table 2's γ range [0°, 85°]; the model is valid there
     (|γ| < 90°) and the foot retraces its path since eq. (11) is even in γ.
+
+    Parameters
+    ----------
+    t : array_like, shape (...)
+        Times (s), typically in ``[0, EQ52_DURATION]``.
+
+    Returns
+    -------
+    Profile
+        ``q`` joint angles (rad), ``qd`` rates (rad/s), ``qdd`` accelerations (rad/s²), each (..., 3).
+
+    Raises
+    ------
+    ValueError
+        If ``t`` is not a finite real array.
+
+    Examples
+    --------
+    >>> p = joint_trajectory_eq52([0.0, 1.5])
+    >>> np.round(np.degrees(p.q), 6)
+    array([[ 0.,  0.,  0.],
+           [30., 30., 25.]])
     """
     t = as_array(t, "t")
     return sinusoid(t[..., None], EQ52_AMPLITUDE, EQ52_FREQUENCY)
@@ -84,7 +153,16 @@ def joint_trajectory_eq52(t: object) -> Profile:
 
 @dataclass(frozen=True)
 class GaitProfile:
-    """Foot profile (position, velocity, acceleration (..., 3)) and ``stance (...)`` mask of eq. (53)."""
+    """Foot profile (position, velocity, acceleration (..., 3)) and ``stance (...)`` mask of eq. (53).
+
+    Attributes
+    ----------
+    foot : Profile
+        Foot position ``q`` (m), velocity ``qd`` (m/s) and acceleration ``qdd`` (m/s²), each (..., 3),
+        hip frame.
+    stance : ndarray of bool, shape (...)
+        True during the stance periods (foot on the ground), false during swing.
+    """
 
     foot: Profile
     stance: np.ndarray
@@ -97,6 +175,32 @@ def gait_eq53(leg: OmniLeg, t: object, periods: int = 6) -> GaitProfile:
     from +L/2 to -L/2 on the ground (H = 0), as the body moves forward.  The paper writes only the swing
     form (Y from 0 to L); centring the stride under the hip and reversing it in stance is robomech's
     reading (a foot fixed relative to the ground moves backward relative to the hip).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m).
+    t : array_like, shape (...)
+        Times (s), in ``[0, periods * GAIT_PERIOD]`` (``GAIT_PERIOD`` = 1 s).
+    periods : int, optional
+        Number of periods (>= 1; default 6), starting with a swing.
+
+    Returns
+    -------
+    GaitProfile
+        The foot profile (..., 3) (m, m/s, m/s²) and the ``stance`` mask (...).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg`, ``t`` is not a finite real array, or ``periods`` is not an
+        int >= 1.
+
+    Examples
+    --------
+    >>> g = gait_eq53(OmniLeg.paper(), [0.5, 1.5])
+    >>> g.foot.q.shape, g.stance
+    ((2, 3), array([False,  True]))
     """
     check_params(leg, OmniLeg, "leg")
     t = as_array(t, "t")

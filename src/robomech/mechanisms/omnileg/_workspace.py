@@ -48,10 +48,30 @@ BOUNDARY_POINTS = 200
 
 @dataclass(frozen=True)
 class WorkspaceMap:
-    """Per joint sample (...): foot position (..., 3) m; within_limits (Table 2); det (...) of J (m²/rad³);
+    """Per joint sample (...): foot position (..., 3) m; within_limits (Table 2); det (...) of J (m³/rad³);
     cond (...) 2-norm condition number (inf where singular); dexterity 1/cond in [0, 1]; sigma_min (...)
     m/rad; singular (...) where sigma_min / sigma_max < SINGULAR_RCOND (the threshold of the damped
-    solves, γ ≈ 0)."""
+    solves, γ ≈ 0).
+
+    Attributes
+    ----------
+    q : ndarray, shape (..., 3)
+        The joint samples ``(α, β, γ)`` (rad).
+    foot : ndarray, shape (..., 3)
+        Foot position in the hip frame (m).
+    within_limits : ndarray of bool, shape (...)
+        The sample is within Table 2's joint ranges.
+    det : ndarray, shape (...)
+        Determinant of the foot Jacobian (m³/rad³).
+    cond : ndarray, shape (...)
+        2-norm condition number of the Jacobian (inf where singular).
+    dexterity : ndarray, shape (...)
+        ``1 / cond``, in [0, 1].
+    sigma_min : ndarray, shape (...)
+        Smallest singular value of the Jacobian (m/rad).
+    singular : ndarray of bool, shape (...)
+        ``sigma_min / sigma_max < SINGULAR_RCOND``.
+    """
 
     q: np.ndarray
     foot: np.ndarray
@@ -65,7 +85,30 @@ class WorkspaceMap:
 
 def joint_grid(leg: OmniLeg, n: int | tuple[int, int, int]) -> np.ndarray:
     """Regular grid ``(n_α, n_β, n_γ, 3)`` over Table 2's joint ranges (|α| <= α_max, |β| <= β_max,
-    γ_min <= γ <= γ_max), rad."""
+    γ_min <= γ <= γ_max), rad.
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg and its joint limits (rad).
+    n : int or tuple of int
+        Samples per joint (each >= 2): one count for all three, or ``(n_α, n_β, n_γ)``.
+
+    Returns
+    -------
+    ndarray, shape (n_α, n_β, n_γ, 3)
+        Joint samples ``(α, β, γ)`` (rad), the range ends included.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg` or ``n`` is not an int >= 2 or three of them.
+
+    Examples
+    --------
+    >>> joint_grid(OmniLeg.paper(), (3, 4, 5)).shape
+    (3, 4, 5, 3)
+    """
     _leg(leg)
     if isinstance(n, tuple | list):
         if len(n) != 3:
@@ -83,7 +126,35 @@ def _leg(leg: object) -> OmniLeg:
 
 
 def workspace_map(leg: OmniLeg, q: object) -> WorkspaceMap:
-    """Foot position and Jacobian conditioning at joint samples ``q (..., 3)`` (e.g. :func:`joint_grid`)."""
+    """Foot position and Jacobian conditioning at joint samples ``q (..., 3)`` (e.g. :func:`joint_grid`).
+
+    Paper 2, eqs. (11) and (14) evaluated per sample.
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m) and joint limits (rad).
+    q : array_like, shape (..., 3)
+        Joint samples ``(α, β, γ)`` (rad).
+
+    Returns
+    -------
+    WorkspaceMap
+        The samples ``q`` and per sample the ``foot`` position (..., 3) m, ``within_limits``, ``det``,
+        ``cond``, ``dexterity``, ``sigma_min`` and ``singular``.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg` or ``q`` is not a finite real array of shape (..., 3).
+
+    Examples
+    --------
+    >>> leg = OmniLeg.paper()
+    >>> w = workspace_map(leg, joint_grid(leg, 5))
+    >>> w.foot.shape, bool(w.singular[..., 0].all()), bool(w.singular[..., 1:].any())  # γ = 0 singular
+    ((5, 5, 5, 3), True, False)
+    """
     _leg(leg)
     q = as_array(q, "q", (3,))
     J = jacobian(leg, q)
@@ -101,7 +172,26 @@ def workspace_map(leg: OmniLeg, q: object) -> WorkspaceMap:
 
 
 def singular_surface(leg: OmniLeg, alpha: object, beta: object) -> np.ndarray:
-    """Foot positions (..., 3) m on the singular surface γ = 0 (the fully extended shank) at (α, β) rad."""
+    """Foot positions (..., 3) m on the singular surface γ = 0 (the fully extended shank) at (α, β) rad.
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m).
+    alpha, beta : array_like, shape (...)
+        Thigh angles (rad); broadcast together.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Foot positions ``FK(α, β, 0)`` in the hip frame (m).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg`, ``alpha``/``beta`` is not a finite real array, or they do
+        not broadcast.
+    """
     _leg(leg)
     a = as_array(alpha, "alpha")
     b = as_array(beta, "beta")
@@ -123,6 +213,21 @@ class FootWorkspace:
     the closed horizontal boundary (x, y), images of the edges |α| = α_max, |β| = β_max; depth_min,
     depth_max (m): the shallowest and deepest foot positions along Z0; radius_max (m): the largest
     horizontal distance of the foot from Z0.
+
+    Attributes
+    ----------
+    volume : float
+        Workspace volume (m³), ``projected_area * stroke``.
+    projected_area : float
+        Area of the workspace's horizontal section (m²).
+    stroke : float
+        Vertical travel of the shank (m).
+    boundary : ndarray, shape (M, 2)
+        Closed horizontal boundary ``(x, y)`` (m, hip frame), ``M = 4 BOUNDARY_POINTS``.
+    depth_min, depth_max : float
+        Shallowest and deepest foot positions along Z0 (m).
+    radius_max : float
+        Largest horizontal distance of the foot from Z0 (m).
     """
 
     volume: float
@@ -141,7 +246,35 @@ def _projected_jacobian_det(leg: OmniLeg, a: np.ndarray, b: np.ndarray) -> np.nd
 
 
 def foot_workspace(leg: OmniLeg, *, nodes: int = AREA_NODES) -> FootWorkspace:
-    """Volume, horizontal section, boundary and extent of the foot workspace over Table 2's ranges."""
+    """Volume, horizontal section, boundary and extent of the foot workspace over Table 2's ranges.
+
+    The area is a Gauss-Legendre double integral over (α, β) of the knee's projected Jacobian
+    determinant (module docstring).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m) and joint limits (rad).
+    nodes : int, optional
+        Gauss-Legendre nodes per joint coordinate (>= 2; default ``AREA_NODES``).
+
+    Returns
+    -------
+    FootWorkspace
+        ``volume`` (m³), ``projected_area`` (m²), ``stroke``, ``boundary`` (M, 2), ``depth_min``,
+        ``depth_max`` and ``radius_max`` (m).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg` or ``nodes`` is not an int >= 2.
+
+    Examples
+    --------
+    >>> ws = foot_workspace(OmniLeg.paper())
+    >>> bool(np.isclose(ws.volume, ws.projected_area * ws.stroke)), ws.boundary.shape
+    (True, (800, 2))
+    """
     _leg(leg)
     nodes = check_int(nodes, "nodes", low=2)
     x, w = np.polynomial.legendre.leggauss(nodes)
@@ -181,7 +314,17 @@ def foot_workspace(leg: OmniLeg, *, nodes: int = AREA_NODES) -> FootWorkspace:
 class SymmetryResult:
     """Per foot sample (...): reachable (within Table 2's ranges) and, for each symmetry of the claim,
     whether the image's reachability agrees: mirror_x (x -> -x), mirror_y (y -> -y), swap
-    ((x, y) -> (-y, -x), the α <-> β exchange); holds = all three agree."""
+    ((x, y) -> (-y, -x), the α <-> β exchange); holds = all three agree.
+
+    Attributes
+    ----------
+    reachable : ndarray of bool, shape (...)
+        The foot sample is reachable within Table 2's ranges.
+    mirror_x, mirror_y, swap : ndarray of bool, shape (...)
+        The image under x -> -x, y -> -y, (x, y) -> (-y, -x) has the same reachability.
+    holds : ndarray of bool, shape (...)
+        ``mirror_x & mirror_y & swap``.
+    """
 
     reachable: np.ndarray
     mirror_x: np.ndarray
@@ -194,6 +337,31 @@ def workspace_symmetry(leg: OmniLeg, p_foot: object) -> SymmetryResult:
     """Test paper 2's claim that the foot workspace is symmetric at foot positions ``p_foot (..., 3)`` m.
 
     Non-finite samples are unreachable, as are their images (they agree).
+
+    Parameters
+    ----------
+    leg : OmniLeg
+        The leg's geometry (m) and joint limits (rad).
+    p_foot : array_like, shape (..., 3)
+        Foot positions in the hip frame (m); non-finite samples allowed.
+
+    Returns
+    -------
+    SymmetryResult
+        ``reachable``, ``mirror_x``, ``mirror_y``, ``swap`` and ``holds`` masks, each (...).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not an :class:`OmniLeg` or ``p_foot`` is not a real array of shape (..., 3).
+
+    Examples
+    --------
+    >>> leg = OmniLeg.paper()
+    >>> p = forward_kinematics(leg, [0.3, -0.2, 0.7])
+    >>> r = workspace_symmetry(leg, p)
+    >>> bool(r.reachable), bool(r.holds)
+    (True, True)
     """
     _leg(leg)
     p = as_array(p_foot, "p_foot", (3,), finite=False)

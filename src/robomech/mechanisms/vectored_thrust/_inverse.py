@@ -54,6 +54,23 @@ class InverseRatesResult:
     1 / INPUT_GAIN_MAX`` or J does not exist (there the weak direction is damped); ``omega_residual``
     ``|J q̇ - ω|`` (rad/s) and ``omega_dot_residual`` ``|J q̈ + J̇q̇ - ω̇|`` (rad/s²): the part of the
     command the mechanism cannot realise (ω outside J's range, or damped); ``valid = ~singular``.
+
+    Attributes
+    ----------
+    qd : ndarray, shape (..., 2)
+        Input rates (rad/s); NaN where J does not exist.
+    qdd : ndarray, shape (..., 2)
+        Input accelerations (rad/s²); NaN if no ω̇ was given or J does not exist.
+    sigma_min : ndarray, shape (...)
+        Smallest singular value of J (dimensionless; 0 where J does not exist).
+    singular : ndarray of bool, shape (...)
+        ``sigma_min < 1 / INPUT_GAIN_MAX`` or J does not exist.
+    omega_residual : ndarray, shape (...)
+        ``|J q̇ - ω|`` (rad/s).
+    omega_dot_residual : ndarray, shape (...)
+        ``|J q̈ + J̇ q̇ - ω̇|`` (rad/s²); NaN if no ω̇ was given.
+    valid : ndarray of bool, shape (...)
+        Not singular and every value finite.
     """
 
     qd: np.ndarray
@@ -94,6 +111,39 @@ def inverse_rates(
     all broadcast.  paper 5, Section 3.3 (eqs. (22)-(28)): the inverse acceleration model, here with
     the Lie-bracket velocity products the print drops.  ``damping`` (>= 0, relative to sigma_max)
     applies to the directions with ``sigma < 1 / INPUT_GAIN_MAX`` (selectively damped least squares).
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    q : array_like, shape (..., 2)
+        Input angles ``(q1, q2)`` (rad).
+    omega : array_like, shape (..., 3)
+        Commanded platform angular velocity (rad/s, base frame).
+    omega_dot : array_like, shape (..., 3), optional
+        Commanded platform angular acceleration (rad/s², base frame); ``None`` (default) leaves ``qdd``
+        NaN.
+    damping : float, optional
+        Damping of the weak directions relative to sigma_max (>= 0; default ``DEFAULT_DAMPING``).
+
+    Returns
+    -------
+    InverseRatesResult
+        ``qd`` (rad/s) and ``qdd`` (rad/s²), each (..., 2); ``sigma_min``, ``singular``, the residuals
+        and ``valid``, each (...).
+
+    Raises
+    ------
+    ValueError
+        If ``th`` is not a :class:`VectoredThruster`, an array is not finite and real with the stated
+        last dimension, the batch shapes do not broadcast, or ``damping`` is negative.
+
+    Examples
+    --------
+    >>> th = VectoredThruster.paper()
+    >>> r = inverse_rates(th, [[0.1, 0.2]] * 3, [0.0, 0.0, 0.0])
+    >>> r.qd.shape, bool(r.valid.all()), bool(np.allclose(r.qd, 0.0))
+    ((3, 2), True, True)
     """
     _check_thruster(th)
     q = _q(q)
@@ -156,7 +206,19 @@ class StaticsResult:
     """Motor torques ``tau (..., 2)`` N·m (inputs q1, q2) holding a wrench on the platform; NaN where
     not ``valid`` (J does not exist: passive axes parallel); ``moment (..., 3)`` N·m the wrench's moment
     about O, the only part that loads the motors; ``unloaded (..., 3)`` N·m its component outside J's
-    range, carried by the closure without motor torque."""
+    range, carried by the closure without motor torque.
+
+    Attributes
+    ----------
+    tau : ndarray, shape (..., 2)
+        Motor torques on the inputs q1, q2 (N·m); NaN where not ``valid``.
+    moment : ndarray, shape (..., 3)
+        Moment of the wrench about O (N·m, base frame).
+    unloaded : ndarray, shape (..., 3)
+        Component of ``moment`` outside J's range (N·m), carried without motor torque.
+    valid : ndarray of bool, shape (...)
+        J exists and the torques are finite.
+    """
 
     tau: np.ndarray
     moment: np.ndarray
@@ -171,6 +233,33 @@ def static_torques(th: VectoredThruster, q: object, wrench: object) -> StaticsRe
     (conventions: ``[m; f]``); virtual work ``τ·q̇ + m_O·ω = 0``.  The force f passes through the
     universal joint at O and needs no motor torque.  For a propeller thrust T along the shaft s0 and a
     reaction torque Q about it, the wrench is ``[Q s0; T s0]`` (the thrust line passes through O).
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    q : array_like, shape (..., 2)
+        Input angles ``(q1, q2)`` (rad).
+    wrench : array_like, shape (..., 6)
+        Wrench ``[m_O; f]`` applied to the platform (N·m, N; base frame, moment about O).
+
+    Returns
+    -------
+    StaticsResult
+        ``tau`` (..., 2) N·m, the ``moment`` and its ``unloaded`` part (..., 3) N·m, and ``valid``.
+
+    Raises
+    ------
+    ValueError
+        If ``th`` is not a :class:`VectoredThruster`, an array is not finite and real with the stated
+        last dimension, or the batch shapes do not broadcast.
+
+    Examples
+    --------
+    >>> th = VectoredThruster.paper()
+    >>> r = static_torques(th, [0.0, 0.0], [0.0, 0.0, 0.0, 0.0, 0.0, 10.0])  # thrust along s0 = +Z
+    >>> bool(np.allclose(r.tau, 0.0)), bool(r.valid)
+    (True, True)
     """
     _check_thruster(th)
     q = _q(q)

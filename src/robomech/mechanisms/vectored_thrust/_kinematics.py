@@ -113,7 +113,27 @@ _Y = np.array([0.0, 1.0, 0.0])
 
 @dataclass(frozen=True)
 class JointAxes:
-    """Unit joint axes (..., 3) in the base frame; all pass through O."""
+    """Unit joint axes (..., 3) in the base frame; all pass through O.
+
+    Attributes
+    ----------
+    s11 : ndarray, shape (..., 3)
+        RRR input axis (X).
+    s12 : ndarray, shape (..., 3)
+        RRR passive axis between the 45° and the 90° arcs (eq. (7)).
+    s13 : ndarray, shape (..., 3)
+        RRR passive axis on the platform (eq. (8)); NaN where singular.
+    s21 : ndarray, shape (..., 3)
+        RR input axis (Y).
+    s22 : ndarray, shape (..., 3)
+        RR passive axis on the platform (eq. (5)).
+    s0 : ndarray, shape (..., 3)
+        Propeller shaft ``s22 x s13`` (eq. (11)); NaN where singular.
+    distance : ndarray, shape (...)
+        ``|s22 x s12|``, the distance to the singularity, in [0, 1].
+    valid : ndarray of bool, shape (...)
+        ``distance > SINGULAR_TOL``.
+    """
 
     s11: np.ndarray  # RRR input axis (X)
     s12: np.ndarray  # RRR passive axis between the 45 deg and the 90 deg arcs
@@ -127,6 +147,26 @@ class JointAxes:
 
 @dataclass(frozen=True)
 class FKResult:
+    """Forward kinematics per sample (:func:`forward_kinematics`).
+
+    Attributes
+    ----------
+    axis : ndarray, shape (..., 3)
+        Unit propeller axis s0 (base frame); NaN where not valid.
+    tip : ndarray, shape (..., 3)
+        Propeller position ``propeller_arm * s0`` (m, base frame).
+    tilt : ndarray, shape (...)
+        Angle between s0 and Z, the universal joint's deflection (rad).
+    valid : ndarray of bool, shape (...)
+        Assembled and not singular.
+    in_range : ndarray of bool, shape (...)
+        Inputs within ``q1_limits`` and ``q2_limits``.
+    tilt_ok : ndarray of bool, shape (...)
+        Valid and ``tilt <= tilt_limit``.
+    within_limits : ndarray of bool, shape (...)
+        ``in_range & tilt_ok`` (link interference: see :func:`link_clearance`, ``workspace_map``).
+    """
+
     axis: np.ndarray  # (..., 3) unit propeller axis s0; NaN where not valid
     tip: np.ndarray  # (..., 3) propeller tip propeller_arm * s0, metres
     tilt: np.ndarray  # (...,) angle between s0 and Z (universal-joint deflection), rad
@@ -138,6 +178,22 @@ class FKResult:
 
 @dataclass(frozen=True)
 class IKResult:
+    """Inverse kinematics per sample (:func:`inverse_kinematics`).
+
+    Attributes
+    ----------
+    q : ndarray, shape (..., 2)
+        Inputs ``(q1, q2)`` (rad); NaN where not solved.
+    solved : ndarray of bool, shape (...)
+        An assembly with this propeller direction exists (limits ignored).
+    in_range : ndarray of bool, shape (...)
+        Solved and ``q`` within ``q1_limits``, ``q2_limits``.
+    tilt_ok : ndarray of bool, shape (...)
+        Solved and the direction within ``tilt_limit`` of Z.
+    valid : ndarray of bool, shape (...)
+        ``solved & in_range & tilt_ok``.
+    """
+
     q: np.ndarray  # (..., 2) inputs (q1, q2), rad; NaN where not solved
     solved: np.ndarray  # (...,) an assembly with this propeller direction exists (ignoring limits)
     in_range: np.ndarray  # (...,) solved and q within q1_limits, q2_limits
@@ -147,13 +203,31 @@ class IKResult:
 
 @dataclass(frozen=True)
 class RotationResult:
+    """Platform rotation per sample (:func:`platform_rotation`).
+
+    Attributes
+    ----------
+    R : ndarray, shape (..., 3, 3)
+        Platform rotation ``R_OP``, columns ``(-s22, -s13, s0)``; NaN where not valid.
+    valid : ndarray of bool, shape (...)
+        Not singular.
+    """
+
     R: np.ndarray  # (..., 3, 3) platform rotation R_OP, columns (-s22, -s13, s0); NaN where not valid
     valid: np.ndarray
 
 
 @dataclass(frozen=True)
 class PassiveResult:
-    """Passive joint quantities ordered (RR s22, RRR s12, RRR s13), shape (..., 3)."""
+    """Passive joint quantities ordered (RR s22, RRR s12, RRR s13), shape (..., 3).
+
+    Attributes
+    ----------
+    values : ndarray, shape (..., 3)
+        Passive angles (rad) or rates (rad/s); NaN where not valid.
+    valid : ndarray of bool, shape (...)
+        Not singular.
+    """
 
     values: np.ndarray
     valid: np.ndarray
@@ -161,6 +235,18 @@ class PassiveResult:
 
 @dataclass(frozen=True)
 class JacobianResult:
+    """Platform Jacobian per sample (:func:`jacobian`).
+
+    Attributes
+    ----------
+    J : ndarray, shape (..., 3, 2)
+        ``omega = J qd``, omega the platform's angular velocity (base frame); NaN where not valid.
+    valid : ndarray of bool, shape (...)
+        Not singular.
+    distance : ndarray, shape (...)
+        ``|s22 x s12|``, in [0, 1].
+    """
+
     J: np.ndarray  # (..., 3, 2): omega = J qd, omega the platform's angular velocity (base frame)
     valid: np.ndarray  # (...,) not singular; J is NaN elsewhere
     distance: np.ndarray  # (...,) |s22 x s12|
@@ -168,6 +254,22 @@ class JacobianResult:
 
 @dataclass(frozen=True)
 class AccelerationResult:
+    """Platform angular motion per sample (:func:`angular_acceleration`); NaN where not valid.
+
+    Attributes
+    ----------
+    omega : ndarray, shape (..., 3)
+        Platform angular velocity (rad/s, base frame).
+    omega_dot : ndarray, shape (..., 3)
+        Platform angular acceleration (rad/s², base frame).
+    passive_acc : ndarray, shape (..., 3)
+        Passive accelerations (RR s22, RRR s12, RRR s13), rad/s².
+    velocity_product : ndarray, shape (..., 3)
+        The Lie-bracket part ``J̇ q̇`` of ``omega_dot`` (rad/s²).
+    valid : ndarray of bool, shape (...)
+        Not singular.
+    """
+
     omega: np.ndarray  # (..., 3) platform angular velocity, rad/s
     omega_dot: np.ndarray  # (..., 3) platform angular acceleration, rad/s^2
     passive_acc: np.ndarray  # (..., 3) passive accelerations (RR s22, RRR s12, RRR s13)
@@ -211,7 +313,30 @@ def _axes(th: VectoredThruster, q: np.ndarray) -> JointAxes:
 def joint_axes(th: VectoredThruster, q: object) -> JointAxes:
     """Unit joint axes at inputs ``q (..., 2)`` (rad).
 
-    Singular samples have NaN s13 and s0 and ``valid`` False.
+    Singular samples have NaN s13 and s0 and ``valid`` False.  Paper 5, eqs. (5), (7), (8), (11).
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    q : array_like, shape (..., 2)
+        Inputs ``(q1, q2)`` (rad).
+
+    Returns
+    -------
+    JointAxes
+        ``s11, s12, s13, s21, s22, s0`` (..., 3), ``distance`` and ``valid`` (...).
+
+    Raises
+    ------
+    ValueError
+        If ``th`` is not a :class:`VectoredThruster` or ``q`` is not a finite real array of shape (..., 2).
+
+    Examples
+    --------
+    >>> ax = joint_axes(VectoredThruster.paper(), [0.0, 0.0])
+    >>> ax.s0 + 0.0, bool(ax.valid)
+    (array([0., 0., 1.]), True)
     """
     check_params(th, VectoredThruster, "th")
     return _axes(th, _q(q))
@@ -291,6 +416,28 @@ def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
     """Angular distance (rad) between the minor great-circle arcs (a1 -> b1) and (a2 -> b2) (unit, (..., 3)).
 
     Zero where they cross; otherwise the closest point is an end of one of them.
+
+    Parameters
+    ----------
+    a1, b1 : array_like, shape (..., 3)
+        Unit start and end points of the first arc.
+    a2, b2 : array_like, shape (..., 3)
+        Unit start and end points of the second arc; all four broadcast.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Angular distance between the arcs (rad), in [0, π].
+
+    Raises
+    ------
+    ValueError
+        If an argument is not a finite real array of shape (..., 3).
+
+    Examples
+    --------
+    >>> round(float(arc_clearance([1, 0, 0], [0, 1, 0], [0, 0, 1], [0, 1, 0])), 12)   # share an end
+    0.0
     """
     arrs = [as_array(v, name, (3,)) for v, name in ((a1, "a1"), (b1, "b1"), (a2, "a2"), (b2, "b2"))]
     return _arc_clearance(*(_split(v) for v in arrs))
@@ -355,6 +502,23 @@ def link_clearance(th: VectoredThruster, q: object) -> np.ndarray:
     """Angular clearance (rad) between the RRR chain's 45 deg arc and the fixing device at ``q (..., 2)``.
 
     Section 4.1 (2).  NaN where the configuration is singular (covered by ``joint_axes(...).valid``).
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    q : array_like, shape (..., 2)
+        Inputs ``(q1, q2)`` (rad).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Clearance (rad) on the unit sphere about O; compare with ``th.interference_clearance``.
+
+    Raises
+    ------
+    ValueError
+        If ``th`` is not a :class:`VectoredThruster` or ``q`` is not a finite real array of shape (..., 2).
     """
     check_params(th, VectoredThruster, "th")
     return _interference(th, _q(q))
@@ -437,7 +601,31 @@ def forward_kinematics(th: VectoredThruster, q: object) -> FKResult:
 
 
 def platform_rotation(th: VectoredThruster, q: object) -> RotationResult:
-    """Platform rotation ``R_OP (..., 3, 3)`` = Ry(q2) Rx(-theta), columns (-s22, -s13, s0)."""
+    """Platform rotation ``R_OP (..., 3, 3)`` = Ry(q2) Rx(-theta), columns (-s22, -s13, s0).
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    q : array_like, shape (..., 2)
+        Inputs ``(q1, q2)`` (rad).
+
+    Returns
+    -------
+    RotationResult
+        ``R`` (..., 3, 3) (NaN where singular) and ``valid`` (...).
+
+    Raises
+    ------
+    ValueError
+        If ``th`` is not a :class:`VectoredThruster` or ``q`` is not a finite real array of shape (..., 2).
+
+    Examples
+    --------
+    >>> r = platform_rotation(VectoredThruster.paper(), [0.3, 0.2])
+    >>> bool(np.allclose(r.R @ r.R.T, np.eye(3))), bool(np.isclose(np.linalg.det(r.R), 1.0))
+    (True, True)
+    """
     check_params(th, VectoredThruster, "th")
     ax = _axes(th, _q(q))
     return RotationResult(R=np.stack([-ax.s22, -ax.s13, ax.s0], axis=-1), valid=ax.valid)
@@ -582,6 +770,23 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
 
     Product of exponentials from the home axes: ``R = Ry(q2) exp(s22(0) theta)`` on the RR chain and
     ``R = Rx(q1) exp(s12(0) rho2) exp(s13(0) rho3)`` on the RRR chain.
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    q : array_like, shape (..., 2)
+        Inputs ``(q1, q2)`` (rad).
+
+    Returns
+    -------
+    PassiveResult
+        ``values`` (..., 3) the angles (theta, rho2, rho3), rad (NaN where singular), and ``valid``.
+
+    Raises
+    ------
+    ValueError
+        If ``th`` is not a :class:`VectoredThruster` or ``q`` is not a finite real array of shape (..., 2).
     """
     check_params(th, VectoredThruster, "th")
     q = _q(q)
@@ -605,7 +810,30 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
 
 
 def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
-    """Passive joint rates (..., 3), rad/s, ordered (RR s22, RRR s12, RRR s13), from ``q, qd (..., 2)``."""
+    """Passive joint rates (..., 3), rad/s, ordered (RR s22, RRR s12, RRR s13), from ``q, qd (..., 2)``.
+
+    The velocity closure (paper 5, eq. (16)) solved; eq. (17)'s printed rates violate it.
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    q : array_like, shape (..., 2)
+        Inputs ``(q1, q2)`` (rad).
+    qd : array_like, shape (..., 2)
+        Input rates (rad/s).
+
+    Returns
+    -------
+    PassiveResult
+        ``values`` (..., 3) passive rates (rad/s; NaN where singular) and ``valid``.
+
+    Raises
+    ------
+    ValueError
+        If ``th`` is not a :class:`VectoredThruster`, an array is not a finite real array of shape
+        (..., 2), or the shapes do not broadcast.
+    """
     check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
     ax = _axes(th, q)
@@ -680,12 +908,49 @@ def jacobian(th: VectoredThruster, q: object) -> JacobianResult:
 
 @dataclass(frozen=True)
 class VelocityResult:
+    """Platform angular velocity per sample (:func:`angular_velocity`).
+
+    Attributes
+    ----------
+    omega : ndarray, shape (..., 3)
+        Platform angular velocity (rad/s, base frame); NaN where not valid.
+    valid : ndarray of bool, shape (...)
+        Not singular.
+    """
+
     omega: np.ndarray  # (..., 3) platform angular velocity, rad/s; NaN where not valid
     valid: np.ndarray  # (...,) not singular
 
 
 def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityResult:
-    """Platform angular velocity ``omega = J qd`` (..., 3), rad/s, from ``q, qd (..., 2)``."""
+    """Platform angular velocity ``omega = J qd`` (..., 3), rad/s, from ``q, qd (..., 2)``.
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    q : array_like, shape (..., 2)
+        Inputs ``(q1, q2)`` (rad).
+    qd : array_like, shape (..., 2)
+        Input rates (rad/s).
+
+    Returns
+    -------
+    VelocityResult
+        ``omega`` (..., 3) rad/s, base frame (NaN where singular), and ``valid``.
+
+    Raises
+    ------
+    ValueError
+        If ``th`` is not a :class:`VectoredThruster`, an array is not a finite real array of shape
+        (..., 2), or the shapes do not broadcast.
+
+    Examples
+    --------
+    >>> w = angular_velocity(VectoredThruster.paper(), [0.0, 0.0], [0.0, 1.0])  # q2 turns about Y
+    >>> w.omega.round(12) + 0.0, bool(w.valid)
+    (array([0., 1., 0.]), True)
+    """
     check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
     jr = _jacobian(th, q)
@@ -706,6 +971,29 @@ def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: objec
     ``omega' = q2'' Y + theta'' s22 + [q2' S21, theta' S22]``.
     paper 5, eq. (24): printed with the Klein form (a scalar, zero for axes through O) where the Lie
     bracket is needed; eq. (32) therefore lacks the velocity-product terms included here.
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    q : array_like, shape (..., 2)
+        Inputs ``(q1, q2)`` (rad).
+    qd : array_like, shape (..., 2)
+        Input rates (rad/s).
+    qdd : array_like, shape (..., 2)
+        Input accelerations (rad/s²).
+
+    Returns
+    -------
+    AccelerationResult
+        ``omega`` (rad/s), ``omega_dot`` (rad/s²), ``passive_acc`` and ``velocity_product``, each
+        (..., 3) in the base frame (NaN where singular), and ``valid``.
+
+    Raises
+    ------
+    ValueError
+        If ``th`` is not a :class:`VectoredThruster`, an array is not a finite real array of shape
+        (..., 2), or the shapes do not broadcast.
     """
     check_params(th, VectoredThruster, "th")
     q, qd, qdd = _q(q), as_array(qd, "qd", (2,)), as_array(qdd, "qdd", (2,))

@@ -35,6 +35,35 @@ def chain_screws(
     ``offsets`` moves named axes (``"s11"``, ``"s12"``, ``"s13"``, ``"s21"``, ``"s22"``) to pass through
     the given point (3,) in metres instead of through O (a design perturbation; the paper's axes all
     pass through O, eqs. (5) and (7)).
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    q : array_like, shape (2,)
+        One input configuration ``(q1, q2)`` (rad), away from the singularity.
+    offsets : dict of str to array_like, optional
+        Axis name (``"s11"``, ``"s12"``, ``"s13"``, ``"s21"``, ``"s22"``) -> point (3,) (m, base frame)
+        the axis is moved to pass through; ``None`` (default): every axis through O.
+
+    Returns
+    -------
+    rrr : ndarray, shape (3, 6)
+        Screws ``[s; r x s]`` (moment part in m) of s11, s12, s13.
+    rr : ndarray, shape (2, 6)
+        Screws of s21, s22.
+
+    Raises
+    ------
+    ValueError
+        If ``th`` is not a :class:`VectoredThruster`, ``q`` is not a finite (2,) array or is singular,
+        or ``offsets`` is not a dict of known axis names to finite (3,) points.
+
+    Examples
+    --------
+    >>> rrr, rr = chain_screws(VectoredThruster.paper(), [0.1, 0.2])
+    >>> rrr.shape, rr.shape, bool(np.allclose(rrr[:, 3:], 0.0))   # axes through O: no moment part
+    ((3, 6), (2, 6), True)
     """
     check_params(th, VectoredThruster, "th")
     qa = as_array(q, "q", (2,))
@@ -62,6 +91,34 @@ def platform_mobility(
     Screws are in metres with ``length_scale = 1``: offsets of millimetres give moment parts ~1e-3,
     far above the SVD rank tolerance (1e-9).  The returned ``constraint_wrenches`` are wrenches
     ``[m; f]`` that do no work on any joint screw S: ``virtual_power(W, S) = 0``.
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    q : array_like, shape (2,), optional
+        Input configuration (rad); default ``(0, 0)``.
+    offsets : dict of str to array_like, optional
+        Axis name (``"s11"``, ``"s12"``, ``"s13"``, ``"s21"``, ``"s22"``) -> point (3,) (m, base frame)
+        the axis is moved to pass through; ``None`` (default): every axis through O.
+
+    Returns
+    -------
+    MobilityResult
+        ``dof``, the ``platform_twists`` (dof, 6) and ``constraint_wrenches`` (6 - dof, 6), the
+        rotational/translational DOF split, the Grübler-Kutzbach counts and the ``singular`` flag
+        (:mod:`robomech.analysis.mobility`).
+
+    Raises
+    ------
+    ValueError
+        As :func:`chain_screws`.
+
+    Examples
+    --------
+    >>> m = platform_mobility(VectoredThruster.paper())
+    >>> m.dof, m.rotational_dof, m.translational_dof
+    (2, 2, 0)
     """
     check_params(th, VectoredThruster, "th")
     rrr, rr = chain_screws(th, q, offsets)
@@ -70,6 +127,16 @@ def platform_mobility(
 
 @dataclass(frozen=True)
 class MechanismMobility:
+    """Mobility of the platform and of the propeller body (:func:`mechanism_mobility`).
+
+    Attributes
+    ----------
+    platform : MobilityResult
+        The RRR-RR platform (2R expected).
+    propeller : MobilityResult
+        The propeller body: the central RU chain closed with the platform's twists and the shaft s0.
+    """
+
     platform: mobility.MobilityResult  # RRR-RR platform (2R expected)
     propeller: mobility.MobilityResult  # propeller body: RU central chain + (platform twists, s0)
 
@@ -86,6 +153,34 @@ def mechanism_mobility(
     axes X and Y at ``ujoint_centre``) and the platform (its twist system from :func:`platform_mobility`,
     taken as an equivalent chain) followed by the shaft bearing R about s0 through O.  The propeller has
     3 rotational DOF (platform 2R + spin) when the universal-joint centre coincides with O.
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    q : array_like, shape (2,), optional
+        Input configuration (rad); default ``(0, 0)``.
+    offsets : dict of str to array_like, optional
+        Axis name (``"s11"``, ``"s12"``, ``"s13"``, ``"s21"``, ``"s22"``) -> point (3,) (m, base frame)
+        the axis is moved to pass through; ``None`` (default): every axis through O.
+    ujoint_centre : array_like, shape (3,), optional
+        Centre of the central universal joint (m, base frame); default O.
+
+    Returns
+    -------
+    MechanismMobility
+        The ``platform`` and ``propeller`` ``MobilityResult``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`chain_screws`, or if ``ujoint_centre`` is not a finite (3,) array.
+
+    Examples
+    --------
+    >>> mm = mechanism_mobility(VectoredThruster.paper(), (0.1, 0.2))
+    >>> mm.platform.dof, mm.propeller.dof
+    (2, 3)
     """
     check_params(th, VectoredThruster, "th")
     plat = platform_mobility(th, q, offsets)

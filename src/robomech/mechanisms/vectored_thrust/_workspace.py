@@ -39,6 +39,34 @@ DEXTERITY_TOL = 1e-8
 
 @dataclass(frozen=True)
 class WorkspaceMap:
+    """Section 4 of paper 5 per input sample (:func:`workspace_map`).
+
+    Attributes
+    ----------
+    q : ndarray, shape (..., 2)
+        The input samples (rad).
+    tip : ndarray, shape (..., 3)
+        Propeller tip (m, base frame); NaN where singular.
+    tilt : ndarray, shape (...)
+        Universal-joint deflection (rad).
+    clearance : ndarray, shape (...)
+        Angular clearance of the 45° arc from the fixing device (rad).
+    distance : ndarray, shape (...)
+        ``|s22 x s12|`` (0 at the passive-axes-parallel singularity).
+    dexterity : ndarray, shape (...)
+        ``1 / cond(J)`` in [0, 1]; 0 where singular.
+    singular : ndarray of bool, shape (...)
+        ``dexterity < DEXTERITY_TOL`` or passive axes parallel.
+    in_range : ndarray of bool, shape (...)
+        Inputs within ``q1_limits``, ``q2_limits``.
+    tilt_ok : ndarray of bool, shape (...)
+        Not singular and ``tilt <= tilt_limit``.
+    clear : ndarray of bool, shape (...)
+        ``clearance >= interference_clearance``.
+    reachable : ndarray of bool, shape (...)
+        ``in_range & tilt_ok & clear`` and not singular.
+    """
+
     q: np.ndarray  # (..., 2) inputs, rad
     tip: np.ndarray  # (..., 3) propeller tip, m (NaN where singular)
     tilt: np.ndarray  # (...,) universal-joint deflection, rad
@@ -74,14 +102,64 @@ def _dexterity(J: np.ndarray, ok: np.ndarray) -> np.ndarray:
 
 
 def dexterity(th: VectoredThruster, q: object) -> np.ndarray:
-    """Dexterity 1/cond(J) (...,) in [0, 1] at inputs ``q (..., 2)``; 0 at singular inputs."""
+    """Dexterity 1/cond(J) (...,) in [0, 1] at inputs ``q (..., 2)``; 0 at singular inputs.
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    q : array_like, shape (..., 2)
+        Inputs ``(q1, q2)`` (rad).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        ``sigma_min / sigma_max`` of the platform Jacobian, in [0, 1].
+
+    Raises
+    ------
+    ValueError
+        If ``th`` is not a :class:`VectoredThruster` or ``q`` is not a finite real array of shape (..., 2).
+
+    Examples
+    --------
+    >>> th = VectoredThruster.paper()
+    >>> float(dexterity(th, singular_points(th)[0]))   # passive axes parallel
+    0.0
+    """
     check_params(th, VectoredThruster, "th")
     jr = _jacobian(th, _q(q))
     return _dexterity(jr.J, jr.valid)
 
 
 def workspace_map(th: VectoredThruster, q: object) -> WorkspaceMap:
-    """Section 4 at each input sample ``q (..., 2)`` (rad): tip, limits, singularity, dexterity."""
+    """Section 4 at each input sample ``q (..., 2)`` (rad): tip, limits, singularity, dexterity.
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    q : array_like, shape (..., 2)
+        Inputs ``(q1, q2)`` (rad), e.g. :func:`input_grid`.
+
+    Returns
+    -------
+    WorkspaceMap
+        ``q``, ``tip`` (..., 3) m, ``tilt``, ``clearance`` (rad), ``distance``, ``dexterity`` and the
+        masks ``singular``, ``in_range``, ``tilt_ok``, ``clear``, ``reachable``, each (...).
+
+    Raises
+    ------
+    ValueError
+        If ``th`` is not a :class:`VectoredThruster` or ``q`` is not a finite real array of shape (..., 2).
+
+    Examples
+    --------
+    >>> th = VectoredThruster.paper()
+    >>> w = workspace_map(th, input_grid(th, (5, 4)))
+    >>> w.tip.shape, w.reachable.shape
+    ((5, 4, 3), (5, 4))
+    """
     check_params(th, VectoredThruster, "th")
     return _chunked(_workspace_map, th, _q(q))
 
@@ -110,7 +188,33 @@ def _workspace_map(th: VectoredThruster, q: np.ndarray) -> WorkspaceMap:
 
 
 def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = None) -> np.ndarray:
-    """Regular grid (n1, n2, 2) over ``limits`` ((lo, hi) per input, rad; default the input ranges)."""
+    """Regular grid (n1, n2, 2) over ``limits`` ((lo, hi) per input, rad; default the input ranges).
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    n : int or tuple of int
+        Samples per input (each >= 2): one count for both, or ``(n1, n2)``.
+    limits : array_like, shape (2, 2), optional
+        ``[[lo1, hi1], [lo2, hi2]]`` (rad), lo < hi; ``None`` (default): ``q1_limits``, ``q2_limits``.
+
+    Returns
+    -------
+    ndarray, shape (n1, n2, 2)
+        Input samples ``(q1, q2)`` (rad), the ends included.
+
+    Raises
+    ------
+    ValueError
+        If ``th`` is not a :class:`VectoredThruster`, ``n`` is not an int >= 2 or a pair of them, or
+        ``limits`` is not a finite (2, 2) array with lo < hi.
+
+    Examples
+    --------
+    >>> input_grid(VectoredThruster.paper(), (3, 5)).shape
+    (3, 5, 2)
+    """
     check_params(th, VectoredThruster, "th")
     lim = np.array([th.q1_limits, th.q2_limits]) if limits is None else as_array(limits, "limits", (2, 2))
     if lim.shape != (2, 2) or np.any(lim[:, 1] <= lim[:, 0]):
@@ -127,14 +231,57 @@ def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = 
 
 
 def singular_points(th: VectoredThruster) -> np.ndarray:
-    """Passive-axes-parallel singular inputs (2, 2), q1 in (-pi, pi], |q2| < pi/2: (0, a), (pi, -a)."""
+    """Passive-axes-parallel singular inputs (2, 2), q1 in (-pi, pi], |q2| < pi/2: (0, a), (pi, -a).
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+
+    Returns
+    -------
+    ndarray, shape (2, 2)
+        The two singular inputs ``(q1, q2)`` (rad), a = ``th.arc_angle``.
+
+    Raises
+    ------
+    ValueError
+        If ``th`` is not a :class:`VectoredThruster`.
+    """
     check_params(th, VectoredThruster, "th")
     a = th.arc_angle
     return np.array([[0.0, a], [np.pi, -a]])
 
 
 def idle_input_curve(th: VectoredThruster, q1: object) -> np.ndarray:
-    """q2 (...,) on the rank-deficient curve ``tan q2 = tan a / cos q1`` for |q1| < pi/2 (rad)."""
+    """q2 (...,) on the rank-deficient curve ``tan q2 = tan a / cos q1`` for |q1| < pi/2 (rad).
+
+    On this curve input 1 is idle (X, s12, s13 coplanar): J loses rank (module docstring).
+
+    Parameters
+    ----------
+    th : VectoredThruster
+        The mechanism's geometry.
+    q1 : array_like, shape (...)
+        Input 1 angles (rad).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        The input 2 angle q2 (rad) on the curve, ``atan2(tan a, cos q1)``.
+
+    Raises
+    ------
+    ValueError
+        If ``th`` is not a :class:`VectoredThruster` or ``q1`` is not a finite real array.
+
+    Examples
+    --------
+    >>> th = VectoredThruster.paper()
+    >>> q2 = idle_input_curve(th, 0.3)
+    >>> float(dexterity(th, [0.3, float(q2)])) < 1e-8
+    True
+    """
     check_params(th, VectoredThruster, "th")
     q1 = as_array(q1, "q1")
     return np.arctan2(np.tan(th.arc_angle), np.cos(q1))
