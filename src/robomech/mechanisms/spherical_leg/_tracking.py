@@ -78,7 +78,41 @@ def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> Br
 
     The time axis is the second-to-last axis of ``lengths`` (N >= 1 samples in order); leading axes are
     independent trajectories.  Samples that do not assemble are flagged (``valid`` False) and bridged:
-    the branch carries across them.
+    the branch carries across them.  Where the two closed-form solutions of :func:`forward_kinematics`
+    meet, the tracker keeps the one that continues the motion (a quadratic extrapolation of the
+    preceding samples).
+
+    Parameters
+    ----------
+    leg : SphericalLeg
+        The leg's geometry (m).
+    lengths : array_like, shape (..., N, 3)
+        Leg lengths ``(l1, l2, l3)`` (m) at N >= 1 consecutive samples of each trajectory; non-finite or
+        non-positive samples are flagged, not raised.
+    branch : {0, 1}, optional
+        The assembly branch at the first sample (0: the one containing alpha = 0).
+
+    Returns
+    -------
+    BranchTrack
+        ``alpha``, ``beta`` (rad), ``residual`` (m), ``valid``, ``branch``, ``separation`` (rad),
+        ``meeting`` and ``switched``, each of shape ``(..., N)``.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not a :class:`SphericalLeg`, ``lengths`` does not end in a sample axis and an axis
+        of 3 or has a non-real dtype, or ``branch`` is not 0 or 1.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> leg = sl.SphericalLeg.paper()
+    >>> L = sl.inverse_kinematics(leg, np.linspace(0.0, 0.3, 5), 0.1).lengths   # (5, 3), m
+    >>> tr = sl.track_branches(leg, L)
+    >>> tr.alpha.round(6) + 0.0, tr.branch
+    (array([0.   , 0.075, 0.15 , 0.225, 0.3  ]), array([0, 0, 0, 0, 0], dtype=int8))
     """
     check_params(leg, SphericalLeg, "leg")
     branch = check_int(branch, "branch", low=0, high=1)
