@@ -63,6 +63,47 @@ def identify_friction_from_pose(
     paper 3, eq. (38) fits the friction factors ε by "linear least squares"; the factors are exp(−μη)
     of the geometry, so μ itself is fitted here, nonlinearly (scipy.optimize.least_squares, bounds
     0 ≤ μ ≤ IDENTIFY_MU_MAX).  Table 1's λ (mm) is not defined in the paper and is not fitted.
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m); its ``friction`` is the starting guess, its pretension and core
+        stiffness are used as given.
+    psi : array_like, shape (m, 2 n)
+        Measured pose ``[theta_1, beta_1, ...]`` (rad) of each of the m samples.
+    t_act : array_like, shape (m, 3 n)
+        Measured actuator-side tension of each cable (N, > 0).
+    direction : array_like, shape (m, 3 n)
+        Sliding direction of each cable (+1 pulled in, -1 paid out).
+    sigma_t : float, optional
+        Standard deviation of a tension reading (N, > 0); ``None``: from the residuals.
+    model : {"chord", "arc"}, optional
+        Cable path model of :func:`cable_tensions`.
+
+    Returns
+    -------
+    PoseFrictionEstimate
+        ``mu``, ``std``, ``ci_low``, ``ci_high``, ``identifiable`` (each ``(3 n,)``), ``residual_rms``
+        (N) and ``success``.
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot`; the arrays are not real and finite or their
+        shapes do not match; a direction is not +-1; a tension is not positive; ``sigma_t`` is not
+        positive; or ``model`` is unknown.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> truth = cr.ContinuumRobot(friction=(0.2, 0.3, 0.25))
+    >>> psi = np.array([[0.3, 0.0], [0.6, 1.0], [0.9, 2.0], [0.4, 4.0]])   # rad
+    >>> d = np.ones((4, 3))                                                 # all pulled in
+    >>> t = cr.cable_tensions(truth, psi, direction=d).tension             # N, synthetic
+    >>> est = cr.identify_friction_from_pose(cr.ContinuumRobot.paper(), psi, t, d)
+    >>> est.mu.round(6), est.success
+    (array([0.2 , 0.3 , 0.25]), True)
     """
     check_params(robot, ContinuumRobot, "robot")
     n_c = robot.n_cables
@@ -171,6 +212,39 @@ def identify_friction_from_tip(
     Under friction the shape is not one arc per segment, and that fit absorbs the shape error into μ
     (−25 % on reference data); here the forward model predicts the tip from the measured tensions
     (output error), which needs no pose inversion.
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m); its ``friction`` is the starting guess and its ``core_modulus`` the
+        reference of the stiffness factor.
+    tip : array_like, shape (m, 3)
+        Tracked tip positions (m, base frame).
+    t_act : array_like, shape (m, 3 n)
+        Measured actuator-side tensions (N, > 0).
+    direction : array_like, shape (m, 3 n)
+        Sliding direction of each cable (+1 pulled in, -1 paid out).
+    fit_stiffness : bool, optional
+        Also fit the core-stiffness factor EI / EI_robot.
+    initial : array_like, shape (m, 2 n), optional
+        Poses ``[theta_1, beta_1, ...]`` (rad) to start the equilibria from; ``None``: straight.
+    sigma_t : float, optional
+        Load-cell noise (N, > 0); give it together with ``sigma_tip`` for the errors-in-variables fit.
+    sigma_tip : float, optional
+        Tracker noise (m, > 0); together with ``sigma_t``.
+
+    Returns
+    -------
+    TipFrictionEstimate
+        ``mu (3 n,)``, ``stiffness_scale``, ``std``, ``ci_low``, ``ci_high`` and ``identifiable`` (each
+        ``(3 n,)``, or ``(3 n + 1,)`` with the stiffness), ``residual_rms`` (m) and ``success``.
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot`; an array is not real and finite or the shapes do
+        not match; a direction is not +-1; a tension is not positive; ``fit_stiffness`` is not a bool;
+        or only one of ``sigma_t``, ``sigma_tip`` is given, or one is not positive.
     """
     from ._compensation import disk_equilibrium
 
