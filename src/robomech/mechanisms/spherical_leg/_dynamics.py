@@ -406,15 +406,25 @@ def mechanical_energy(
 
 @dataclass(frozen=True)
 class ForceDistribution:
-    """Leg forces f (..., 3) (N, positive extends the leg) with J^T f = tau; residual (...) N m is
-    |J^T f - tau| (rounding level where the solve is regular).
+    """Leg forces f with J^T f = tau (the result of :func:`distribute_forces`).
 
-    ``sigma_min`` (...) m/rad: the conditioning measure, the smallest singular value of J (minimum-norm
-    rule) or of the driven legs' 2x2 block (the lever arm through which the legs act; 0 where singular
-    or non-finite); ``rcond`` (...) its ratio to the largest.  ``valid`` (...) is False where
-    ``sigma_min < sigma_min_bound`` (default ``ACTUATION_SIGMA_MIN``, an actuation singularity or its
-    neighbourhood): there f is NaN if the solve is numerically singular (``rcond`` below
-    ``ACTUATION_SINGULAR_RTOL``), else the exact but physically meaningless value."""
+    Attributes
+    ----------
+    forces : ndarray, shape (..., 3)
+        Leg forces (N, positive extends the leg); NaN where the solve is numerically singular
+        (``rcond`` below ``ACTUATION_SINGULAR_RTOL``) or the input is not finite.
+    residual : ndarray, shape (...)
+        ``|J^T f - tau|`` (N m), rounding level where the solve is regular.
+    valid : ndarray of bool, shape (...)
+        False where ``sigma_min < sigma_min_bound`` (default ``ACTUATION_SIGMA_MIN``: an actuation
+        singularity or its neighbourhood; f is then the exact but physically meaningless value) or the
+        forces are NaN.
+    sigma_min : ndarray, shape (...)
+        Smallest singular value of J (minimum-norm rule) or of the driven legs' 2x2 block (m/rad): the
+        lever arm through which the legs act; 0 where singular or non-finite.
+    rcond : ndarray, shape (...)
+        ``sigma_min`` over the largest singular value (unit-free).
+    """
 
     forces: np.ndarray
     residual: np.ndarray
@@ -538,11 +548,24 @@ def _singular_values_2x2_gram(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass(frozen=True)
 class InverseDynamicsResult:
-    """generalized_forces (..., 2) N m on (alpha, beta); leg_forces (..., 3) N (positive extends);
-    residual (...) N m of J^T f = tau; valid (...) False at or near an actuation singularity
-    (``sigma_min < ACTUATION_SIGMA_MIN``; forces NaN where the solve is numerically singular) or a
-    gimbal lock of a base universal joint (``CARDAN_LOCK_TOL``);
-    sigma_min (...) m/rad and rcond (...) the per-sample conditioning (:class:`ForceDistribution`)."""
+    """Generalized and leg forces of a platform motion (the result of :func:`inverse_dynamics`).
+
+    Attributes
+    ----------
+    generalized_forces : ndarray, shape (..., 2)
+        ``tau`` on (alpha, beta) (N m).
+    leg_forces : ndarray, shape (..., 3)
+        Leg actuator forces (N, positive extends the leg); NaN where the solve is numerically singular.
+    residual : ndarray, shape (...)
+        ``|J^T f - tau|`` (N m).
+    valid : ndarray of bool, shape (...)
+        False at or near an actuation singularity (``sigma_min < ACTUATION_SIGMA_MIN``) or a gimbal
+        lock of a base universal joint (``CARDAN_LOCK_TOL``).
+    sigma_min : ndarray, shape (...)
+        The per-sample lever arm (m/rad), as in :class:`ForceDistribution`.
+    rcond : ndarray, shape (...)
+        Its ratio to the largest singular value (unit-free).
+    """
 
     generalized_forces: np.ndarray
     leg_forces: np.ndarray

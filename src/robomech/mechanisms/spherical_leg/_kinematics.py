@@ -146,11 +146,20 @@ def _squared_lengths(leg: SphericalLeg, sa, ca, sb, cb) -> np.ndarray:
 
 @dataclass(frozen=True)
 class InverseKinematicsResult:
-    """Leg lengths and geometry for platform angles (alpha, beta).
+    """Leg lengths and geometry for platform angles (alpha, beta) (the result of :func:`inverse_kinematics`).
 
-    lengths (..., 3) m; unit_vectors (..., 3, 3) rows s_i = (B_i - A_i)/l_i; platform_points
-    (..., 3, 3) rows B_i in the base frame; base_points (3, 3) rows A_i; within_limits (..., 3) bool:
-    length_min <= l_i <= length_max.
+    Attributes
+    ----------
+    lengths : ndarray, shape (..., 3)
+        Leg lengths l_i (m).
+    unit_vectors : ndarray, shape (..., 3, 3)
+        Rows ``s_i = (B_i - A_i) / l_i``: leg directions (base frame).
+    platform_points : ndarray, shape (..., 3, 3)
+        Rows B_i (m, base frame, relative to O).
+    base_points : ndarray, shape (3, 3)
+        Rows A_i (m, base frame).
+    within_limits : ndarray of bool, shape (..., 3)
+        ``length_min <= l_i <= length_max``.
     """
 
     lengths: np.ndarray
@@ -231,11 +240,19 @@ def _ik_kernel(leg: SphericalLeg, a, b, L, S, B) -> None:
 
 @dataclass(frozen=True)
 class ForwardKinematicsResult:
-    """Platform angles from leg lengths.
+    """Platform angles from leg lengths (the result of :func:`forward_kinematics`).
 
-    alpha, beta (...) rad; residual (...) m: norm of (l(alpha, beta) - lengths), i.e. how inconsistent
-    the three lengths are (rounding level for exact lengths); valid (...) bool: finite positive lengths
-    that assemble (NaN angles only where valid is false); converged (...) bool: the beta fit converged.
+    Attributes
+    ----------
+    alpha, beta : ndarray, shape (...)
+        Platform angles (rad); NaN where not ``valid``.
+    residual : ndarray, shape (...)
+        Norm of ``l(alpha, beta) - lengths`` (m): how inconsistent the three lengths are (rounding
+        level for exact lengths).
+    valid : ndarray of bool, shape (...)
+        Finite positive lengths that assemble (NaN angles only where this is False).
+    converged : ndarray of bool, shape (...)
+        The beta fit converged.
     """
 
     alpha: np.ndarray

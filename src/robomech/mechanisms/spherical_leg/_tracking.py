@@ -38,13 +38,27 @@ MEET_STEP_FACTOR = 2.5
 
 @dataclass(frozen=True)
 class BranchTrack:
-    """Forward kinematics along a trajectory (axis -1 of the batch is time), per sample (..., N):
+    """Forward kinematics along a trajectory (the result of :func:`track_branches`).
 
-    alpha, beta (rad; NaN where not valid), residual (m, as :func:`forward_kinematics`), valid;
-    branch (int8, 0 or 1: which closed-form solution the motion is on; -1 where not valid);
-    separation (rad) between the two solutions (0 on the singular curve); meeting (bool): samples where
-    the branches meet (within the sampling: see MEET_STEP_FACTOR), i.e. where the tracker had to choose,
-    and switched (bool): the meetings where the motion changed branch.
+    Axis -1 of every field is time (N samples); leading axes are independent trajectories.
+
+    Attributes
+    ----------
+    alpha, beta : ndarray, shape (..., N)
+        Platform angles (rad); NaN where not ``valid``.
+    residual : ndarray, shape (..., N)
+        Length residual (m), as in :func:`forward_kinematics`.
+    valid : ndarray of bool, shape (..., N)
+        Both closed-form solutions exist (finite positive lengths that assemble).
+    branch : ndarray of int8, shape (..., N)
+        Which closed-form solution the motion is on (0 or 1); -1 where not valid.
+    separation : ndarray, shape (..., N)
+        Angle between the two solutions (rad); 0 on the singular curve.
+    meeting : ndarray of bool, shape (..., N)
+        Samples where the branches meet (within the sampling, see ``MEET_STEP_FACTOR``), i.e. where the
+        tracker had to choose.
+    switched : ndarray of bool, shape (..., N)
+        The meetings where the motion changed branch.
     """
 
     alpha: np.ndarray

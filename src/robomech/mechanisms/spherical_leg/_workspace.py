@@ -32,9 +32,25 @@ ILL_CONDITIONED = 100.0
 
 @dataclass(frozen=True)
 class WorkspaceMap:
-    """Per pose (...): lengths (..., 3) m; reachable: every leg within [length_min, length_max];
-    sigma_min, sigma_max (m/rad) and cond of J; singular (sigma_min/sigma_max < SINGULAR_RTOL);
-    ill_conditioned (cond > ILL_CONDITIONED); dl3_dalpha (m/rad), whose sign marks the assembly branch."""
+    """Workspace and singularity measures per pose (the result of :func:`workspace_map`).
+
+    Attributes
+    ----------
+    lengths : ndarray, shape (..., 3)
+        Leg lengths (m).
+    reachable : ndarray of bool, shape (...)
+        Every leg within ``[length_min, length_max]``.
+    sigma_min, sigma_max : ndarray, shape (...)
+        Smallest and largest singular value of the leg Jacobian J (m/rad).
+    cond : ndarray, shape (...)
+        Condition number ``sigma_max / sigma_min`` of J (unit-free).
+    singular : ndarray of bool, shape (...)
+        ``sigma_min / sigma_max < SINGULAR_RTOL``.
+    ill_conditioned : ndarray of bool, shape (...)
+        ``cond > ILL_CONDITIONED``.
+    dl3_dalpha : ndarray, shape (...)
+        ``d l3 / d alpha`` (m/rad), whose sign marks the assembly branch.
+    """
 
     lengths: np.ndarray
     reachable: np.ndarray
