@@ -426,11 +426,18 @@ def capstan_tension_ratio(
 # ---- identification -------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class FrictionEstimate:
-    """Least-squares friction coefficients with their standard uncertainty (batch shape ``...``).
+    """Least-squares friction coefficients with their standard uncertainty (from :func:`identify_friction`).
 
-    ``mu`` estimate, ``std`` its standard deviation (from the stated tension noise if given, else from
-    the residual scatter), ``chi2_per_dof`` the weighted residual per degree of freedom (about 1 when the
-    noise model holds), ``n_used`` measurements used (those with nonzero direction).
+    Attributes
+    ----------
+    mu : ndarray, shape (...)
+        Estimated Coulomb friction coefficient (unit-free).
+    std : ndarray, shape (...)
+        Its standard deviation (from the stated tension noise if given, else from the residual scatter).
+    chi2_per_dof : ndarray, shape (...)
+        Weighted residual per degree of freedom (about 1 when the noise model holds).
+    n_used : ndarray of int, shape (...)
+        Measurements used (those with nonzero direction).
     """
 
     mu: np.ndarray
@@ -516,12 +523,20 @@ def identify_friction(
 # ---- stick-slip with memory (eq. (19)) --------------------------------------------------------------
 @dataclass(frozen=True)
 class TensionHistory:
-    """Span tensions of every cable over a history (time axis first, batch shape ``...``).
+    """Span tensions of every cable over a history (the result of :func:`stick_slip_tensions`).
 
-    ``span_tension (n_t, ..., 3 n, n N)`` (N, zero beyond a cable's termination disk); ``state
-    (n_t, ..., 3 n, n N)`` per hole (the hole where each span starts): +1 sliding with the cable pulled
-    in (span at its lower friction bound), -1 sliding paid out (upper bound), 0 stuck (tension kept from
-    the previous step, strictly within the bounds); ``distal (n_t, ..., 3 n)`` tension of the last span.
+    The time axis is first (n_t steps), then the batch axes ``...``.
+
+    Attributes
+    ----------
+    span_tension : ndarray, shape (n_t, ..., 3 n, n N)
+        Tension of every span (N); zero beyond a cable's termination disk.
+    state : ndarray of int, shape (n_t, ..., 3 n, n N)
+        Per hole (the hole where each span starts): +1 sliding with the cable pulled in (span at its
+        lower friction bound), -1 sliding paid out (upper bound), 0 stuck (tension kept from the
+        previous step, strictly within the bounds).
+    distal : ndarray, shape (n_t, ..., 3 n)
+        Tension of each cable's last span (N).
     """
 
     span_tension: np.ndarray

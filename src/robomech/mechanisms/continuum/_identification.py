@@ -32,10 +32,26 @@ _Z95 = 1.959963984540054  # two-sided 95 % quantile of the standard normal
 
 @dataclass(frozen=True)
 class PoseFrictionEstimate:
-    """Least-squares friction coefficients per cable (3 n,) with their standard deviation and 95 %
-    confidence interval (linearised: covariance s² (JᵀJ)⁻¹, s² from ``sigma_t`` if given, else from the
-    residuals); ``residual_rms`` (N) of the tension fit; ``identifiable`` where the data constrain a
-    cable's μ (its Jacobian column is not zero); ``success`` of the solver."""
+    """Friction coefficients fitted to tensions at measured poses (:func:`identify_friction_from_pose`).
+
+    Uncertainties are linearised: covariance s² (JᵀJ)⁻¹, s² from ``sigma_t`` if given, else from the
+    residuals.
+
+    Attributes
+    ----------
+    mu : ndarray, shape (3 n,)
+        Estimated Coulomb friction coefficient per cable (unit-free).
+    std : ndarray, shape (3 n,)
+        Its standard deviation (inf where not identifiable).
+    ci_low, ci_high : ndarray, shape (3 n,)
+        Bounds of the 95 % confidence interval.
+    residual_rms : float
+        RMS of the tension fit residual (N).
+    identifiable : ndarray of bool, shape (3 n,)
+        The data constrain the cable's μ (its Jacobian column is not zero).
+    success : bool
+        The solver reported success.
+    """
 
     mu: np.ndarray
     std: np.ndarray
@@ -161,13 +177,27 @@ core diameter is not printed: a factor 4 either way covers any plausible core)."
 
 @dataclass(frozen=True)
 class TipFrictionEstimate:
-    """Output-error fit of the disk-wise model to tracked tips (issue 16).
+    """Output-error fit of the disk-wise model to tracked tips (:func:`identify_friction_from_tip`, issue 16).
 
-    ``mu (3 n,)`` friction per cable, ``stiffness_scale`` the fitted EI / EI_robot (1.0 if not fitted);
-    ``std``, ``ci_low``, ``ci_high`` for ``[*mu, stiffness_scale]`` (the last entry only if fitted):
-    linearised covariance s² (JᵀJ)⁻¹ with s² the residual variance of the tip fit (model error
-    included, not only the tracker noise); ``residual_rms`` (m) of the tip; ``identifiable`` per
-    parameter; ``success`` of the solver and every disk-wise equilibrium converged."""
+    Uncertainties are linearised: covariance s² (JᵀJ)⁻¹ with s² the residual variance of the tip fit
+    (model error included, not only the tracker noise), or 1 in the errors-in-variables fit.
+
+    Attributes
+    ----------
+    mu : ndarray, shape (3 n,)
+        Estimated Coulomb friction coefficient per cable (unit-free).
+    stiffness_scale : float
+        Fitted core-stiffness factor EI / EI_robot (1.0 if not fitted).
+    std, ci_low, ci_high : ndarray, shape (3 n,) or (3 n + 1,)
+        Standard deviation and 95 % confidence bounds of ``[*mu, stiffness_scale]`` (the last entry
+        only if the stiffness was fitted).
+    residual_rms : float
+        RMS of the tip residual (m).
+    identifiable : ndarray of bool, shape (3 n,) or (3 n + 1,)
+        Per parameter: the data constrain it (its Jacobian column is not zero).
+    success : bool
+        The solver reported success and every disk-wise equilibrium converged.
+    """
 
     mu: np.ndarray
     stiffness_scale: float

@@ -140,12 +140,20 @@ def coupling_moments(robot: ContinuumRobot, psi: object) -> np.ndarray:
 
 @dataclass(frozen=True)
 class TensionResult:
-    """Cable tensions in equilibrium (batch shape ``...``).
+    """Cable tensions in equilibrium (the result of :func:`cable_tensions`).
 
-    ``tension (..., 3 n)``: tension of every cable where it enters the base plate (N, positive = pull);
-    ``minimum_norm``: the part that balances the core and the load; ``taut``: all cables at or above
-    ``TENSION_FLOOR``; ``min_tension``: the smallest tension; ``residual``: norm of the virtual-work
-    balance (N m), ~1e-15 when the balance holds.
+    Attributes
+    ----------
+    tension : ndarray, shape (..., 3 n)
+        Tension of every cable where it enters the base plate (N, positive = pull).
+    minimum_norm : ndarray, shape (..., 3 n)
+        The minimum-norm part that balances the core and the load (N), without pretension.
+    taut : ndarray of bool, shape (...)
+        All cables at or above ``TENSION_FLOOR``.
+    min_tension : ndarray, shape (...)
+        The smallest cable tension (N).
+    residual : ndarray, shape (...)
+        Norm of the virtual-work balance (N m), ~1e-15 when the balance holds.
     """
 
     tension: np.ndarray
