@@ -52,12 +52,29 @@ DISK_FD_STEP = 6e-6
 class DiskEquilibrium:
     """Equilibrium of the disk-wise constant-curvature robot (batch shape ``...``), SI units.
 
-    ``bend (..., n N, 2)`` [theta_j, beta_j] of every disk interval (base first); ``disk_T (..., 1 + n N,
-    4, 4)`` base plate and disk poses; ``tip (..., 3)``; ``tension (..., 3 n)`` actuator side (base
-    plate); ``span_tension (..., 3 n, n N)`` (0 beyond a cable's end); ``elongation (..., 3 n)`` stretch
-    from the straight pose at the pretension; ``drive (..., 3 n)`` the cable pulled in by each actuator
-    that holds this equilibrium (= the given drive in drive mode); ``taut`` no cable slack;
-    ``converged`` residual below ``DISK_TOLERANCE``; ``residual`` (N m).
+    Attributes
+    ----------
+    bend : ndarray, shape (..., n N, 2)
+        ``[theta_j, beta_j]`` (rad) of every disk interval, base first.
+    disk_T : ndarray, shape (..., 1 + n N, 4, 4)
+        Poses of the base plate and of every disk in the base frame (m).
+    tip : ndarray, shape (..., 3)
+        Tip position (m, base frame).
+    tension : ndarray, shape (..., 3 n)
+        Cable tensions on the actuator side, at the base plate (N).
+    span_tension : ndarray, shape (..., 3 n, n N)
+        Tension of every span (N); 0 beyond a cable's termination disk.
+    elongation : ndarray, shape (..., 3 n)
+        Cable stretch from the straight pose at the pretension (m).
+    drive : ndarray, shape (..., 3 n)
+        Cable length pulled in by each actuator that holds this equilibrium (m; the given drive in
+        drive mode).
+    taut : ndarray of bool, shape (...)
+        No cable slack.
+    converged : ndarray of bool, shape (...)
+        ``residual`` below ``DISK_TOLERANCE``.
+    residual : ndarray, shape (...)
+        Generalized-force residual of the equilibrium (N m).
     """
 
     bend: Array

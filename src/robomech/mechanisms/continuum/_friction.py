@@ -60,7 +60,34 @@ def wrap_angles(robot: ContinuumRobot, psi: object) -> np.ndarray:
 
     Span 0 starts at the base plate, where the cable arrives along the base z axis; span k at disk k.
     Zero beyond the cable's termination disk.  Under constant curvature every cable of a segment wraps
-    theta / (2 N) at the segment's base and theta / N at each interior disk.
+    theta / (2 N) at the segment's base and theta / N at each interior disk (paper 3, eqs. (21)-(22)).
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
+    psi : array_like, shape (..., 2 n)
+        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 3 n, n N)
+        Wrap angle eta (rad) of cable c at the hole where span k starts (``N = disks_per_segment``).
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot`, or ``psi`` does not end in an axis of 2 n or is
+        not real and finite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> cr.wrap_angles(cr.ContinuumRobot.paper(), np.array([0.5, 0.0])).round(4)   # theta = 0.5 rad
+    array([[0.05, 0.1 , 0.1 , 0.1 , 0.1 ],
+           [0.05, 0.1 , 0.1 , 0.1 , 0.1 ],
+           [0.05, 0.1 , 0.1 , 0.1 , 0.1 ]])
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -98,6 +125,38 @@ def friction_factors(robot: ContinuumRobot, psi: object, direction: object | Non
     ``direction (..., 3 n)``: +1 where the cable slides toward the actuator (pulled in), -1 where it is
     paid out; ``None``: frictionless.  0 (sticking, eq. (19)'s stuck branch) raises ValueError for a cable
     with friction: its tension is undetermined within the friction band without a stick-slip memory.
+    Paper 3, eqs. (17)-(19) and (23), with the physical sign: a cable pulled in loses tension
+    distally, ``T_k+1 = T_k exp(-mu eta_k)`` (the print has ``exp(+sgn(q_dot) mu eta)``).
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
+    psi : array_like, shape (..., 2 n)
+        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
+    direction : array_like, shape (..., 3 n), optional
+        Sliding direction of each cable (+1 pulled in, -1 paid out); ``None``: no friction (all 1).
+
+    Returns
+    -------
+    ndarray, shape (..., 3 n, n N)
+        Span tension / base-plate tension (unit-free) of every cable and span (cumulative capstan
+        factors ``exp(-direction mu sum eta)``; constant beyond a cable's termination disk).
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot`, or ``psi`` does not end in an axis of 2 n or is
+        not real and finite, or ``direction`` has a wrong shape or a value
+        other than +-1 on a cable with friction.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> P = cr.friction_factors(cr.ContinuumRobot.paper(), np.array([0.5, 0.0]), [1.0, 1.0, 1.0])
+    >>> P.shape, bool(np.all(P <= 1.0))
+    ((3, 5), True)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -130,7 +189,36 @@ _GROWTH_MARGIN = 1.1
 
 
 def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np.ndarray:
-    """c = (rho / n) ((1 + rho) / (alpha rho))^(1/n) of paper 3, eq. (29); rho, alpha > 0, n in (0, 1]."""
+    """c = (rho / n) ((1 + rho) / (alpha rho))^(1/n) of paper 3, eq. (29); rho, alpha > 0, n in (0, 1].
+
+    Parameters
+    ----------
+    rho : array_like
+        Pulley radius / cable radius (unit-free, > 0).
+    alpha : array_like
+        Coefficient of the friction law ``f = alpha N^n`` (paper 3, eq. (25); > 0).
+    n : array_like
+        Exponent of that law, in (0, 1]. The three arguments broadcast together.
+
+    Returns
+    -------
+    ndarray
+        The coefficient ``c`` of eq. (29) (units of ``N^(-(1-n)/n)``; unit-free for n = 1), broadcast
+        shape.
+
+    Raises
+    ------
+    ValueError
+        If an argument is not real and finite, ``rho`` or ``alpha`` is not positive, or ``n`` lies
+        outside (0, 1].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> np.round(cr.capstan_coefficient(10.0, 0.3, 1.0), 4)
+    np.float64(36.6667)
+    """
     rho, alpha, n = as_array(rho, "rho"), as_array(alpha, "alpha"), as_array(n, "n")
     if np.any(rho <= 0.0) or np.any(alpha <= 0.0) or np.any(n <= 0.0) or np.any(n > 1.0):
         bad = "rho" if np.any(rho <= 0.0) else "alpha" if np.any(alpha <= 0.0) else "n"
@@ -139,7 +227,32 @@ def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np
 
 
 def classical_capstan_ratio(phi: object, mu: object) -> np.ndarray:
-    """Euler-Eytelwein capstan law T_in / T_out = exp(mu phi)."""
+    """Euler-Eytelwein capstan law T_in / T_out = exp(mu phi).
+
+    Parameters
+    ----------
+    phi : array_like
+        Wrap angle (rad).
+    mu : array_like
+        Coulomb friction coefficient (unit-free); broadcast with ``phi``.
+
+    Returns
+    -------
+    ndarray
+        The tension ratio ``exp(mu phi)`` (unit-free), broadcast shape.
+
+    Raises
+    ------
+    ValueError
+        If ``phi`` or ``mu`` is not real and finite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> np.round(cr.classical_capstan_ratio(np.pi, 0.1), 4)
+    np.float64(1.3691)
+    """
     return np.exp(as_array(mu, "mu") * as_array(phi, "phi"))
 
 
@@ -199,6 +312,39 @@ def capstan_tension_ratio(
     (0, 1] of the friction law f = alpha N^n (eq. (25)), ``t_out`` output tension (N, > 0; the ratio
     depends on it when n != 1).  n = 1 and rho = inf are solved in closed form; otherwise the ODE is
     integrated (see the CAPSTAN_* constants).
+
+    Parameters
+    ----------
+    phi : array_like
+        Wrap angle (rad, >= 0).
+    rho : array_like
+        Pulley radius / cable radius (unit-free, > 0; ``np.inf`` allowed).
+    alpha : array_like
+        Coefficient of the friction law ``f = alpha N^n`` (> 0).
+    n : array_like
+        Exponent of the friction law, in (0, 1].
+    t_out : array_like, optional
+        Output-side tension (N, > 0); default 1 N.
+
+    Returns
+    -------
+    ndarray
+        ``kappa = T_in / T_out`` (unit-free, >= 1), the broadcast shape of the arguments.
+
+    Raises
+    ------
+    ValueError
+        If an argument is not real (or, except ``rho = inf``, not finite), out of its range, or if
+        ``rho`` is too large for the explicit integration with n < 1 (use ``rho=np.inf``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> np.round(cr.capstan_tension_ratio(np.pi, rho=np.inf, alpha=0.1, n=1.0), 4)   # = exp(0.1 pi)
+    np.float64(1.3691)
+    >>> cr.capstan_tension_ratio([0.5, np.pi], rho=20.0, alpha=0.1, n=0.8).round(4)
+    array([1.0212, 1.1396])
     """
     phi_a = as_array(phi, "phi")
     rho_a = as_array(rho, "rho", finite=False)
@@ -280,11 +426,18 @@ def capstan_tension_ratio(
 # ---- identification -------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class FrictionEstimate:
-    """Least-squares friction coefficients with their standard uncertainty (batch shape ``...``).
+    """Least-squares friction coefficients with their standard uncertainty (from :func:`identify_friction`).
 
-    ``mu`` estimate, ``std`` its standard deviation (from the stated tension noise if given, else from
-    the residual scatter), ``chi2_per_dof`` the weighted residual per degree of freedom (about 1 when the
-    noise model holds), ``n_used`` measurements used (those with nonzero direction).
+    Attributes
+    ----------
+    mu : ndarray, shape (...)
+        Estimated Coulomb friction coefficient (unit-free).
+    std : ndarray, shape (...)
+        Its standard deviation (from the stated tension noise if given, else from the residual scatter).
+    chi2_per_dof : ndarray, shape (...)
+        Weighted residual per degree of freedom (about 1 when the noise model holds).
+    n_used : ndarray of int, shape (...)
+        Measurements used (those with nonzero direction).
     """
 
     mu: np.ndarray
@@ -304,6 +457,43 @@ def identify_friction(
     ``t_out`` distal tension (N, > 0), ``direction`` s in {-1, 0, +1} (0 rows are ignored: no sliding).
     ``sigma_t`` (N): standard deviation of each tension reading; the log-ratio's variance is then
     sigma_t^2 (1/t_in^2 + 1/t_out^2) (first order) and weights the fit.  Solves over the last axis.
+
+    Parameters
+    ----------
+    wrap : array_like, shape (..., m)
+        Total wrap angle eta (rad) of each of the m measurements.
+    t_in : array_like, shape (..., m)
+        Actuator-side tension (N, > 0).
+    t_out : array_like, shape (..., m)
+        Distal tension (N, > 0).
+    direction : array_like, shape (..., m)
+        Sliding direction s of each measurement: +1 pulled in, -1 paid out, 0 ignored.
+        The four arrays broadcast together.
+    sigma_t : float, optional
+        Standard deviation of each tension reading (N, > 0); ``None``: unweighted, the uncertainty
+        taken from the residual scatter.
+
+    Returns
+    -------
+    FrictionEstimate
+        ``mu``, ``std``, ``chi2_per_dof`` and ``n_used``, each of the batch shape ``(...)``.
+
+    Raises
+    ------
+    ValueError
+        If an array is not real and finite or the arrays do not broadcast, a tension is not positive,
+        ``sigma_t`` is not positive, or a batch element has no measurement with nonzero wrap and
+        direction.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> eta = np.array([0.5, 1.0, 1.5])                        # rad
+    >>> t_in = np.full(3, 2.0)                                 # N
+    >>> est = cr.identify_friction(eta, t_in, t_in * np.exp(-0.3 * eta), [1.0, 1.0, 1.0])
+    >>> np.round(est.mu, 6), int(est.n_used)
+    (np.float64(0.3), 3)
     """
     eta = as_array(wrap, "wrap", (None,))
     ti = as_array(t_in, "t_in", (None,))
@@ -333,12 +523,20 @@ def identify_friction(
 # ---- stick-slip with memory (eq. (19)) --------------------------------------------------------------
 @dataclass(frozen=True)
 class TensionHistory:
-    """Span tensions of every cable over a history (time axis first, batch shape ``...``).
+    """Span tensions of every cable over a history (the result of :func:`stick_slip_tensions`).
 
-    ``span_tension (n_t, ..., 3 n, n N)`` (N, zero beyond a cable's termination disk); ``state
-    (n_t, ..., 3 n, n N)`` per hole (the hole where each span starts): +1 sliding with the cable pulled
-    in (span at its lower friction bound), -1 sliding paid out (upper bound), 0 stuck (tension kept from
-    the previous step, strictly within the bounds); ``distal (n_t, ..., 3 n)`` tension of the last span.
+    The time axis is first (n_t steps), then the batch axes ``...``.
+
+    Attributes
+    ----------
+    span_tension : ndarray, shape (n_t, ..., 3 n, n N)
+        Tension of every span (N); zero beyond a cable's termination disk.
+    state : ndarray of int, shape (n_t, ..., 3 n, n N)
+        Per hole (the hole where each span starts): +1 sliding with the cable pulled in (span at its
+        lower friction bound), -1 sliding paid out (upper bound), 0 stuck (tension kept from the
+        previous step, strictly within the bounds).
+    distal : ndarray, shape (n_t, ..., 3 n)
+        Tension of each cable's last span (N).
     """
 
     span_tension: np.ndarray
@@ -361,6 +559,42 @@ def stick_slip_tensions(
     physical sign of departure 4).  Loading and unloading therefore give hysteresis loops; the result is
     path-dependent.  This is the rigid-cable (inextensible) limit of a tendon-through-holes model: the
     tension change travels from the actuator; cable stretch does not feed back on the sliding.
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m), with ``friction`` per cable.
+    psi : array_like, shape (n_t, ..., 2 n)
+        Pose ``[theta_1, beta_1, ...]`` (rad) at each of the n_t steps.
+    t_act : array_like, shape (n_t, ..., 3 n)
+        Actuator-side tension of each cable at each step (N, > 0); the batch axes broadcast with psi's.
+    initial : array_like, shape (..., 3 n, n N), optional
+        Span tensions before the first step (N, > 0 on every active span); ``None``: every span at the
+        first actuator tension.
+
+    Returns
+    -------
+    TensionHistory
+        ``span_tension (n_t, ..., 3 n, n N)`` (N), ``state (n_t, ..., 3 n, n N)`` (+1, -1 or 0) and
+        ``distal (n_t, ..., 3 n)`` (N).
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot`; ``psi`` or ``t_act`` has a wrong shape, no
+        common leading time axis of length >= 1, or is not real and finite; a tension is not positive;
+        or ``initial`` has a wrong shape or a non-positive active span.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> robot = cr.ContinuumRobot.paper()
+    >>> psi = np.tile([0.5, 0.0], (3, 1))                      # 3 steps at one pose (rad)
+    >>> t_act = np.array([[5.0, 5, 5], [6, 5, 5], [5, 5, 5]])  # cable 0 pulled, then released (N)
+    >>> h = cr.stick_slip_tensions(robot, psi, t_act)
+    >>> h.span_tension.shape, h.distal[:, 0].round(4)          # the released cable keeps 5.34 N
+    ((3, 3, 5), array([5.    , 5.3375, 5.3375]))
     """
     check_params(robot, ContinuumRobot, "robot")
     p = as_array(psi, "psi", (None, 2 * robot.n_segments))

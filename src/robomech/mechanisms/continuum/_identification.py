@@ -32,10 +32,26 @@ _Z95 = 1.959963984540054  # two-sided 95 % quantile of the standard normal
 
 @dataclass(frozen=True)
 class PoseFrictionEstimate:
-    """Least-squares friction coefficients per cable (3 n,) with their standard deviation and 95 %
-    confidence interval (linearised: covariance s² (JᵀJ)⁻¹, s² from ``sigma_t`` if given, else from the
-    residuals); ``residual_rms`` (N) of the tension fit; ``identifiable`` where the data constrain a
-    cable's μ (its Jacobian column is not zero); ``success`` of the solver."""
+    """Friction coefficients fitted to tensions at measured poses (:func:`identify_friction_from_pose`).
+
+    Uncertainties are linearised: covariance s² (JᵀJ)⁻¹, s² from ``sigma_t`` if given, else from the
+    residuals.
+
+    Attributes
+    ----------
+    mu : ndarray, shape (3 n,)
+        Estimated Coulomb friction coefficient per cable (unit-free).
+    std : ndarray, shape (3 n,)
+        Its standard deviation (inf where not identifiable).
+    ci_low, ci_high : ndarray, shape (3 n,)
+        Bounds of the 95 % confidence interval.
+    residual_rms : float
+        RMS of the tension fit residual (N).
+    identifiable : ndarray of bool, shape (3 n,)
+        The data constrain the cable's μ (its Jacobian column is not zero).
+    success : bool
+        The solver reported success.
+    """
 
     mu: np.ndarray
     std: np.ndarray
@@ -63,6 +79,47 @@ def identify_friction_from_pose(
     paper 3, eq. (38) fits the friction factors ε by "linear least squares"; the factors are exp(−μη)
     of the geometry, so μ itself is fitted here, nonlinearly (scipy.optimize.least_squares, bounds
     0 ≤ μ ≤ IDENTIFY_MU_MAX).  Table 1's λ (mm) is not defined in the paper and is not fitted.
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m); its ``friction`` is the starting guess, its pretension and core
+        stiffness are used as given.
+    psi : array_like, shape (m, 2 n)
+        Measured pose ``[theta_1, beta_1, ...]`` (rad) of each of the m samples.
+    t_act : array_like, shape (m, 3 n)
+        Measured actuator-side tension of each cable (N, > 0).
+    direction : array_like, shape (m, 3 n)
+        Sliding direction of each cable (+1 pulled in, -1 paid out).
+    sigma_t : float, optional
+        Standard deviation of a tension reading (N, > 0); ``None``: from the residuals.
+    model : {"chord", "arc"}, optional
+        Cable path model of :func:`cable_tensions`.
+
+    Returns
+    -------
+    PoseFrictionEstimate
+        ``mu``, ``std``, ``ci_low``, ``ci_high``, ``identifiable`` (each ``(3 n,)``), ``residual_rms``
+        (N) and ``success``.
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot`; the arrays are not real and finite or their
+        shapes do not match; a direction is not +-1; a tension is not positive; ``sigma_t`` is not
+        positive; or ``model`` is unknown.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> truth = cr.ContinuumRobot(friction=(0.2, 0.3, 0.25))
+    >>> psi = np.array([[0.3, 0.0], [0.6, 1.0], [0.9, 2.0], [0.4, 4.0]])   # rad
+    >>> d = np.ones((4, 3))                                                 # all pulled in
+    >>> t = cr.cable_tensions(truth, psi, direction=d).tension             # N, synthetic
+    >>> est = cr.identify_friction_from_pose(cr.ContinuumRobot.paper(), psi, t, d)
+    >>> est.mu.round(6), est.success
+    (array([0.2 , 0.3 , 0.25]), True)
     """
     check_params(robot, ContinuumRobot, "robot")
     n_c = robot.n_cables
@@ -120,13 +177,27 @@ core diameter is not printed: a factor 4 either way covers any plausible core)."
 
 @dataclass(frozen=True)
 class TipFrictionEstimate:
-    """Output-error fit of the disk-wise model to tracked tips (issue 16).
+    """Output-error fit of the disk-wise model to tracked tips (:func:`identify_friction_from_tip`, issue 16).
 
-    ``mu (3 n,)`` friction per cable, ``stiffness_scale`` the fitted EI / EI_robot (1.0 if not fitted);
-    ``std``, ``ci_low``, ``ci_high`` for ``[*mu, stiffness_scale]`` (the last entry only if fitted):
-    linearised covariance s² (JᵀJ)⁻¹ with s² the residual variance of the tip fit (model error
-    included, not only the tracker noise); ``residual_rms`` (m) of the tip; ``identifiable`` per
-    parameter; ``success`` of the solver and every disk-wise equilibrium converged."""
+    Uncertainties are linearised: covariance s² (JᵀJ)⁻¹ with s² the residual variance of the tip fit
+    (model error included, not only the tracker noise), or 1 in the errors-in-variables fit.
+
+    Attributes
+    ----------
+    mu : ndarray, shape (3 n,)
+        Estimated Coulomb friction coefficient per cable (unit-free).
+    stiffness_scale : float
+        Fitted core-stiffness factor EI / EI_robot (1.0 if not fitted).
+    std, ci_low, ci_high : ndarray, shape (3 n,) or (3 n + 1,)
+        Standard deviation and 95 % confidence bounds of ``[*mu, stiffness_scale]`` (the last entry
+        only if the stiffness was fitted).
+    residual_rms : float
+        RMS of the tip residual (m).
+    identifiable : ndarray of bool, shape (3 n,) or (3 n + 1,)
+        Per parameter: the data constrain it (its Jacobian column is not zero).
+    success : bool
+        The solver reported success and every disk-wise equilibrium converged.
+    """
 
     mu: np.ndarray
     stiffness_scale: float
@@ -171,6 +242,39 @@ def identify_friction_from_tip(
     Under friction the shape is not one arc per segment, and that fit absorbs the shape error into μ
     (−25 % on reference data); here the forward model predicts the tip from the measured tensions
     (output error), which needs no pose inversion.
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m); its ``friction`` is the starting guess and its ``core_modulus`` the
+        reference of the stiffness factor.
+    tip : array_like, shape (m, 3)
+        Tracked tip positions (m, base frame).
+    t_act : array_like, shape (m, 3 n)
+        Measured actuator-side tensions (N, > 0).
+    direction : array_like, shape (m, 3 n)
+        Sliding direction of each cable (+1 pulled in, -1 paid out).
+    fit_stiffness : bool, optional
+        Also fit the core-stiffness factor EI / EI_robot.
+    initial : array_like, shape (m, 2 n), optional
+        Poses ``[theta_1, beta_1, ...]`` (rad) to start the equilibria from; ``None``: straight.
+    sigma_t : float, optional
+        Load-cell noise (N, > 0); give it together with ``sigma_tip`` for the errors-in-variables fit.
+    sigma_tip : float, optional
+        Tracker noise (m, > 0); together with ``sigma_t``.
+
+    Returns
+    -------
+    TipFrictionEstimate
+        ``mu (3 n,)``, ``stiffness_scale``, ``std``, ``ci_low``, ``ci_high`` and ``identifiable`` (each
+        ``(3 n,)``, or ``(3 n + 1,)`` with the stiffness), ``residual_rms`` (m) and ``success``.
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot`; an array is not real and finite or the shapes do
+        not match; a direction is not +-1; a tension is not positive; ``fit_stiffness`` is not a bool;
+        or only one of ``sigma_t``, ``sigma_tip`` is given, or one is not positive.
     """
     from ._compensation import disk_equilibrium
 

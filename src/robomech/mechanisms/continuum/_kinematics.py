@@ -660,13 +660,23 @@ def cable_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "arc"
 # ---- inverse kinematics ---------------------------------------------------------------------------
 @dataclass(frozen=True)
 class IKResult:
-    """Inverse kinematics from a tip position (batch shape ``...``).
+    """Inverse kinematics from a tip position (the result of :func:`inverse_kinematics`).
 
-    ``psi (..., 2 n)`` with theta >= 0 and beta in (-pi, pi] (beta = 0 where theta = 0); ``reachable``
-    where the tip residual ``residual`` (m) is below ``IK_TOLERANCE``; otherwise ``psi`` is the best
-    least-squares pose found (a local minimum of the tip distance).  ``converged`` where the solver stopped
-    on its own criterion (target reached, or a step below IK_TOLERANCE: a stationary point) rather than on
-    IK_MAX_ITERATIONS; ``iterations`` counts the iterations of all starts tried for the sample.
+    Attributes
+    ----------
+    psi : ndarray, shape (..., 2 n)
+        ``[theta_1, beta_1, ...]`` (rad) with theta >= 0 and beta in (-pi, pi] (beta = 0 where
+        theta = 0); where not ``reachable``, the best least-squares pose found (a local minimum of the
+        tip distance).
+    residual : ndarray, shape (...)
+        Distance of the pose's tip from the target (m).
+    reachable : ndarray of bool, shape (...)
+        ``residual`` below ``IK_TOLERANCE``.
+    converged : ndarray of bool, shape (...)
+        The solver stopped on its own criterion (target reached, or a step below ``IK_TOLERANCE``: a
+        stationary point) rather than on ``IK_MAX_ITERATIONS``.
+    iterations : ndarray of int, shape (...)
+        Iterations of all starts tried for the sample.
     """
 
     psi: np.ndarray

@@ -25,17 +25,36 @@ class ContinuumRobot:
     and run through the holes of all proximal segments; their hole angles are
     ``(0, 2 pi/3, 4 pi/3) + i * cable_offset``.
 
-    Attributes (SI):
-        n_segments: number of segments n.
-        segment_length: arc length of every segment (m); paper: 90 mm.
-        disks_per_segment: disks N per segment (chord spans per segment); paper: 5 disks.
-        hole_radius: distance r of the cable holes from the core axis (m); not printed, default 4 mm.
-        core_modulus, core_diameter: Young's modulus (Pa) and diameter (m) of the NiTi core; not printed.
-        cable_modulus, cable_diameter: Dyneema cable, paper: E = 4.96 GPa, 0.8 mm.
-        friction: Coulomb friction coefficient per cable (3 n), paper Table 1 (0.26, 0.31, 0.28).
-        pretension: cable pretension T0 (N); not printed, default 5 N (inside Fig. 6's 3-11 N range).
-        free_length: cable length between the actuator and the base plate (m); not printed, default 0.1 m.
-        cable_offset: angular offset of the holes of successive segments (rad).
+    Parameters
+    ----------
+    n_segments : int
+        Number of segments n (>= 1).
+    segment_length : float
+        Arc length of every segment (m); paper: 90 mm.
+    disks_per_segment : int
+        Disks N per segment (chord spans per segment, >= 1); paper: 5 disks.
+    hole_radius : float
+        Distance r of the cable holes from the core axis (m); not printed, default 4 mm. Must be well
+        below ``segment_length`` (``n_segments * hole_radius < segment_length``).
+    core_modulus, core_diameter : float
+        Young's modulus (Pa) and diameter (m) of the NiTi core; not printed (60 GPa, 0.8 mm).
+    cable_modulus, cable_diameter : float
+        Young's modulus (Pa) and diameter (m) of the Dyneema cable; paper: 4.96 GPa, 0.8 mm.
+    friction : tuple of float
+        Coulomb friction coefficient per cable (3 n entries, >= 0); paper Table 1 (0.26, 0.31, 0.28).
+    pretension : float
+        Cable pretension T0 (N, >= 0); not printed, default 5 N (inside Fig. 6's 3-11 N range).
+    free_length : float
+        Cable length between the actuator and the base plate (m, >= 0); not printed, default 0.1 m.
+    cable_offset : float
+        Angular offset of the holes of successive segments (rad).
+
+    Raises
+    ------
+    ValueError
+        If a count is not an integer >= 1, a length or modulus is not positive, ``pretension`` or
+        ``free_length`` is negative, ``hole_radius`` is too large, or ``friction`` does not have 3 n
+        finite non-negative entries.
     """
 
     n_segments: int = 1

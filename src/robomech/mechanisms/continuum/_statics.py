@@ -27,7 +27,33 @@ TENSION_FLOOR = 0.0
 
 
 def elastic_energy(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """Bending energy of the cores, U = sum EI theta_i^2 / (2 l) (paper 3, eq. (8)), ``(...)`` in J."""
+    """Bending energy of the cores, U = sum EI theta_i^2 / (2 l) (paper 3, eq. (8)), ``(...)`` in J.
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
+    psi : array_like, shape (..., 2 n)
+        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Elastic energy U (J) of all cores (``EI = robot.bending_stiffness``, ``l = segment_length``).
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot`, or ``psi`` does not end in an axis of 2 n or is
+        not real and finite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> np.round(cr.elastic_energy(cr.ContinuumRobot.paper(), np.array([0.5, 0.0])), 8)
+    np.float64(0.00167552)
+    """
     check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
     return 0.5 * robot.bending_stiffness / robot.segment_length * np.sum(theta**2, axis=-1)
@@ -40,7 +66,33 @@ def _grad_u(robot: ContinuumRobot, theta: np.ndarray) -> np.ndarray:
 
 
 def elastic_gradient(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """dU/dpsi ``(..., 2 n)``: (EI theta_i / l, 0) per segment."""
+    """dU/dpsi ``(..., 2 n)``: (EI theta_i / l, 0) per segment (gradient of paper 3, eq. (8)).
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
+    psi : array_like, shape (..., 2 n)
+        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., 2 n)
+        ``dU/dpsi`` (N m per rad), ordered like ``psi``; the beta entries are 0.
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot`, or ``psi`` does not end in an axis of 2 n or is
+        not real and finite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> cr.elastic_gradient(cr.ContinuumRobot.paper(), np.array([0.5, 0.0])).round(6)
+    array([0.006702, 0.      ])
+    """
     check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
     return _grad_u(robot, theta)
@@ -52,6 +104,32 @@ def coupling_moments(robot: ContinuumRobot, psi: object) -> np.ndarray:
     The last segment has none.  The full virtual-work model of :func:`cable_tensions` contains this
     coupling exactly (distal cables run through proximal segments); this function is the paper's
     one-neighbour form, for comparison.
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
+    psi : array_like, shape (..., 2 n)
+        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
+
+    Returns
+    -------
+    ndarray, shape (..., n, 2)
+        Per segment i, ``(-EI theta_i+1 / l, 0)`` (N m); zero for the last segment.
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot`, or ``psi`` does not end in an axis of 2 n or is
+        not real and finite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> robot = cr.ContinuumRobot(n_segments=2, friction=(0.2,) * 6)
+    >>> cr.coupling_moments(robot, np.array([0.5, 0.0, 0.2, 0.0])).shape
+    (2, 2)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
@@ -62,12 +140,20 @@ def coupling_moments(robot: ContinuumRobot, psi: object) -> np.ndarray:
 
 @dataclass(frozen=True)
 class TensionResult:
-    """Cable tensions in equilibrium (batch shape ``...``).
+    """Cable tensions in equilibrium (the result of :func:`cable_tensions`).
 
-    ``tension (..., 3 n)``: tension of every cable where it enters the base plate (N, positive = pull);
-    ``minimum_norm``: the part that balances the core and the load; ``taut``: all cables at or above
-    ``TENSION_FLOOR``; ``min_tension``: the smallest tension; ``residual``: norm of the virtual-work
-    balance (N m), ~1e-15 when the balance holds.
+    Attributes
+    ----------
+    tension : ndarray, shape (..., 3 n)
+        Tension of every cable where it enters the base plate (N, positive = pull).
+    minimum_norm : ndarray, shape (..., 3 n)
+        The minimum-norm part that balances the core and the load (N), without pretension.
+    taut : ndarray of bool, shape (...)
+        All cables at or above ``TENSION_FLOOR``.
+    min_tension : ndarray, shape (...)
+        The smallest cable tension (N).
+    residual : ndarray, shape (...)
+        Norm of the virtual-work balance (N m), ~1e-15 when the balance holds.
     """
 
     tension: np.ndarray
@@ -100,6 +186,43 @@ def cable_tensions(
     (``direction``, see :func:`friction_factors`), and ``W = [m; f] (..., 6)`` an external wrench at the
     tip, in the base frame.  Solution: ``tau = -(G^T)^+ (grad U - J_x^T W) + (I - (G^T)^+ G^T) eta`` with
     ``eta = pretension * 1`` (default ``robot.pretension``).
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
+    psi : array_like, shape (..., 2 n)
+        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
+    wrench : array_like, shape (..., 6), optional
+        External wrench ``[m; f]`` (N m, N) at the tip, base frame; ``None``: unloaded.
+    direction : array_like, shape (..., 3 n), optional
+        Sliding direction of each cable (+1 pulled in, -1 paid out, see :func:`friction_factors`);
+        ``None``: frictionless.
+    pretension : float, optional
+        Null-space pretension (N, >= 0); ``None``: ``robot.pretension``.
+    model : {"chord", "arc"}, optional
+        Cable path model of the span Jacobian (straight chords between holes, or arcs).
+
+    Returns
+    -------
+    TensionResult
+        ``tension (..., 3 n)`` (N), ``minimum_norm (..., 3 n)`` (N), ``taut (...)``,
+        ``min_tension (...)`` (N) and ``residual (...)`` (N m).
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot`, or ``psi`` does not end in an axis of 2 n or is
+        not real and finite; ``wrench`` or ``direction`` has a wrong shape
+        or invalid values; ``pretension`` is negative; or ``model`` is unknown.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> res = cr.cable_tensions(cr.ContinuumRobot.paper(), np.array([0.5, 0.0]))
+    >>> res.tension.round(4), bool(res.taut), bool(res.residual < 1e-9)
+    (array([5.7688, 4.6573, 4.6573]), True, True)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)

@@ -53,6 +53,20 @@ class ICRModel:
     """Lateral ICR positions of the left and right tracks and the longitudinal ICR position (m, body axes).
 
     ``y_left > y_right`` is required (otherwise the yaw rate has the wrong sign or is undefined).
+
+    Parameters
+    ----------
+    y_left : float
+        Lateral position of the left track's ICR (m, body y axis, positive to the left).
+    y_right : float
+        Lateral position of the right track's ICR (m, body y axis).
+    x_icr : float, optional
+        Longitudinal position of the body's ICR (m, body x axis).
+
+    Raises
+    ------
+    ValueError
+        If a field is not a finite real number or ``y_left <= y_right``.
     """
 
     y_left: float
@@ -79,8 +93,17 @@ class ICRModel:
 
 @dataclass(frozen=True)
 class PlanarVelocity:
-    """Planar body velocity (batch shape ``...``): ``v_x``, ``v_y`` (m/s, body axes), ``yaw_rate``
-    (rad/s); ``valid`` false (and the values NaN) where an input track speed was not finite."""
+    """Planar body velocity (the result of :func:`icr_velocity`).
+
+    Attributes
+    ----------
+    v_x, v_y : ndarray, shape (...)
+        Body velocity (m/s, body axes); NaN where not ``valid``.
+    yaw_rate : ndarray, shape (...)
+        Yaw rate (rad/s, about body z); NaN where not ``valid``.
+    valid : ndarray of bool, shape (...)
+        False where an input track speed was not finite.
+    """
 
     v_x: np.ndarray
     v_y: np.ndarray
@@ -158,8 +181,15 @@ def wheel_radii(robot: ExplorationRobot) -> np.ndarray:
 
 @dataclass(frozen=True)
 class TrackSpeeds:
-    """No-slip track speeds (m/s, batch shape ``...``): ``right``, ``left``; ``valid`` false (values
-    NaN) where a wheel rate of the sample was not finite (an encoder drop-out)."""
+    """No-slip track speeds from wheel rates (the result of :func:`encoder_track_speeds`).
+
+    Attributes
+    ----------
+    right, left : ndarray, shape (...)
+        Track speeds (m/s); NaN where not ``valid``.
+    valid : ndarray of bool, shape (...)
+        False where a wheel rate of the sample was not finite (an encoder drop-out).
+    """
 
     right: np.ndarray
     left: np.ndarray
@@ -202,12 +232,22 @@ def encoder_track_speeds(robot: ExplorationRobot, wheel_rate: ArrayLike) -> Trac
 
 @dataclass(frozen=True)
 class ICRIdentification:
-    """Least-squares ICR parameters and their quality.
+    """Least-squares ICR parameters and their quality (the result of :func:`identify_icr`).
 
-    ``model``: the identified :class:`ICRModel` (``None`` when not identifiable: ``identifiable`` false);
-    ``residual_rms (3,)``: RMS misfit of the three equation groups (right track, left track, lateral; m/s);
-    ``used (N,)``: samples that entered (finite); ``n_used``; ``cond``: condition number of the system;
-    ``identifiable``: enough turning in the used samples for a full-rank system with ``y_left > y_right``.
+    Attributes
+    ----------
+    model : ICRModel or None
+        The identified model; ``None`` when not identifiable.
+    residual_rms : ndarray, shape (3,)
+        RMS misfit of the three equation groups (right track, left track, lateral; m/s).
+    used : ndarray of bool, shape (N,)
+        Samples that entered the fit (finite).
+    n_used : int
+        Number of samples used.
+    cond : float
+        Condition number of the least-squares system.
+    identifiable : bool
+        Enough turning in the used samples for a full-rank system with ``y_left > y_right``.
     """
 
     model: ICRModel | None
@@ -303,6 +343,15 @@ class WheelSlip:
     of the contact along the wheel's heading.  ``lateral_velocity``: sideways sliding of the contact (m/s).
     ``valid``: a finite wheel rate (a drop-out is flagged for that wheel) and not both speeds below
     ``SLIP_SPEED_FLOOR`` (NaN exactly where it is false).
+
+    Attributes
+    ----------
+    ratio : ndarray, shape (..., 6)
+        Longitudinal slip ratio in [-1, 1] (unit-free); NaN where not ``valid``.
+    lateral_velocity : ndarray, shape (..., 6)
+        Sideways sliding speed of each contact (m/s); NaN where not ``valid``.
+    valid : ndarray of bool, shape (..., 6)
+        A finite wheel rate and not both speeds below ``SLIP_SPEED_FLOOR``.
     """
 
     ratio: np.ndarray

@@ -54,7 +54,18 @@ N_STATE = 8
 
 @dataclass(frozen=True)
 class EncoderModel:
-    """Incremental wheel encoder: ``counts_per_rev`` counts per wheel revolution (quantisation only)."""
+    """Incremental wheel encoder: ``counts_per_rev`` counts per wheel revolution (quantisation only).
+
+    Parameters
+    ----------
+    counts_per_rev : int, optional
+        Encoder counts per wheel revolution (>= 1).
+
+    Raises
+    ------
+    ValueError
+        If ``counts_per_rev`` is not an integer >= 1.
+    """
 
     counts_per_rev: int = 2048
 
@@ -73,6 +84,22 @@ class ImuModel:
 
     Defaults: a MEMS IMU of the ADIS16470 class (gyro 0.008 °/s/√Hz, accelerometer 0.5 mg/√Hz); the
     biases are of the size left after a start-up calibration.
+
+    Parameters
+    ----------
+    gyro_noise_density : float, optional
+        Gyro white-noise density (rad/s/√Hz, >= 0).
+    gyro_bias : tuple of float, optional
+        Constant gyro bias per body axis (rad/s).
+    accel_noise_density : float, optional
+        Accelerometer white-noise density (m/s²/√Hz, >= 0).
+    accel_bias : tuple of float, optional
+        Constant accelerometer bias per body axis (m/s²).
+
+    Raises
+    ------
+    ValueError
+        If a noise density is negative or not finite, or a bias is not three finite numbers.
     """
 
     gyro_noise_density: float = math.radians(0.008)  # rad/s/√Hz
@@ -105,8 +132,15 @@ def _rng(seed: object) -> np.random.Generator:
 
 @dataclass(frozen=True)
 class EncoderReadings:
-    """Measured spin rates ``rate (N, 6)`` (rad/s, ``WHEELS`` order); ``valid (N,)`` false where there
-    is no reading (the first sample: no previous count), and ``rate`` is NaN exactly there."""
+    """Measured wheel spin rates from quantised encoder counts.
+
+    Attributes
+    ----------
+    rate : ndarray, shape (N, 6)
+        Spin rate of each wheel (rad/s, ``WHEELS`` order); NaN exactly where ``valid`` is false.
+    valid : ndarray of bool, shape (N,)
+        False where there is no reading (the first sample: no previous count).
+    """
 
     rate: np.ndarray
     valid: np.ndarray
@@ -221,12 +255,17 @@ def track_speed_sigma(encoder: EncoderModel, radii: ArrayLike, dt: float) -> flo
 
 @dataclass(frozen=True)
 class EKFResult:
-    """Filtered planar odometry, ``N`` samples.
+    """Filtered planar odometry over ``N`` samples (the result of :func:`planar_ekf`).
 
-    ``state (N, 8)`` = ``[x, y, ψ, v_x, r, b_gyro, y_left, y_right]`` (m, m, rad, m/s, rad/s, rad/s, m, m),
-    ``covariance (N, 8, 8)``;
-    ``encoder_used`` / ``gyro_used (N,)``: whether that sample's measurement updated the filter (false
-    at the drop-outs marked by ``encoder_ok`` / ``gyro_ok``: the filter only predicts there).
+    Attributes
+    ----------
+    state : ndarray, shape (N, 8)
+        ``[x, y, ψ, v_x, r, b_gyro, y_left, y_right]`` (m, m, rad, m/s, rad/s, rad/s, m, m).
+    covariance : ndarray, shape (N, 8, 8)
+        Covariance of ``state`` (in the squared units of its entries).
+    encoder_used, gyro_used : ndarray of bool, shape (N,)
+        Whether that sample's measurement updated the filter (false at the drop-outs marked by
+        ``encoder_ok`` / ``gyro_ok``: the filter only predicts there).
     """
 
     state: np.ndarray

@@ -38,6 +38,17 @@ class SkidSteerTurn:
     ``yaw_rate = (v1 - v2)/S`` (rad/s, positive counter-clockwise about body z, i.e. turning left);
     ``forward_speed = (v1 + v2)/2`` of the body centre; ``radius`` of the body centre's path, signed
     (positive: centre of rotation on the left), ``inf`` where ``turning`` is false (straight or at rest).
+
+    Attributes
+    ----------
+    yaw_rate : ndarray, shape (...)
+        ``(v1 - v2) / S`` (rad/s, about body z).
+    forward_speed : ndarray, shape (...)
+        ``(v1 + v2) / 2`` of the body centre (m/s).
+    radius : ndarray, shape (...)
+        Signed radius of the body centre's path (m); ``inf`` where not ``turning``.
+    turning : ndarray of bool, shape (...)
+        ``|v1 - v2|`` above ``STRAIGHT_RTOL`` times ``|v1| + |v2|``.
     """
 
     yaw_rate: np.ndarray
@@ -120,8 +131,16 @@ def wheel_lateral_velocity(yaw_rate: ArrayLike, wheel_x: ArrayLike, icr_x: Array
 
 @dataclass(frozen=True)
 class LateralSlip:
-    """Lateral slip speed of the outer wheel (m/s, batch shape ``...``); NaN exactly where ``valid`` is
-    false: the centre of rotation within ``LATERAL_SLIP_RTOL`` S of the inner track (or an overflow)."""
+    """Lateral slip speed of the outer wheel (the result of :func:`paper_lateral_slip`, paper 4, Sec. 1.2).
+
+    Attributes
+    ----------
+    lateral_speed : ndarray, shape (...)
+        Lateral slip speed ``v_Y`` (m/s); NaN exactly where ``valid`` is false.
+    valid : ndarray of bool, shape (...)
+        False where the centre of rotation lies within ``LATERAL_SLIP_RTOL`` S of the inner track (or
+        on an overflow).
+    """
 
     lateral_speed: np.ndarray
     valid: np.ndarray

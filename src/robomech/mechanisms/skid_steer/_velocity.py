@@ -200,14 +200,24 @@ def wheel_measurements(
 
 @dataclass(frozen=True)
 class BodyVelocity:
-    """Estimated body motion per sample (batch shape ``...``).
+    """Estimated body motion per sample (the result of :func:`body_velocity`).
 
-    ``twist (..., 6)``: ``[ω_B; v_B]`` in body axes (ω_BY from the rockers, the rest estimated);
-    ``config_rate (..., 8)``: all joint rates (rockers from ω1, ω2; the rest estimated);
-    ``unknowns (..., 11)``: the least-squares solution in paper order; ``residual_norm`` ``‖A0 ṗ - J q̇‖``
-    (m/s and rad/s mixed, as in the paper); ``cond``: condition number of ``A0``; ``valid``: finite
-    inputs and full-rank ``A0`` (NaN entries appear only where ``valid`` is false; ``cond`` is NaN only
-    for non-finite inputs).
+    NaN entries appear only where ``valid`` is false.
+
+    Attributes
+    ----------
+    twist : ndarray, shape (..., 6)
+        ``[ω_B; v_B]`` (rad/s, m/s) in body axes (ω_BY from the rockers, the rest estimated).
+    config_rate : ndarray, shape (..., 8)
+        All joint rates (rad/s, m/s; rockers from ω1, ω2, the rest estimated).
+    unknowns : ndarray, shape (..., 11)
+        The least-squares solution in paper order.
+    residual_norm : ndarray, shape (...)
+        ``‖A0 ṗ - J q̇‖`` (m/s and rad/s mixed, as in the paper).
+    cond : ndarray, shape (...)
+        Condition number of ``A0`` (NaN only for non-finite inputs).
+    valid : ndarray of bool, shape (...)
+        Finite inputs and full-rank ``A0``.
     """
 
     twist: np.ndarray

@@ -248,7 +248,40 @@ def generalized_forces(
     about O (conventions); tau is what the actuators must supply.  ``paper_as_printed``: see
     :func:`inverse_dynamics`.  Near a gimbal lock of a base universal joint (``CARDAN_LOCK_TOL``, far
     outside the paper's motions) the values are finite but meaningless: :func:`inverse_dynamics` flags
-    them.
+    them. Replaces paper 1, eqs. (19)-(28) (see the module docstring).
+
+    Parameters
+    ----------
+    leg : SphericalLeg
+        The leg's geometry (m) and mass properties (kg, kg m^2); ``leg.gravity`` (m/s^2, base frame).
+    q : array_like, shape (..., 2)
+        Platform angles ``(alpha, beta)`` (rad).
+    qd : array_like, shape (..., 2)
+        Their rates (rad/s).
+    qdd : array_like, shape (..., 2)
+        Their accelerations (rad/s^2). ``q``, ``qd`` and ``qdd`` broadcast together.
+    platform_wrench : array_like, shape (..., 6), optional
+        External wrench ``[m_O; f]`` (N m, N) on the platform, base frame, moment about O; ``None``:
+        no external load.
+    paper_as_printed : bool, optional
+        Drop the Cardan spin of the legs (paper 1, eq. (23)), for comparison only.
+
+    Returns
+    -------
+    ndarray, shape (..., 2)
+        Generalized forces ``tau`` on (alpha, beta) (N m).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not a :class:`SphericalLeg`, or an input has a wrong shape, is not real and
+        finite, or the inputs do not broadcast.
+
+    Examples
+    --------
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> sl.generalized_forces(sl.SphericalLeg.paper(), [0.1, 0.05], [0.0, 0.0], [0.0, 0.0]).shape
+    (2,)
     """
     check_params(leg, SphericalLeg, "leg")
     qa, qda, qdda = _check_state(q, qd, qdd)
@@ -260,7 +293,35 @@ def generalized_forces(
 def mass_matrix(leg: SphericalLeg, q: object, *, paper_as_printed: bool = False) -> NDArray[np.float64]:
     """Mass matrix M(q) (..., 2, 2) of the coordinates (alpha, beta): tau = M qdd + c(q, qd) + g(q).
 
-    ``paper_as_printed``: see :func:`inverse_dynamics`."""
+    Built column by column from :func:`generalized_forces` with zero gravity and rates.
+
+    Parameters
+    ----------
+    leg : SphericalLeg
+        The leg's geometry (m) and mass properties (kg, kg m^2).
+    q : array_like, shape (..., 2)
+        Platform angles ``(alpha, beta)`` (rad).
+    paper_as_printed : bool, optional
+        Drop the Cardan spin of the legs (see :func:`inverse_dynamics`), for comparison only.
+
+    Returns
+    -------
+    ndarray, shape (..., 2, 2)
+        ``M(q)`` (kg m^2), symmetric positive definite.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not a :class:`SphericalLeg`, or ``q`` has a wrong shape or is not real and finite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> M = sl.mass_matrix(sl.SphericalLeg.paper(), [0.1, 0.05])
+    >>> M.shape, bool(np.allclose(M, M.T))
+    ((2, 2), True)
+    """
     check_params(leg, SphericalLeg, "leg")
     qa = as_array(q, "q", (2,))
     cardan = not check_bool(paper_as_printed, "paper_as_printed")
@@ -283,7 +344,37 @@ def mechanical_energy(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Kinetic and potential energy (J) of platform and legs, each (...); potential zero at O.
 
-    ``paper_as_printed``: see :func:`inverse_dynamics`."""
+    Parameters
+    ----------
+    leg : SphericalLeg
+        The leg's geometry (m), mass properties (kg, kg m^2) and ``gravity`` (m/s^2, base frame).
+    q : array_like, shape (..., 2)
+        Platform angles ``(alpha, beta)`` (rad).
+    qd : array_like, shape (..., 2)
+        Their rates (rad/s); broadcast with ``q``.
+    paper_as_printed : bool, optional
+        Drop the Cardan spin of the legs (see :func:`inverse_dynamics`), for comparison only.
+
+    Returns
+    -------
+    T : ndarray, shape (...)
+        Kinetic energy (J).
+    V : ndarray, shape (...)
+        Gravitational potential energy (J), zero with every centre of mass at O.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not a :class:`SphericalLeg`, or an input has a wrong shape, is not real and
+        finite, or the inputs do not broadcast.
+
+    Examples
+    --------
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> T, V = sl.mechanical_energy(sl.SphericalLeg.paper(), [0.1, 0.05], [0.0, 0.0])
+    >>> float(T)
+    0.0
+    """
     check_params(leg, SphericalLeg, "leg")
     qa, qda = _check_state(q, qd)
     cardan = not check_bool(paper_as_printed, "paper_as_printed")
@@ -315,15 +406,25 @@ def mechanical_energy(
 
 @dataclass(frozen=True)
 class ForceDistribution:
-    """Leg forces f (..., 3) (N, positive extends the leg) with J^T f = tau; residual (...) N m is
-    |J^T f - tau| (rounding level where the solve is regular).
+    """Leg forces f with J^T f = tau (the result of :func:`distribute_forces`).
 
-    ``sigma_min`` (...) m/rad: the conditioning measure, the smallest singular value of J (minimum-norm
-    rule) or of the driven legs' 2x2 block (the lever arm through which the legs act; 0 where singular
-    or non-finite); ``rcond`` (...) its ratio to the largest.  ``valid`` (...) is False where
-    ``sigma_min < sigma_min_bound`` (default ``ACTUATION_SIGMA_MIN``, an actuation singularity or its
-    neighbourhood): there f is NaN if the solve is numerically singular (``rcond`` below
-    ``ACTUATION_SINGULAR_RTOL``), else the exact but physically meaningless value."""
+    Attributes
+    ----------
+    forces : ndarray, shape (..., 3)
+        Leg forces (N, positive extends the leg); NaN where the solve is numerically singular
+        (``rcond`` below ``ACTUATION_SINGULAR_RTOL``) or the input is not finite.
+    residual : ndarray, shape (...)
+        ``|J^T f - tau|`` (N m), rounding level where the solve is regular.
+    valid : ndarray of bool, shape (...)
+        False where ``sigma_min < sigma_min_bound`` (default ``ACTUATION_SIGMA_MIN``: an actuation
+        singularity or its neighbourhood; f is then the exact but physically meaningless value) or the
+        forces are NaN.
+    sigma_min : ndarray, shape (...)
+        Smallest singular value of J (minimum-norm rule) or of the driven legs' 2x2 block (m/rad): the
+        lever arm through which the legs act; 0 where singular or non-finite.
+    rcond : ndarray, shape (...)
+        ``sigma_min`` over the largest singular value (unit-free).
+    """
 
     forces: np.ndarray
     residual: np.ndarray
@@ -345,6 +446,39 @@ def distribute_forces(
     no internal preload). ``driven_legs=(i, j)``: only those two legs act (paper 1's choice is
     ``PAPER_DRIVEN_LEGS``, legs 1 and 3), the third carries no force.  ``sigma_min_bound`` (m/rad,
     >= 0): the lever arm below which a sample is flagged (see ``ACTUATION_SIGMA_MIN``).
+
+    Parameters
+    ----------
+    J : array_like, shape (..., 3, 2)
+        Leg Jacobian ``d l_i / d(alpha, beta)_j`` (m/rad), e.g. from :func:`jacobian`. Non-finite
+        samples are flagged, not raised.
+    tau : array_like, shape (..., 2)
+        Generalized forces on (alpha, beta) (N m); broadcast with ``J``. Non-finite samples are flagged.
+    driven_legs : tuple of int, optional
+        Two different leg indices in 0..2 that carry the load; ``None``: minimum-norm over all three.
+    sigma_min_bound : float, optional
+        Smallest acceptable lever arm (m/rad, >= 0); default ``ACTUATION_SIGMA_MIN``.
+
+    Returns
+    -------
+    ForceDistribution
+        ``forces (..., 3)`` (N), ``residual (...)`` (N m), ``valid (...)``, ``sigma_min (...)`` (m/rad)
+        and ``rcond (...)``.
+
+    Raises
+    ------
+    ValueError
+        If ``J`` or ``tau`` has a wrong shape or a non-real dtype, ``driven_legs`` is not two
+        different indices in 0..2, or ``sigma_min_bound`` is negative or not a real number.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> J = sl.jacobian(sl.SphericalLeg.paper(), 0.1, 0.05)
+    >>> fd = sl.distribute_forces(J, [1.0, 0.0], driven_legs=sl.PAPER_DRIVEN_LEGS)
+    >>> fd.forces[1], bool(fd.valid), bool(fd.residual < 1e-9)
+    (np.float64(0.0), True, True)
     """
     J = as_array(J, "J", (3, 2), finite=False)
     t = as_array(tau, "tau", (2,), finite=False)
@@ -414,11 +548,24 @@ def _singular_values_2x2_gram(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass(frozen=True)
 class InverseDynamicsResult:
-    """generalized_forces (..., 2) N m on (alpha, beta); leg_forces (..., 3) N (positive extends);
-    residual (...) N m of J^T f = tau; valid (...) False at or near an actuation singularity
-    (``sigma_min < ACTUATION_SIGMA_MIN``; forces NaN where the solve is numerically singular) or a
-    gimbal lock of a base universal joint (``CARDAN_LOCK_TOL``);
-    sigma_min (...) m/rad and rcond (...) the per-sample conditioning (:class:`ForceDistribution`)."""
+    """Generalized and leg forces of a platform motion (the result of :func:`inverse_dynamics`).
+
+    Attributes
+    ----------
+    generalized_forces : ndarray, shape (..., 2)
+        ``tau`` on (alpha, beta) (N m).
+    leg_forces : ndarray, shape (..., 3)
+        Leg actuator forces (N, positive extends the leg); NaN where the solve is numerically singular.
+    residual : ndarray, shape (...)
+        ``|J^T f - tau|`` (N m).
+    valid : ndarray of bool, shape (...)
+        False at or near an actuation singularity (``sigma_min < ACTUATION_SIGMA_MIN``) or a gimbal
+        lock of a base universal joint (``CARDAN_LOCK_TOL``).
+    sigma_min : ndarray, shape (...)
+        The per-sample lever arm (m/rad), as in :class:`ForceDistribution`.
+    rcond : ndarray, shape (...)
+        Its ratio to the largest singular value (unit-free).
+    """
 
     generalized_forces: np.ndarray
     leg_forces: np.ndarray
@@ -445,7 +592,48 @@ def inverse_dynamics(
     ``valid`` is also False where a base universal joint is at or near gimbal lock
     (``CARDAN_LOCK_TOL``).  ``paper_as_printed=True``: without the spin of the legs about their own
     axes that the base universal joints impose (paper 1, eq. (23), and this module before issue 13),
-    for comparison only; the lead-screw spin still follows ``leg.screw_spin``.
+    for comparison only; the lead-screw spin still follows ``leg.screw_spin``. Replaces paper 1,
+    eqs. (19)-(28) (see the module docstring).
+
+    Parameters
+    ----------
+    leg : SphericalLeg
+        The leg's geometry (m) and mass properties (kg, kg m^2); ``leg.gravity`` (m/s^2, base frame).
+    q : array_like, shape (..., 2)
+        Platform angles ``(alpha, beta)`` (rad).
+    qd : array_like, shape (..., 2)
+        Their rates (rad/s).
+    qdd : array_like, shape (..., 2)
+        Their accelerations (rad/s^2). ``q``, ``qd`` and ``qdd`` broadcast together.
+    platform_wrench : array_like, shape (..., 6), optional
+        External wrench ``[m_O; f]`` (N m, N) on the platform, base frame, moment about O; ``None``:
+        no external load.
+    driven_legs : tuple of int, optional
+        Two leg indices that carry the load (e.g. ``PAPER_DRIVEN_LEGS``); ``None``: minimum-norm forces
+        over all three legs.
+    paper_as_printed : bool, optional
+        Drop the Cardan spin of the legs, for comparison only.
+
+    Returns
+    -------
+    InverseDynamicsResult
+        ``generalized_forces (..., 2)`` (N m), ``leg_forces (..., 3)`` (N), ``residual (...)`` (N m),
+        ``valid (...)``, ``sigma_min (...)`` (m/rad) and ``rcond (...)``.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not a :class:`SphericalLeg`, or an input has a wrong shape, is not real and
+        finite, or the inputs do not broadcast.
+        Also if ``driven_legs`` is not two different indices in 0..2.
+
+    Examples
+    --------
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> q, qd, qdd = sl.fig5_motion("a", [0.0, 1.0])
+    >>> res = sl.inverse_dynamics(sl.SphericalLeg.paper(), q, qd, qdd, driven_legs=(0, 2))
+    >>> res.leg_forces.shape, res.valid
+    ((2, 3), array([ True,  True]))
     """
     check_params(leg, SphericalLeg, "leg")
     qa, qda, qdda = _check_state(q, qd, qdd)

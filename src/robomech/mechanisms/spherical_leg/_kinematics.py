@@ -92,7 +92,29 @@ def _angles(alpha: object, beta: object) -> tuple[np.ndarray, np.ndarray]:
 
 
 def platform_rotation(alpha: object, beta: object) -> np.ndarray:
-    """``T = Rx(alpha) Ry(beta)`` (paper 1, eq. (1)) -> (..., 3, 3)."""
+    """Platform rotation ``T = Rx(alpha) Ry(beta)`` (paper 1, eq. (1)).
+
+    Parameters
+    ----------
+    alpha, beta : array_like, shape (...)
+        Platform angles (rad) about the base X axis and the turned Y axis; broadcast together.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        The rotation of the platform frame relative to the base frame (``R_base_platform``).
+
+    Raises
+    ------
+    ValueError
+        If an angle is not real and finite, or the two do not broadcast.
+
+    Examples
+    --------
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> sl.platform_rotation([0.0, 0.1], 0.2).shape
+    (2, 3, 3)
+    """
     a, b = _angles(alpha, beta)
     return _rotation(np.sin(a), np.cos(a), np.sin(b), np.cos(b))
 
@@ -124,11 +146,20 @@ def _squared_lengths(leg: SphericalLeg, sa, ca, sb, cb) -> np.ndarray:
 
 @dataclass(frozen=True)
 class InverseKinematicsResult:
-    """Leg lengths and geometry for platform angles (alpha, beta).
+    """Leg lengths and geometry for platform angles (alpha, beta) (the result of :func:`inverse_kinematics`).
 
-    lengths (..., 3) m; unit_vectors (..., 3, 3) rows s_i = (B_i - A_i)/l_i; platform_points
-    (..., 3, 3) rows B_i in the base frame; base_points (3, 3) rows A_i; within_limits (..., 3) bool:
-    length_min <= l_i <= length_max.
+    Attributes
+    ----------
+    lengths : ndarray, shape (..., 3)
+        Leg lengths l_i (m).
+    unit_vectors : ndarray, shape (..., 3, 3)
+        Rows ``s_i = (B_i - A_i) / l_i``: leg directions (base frame).
+    platform_points : ndarray, shape (..., 3, 3)
+        Rows B_i (m, base frame, relative to O).
+    base_points : ndarray, shape (3, 3)
+        Rows A_i (m, base frame).
+    within_limits : ndarray of bool, shape (..., 3)
+        ``length_min <= l_i <= length_max``.
     """
 
     lengths: np.ndarray
@@ -209,11 +240,19 @@ def _ik_kernel(leg: SphericalLeg, a, b, L, S, B) -> None:
 
 @dataclass(frozen=True)
 class ForwardKinematicsResult:
-    """Platform angles from leg lengths.
+    """Platform angles from leg lengths (the result of :func:`forward_kinematics`).
 
-    alpha, beta (...) rad; residual (...) m: norm of (l(alpha, beta) - lengths), i.e. how inconsistent
-    the three lengths are (rounding level for exact lengths); valid (...) bool: finite positive lengths
-    that assemble (NaN angles only where valid is false); converged (...) bool: the beta fit converged.
+    Attributes
+    ----------
+    alpha, beta : ndarray, shape (...)
+        Platform angles (rad); NaN where not ``valid``.
+    residual : ndarray, shape (...)
+        Norm of ``l(alpha, beta) - lengths`` (m): how inconsistent the three lengths are (rounding
+        level for exact lengths).
+    valid : ndarray of bool, shape (...)
+        Finite positive lengths that assemble (NaN angles only where this is False).
+    converged : ndarray of bool, shape (...)
+        The beta fit converged.
     """
 
     alpha: np.ndarray
@@ -635,7 +674,32 @@ def _derivatives(leg: SphericalLeg, sa, ca, sb, cb):
 
 
 def hessian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
-    """``H[..., i, j, k] = d^2 l_i / dq_j dq_k`` with q = (alpha, beta) -> (..., 3, 2, 2) in m/rad^2."""
+    """Second derivatives of the leg lengths, ``H[..., i, j, k] = d^2 l_i / dq_j dq_k``, q = (alpha, beta).
+
+    Parameters
+    ----------
+    leg : SphericalLeg
+        The leg's geometry (m).
+    alpha, beta : array_like, shape (...)
+        Platform angles (rad); broadcast together.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 2, 2)
+        ``d^2 l_i / dq_j dq_k`` (m/rad^2), symmetric in (j, k); the derivative of :func:`jacobian`.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not a :class:`SphericalLeg`, or an angle is not real and finite, or the angles do
+        not broadcast.
+
+    Examples
+    --------
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> sl.hessian(sl.SphericalLeg.paper(), [0.0, 0.1], 0.05).shape
+    (2, 3, 2, 2)
+    """
     check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
     q, dq, d2q = _derivatives(leg, np.sin(a), np.cos(a), np.sin(b), np.cos(b))
@@ -648,6 +712,30 @@ def angular_velocity_jacobian(alpha: object) -> np.ndarray:
     """``E`` with platform angular velocity ``omega = E (alpha_dot, beta_dot)`` (base frame), (..., 3, 2).
 
     For T = Rx(alpha) Ry(beta): omega = alpha_dot x + beta_dot Rx(alpha) y.
+
+    Parameters
+    ----------
+    alpha : array_like, shape (...)
+        Platform angle alpha (rad); ``E`` does not depend on beta.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 2)
+        ``E`` (rad/s of omega, base frame, per rad/s of (alpha_dot, beta_dot)): columns ``x`` and
+        ``Rx(alpha) y``.
+
+    Raises
+    ------
+    ValueError
+        If ``alpha`` is not real and finite.
+
+    Examples
+    --------
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> sl.angular_velocity_jacobian(0.0)
+    array([[1., 0.],
+           [0., 1.],
+           [0., 0.]])
     """
     a = as_array(alpha, "alpha")
     E = np.zeros((*a.shape, 3, 2))
@@ -664,6 +752,31 @@ def influence_coefficients(leg: SphericalLeg, alpha: object, beta: object) -> np
     ``[omega; v_O]`` (base frame, reference point O; for this leg v_O = 0 since O is fixed). This is
     paper 1, eqs. (8)-(12) with the reference point moved from P to O; eq. (12)'s first row lacks a
     factor sin(alpha) on its ``R r`` term (errata). ``jacobian = G[..., :3] @ angular_velocity_jacobian``.
+
+    Parameters
+    ----------
+    leg : SphericalLeg
+        The leg's geometry (m).
+    alpha, beta : array_like, shape (...)
+        Platform angles (rad); broadcast together.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 6)
+        ``G``: row i is ``[(B_i - O) x s_i; s_i]`` (first three columns in m, last three unit-free),
+        base frame, so that ``ldot = G @ [omega; v_O]`` (m/s).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not a :class:`SphericalLeg`, or an angle is not real and finite, or the angles do
+        not broadcast.
+
+    Examples
+    --------
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> sl.influence_coefficients(sl.SphericalLeg.paper(), 0.1, 0.05).shape
+    (3, 6)
     """
     check_params(leg, SphericalLeg, "leg")
     ik = inverse_kinematics(leg, alpha, beta)
@@ -678,7 +791,41 @@ def leg_rates(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Leg lengths, rates and accelerations ``(l, ldot, lddot)`` (each (..., 3)) along q = (alpha, beta).
 
-    ``ldot = J qd``, ``lddot = J qdd + qd^T H qd`` (conventions: H[..., i, j, k] = dJ_ij/dq_k).
+    ``ldot = J qd``, ``lddot = J qdd + qd^T H qd`` (conventions: H[..., i, j, k] = dJ_ij/dq_k). This
+    replaces paper 1, eqs. (13)-(17), whose printed acceleration is wrong (see the comment in the code).
+
+    Parameters
+    ----------
+    leg : SphericalLeg
+        The leg's geometry (m).
+    q : array_like, shape (..., 2)
+        Platform angles ``(alpha, beta)`` (rad).
+    qd : array_like, shape (..., 2)
+        Their rates (rad/s).
+    qdd : array_like, shape (..., 2)
+        Their accelerations (rad/s^2). ``q``, ``qd`` and ``qdd`` broadcast together.
+
+    Returns
+    -------
+    l : ndarray, shape (..., 3)
+        Leg lengths (m).
+    ldot : ndarray, shape (..., 3)
+        Leg extension rates (m/s).
+    lddot : ndarray, shape (..., 3)
+        Leg extension accelerations (m/s^2).
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not a :class:`SphericalLeg`, or an input has a wrong shape, is not real and
+        finite, or the three do not broadcast.
+
+    Examples
+    --------
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> l, ld, ldd = sl.leg_rates(sl.SphericalLeg.paper(), [0.1, 0.05], [0.0, 0.0], [0.0, 0.0])
+    >>> l.round(5), ld
+    (array([0.10621, 0.11305, 0.11637]), array([0., 0., 0.]))
     """
     check_params(leg, SphericalLeg, "leg")
     qa = as_array(q, "q", (2,))

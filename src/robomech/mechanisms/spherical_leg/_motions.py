@@ -19,7 +19,38 @@ FIG5B_TRANSITION = 5.0
 def sway(t: object, about: str, beta0: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Section 6.1 sway ``A sin(2 pi f t)`` about X (alpha; beta held at ``beta0``) or Y (beta; alpha = 0).
 
-    Returns q, qd, qdd, each (..., 2) with q = (alpha, beta).
+    ``A = AMPLITUDE`` (pi/3 rad) and ``f = FREQUENCY`` (0.05 Hz), as paper 1, Section 6.1 states.
+
+    Parameters
+    ----------
+    t : array_like, shape (...)
+        Times (s).
+    about : {"x", "y"}
+        The sway axis: ``"x"`` sways alpha, ``"y"`` sways beta.
+    beta0 : float, optional
+        The constant beta (rad) held during a sway about X (ignored for ``"y"``).
+
+    Returns
+    -------
+    q : ndarray, shape (..., 2)
+        Platform angles ``(alpha, beta)`` (rad).
+    qd : ndarray, shape (..., 2)
+        Their rates (rad/s).
+    qdd : ndarray, shape (..., 2)
+        Their accelerations (rad/s^2).
+
+    Raises
+    ------
+    ValueError
+        If ``about`` is not ``"x"`` or ``"y"``, or ``t`` or ``beta0`` is not real and finite.
+
+    Examples
+    --------
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> q, qd, qdd = sl.sway([0.0, 5.0], "x", beta0=0.5)
+    >>> q.round(6)
+    array([[0.      , 0.5     ],
+           [1.047198, 0.5     ]])
     """
     check_choice(about, "about", ("x", "y"))
     beta0 = check_real(beta0, "beta0")
@@ -38,6 +69,35 @@ def fig5_motion(case: str, t: object) -> tuple[np.ndarray, np.ndarray, np.ndarra
     alpha = 0 (one period = 20 s); as printed the sine starts from rest, so alpha_dot steps by
     A 2 pi f = 0.33 rad/s at t = 5 s (an impulse the forces cannot show). ``"c"``: sway about X at
     beta = 0 (the print does not state beta for case (c): an assumption).
+
+    Parameters
+    ----------
+    case : {"a", "b", "c"}
+        The panel of paper 1, Fig. 5.
+    t : array_like, shape (...)
+        Times (s).
+
+    Returns
+    -------
+    q : ndarray, shape (..., 2)
+        Platform angles ``(alpha, beta)`` (rad).
+    qd : ndarray, shape (..., 2)
+        Their rates (rad/s).
+    qdd : ndarray, shape (..., 2)
+        Their accelerations (rad/s^2).
+
+    Raises
+    ------
+    ValueError
+        If ``case`` is not ``"a"``, ``"b"`` or ``"c"``, or ``t`` is not real and finite.
+
+    Examples
+    --------
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> q, qd, qdd = sl.fig5_motion("b", [0.0, 5.0])
+    >>> q.round(6)
+    array([[0.      , 1.047198],
+           [0.      , 0.523599]])
     """
     check_choice(case, "case", ("a", "b", "c"))
     t = as_array(t, "t")

@@ -40,6 +40,27 @@ class LegBody:
     ``shape`` is ``"round"`` (cylinder of outer diameter ``width``) or ``"square"`` (square section of
     side ``width``); ``wall`` is the wall thickness of a hollow section (``wall >= width / 2`` means
     solid). Lengths in metres, mass in kg.
+
+    Parameters
+    ----------
+    name : str
+        Label used in error messages (e.g. ``"screw"``).
+    length : float
+        Length along the leg axis (m, > 0).
+    width : float
+        Outer diameter (round) or side (square) of the section (m, > 0).
+    wall : float
+        Wall thickness of the section (m, > 0; ``>= width / 2``: solid).
+    mass : float
+        Mass (kg, >= 0).
+    shape : {"round", "square"}, optional
+        Section shape.
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not a str, a dimension is not positive, ``mass`` is negative or ``shape`` is not
+        ``"round"`` or ``"square"``.
     """
 
     name: str
@@ -89,6 +110,36 @@ class SphericalLeg:
     screw) spins about the leg axis at ``2 pi ldot / screw_lead`` relative to the upper body when
     ``screw_spin`` is true. ``length_min``/``length_max``: leg stroke limits (the paper gives none).
     ``gravity``: acceleration vector in the base frame (paper: (0, 0, -10) m/s^2).
+
+    Parameters
+    ----------
+    R : float
+        Radius OA_i of the base joint circle (m); paper: 75 mm.
+    r : float
+        Radius PB_i of the platform joint circle (m); paper: 30 mm.
+    h : float
+        Distance OP at the home pose (m); paper: 100 mm.
+    platform_side, platform_thickness : float
+        Side and thickness of the box-shaped platform (m); paper: 60 mm, 20 mm.
+    platform_mass : float
+        Platform mass (kg, >= 0); paper: 5 kg.
+    lower, upper : tuple of LegBody
+        The lower (at A_i) and upper (at B_i) body of each of the three legs.
+    screw_lead : float
+        Lead of the helical joints of legs 1 and 3 (m per turn); paper: 10 mm.
+    screw_spin : bool
+        Whether the screw spins relative to the sleeve at ``2 pi ldot / screw_lead`` (the dynamics).
+    length_min, length_max : float
+        Leg stroke limits (m), ``length_max > length_min >= 0``; not printed (30 mm, 170 mm).
+    gravity : tuple of float
+        Gravitational acceleration in the base frame (m/s^2).
+
+    Raises
+    ------
+    ValueError
+        If a length or ``screw_lead`` is not positive, a mass is negative, ``length_max <=
+        length_min``, ``lower``/``upper`` is not three :class:`LegBody`, or ``gravity`` is not three
+        finite numbers.
     """
 
     R: float = 75 * _MM

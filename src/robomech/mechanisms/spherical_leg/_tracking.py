@@ -38,13 +38,27 @@ MEET_STEP_FACTOR = 2.5
 
 @dataclass(frozen=True)
 class BranchTrack:
-    """Forward kinematics along a trajectory (axis -1 of the batch is time), per sample (..., N):
+    """Forward kinematics along a trajectory (the result of :func:`track_branches`).
 
-    alpha, beta (rad; NaN where not valid), residual (m, as :func:`forward_kinematics`), valid;
-    branch (int8, 0 or 1: which closed-form solution the motion is on; -1 where not valid);
-    separation (rad) between the two solutions (0 on the singular curve); meeting (bool): samples where
-    the branches meet (within the sampling: see MEET_STEP_FACTOR), i.e. where the tracker had to choose,
-    and switched (bool): the meetings where the motion changed branch.
+    Axis -1 of every field is time (N samples); leading axes are independent trajectories.
+
+    Attributes
+    ----------
+    alpha, beta : ndarray, shape (..., N)
+        Platform angles (rad); NaN where not ``valid``.
+    residual : ndarray, shape (..., N)
+        Length residual (m), as in :func:`forward_kinematics`.
+    valid : ndarray of bool, shape (..., N)
+        Both closed-form solutions exist (finite positive lengths that assemble).
+    branch : ndarray of int8, shape (..., N)
+        Which closed-form solution the motion is on (0 or 1); -1 where not valid.
+    separation : ndarray, shape (..., N)
+        Angle between the two solutions (rad); 0 on the singular curve.
+    meeting : ndarray of bool, shape (..., N)
+        Samples where the branches meet (within the sampling, see ``MEET_STEP_FACTOR``), i.e. where the
+        tracker had to choose.
+    switched : ndarray of bool, shape (..., N)
+        The meetings where the motion changed branch.
     """
 
     alpha: np.ndarray
@@ -78,7 +92,41 @@ def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> Br
 
     The time axis is the second-to-last axis of ``lengths`` (N >= 1 samples in order); leading axes are
     independent trajectories.  Samples that do not assemble are flagged (``valid`` False) and bridged:
-    the branch carries across them.
+    the branch carries across them.  Where the two closed-form solutions of :func:`forward_kinematics`
+    meet, the tracker keeps the one that continues the motion (a quadratic extrapolation of the
+    preceding samples).
+
+    Parameters
+    ----------
+    leg : SphericalLeg
+        The leg's geometry (m).
+    lengths : array_like, shape (..., N, 3)
+        Leg lengths ``(l1, l2, l3)`` (m) at N >= 1 consecutive samples of each trajectory; non-finite or
+        non-positive samples are flagged, not raised.
+    branch : {0, 1}, optional
+        The assembly branch at the first sample (0: the one containing alpha = 0).
+
+    Returns
+    -------
+    BranchTrack
+        ``alpha``, ``beta`` (rad), ``residual`` (m), ``valid``, ``branch``, ``separation`` (rad),
+        ``meeting`` and ``switched``, each of shape ``(..., N)``.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not a :class:`SphericalLeg`, ``lengths`` does not end in a sample axis and an axis
+        of 3 or has a non-real dtype, or ``branch`` is not 0 or 1.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> leg = sl.SphericalLeg.paper()
+    >>> L = sl.inverse_kinematics(leg, np.linspace(0.0, 0.3, 5), 0.1).lengths   # (5, 3), m
+    >>> tr = sl.track_branches(leg, L)
+    >>> tr.alpha.round(6) + 0.0, tr.branch
+    (array([0.   , 0.075, 0.15 , 0.225, 0.3  ]), array([0, 0, 0, 0, 0], dtype=int8))
     """
     check_params(leg, SphericalLeg, "leg")
     branch = check_int(branch, "branch", low=0, high=1)

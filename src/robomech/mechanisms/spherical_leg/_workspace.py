@@ -32,9 +32,25 @@ ILL_CONDITIONED = 100.0
 
 @dataclass(frozen=True)
 class WorkspaceMap:
-    """Per pose (...): lengths (..., 3) m; reachable: every leg within [length_min, length_max];
-    sigma_min, sigma_max (m/rad) and cond of J; singular (sigma_min/sigma_max < SINGULAR_RTOL);
-    ill_conditioned (cond > ILL_CONDITIONED); dl3_dalpha (m/rad), whose sign marks the assembly branch."""
+    """Workspace and singularity measures per pose (the result of :func:`workspace_map`).
+
+    Attributes
+    ----------
+    lengths : ndarray, shape (..., 3)
+        Leg lengths (m).
+    reachable : ndarray of bool, shape (...)
+        Every leg within ``[length_min, length_max]``.
+    sigma_min, sigma_max : ndarray, shape (...)
+        Smallest and largest singular value of the leg Jacobian J (m/rad).
+    cond : ndarray, shape (...)
+        Condition number ``sigma_max / sigma_min`` of J (unit-free).
+    singular : ndarray of bool, shape (...)
+        ``sigma_min / sigma_max < SINGULAR_RTOL``.
+    ill_conditioned : ndarray of bool, shape (...)
+        ``cond > ILL_CONDITIONED``.
+    dl3_dalpha : ndarray, shape (...)
+        ``d l3 / d alpha`` (m/rad), whose sign marks the assembly branch.
+    """
 
     lengths: np.ndarray
     reachable: np.ndarray
@@ -50,6 +66,32 @@ def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMa
     """Workspace and singularity map at poses ``alpha``, ``beta`` (rad, broadcast) in closed form.
 
     The singular values of the 3x2 J come from the eigenvalues of the 2x2 Gram matrix J^T J.
+
+    Parameters
+    ----------
+    leg : SphericalLeg
+        The leg's geometry (m) and stroke (``length_min``, ``length_max``).
+    alpha, beta : array_like, shape (...)
+        Platform angles (rad); broadcast together (e.g. a meshgrid).
+
+    Returns
+    -------
+    WorkspaceMap
+        ``lengths (..., 3)`` (m), ``reachable``, ``sigma_min``, ``sigma_max`` (m/rad), ``cond``,
+        ``singular``, ``ill_conditioned`` and ``dl3_dalpha`` (m/rad), each of shape ``(...)``.
+
+    Raises
+    ------
+    ValueError
+        If ``leg`` is not a :class:`SphericalLeg`, or an angle is not real and finite, or the angles do
+        not broadcast.
+
+    Examples
+    --------
+    >>> from robomech.mechanisms import spherical_leg as sl
+    >>> ws = sl.workspace_map(sl.SphericalLeg.paper(), [0.0, 0.1], 0.05)
+    >>> ws.lengths.shape, ws.singular
+    ((2, 3), array([False, False]))
     """
     check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
