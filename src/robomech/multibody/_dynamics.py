@@ -753,6 +753,50 @@ def inverse_dynamics(
     redundant-actuation rule (module docstring; default minimum norm).  Actuator ``gear`` is not
     applied: ``tau`` is the generalized force at each actuated joint.  Batched over any leading shape;
     non-finite samples and singular configurations give ``valid = False`` and NaN forces.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism, actuated in every degree of freedom.
+    q : array_like, shape (..., nq)
+        Assembled configurations (MuJoCo ``qpos``).
+    qd_act : array_like, shape (..., n_act)
+        Actuated joints' rates in actuator order (rad/s or m/s); must be admissible (with redundant
+        actuation, in the consistent subspace), else ``valid`` is False.
+    qdd_act : array_like, shape (..., n_act)
+        Actuated joints' accelerations (rad/s^2 or m/s^2).
+    wrenches : mapping of str to array_like, shape (..., 6), optional
+        Site name -> wrench ``[m; f]`` applied *to* the mechanism at that site (world axes, moment
+        about the site point; N m, N).  Default None: no external wrench.
+    weights : array_like, shape (n_act,), optional
+        Redundant-actuation rule: minimise ``sum tau_i^2 / w_i`` (``w_i = 0``: actuator i carries
+        nothing).  Default None: minimum-norm forces.  Irrelevant without redundant actuation.
+    gravity : bool, optional
+        Apply ``mech.gravity`` (MJCF ``<option gravity>``, m/s^2); default True.
+
+    Returns
+    -------
+    InverseDynamicsResult
+        ``tau``, ``M_a``, ``velocity_terms``, ``gravity_terms``, ``external_terms``, every coordinate's
+        ``qd`` and ``qdd``, the per-sample ``cond``, ``sigma_min``, ``admissibility`` and ``valid``.
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, an array is not
+        real of the stated shape (non-finite values are allowed and masked), a quaternion in ``q`` is
+        zero, the batch shapes do not broadcast, ``wrenches`` is not a mapping of site names,
+        ``weights`` is not ``n_act`` non-negative numbers (not all zero), or ``gravity`` is not a bool.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> r = mb.inverse_dynamics(mech, q, [1.0], [0.5])
+    >>> r.tau.shape, r.M_a.shape, bool(r.valid)
+    ((1,), (1, 1), True)
     """
     mech = check_mechanism(mech)
     _fully_actuated(mech)
@@ -801,7 +845,45 @@ def statics(
 ) -> StaticsResult:
     """Actuator forces balancing ``wrenches`` (applied to the mechanism at sites) and gravity at rest.
 
-    The same virtual-work projection as :func:`inverse_dynamics` at ``qd = qdd = 0``.
+    The same virtual-work projection as :func:`inverse_dynamics` at ``qd = qdd = 0``:
+    ``tau = -G^T (J_s^T W - g)``.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism, actuated in every degree of freedom.
+    q : array_like, shape (..., nq)
+        Assembled configurations (MuJoCo ``qpos``).
+    wrenches : mapping of str to array_like, shape (..., 6), optional
+        Site name -> wrench ``[m; f]`` applied *to* the mechanism at that site (world axes, moment
+        about the site point; N m, N).  Default None: no external wrench.
+    weights : array_like, shape (n_act,), optional
+        Redundant-actuation rule, as in :func:`inverse_dynamics` (default None: minimum norm).
+    gravity : bool, optional
+        Apply ``mech.gravity`` (MJCF ``<option gravity>``, m/s^2); default True.
+
+    Returns
+    -------
+    StaticsResult
+        ``tau``, ``gravity_terms``, ``external_terms`` (..., n_act) (N m or N), ``cond`` and ``valid``.
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, an array is not
+        real of the stated shape (non-finite values are allowed and masked), a quaternion in ``q`` is
+        zero, the batch shapes do not broadcast, ``wrenches`` is not a mapping of site names,
+        ``weights`` is not ``n_act`` non-negative numbers (not all zero), or ``gravity`` is not a bool.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> st = mb.statics(mech, q, gravity=False)
+    >>> bool(np.abs(st.tau).max() < 1e-12), bool(st.valid)
+    (True, True)
     """
     mech = check_mechanism(mech)
     q = as_array(q, "q", (mech.nq,), finite=False)
@@ -831,7 +913,47 @@ class SiteWrenchResult:
 def site_wrench(
     mech: Mechanism, q: object, site: str, tau: object, *, gravity: bool = True
 ) -> SiteWrenchResult:
-    """Inverse static map: the site wrench produced by actuator forces ``tau (..., n_act)`` at ``q``."""
+    """Inverse static map: the site wrench produced by actuator forces ``tau (..., n_act)`` at ``q``.
+
+    The least-squares solution of ``J^T W = tau - g_a`` at rest (``J`` the :func:`site_jacobian`), with
+    the rotation rows scaled by the characteristic length; see :class:`SiteWrenchResult`.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism, actuated in every degree of freedom.
+    q : array_like, shape (..., nq)
+        Assembled configurations (MuJoCo ``qpos``).
+    site : str
+        Name of the site where the mechanism acts on its environment.
+    tau : array_like, shape (..., n_act)
+        Actuator forces in actuator order (N m or N).  Batch dimensions broadcast with ``q``.
+    gravity : bool, optional
+        Apply ``mech.gravity`` (MJCF ``<option gravity>``, m/s^2); default True.
+
+    Returns
+    -------
+    SiteWrenchResult
+        ``wrench [m; f] (..., 6)`` exerted *by* the mechanism (world axes, moment about the site point;
+        N m, N), ``residual`` (N m or N), ``sigma_min`` (m), ``cond`` and ``valid`` per sample.
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, ``site`` is not a
+        site name, ``q`` or ``tau`` is not real of the stated shape (non-finite values are masked),
+        the batch shapes do not broadcast, or ``gravity`` is not a bool.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> w = mb.site_wrench(mech, q, "coupler_point", [0.0], gravity=False)
+    >>> w.wrench.shape, bool(np.abs(w.wrench).max() < 1e-12)
+    ((6,), True)
+    """
     from ._influence import _influence_flat
 
     mech = check_mechanism(mech)
@@ -944,7 +1066,50 @@ def forward_dynamics(
     """Accelerations under actuator forces ``tau (..., n_act)`` at ``(q, qd_act)`` (idle motions at rest).
 
     The inverse of :func:`inverse_dynamics`: ``forward_dynamics(mech, q, qd, inverse_dynamics(mech, q,
-    qd, qdd).tau).qdd_act == qdd`` wherever both are valid (idle motions decoupled).
+    qd, qdd).tau).qdd_act == qdd`` wherever both are valid (idle motions decoupled).  The rates of the
+    passive coordinates are ``qd = G qd_act``; the closure is a constraint on the tree accelerations
+    (``K qdd = -Kdot qd``, module docstring).
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism, actuated in every degree of freedom.
+    q : array_like, shape (..., nq)
+        Assembled configurations (MuJoCo ``qpos``).
+    qd_act : array_like, shape (..., n_act)
+        Actuated joints' rates in actuator order (rad/s or m/s).
+    tau : array_like, shape (..., n_act)
+        Generalized forces at the actuated joints (N m or N; actuator ``gear`` not applied).
+    wrenches : mapping of str to array_like, shape (..., 6), optional
+        Site name -> wrench ``[m; f]`` applied *to* the mechanism at that site (world axes, moment
+        about the site point; N m, N).  Default None: no external wrench.
+    gravity : bool, optional
+        Apply ``mech.gravity`` (MJCF ``<option gravity>``, m/s^2); default True.
+
+    Returns
+    -------
+    ForwardDynamicsResult
+        ``qdd_act (..., n_act)``, every coordinate's ``qdd`` and ``qd (..., nv)``, and per sample
+        ``cond``, ``admissibility`` and ``valid`` (accelerations NaN where not valid).
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, an array is not
+        real of the stated shape (non-finite values are masked), a quaternion in ``q`` is zero, the
+        batch shapes do not broadcast, ``wrenches`` is not a mapping of site names, or ``gravity`` is
+        not a bool.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> tau = mb.inverse_dynamics(mech, q, [1.0], [0.5]).tau
+    >>> fd = mb.forward_dynamics(mech, q, [1.0], tau)
+    >>> bool(np.allclose(fd.qdd_act, 0.5)), bool(fd.valid)
+    (True, True)
     """
     mech = check_mechanism(mech)
     _fully_actuated(mech)
@@ -988,7 +1153,42 @@ def forward_dynamics(
 # ----------------------------------------------------------------------------- energy
 def energy(mech: Mechanism, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
     """Kinetic and potential energy ``(T, U) (...)`` (J) at ``q (..., nq)`` with every coordinate's rate
-    ``qd (..., nv)`` (``U = -sum m g . c``, zero at the world origin)."""
+    ``qd (..., nv)`` (``U = -sum m g . c``, zero at the world origin).
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (..., nq)
+        Configurations (MuJoCo ``qpos``).
+    qd : array_like, shape (..., nv)
+        Rate of every velocity coordinate (``qvel``; rad/s, m/s), e.g. ``influence(mech, q).G @
+        qd_act``.  Batch dimensions broadcast with ``q``.
+
+    Returns
+    -------
+    T : ndarray, shape (...)
+        Kinetic energy of every body (J).
+    U : ndarray, shape (...)
+        Gravitational potential energy ``-sum m g . c`` with ``g = mech.gravity`` and ``c`` each body's
+        centre of mass in the world frame (J).
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism, ``q`` or ``qd`` is not finite real of the stated shape, or the
+        batch shapes do not broadcast.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> T, U = mb.energy(mech, q, np.zeros(mech.nv))
+    >>> T.shape, float(T)
+    ((), 0.0)
+    """
     mech = check_mechanism(mech)
     q = check_q(mech, q)
     qd = as_array(qd, "qd", (mech.nv,))
@@ -1127,6 +1327,46 @@ def simulate(
     ``SIM_RTOL = 1e-10``, ``SIM_ATOL = 1e-12``) between consecutive output times, projected back onto the
     constraint manifold at each of them.  Batched over initial conditions (one ODE system; a batch
     whose integration fails is retried sample by sample so that one bad sample does not spoil the rest).
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism, actuated in every degree of freedom.
+    q0 : array_like, shape (..., nq)
+        Initial configurations (MuJoCo ``qpos``); projected onto the closure before the start.
+    qd_act0 : array_like, shape (..., n_act)
+        Initial actuated rates (rad/s or m/s); the other coordinates start at ``qd = G qd_act0``.
+    t : array_like, shape (nt,)
+        Strictly increasing output times (s), at least two; the first is the start time.
+    tau : None, array_like of shape (..., n_act), or callable, optional
+        Actuator forces (N m or N): None (default, no actuator force), constant forces, or
+        ``tau(t, q (N, nq), qd (N, nv)) -> (N, n_act)`` over the flattened batch.
+    gravity : bool, optional
+        Apply ``mech.gravity`` (MJCF ``<option gravity>``, m/s^2); default True.
+
+    Returns
+    -------
+    SimulationResult
+        ``t``, the trajectories ``q``, ``qd``, ``q_act``, ``qd_act`` ``(..., nt, ·)``, the energies and
+        actuator work ``(..., nt)`` (J), ``energy_drift``, ``energy_drift_rel``, ``closure`` and
+        ``success``.
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, ``t`` is not at
+        least two increasing times, an array is not real of the stated shape, ``q0`` or ``qd_act0`` is
+        not finite or exceeds ``MAX_STATE``, or ``gravity`` is not a bool.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> sim = mb.simulate(mech, q, [1.0], [0.0, 0.01, 0.02])
+    >>> sim.q.shape, sim.qd_act.shape, bool(sim.success)
+    ((3, 3), (3, 1), True)
     """
     mech = check_mechanism(mech)
     _fully_actuated(mech)
