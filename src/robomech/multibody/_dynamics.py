@@ -460,15 +460,36 @@ def _fully_actuated(mech: Mechanism) -> tuple[int, int]:
 class InverseDynamicsResult:
     """``tau = M_a qdd_act + velocity_terms + gravity_terms + external_terms`` per sample.
 
-    ``tau (..., n_act)`` generalized force at each actuated joint (N m or N, no gear);
-    ``M_a (..., n_act, n_act)`` the mass matrix in actuator space (``G^T M G``; with redundant actuation
-    the distributed ``Pi G^T M G``, ``Pi`` the stated rule's projector); ``velocity_terms``,
-    ``gravity_terms``, ``external_terms (..., n_act)`` (the last: site wrenches).  ``qd``, ``qdd``
-    ``(..., nv)`` every tree coordinate's rate and acceleration.  ``cond`` the condition number of the
-    passive constraint block (grows without bound at a type II / parallel singularity), ``sigma_min``
-    its smallest kept singular value (m), ``admissibility`` the closure error of the prescribed motion
-    (relative), ``valid`` False at a singular configuration, an inadmissible motion or a non-finite
-    input — forces NaN there.
+    The result of :func:`inverse_dynamics`; ``...`` is the broadcast batch shape of its inputs.
+
+    Attributes
+    ----------
+    tau : ndarray, shape (..., n_act)
+        Generalized force at each actuated joint, in actuator order (N m or N; actuator gear not
+        applied).  NaN where not ``valid``.
+    M_a : ndarray, shape (..., n_act, n_act)
+        Mass matrix in actuator space, ``G^T M G`` (kg m^2, kg); with redundant actuation the
+        distributed ``Pi G^T M G``, ``Pi`` the stated rule's projector.
+    velocity_terms : ndarray, shape (..., n_act)
+        Coriolis and centrifugal share of ``tau`` (N m or N).
+    gravity_terms : ndarray, shape (..., n_act)
+        Gravity share of ``tau`` (N m or N).
+    external_terms : ndarray, shape (..., n_act)
+        Share of ``tau`` that balances the site wrenches (N m or N).
+    qd : ndarray, shape (..., nv)
+        Every tree coordinate's rate, ``G qd_act`` (MuJoCo ``qvel`` order; rad/s, m/s).
+    qdd : ndarray, shape (..., nv)
+        Every tree coordinate's acceleration, ``G qdd_act + Gdot qd_act`` (rad/s^2, m/s^2).
+    cond : ndarray, shape (...)
+        Condition number of the passive constraint block (grows without bound at a type II /
+        parallel singularity; above ``SINGULAR_COND`` the sample is not valid).
+    sigma_min : ndarray, shape (...)
+        Smallest kept singular value of the passive constraint block (m).
+    admissibility : ndarray, shape (...)
+        Closure error of the prescribed motion, relative (above ``ADMISSIBLE_RTOL``: not valid).
+    valid : ndarray of bool, shape (...)
+        False at a singular configuration, an inadmissible motion or a non-finite input; the forces
+        are NaN there.
     """
 
     tau: np.ndarray
@@ -824,9 +845,23 @@ def inverse_dynamics(
 # ----------------------------------------------------------------------------- statics
 @dataclass(frozen=True)
 class StaticsResult:
-    """Actuator forces ``tau (..., n_act)`` holding the mechanism at rest against the site wrenches and
-    gravity (virtual work: ``tau = -G^T (J_s^T W - g)``), its parts, the passive-block ``cond`` and
-    ``valid`` (False at a singular configuration; forces NaN there)."""
+    """Actuator forces holding the mechanism at rest against the site wrenches and gravity.
+
+    The result of :func:`statics` (virtual work: ``tau = -G^T (J_s^T W - g)``).
+
+    Attributes
+    ----------
+    tau : ndarray, shape (..., n_act)
+        Actuator forces, ``gravity_terms + external_terms`` (N m or N); NaN where not ``valid``.
+    gravity_terms : ndarray, shape (..., n_act)
+        Share that holds the weight (N m or N).
+    external_terms : ndarray, shape (..., n_act)
+        Share that balances the site wrenches (N m or N).
+    cond : ndarray, shape (...)
+        Condition number of the passive constraint block.
+    valid : ndarray of bool, shape (...)
+        False at a singular configuration or a non-finite input.
+    """
 
     tau: np.ndarray
     gravity_terms: np.ndarray
@@ -894,14 +929,28 @@ def statics(
 
 @dataclass(frozen=True)
 class SiteWrenchResult:
-    """The wrench ``[m; f] (..., 6)`` the mechanism exerts on its environment at a site under actuator
-    forces ``tau`` (at rest): the least-squares solution of ``J^T W = tau - g_a`` (rotation rows scaled by
-    the characteristic length, so that N m and N are compared as N).  ``residual (...)`` the part of
-    ``tau`` the site cannot transmit (N m or N; non-zero when the actuators preload internally or
-    n_act > 6), ``sigma_min`` the smallest singular value of ``J`` (rotation rows times L, m; zero at an
-    output singularity where the site cannot resist some wrench), ``cond``, ``valid``.  With
-    ``n_act < 6`` the wrench components the structure carries (``null(J^T)``) are not determined by the
-    actuators and are returned as zero (minimum norm)."""
+    """The wrench the mechanism exerts on its environment at a site under actuator forces (at rest).
+
+    The result of :func:`site_wrench`: the least-squares solution of ``J^T W = tau - g_a`` (rotation rows
+    scaled by the characteristic length, so that N m and N are compared as N).  With ``n_act < 6`` the
+    wrench components the structure carries (``null(J^T)``) are not determined by the actuators and
+    are returned as zero (minimum norm).
+
+    Attributes
+    ----------
+    wrench : ndarray, shape (..., 6)
+        ``[m; f]`` in world axes, moment about the site point (N m, N); NaN where not ``valid``.
+    residual : ndarray, shape (...)
+        Norm of the part of ``tau`` the site cannot transmit (N m or N; non-zero when the actuators
+        preload internally or n_act > 6).
+    sigma_min : ndarray, shape (...)
+        Smallest singular value of ``J`` with its rotation rows times L (m); zero at an output
+        singularity where the site cannot resist some wrench.
+    cond : ndarray, shape (...)
+        Condition number of that scaled ``J`` (above ``SINGULAR_COND``: not valid).
+    valid : ndarray of bool, shape (...)
+        False at a singular configuration, a non-finite input or a non-finite wrench.
+    """
 
     wrench: np.ndarray
     residual: np.ndarray
@@ -1042,9 +1091,24 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
 
 @dataclass(frozen=True)
 class ForwardDynamicsResult:
-    """``qdd_act (..., n_act)`` and every tree coordinate's ``qdd (..., nv)`` under the actuator forces;
-    ``cond`` the condition number of the constrained mass matrix (large: a nearly massless motion),
-    ``admissibility`` the closure error of the resulting acceleration (relative), ``valid``."""
+    """Accelerations under actuator forces: the result of :func:`forward_dynamics`.
+
+    Attributes
+    ----------
+    qdd_act : ndarray, shape (..., n_act)
+        Actuated joints' accelerations in actuator order (rad/s^2 or m/s^2); NaN where not ``valid``.
+    qdd : ndarray, shape (..., nv)
+        Every tree coordinate's acceleration (MuJoCo ``qvel`` order); NaN where not ``valid``.
+    qd : ndarray, shape (..., nv)
+        Every tree coordinate's rate, ``G qd_act`` (rad/s, m/s).
+    cond : ndarray, shape (...)
+        Condition number of the constrained mass matrix (large: a nearly massless motion).
+    admissibility : ndarray, shape (...)
+        Closure error ``|K qdd + Kdot qd|`` of the resulting acceleration, relative.
+    valid : ndarray of bool, shape (...)
+        False at a singular configuration, a rank-deficient mass matrix, an inadmissible result or a
+        non-finite input.
+    """
 
     qdd_act: np.ndarray
     qdd: np.ndarray
@@ -1230,12 +1294,35 @@ def _qpos_rate(tree, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
 class SimulationResult:
     """A simulated motion, batch ``...`` of initial conditions, ``nt`` output times.
 
-    ``t (nt,)``; ``q (..., nt, nq)``, ``qd (..., nt, nv)``, ``q_act``, ``qd_act (..., nt, n_act)``;
-    ``kinetic``, ``potential`` (J) and ``work`` (the actuators' work since t0, J) ``(..., nt)``;
-    ``energy_drift (...)`` = max over t of ``|T + U - W - (T + U)(t0)|`` (J) and ``energy_drift_rel``
-    the same divided by the largest of ``T``, ``|U - U(t0)|`` and ``W`` over the motion;
-    ``closure (..., nt)`` the closure residual after projection (m); ``success (...)`` the integration
-    succeeded, every state is finite and every closure below CONVERGED_RTOL * L.
+    The result of :func:`simulate`.
+
+    Attributes
+    ----------
+    t : ndarray, shape (nt,)
+        Output times (s).
+    q : ndarray, shape (..., nt, nq)
+        Configurations (MuJoCo ``qpos``) after projection onto the closure; NaN after a failure.
+    qd : ndarray, shape (..., nt, nv)
+        Every tree coordinate's rate (``qvel``; rad/s, m/s).
+    q_act : ndarray, shape (..., nt, n_act)
+        Actuated joints' positions in actuator order (rad or m).
+    qd_act : ndarray, shape (..., nt, n_act)
+        Actuated joints' rates (rad/s or m/s).
+    kinetic : ndarray, shape (..., nt)
+        Kinetic energy ``T`` (J).
+    potential : ndarray, shape (..., nt)
+        Gravitational potential energy ``U`` (J).
+    work : ndarray, shape (..., nt)
+        The actuators' work since ``t[0]`` (J).
+    energy_drift : ndarray, shape (...)
+        Max over t of ``|T + U - W - (T + U)(t0)|`` (J); NaN where not ``success``.
+    energy_drift_rel : ndarray, shape (...)
+        ``energy_drift`` divided by the largest of ``T``, ``|U - U(t0)|`` and ``W`` over the motion.
+    closure : ndarray, shape (..., nt)
+        Closure residual after projection (m).
+    success : ndarray of bool, shape (...)
+        The integration succeeded, every state is finite and every closure is below
+        ``CONVERGED_RTOL * L``.
     """
 
     t: np.ndarray

@@ -50,10 +50,27 @@ PASSIVE_RANK_RTOL = 1e-10
 class Influence:
     """``G (..., nv, n_act)`` and ``dG (..., nv, n_act, n_act)`` with ``dG[..., i, j, k] = ∂G_ij/∂q_act,k``.
 
-    ``passive_rank`` the rank of K_p, ``n_passive`` its columns (``passive_rank < n_passive``: idle
-    or undetermined passive motion); ``consistency`` = max |K G| / L: zero where every input rate is
-    admissible, > 0 with redundant actuation (only admissible ``qd_act`` then have a meaning);
-    ``sigma_min`` the smallest non-zero singular value of K_p (m) and ``cond`` its condition number.
+    The result of :func:`influence`; ``...`` is the batch shape of ``q``.
+
+    Attributes
+    ----------
+    G : ndarray, shape (..., nv, n_act)
+        First-order influence coefficients ``∂qd/∂qd_act`` (rows in MuJoCo ``qvel`` order, columns in
+        actuator order; the actuated rows are the identity).
+    dG : ndarray, shape (..., nv, n_act, n_act), or None
+        Second-order coefficients ``∂G/∂q_act``; None when ``second_order=False``.
+    passive_rank : ndarray of int, shape (...)
+        Rank of the passive constraint block ``K_p`` (``passive_rank < n_passive``: idle or
+        undetermined passive motion).
+    n_passive : int
+        Number of passive velocity coordinates (columns of ``K_p``).
+    consistency : ndarray, shape (...)
+        ``max |K G| / L``: zero where every input rate is admissible, > 0 with redundant actuation
+        (only admissible ``qd_act`` then have a meaning).
+    sigma_min : ndarray, shape (...)
+        Smallest non-zero singular value of ``K_p`` (m).
+    cond : ndarray, shape (...)
+        Condition number of ``K_p``.
     """
 
     G: np.ndarray
