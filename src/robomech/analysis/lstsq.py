@@ -38,6 +38,22 @@ class LstsqResult:
     ``||R||_1 ||R^-1||_1`` (it equals that of A in the 2-norm within a factor n; ``solve(...,
     exact_cond=True)`` gives the 2-norm condition number instead; ``solve_normal_equations`` gives
     the 2-norm one of A from the normal matrix).
+
+    Attributes
+    ----------
+    x : ndarray, shape (..., n)
+        Least-squares solution of ``A x ≈ b`` (minimum norm when rank deficient), in the units of
+        ``b`` over those of ``A``; NaN where not ``ok``.
+    residual_norm : ndarray, shape (...)
+        ``||A x - b||_2`` (units of ``b``); NaN where not ``ok``.
+    rank : ndarray of int, shape (...)
+        Numerical rank of ``A`` (0 where not ``ok``).
+    cond : ndarray, shape (...)
+        Condition number (of R in the 1-norm unless stated above); NaN where not ``ok``.
+    full_rank : ndarray of bool, shape (...)
+        ``ok`` and ``cond`` within :func:`rank_cond_limit` (rank n).
+    ok : ndarray of bool, shape (...)
+        The input was finite and ``x`` and the residual are finite.
     """
 
     x: np.ndarray

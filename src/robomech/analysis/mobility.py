@@ -133,13 +133,55 @@ def constraint_wrenches(twists: ArrayLike, *, tol: float = RANK_RTOL) -> np.ndar
 
 @dataclass(frozen=True)
 class ChainScrews:
+    """The screw systems of one chain (part of :class:`MobilityResult`).
+
+    Attributes
+    ----------
+    twists : ndarray, shape (r_i, 6)
+        Orthonormal basis of the chain's twist system ``[w; v]`` (moments divided by
+        ``length_scale``).
+    constraints : ndarray, shape (c_i, 6)
+        Basis of its constraint wrenches ``[m; f]`` (same scaled coordinates), ``c_i = 6 - r_i``.
+    """
+
     twists: np.ndarray  # (r_i, 6) basis of the chain's twist system
     constraints: np.ndarray  # (c_i, 6) basis of its constraint wrenches [m; f] (scaled coordinates)
 
 
 @dataclass(frozen=True)
 class MobilityResult:
-    """Mobility of the platform and the counts that explain it."""
+    """Mobility of the platform and the counts that explain it: the result of :func:`analyze`.
+
+    Moments and linear parts are in the scaled coordinates (divided by ``length_scale``).
+
+    Attributes
+    ----------
+    dof : int
+        Degrees of freedom of the platform, ``6 - rank`` of the union of the constraints.
+    platform_twists : ndarray, shape (dof, 6)
+        Orthonormal basis of the platform twist system ``[w; v]``.
+    constraint_wrenches : ndarray, shape (6 - dof, 6)
+        Wrenches ``[m; f]`` spanning the union of the chains' constraints.
+    chains : tuple of ChainScrews
+        Each chain's twist and constraint systems, in the order given.
+    rotational_dof : int
+        Rank of the angular parts of the platform twists.
+    translational_dof : int
+        Dimension of the pure translations the platform can make.
+    common_constraints : int
+        ``lambda``: dimension of the constraints shared by every chain.
+    redundant_constraints : int
+        ``nu``: constraints beyond the common ones that repeat others.
+    gruebler_kutzbach : int
+        The spatial count ``6 (n - g - 1) + sum f``.
+    modified_gruebler_kutzbach : int
+        ``(6 - lambda)(n - g - 1) + sum f + nu``.
+    singular : bool
+        The screw-theory DOF disagrees with the modified count: the rank of the constraint system is
+        not locally constant, and ``dof`` holds at this instant only.
+    warning : str
+        Why ``singular`` is set; empty otherwise.
+    """
 
     dof: int
     platform_twists: np.ndarray  # (dof, 6) orthonormal basis of the platform twist system
@@ -159,6 +201,7 @@ class MobilityResult:
     warning: str = ""  # why ``singular`` is set, empty otherwise
 
     def summary(self) -> str:
+        """One line: DOF (rotational / translational), constraint counts, both mobility counts."""
         return (
             f"DOF {self.dof} ({self.rotational_dof}R{self.translational_dof}T); "
             f"constraints {self.constraint_wrenches.shape[0]} independent, "

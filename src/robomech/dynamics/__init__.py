@@ -164,7 +164,22 @@ def kinetic_energy(G: np.ndarray, J: np.ndarray, qd: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class DynamicsTerms:
-    """``tau = M qdd + c + g_terms`` split into its parts (each (..., n); M (..., n, n))."""
+    """``tau = M qdd + c + g_terms`` split into its parts (each (..., n); M (..., n, n)).
+
+    The result of :func:`inverse_dynamics` and :func:`com_inverse_dynamics`; ``n`` the independent
+    coordinates that the Jacobians map.
+
+    Attributes
+    ----------
+    tau : ndarray, shape (..., n)
+        Generalized forces the joints must supply (N m for revolute, N for prismatic coordinates).
+    M : ndarray, shape (..., n, n)
+        Symmetric mass matrix (kg m^2 / kg).
+    velocity_terms : ndarray, shape (..., n)
+        Coriolis and centrifugal forces ``c(q, qd)`` (N m or N).
+    gravity_terms : ndarray, shape (..., n)
+        Gravity forces, including any external wrenches' share (N m or N).
+    """
 
     tau: np.ndarray
     M: np.ndarray

@@ -41,7 +41,19 @@ _BUILTIN = ("_spherical_leg", "_vectored_thrust", "_omnileg")
 
 
 def available_studies() -> dict[str, DesignStudy]:
-    """The built-in design studies by name."""
+    """The built-in design studies by name.
+
+    Returns
+    -------
+    dict of str to DesignStudy
+        Every registered study, keyed by its ``name``.
+
+    Examples
+    --------
+    >>> from robomech.explore import available_studies
+    >>> sorted(available_studies())
+    ['omnileg-synthesis', 'spherical-leg-synthesis', 'vectored-thrust-tolerance']
+    """
     import importlib
 
     out = {}
@@ -52,7 +64,28 @@ def available_studies() -> dict[str, DesignStudy]:
 
 
 def get_study(name: str) -> DesignStudy:
-    """The built-in design study called ``name`` (ValueError listing the valid names otherwise)."""
+    """The built-in design study called ``name`` (ValueError listing the valid names otherwise).
+
+    Parameters
+    ----------
+    name : str
+        A key of :func:`available_studies`.
+
+    Returns
+    -------
+    DesignStudy
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not a str or not a registered study (the message lists the valid names).
+
+    Examples
+    --------
+    >>> from robomech.explore import get_study
+    >>> get_study("omnileg-synthesis").variable_names
+    ('L1', 'L4', 'L5')
+    """
     if not isinstance(name, str):
         raise ValueError(f"Expected name to be a study name (str), got {type(name).__name__}.")
     studies = available_studies()

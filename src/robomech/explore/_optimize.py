@@ -53,7 +53,52 @@ def optimize_nsga2(
     progress: bool = True,
     connect_timeout: float = CONNECT_TIMEOUT,
 ) -> SweepSummary:
-    """NSGA-II over the study's range variables and objectives; all evaluations stored under ``out``."""
+    """NSGA-II over the study's range variables and objectives; all evaluations stored under ``out``.
+
+    Generation g's population is rows ``[g P, (g + 1) P)`` of the store (module docstring); a rerun into
+    the same store reuses every generation already stored.  Pareto-optimal designs:
+    ``pareto_front(open_results(out), study.objectives)``.
+
+    Parameters
+    ----------
+    study : DesignStudy
+        A study with objectives and only range variables.
+    out : str or pathlib.Path
+        Directory of the Zarr store (created if absent).
+    population : int, optional
+        Population size P (>= 4; default 32).
+    generations : int, optional
+        Number of generations (>= 1; default 10).
+    seed : int, optional
+        pymoo's seed and the chunks' (>= 0; default 0).
+    variables : sequence of Variable, optional
+        Overrides or additions to the study's variables (:func:`with_variables`).
+    scheduler : str, optional
+        Address ``tcp://HOST:PORT`` of an existing Dask scheduler; None (default): a LocalCluster.
+    workers : int, optional
+        Worker processes of the LocalCluster (>= 1; default one per core).
+    client : distributed.Client, optional
+        An existing client to use instead (not closed).
+    progress : bool, optional
+        Print a progress line on stderr (default True).
+    connect_timeout : float, optional
+        Seconds to wait for ``scheduler`` (> 0).
+
+    Returns
+    -------
+    SweepSummary
+        One chunk per generation: the generations computed and those taken from the store.
+
+    Raises
+    ------
+    ValueError
+        If an argument is of the wrong type or out of range, or the study has no objectives or a
+        normal (tolerance) variable.
+    StoreMismatch
+        If ``out`` holds something other than this optimisation's store.
+    SchedulerUnreachable
+        If ``scheduler`` is malformed or does not answer.
+    """
     if not isinstance(study, DesignStudy):
         raise ValueError(f"Expected study to be a DesignStudy, got {type(study).__name__}.")
     variables = check_variables(variables)

@@ -46,7 +46,38 @@ def objective_matrix(
 
 
 def pareto_front(metrics: Mapping[str, np.ndarray], objectives: Sequence[Objective]) -> np.ndarray:
-    """Indices (ascending) of the feasible designs no other feasible design dominates."""
+    """Indices (ascending) of the feasible designs no other feasible design dominates.
+
+    Non-dominated sorting by pymoo on the objectives (``max`` ones negated); a design is feasible where
+    every objective value is finite and, if present, ``metrics["design_ok"]`` is True.
+
+    Parameters
+    ----------
+    metrics : mapping of str to ndarray, shape (n,)
+        Per-design metric arrays, e.g. :func:`open_results` of a sweep store.
+    objectives : sequence of Objective
+        Non-empty; each names a metric of shape ``(n,)``.
+
+    Returns
+    -------
+    ndarray of int, shape (k,)
+        Row indices of the Pareto-optimal designs (empty if none is feasible).
+
+    Raises
+    ------
+    ValueError
+        If ``metrics`` is not a mapping, ``objectives`` is not a non-empty sequence of Objective, an
+        objective's metric is missing or not of shape ``(n,)``, the lengths differ, or ``design_ok``
+        is not bool of shape ``(n,)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.explore import Objective, pareto_front
+    >>> m = {"a": np.array([1.0, 2.0, 3.0]), "b": np.array([1.0, 2.0, 0.0])}
+    >>> pareto_front(m, [Objective("a", "min"), Objective("b", "min")])
+    array([0, 2])
+    """
     from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
     F, ok = objective_matrix(metrics, objectives)

@@ -52,11 +52,40 @@ WORKER_ENV = {
 
 
 class SchedulerUnreachable(ValueError):
-    """The ``--scheduler`` address does not answer."""
+    """The ``--scheduler`` address does not answer.
+
+    A ``ValueError`` subclass, raised by :func:`run_sweep` and :func:`optimize_nsga2` when
+    ``scheduler`` is not of the form ``tcp://HOST:PORT`` or no scheduler answers within
+    ``connect_timeout`` seconds.
+    """
 
 
 @dataclass(frozen=True)
 class SweepSummary:
+    """What a run of :func:`run_sweep` or :func:`optimize_nsga2` did.
+
+    Attributes
+    ----------
+    study : str
+        The study's name.
+    out : str
+        Path of the Zarr store.
+    n_designs : int
+        Designs of the whole sweep (stored and computed).
+    n_chunks : int
+        Chunks of the sweep (generations, for NSGA-II).
+    computed_chunks : tuple of int
+        Indices of the chunks this run computed, ascending.
+    skipped_chunks : int
+        Chunks already in the store (resumed).
+    seconds : float
+        Wall time of this run (s).
+    workers : int
+        Dask workers seen by the client (0 when nothing was computed).
+    computed_designs : int
+        Designs computed by this run; ``designs_per_second`` divides it by ``seconds``.
+    """
+
     study: str
     out: str
     n_designs: int
@@ -69,9 +98,11 @@ class SweepSummary:
 
     @property
     def designs_per_second(self) -> float:
+        """``computed_designs / seconds`` (1/s; NaN for a run that took no time)."""
         return self.computed_designs / self.seconds if self.seconds > 0 else float("nan")
 
     def as_dict(self) -> dict[str, Any]:
+        """The summary as plain JSON-ready data (``computed_chunks`` as a count)."""
         return {
             "study": self.study,
             "out": self.out,
@@ -243,6 +274,53 @@ def run_sweep(
     ``variables`` override or extend the study's design variables; ``client`` an existing
     ``distributed.Client`` (else ``scheduler`` / a LocalCluster of ``workers`` processes).  ``on_chunk(k)``
     is called after chunk ``k`` is stored.  Returns which chunks this run computed.
+
+    A store already holding this sweep (same fingerprint: study, variables, designs, sampler, seed,
+    chunk size) is resumed: only the chunks whose ``chunk_done`` flag is false are computed.
+
+    Parameters
+    ----------
+    study : DesignStudy
+        The study (e.g. :func:`get_study`).
+    out : str or pathlib.Path
+        Directory of the Zarr store (created if absent).
+    designs : int, optional
+        Number of designs (>= 1; default ``study.default_designs``; ``grid`` rounds it).
+    seed : int, optional
+        Seed of the design matrix and the per-chunk streams (>= 0; default 0).
+    sampler : str, optional
+        ``"sobol"``, ``"lhs"``, ``"grid"`` or ``"random"`` (default ``study.default_sampler``).
+    chunk_size : int, optional
+        Designs per task (>= 1; default ``study.default_chunk``).
+    variables : sequence of Variable, optional
+        Overrides or additions to the study's variables (:func:`with_variables`).
+    scheduler : str, optional
+        Address ``tcp://HOST:PORT`` of an existing Dask scheduler; None (default): a LocalCluster.
+    workers : int, optional
+        Worker processes of the LocalCluster (>= 1; default one per core).
+    client : distributed.Client, optional
+        An existing client to use instead (not closed).
+    progress : bool, optional
+        Print a progress line on stderr (default True).
+    on_chunk : callable, optional
+        ``on_chunk(k)`` called after chunk ``k`` is stored.
+    connect_timeout : float, optional
+        Seconds to wait for ``scheduler`` (> 0; default ``CONNECT_TIMEOUT``).
+
+    Returns
+    -------
+    SweepSummary
+        Designs and chunks of the sweep, the chunks computed and skipped, wall time and workers.
+
+    Raises
+    ------
+    ValueError
+        If an argument is of the wrong type or out of range (``study`` not a DesignStudy, ``out`` not
+        a path, ...).
+    StoreMismatch
+        If ``out`` holds something other than this sweep's store (nothing is overwritten).
+    SchedulerUnreachable
+        If ``scheduler`` is malformed or does not answer.
     """
     study, X, sampler, chunk = plan(study, designs, seed, sampler, chunk_size, variables)
     out = check_runtime(out, scheduler, workers, progress, connect_timeout, on_chunk)

@@ -27,7 +27,30 @@ UNIT_MARGIN = 1e-12
 
 
 def chunk_seed(seed: int, chunk: int) -> np.random.SeedSequence:
-    """The independent random stream of chunk ``chunk`` of a sweep with ``seed``."""
+    """The independent random stream of chunk ``chunk`` of a sweep with ``seed``.
+
+    Parameters
+    ----------
+    seed : int
+        The sweep's seed, >= 0.
+    chunk : int
+        Chunk index, >= 0.
+
+    Returns
+    -------
+    numpy.random.SeedSequence
+        ``SeedSequence([seed, chunk])``.
+
+    Raises
+    ------
+    ValueError
+        If ``seed`` or ``chunk`` is not a non-negative int.
+
+    Examples
+    --------
+    >>> chunk_seed(0, 3).entropy
+    [0, 3]
+    """
     return np.random.SeedSequence([check_int(seed, "seed", low=0), check_int(chunk, "chunk", low=0)])
 
 
@@ -40,7 +63,38 @@ def grid_size(n: int, d: int) -> int:
 
 
 def design_matrix(variables: Sequence[Variable], n: int, sampler: str, seed: int, chunk: int) -> np.ndarray:
-    """``(n', len(variables))`` design rows; ``n' = n`` except for ``grid`` (``grid_size(n, d)**d``)."""
+    """``(n', len(variables))`` design rows; ``n' = n`` except for ``grid`` (``grid_size(n, d)**d``).
+
+    Parameters
+    ----------
+    variables : sequence of Variable
+        The design variables (at least one): one column each.
+    n : int
+        Number of designs asked for (>= 1).
+    sampler : str
+        ``"sobol"`` (scrambled), ``"lhs"``, ``"grid"`` or ``"random"`` (module docstring).
+    seed : int
+        Seed (>= 0); the design matrix depends only on it (and on ``chunk`` for ``random``).
+    chunk : int
+        Chunk size (>= 1): ``random`` draws each chunk from :func:`chunk_seed`.
+
+    Returns
+    -------
+    ndarray, shape (n', len(variables))
+        Each variable's values in its SI units (uniform over its range, or normal errors).
+
+    Raises
+    ------
+    ValueError
+        If ``variables`` is not a non-empty sequence of Variable, ``sampler`` is unknown, or ``n``,
+        ``seed``, ``chunk`` are not ints in range.
+
+    Examples
+    --------
+    >>> from robomech.explore import Variable, design_matrix
+    >>> design_matrix([Variable("a", 0.0, 1.0)], 4, "grid", 0, 2).ravel().round(3)
+    array([0.   , 0.333, 0.667, 1.   ])
+    """
     variables = check_variables(variables)
     check_choice(sampler, "sampler", SAMPLERS)
     n = check_int(n, "n", low=1)

@@ -44,7 +44,11 @@ FORMAT = "robomech-sweep/1"
 
 
 class StoreMismatch(ValueError):
-    """``--out`` already holds something that is not this sweep's store (nothing is overwritten)."""
+    """``--out`` already holds something that is not this sweep's store (nothing is overwritten).
+
+    A ``ValueError`` subclass, raised by :func:`run_sweep` and :func:`optimize_nsga2` before anything
+    is written when the directory is not empty and not a store with the same sweep fingerprint.
+    """
 
 
 def _check_path(out: object, name: str) -> Path:
@@ -160,7 +164,25 @@ def prepare_store(
 
 
 def open_results(out: Path | str) -> dict[str, Any]:
-    """A sweep store as plain data: ``attrs`` (the robomech attributes) and every array as numpy."""
+    """A sweep store as plain data: ``attrs`` (the robomech attributes) and every array as numpy.
+
+    Parameters
+    ----------
+    out : str or pathlib.Path
+        Directory of a store written by :func:`run_sweep` or :func:`optimize_nsga2`.
+
+    Returns
+    -------
+    dict
+        ``"attrs"``: the store's robomech attributes (study, fingerprint, variables, metrics, units);
+        and one ndarray per array: ``designs (n, n_variables)``, ``design_ok (n,)``, each metric
+        ``(n, *shape)``, ``chunk_done``, ``chunk_seconds``, ``chunk_cpu_seconds (n_chunks,)``.
+
+    Raises
+    ------
+    ValueError
+        If ``out`` is not a path to a directory holding a robomech sweep store.
+    """
     out = _check_path(out, "out")
     if not out.is_dir():
         raise ValueError(f"Expected out to be a sweep store directory, got {str(out)!r} (not a directory).")

@@ -32,6 +32,34 @@ class Variable:
     ``kind="range"``: a field ``name`` of the study's parameter dataclass, sampled in ``[low, high]``
     (SI units).  ``kind="normal"``: a manufacturing error ``name`` of the study, zero mean and standard
     deviation ``sigma`` (SI units).
+
+    Parameters
+    ----------
+    name : str
+        A Python identifier: the parameter field (range) or manufacturing error (normal) it sets.
+    low, high : float, optional
+        The range ``low < high``, both finite (SI units: m, rad, ...); required for ``kind="range"``.
+    unit : str, optional
+        Unit label for reports (e.g. ``"m"``).
+    kind : str, optional
+        ``"range"`` (default, uniform over ``[low, high]``) or ``"normal"``.
+    sigma : float, optional
+        Standard deviation (> 0, SI units); required for ``kind="normal"``.
+    description : str, optional
+        Free text for reports.
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not an identifier, ``kind`` is unknown, the range is not finite with
+        ``low < high`` (range), or ``sigma`` is not positive (normal).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> v = Variable("L1", 0.1, 0.2, unit="m")
+    >>> v.from_unit(np.array([0.0, 0.5, 1.0]))
+    array([0.1 , 0.15, 0.2 ])
     """
 
     name: str
@@ -76,6 +104,7 @@ class Variable:
         return self.sigma * norm.ppf(u)
 
     def as_dict(self) -> dict[str, Any]:
+        """The variable as plain JSON-ready data (``low``/``high`` or ``sigma`` by kind)."""
         d: dict[str, Any] = {
             "name": self.name,
             "kind": self.kind,
@@ -91,7 +120,27 @@ class Variable:
 
 @dataclass(frozen=True)
 class Metric:
-    """One per-design output: ``shape`` is the trailing shape of its array (() for a scalar)."""
+    """One per-design output: ``shape`` is the trailing shape of its array (() for a scalar).
+
+    Parameters
+    ----------
+    name : str
+        A Python identifier, unique in the study and none of the store's reserved names.
+    unit : str
+        Unit label for reports (e.g. ``"m"``, ``"N m"``, ``""`` for dimensionless).
+    description : str
+        Free text for reports.
+    shape : tuple of int, optional
+        Trailing shape of the per-design value (each entry >= 1); default ``()``, a scalar.
+    dtype : str, optional
+        ``"float64"`` (default) or ``"bool"``.
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not an identifier, ``unit`` / ``description`` are not str, ``shape`` is not a
+        tuple of positive ints, or ``dtype`` is unknown.
+    """
 
     name: str
     unit: str
@@ -113,7 +162,20 @@ class Metric:
 
 @dataclass(frozen=True)
 class Objective:
-    """A metric to optimise: ``sense`` is ``"max"`` or ``"min"``."""
+    """A metric to optimise: ``sense`` is ``"max"`` or ``"min"``.
+
+    Parameters
+    ----------
+    metric : str
+        Name of a scalar metric of the study.
+    sense : str
+        ``"max"`` or ``"min"``.
+
+    Raises
+    ------
+    ValueError
+        If ``metric`` is not a str or ``sense`` is neither ``"max"`` nor ``"min"``.
+    """
 
     metric: str
     sense: str
@@ -138,6 +200,50 @@ class DesignStudy:
     ``parameters`` the study's fixed settings (pose grids, motions), stored in the results;
     ``poses_per_design`` the number of pose evaluations one design costs (for throughput figures);
     ``default_sampler`` / ``default_chunk`` the sampling method and chunk size (designs per task).
+
+    Parameters
+    ----------
+    name : str
+        Registry name (e.g. ``"omnileg-synthesis"``).
+    title : str
+        Human-readable title.
+    mechanism : str
+        The mechanism subpackage it studies.
+    nominal : callable
+        ``nominal() -> parameter dataclass``: the nominal design.
+    variables : tuple of Variable
+        Default design variables (non-empty).
+    metrics : tuple of Metric
+        What ``evaluate`` returns (non-empty, unique names).
+    evaluate : callable
+        ``evaluate(study, params, rows (n, n_variables), seed) -> {metric name: (n, *shape)}``;
+        ``params`` holds None where the dataclass rejected the design.
+    parameters : mapping, optional
+        Fixed settings (pose grids, motions), stored in the results.
+    objectives : tuple of Objective, optional
+        Pareto / NSGA-II objectives, each naming a metric.
+    poses_per_design : int, optional
+        Pose evaluations one design costs (>= 1; for throughput figures).
+    default_sampler : str, optional
+        ``"sobol"`` (default), ``"lhs"``, ``"grid"`` or ``"random"``.
+    default_chunk : int, optional
+        Designs per Dask task (>= 1).
+    default_designs : int, optional
+        Designs of a sweep when not given (>= 1).
+    notes : tuple of str, optional
+        Notes for the report.
+    error_names : tuple of str, optional
+        The names a ``kind="normal"`` variable may take (manufacturing errors).
+    summarize : callable, optional
+        ``summarize(study, results) -> list of tables`` for the report; None: none.
+
+    Raises
+    ------
+    ValueError
+        If a text field is not a str, a callable field is not callable, ``variables`` / ``metrics`` /
+        ``objectives`` are not tuples of their class (or empty, or with duplicate or reserved metric
+        names, or an objective names no metric), an int field is below 1, the sampler is unknown, or
+        ``parameters`` is not a mapping.
     """
 
     name: str
@@ -197,9 +303,11 @@ class DesignStudy:
 
     @property
     def variable_names(self) -> tuple[str, ...]:
+        """Names of the design variables, in order (the columns of the design matrix)."""
         return tuple(v.name for v in self.variables)
 
     def parameter_fields(self) -> tuple[str, ...]:
+        """Field names of the nominal parameter dataclass (what a range variable may name)."""
         return tuple(f.name for f in dataclasses.fields(self.nominal()))
 
     def designs_to_params(self, rows: np.ndarray) -> list[Any]:
@@ -247,6 +355,7 @@ class DesignStudy:
         return res
 
     def describe(self) -> dict[str, Any]:
+        """The study as plain JSON-ready data (stored in a sweep's attributes)."""
         return {
             "study": self.name,
             "title": self.title,
@@ -280,6 +389,32 @@ def with_variables(study: DesignStudy, variables: Sequence[Variable]) -> DesignS
     A ``range`` variable must name a field of the study's parameter dataclass; a ``normal`` variable must
     name one of the study's manufacturing errors.  An override of an existing variable keeps its unit
     and description when the override gives none.
+
+    Parameters
+    ----------
+    study : DesignStudy
+        The study to modify (unchanged: studies are frozen).
+    variables : sequence of Variable
+        Replacements (same name) or additions.
+
+    Returns
+    -------
+    DesignStudy
+        A copy with the new variables, existing ones in their order, new ones appended.
+
+    Raises
+    ------
+    ValueError
+        If ``study`` is not a DesignStudy, ``variables`` is not a sequence of Variable, a range
+        variable names no parameter field (or names an error), a normal variable names no error, or an
+        override changes a variable's kind.
+
+    Examples
+    --------
+    >>> from robomech.explore import Variable, get_study, with_variables
+    >>> study = get_study("omnileg-synthesis")
+    >>> with_variables(study, [Variable("L3", 0.05, 0.1, unit="m")]).variable_names
+    ('L1', 'L4', 'L5', 'L3')
     """
     if not isinstance(study, DesignStudy):
         raise ValueError(f"Expected study to be a DesignStudy, got {type(study).__name__}.")

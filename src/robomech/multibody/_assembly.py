@@ -157,9 +157,18 @@ def solve_closure(
 class FKResult:
     """Forward kinematics per sample (batch shape ``...`` of ``q_act``).
 
-    ``q (..., nq)`` the assembled configuration (MuJoCo qpos; NaN where the input was not finite);
-    ``residual (...)`` the largest closure row (m); ``converged`` = residual <= CONVERGED_RTOL * L;
-    ``iterations`` the LM iterations used.
+    The result of :func:`forward_kinematics`.
+
+    Attributes
+    ----------
+    q : ndarray, shape (..., nq)
+        The assembled configuration (MuJoCo ``qpos``; NaN where the input was not finite).
+    residual : ndarray, shape (...)
+        The largest closure row (m).
+    converged : ndarray of bool, shape (...)
+        ``residual <= CONVERGED_RTOL * L``.
+    iterations : ndarray of int, shape (...)
+        The Levenberg-Marquardt iterations used.
     """
 
     q: np.ndarray
@@ -172,9 +181,22 @@ class FKResult:
 class IKResult:
     """Inverse kinematics per sample (batch shape ``...`` of ``T_target``).
 
-    ``q (..., nq)``, ``q_act (..., n_act)``; ``residual`` the largest closure row (m);
-    ``pose_error`` the weighted pose error left (rotation times L, m); ``converged`` both below
-    CONVERGED_RTOL * L.
+    The result of :func:`inverse_kinematics`.
+
+    Attributes
+    ----------
+    q : ndarray, shape (..., nq)
+        The configuration found (MuJoCo ``qpos``).
+    q_act : ndarray, shape (..., n_act)
+        Its actuated joints' entries, in actuator order (rad or m).
+    residual : ndarray, shape (...)
+        The largest closure row (m).
+    pose_error : ndarray, shape (...)
+        The weighted site pose error left (rotation times L, m).
+    converged : ndarray of bool, shape (...)
+        ``residual`` and ``pose_error`` both below ``CONVERGED_RTOL * L``.
+    iterations : ndarray of int, shape (...)
+        The Levenberg-Marquardt iterations used.
     """
 
     q: np.ndarray

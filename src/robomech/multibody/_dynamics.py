@@ -460,15 +460,36 @@ def _fully_actuated(mech: Mechanism) -> tuple[int, int]:
 class InverseDynamicsResult:
     """``tau = M_a qdd_act + velocity_terms + gravity_terms + external_terms`` per sample.
 
-    ``tau (..., n_act)`` generalized force at each actuated joint (N m or N, no gear);
-    ``M_a (..., n_act, n_act)`` the mass matrix in actuator space (``G^T M G``; with redundant actuation
-    the distributed ``Pi G^T M G``, ``Pi`` the stated rule's projector); ``velocity_terms``,
-    ``gravity_terms``, ``external_terms (..., n_act)`` (the last: site wrenches).  ``qd``, ``qdd``
-    ``(..., nv)`` every tree coordinate's rate and acceleration.  ``cond`` the condition number of the
-    passive constraint block (grows without bound at a type II / parallel singularity), ``sigma_min``
-    its smallest kept singular value (m), ``admissibility`` the closure error of the prescribed motion
-    (relative), ``valid`` False at a singular configuration, an inadmissible motion or a non-finite
-    input — forces NaN there.
+    The result of :func:`inverse_dynamics`; ``...`` is the broadcast batch shape of its inputs.
+
+    Attributes
+    ----------
+    tau : ndarray, shape (..., n_act)
+        Generalized force at each actuated joint, in actuator order (N m or N; actuator gear not
+        applied).  NaN where not ``valid``.
+    M_a : ndarray, shape (..., n_act, n_act)
+        Mass matrix in actuator space, ``G^T M G`` (kg m^2, kg); with redundant actuation the
+        distributed ``Pi G^T M G``, ``Pi`` the stated rule's projector.
+    velocity_terms : ndarray, shape (..., n_act)
+        Coriolis and centrifugal share of ``tau`` (N m or N).
+    gravity_terms : ndarray, shape (..., n_act)
+        Gravity share of ``tau`` (N m or N).
+    external_terms : ndarray, shape (..., n_act)
+        Share of ``tau`` that balances the site wrenches (N m or N).
+    qd : ndarray, shape (..., nv)
+        Every tree coordinate's rate, ``G qd_act`` (MuJoCo ``qvel`` order; rad/s, m/s).
+    qdd : ndarray, shape (..., nv)
+        Every tree coordinate's acceleration, ``G qdd_act + Gdot qd_act`` (rad/s^2, m/s^2).
+    cond : ndarray, shape (...)
+        Condition number of the passive constraint block (grows without bound at a type II /
+        parallel singularity; above ``SINGULAR_COND`` the sample is not valid).
+    sigma_min : ndarray, shape (...)
+        Smallest kept singular value of the passive constraint block (m).
+    admissibility : ndarray, shape (...)
+        Closure error of the prescribed motion, relative (above ``ADMISSIBLE_RTOL``: not valid).
+    valid : ndarray of bool, shape (...)
+        False at a singular configuration, an inadmissible motion or a non-finite input; the forces
+        are NaN there.
     """
 
     tau: np.ndarray
@@ -753,6 +774,50 @@ def inverse_dynamics(
     redundant-actuation rule (module docstring; default minimum norm).  Actuator ``gear`` is not
     applied: ``tau`` is the generalized force at each actuated joint.  Batched over any leading shape;
     non-finite samples and singular configurations give ``valid = False`` and NaN forces.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism, actuated in every degree of freedom.
+    q : array_like, shape (..., nq)
+        Assembled configurations (MuJoCo ``qpos``).
+    qd_act : array_like, shape (..., n_act)
+        Actuated joints' rates in actuator order (rad/s or m/s); must be admissible (with redundant
+        actuation, in the consistent subspace), else ``valid`` is False.
+    qdd_act : array_like, shape (..., n_act)
+        Actuated joints' accelerations (rad/s^2 or m/s^2).
+    wrenches : mapping of str to array_like, shape (..., 6), optional
+        Site name -> wrench ``[m; f]`` applied *to* the mechanism at that site (world axes, moment
+        about the site point; N m, N).  Default None: no external wrench.
+    weights : array_like, shape (n_act,), optional
+        Redundant-actuation rule: minimise ``sum tau_i^2 / w_i`` (``w_i = 0``: actuator i carries
+        nothing).  Default None: minimum-norm forces.  Irrelevant without redundant actuation.
+    gravity : bool, optional
+        Apply ``mech.gravity`` (MJCF ``<option gravity>``, m/s^2); default True.
+
+    Returns
+    -------
+    InverseDynamicsResult
+        ``tau``, ``M_a``, ``velocity_terms``, ``gravity_terms``, ``external_terms``, every coordinate's
+        ``qd`` and ``qdd``, the per-sample ``cond``, ``sigma_min``, ``admissibility`` and ``valid``.
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, an array is not
+        real of the stated shape (non-finite values are allowed and masked), a quaternion in ``q`` is
+        zero, the batch shapes do not broadcast, ``wrenches`` is not a mapping of site names,
+        ``weights`` is not ``n_act`` non-negative numbers (not all zero), or ``gravity`` is not a bool.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> r = mb.inverse_dynamics(mech, q, [1.0], [0.5])
+    >>> r.tau.shape, r.M_a.shape, bool(r.valid)
+    ((1,), (1, 1), True)
     """
     mech = check_mechanism(mech)
     _fully_actuated(mech)
@@ -780,9 +845,23 @@ def inverse_dynamics(
 # ----------------------------------------------------------------------------- statics
 @dataclass(frozen=True)
 class StaticsResult:
-    """Actuator forces ``tau (..., n_act)`` holding the mechanism at rest against the site wrenches and
-    gravity (virtual work: ``tau = -G^T (J_s^T W - g)``), its parts, the passive-block ``cond`` and
-    ``valid`` (False at a singular configuration; forces NaN there)."""
+    """Actuator forces holding the mechanism at rest against the site wrenches and gravity.
+
+    The result of :func:`statics` (virtual work: ``tau = -G^T (J_s^T W - g)``).
+
+    Attributes
+    ----------
+    tau : ndarray, shape (..., n_act)
+        Actuator forces, ``gravity_terms + external_terms`` (N m or N); NaN where not ``valid``.
+    gravity_terms : ndarray, shape (..., n_act)
+        Share that holds the weight (N m or N).
+    external_terms : ndarray, shape (..., n_act)
+        Share that balances the site wrenches (N m or N).
+    cond : ndarray, shape (...)
+        Condition number of the passive constraint block.
+    valid : ndarray of bool, shape (...)
+        False at a singular configuration or a non-finite input.
+    """
 
     tau: np.ndarray
     gravity_terms: np.ndarray
@@ -801,7 +880,45 @@ def statics(
 ) -> StaticsResult:
     """Actuator forces balancing ``wrenches`` (applied to the mechanism at sites) and gravity at rest.
 
-    The same virtual-work projection as :func:`inverse_dynamics` at ``qd = qdd = 0``.
+    The same virtual-work projection as :func:`inverse_dynamics` at ``qd = qdd = 0``:
+    ``tau = -G^T (J_s^T W - g)``.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism, actuated in every degree of freedom.
+    q : array_like, shape (..., nq)
+        Assembled configurations (MuJoCo ``qpos``).
+    wrenches : mapping of str to array_like, shape (..., 6), optional
+        Site name -> wrench ``[m; f]`` applied *to* the mechanism at that site (world axes, moment
+        about the site point; N m, N).  Default None: no external wrench.
+    weights : array_like, shape (n_act,), optional
+        Redundant-actuation rule, as in :func:`inverse_dynamics` (default None: minimum norm).
+    gravity : bool, optional
+        Apply ``mech.gravity`` (MJCF ``<option gravity>``, m/s^2); default True.
+
+    Returns
+    -------
+    StaticsResult
+        ``tau``, ``gravity_terms``, ``external_terms`` (..., n_act) (N m or N), ``cond`` and ``valid``.
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, an array is not
+        real of the stated shape (non-finite values are allowed and masked), a quaternion in ``q`` is
+        zero, the batch shapes do not broadcast, ``wrenches`` is not a mapping of site names,
+        ``weights`` is not ``n_act`` non-negative numbers (not all zero), or ``gravity`` is not a bool.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> st = mb.statics(mech, q, gravity=False)
+    >>> bool(np.abs(st.tau).max() < 1e-12), bool(st.valid)
+    (True, True)
     """
     mech = check_mechanism(mech)
     q = as_array(q, "q", (mech.nq,), finite=False)
@@ -812,14 +929,28 @@ def statics(
 
 @dataclass(frozen=True)
 class SiteWrenchResult:
-    """The wrench ``[m; f] (..., 6)`` the mechanism exerts on its environment at a site under actuator
-    forces ``tau`` (at rest): the least-squares solution of ``J^T W = tau - g_a`` (rotation rows scaled by
-    the characteristic length, so that N m and N are compared as N).  ``residual (...)`` the part of
-    ``tau`` the site cannot transmit (N m or N; non-zero when the actuators preload internally or
-    n_act > 6), ``sigma_min`` the smallest singular value of ``J`` (rotation rows times L, m; zero at an
-    output singularity where the site cannot resist some wrench), ``cond``, ``valid``.  With
-    ``n_act < 6`` the wrench components the structure carries (``null(J^T)``) are not determined by the
-    actuators and are returned as zero (minimum norm)."""
+    """The wrench the mechanism exerts on its environment at a site under actuator forces (at rest).
+
+    The result of :func:`site_wrench`: the least-squares solution of ``J^T W = tau - g_a`` (rotation rows
+    scaled by the characteristic length, so that N m and N are compared as N).  With ``n_act < 6`` the
+    wrench components the structure carries (``null(J^T)``) are not determined by the actuators and
+    are returned as zero (minimum norm).
+
+    Attributes
+    ----------
+    wrench : ndarray, shape (..., 6)
+        ``[m; f]`` in world axes, moment about the site point (N m, N); NaN where not ``valid``.
+    residual : ndarray, shape (...)
+        Norm of the part of ``tau`` the site cannot transmit (N m or N; non-zero when the actuators
+        preload internally or n_act > 6).
+    sigma_min : ndarray, shape (...)
+        Smallest singular value of ``J`` with its rotation rows times L (m); zero at an output
+        singularity where the site cannot resist some wrench.
+    cond : ndarray, shape (...)
+        Condition number of that scaled ``J`` (above ``SINGULAR_COND``: not valid).
+    valid : ndarray of bool, shape (...)
+        False at a singular configuration, a non-finite input or a non-finite wrench.
+    """
 
     wrench: np.ndarray
     residual: np.ndarray
@@ -831,7 +962,47 @@ class SiteWrenchResult:
 def site_wrench(
     mech: Mechanism, q: object, site: str, tau: object, *, gravity: bool = True
 ) -> SiteWrenchResult:
-    """Inverse static map: the site wrench produced by actuator forces ``tau (..., n_act)`` at ``q``."""
+    """Inverse static map: the site wrench produced by actuator forces ``tau (..., n_act)`` at ``q``.
+
+    The least-squares solution of ``J^T W = tau - g_a`` at rest (``J`` the :func:`site_jacobian`), with
+    the rotation rows scaled by the characteristic length; see :class:`SiteWrenchResult`.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism, actuated in every degree of freedom.
+    q : array_like, shape (..., nq)
+        Assembled configurations (MuJoCo ``qpos``).
+    site : str
+        Name of the site where the mechanism acts on its environment.
+    tau : array_like, shape (..., n_act)
+        Actuator forces in actuator order (N m or N).  Batch dimensions broadcast with ``q``.
+    gravity : bool, optional
+        Apply ``mech.gravity`` (MJCF ``<option gravity>``, m/s^2); default True.
+
+    Returns
+    -------
+    SiteWrenchResult
+        ``wrench [m; f] (..., 6)`` exerted *by* the mechanism (world axes, moment about the site point;
+        N m, N), ``residual`` (N m or N), ``sigma_min`` (m), ``cond`` and ``valid`` per sample.
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, ``site`` is not a
+        site name, ``q`` or ``tau`` is not real of the stated shape (non-finite values are masked),
+        the batch shapes do not broadcast, or ``gravity`` is not a bool.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> w = mb.site_wrench(mech, q, "coupler_point", [0.0], gravity=False)
+    >>> w.wrench.shape, bool(np.abs(w.wrench).max() < 1e-12)
+    ((6,), True)
+    """
     from ._influence import _influence_flat
 
     mech = check_mechanism(mech)
@@ -920,9 +1091,24 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
 
 @dataclass(frozen=True)
 class ForwardDynamicsResult:
-    """``qdd_act (..., n_act)`` and every tree coordinate's ``qdd (..., nv)`` under the actuator forces;
-    ``cond`` the condition number of the constrained mass matrix (large: a nearly massless motion),
-    ``admissibility`` the closure error of the resulting acceleration (relative), ``valid``."""
+    """Accelerations under actuator forces: the result of :func:`forward_dynamics`.
+
+    Attributes
+    ----------
+    qdd_act : ndarray, shape (..., n_act)
+        Actuated joints' accelerations in actuator order (rad/s^2 or m/s^2); NaN where not ``valid``.
+    qdd : ndarray, shape (..., nv)
+        Every tree coordinate's acceleration (MuJoCo ``qvel`` order); NaN where not ``valid``.
+    qd : ndarray, shape (..., nv)
+        Every tree coordinate's rate, ``G qd_act`` (rad/s, m/s).
+    cond : ndarray, shape (...)
+        Condition number of the constrained mass matrix (large: a nearly massless motion).
+    admissibility : ndarray, shape (...)
+        Closure error ``|K qdd + Kdot qd|`` of the resulting acceleration, relative.
+    valid : ndarray of bool, shape (...)
+        False at a singular configuration, a rank-deficient mass matrix, an inadmissible result or a
+        non-finite input.
+    """
 
     qdd_act: np.ndarray
     qdd: np.ndarray
@@ -944,7 +1130,50 @@ def forward_dynamics(
     """Accelerations under actuator forces ``tau (..., n_act)`` at ``(q, qd_act)`` (idle motions at rest).
 
     The inverse of :func:`inverse_dynamics`: ``forward_dynamics(mech, q, qd, inverse_dynamics(mech, q,
-    qd, qdd).tau).qdd_act == qdd`` wherever both are valid (idle motions decoupled).
+    qd, qdd).tau).qdd_act == qdd`` wherever both are valid (idle motions decoupled).  The rates of the
+    passive coordinates are ``qd = G qd_act``; the closure is a constraint on the tree accelerations
+    (``K qdd = -Kdot qd``, module docstring).
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism, actuated in every degree of freedom.
+    q : array_like, shape (..., nq)
+        Assembled configurations (MuJoCo ``qpos``).
+    qd_act : array_like, shape (..., n_act)
+        Actuated joints' rates in actuator order (rad/s or m/s).
+    tau : array_like, shape (..., n_act)
+        Generalized forces at the actuated joints (N m or N; actuator ``gear`` not applied).
+    wrenches : mapping of str to array_like, shape (..., 6), optional
+        Site name -> wrench ``[m; f]`` applied *to* the mechanism at that site (world axes, moment
+        about the site point; N m, N).  Default None: no external wrench.
+    gravity : bool, optional
+        Apply ``mech.gravity`` (MJCF ``<option gravity>``, m/s^2); default True.
+
+    Returns
+    -------
+    ForwardDynamicsResult
+        ``qdd_act (..., n_act)``, every coordinate's ``qdd`` and ``qd (..., nv)``, and per sample
+        ``cond``, ``admissibility`` and ``valid`` (accelerations NaN where not valid).
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, an array is not
+        real of the stated shape (non-finite values are masked), a quaternion in ``q`` is zero, the
+        batch shapes do not broadcast, ``wrenches`` is not a mapping of site names, or ``gravity`` is
+        not a bool.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> tau = mb.inverse_dynamics(mech, q, [1.0], [0.5]).tau
+    >>> fd = mb.forward_dynamics(mech, q, [1.0], tau)
+    >>> bool(np.allclose(fd.qdd_act, 0.5)), bool(fd.valid)
+    (True, True)
     """
     mech = check_mechanism(mech)
     _fully_actuated(mech)
@@ -988,7 +1217,42 @@ def forward_dynamics(
 # ----------------------------------------------------------------------------- energy
 def energy(mech: Mechanism, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
     """Kinetic and potential energy ``(T, U) (...)`` (J) at ``q (..., nq)`` with every coordinate's rate
-    ``qd (..., nv)`` (``U = -sum m g . c``, zero at the world origin)."""
+    ``qd (..., nv)`` (``U = -sum m g . c``, zero at the world origin).
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (..., nq)
+        Configurations (MuJoCo ``qpos``).
+    qd : array_like, shape (..., nv)
+        Rate of every velocity coordinate (``qvel``; rad/s, m/s), e.g. ``influence(mech, q).G @
+        qd_act``.  Batch dimensions broadcast with ``q``.
+
+    Returns
+    -------
+    T : ndarray, shape (...)
+        Kinetic energy of every body (J).
+    U : ndarray, shape (...)
+        Gravitational potential energy ``-sum m g . c`` with ``g = mech.gravity`` and ``c`` each body's
+        centre of mass in the world frame (J).
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism, ``q`` or ``qd`` is not finite real of the stated shape, or the
+        batch shapes do not broadcast.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> T, U = mb.energy(mech, q, np.zeros(mech.nv))
+    >>> T.shape, float(T)
+    ((), 0.0)
+    """
     mech = check_mechanism(mech)
     q = check_q(mech, q)
     qd = as_array(qd, "qd", (mech.nv,))
@@ -1030,12 +1294,35 @@ def _qpos_rate(tree, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
 class SimulationResult:
     """A simulated motion, batch ``...`` of initial conditions, ``nt`` output times.
 
-    ``t (nt,)``; ``q (..., nt, nq)``, ``qd (..., nt, nv)``, ``q_act``, ``qd_act (..., nt, n_act)``;
-    ``kinetic``, ``potential`` (J) and ``work`` (the actuators' work since t0, J) ``(..., nt)``;
-    ``energy_drift (...)`` = max over t of ``|T + U - W - (T + U)(t0)|`` (J) and ``energy_drift_rel``
-    the same divided by the largest of ``T``, ``|U - U(t0)|`` and ``W`` over the motion;
-    ``closure (..., nt)`` the closure residual after projection (m); ``success (...)`` the integration
-    succeeded, every state is finite and every closure below CONVERGED_RTOL * L.
+    The result of :func:`simulate`.
+
+    Attributes
+    ----------
+    t : ndarray, shape (nt,)
+        Output times (s).
+    q : ndarray, shape (..., nt, nq)
+        Configurations (MuJoCo ``qpos``) after projection onto the closure; NaN after a failure.
+    qd : ndarray, shape (..., nt, nv)
+        Every tree coordinate's rate (``qvel``; rad/s, m/s).
+    q_act : ndarray, shape (..., nt, n_act)
+        Actuated joints' positions in actuator order (rad or m).
+    qd_act : ndarray, shape (..., nt, n_act)
+        Actuated joints' rates (rad/s or m/s).
+    kinetic : ndarray, shape (..., nt)
+        Kinetic energy ``T`` (J).
+    potential : ndarray, shape (..., nt)
+        Gravitational potential energy ``U`` (J).
+    work : ndarray, shape (..., nt)
+        The actuators' work since ``t[0]`` (J).
+    energy_drift : ndarray, shape (...)
+        Max over t of ``|T + U - W - (T + U)(t0)|`` (J); NaN where not ``success``.
+    energy_drift_rel : ndarray, shape (...)
+        ``energy_drift`` divided by the largest of ``T``, ``|U - U(t0)|`` and ``W`` over the motion.
+    closure : ndarray, shape (..., nt)
+        Closure residual after projection (m).
+    success : ndarray of bool, shape (...)
+        The integration succeeded, every state is finite and every closure is below
+        ``CONVERGED_RTOL * L``.
     """
 
     t: np.ndarray
@@ -1127,6 +1414,46 @@ def simulate(
     ``SIM_RTOL = 1e-10``, ``SIM_ATOL = 1e-12``) between consecutive output times, projected back onto the
     constraint manifold at each of them.  Batched over initial conditions (one ODE system; a batch
     whose integration fails is retried sample by sample so that one bad sample does not spoil the rest).
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism, actuated in every degree of freedom.
+    q0 : array_like, shape (..., nq)
+        Initial configurations (MuJoCo ``qpos``); projected onto the closure before the start.
+    qd_act0 : array_like, shape (..., n_act)
+        Initial actuated rates (rad/s or m/s); the other coordinates start at ``qd = G qd_act0``.
+    t : array_like, shape (nt,)
+        Strictly increasing output times (s), at least two; the first is the start time.
+    tau : None, array_like of shape (..., n_act), or callable, optional
+        Actuator forces (N m or N): None (default, no actuator force), constant forces, or
+        ``tau(t, q (N, nq), qd (N, nv)) -> (N, n_act)`` over the flattened batch.
+    gravity : bool, optional
+        Apply ``mech.gravity`` (MJCF ``<option gravity>``, m/s^2); default True.
+
+    Returns
+    -------
+    SimulationResult
+        ``t``, the trajectories ``q``, ``qd``, ``q_act``, ``qd_act`` ``(..., nt, ·)``, the energies and
+        actuator work ``(..., nt)`` (J), ``energy_drift``, ``energy_drift_rel``, ``closure`` and
+        ``success``.
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, ``t`` is not at
+        least two increasing times, an array is not real of the stated shape, ``q0`` or ``qd_act0`` is
+        not finite or exceeds ``MAX_STATE``, or ``gravity`` is not a bool.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> sim = mb.simulate(mech, q, [1.0], [0.0, 0.01, 0.02])
+    >>> sim.q.shape, sim.qd_act.shape, bool(sim.success)
+    ((3, 3), (3, 1), True)
     """
     mech = check_mechanism(mech)
     _fully_actuated(mech)

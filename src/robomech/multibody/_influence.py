@@ -50,10 +50,27 @@ PASSIVE_RANK_RTOL = 1e-10
 class Influence:
     """``G (..., nv, n_act)`` and ``dG (..., nv, n_act, n_act)`` with ``dG[..., i, j, k] = ∂G_ij/∂q_act,k``.
 
-    ``passive_rank`` the rank of K_p, ``n_passive`` its columns (``passive_rank < n_passive``: idle
-    or undetermined passive motion); ``consistency`` = max |K G| / L: zero where every input rate is
-    admissible, > 0 with redundant actuation (only admissible ``qd_act`` then have a meaning);
-    ``sigma_min`` the smallest non-zero singular value of K_p (m) and ``cond`` its condition number.
+    The result of :func:`influence`; ``...`` is the batch shape of ``q``.
+
+    Attributes
+    ----------
+    G : ndarray, shape (..., nv, n_act)
+        First-order influence coefficients ``∂qd/∂qd_act`` (rows in MuJoCo ``qvel`` order, columns in
+        actuator order; the actuated rows are the identity).
+    dG : ndarray, shape (..., nv, n_act, n_act), or None
+        Second-order coefficients ``∂G/∂q_act``; None when ``second_order=False``.
+    passive_rank : ndarray of int, shape (...)
+        Rank of the passive constraint block ``K_p`` (``passive_rank < n_passive``: idle or
+        undetermined passive motion).
+    n_passive : int
+        Number of passive velocity coordinates (columns of ``K_p``).
+    consistency : ndarray, shape (...)
+        ``max |K G| / L``: zero where every input rate is admissible, > 0 with redundant actuation
+        (only admissible ``qd_act`` then have a meaning).
+    sigma_min : ndarray, shape (...)
+        Smallest non-zero singular value of ``K_p`` (m).
+    cond : ndarray, shape (...)
+        Condition number of ``K_p``.
     """
 
     G: np.ndarray
@@ -121,7 +138,40 @@ def influence(mech: Mechanism, q: object, *, second_order: bool = True) -> Influ
     """``G = ∂q/∂q_act`` (velocity coordinates) and ``∂G/∂q_act`` at assembled configurations ``q (..., nq)``.
 
     ``Ġ = einsum("...ijk,...k->...ij", dG, qd_act)`` and ``qdd = G qdd_act + einsum("...ijk,...j,...k->...i",
-    dG, qd_act, qd_act)``.
+    dG, qd_act, qd_act)``.  ``G = [I; -K_p^+ K_a]`` (rows in ``qvel`` order) is the minimum-norm choice
+    where the passive coordinates include idle motions (module docstring); nothing is a finite difference.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (..., nq)
+        Assembled configurations (MuJoCo ``qpos``; e.g. ``forward_kinematics(mech, q_act).q``).  Not
+        checked for closure: at an unassembled ``q`` the coefficients have no meaning.
+    second_order : bool, optional
+        Also compute ``dG`` (default True); False leaves ``Influence.dG`` None and is cheaper.
+
+    Returns
+    -------
+    Influence
+        ``G (..., nv, n_act)`` (rad/rad, m/rad, ... per velocity coordinate and unit input rate),
+        ``dG (..., nv, n_act, n_act)`` or None, and per sample ``passive_rank``, ``consistency``,
+        ``sigma_min`` (m), ``cond``; ``n_passive`` an int.
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism, ``q`` is not finite real of shape ``(..., nq)``, or ``second_order``
+        is not a bool.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> inf = mb.influence(mech, mb.forward_kinematics(mech, np.array([0.2])).q)
+    >>> inf.G.shape, inf.dG.shape, inf.n_passive
+    ((3, 1), (3, 1, 1), 2)
     """
     mech = check_mechanism(mech)
     second_order = check_bool(second_order, "second_order")
@@ -140,7 +190,37 @@ def influence(mech: Mechanism, q: object, *, second_order: bool = True) -> Influ
 
 
 def site_pose(mech: Mechanism, q: object, site: str) -> np.ndarray:
-    """World pose ``T (..., 4, 4)`` of ``site`` at ``q (..., nq)`` (any q: tree kinematics, no closure)."""
+    """World pose ``T (..., 4, 4)`` of ``site`` at ``q (..., nq)`` (any q: tree kinematics, no closure).
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (..., nq)
+        Configurations (MuJoCo ``qpos``, ``[w, x, y, z]`` quaternions for ball/free joints); the
+        closures are not imposed, so an unassembled ``q`` gives the spanning tree's pose.
+    site : str
+        Name of a site of ``mech``.
+
+    Returns
+    -------
+    ndarray, shape (..., 4, 4)
+        ``T_WS``, the site frame in the world frame (translation in m).
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism, ``site`` is not a site name, or ``q`` is not finite real of shape
+        ``(..., nq)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> mb.site_pose(mech, np.zeros((5, mech.nq)), "coupler_point").shape
+    (5, 4, 4)
+    """
     mech = check_mechanism(mech)
     si = _site_index(mech, site)
     qf, batch = _flat(mech, q)
@@ -151,7 +231,41 @@ def site_pose(mech: Mechanism, q: object, site: str) -> np.ndarray:
 
 
 def site_jacobian(mech: Mechanism, q: object, site: str) -> np.ndarray:
-    """``[ω; ṗ] = J qd_act`` for ``site`` at assembled ``q (..., nq)``: ``(..., 6, n_act)`` (mj_jacSite)."""
+    """``[ω; ṗ] = J qd_act`` for ``site`` at assembled ``q (..., nq)``: ``(..., 6, n_act)`` (mj_jacSite).
+
+    ``J = J_f G``: the site's frame Jacobian over every velocity coordinate times the first-order
+    influence coefficients (:func:`influence`), so that ``J`` maps the actuated rates alone.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (..., nq)
+        Assembled configurations (MuJoCo ``qpos``, e.g. ``forward_kinematics(mech, q_act).q``).
+    site : str
+        Name of a site of ``mech``.
+
+    Returns
+    -------
+    ndarray, shape (..., 6, n_act)
+        Rows ``[ω; ṗ]`` in world axes: angular velocity (rad/s) and the velocity of the site point (m/s)
+        per unit rate of each actuated joint (rad/s or m/s), columns in actuator order.
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism, ``site`` is not a site name, or ``q`` is not finite real of shape
+        ``(..., nq)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> mb.site_jacobian(mech, q, "coupler_point").shape
+    (6, 1)
+    """
     mech = check_mechanism(mech)
     si = _site_index(mech, site)
     qf, batch = _flat(mech, q)
@@ -173,7 +287,38 @@ def site_jacobian(mech: Mechanism, q: object, site: str) -> np.ndarray:
 def site_hessian(mech: Mechanism, q: object, site: str) -> np.ndarray:
     """``H[..., i, j, k] = ∂J[..., i, j]/∂q_act,k`` for ``site`` at assembled ``q``: (..., 6, n_act, n_act).
 
-    ``[ω̇; p̈] = J qdd_act + einsum("...ijk,...j,...k->...i", H, qd_act, qd_act)``.
+    ``[ω̇; p̈] = J qdd_act + einsum("...ijk,...j,...k->...i", H, qd_act, qd_act)``.  Exact:
+    ``∂J/∂q_act,k = (dJ_f/dt) G + J_f ∂G/∂q_act,k`` along ``qd = G e_k`` (module docstring).
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (..., nq)
+        Assembled configurations (MuJoCo ``qpos``).
+    site : str
+        Name of a site of ``mech``.
+
+    Returns
+    -------
+    ndarray, shape (..., 6, n_act, n_act)
+        Rows ``[ω; ṗ]`` as in :func:`site_jacobian` (world axes; rad and m per unit input squared);
+        ``(..., 6, 0, 0)`` for a mechanism without actuators.
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism, ``site`` is not a site name, or ``q`` is not finite real of shape
+        ``(..., nq)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> mb.site_hessian(mech, q, "coupler_point").shape
+    (6, 1, 1)
     """
     mech = check_mechanism(mech)
     si = _site_index(mech, site)
@@ -192,7 +337,35 @@ def site_hessian(mech: Mechanism, q: object, site: str) -> np.ndarray:
 
 
 def constraint_residual(mech: Mechanism, q: object) -> np.ndarray:
-    """Closure residual ``(..., m)`` in length units (rotation rows times the characteristic length)."""
+    """Closure residual ``(..., m)`` in length units (rotation rows times the characteristic length).
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (..., nq)
+        Configurations (MuJoCo ``qpos``); any, assembled or not.
+
+    Returns
+    -------
+    ndarray, shape (..., m)
+        One entry per closure constraint row (m rows over all closures), in m; zero where every
+        closure is assembled.
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism or ``q`` is not finite real of shape ``(..., nq)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> bool(np.max(np.abs(mb.constraint_residual(mech, q))) < 1e-9)
+    True
+    """
     from ._constraints import residual
 
     mech = check_mechanism(mech)
@@ -203,7 +376,36 @@ def constraint_residual(mech: Mechanism, q: object) -> np.ndarray:
 
 
 def constraint_jacobian(mech: Mechanism, q: object) -> np.ndarray:
-    """Velocity constraint matrix ``K (..., m, nv)``: admissible ``qd`` (qvel) satisfy ``K qd = 0``."""
+    """Velocity constraint matrix ``K (..., m, nv)``: admissible ``qd`` (qvel) satisfy ``K qd = 0``.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (..., nq)
+        Configurations (MuJoCo ``qpos``), normally assembled.
+
+    Returns
+    -------
+    ndarray, shape (..., m, nv)
+        Rows as in :func:`constraint_residual` (length units), one column per velocity coordinate
+        (MuJoCo ``qvel``; local angular velocity for ball joints).
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism or ``q`` is not finite real of shape ``(..., nq)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> K = mb.constraint_jacobian(mech, q)
+    >>> K.shape, bool(np.allclose(K @ mb.influence(mech, q).G, 0.0))
+    ((3, 3), True)
+    """
     mech = check_mechanism(mech)
     qf, batch = _flat(mech, q)
     st = kinematics(mech.tree, qf)
@@ -212,7 +414,38 @@ def constraint_jacobian(mech: Mechanism, q: object) -> np.ndarray:
 
 
 def constraint_jacobian_rate(mech: Mechanism, q: object, qd: object) -> np.ndarray:
-    """``dK/dt (..., m, nv)`` along ``qd (..., nv)``: ``K qdd + dK/dt qd = 0`` for admissible motions."""
+    """``dK/dt (..., m, nv)`` along ``qd (..., nv)``: ``K qdd + dK/dt qd = 0`` for admissible motions.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (..., nq)
+        Configurations (MuJoCo ``qpos``), normally assembled.
+    qd : array_like, shape (..., nv)
+        Rate of every velocity coordinate (``qvel``; rad/s, m/s).  Batch dimensions of ``q`` and
+        ``qd`` broadcast.
+
+    Returns
+    -------
+    ndarray, shape (..., m, nv)
+        Time derivative of :func:`constraint_jacobian` along the motion ``qd`` (length units per s).
+
+    Raises
+    ------
+    ValueError
+        If ``mech`` is not a Mechanism, ``q`` or ``qd`` is not finite real of the shape above, or their batch
+        shapes do not broadcast.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> mech = mb.gallery.load("four_bar")
+    >>> q = mb.forward_kinematics(mech, np.array([0.2])).q
+    >>> mb.constraint_jacobian_rate(mech, q, np.zeros(mech.nv)).shape
+    (3, 3)
+    """
     mech = check_mechanism(mech)
     q = check_q(mech, q)
     qd = as_array(qd, "qd", (mech.nv,))

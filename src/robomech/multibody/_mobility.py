@@ -50,6 +50,49 @@ _C = {"point": 3, "revolute": 5, "rigid": 6}
 
 @dataclass(frozen=True)
 class MobilityReport:
+    """Mobility of a mechanism at one configuration: the result of :func:`mobility`.
+
+    Attributes
+    ----------
+    dof : int
+        Degrees of freedom: admissible motions that move an output (a site's body, or any body
+        without sites), idle motions excluded.
+    total_dof : int
+        ``nv - rank``: every instantaneous admissible motion, idle motions included.
+    idle_dof : int
+        Motions that move no output with every actuated joint locked (a leg spinning about its axis).
+    locked_dof : int
+        Motions left with every actuated joint locked (idle plus uncontrolled).
+    redundant_constraints : int
+        ``n_equations - rank``: dependent closure equations (a planar loop in space has 3).
+    n_equations : int
+        Sum of the cut joints' constraint counts (point 3, revolute 5, rigid 6, coupling 1).
+    rank : int
+        Rank of the (unit-scaled) constraint Jacobian K.
+    gruebler_kutzbach : int
+        The spatial count ``nv - n_equations``.
+    singular : bool
+        The rank of K changes within ``NEIGHBOUR_STEP`` along some admissible direction.
+    rank_nearby : tuple of int
+        The ranks of K at those neighbouring, re-assembled configurations.
+    n_actuated : int
+        Number of actuated joints.
+    actuation : str
+        ``"exact"`` (n_act = dof), ``"redundant"`` (n_act > dof) or ``"under"`` (n_act < dof).
+    platform : str or None
+        The body whose twist system is analysed (default the body of the first site).
+    platform_dof : int or None
+        Rank of the platform twists over the admissible motions.
+    platform_rotational_dof : int or None
+        Rank of their angular parts.
+    platform_twists : ndarray, shape (platform_dof, 6), or None
+        Orthonormal basis of the platform twists, rows ``[ω; v / L]``.
+    screw_theory : MobilityResult or None
+        :func:`robomech.analysis.mobility.analyze` on the platform's serial legs, if it has them.
+    length : float
+        The characteristic length L (m).
+    """
+
     dof: int
     total_dof: int
     idle_dof: int
@@ -70,6 +113,7 @@ class MobilityReport:
     length: float
 
     def summary(self) -> str:
+        """One line: DOF, idle motions, closure equations, rank, redundancy, actuation, platform."""
         s = (
             f"DOF {self.dof} (+{self.idle_dof} idle); {self.n_equations} closure equations, "
             f"rank {self.rank}, "

@@ -73,6 +73,26 @@ class Joint:
     Velocity coordinates (and the columns of every Jacobian over all coordinates) follow MuJoCo's
     ``qvel``: 1 for hinge and slide, the local angular velocity (3) for a ball, world linear velocity
     of the body origin then local angular velocity (6) for a free joint.
+
+    Parameters
+    ----------
+    name : str
+        Unique, non-empty joint name.
+    type : str, optional
+        One of ``"hinge"`` (default), ``"slide"``, ``"ball"``, ``"free"``.
+    axis : tuple of float, shape (3,), optional
+        Hinge / slide axis in the body frame (normalised on construction); default ``+z``.  Unused
+        for ball and free joints.
+    pos : tuple of float, shape (3,), optional
+        Point of the axis (hinge) or centre (ball) in the body frame (m); default the body origin.
+    ref : float, optional
+        Joint value (rad or m) at which the joint is in its reference pose (MuJoCo ``ref``); default 0.
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is empty, ``type`` is unknown, ``axis`` is not a non-zero 3-vector, or ``pos`` /
+        ``ref`` are not finite reals.
     """
 
     name: str
@@ -100,7 +120,26 @@ class Joint:
 
 @dataclass(frozen=True)
 class Inertial:
-    """Mass, centre of mass ``pos`` and principal inertia ``diaginertia`` in the frame ``quat`` (body)."""
+    """Mass, centre of mass ``pos`` and principal inertia ``diaginertia`` in the frame ``quat`` (body).
+
+    Parameters
+    ----------
+    mass : float
+        Mass (kg), >= 0.
+    pos : tuple of float, shape (3,), optional
+        Centre of mass in the body frame (m); default the body origin.
+    quat : tuple of float, shape (4,), optional
+        Orientation ``[w, x, y, z]`` of the principal axes in the body frame (normalised); default
+        the identity.
+    diaginertia : tuple of float, shape (3,), optional
+        Principal moments of inertia about the centre of mass (kg m^2), each >= 0; default zero (a
+        point mass).
+
+    Raises
+    ------
+    ValueError
+        If ``mass`` or a moment is negative or not finite, or ``quat`` is zero.
+    """
 
     mass: float
     pos: tuple[float, ...] = (0.0, 0.0, 0.0)
@@ -119,7 +158,31 @@ class Inertial:
 
 @dataclass(frozen=True)
 class Body:
-    """A body: its pose ``(pos, quat)`` in ``parent`` ("world" for the base) and its joints, in order."""
+    """A body: its pose ``(pos, quat)`` in ``parent`` ("world" for the base) and its joints, in order.
+
+    Parameters
+    ----------
+    name : str
+        Unique, non-empty body name other than ``"world"``.
+    parent : str, optional
+        Name of the parent body; default ``"world"`` (the fixed base).
+    pos : tuple of float, shape (3,), optional
+        Origin of the body frame in the parent frame at zero joint motion (m).
+    quat : tuple of float, shape (4,), optional
+        Orientation ``[w, x, y, z]`` of the body frame in the parent frame (normalised).
+    joints : tuple of Joint, optional
+        The joints between parent and body, applied in order; empty: welded to the parent.  A free
+        joint must be the only joint of a top-level body.
+    inertial : Inertial, optional
+        Mass properties; None (default) leaves them to the MJCF export (derived from geoms).
+
+    Raises
+    ------
+    ValueError
+        If a name is empty or ``"world"``, a vector is not finite of the stated length, ``joints``
+        holds something other than Joint objects, a free joint is misplaced, or ``inertial`` is not an
+        Inertial.
+    """
 
     name: str
     parent: str = "world"
@@ -155,7 +218,24 @@ class Body:
 
 @dataclass(frozen=True)
 class Site:
-    """A named frame fixed in ``body`` at ``(pos, quat)``: an output of the kinematics."""
+    """A named frame fixed in ``body`` at ``(pos, quat)``: an output of the kinematics.
+
+    Parameters
+    ----------
+    name : str
+        Unique, non-empty site name (the ``site`` argument of :func:`site_pose` and friends).
+    body : str
+        Name of the body that carries the site.
+    pos : tuple of float, shape (3,), optional
+        Site origin in the body frame (m).
+    quat : tuple of float, shape (4,), optional
+        Site orientation ``[w, x, y, z]`` in the body frame (normalised).
+
+    Raises
+    ------
+    ValueError
+        If a name is empty, ``pos`` is not 3 finite reals, or ``quat`` is not a non-zero 4-vector.
+    """
 
     name: str
     body: str
@@ -180,6 +260,34 @@ class Closure:
     * ``revolute``: as ``point`` and, in addition, ``axis`` (body1 frame) stays aligned with ``axis2``
       (body2 frame): a hinge cut joint; 6 equations of rank 5, written as two point closures one
       characteristic length apart along the axis, which is how MJCF expresses it.
+
+    Parameters
+    ----------
+    name : str
+        Unique, non-empty closure name.
+    kind : str
+        ``"point"``, ``"rigid"`` or ``"revolute"``.
+    body1, body2 : str
+        The two bodies joined (different; ``"world"`` allowed).
+    anchor1 : tuple of float, shape (3,), optional
+        Point of body1, in the body1 frame (m); point and revolute closures.
+    anchor2 : tuple of float, shape (3,), optional
+        Point of body2, in the body2 frame (m); for a rigid closure the point where the position
+        rows are measured.
+    relpos : tuple of float, shape (3,), optional
+        Rigid closure: body2's origin in the body1 frame (m).
+    relquat : tuple of float, shape (4,), optional
+        Rigid closure: body2's orientation ``[w, x, y, z]`` in the body1 frame (normalised).
+    axis : tuple of float, shape (3,), optional
+        Revolute closure: hinge axis in the body1 frame (normalised).
+    axis2 : tuple of float, shape (3,), optional
+        Revolute closure: the same axis in the body2 frame (normalised).
+
+    Raises
+    ------
+    ValueError
+        If a name is empty, ``kind`` is unknown, ``body1 == body2``, or a vector is not finite of the
+        stated length (or zero, for a quaternion or axis).
     """
 
     name: str
@@ -215,6 +323,23 @@ class Coupling:
     """MuJoCo's joint equality: ``q1 - ref1 = c0 + c1 x + c2 x^2 + c3 x^3 + c4 x^4`` with ``x = q2 - ref2``.
 
     ``joint2 = None`` fixes ``joint1`` at ``ref1 + c0``.  Both joints are hinges or slides.
+
+    Parameters
+    ----------
+    name : str
+        Unique, non-empty coupling name.
+    joint1 : str
+        The driven joint.
+    joint2 : str, optional
+        The driving joint; None (default) fixes ``joint1``.
+    polycoef : tuple of float, shape (5,), optional
+        ``(c0, c1, c2, c3, c4)`` in the joints' units (rad, m); default ``(0, 1, 0, 0, 0)``:
+        ``q1 - ref1 = q2 - ref2``.
+
+    Raises
+    ------
+    ValueError
+        If a name is empty or ``polycoef`` is not 5 finite reals.
     """
 
     name: str
@@ -239,7 +364,35 @@ class Mechanism:
 
     ``actuated`` names hinge or slide joints in actuator order; ``q_act`` are their ``qpos`` entries.
     The reference configuration ``q0`` is MuJoCo's ``qpos0`` (hinge/slide ``ref``, identity
-    quaternions, a free body's own pose).
+    quaternions, a free body's own pose).  Usually made by :class:`Builder` or :func:`from_mjcf`.
+    ``nq``, ``nv`` (sizes of ``qpos`` and ``qvel``), ``q0`` and ``length`` are derived properties.
+
+    Parameters
+    ----------
+    bodies : tuple of Body
+        At least one body; parents before children (reordered depth-first on construction).
+    closures : tuple of Closure, optional
+        Loop closures (cut joints) between named bodies.
+    couplings : tuple of Coupling, optional
+        Joint equalities between hinge / slide joints.
+    sites : tuple of Site, optional
+        Named output frames.
+    actuated : tuple of str, optional
+        Actuated hinge or slide joints, each once, in actuator order.
+    gravity : tuple of float, shape (3,), optional
+        Gravitational acceleration in the world frame (m/s^2); default ``(0, 0, -9.81)``.
+    name : str, optional
+        Non-empty mechanism name.
+    characteristic_length : float, optional
+        Length (m) that makes rotations and translations commensurate (residual scaling,
+        conditioning); None (default): computed from the geometry.
+
+    Raises
+    ------
+    ValueError
+        If a field has the wrong type, names are not unique, a parent, closure body, coupled joint,
+        site body or actuated joint is unknown, an actuated or coupled joint is not a hinge or slide,
+        or ``characteristic_length`` is not positive.
     """
 
     bodies: tuple[Body, ...]
@@ -404,14 +557,40 @@ def _depth_first(bodies: tuple[Body, ...]) -> tuple[Body, ...]:
 class Builder:
     """Assemble a :class:`Mechanism` in Python (no XML), MuJoCo semantics throughout.
 
-    >>> b = Builder("four-bar")
-    >>> b.body("crank", joints=[b.hinge("a", axis=(0, 0, 1))])            # doctest: +SKIP
-    >>> b.connect("loop", "rocker", "coupler", anchor1=(0.3, 0, 0))        # doctest: +SKIP
-    >>> mech = b.build()                                                   # doctest: +SKIP
-
     The builder only collects descriptions; ``Builder.build()`` returns the frozen, validated mechanism.
     A closure anchor not given on the second body is computed at the reference configuration
-    (MuJoCo's qpos0 semantics for ``connect`` and ``weld``).
+    (MuJoCo's qpos0 semantics for ``connect`` and ``weld``).  Joints come from the static makers
+    :meth:`hinge`, :meth:`slide`, :meth:`ball`, :meth:`free`, :meth:`universal`; :meth:`helical` also
+    records its coupling.
+
+    Parameters
+    ----------
+    name : str, optional
+        Non-empty mechanism name.
+    gravity : array_like, shape (3,), optional
+        Gravitational acceleration in the world frame (m/s^2); default ``(0, 0, -9.81)``.
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is empty or ``gravity`` is not 3 finite reals (the element methods and
+        :meth:`build` raise as the dataclasses they make do).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech import multibody as mb
+    >>> b = mb.Builder("pendulum")
+    >>> b.body("link", joints=[b.hinge("a", axis=(0, 1, 0))], inertial=mb.Inertial(1.0, pos=(0.5, 0, 0)))
+    'link'
+    >>> b.site("tip", "link", pos=(1.0, 0, 0))
+    'tip'
+    >>> b.actuate("a")
+    >>> mech = b.build()
+    >>> mech.nq, mech.actuated
+    (1, ('a',))
+    >>> np.round(mb.site_pose(mech, [np.pi / 2], "tip")[:3, 3], 6) + 0.0
+    array([ 0.,  0., -1.])
     """
 
     def __init__(self, name: str = "mechanism", gravity: Vector = (0.0, 0.0, -9.81)) -> None:
@@ -428,20 +607,24 @@ class Builder:
     def hinge(
         name: str, axis: Vector = (0, 0, 1), pos: Vector = (0, 0, 0), ref: float = 0.0
     ) -> Joint:
+        """A hinge ``Joint`` about ``axis`` (body frame) through ``pos`` (m), zero at ``ref`` (rad)."""
         return Joint(name, "hinge", tuple(axis), tuple(pos), ref)
 
     @staticmethod
     def slide(
         name: str, axis: Vector = (0, 0, 1), pos: Vector = (0, 0, 0), ref: float = 0.0
     ) -> Joint:
+        """A slide ``Joint`` along ``axis`` (body frame), zero at ``ref`` (m)."""
         return Joint(name, "slide", tuple(axis), tuple(pos), ref)
 
     @staticmethod
     def ball(name: str, pos: Vector = (0, 0, 0)) -> Joint:
+        """A ball ``Joint`` centred at ``pos`` (body frame, m): 4 ``qpos`` (quaternion), 3 ``qvel``."""
         return Joint(name, "ball", (0.0, 0.0, 1.0), tuple(pos))
 
     @staticmethod
     def free(name: str) -> Joint:
+        """A free ``Joint`` (top-level bodies only): 7 ``qpos`` ``(x, y, z, qw, qx, qy, qz)``, 6 ``qvel``."""
         return Joint(name, "free")
 
     @staticmethod
@@ -483,6 +666,7 @@ class Builder:
     def site(
         self, name: str, body: str, pos: Vector = (0, 0, 0), quat: Vector = (1, 0, 0, 0)
     ) -> str:
+        """Add a site on ``body`` at ``pos`` (m), ``quat`` ``[w, x, y, z]`` (body frame); returns the name."""
         self._sites.append(Site(name, body, tuple(pos), tuple(quat)))
         return name
 
@@ -527,13 +711,16 @@ class Builder:
         self._closures.append(("rigid", name, body1, body2, tuple(anchor2), rel, None))
 
     def couple(self, name: str, joint1: str, joint2: str | None, polycoef: Vector) -> None:
+        """Add a :class:`Coupling` (``polycoef`` padded with zeros to 5 coefficients)."""
         c = tuple(polycoef) + (0.0,) * (5 - len(polycoef))
         self._couplings.append(Coupling(name, joint1, joint2, c))
 
     def actuate(self, *joints: str) -> None:
+        """Mark hinge / slide ``joints`` as actuated, appended in actuator order."""
         self._actuated.extend(joints)
 
     def build(self) -> Mechanism:
+        """The frozen, validated :class:`Mechanism` (closure anchors / poses not given: those at q0)."""
         # First the tree (no closures) to evaluate reference poses for MuJoCo's qpos0 defaults.
         tree_only = Mechanism(
             tuple(self._bodies),

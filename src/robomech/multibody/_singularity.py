@@ -43,7 +43,32 @@ __all__ = ["SingularityMapResult", "SingularityResult", "singularities", "singul
 
 @dataclass(frozen=True)
 class SingularityResult:
-    """Per-sample measures (batch shape of ``q``); lengths in metres, conditions dimensionless."""
+    """Per-sample measures (batch shape of ``q``); lengths in metres, conditions dimensionless.
+
+    The result of :func:`singularities`.  Rotations and hinge columns are scaled by the characteristic
+    length L so that every singular value is a length; each condition number is the largest singular
+    value (or L if larger) over the relevant one, and a type is flagged when it exceeds ``1 / rtol``.
+
+    Attributes
+    ----------
+    sigma_I : ndarray, shape (...)
+        The ``dof``-th singular value of the scaled input-output Jacobian of the site (m): zero at a
+        type I (serial, output) singularity.
+    sigma_II : ndarray, shape (...)
+        The relevant smallest singular value of the passive constraint block (m): zero at a type II
+        (parallel, input) singularity.
+    sigma_C : ndarray, shape (...)
+        The ``rank``-th singular value of the whole constraint Jacobian (m): zero at a constraint
+        singularity.
+    cond_I, cond_II, cond_C : ndarray, shape (...)
+        The corresponding condition numbers (inf where the singular value is zero).
+    type_I, type_II, constraint : ndarray of bool, shape (...)
+        ``cond_I``, ``cond_II``, ``cond_C`` above ``1 / rtol``.
+    singular : ndarray of bool, shape (...)
+        Any of the three.
+    length : float
+        The characteristic length used (m).
+    """
 
     sigma_I: np.ndarray
     sigma_II: np.ndarray
@@ -175,6 +200,22 @@ class SingularityMapResult:
     ``reachable`` = the sample assembled (FK) or the target was reached (IK); every other field is
     NaN / False where it is false.  ``dexterity`` and ``cond`` are those of
     :func:`robomech.analysis.workspace.singularity_map` on the unit-scaled input–output Jacobian.
+
+    Attributes
+    ----------
+    q : ndarray, shape (..., nq)
+        Assembled configurations (MuJoCo ``qpos``); NaN where not reachable.
+    reachable : ndarray of bool, shape (...)
+        The closure assembled (FK grid) or the site target was reached (IK grid).
+    singularity : SingularityResult
+        :func:`singularities` at ``q`` (the same batch shape; NaN / False where not reachable).
+    cond : ndarray, shape (...)
+        Condition number of the unit-scaled input-output Jacobian.
+    dexterity : ndarray, shape (...)
+        ``1 / cond`` in ``[0, 1]``.
+    singular : ndarray of bool, shape (...)
+        The scaled Jacobian is singular (``workspace.singularity_map``) or ``singularity.singular``;
+        False where not reachable.
     """
 
     q: np.ndarray

@@ -26,12 +26,46 @@ __all__ = [
 
 
 def available_studies() -> dict[str, Study]:
-    """All registered studies by name, in a stable order."""
+    """All registered studies by name, in a stable order.
+
+    Discovered from the modules ``robomech/studies/<module>.py`` that define ``STUDY``; nothing is run.
+
+    Returns
+    -------
+    dict of str to Study
+
+    Examples
+    --------
+    >>> from robomech.studies import available_studies
+    >>> "omnileg" in available_studies()
+    True
+    """
     return discover(__name__, __path__, "STUDY", Study)
 
 
 def get_study(name: str) -> Study:
-    """The registered study ``name``; ``ValueError`` listing the valid names otherwise."""
+    """The registered study ``name``; ``ValueError`` listing the valid names otherwise.
+
+    Parameters
+    ----------
+    name : str
+        A key of :func:`available_studies`.
+
+    Returns
+    -------
+    Study
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not a str or not a registered study (the message lists the valid names).
+
+    Examples
+    --------
+    >>> from robomech.studies import get_study
+    >>> get_study("omnileg").name
+    'omnileg'
+    """
     studies = available_studies()
     if not isinstance(name, str) or name not in studies:
         raise ValueError(

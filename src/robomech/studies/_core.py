@@ -35,7 +35,24 @@ T = TypeVar("T")
 
 @dataclass(frozen=True)
 class Table:
-    """A table of the report; cells are numbers or text (numbers are formatted by the writer)."""
+    """A table of the report; cells are numbers or text (numbers are formatted by the writer).
+
+    Parameters
+    ----------
+    title : str
+        Table title.
+    columns : sequence of str
+        Column headers (units belong in the header or a unit column).
+    rows : sequence of sequence
+        One sequence of cells per row, each as long as ``columns``.
+    note : str, optional
+        Text shown under the table.
+
+    Raises
+    ------
+    ValueError
+        If a row does not have one cell per column.
+    """
 
     title: str
     columns: Sequence[str]
@@ -53,7 +70,17 @@ class Table:
 
 @dataclass(frozen=True)
 class Figure:
-    """A PNG written by the study into its output folder; ``alt`` (default: the caption) for readers."""
+    """A PNG written by the study into its output folder; ``alt`` (default: the caption) for readers.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The image file, inside the study's output folder.
+    caption : str
+        Caption shown under the figure.
+    alt : str, optional
+        Alternative text; empty (default): the caption.
+    """
 
     path: Path
     caption: str
@@ -93,7 +120,31 @@ class Printed:
 
 @dataclass
 class StudyResult:
-    """Everything a study reports: prose, tables, figures and machine-readable data."""
+    """Everything a study reports: prose, tables, figures and machine-readable data.
+
+    Returned by a :class:`Study`'s ``run``; the report writer turns it into ``report.md``,
+    ``report.html`` and ``results.json``.
+
+    Attributes
+    ----------
+    name : str
+        The study's name.
+    title : str
+        Report title.
+    source : str
+        The paper (or other source) it reproduces.
+    summary : str
+        Prose at the top of the report.
+    tables : list of Table
+        The report's tables, in order.
+    figures : list of Figure
+        The figures written into the output folder, in order.
+    data : dict
+        Machine-readable results for ``results.json`` (anything :func:`robomech.verify.to_jsonable`
+        accepts; units in the keys or alongside).
+    notes : list of str
+        Remarks listed at the end (departures from the paper, choices made).
+    """
 
     name: str
     title: str
@@ -107,7 +158,25 @@ class StudyResult:
 
 @dataclass(frozen=True)
 class Study:
-    """A registered paper reproduction: ``run(out_dir, progress)`` returns a :class:`StudyResult`."""
+    """A registered paper reproduction: ``run(out_dir, progress)`` returns a :class:`StudyResult`.
+
+    What ``robomech/studies/<module>.py`` defines as ``STUDY``.
+
+    Parameters
+    ----------
+    name : str
+        Registry name, the key of :func:`available_studies`.
+    title : str
+        Human-readable title.
+    source : str
+        The paper (or other source) it reproduces.
+    run : callable
+        ``run(out_dir: pathlib.Path, progress: Progress) -> StudyResult``; writes its figures into
+        ``out_dir``.
+    requires : tuple of str, optional
+        Optional modules the run needs (e.g. ``("mujoco",)``); missing ones skip it with the extra to
+        install.
+    """
 
     name: str
     title: str
@@ -128,6 +197,35 @@ def comparison_table(
     ``rows`` are ``(quantity, printed, robomech, unit)``; ``printed`` may be ``None`` where the paper
     gives no number.  The printed value is shown exactly as given (a string such as ``"1.50"`` keeps
     its digits; a float is shown by its shortest round-trip form, i.e. as typed from the paper).
+
+    Parameters
+    ----------
+    title : str
+        Table title.
+    rows : iterable of tuple
+        ``(quantity: str, printed: str or float or None, robomech: float, unit: str)``.
+    note : str, optional
+        Text shown under the table.
+
+    Returns
+    -------
+    Table
+        Columns quantity, unit, paper (printed), robomech, difference (robomech - printed, in
+        ``unit``) and relative (``|difference| / |printed|``; a dash where the printed value is
+        missing or zero).
+
+    Raises
+    ------
+    ValueError
+        If ``title`` is not a str, ``rows`` is not an iterable of 4-tuples, a printed text is not a
+        number, or a value is not a real number.
+
+    Examples
+    --------
+    >>> from robomech.studies import comparison_table
+    >>> t = comparison_table("demo", [("length", "1.50", 1.5, "m")])
+    >>> [str(c) for c in t.rows[0]]
+    ['length', 'm', '1.50', '1.5', '0.0', '0.0']
     """
     if not isinstance(title, str):
         raise ValueError(f"Expected title to be a str, got {type(title).__name__}.")
@@ -170,7 +268,28 @@ def comparison_table(
 
 
 class Progress:
-    """Progress lines on stderr for long runs; silent when ``enabled`` is false."""
+    """Progress lines on stderr for long runs; silent when ``enabled`` is false.
+
+    Each line is ``[elapsed s] prefix message``.
+
+    Parameters
+    ----------
+    prefix : str, optional
+        Text put before every message (e.g. the study's name).
+    enabled : bool, optional
+        Print at all (default True).
+    stream : file-like, optional
+        Where to print (default ``sys.stderr``).
+
+    Examples
+    --------
+    >>> import io
+    >>> out = io.StringIO()
+    >>> p = Progress("demo: ", stream=out)
+    >>> p.step("done")
+    >>> out.getvalue().rstrip().endswith("demo: done")
+    True
+    """
 
     def __init__(self, prefix: str = "", *, enabled: bool = True, stream=None) -> None:
         self.prefix = prefix
@@ -179,6 +298,7 @@ class Progress:
         self._t0 = time.perf_counter()
 
     def step(self, message: str) -> None:
+        """Print ``message`` with the elapsed time (s) and the prefix."""
         if self.enabled:
             elapsed = time.perf_counter() - self._t0
             print(f"[{elapsed:7.1f} s] {self.prefix}{message}", file=self.stream, flush=True)

@@ -37,7 +37,21 @@ __all__ = [
 
 
 def available_verifications() -> dict[str, Verification]:
-    """All registered verifications by mechanism name, in a stable order."""
+    """All registered verifications by mechanism name, in a stable order.
+
+    Discovered from the modules ``robomech/verify/<module>.py`` that define ``VERIFICATION``; nothing
+    is run and no engine is imported.
+
+    Returns
+    -------
+    dict of str to Verification
+
+    Examples
+    --------
+    >>> from robomech.verify import available_verifications
+    >>> "omnileg" in available_verifications()
+    True
+    """
     return discover(__name__, __path__, "VERIFICATION", Verification)
 
 

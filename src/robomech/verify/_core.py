@@ -37,7 +37,11 @@ __all__ = [
 
 
 class EngineUnavailable(ImportError):
-    """An optional engine is needed but not installed; the message names the extra to install."""
+    """An optional engine is needed but not installed; the message names the extra to install.
+
+    An ``ImportError`` subclass, raised on first use of an :func:`optional_module` whose module is
+    absent, e.g. ``mujoco is not installed; install it with: pip install 'robomech[verify]'``.
+    """
 
 
 class _OptionalModule:
@@ -97,6 +101,23 @@ def to_jsonable(obj: Any) -> Any:
 
     Non-finite floats become ``None`` (JSON ``null``): strict JSON has no NaN or infinity.
 
+    Parameters
+    ----------
+    obj : object
+        Nested dicts (keys become str), lists, tuples, sets, numpy arrays and scalars, str, int,
+        float, bool, None and ``pathlib.Path`` (becomes str).
+
+    Returns
+    -------
+    object
+        The same structure in dict, list, str, int, float, bool and None only.
+
+    Raises
+    ------
+    ValueError
+        If ``obj`` holds a complex number or anything else not representable in JSON (a dataclass,
+        say: convert it with its ``as_dict()`` first).
+
     Examples
     --------
     >>> import numpy as np
@@ -126,6 +147,23 @@ def to_jsonable(obj: Any) -> Any:
 def dumps_json(obj: Any, *, indent: int | None = 2) -> str:
     """Strict JSON text (``allow_nan=False``) of :func:`to_jsonable` of ``obj``.
 
+    Parameters
+    ----------
+    obj : object
+        Anything :func:`to_jsonable` accepts.
+    indent : int, optional
+        Indentation (>= 0; default 2); None for one line.
+
+    Returns
+    -------
+    str
+        The JSON text (non-ASCII characters kept).
+
+    Raises
+    ------
+    ValueError
+        If ``indent`` is not None or a non-negative int, or ``obj`` is not JSON-representable.
+
     Examples
     --------
     >>> import numpy as np
@@ -139,7 +177,23 @@ def dumps_json(obj: Any, *, indent: int | None = 2) -> str:
 
 @dataclass(frozen=True)
 class Tolerance:
-    """A named tolerance with its reason; ``relative`` says how the error was normalised."""
+    """A named tolerance with its reason; ``relative`` says how the error was normalised.
+
+    Parameters
+    ----------
+    value : float
+        The bound on the error (> 0), in the units of the checked quantity (or dimensionless when
+        ``relative``).
+    reason : str
+        Why this value (engine constraint stiffness, step size, model fidelity); non-empty.
+    relative : bool, optional
+        The error is relative (normalised by the quantity's scale); default False (absolute).
+
+    Raises
+    ------
+    ValueError
+        If ``value`` is not positive and finite, ``reason`` is empty, or ``relative`` is not a bool.
+    """
 
     value: float
     reason: str
@@ -154,6 +208,30 @@ class Tolerance:
 
 @dataclass(frozen=True)
 class Check:
+    """One comparison of a model quantity against an independent engine or model.
+
+    Parameters
+    ----------
+    mechanism : str
+        The mechanism verified (e.g. ``"omnileg"``).
+    quantity : str
+        What was compared (e.g. ``"forward kinematics, foot position"``).
+    max_error : float
+        The largest error found, in the quantity's units (or relative, as ``tolerance`` says); NaN
+        or inf fails the check.
+    tolerance : Tolerance
+        The bound and its reason.
+    detail : str, optional
+        Free text (sample counts, where the maximum occurred).
+
+    Examples
+    --------
+    >>> from robomech.verify import Check, Tolerance
+    >>> c = Check("demo", "tip position (m)", 2e-9, Tolerance(1e-6, "engine constraint stiffness"))
+    >>> c.passed, c.as_dict()["tolerance"]
+    (True, 1e-06)
+    """
+
     mechanism: str
     quantity: str
     max_error: float
@@ -162,6 +240,7 @@ class Check:
 
     @property
     def passed(self) -> bool:
+        """``max_error`` is finite and at most ``tolerance.value``."""
         return math.isfinite(self.max_error) and self.max_error <= self.tolerance.value
 
     def as_dict(self) -> dict[str, Any]:
@@ -181,6 +260,23 @@ class Check:
 
 @dataclass(frozen=True)
 class Verification:
+    """A registered verification: what ``robomech/verify/<module>.py`` defines as ``VERIFICATION``.
+
+    Parameters
+    ----------
+    name : str
+        Mechanism name, the key of :func:`available_verifications`.
+    title : str
+        Human-readable title.
+    engine : str
+        The independent engine or model compared against (e.g. ``"MuJoCo"``).
+    run : callable
+        ``run() -> sequence of Check``; imports its engine on first use only.
+    requires : tuple of str, optional
+        Optional modules the run needs (e.g. ``("mujoco",)``); where one is missing the verification
+        is skipped with the extra to install.
+    """
+
     name: str
     title: str
     engine: str
@@ -191,6 +287,24 @@ class Verification:
 
 @dataclass
 class VerificationReport:
+    """The result of :func:`run_verifications`.
+
+    Attributes
+    ----------
+    checks : list of Check
+        Every check of the verifications that ran.
+    skipped : list of tuple of str
+        ``(mechanism, reason)`` of the verifications that could not run here (an engine not
+        installed; ``reason`` names the extra).
+
+    Examples
+    --------
+    >>> from robomech.verify import Check, Tolerance, VerificationReport
+    >>> r = VerificationReport([Check("demo", "q", 1e-9, Tolerance(1e-6, "why"))])
+    >>> r.passed, r.table().splitlines()[-1]
+    (True, '1 passed, 0 failed')
+    """
+
     checks: list[Check] = field(default_factory=list)
     # (mechanism, reason) of verifications that could not run here, e.g. the engine is not installed
     skipped: list[tuple[str, str]] = field(default_factory=list)
@@ -201,6 +315,7 @@ class VerificationReport:
         return all(c.passed for c in self.checks)
 
     def as_dict(self) -> dict[str, Any]:
+        """``passed``, every check's :meth:`Check.as_dict` and the skipped ones, as plain data."""
         return {
             "passed": self.passed,
             "checks": [c.as_dict() for c in self.checks],
@@ -208,6 +323,7 @@ class VerificationReport:
         }
 
     def table(self) -> str:
+        """A plain-text table: one line per check (error, tolerance, pass/FAIL), skips and counts."""
         wq = max([len("quantity"), *(len(c.quantity) for c in self.checks)])
         wm = max([len("mechanism"), *(len(c.mechanism) for c in self.checks)])
         header = f"{'mechanism':<{wm}} {'quantity':<{wq}} {'max error':>11} {'tolerance':>11}      result"
