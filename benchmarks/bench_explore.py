@@ -23,7 +23,12 @@ Reported per study (medians over the repeats):
   the study's computation (scheduling, transfer, the worker's task wrapper, the client's receipt and
   Zarr write competing for the cores, and the 2-worker load imbalance), as a fraction of the mean chunk
   work; and its parts, the worker-side task overhead and the client's write time;
-- the 10^6-design spherical-leg synthesis extrapolated from the 1-worker steady throughput.
+- the 10^6-design spherical-leg synthesis extrapolated from the 1-worker steady throughput;
+- the machine's own two-process ceiling, without Dask: the same chunks evaluated by plain processes
+  (``concurrent.futures``, spawned with ``WORKER_ENV``), all by one process vs half each by two at once,
+  ``ceiling = T1 / (2 T2)``.  On a machine whose two cores slow each other down (shared caches, memory
+  bandwidth, a hypervisor's vCPUs) the ceiling is below 1 and no scheduler can beat it, so Dask's
+  efficiency is also reported relative to it (``efficiency / ceiling``: what Dask itself loses).
 """
 
 from __future__ import annotations
@@ -146,6 +151,51 @@ def _measure(names: list[str], chunks: int, repeats: int) -> dict[int, dict[str,
     return out
 
 
+def _ceiling_chunks(name: str, chunks: list[int]) -> float:
+    """In a plain worker process: evaluate the given default-size chunks of a study; the seconds it took."""
+    st = get_study(name)
+    t0 = time.perf_counter()
+    for k in chunks:
+        X = design_matrix(st.variables, st.default_chunk, st.default_sampler, 0, st.default_chunk)
+        st.evaluate_rows(X, chunk_seed(0, k))
+    return time.perf_counter() - t0
+
+
+def _ceiling(names: list[str], chunks: int, repeats: int) -> dict[str, float]:
+    """Two-process efficiency T1 / (2 T2) of the bare chunk computation (no Dask), median of repeats."""
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+
+    saved = {k: os.environ.get(k) for k in runner_mod.WORKER_ENV}
+    os.environ.update(runner_mod.WORKER_ENV)  # inherited by the spawned processes before they import numpy
+    try:
+        ctx = mp.get_context("spawn")
+        with ProcessPoolExecutor(1, mp_context=ctx) as one, ProcessPoolExecutor(2, mp_context=ctx) as two:
+            out = {}
+            for name in names:
+                one.submit(_ceiling_chunks, name, [0]).result()  # warm-up: imports, first-call costs
+                list(two.map(_ceiling_chunks, [name, name], [[0], [1]]))
+                effs = []
+                for _ in range(repeats):
+                    t0 = time.perf_counter()
+                    one.submit(_ceiling_chunks, name, list(range(chunks))).result()
+                    t1 = time.perf_counter() - t0
+                    half = chunks // 2
+                    t0 = time.perf_counter()
+                    halves = [list(range(half)), list(range(half, chunks))]
+                    list(two.map(_ceiling_chunks, [name, name], halves))
+                    t2 = time.perf_counter() - t0
+                    effs.append(t1 / (2 * t2))
+                out[name] = statistics.median(effs)
+            return out
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
 def _median(runs: list[dict[str, float]], key: str) -> float:
     return statistics.median(r[key] for r in runs)
 
@@ -161,6 +211,7 @@ def main() -> int:
     t_start = time.perf_counter()
     load = os.getloadavg()[0]
     res = _measure(names, args.chunks, args.repeats)
+    ceiling = _ceiling(names, args.chunks, args.repeats)
     rows = []
     print(
         f"\n{args.chunks} chunks per sweep, median of {args.repeats}; load average {load:.1f} at the start, "
@@ -197,6 +248,8 @@ def main() -> int:
                 "task_overhead_s": _median(runs, "task_overhead_s"),
                 "client_write_s": _median(runs, "client_write_s"),
                 "cpu_per_design_s": _median(runs, "cpu_s") / n,
+                "ceiling": ceiling[name],
+                "efficiency_vs_ceiling": eff / ceiling[name] if workers == 2 else 1.0,
                 "runs": runs,
             }
             rows.append(row)
@@ -207,6 +260,18 @@ def main() -> int:
                 f"{1e3 * row['task_overhead_s']:.1f} | {1e3 * row['client_write_s']:.1f} | "
                 f"{row['wall_s'] - row['window_s']:.2f} |",
                 flush=True,
+            )
+    print(
+        "\nThe machine's two-process ceiling without Dask (same chunks, plain processes, T1 / (2 T2)) and "
+        "Dask's 2-worker efficiency relative to it:\n"
+    )
+    print("| study | ceiling (no Dask) | Dask T1/(2 T2) | Dask / ceiling |")
+    print("|---|---|---|---|")
+    for row in rows:
+        if row["workers"] == 2:
+            print(
+                f"| {row['study']} | {row['ceiling']:.2f} | {row['efficiency']:.2f} | "
+                f"{row['efficiency_vs_ceiling']:.2f} |"
             )
     if "spherical-leg-synthesis" in names:
         st = get_study("spherical-leg-synthesis")
