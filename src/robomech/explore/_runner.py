@@ -57,6 +57,11 @@ class SchedulerUnreachable(ValueError):
     A ``ValueError`` subclass, raised by :func:`run_sweep` and :func:`optimize_nsga2` when
     ``scheduler`` is not of the form ``tcp://HOST:PORT`` or no scheduler answers within
     ``connect_timeout`` seconds.
+
+    Parameters
+    ----------
+    message : str
+        What was expected and what was got (the scheduler address, the timeout).
     """
 
 

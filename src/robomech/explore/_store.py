@@ -48,6 +48,11 @@ class StoreMismatch(ValueError):
 
     A ``ValueError`` subclass, raised by :func:`run_sweep` and :func:`optimize_nsga2` before anything
     is written when the directory is not empty and not a store with the same sweep fingerprint.
+
+    Parameters
+    ----------
+    message : str
+        Which part of the store differs from this sweep's (path, fingerprint, array).
     """
 
 

@@ -41,6 +41,11 @@ class EngineUnavailable(ImportError):
 
     An ``ImportError`` subclass, raised on first use of an :func:`optional_module` whose module is
     absent, e.g. ``mujoco is not installed; install it with: pip install 'robomech[verify]'``.
+
+    Parameters
+    ----------
+    message : str
+        The missing module and the ``pip install`` command of the extra that provides it.
     """
 
 

@@ -95,6 +95,42 @@ def cable_elongation(
     ``tension (..., 3 n)`` the tension at the base plate, constant over the free length between the
     actuator and the base and reduced span by span by the disk friction (``direction``).  This is the
     discrete form of eq. (36) (which integrates an exponential tension profile).
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
+    psi : array_like, shape (..., 2 n)
+        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
+    tension : array_like, shape (..., 3 n)
+        Tension of every cable where it enters the base plate (N), e.g. ``cable_tensions(...).tension``.
+    direction : array_like, shape (..., 3 n), optional
+        Sliding direction of each cable (+1 pulled in, -1 paid out, see :func:`friction_factors`);
+        ``None``: frictionless.
+    model : {"chord", "arc"}, optional
+        Cable path model of the spans (straight chords between holes, or arcs); default ``"chord"``.
+
+    Returns
+    -------
+    ndarray, shape (..., 3 n)
+        Elongation delta of every cable (m), positive = stretched beyond its pretensioned straight
+        length; the batch shape is the broadcast of those of ``psi``, ``tension`` and ``direction``.
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot`; ``psi`` does not end in an axis of 2 n, or
+        ``tension`` in one of 3 n, or either is not real and finite; ``direction`` has a wrong shape or
+        invalid values.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> robot = cr.ContinuumRobot.paper()
+    >>> t = cr.cable_tensions(robot, np.array([0.5, 0.0])).tension
+    >>> cr.cable_elongation(robot, np.array([0.5, 0.0]), t).shape
+    (3,)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -105,7 +141,39 @@ def cable_elongation(
 
 
 def theoretical_drive(robot: ContinuumRobot, psi: object, model: CableModel = "arc") -> np.ndarray:
-    """Cable pulled in by each actuator for a rigid, frictionless robot: q = -(L(psi) - L(0))."""
+    """Cable pulled in by each actuator for a rigid, frictionless robot: q = -(L(psi) - L(0)).
+
+    The theoretical drive of paper 3, eq. (37) (before the elongation delta is added): the change of the
+    geometric cable length between the straight pose and ``psi``, sign flipped so that a cable that
+    shortens is pulled in (q > 0).
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
+    psi : array_like, shape (..., 2 n)
+        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
+    model : {"chord", "arc"}, optional
+        Cable path model of the spans (straight chords between holes, or arcs); default ``"arc"``.
+
+    Returns
+    -------
+    ndarray, shape (..., 3 n)
+        Cable length pulled in by every actuator since the straight pose (m); 0 at ``psi = 0``.
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot`, or ``psi`` does not end in an axis of 2 n or is
+        not real and finite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> cr.theoretical_drive(cr.ContinuumRobot.paper(), np.array([0.5, 0.0])).round(6)
+    array([ 0.002, -0.001, -0.001])
+    """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     psi_a = np.stack([theta, beta], -1).reshape(*theta.shape[:-1], 2 * theta.shape[-1])
@@ -114,11 +182,30 @@ def theoretical_drive(robot: ContinuumRobot, psi: object, model: CableModel = "a
 
 @dataclass(frozen=True)
 class DriveResult:
-    """Compensated drive (batch shape ``...``): ``q`` theoretical, ``delta`` elongation, ``q_compensated``
-    = q + delta (paper 3, eq. (37)), the model ``tension`` behind delta, and ``taut`` (all cables in
-    tension; where false the compensation is not meaningful).  ``actuator_tension`` is the tension at the
-    actuator, beyond the pulley (equal to ``tension`` without a ``pulley``), ``delta_pulley`` the part of
-    ``delta`` stretched over the pulley wrap (0 without one)."""
+    """Compensated drive, the result of :func:`compensated_drive` (paper 3, eq. (37)).
+
+    ``q_compensated = q + delta``; where ``taut`` is false the compensation is not meaningful.
+
+    Attributes
+    ----------
+    q : ndarray, shape (..., 3 n)
+        Theoretical drive of the rigid, frictionless robot, :func:`theoretical_drive` (m).
+    delta : ndarray, shape (..., 3 n)
+        Cable elongation to compensate (m), including ``delta_pulley``.
+    q_compensated : ndarray, shape (..., 3 n)
+        Feed-forward drive q~ = q + delta (m): cable each actuator pulls in since the straight,
+        pretensioned pose.
+    tension : ndarray, shape (..., 3 n)
+        Model tension behind delta, where the cable enters the base plate (N).
+    taut : ndarray of bool, shape (...)
+        All cables in tension (and, for ``method="disk"`` or with a pulley, the model solved and the
+        tensions finite and positive).
+    actuator_tension : ndarray, shape (..., 3 n)
+        Tension at the actuator, beyond the pulley (N); equal to ``tension`` without a pulley, NaN
+        where ``taut`` is false with one.
+    delta_pulley : ndarray, shape (..., 3 n)
+        Part of ``delta`` stretched over the pulley wrap, eq. (34) (m); 0 without a pulley.
+    """
 
     q: np.ndarray
     delta: np.ndarray
@@ -157,6 +244,47 @@ def compensated_drive(
     robot is the model tension above; the actuator side differs by the improved-capstan ratio kappa
     (eq. (32), in the cable's sliding ``direction``), and the cable wrapped over the pulley stretches by
     delta_c (eq. (34)), which is added to delta.  None (default): no pulley, today's drive exactly.
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
+    psi : array_like, shape (..., 2 n)
+        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
+    direction : array_like, shape (..., 3 n), optional
+        Sliding direction of each cable (+1 pulled in, -1 paid out, see :func:`friction_factors`);
+        ``None``: frictionless.
+    model : {"chord", "arc"}, optional
+        Cable path model of the spans (straight chords between holes, or arcs); default ``"chord"``.
+    wrench : array_like, shape (..., 6), optional
+        External wrench ``[m; f]`` (N m, N) at the tip, base frame (``method="paper"`` only); ``None``:
+        unloaded.
+    method : {"paper", "disk"}, optional
+        ``"paper"`` (default): segment-wise constant curvature as printed; ``"disk"``: the disk-wise
+        model (issue 16), see above.
+    pulley : Pulley, optional
+        Guide pulley at every actuator (eqs. (29)-(35)); ``None``: no pulley.
+
+    Returns
+    -------
+    DriveResult
+        ``q``, ``delta``, ``q_compensated``, ``tension``, ``actuator_tension``, ``delta_pulley``
+        ``(..., 3 n)`` (m, N) and ``taut (...)``.
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot` or ``pulley`` not a :class:`Pulley`; ``psi``,
+        ``direction`` or ``wrench`` has a wrong shape or invalid values; ``method`` or ``model`` is
+        unknown; or ``method="disk"`` is combined with ``model="arc"`` or a ``wrench``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> res = cr.compensated_drive(cr.ContinuumRobot.paper(), np.array([0.5, 0.0]))
+    >>> res.q_compensated.shape, bool(res.taut)
+    ((3,), True)
     """
     check_params(robot, ContinuumRobot, "robot")
     check_choice(method, "method", ("paper", "disk"))
@@ -208,11 +336,24 @@ def compensated_drive(
 # ---- the simulated robot --------------------------------------------------------------------------
 @dataclass(frozen=True)
 class SimulationResult:
-    """Quasi-static equilibrium of the simulated robot under a drive (batch shape ``...``).
+    """Quasi-static equilibrium of the simulated robot under a drive, the result of :func:`simulate`.
 
-    ``psi (..., 2 n)`` pose, ``tension (..., 3 n)`` at the base plate, ``taut`` no cable went slack,
-    ``converged`` Newton met ``SIM_TOLERANCE``, ``residual`` generalized-force residual (N m),
-    ``actuator_tension`` beyond the pulley (= ``tension`` without one).
+    Attributes
+    ----------
+    psi : ndarray, shape (..., 2 n)
+        Equilibrium pose ``[theta_1, beta_1, ...]`` (rad).
+    tension : ndarray, shape (..., 3 n)
+        Cable tension where it enters the base plate (N, >= 0; 0 for a slack cable).
+    taut : ndarray of bool, shape (...)
+        No cable went slack.
+    converged : ndarray of bool, shape (...)
+        Newton met ``SIM_TOLERANCE``.
+    residual : ndarray, shape (...)
+        Norm of the generalized-force residual (N m).
+    iterations : ndarray of int, shape (...)
+        Newton iterations used.
+    actuator_tension : ndarray, shape (..., 3 n)
+        Tension at the actuator, beyond the pulley (N); equal to ``tension`` without a pulley.
     """
 
     psi: np.ndarray
@@ -284,6 +425,47 @@ def simulate(
     (smooth through the straight pose), starting from ``initial`` psi or the rigid-cable arc solution.
     ``pulley``: the guide pulley at every actuator (eqs. (29)-(34)): its wrapped cable stretches with the
     improved-capstan tension profile; ``actuator_tension`` is the tension beyond it.  None: no pulley.
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
+    q : array_like, shape (..., 3 n)
+        Cable pulled in by each actuator since the straight, pretensioned pose (m), e.g.
+        ``compensated_drive(...).q_compensated``.
+    direction : array_like, shape (..., 3 n), optional
+        Sliding direction of each cable (+1 pulled in, -1 paid out, see :func:`friction_factors`);
+        ``None``: frictionless.
+    model : {"chord", "arc"}, optional
+        Cable path model of the spans (straight chords between holes, or arcs); default ``"chord"``.
+    initial : array_like, shape (..., 2 n), optional
+        Pose ``[theta_1, beta_1, ...]`` (rad) to start Newton from; ``None``: the least-squares
+        rigid-arc-cable pose for ``q``.
+    pulley : Pulley, optional
+        Guide pulley at every actuator (eqs. (29)-(34)); ``None``: no pulley.
+
+    Returns
+    -------
+    SimulationResult
+        ``psi (..., 2 n)`` (rad), ``tension``, ``actuator_tension (..., 3 n)`` (N), ``taut``,
+        ``converged``, ``residual`` (N m) and ``iterations`` per sample ``(...)``.
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot` or ``pulley`` not a :class:`Pulley`; ``q`` does
+        not end in an axis of 3 n or is not real and finite; ``direction`` or ``initial`` has a wrong
+        shape or invalid values.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> robot = cr.ContinuumRobot.paper()
+    >>> q = cr.compensated_drive(robot, np.array([0.5, 0.0])).q_compensated
+    >>> res = cr.simulate(robot, q)
+    >>> bool(res.converged), bool(res.taut), round(float(res.psi[0]), 4)
+    (True, True, 0.5)
     """
     check_params(robot, ContinuumRobot, "robot")
     if pulley is not None:
@@ -361,14 +543,34 @@ def simulate(
 
 @dataclass(frozen=True)
 class HistoryResult:
-    """Quasi-static response to a history of drives (time axis first, batch shape ``...``).
+    """Quasi-static response to a history of drives, the result of :func:`simulate_history`.
 
-    ``psi (n_t, ..., 2 n)``, ``tension (n_t, ..., 3 n)`` at the base plate, ``actuator_tension`` beyond
-    the pulley, ``direction (n_t, ..., 3 n)`` the sliding direction every cable had at each step (its
-    last nonzero drive increment: a cable whose drive stops keeps sliding-state memory), ``span_tension``
-    and ``state (n_t, ..., 3 n, n N)`` the stick-slip span tensions with memory (:func:`stick_slip_tensions`
-    fed with the base tensions), ``taut``, ``converged``, ``residual`` per sample, ``valid`` = taut and
-    converged.
+    Time axis first (``n_t`` samples), then the batch shape ``...``.
+
+    Attributes
+    ----------
+    psi : ndarray, shape (n_t, ..., 2 n)
+        Equilibrium pose at every step (rad).
+    tension : ndarray, shape (n_t, ..., 3 n)
+        Cable tension at the base plate (N, >= 0).
+    actuator_tension : ndarray, shape (n_t, ..., 3 n)
+        Tension at the actuator, beyond the pulley (N); equal to ``tension`` without a pulley.
+    direction : ndarray, shape (n_t, ..., 3 n)
+        Sliding direction (+1 / -1) every cable had at each step: that of its last nonzero drive
+        increment (a cable whose drive stops keeps its sliding-state memory).
+    span_tension : ndarray, shape (n_t, ..., 3 n, n N)
+        Stick-slip span tensions with memory along the disks (N), :func:`stick_slip_tensions` fed with
+        the base tensions.
+    state : ndarray, shape (n_t, ..., 3 n, n N)
+        Stick-slip state of every span (as returned by :func:`stick_slip_tensions`).
+    taut : ndarray of bool, shape (n_t, ...)
+        No cable went slack.
+    converged : ndarray of bool, shape (n_t, ...)
+        Newton met ``SIM_TOLERANCE``.
+    residual : ndarray, shape (n_t, ...)
+        Norm of the generalized-force residual (N m).
+    valid : ndarray of bool, shape (n_t, ...)
+        ``taut & converged``.
     """
 
     psi: np.ndarray
@@ -399,9 +601,47 @@ def simulate_history(
     last slip; +1 before it ever moved).  Each step is :func:`simulate` with that direction, started
     from the previous pose.  Loading and unloading the same drive therefore meet the friction bounds
     from opposite sides: hysteresis.  The span tensions with memory along the disks follow from
-    :func:`stick_slip_tensions`.  ``times (n_t,)`` optional strictly increasing time stamps (s): the
-    quasi-static model does not use them beyond the check (rate-independent friction).
+    :func:`stick_slip_tensions`.
     Cables that would push are flagged per sample (``taut`` false), not raised.
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
+    q : array_like, shape (n_t, ..., 3 n)
+        Drive history: cable pulled in by each actuator since the straight, pretensioned pose (m),
+        time axis first (``n_t >= 1``).
+    times : array_like, shape (n_t,), optional
+        Strictly increasing time stamps (s); the quasi-static model does not use them beyond the
+        check (rate-independent friction).  ``None``: no time stamps.
+    model : {"chord", "arc"}, optional
+        Cable path model of the spans (straight chords between holes, or arcs); default ``"chord"``.
+    pulley : Pulley, optional
+        Guide pulley at every actuator (eqs. (29)-(34)); ``None``: no pulley.
+
+    Returns
+    -------
+    HistoryResult
+        ``psi (n_t, ..., 2 n)``, ``tension``, ``actuator_tension``, ``direction (n_t, ..., 3 n)``,
+        ``span_tension``, ``state (n_t, ..., 3 n, n N)`` and the flags ``taut``, ``converged``,
+        ``valid`` and ``residual (n_t, ...)``.
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot` or ``pulley`` not a :class:`Pulley`; ``q`` has no
+        leading time axis, does not end in an axis of 3 n or is not real and finite; ``times`` has a
+        shape other than ``(n_t,)`` or is not strictly increasing; or ``model`` is unknown.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> robot = cr.ContinuumRobot.paper()
+    >>> q = cr.compensated_drive(robot, np.array([0.5, 0.0])).q_compensated
+    >>> res = cr.simulate_history(robot, np.linspace(0.0, 1.0, 3)[:, None] * q)
+    >>> res.psi.shape, bool(res.valid.all())
+    ((3, 2), True)
     """
     check_params(robot, ContinuumRobot, "robot")
     if pulley is not None:
@@ -512,13 +752,43 @@ def disk_equilibrium(
 ) -> DiskEquilibrium:
     """Equilibrium of the disk-wise constant-curvature robot: one arc per disk interval (issue 16).
 
-    Exactly one of ``tension (..., 3 n)`` (actuator-side tensions, N, >= 0) and ``drive (..., 3 n)``
-    (cable pulled in since the straight pretensioned pose, m; elastic cables, slack ones flagged).
-    ``direction (..., 3 n)`` the sliding direction of every cable (+1 pulled in, -1 paid out; None
-    frictionless), ``initial (..., 2 n)`` a segment pose to start from (default: the straight robot).
-    Chord spans, wrap angles, capstan friction and cable stretch as in the segment model; the
-    curvature may differ from interval to interval.  See :class:`DiskEquilibrium` and
-    ``docs/mechanisms/continuum.md``.
+    Exactly one of ``tension`` and ``drive`` loads the robot.  Chord spans, wrap angles, capstan
+    friction and cable stretch as in the segment model; the curvature may differ from interval to
+    interval.  Not in paper 3 (which keeps one arc per segment); see ``docs/mechanisms/continuum.md``.
+
+    Parameters
+    ----------
+    robot : ContinuumRobot
+        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
+    tension : array_like, shape (..., 3 n), optional
+        Actuator-side tensions (N, >= 0).
+    drive : array_like, shape (..., 3 n), optional
+        Cable pulled in since the straight pretensioned pose (m); elastic cables, slack ones flagged.
+    direction : array_like, shape (..., 3 n), optional
+        Sliding direction of every cable (+1 pulled in, -1 paid out); ``None``: frictionless.
+    initial : array_like, shape (..., 2 n), optional
+        Segment pose ``[theta_1, beta_1, ...]`` (rad) to start from; ``None``: the straight robot.
+
+    Returns
+    -------
+    DiskEquilibrium
+        The disk-wise pose, tensions and per-sample flags (see :class:`DiskEquilibrium`).
+
+    Raises
+    ------
+    ValueError
+        If ``robot`` is not a :class:`ContinuumRobot`; both or neither of ``tension`` and ``drive`` are
+        given; ``tension`` is negative; or an array has a wrong shape or is not real and finite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import continuum as cr
+    >>> robot = cr.ContinuumRobot.paper()
+    >>> t = cr.compensated_drive(robot, np.array([0.5, 0.0])).tension
+    >>> eq = cr.disk_equilibrium(robot, tension=t)
+    >>> eq.tip.shape, bool(eq.converged)
+    ((3,), True)
     """
     check_params(robot, ContinuumRobot, "robot")
     if (tension is None) == (drive is None):

@@ -29,14 +29,32 @@ PULLEY_FIXED_POINT_ITERATIONS = 30
 class Pulley:
     """The guide pulley between an actuator and the robot's base plate (paper 3, Section 3.3, Fig. 7).
 
-    Attributes (SI):
-        radius: pulley radius R_j (m); not printed, default 5 mm.
-        wrap: contact (wrap) angle phi of the cable (rad), 0 <= phi; paper Fig. 9: 0 ... pi.
-        alpha: friction constant of f = alpha N^n (eq. (25)); alpha = mu, n = 1 is Amontons' law;
-            paper Fig. 9: 0.15 or 0.6.  alpha = 0 is the frictionless pulley.
-        n: exponent of eq. (25), in (0, 1]; paper Fig. 9: 0.67 or 1.
     The cable radius r_s is the robot's ``cable_diameter / 2``; rho = R_j / r_s and the contact arc radius
     R = R_j + r_s (eq. (34)).
+
+    Parameters
+    ----------
+    radius : float, optional
+        Pulley radius R_j (m, > 0); not printed in the paper, default 5 mm.
+    wrap : float, optional
+        Contact (wrap) angle phi of the cable (rad, >= 0); paper Fig. 9: 0 ... pi; default pi / 2.
+    alpha : float, optional
+        Friction constant of f = alpha N^n (eq. (25), >= 0); alpha = mu, n = 1 is Amontons' law;
+        paper Fig. 9: 0.15 or 0.6; default 0.15.  alpha = 0 is the frictionless pulley.
+    n : float, optional
+        Exponent of eq. (25), in (0, 1]; paper Fig. 9: 0.67 or 1; default 1.
+
+    Raises
+    ------
+    ValueError
+        If ``radius`` is not positive, ``wrap`` or ``alpha`` is negative, ``n`` is not in (0, 1], or a
+        field is not a real finite number.
+
+    Examples
+    --------
+    >>> from robomech.mechanisms import continuum as cr
+    >>> cr.Pulley(radius=0.01, wrap=1.0, alpha=0.6, n=0.67).alpha
+    0.6
     """
 
     radius: float = 0.005
