@@ -94,3 +94,33 @@ def test_the_docs_show_every_example_and_the_paper_pages():
     assert "papers/*/index" in (DOCS / "papers.md").read_text()
     index = (DOCS / "index.md").read_text()
     assert re.search(r"^papers$", index, re.M) and re.search(r"^examples$", index, re.M)
+
+
+# The packages whose public names the API reference documents (docs/api/*.rst).
+_DOCUMENTED_PACKAGES = (
+    "spatial", "kinematics", "trajectory", "dynamics", "analysis.lstsq", "analysis.mobility",
+    "analysis.workspace", "multibody", "mechanisms.spherical_leg", "mechanisms.omnileg",
+    "mechanisms.continuum", "mechanisms.skid_steer", "mechanisms.vectored_thrust", "explore", "verify",
+    "studies", "testing",
+)  # fmt: skip
+_NUMPYDOC_SECTIONS = ("Parameters\n", "Returns\n", "Attributes\n", "Yields\n")
+
+
+def test_every_public_class_and_function_has_numpydoc_sections():
+    # Issue 19: shapes, units and frames in every public docstring. A new public name whose docstring
+    # has no Parameters / Returns / Attributes section fails here (module constants are exempt: they
+    # cannot carry a docstring and are explained by the comment above them).
+    import importlib
+    import inspect
+
+    missing = []
+    for pkg in _DOCUMENTED_PACKAGES:
+        module = importlib.import_module(f"robomech.{pkg}")
+        for name in module.__all__:
+            obj = getattr(module, name)
+            if not (inspect.isfunction(obj) or inspect.isclass(obj)):
+                continue
+            doc = inspect.getdoc(obj) or ""
+            if not any(s in doc for s in _NUMPYDOC_SECTIONS):
+                missing.append(f"robomech.{pkg}.{name}")
+    assert not missing, f"public names without numpydoc sections: {missing}"
