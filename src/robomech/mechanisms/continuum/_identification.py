@@ -123,18 +123,7 @@ def identify_friction_from_pose(
     """
     check_params(robot, ContinuumRobot, "robot")
     n_c = robot.n_cables
-    p = as_array(psi, "psi", (2 * robot.n_segments,))
-    t = as_array(t_act, "t_act", (n_c,))
-    d = as_array(direction, "direction", (n_c,))
-    if p.ndim != 2 or p.shape[0] < 1 or t.shape != (p.shape[0], n_c) or d.shape != t.shape:
-        raise ValueError(
-            f"Expected psi (m, {2 * robot.n_segments}), t_act and direction (m, {n_c}) with one m >= 1, got "
-            f"{p.shape}, {t.shape}, {d.shape}."
-        )
-    if np.any((d != 1.0) & (d != -1.0)):
-        raise ValueError("Expected direction entries +1 or -1 (a sliding cable), got others.")
-    if np.any(t <= 0.0):
-        raise ValueError("Expected t_act > 0 (a slack cable carries no friction information).")
+    p, t, d = _measurements(psi, "psi", 2 * robot.n_segments, t_act, direction, n_c)
     if sigma_t is not None:
         sigma_t = check_positive(sigma_t, "sigma_t")
     if model not in ("arc", "chord"):
@@ -280,18 +269,7 @@ def identify_friction_from_tip(
 
     check_params(robot, ContinuumRobot, "robot")
     n_c = robot.n_cables
-    p = as_array(tip, "tip", (3,))
-    t = as_array(t_act, "t_act", (n_c,))
-    d = as_array(direction, "direction", (n_c,))
-    if p.ndim != 2 or p.shape[0] < 1 or t.shape != (p.shape[0], n_c) or d.shape != t.shape:
-        raise ValueError(
-            f"Expected tip (m, 3), t_act and direction (m, {n_c}) with one m >= 1, got "
-            f"{p.shape}, {t.shape}, {d.shape}."
-        )
-    if np.any((d != 1.0) & (d != -1.0)):
-        raise ValueError("Expected direction entries +1 or -1 (a sliding cable), got others.")
-    if np.any(t <= 0.0):
-        raise ValueError("Expected t_act > 0 (a slack cable carries no friction information).")
+    p, t, d = _measurements(tip, "tip", 3, t_act, direction, n_c)
     fit = check_bool(fit_stiffness, "fit_stiffness")
     init = None if initial is None else as_array(initial, "initial", (2 * robot.n_segments,))
     if init is not None and init.shape != (p.shape[0], 2 * robot.n_segments):
@@ -369,3 +347,23 @@ def identify_friction_from_tip(
         identifiable=identifiable[:k_par],
         success=bool(sol.success) and state["ok"],
     )
+
+
+def _measurements(
+    pose: object, pose_name: str, pose_size: int, t_act: object, direction: object, n_c: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The measured poses ``(m, pose_size)``, actuator-side tensions and sliding directions ``(m, n_c)``
+    of an identification data set, validated together (one m >= 1, directions +-1, tensions > 0)."""
+    p = as_array(pose, pose_name, (pose_size,))
+    t = as_array(t_act, "t_act", (n_c,))
+    d = as_array(direction, "direction", (n_c,))
+    if p.ndim != 2 or p.shape[0] < 1 or t.shape != (p.shape[0], n_c) or d.shape != t.shape:
+        raise ValueError(
+            f"Expected {pose_name} (m, {pose_size}), t_act and direction (m, {n_c}) with one m >= 1, got "
+            f"{p.shape}, {t.shape}, {d.shape}."
+        )
+    if np.any((d != 1.0) & (d != -1.0)):
+        raise ValueError("Expected direction entries +1 or -1 (a sliding cable), got others.")
+    if np.any(t <= 0.0):
+        raise ValueError("Expected t_act > 0 (a slack cable carries no friction information).")
+    return p, t, d
