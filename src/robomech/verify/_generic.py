@@ -80,6 +80,38 @@ AMP = 0.15
 ENGINE_RANK_RTOL = 1e-10
 
 
+def engine_options(
+    xml: str,
+    *,
+    timestep: float,
+    integrator: str | None = None,
+    jacobian: str | None = None,
+    solref: str | None = None,
+    solimp: str | None = None,
+    contact: bool = True,
+) -> ET.Element:
+    """The exported MJCF ``xml`` with the engine options a check simulates with (not part of a mechanism
+    description): ``<option timestep integrator jacobian>``, contacts off with ``contact=False``, and
+    ``solref`` / ``solimp`` on every equality constraint; ``None`` leaves MuJoCo's default. Returns the
+    root element (serialise with ``ET.tostring(root, encoding="unicode")``)."""
+    root = ET.fromstring(xml)
+    opt = root.find("option")
+    if opt is None:  # to_mjcf always writes <option gravity=...>; kept robust
+        opt = ET.SubElement(root, "option")
+    opt.set("timestep", repr(timestep))
+    for key, value in (("integrator", integrator), ("jacobian", jacobian)):
+        if value is not None:
+            opt.set(key, value)
+    if not contact:
+        ET.SubElement(opt, "flag", contact="disable")
+    eq = root.find("equality")
+    for e in [] if eq is None else list(eq):
+        for key, value in (("solref", solref), ("solimp", solimp)):
+            if value is not None:
+                e.set(key, value)
+    return root
+
+
 def engine_model(mech, *, simulation: bool = False):
     """MuJoCo model of ``mech`` from ``mb.to_mjcf``; ``simulation=True`` sets the stiff equality
     constraints and the RK4 step used by the forward-simulation check."""
@@ -89,16 +121,9 @@ def engine_model(mech, *, simulation: bool = False):
 
     xml = mb.to_mjcf(mech)
     if simulation:
-        root = ET.fromstring(xml)
-        opt = root.find("option")
-        if opt is None:
-            opt = ET.SubElement(root, "option")
-        opt.set("timestep", repr(SIM_TIMESTEP))
-        opt.set("integrator", "RK4")
-        eq = root.find("equality")
-        for e in [] if eq is None else list(eq):
-            e.set("solref", SIM_SOLREF)
-            e.set("solimp", SIM_SOLIMP)
+        root = engine_options(
+            xml, timestep=SIM_TIMESTEP, integrator="RK4", solref=SIM_SOLREF, solimp=SIM_SOLIMP
+        )
         xml = ET.tostring(root, encoding="unicode")
     return mujoco.MjModel.from_xml_string(xml)
 
@@ -388,6 +413,7 @@ def split_targets(targets, available) -> tuple[list[str], list[str]]:
     from robomech import multibody as mb
 
     described = set(_paper()) | set(mb.gallery.NAMES)
+
     def is_generic(a: str) -> bool:
         return a not in available and (a in described or a.endswith(".xml") or Path(a).is_file())
 

@@ -38,6 +38,7 @@ from robomech._validation import as_array, broadcast_batch, check_params
 from robomech.trajectory import Profile
 
 from ._core import Check, Tolerance, Verification, optional_module
+from ._generic import engine_options
 
 if TYPE_CHECKING:
     import mujoco
@@ -91,17 +92,14 @@ def build_mjcf(leg: ol.OmniLeg) -> str:
     constraints ``SIM_SOLREF``/``SIM_SOLIMP``, dense constraint Jacobian, contacts off.
     """
     check_params(leg, ol.OmniLeg, "leg")
-    root = ET.fromstring(mb.to_mjcf(ol.to_multibody(leg), comment="robomech verify omnileg"))
-    opt = root.find("option")
-    if opt is None:  # to_mjcf always writes <option gravity=...>; kept robust
-        opt = ET.SubElement(root, "option")
-    opt.set("timestep", repr(SIM_TIMESTEP))
-    opt.set("jacobian", "dense")
-    ET.SubElement(opt, "flag", contact="disable")
-    eq = root.find("equality")
-    for e in [] if eq is None else list(eq):
-        e.set("solref", _vec(SIM_SOLREF))
-        e.set("solimp", _vec(SIM_SOLIMP))
+    root = engine_options(
+        mb.to_mjcf(ol.to_multibody(leg), comment="robomech verify omnileg"),
+        timestep=SIM_TIMESTEP,
+        jacobian="dense",
+        solref=_vec(SIM_SOLREF),
+        solimp=_vec(SIM_SOLIMP),
+        contact=False,
+    )
     return ET.tostring(root, encoding="unicode")
 
 

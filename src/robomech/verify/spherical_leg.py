@@ -43,6 +43,7 @@ from robomech._validation import as_array, check_bool, check_int, check_params, 
 from robomech.mechanisms import spherical_leg as sl
 
 from ._core import Check, Tolerance, Verification, optional_module
+from ._generic import engine_options
 
 if TYPE_CHECKING:
     import mujoco
@@ -100,17 +101,14 @@ def build_model(leg: sl.SphericalLeg, timestep: float = SIM_TIMESTEP) -> mujoco.
     from robomech import multibody as mb
 
     mech = sl.to_multibody(leg)
-    root = ET.fromstring(mb.to_mjcf(mech))
-    opt = root.find("option")
-    if opt is None:
-        opt = ET.SubElement(root, "option")
-    opt.set("timestep", repr(timestep))
-    opt.set("integrator", "Euler")
-    opt.set("jacobian", "dense")
-    eq = root.find("equality")
-    for e in [] if eq is None else list(eq):
-        e.set("solref", _SOLREF)
-        e.set("solimp", _SOLIMP)
+    root = engine_options(
+        mb.to_mjcf(mech),
+        timestep=timestep,
+        integrator="Euler",
+        jacobian="dense",
+        solref=_SOLREF,
+        solimp=_SOLIMP,
+    )
     m = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
     for b in mech.bodies:
         if b.inertial is None:  # MuJoCo inferred an inertia from the visual geoms: the description has none

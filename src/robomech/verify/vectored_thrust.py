@@ -41,6 +41,7 @@ from robomech.mechanisms import vectored_thrust as vt
 from robomech.spatial import exp_so3
 
 from ._core import Check, Tolerance, Verification, optional_module
+from ._generic import engine_options
 
 if TYPE_CHECKING:
     import mujoco
@@ -100,15 +101,9 @@ def build_mjcf(th: vt.VectoredThruster, *, actuated: bool = False) -> str:
     actuated = check_bool(actuated, "actuated")
     from robomech import multibody as mb
 
-    root = ET.fromstring(mb.to_mjcf(vt.to_multibody(th)))
-    opt = root.find("option")
-    if opt is None:
-        opt = ET.SubElement(root, "option")
-    opt.set("timestep", repr(SIM_TIMESTEP))
-    opt.set("integrator", "implicitfast")
-    eq = root.find("equality")
-    for e in [] if eq is None else list(eq):
-        e.set("solref", _SOLREF)
+    root = engine_options(
+        mb.to_mjcf(vt.to_multibody(th)), timestep=SIM_TIMESTEP, integrator="implicitfast", solref=_SOLREF
+    )
     act = root.find("actuator")
     if act is not None and not actuated:
         root.remove(act)
