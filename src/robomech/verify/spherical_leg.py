@@ -381,18 +381,25 @@ def _state_errors(
         Te, Ve = float(d.energy[1]), float(d.energy[0])
         up("energy", max(abs(Te - Ta[t]), abs(Ve - Va[t])) / max(abs(Ta[t]) + abs(Va[t]), 1e-300))
     # FK of the engine's own leg lengths (only alpha, beta set: the platform placed by the engine)
-    L = np.zeros((n, 3))
-    for t in range(n):
-        d2.qpos[:] = 0.0
-        d2.qpos[lay.alpha[0]], d2.qpos[lay.beta[0]] = q[t]
-        mujoco.mj_kinematics(m, d2)
-        Rp, pp = d2.xmat[lay.platform].reshape(3, 3), d2.xpos[lay.platform]
-        for i in range(3):
-            L[t, i] = np.linalg.norm(Rp @ lay.B_home[i] + pp - d2.xpos[lay.cardan[i]])
+    L = _engine_leg_lengths(m, d2, lay, q)
     fk = sl.forward_kinematics(leg, L)
     fk_err = np.abs(np.stack([fk.alpha, fk.beta], -1) - q)
     up("fk", float(np.max(fk_err)) if bool(np.all(fk.valid)) else np.inf)
     return err
+
+
+def _engine_leg_lengths(m: mujoco.MjModel, d: mujoco.MjData, lay: _Layout, q: Array) -> Array:
+    """Leg lengths |B_i - A_i| ``(n, 3)`` in the engine at the platform angles ``q (n, 2)``: only alpha,
+    beta set (the platform placed by the engine's hinges), A_i the cardans' origins."""
+    L = np.zeros((len(q), 3))
+    for k in range(len(q)):
+        d.qpos[:] = 0.0
+        d.qpos[lay.alpha[0]], d.qpos[lay.beta[0]] = q[k]
+        mujoco.mj_kinematics(m, d)
+        Rp, pp = d.xmat[lay.platform].reshape(3, 3), d.xpos[lay.platform]
+        for i in range(3):
+            L[k, i] = np.linalg.norm(Rp @ lay.B_home[i] + pp - d.xpos[lay.cardan[i]])
+    return L
 
 
 def engine_leg_accelerations(leg: sl.SphericalLeg, t: Array, q: Array) -> Array:
@@ -401,14 +408,7 @@ def engine_leg_accelerations(leg: sl.SphericalLeg, t: Array, q: Array) -> Array:
     m = build_model(leg)
     d = mujoco.MjData(m)
     lay = _Layout(m, leg)
-    L = np.zeros((len(t), 3))
-    for k in range(len(t)):
-        d.qpos[:] = 0.0
-        d.qpos[lay.alpha[0]], d.qpos[lay.beta[0]] = q[k]
-        mujoco.mj_kinematics(m, d)
-        Rp, pp = d.xmat[lay.platform].reshape(3, 3), d.xpos[lay.platform]
-        for i in range(3):
-            L[k, i] = np.linalg.norm(Rp @ lay.B_home[i] + pp - d.xpos[lay.cardan[i]])
+    L = _engine_leg_lengths(m, d, lay, q)
     dt = t[1] - t[0]
     return np.asarray((-L[:-4] + 16 * L[1:-3] - 30 * L[2:-2] + 16 * L[3:-1] - L[4:]) / (12 * dt * dt))
 
