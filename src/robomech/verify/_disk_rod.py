@@ -50,6 +50,7 @@ __all__ = [
     "DiskRobot",
     "DiskSolution",
     "solve_disk_robot",
+    "straight_stability",
 ]
 
 DISK_RK4_STEPS = 12
@@ -473,6 +474,38 @@ def _solve_case(model, t_act, q, F_tip, L_tip, direction, mode, steps):
     if frac < 1.0:
         _, r = run(x, 1.0)  # residual of the full load at the last converged state
     return x, r, frac, Rbar
+
+
+def straight_stability(robot: DiskRobot, tension: object, *, steps: int = DISK_RK4_STEPS) -> np.ndarray:
+    """Smallest singular value of the shooting Jacobian (nondimensional) at the straight equilibrium
+    under equal tensions ``tension (*B,)`` (N) in every cable, frictionless.
+
+    The straight rod under equal tensions is an exact equilibrium at every tension; where this value
+    falls to 0 that equilibrium bifurcates (the robot buckles: a double zero, one per bending plane, so
+    the determinant touches 0 without changing sign).  Issue 16: with the 0.8 mm core assumed before,
+    the zero sits at 12.25 N per cable, = the Euler load pi² EI / h² of one disk interval under the
+    three cables' compression 3 T, inside the paper's 3-11 N range plus margin; see
+    ``docs/mechanisms/continuum_cosserat.md``."""
+    t = as_array(tension, "tension", ())
+    if np.any(t < 0):
+        raise ValueError(f"Expected tension >= 0, got min {t.min()!r}.")
+    if not (isinstance(steps, int) and steps >= 1):
+        raise ValueError(f"Expected steps an integer >= 1, got {steps!r}.")
+    model = _Model(robot)
+    fs = model.ei / model.L**2
+    zero = np.zeros(3)
+    out = np.empty(t.size)
+    for b, tb in enumerate(t.ravel()):
+        t_act = np.full(model.n_c, float(tb) / fs)
+        p, Rbar, n, m = _guess(model, t_act, zero, zero)
+        x = np.concatenate([p, np.zeros_like(p), n, m], 1).ravel()
+
+        def assemble(z, ends, t_act=t_act, Rbar=Rbar):
+            return _assemble(model, z, Rbar, ends, zero, zero, np.zeros(model.n_c), "tension", t_act)
+
+        jac = _jacobian(model, x, Rbar, steps, assemble)
+        out[b] = np.linalg.svd(jac, compute_uv=False)[-1]
+    return out.reshape(t.shape)
 
 
 def _as_direction(direction, n_c, batch):
