@@ -7,6 +7,13 @@ tests solve a few cases of each.  Run: ``PYTHONPATH=src python benchmarks/contin
 
 from __future__ import annotations
 
+import os
+
+# one BLAS thread: the solves are many small dense systems, and on a shared machine a multi-threaded
+# BLAS spends most of its time waiting (measured: a 2-segment disk solve 52 s -> 12 s)
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
 import sys
 import time
 
@@ -27,21 +34,26 @@ def main(argv: list[str]) -> None:
         )
     if "disks" in which:
         t0 = time.perf_counter()
-        segments = (1, 2) if "disks2" in which else (1,)
-        for n in segments:  # row by row, printed as they finish (the whole table takes long)
+        segments = tuple(int(a[5:]) for a in which if a.startswith("disks") and a[5:].isdigit()) or (1, 2, 3)
+        rows = []
+        for n in sorted(segments):  # row by row, printed as they finish (the whole table takes long)
             for t in V.CONVERGENCE_PRETENSIONS_N:
                 table = V.disk_agreement_table((n,), (t,))
-                print(table.markdown().splitlines()[-1], flush=True)
-                v = table.valid
-                if v.any():
-                    print(
-                        f"  chord max {1e3 * np.nanmax(table.chord_error[v]):.2f} mm, arc max "
-                        f"{1e3 * np.nanmax(table.arc_error[v]):.2f} mm, elongation max "
-                        f"{1e6 * np.nanmax(table.elongation_error[v]):.1f} µm, "
-                        f"{int(v.sum())}/{v.size} valid, "
-                        f"{time.perf_counter() - t0:.0f} s",
-                        flush=True,
-                    )
+                rows.append(table)
+                conv, err = (part.splitlines()[-1] for part in table.markdown().split("\n\n"))
+                print("conv", conv, "\nerr ", err, f"\n  {time.perf_counter() - t0:.0f} s", flush=True)
+        valid = np.concatenate([r.valid.ravel() for r in rows])
+        for name in ("chord_error", "arc_error", "elongation_error", "diskwise_error"):
+            vals = np.concatenate([getattr(r, name).ravel() for r in rows])[valid]
+            vals = vals[np.isfinite(vals)]
+            if vals.size:
+                print(
+                    f"{name}: {vals.size} cases, min {vals.min():.3g}, "
+                    f"median {np.median(vals):.3g}, max {vals.max():.3g}"
+                )
+        conv = np.concatenate([r.converged.ravel() for r in rows])
+        taut = np.concatenate([r.taut.ravel() for r in rows])
+        print(f"{int(conv.sum())}/{conv.size} converged, {int(taut.sum())} taut, {int(valid.sum())} compared")
     if "ident" in which:
         for estimator, stiff in (("pose", False), ("tip", False), ("tip", True), ("tip-eiv", False)):
             t0 = time.perf_counter()
