@@ -54,6 +54,33 @@ def main(argv: list[str]) -> None:
         conv = np.concatenate([r.converged.ravel() for r in rows])
         taut = np.concatenate([r.taut.ravel() for r in rows])
         print(f"{int(conv.sum())}/{conv.size} converged, {int(taut.sum())} taut, {int(valid.sum())} compared")
+    if "cosserat" in which:  # the disk reference with many disks vs the continuous-tendon rod
+        import dataclasses
+        import math
+
+        from robomech.mechanisms.continuum import ContinuumRobot, cable_tensions
+        from robomech.verify._cosserat import solve_static
+        from robomech.verify._disk_rod import solve_disk_robot
+
+        cases = (
+            (1, 10.0, 90.0, (5, 10, 20, 40)),
+            (1, 15.0, 60.0, (5, 10, 20, 40)),
+            (2, 10.0, 45.0, (5, 10, 20)),
+            (3, 5.0, 30.0, (5, 10)),
+        )
+        for n, t0, bend, disks in cases:
+            rob = ContinuumRobot(n_segments=n, friction=(0.0,) * (3 * n), pretension=t0)
+            psi = np.zeros(2 * n)
+            psi[0::2], psi[1::2] = math.radians(bend), V.CONVERGENCE_PLANES[:n]
+            t = cable_tensions(rob, psi, model="arc")
+            cos = solve_static(V.rod_for(rob), t.tension)
+            gaps = []
+            for nd in disks:
+                ref = V.disk_robot_for(dataclasses.replace(rob, disks_per_segment=nd))
+                sol = solve_disk_robot(ref, tension=t.tension)
+                gap = 1e3 * np.linalg.norm(sol.T_tip[:3, 3] - cos.T_tip[:3, 3])
+                gaps.append(f"N={nd}: {gap:.3f} mm" + ("" if sol.converged else " (not converged)"))
+            print(f"{n} segments, {t0:g} N, {bend:g}°: " + "; ".join(gaps), flush=True)
     if "ident" in which:
         for estimator, stiff in (("pose", False), ("tip", False), ("tip", True), ("tip-eiv", False)):
             t0 = time.perf_counter()

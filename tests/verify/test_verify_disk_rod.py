@@ -168,3 +168,18 @@ def test_multi_segment_robots_buckle_at_the_proximal_segments_compression(robot)
     euler = math.pi**2 * rob.bending_stiffness / (6.0 * h**2)
     t_cr = straight_buckling_tension(V.disk_robot_for(rob), 0.8 * euler, 1.2 * euler)
     assert abs(t_cr / euler - 1.0) < BUCKLING_REL_TOL
+
+
+@pytest.mark.slow
+def test_segment_check_has_teeth_a_1mm_hole_radius_error_fails() -> None:
+    """The 2-segment agreement check of verify continuum fails for a library whose holes are 1 mm short
+    (measured 0.12 L against the 0.05 L tolerance; the true library: 0.014 L)."""
+    n, t0, bend = V.SEGMENT_CHECK_CASES[0]
+    true = ContinuumRobot(n_segments=n, friction=V.AGREEMENT_MU * n, pretension=t0)
+    wrong = dataclasses.replace(true, hole_radius=true.hole_radius - 1e-3)
+    psi = np.zeros(2 * n)
+    psi[0::2], psi[1::2] = math.radians(bend), V.CONVERGENCE_PLANES[:n]
+    d = np.tile([1.0, -1.0, -1.0], n)
+    p, _, ok, conv = V.library_disk_error(wrong, psi, d, reference=V.disk_robot_for(true))
+    assert ok.all() and conv.all()
+    assert p[0] / (n * true.segment_length) > V.SEGMENT_CHORD_TOLERANCE.value
