@@ -55,6 +55,11 @@ class Spec:
     ``slow``     mark the good call and its bad calls ``pytest.mark.slow``.
     ``empty_batch``  the good call with every array argument cut to an empty leading batch must
                  return (empty results), not raise; False where an array's leading axis is no batch.
+    ``unbatched``  array arguments that carry no batch axis (every axis is core: ``weights (6,)``,
+                 ``M (4, 4)``, a mechanism's ``screws (n, 6)``).  In a spec with two or more arrays every
+                 other array must have a batch in ``args`` (more axes than its core): the suite then
+                 gives one of them a batch that does not broadcast with the others' and expects a
+                 ValueError naming it, the other argument and the shape.
     ``good_elsewhere``  for a call that takes minutes (a whole engine verification): the test file
                  that runs the good call; the contract suite then makes only the bad calls.
     """
@@ -71,6 +76,7 @@ class Spec:
     slow: bool = False
     good_elsewhere: str = ""
     empty_batch: bool = True
+    unbatched: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.good_elsewhere and (self.masked or self.mask is not None):
@@ -80,11 +86,18 @@ class Spec:
         for a in self.masked:
             if a not in self.arrays:
                 raise ValueError(f"masked argument {a!r} must also be listed in arrays")
+        for a in self.unbatched:
+            if a not in self.arrays:
+                raise ValueError(f"unbatched argument {a!r} must also be listed in arrays")
         if self.masked and self.mask is None:
             raise ValueError("a spec with masked arguments needs mask=")
         for a in (*self.arrays, *self.params, *self.options):
             if a not in self.args:
                 raise ValueError(f"argument {a!r} needs a good value in args")
+
+    def batched(self) -> tuple[str, ...]:
+        """The array arguments that carry a leading batch (all of ``arrays`` but ``unbatched``)."""
+        return tuple(a for a in self.arrays if a not in self.unbatched)
 
 
 @dataclass(frozen=True)

@@ -94,7 +94,7 @@ SPECS = {
         params=("robot",),
     ),
     P + "segment_transform": Spec(
-        args={"theta": PSI[:, 0], "beta": PSI[:, 1], "length": 0.09},
+        args={"theta": PSI[:, 0], "beta": PSI[:, 1], "length": np.array([0.09, 0.08, 0.1])},
         arrays={"theta": 0, "beta": 0, "length": 0},
         options={"length": (-0.1,)},
     ),
@@ -161,17 +161,23 @@ SPECS = {
         },
     ),
     P + "capstan_coefficient": Spec(
-        args={"rho": np.array([2.0, 3.0]), "alpha": 1.0, "n": 0.5},
+        args={"rho": np.array([2.0, 3.0]), "alpha": np.array([1.0, 0.8]), "n": np.array([0.5, 1.0])},
         arrays={"rho": 0, "alpha": 0, "n": 0},
         options={"n": (0.0, -0.5, 1.5), "rho": (0.0,), "alpha": (-1.0,)},
     ),
     P + "capstan_tension_ratio": Spec(
-        args={"phi": np.array([0.5, 1.0]), "rho": np.array([2.0, 3.0]), "alpha": 1.0, "n": 0.5, "t_out": 1.0},
-        arrays={"phi": 0, "alpha": 0, "n": 0, "t_out": 0},
+        args={
+            "phi": np.array([0.5, 1.0]),
+            "rho": np.array([2.0, 3.0]),
+            "alpha": np.array([1.0, 0.8]),
+            "n": np.array([0.5, 1.0]),
+            "t_out": np.array([1.0, 2.0]),
+        },
+        arrays={"phi": 0, "alpha": 0, "n": 0, "t_out": 0},  # rho: an option (np.inf is allowed)
         options={"n": (0.0, 1.5), "rho": (0.0, np.nan, None, "2"), "phi": (-1.0,), "t_out": (0.0,)},
     ),
     P + "classical_capstan_ratio": Spec(
-        args={"phi": np.array([0.5, 1.0]), "mu": 0.3}, arrays={"phi": 0, "mu": 0}
+        args={"phi": np.array([0.5, 1.0]), "mu": np.array([0.3, 0.1])}, arrays={"phi": 0, "mu": 0}
     ),
     P + "identify_friction": Spec(
         args={
