@@ -60,6 +60,9 @@ class Spec:
                  other array must have a batch in ``args`` (more axes than its core): the suite then
                  gives one of them a batch that does not broadcast with the others' and expects a
                  ValueError naming it, the other argument and the shape.
+    ``batch_core``  core dimensions for the batch tests where they differ from ``arrays`` (an argument
+                 masked per element of its last axis: ``wheel_rate (..., 6)`` is masked per wheel, core 0,
+                 but its batch is everything before the wheel axis, core 1).
     ``good_elsewhere``  for a call that takes minutes (a whole engine verification): the test file
                  that runs the good call; the contract suite then makes only the bad calls.
     """
@@ -77,6 +80,7 @@ class Spec:
     good_elsewhere: str = ""
     empty_batch: bool = True
     unbatched: tuple[str, ...] = ()
+    batch_core: Mapping[str, int] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.good_elsewhere and (self.masked or self.mask is not None):
@@ -86,9 +90,9 @@ class Spec:
         for a in self.masked:
             if a not in self.arrays:
                 raise ValueError(f"masked argument {a!r} must also be listed in arrays")
-        for a in self.unbatched:
+        for a in (*self.unbatched, *self.batch_core):
             if a not in self.arrays:
-                raise ValueError(f"unbatched argument {a!r} must also be listed in arrays")
+                raise ValueError(f"unbatched / batch_core argument {a!r} must also be listed in arrays")
         if self.masked and self.mask is None:
             raise ValueError("a spec with masked arguments needs mask=")
         for a in (*self.arrays, *self.params, *self.options):
@@ -98,6 +102,10 @@ class Spec:
     def batched(self) -> tuple[str, ...]:
         """The array arguments that carry a leading batch (all of ``arrays`` but ``unbatched``)."""
         return tuple(a for a in self.arrays if a not in self.unbatched)
+
+    def core(self, arg: str) -> int:
+        """The number of core dimensions of ``arg`` for the batch tests."""
+        return self.batch_core.get(arg, self.arrays[arg])
 
 
 @dataclass(frozen=True)

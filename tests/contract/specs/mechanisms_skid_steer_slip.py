@@ -86,6 +86,7 @@ SPECS = {
         mask="valid",
         params=("robot",),
         wrong_shapes={"wheel_rate": ((2, 5),)},
+        batch_core={"wheel_rate": 1},  # its batch is everything before the wheel axis
     ),
     P + "EncoderModel": Spec(args={"counts_per_rev": 1024}, options={"counts_per_rev": (*BAD_INT, 0, -5)}),
     P + "ImuModel": Spec(

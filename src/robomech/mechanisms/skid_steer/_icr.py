@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from robomech._validation import as_array, check_params, check_positive, coerce_float_fields
+from robomech._validation import as_array, broadcast_batch, check_params, check_positive, coerce_float_fields
 from robomech.analysis import lstsq
 
 from ._chains import N_WHEELS, WHEEL_SIDE, WHEELS, contact_frames
@@ -308,11 +308,12 @@ def identify_icr(
         )
     if V.shape != (*vr.shape, 3):
         raise ValueError(
-            f"Expected body_velocity to have shape {(*vr.shape, 3)} (one N: one sample rate), got {V.shape}."
+            f"Expected body_velocity to have shape {(*vr.shape, 3)} like v_right {vr.shape} (one N: one "
+            f"sample rate), got {V.shape}."
         )
     w = np.ones(vr.shape) if weights is None else as_array(weights, "weights")
     if w.shape != vr.shape:
-        raise ValueError(f"Expected weights to have shape {vr.shape}, got {w.shape}.")
+        raise ValueError(f"Expected weights to have shape {vr.shape} like v_right, got {w.shape}.")
     if np.any(w < 0):
         raise ValueError(f"Expected weights >= 0, got {int(np.sum(w < 0))} negative value(s).")
     used = np.isfinite(vr) & np.isfinite(vl) & np.all(np.isfinite(V), axis=-1)
@@ -399,6 +400,7 @@ def wheel_slip(
         q[[3, 7]] = robot.rear_wheel_drop
     else:
         q = as_array(config, "config", (8,))
+    broadcast_batch((w, 1, "wheel_rate"), (V, 1, "body_velocity"), (q, 1, "config"))
     p = contact_frames(robot, q)[..., :3, 3]  # (..., 6, 3)
     vx, vy, r = V[..., 0:1], V[..., 1:2], V[..., 2:3]
     ground = vx - r * p[..., 1]
