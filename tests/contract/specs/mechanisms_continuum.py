@@ -137,8 +137,15 @@ SPECS = {
         options={"model": BAD_MODEL, "method": ("segment", None, 1), "pulley": BAD_PULLEY},
     ),
     P + "simulate": Spec(
-        args={"robot": ROBOT, "q": Q, "direction": DIRECTION, "model": "chord", "pulley": PULLEY},
-        arrays={"q": 1, "direction": 1},
+        args={
+            "robot": ROBOT,
+            "q": Q,
+            "direction": DIRECTION,
+            "model": "chord",
+            "pulley": PULLEY,
+            "initial": PSI,
+        },
+        arrays={"q": 1, "direction": 1, "initial": 1},
         params=("robot",),
         mask="converged",
         options={"model": BAD_MODEL, "pulley": BAD_PULLEY},

@@ -44,8 +44,15 @@ SPECS = {
         params=("robot",),
     ),
     P + "body_velocity": Spec(
-        args={"robot": ROBOT, "state": CFG, "measured": MEAS, "solver": "qr", "exact_cond": False},
-        arrays={"state": 1, "measured": 1},
+        args={
+            "robot": ROBOT,
+            "state": CFG,
+            "measured": MEAS,
+            "solver": "qr",
+            "exact_cond": False,
+            "measurement_sigma": np.full(MEAS.shape, 0.01),
+        },
+        arrays={"state": 1, "measured": 1, "measurement_sigma": 1},
         masked=("state", "measured"),
         mask="valid",
         params=("robot",),

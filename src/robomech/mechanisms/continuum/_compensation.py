@@ -479,7 +479,12 @@ def simulate(
     qa = as_array(q, "q", (robot.n_cables,))
     batch = qa.shape[:-1]
     d = _as_direction(robot, direction, batch)
-    broadcast_batch((qa, 1, "q"), (d, 1, "direction"))
+    th_init = [] if initial is None else [(_split(robot, initial, "initial")[0], 1, "initial")]
+    if broadcast_batch((qa, 1, "q"), (d, 1, "direction"), *th_init) != batch:
+        got = ", ".join(f"{nm} {a.shape[:-1]}" for a, _, nm in [(d, 1, "direction"), *th_init])
+        raise ValueError(
+            f"Expected direction and initial with batch shapes that broadcast to q's {batch}, got {got}."
+        )
     n = robot.n_segments
     if initial is None:
         # Rigid arc cables: q_c = r sum_{m <= seg(c)} k_m . (cos s_c, sin s_c); least squares for k.
