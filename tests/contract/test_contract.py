@@ -404,7 +404,10 @@ def test_every_array_of_a_multi_array_spec_is_batched_or_declared_unbatched():
 def test_batches_that_do_not_broadcast(name, arg):
     """``arg`` with a batch of 2 samples, every other batched argument with 3: a ValueError naming
     ``arg``, another of the arguments and ``arg``'s shape."""
-    spec = ACTIVE[name]
+    _check_mismatch(name, ACTIVE[name], arg)
+
+
+def _check_mismatch(name: str, spec: Spec, arg: str) -> None:
     mine, theirs = MISMATCH_LENGTHS
     args = dict(spec.args)
     for a in spec.batched():
@@ -436,7 +439,10 @@ def test_an_extra_batch_axis(name, arg):
     """One argument with an extra axis of 2 just before its core (``q (3, 2)`` -> ``(3, 2, 2)``): a
     bigger batch, which the call either broadcasts (it returns) or refuses with a ValueError naming
     the argument - never another exception (a bare NumPy broadcasting error from inside a kernel)."""
-    spec = ACTIVE[name]
+    _check_extra_axis(name, ACTIVE[name], arg)
+
+
+def _check_extra_axis(name: str, spec: Spec, arg: str) -> None:
     a = np.asarray(spec.args[arg])
     b = np.stack([a, a], axis=a.ndim - spec.core(arg))
     try:
@@ -450,3 +456,32 @@ def test_an_extra_batch_axis(name, arg):
             f"{name}({arg} {b.shape}): expected a result or a ValueError naming {arg!r}, "
             f"got {type(exc).__name__}: {exc}"
         )
+
+
+# The two checks above are not passed by accident: a function that leaves the mismatch to NumPy
+# fails them, the same function with the boundary check passes.
+def _unchecked(q, qd):
+    return np.asarray(q, dtype=float) * np.asarray(qd, dtype=float)
+
+
+def _checked(q, qd):
+    from robomech._validation import as_array, broadcast_batch
+
+    q, qd = as_array(q, "q", (3,)), as_array(qd, "qd", (3,))
+    broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
+    return q * qd
+
+
+_Q3 = np.arange(9.0).reshape(3, 3)
+
+
+@pytest.mark.parametrize("arg", ["q", "qd"])
+def test_the_batch_checks_fail_a_function_that_leaves_the_mismatch_to_numpy(arg):
+    spec = Spec(args={"q": _Q3, "qd": _Q3[::-1]}, arrays={"q": 1, "qd": 1}, call=_unchecked)
+    with pytest.raises(AssertionError, match="must name"):
+        _check_mismatch("unchecked", spec, arg)
+    with pytest.raises(AssertionError, match="must name"):  # NumPy's ValueError names no argument
+        _check_extra_axis("unchecked", spec, arg)
+    checked = Spec(args=spec.args, arrays=spec.arrays, call=_checked)
+    _check_mismatch("checked", checked, arg)
+    _check_extra_axis("checked", checked, arg)
