@@ -23,7 +23,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from robomech._validation import as_array, broadcast_batch, check_params, check_positive, coerce_float_fields
+from robomech._validation import (
+    as_array,
+    broadcast_batch,
+    broadcast_to_batch,
+    check_params,
+    check_positive,
+    coerce_float_fields,
+)
 from robomech.analysis import lstsq
 
 from ._chains import N_WHEELS, WHEEL_SIDE, WHEELS, contact_frames
@@ -138,10 +145,7 @@ def icr_velocity(model: ICRModel, v_right: ArrayLike, v_left: ArrayLike) -> Plan
     check_params(model, ICRModel, "model")
     vr = as_array(v_right, "v_right", finite="mask")
     vl = as_array(v_left, "v_left", finite="mask")
-    try:
-        vr, vl = np.broadcast_arrays(vr, vl)
-    except ValueError as exc:
-        raise ValueError(f"Expected v_right and v_left to broadcast, got {vr.shape} and {vl.shape}.") from exc
+    vr, vl = broadcast_to_batch((vr, 0, "v_right"), (vl, 0, "v_left"))
     valid = np.isfinite(vr) & np.isfinite(vl)
     vr, vl = np.where(valid, vr, 0.0), np.where(valid, vl, 0.0)
     d = model.y_left - model.y_right

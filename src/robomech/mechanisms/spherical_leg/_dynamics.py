@@ -183,11 +183,8 @@ def _check_state(q: object, qd: object, qdd: object = _NO_QDD):
     qa = as_array(q, "q", (2,))
     qda = as_array(qd, "qd", (2,))
     qdda = None if qdd is _NO_QDD else as_array(qdd, "qdd", (2,))
-    shapes = [x.shape for x in (qa, qda, qdda) if x is not None]
-    try:
-        shape = np.broadcast_shapes(*shapes)
-    except ValueError as exc:
-        raise ValueError(f"Expected q, qd, qdd to broadcast, got shapes {shapes}.") from exc
+    with_qdd = [] if qdda is None else [(qdda, 1, "qdd")]
+    shape = (*broadcast_batch((qa, 1, "q"), (qda, 1, "qd"), *with_qdd), 2)
     out = [np.broadcast_to(qa, shape), np.broadcast_to(qda, shape)]
     if qdda is not None:
         out.append(np.broadcast_to(qdda, shape))
