@@ -42,6 +42,14 @@ def _psi_model(default):
     )
 
 
+# a history of 3 steps (leading time axis) for a batch of 2 poses, started from the span tensions a
+# previous history left (> 0 on the active spans, 0 on the others)
+_SS_PSI = np.stack(
+    [np.array([[0.8, 0.0], [1.2, 0.0], [1.0, 0.0]]), np.array([[0.4, 0.3], [0.6, 0.3], [0.5, 0.3]])], 1
+)
+_SS_T = np.stack([np.array([[5.0, 5.0, 5.0], [9.0, 4.0, 4.0], [7.0, 5.0, 5.0]])] * 2, 1)
+_SS_INITIAL = c.stick_slip_tensions(ROBOT, _SS_PSI, _SS_T[::-1]).span_tension[-1]  # (2, 3, 5)
+
 SPECS = {
     P + "IK_TOLERANCE": CONSTANT,
     P + "IDENTIFY_MU_MAX": CONSTANT,
@@ -199,12 +207,8 @@ SPECS = {
         options={"sigma_t": tuple(v for v in BAD_POSITIVE if v is not None)},
     ),
     P + "stick_slip_tensions": Spec(
-        args={
-            "robot": ROBOT,
-            "psi": np.array([[0.8, 0.0], [1.2, 0.0], [1.0, 0.0]]),
-            "t_act": np.array([[5.0, 5.0, 5.0], [9.0, 4.0, 4.0], [7.0, 5.0, 5.0]]),
-        },
-        arrays={"psi": 1, "t_act": 1},
+        args={"robot": ROBOT, "psi": _SS_PSI, "t_act": _SS_T, "initial": _SS_INITIAL},
+        arrays={"psi": 1, "t_act": 1, "initial": 2},
         params=("robot",),
         empty_batch=False,  # the leading axis is time: a history needs a first step
     ),

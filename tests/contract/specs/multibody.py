@@ -210,8 +210,8 @@ SPECS = {
         options={"site": (*BAD_STR, "nope"), "length": BAD_LENGTH, "rtol": (*BAD_REAL, 0.0, 1.0, -1.0)},
     ),
     P + "singularity_map": Spec(
-        args={"mech": MECH, "site": "coupler_point", "q_act": QA, "steps": 2},
-        arrays={"q_act": 1},
+        args={"mech": MECH, "site": "coupler_point", "q_act": QA, "guess": Q, "steps": 2},
+        arrays={"q_act": 1, "guess": 1},
         masked=("q_act",),
         mask="reachable",
         params=("mech",),

@@ -479,7 +479,8 @@ def simulate(
     qa = as_array(q, "q", (robot.n_cables,))
     batch = qa.shape[:-1]
     d = _as_direction(robot, direction, batch)
-    th_init = [] if initial is None else [(_split(robot, initial, "initial")[0], 1, "initial")]
+    n_init = (2 * robot.n_segments,)
+    th_init = [] if initial is None else [(as_array(initial, "initial", n_init), 1, "initial")]
     if broadcast_batch((qa, 1, "q"), (d, 1, "direction"), *th_init) != batch:
         got = ", ".join(f"{nm} {a.shape[:-1]}" for a, _, nm in [(d, 1, "direction"), *th_init])
         raise ValueError(
@@ -817,13 +818,15 @@ def disk_equilibrium(
         mode = "drive"
     batch = load.shape[:-1]
     if initial is not None:
-        th0, be0 = _split(robot, initial, "initial")
-        batch = broadcast_batch((load, 1, mode), (th0, 1, "initial"))
+        init = as_array(initial, "initial", (2 * robot.n_segments,))
+        th0, be0 = _split(robot, init, "initial")
+        batch = broadcast_batch((load, 1, mode), (init, 1, "initial"))
+        with_initial = [(init, 1, "initial")]
     else:
         th0 = np.zeros((*batch, robot.n_segments))
         be0 = np.zeros_like(th0)
+        with_initial = []
     d = _as_direction(robot, direction, batch)
-    with_initial = [] if initial is None else [(th0, 1, "initial")]
     batch = broadcast_batch((load, 1, mode), *with_initial, (d, 1, "direction"))
     k0 = np.broadcast_to(
         _uniform_k(robot, th0, be0), (*batch, 2 * robot.n_segments * robot.disks_per_segment)

@@ -620,26 +620,28 @@ def stick_slip_tensions(
             "Expected t_act > 0 at every step (a cable at or below zero tension is slack and has no friction "
             f"state), got min {t.min()!r} N."
         )
-    # the batch axes follow the time axis: align them from the right (NumPy rules) after it
-    k = max(p.ndim, t.ndim) - 2
+    n_spans = robot.disks_per_segment * (robot.cable_segment + 1)
+    active = np.arange(robot.n_segments * robot.disks_per_segment)[None, :] < n_spans[:, None]
+    init = None if initial is None else as_array(initial, "initial", active.shape)
+    # the batch axes follow the time axis: align them from the right (NumPy rules) after it; an
+    # initial state (no time axis) may extend the history's batch
+    k = max(p.ndim - 2, t.ndim - 2, 0 if init is None else init.ndim - 2)
     p = p.reshape(p.shape[0], *(1,) * (k + 2 - p.ndim), *p.shape[1:])
     t = t.reshape(t.shape[0], *(1,) * (k + 2 - t.ndim), *t.shape[1:])
+    with_initial = [] if init is None else [(init, 2, "initial")]
+    batch = broadcast_batch((p[0], 1, "psi"), (t[0], 1, "t_act"), *with_initial)
     theta, beta = _split(robot, p)
     eta = _wrap(robot, theta, beta)  # (n_t, ..., 3n, nN)
     n_t = p.shape[0]
-    batch = broadcast_batch((p[0], 1, "psi"), (t[0], 1, "t_act"))  # after the time axis
     eta = np.broadcast_to(eta, (n_t, *batch, *eta.shape[-2:]))
     t = np.broadcast_to(t, (n_t, *batch, robot.n_cables))
-    n_spans = robot.disks_per_segment * (robot.cable_segment + 1)
-    active = np.arange(robot.n_segments * robot.disks_per_segment)[None, :] < n_spans[:, None]
     mu = robot.friction_array[:, None]
-    if initial is None:
+    if init is None:
         prev = np.where(active, t[0][..., None], 0.0)
     else:
-        prev = as_array(initial, "initial", active.shape)
-        if np.any(prev[..., active] <= 0.0):
+        if np.any(init[..., active] <= 0.0):
             raise ValueError("Expected initial span tensions > 0 on every active span.")
-        prev = np.where(active, np.broadcast_to(prev, (*batch, *active.shape)), 0.0)
+        prev = np.where(active, np.broadcast_to(init, (*batch, *active.shape)), 0.0)
     out = np.zeros((n_t, *batch, *active.shape))
     state = np.zeros(out.shape, dtype=int)
     K = active.shape[-1]
