@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_params, check_positive
+from robomech._validation import as_array, broadcast_batch, check_params, check_positive
 
 from ._friction import _as_direction, _factors, _wrap
 from ._kinematics import CableModel, _span_jac, _split, _tip_jacobian
@@ -228,11 +228,12 @@ def cable_tensions(
     theta, beta = _split(robot, psi)
     batch = theta.shape[:-1]
     d = _as_direction(robot, direction, batch)
+    W = None if wrench is None else as_array(wrench, "wrench", (6,))
+    broadcast_batch((theta, 1, "psi"), (d, 1, "direction"), *([] if W is None else [(W, 1, "wrench")]))
     T0 = robot.pretension if pretension is None else check_positive(pretension, "pretension", allow_zero=True)
     G = _effective_jacobian(robot, theta, beta, d, model)
     rhs = _grad_u(robot, theta)
-    if wrench is not None:
-        W = as_array(wrench, "wrench", (6,))
+    if W is not None:
         Jx = _tip_jacobian(robot, theta, beta)
         rhs = rhs - np.einsum("...ij,...i->...j", Jx, W)
     Gt = np.swapaxes(G, -1, -2)  # (..., 2n, 3n)
