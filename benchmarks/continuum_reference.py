@@ -7,6 +7,13 @@ tests solve a few cases of each.  Run: ``PYTHONPATH=src python benchmarks/contin
 
 from __future__ import annotations
 
+import os
+
+# one BLAS thread: the solves are many small dense systems, and on a shared machine a multi-threaded
+# BLAS spends most of its time waiting (measured: a 2-segment disk solve 52 s -> 12 s)
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
 import sys
 import time
 
@@ -27,21 +34,53 @@ def main(argv: list[str]) -> None:
         )
     if "disks" in which:
         t0 = time.perf_counter()
-        segments = (1, 2) if "disks2" in which else (1,)
-        for n in segments:  # row by row, printed as they finish (the whole table takes long)
+        segments = tuple(int(a[5:]) for a in which if a.startswith("disks") and a[5:].isdigit()) or (1, 2, 3)
+        rows = []
+        for n in sorted(segments):  # row by row, printed as they finish (the whole table takes long)
             for t in V.CONVERGENCE_PRETENSIONS_N:
                 table = V.disk_agreement_table((n,), (t,))
-                print(table.markdown().splitlines()[-1], flush=True)
-                v = table.valid
-                if v.any():
-                    print(
-                        f"  chord max {1e3 * np.nanmax(table.chord_error[v]):.2f} mm, arc max "
-                        f"{1e3 * np.nanmax(table.arc_error[v]):.2f} mm, elongation max "
-                        f"{1e6 * np.nanmax(table.elongation_error[v]):.1f} µm, "
-                        f"{int(v.sum())}/{v.size} valid, "
-                        f"{time.perf_counter() - t0:.0f} s",
-                        flush=True,
-                    )
+                rows.append(table)
+                conv, err = (part.splitlines()[-1] for part in table.markdown().split("\n\n"))
+                print("conv", conv, "\nerr ", err, f"\n  {time.perf_counter() - t0:.0f} s", flush=True)
+        valid = np.concatenate([r.valid.ravel() for r in rows])
+        for name in ("chord_error", "arc_error", "elongation_error", "diskwise_error"):
+            vals = np.concatenate([getattr(r, name).ravel() for r in rows])[valid]
+            vals = vals[np.isfinite(vals)]
+            if vals.size:
+                print(
+                    f"{name}: {vals.size} cases, min {vals.min():.3g}, "
+                    f"median {np.median(vals):.3g}, max {vals.max():.3g}"
+                )
+        conv = np.concatenate([r.converged.ravel() for r in rows])
+        taut = np.concatenate([r.taut.ravel() for r in rows])
+        print(f"{int(conv.sum())}/{conv.size} converged, {int(taut.sum())} taut, {int(valid.sum())} compared")
+    if "cosserat" in which:  # the disk reference with many disks vs the continuous-tendon rod
+        import dataclasses
+        import math
+
+        from robomech.mechanisms.continuum import ContinuumRobot, cable_tensions
+        from robomech.verify._cosserat import solve_static
+        from robomech.verify._disk_rod import solve_disk_robot
+
+        cases = (
+            (1, 10.0, 90.0, (5, 10, 20, 40)),
+            (1, 15.0, 60.0, (5, 10, 20, 40)),
+            (2, 10.0, 45.0, (5, 10, 20)),
+            (3, 5.0, 30.0, (5, 10)),
+        )
+        for n, t0, bend, disks in cases:
+            rob = ContinuumRobot(n_segments=n, friction=(0.0,) * (3 * n), pretension=t0)
+            psi = np.zeros(2 * n)
+            psi[0::2], psi[1::2] = math.radians(bend), V.CONVERGENCE_PLANES[:n]
+            t = cable_tensions(rob, psi, model="arc")
+            cos = solve_static(V.rod_for(rob), t.tension)
+            gaps = []
+            for nd in disks:
+                ref = V.disk_robot_for(dataclasses.replace(rob, disks_per_segment=nd))
+                sol = solve_disk_robot(ref, tension=t.tension)
+                gap = 1e3 * np.linalg.norm(sol.T_tip[:3, 3] - cos.T_tip[:3, 3])
+                gaps.append(f"N={nd}: {gap:.3f} mm" + ("" if sol.converged else " (not converged)"))
+            print(f"{n} segments, {t0:g} N, {bend:g}°: " + "; ".join(gaps), flush=True)
     if "ident" in which:
         for estimator, stiff in (("pose", False), ("tip", False), ("tip", True), ("tip-eiv", False)):
             t0 = time.perf_counter()

@@ -15,7 +15,13 @@ import pytest
 from robomech.mechanisms.continuum import ContinuumRobot
 from robomech.verify import continuum as V
 from robomech.verify._cosserat import solve_static
-from robomech.verify._disk_rod import DISK_RK4_STEPS, DiskRobot, solve_disk_robot, straight_stability
+from robomech.verify._disk_rod import (
+    DISK_RK4_STEPS,
+    DiskRobot,
+    solve_disk_robot,
+    straight_buckling_tension,
+    straight_stability,
+)
 
 STEP_TOL_REL = 1e-5
 """Doubling the RK4 steps per disk interval moves the tip by less than this × L = 0.9 µm (expected ~0.3 µm
@@ -120,16 +126,8 @@ def test_disk_checks_have_teeth_a_1mm_hole_radius_error_fails(robot) -> None:
 def _buckling_tension(robot: ContinuumRobot, euler: float) -> float:
     """The tension per cable (N) where the smallest singular value of the straight robot's shooting
     Jacobian has its minimum (a double zero: one buckling mode per bending plane)."""
-    from scipy.optimize import minimize_scalar
-
     ref = V.disk_robot_for(dataclasses.replace(robot, friction=(0.0,) * robot.n_cables))
-    res = minimize_scalar(
-        lambda t: float(straight_stability(ref, t)),
-        bounds=(0.8 * euler, 1.2 * euler),
-        method="bounded",
-        options={"xatol": 0.01},
-    )
-    return float(res.x)
+    return straight_buckling_tension(ref, 0.8 * euler, 1.2 * euler)
 
 
 @pytest.mark.parametrize("core_diameter", [0.8e-3, None])
@@ -156,3 +154,32 @@ def test_straight_stability_bad_input(robot) -> None:
         straight_stability(ref, [np.nan])
     with pytest.raises(ValueError, match="steps"):
         straight_stability(ref, 1.0, steps=0)
+    with pytest.raises(ValueError, match="high"):
+        straight_buckling_tension(ref, 5.0, 4.0)
+    with pytest.raises(ValueError, match="low"):
+        straight_buckling_tension(ref, -1.0, 4.0)
+
+
+def test_multi_segment_robots_buckle_at_the_proximal_segments_compression(robot) -> None:
+    """n segments carry 3 n cables through the proximal segment: T_cr = pi² EI / (3 n h²) per cable
+    (15.0 N for 2 segments: the top of issue 16's range; docs: the agreement table's failing cases)."""
+    rob = dataclasses.replace(robot, n_segments=2, friction=(0.0,) * 6)
+    h = rob.segment_length / rob.disks_per_segment
+    euler = math.pi**2 * rob.bending_stiffness / (6.0 * h**2)
+    t_cr = straight_buckling_tension(V.disk_robot_for(rob), 0.8 * euler, 1.2 * euler)
+    assert abs(t_cr / euler - 1.0) < BUCKLING_REL_TOL
+
+
+@pytest.mark.slow
+def test_segment_check_has_teeth_a_1mm_hole_radius_error_fails() -> None:
+    """The 2-segment agreement check of verify continuum fails for a library whose holes are 1 mm short
+    (measured 0.12 L against the 0.05 L tolerance; the true library: 0.014 L)."""
+    n, t0, bend = V.SEGMENT_CHECK_CASES[0]
+    true = ContinuumRobot(n_segments=n, friction=V.AGREEMENT_MU * n, pretension=t0)
+    wrong = dataclasses.replace(true, hole_radius=true.hole_radius - 1e-3)
+    psi = np.zeros(2 * n)
+    psi[0::2], psi[1::2] = math.radians(bend), V.CONVERGENCE_PLANES[:n]
+    d = np.tile([1.0, -1.0, -1.0], n)
+    p, _, ok, conv = V.library_disk_error(wrong, psi, d, reference=V.disk_robot_for(true))
+    assert ok.all() and conv.all()
+    assert p[0] / (n * true.segment_length) > V.SEGMENT_CHORD_TOLERANCE.value

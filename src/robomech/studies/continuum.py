@@ -442,11 +442,11 @@ def _reference_compensation_section(res: StudyResult, progress: Progress) -> Non
             note="Each drive is applied to the disk-resolved Cosserat reference with hole friction and "
             "elastic cables (drive mode) and its tip is compared with the commanded constant-curvature "
             "tip: measured, not by construction. The paper's q + δ raises the error: under friction the "
-            "curvature falls from disk to disk (13.4, 10.5, 8.2, 6.4, 4.9° at 45°), which puts the tip "
-            "~5 mm outward of the arc's tip, and adding the stretch bends it further. The disk-wise "
-            "model (one arc per disk interval, beam-column correction; 14-64 µm from the reference for "
-            "the same tensions) aims the drive at the tip; what remains is the gap between the "
-            "disk-wise tip surface and the arc's (the least-squares point, 0.7 mm at 45°, 2.8 mm at 90°).",
+            "curvature falls from disk to disk (11.8, 9.7, 7.9, 6.5, 5.3° at 45°), which puts the tip "
+            "~2 mm outward of the arc's tip, and adding the stretch bends it further. The disk-wise "
+            "model (one arc per disk interval, beam-column correction; 46 µm from the reference for "
+            "the same tensions at 90°) aims the drive at the tip; what remains is the gap between the "
+            "disk-wise tip surface and the arc's (the least-squares point, 0.6 mm at 45°, 2.3 mm at 90°).",
         )
     )
     res.data["reference_compensation_tip_error_m"] = data

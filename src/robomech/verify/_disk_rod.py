@@ -50,6 +50,7 @@ __all__ = [
     "DiskRobot",
     "DiskSolution",
     "solve_disk_robot",
+    "straight_buckling_tension",
     "straight_stability",
 ]
 
@@ -514,6 +515,30 @@ def straight_stability(robot: DiskRobot, tension: object, *, steps: int = DISK_R
         jac = _jacobian(model, x, Rbar, steps, assemble)
         out[b] = np.linalg.svd(jac, compute_uv=False)[-1]
     return out.reshape(t.shape)
+
+
+BUCKLING_XTOL = 0.01
+"""Tension resolution (N) of :func:`straight_buckling_tension` (the minimum of σ_min is sharp: at the
+located tension it is ~1e-9, against ~1e-4 at 3 N)."""
+
+
+def straight_buckling_tension(robot: DiskRobot, low: float, high: float) -> float:
+    """The tension per cable (N) in ``[low, high]`` where :func:`straight_stability` has its minimum,
+    i.e. where the straight robot under equal tensions buckles (scipy ``minimize_scalar``, bounded, to
+    ``BUCKLING_XTOL``).  The bracket must hold one minimum (e.g. 0.8-1.2 × the Euler load of one disk
+    interval, π² EI / (3 n h²) per cable for n segments)."""
+    from scipy.optimize import minimize_scalar
+
+    lo, hi = check_positive(low, "low"), check_positive(high, "high")
+    if not hi > lo:
+        raise ValueError(f"Expected high > low, got low={lo!r}, high={hi!r}.")
+    res = minimize_scalar(
+        lambda t: float(straight_stability(robot, t)),
+        bounds=(lo, hi),
+        method="bounded",
+        options={"xatol": BUCKLING_XTOL},
+    )
+    return float(res.x)
 
 
 def _as_direction(direction, n_c, batch):

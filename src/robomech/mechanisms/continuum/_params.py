@@ -45,7 +45,9 @@ class ContinuumRobot:
     friction : tuple of float
         Coulomb friction coefficient per cable (3 n entries, >= 0); paper Table 1 (0.26, 0.31, 0.28).
     pretension : float
-        Cable pretension T0 (N, >= 0); not printed, default 5 N (inside Fig. 6's 3-11 N range).
+        Cable pretension T0 (N, >= 0); not printed, default 10 N (inside Fig. 6's 3-11 N range; with the
+        1.0 mm core a 90 deg bend needs ~13 N of tension difference, so 5 N, the default before issue 16,
+        lets the paid-out cables go slack there).
     free_length : float
         Cable length between the actuator and the base plate (m, >= 0); not printed, default 0.1 m.
     cable_offset : float
