@@ -134,10 +134,11 @@ def _loop(robot, q_max=1.5e-3, m=8):
     qs = np.concatenate([up, up[::-1][1:]])
     q = np.zeros((qs.size, 3))
     q[:, 0], q[:, 1], q[:, 2] = qs, -0.5 * qs, -0.5 * qs
-    return qs, q, c.simulate_history(robot, q)
+    return qs, q, c.simulate_history(robot, q, memory="slip")
 
 
 def test_history_hysteresis_loop():
+    """memory='slip' (the sliding approximation): the loop comes from switching the slip direction."""
     qs, _, h = _loop(ROBOT)
     assert np.all(h.valid)
     area = abs(np.trapezoid(h.psi[:, 0], qs))  # closed loop theta(q_0)
@@ -160,11 +161,11 @@ def test_history_hysteresis_loop():
 
 def test_history_step_equals_simulate_and_with_pulley():
     q = c.compensated_drive(ROBOT, PSI, np.ones((3, 3))).q_compensated
-    h = c.simulate_history(ROBOT, q[None])  # one step, batch of 3
+    h = c.simulate_history(ROBOT, q[None], memory="slip")  # one step, batch of 3
     s = c.simulate(ROBOT, q, np.where(q > 0, 1.0, np.where(q < 0, -1.0, 1.0)))
     np.testing.assert_array_equal(h.psi[0], s.psi)
     pulley = c.Pulley(alpha=0.3)
-    hp = c.simulate_history(ROBOT, q[:, None, :], pulley=pulley, times=np.arange(3.0))  # 3 steps
+    hp = c.simulate_history(ROBOT, q[:, None, :], pulley=pulley, times=np.arange(3.0), memory="slip")
     assert np.all(hp.valid)
     assert not np.allclose(hp.actuator_tension, hp.tension)
 

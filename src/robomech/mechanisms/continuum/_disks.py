@@ -236,7 +236,8 @@ def _newton(fun: Callable[[Array], Array], k0: Array) -> tuple[Array, NDArray[np
             conv = f0 < DISK_TOLERANCE
             if np.all(conv | ~np.isfinite(f0)):
                 break
-            cols = [(fun(k + DISK_FD_STEP * e) - fun(k - DISK_FD_STEP * e)) / (2.0 * DISK_FD_STEP) for e in eye]
+            h2 = 2.0 * DISK_FD_STEP
+            cols = [(fun(k + DISK_FD_STEP * e) - fun(k - DISK_FD_STEP * e)) / h2 for e in eye]
             Jm = np.nan_to_num(np.stack(cols, -1))
             # pinv: a singular Newton matrix in one sample must not abort the batch
             step = np.einsum("...ij,...j->...i", np.linalg.pinv(Jm), np.nan_to_num(F))
@@ -414,8 +415,8 @@ def _memory_step(
             # all central differences in one batched evaluation (the perturbations as an extra axis)
             X = np.concatenate([x[..., None, :] + E, x[..., None, :] - E], -2)
             RR = fun(X, own[..., None, :, :], extra=1)[0]
-            Jm = np.swapaxes((RR[..., :n_free, :] - RR[..., n_free:, :]) / (2.0 * steps[lo_idx:, None]), -1, -2)
-            Jm = np.nan_to_num(Jm)
+            diff = (RR[..., :n_free, :] - RR[..., n_free:, :]) / (2.0 * steps[lo_idx:, None])
+            Jm = np.nan_to_num(np.swapaxes(diff, -1, -2))
             step = np.zeros_like(x)
             step[..., lo_idx:] = np.einsum("...ij,...j->...i", np.linalg.pinv(Jm), np.nan_to_num(r))
             scale = np.ones(batch)
@@ -427,7 +428,7 @@ def _memory_step(
                 scale = np.where(worse, 0.5 * scale, scale)
             x = np.where(conv[..., None], x, x - scale[..., None] * step)
         k, s = x[..., :J2], x[..., J2:].reshape(*batch, C, K)
-        r, own, tp, m, a, T, F = _memory_eval(robot, k, s, m_prev, dq)
+        r, own, tp, m, a, T, _ = _memory_eval(robot, k, s, m_prev, dq)
     res = np.linalg.norm(r[..., lo_idx:], axis=-1)
     finite = np.isfinite(res) & np.all(np.isfinite(x), axis=-1)
     act = _active(robot)
