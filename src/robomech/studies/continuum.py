@@ -451,8 +451,9 @@ def _hysteresis_section(res: StudyResult, out_dir: Path, progress: Progress) -> 
             "hole friction alone (no pulley): every span keeps its cable while its tension ratio lies inside "
             "the capstan cone and slides at a bound; the pose is solved under those tensions. The dead band "
             "is the actuator-tension drop of cable 1 before the tip moves when it is paid out alone after "
-            "the load (1 µm steps, ~0.025 N each: the measured band is the last still step, so it lies within "
-            "one step below the last column, the cone of the base-plate hole, which must be crossed first). {n_steps} history steps in {seconds:.1f} s ({1e3 * per_step:.0f} ms per step).",
+            "the load (1 µm steps, ~0.025 N each: the measured band is the last still step, so it lies "
+            "within one step below the last column, the cone of the base-plate hole, which must be crossed "
+            f"first). {n_steps} history steps in {seconds:.1f} s ({1e3 * per_step:.0f} ms per step).",
         )
     )
     res.data["hysteresis_loop_area_rad_m"] = [r[2] * 1e-6 for r in rows]
