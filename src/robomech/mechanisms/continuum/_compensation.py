@@ -582,7 +582,8 @@ class HistoryResult:
         ``[theta_j, beta_j]`` (rad) of every disk interval (``"slip"``: the segment arcs spread evenly).
     slip : ndarray, shape (n_t, ..., 3 n, n N)
         Cable length that crossed every hole toward the actuator during the step (m; 0 where stuck).
-        ``"slip"``: NaN (not tracked).
+        ``"slip"``: the length implied by the sliding model's span lengths and tensions (its sign need
+        not agree with the assumed direction: the model does not enforce it).
     """
 
     psi: np.ndarray
@@ -787,6 +788,19 @@ def _slip_history(
     theta, beta = psi[..., 0::2], psi[..., 1::2]
     disk = _disk_T(robot, np.nan_to_num(theta), np.nan_to_num(beta))
     N = robot.disks_per_segment
+    # the cable that crossed every hole, implied by the sliding model itself: every span holds
+    # ell (1 - T / EA) of cable at its fully sliding tension; s_h = -(change of the cable distal of h)
+    psi0 = np.nan_to_num(psi)
+    ell = span_lengths(robot, psi0, model)
+    span_t = np.nan_to_num(tension)[..., None] * _factors(
+        robot, _wrap(robot, psi0[..., 0::2], psi0[..., 1::2]), dirs
+    )
+    act = _active(robot)
+    mat = np.where(act, ell * (1.0 - span_t / robot.cable_axial_stiffness), 0.0)
+    h0 = robot.segment_length / N
+    rest = np.where(act, h0 * (1.0 - robot.pretension / robot.cable_axial_stiffness), 0.0)
+    dm = np.diff(np.concatenate([np.broadcast_to(rest, mat[:1].shape), mat]), axis=0)
+    slip = -np.cumsum(dm[..., ::-1], axis=-1)[..., ::-1]
     return HistoryResult(
         psi=psi,
         tension=tension,
@@ -800,7 +814,7 @@ def _slip_history(
         valid=taut & conv,
         tip=np.where(np.isfinite(psi).all(-1, keepdims=True), disk[..., -1, :3, 3], np.nan),
         bend=np.stack([np.repeat(theta / N, N, axis=-1), np.repeat(beta, N, axis=-1)], -1),
-        slip=np.full(hist.state.shape, np.nan),
+        slip=np.where(act, slip, 0.0),
     )
 
 

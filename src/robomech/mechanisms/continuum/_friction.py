@@ -105,8 +105,8 @@ def _as_direction(robot: ContinuumRobot, direction: object | None, batch: tuple[
     if np.any(~sliding & (robot.friction_array > 0.0)):
         raise ValueError(
             "Expected direction +1 (pulled in) or -1 (paid out) for every cable with friction, got other "
-            "values (0 = sticking: eq. (19)'s stick-slip branch is not modelled; pass direction=None for "
-            "the frictionless model)."
+            "values (0 = sticking: a stuck cable's tension depends on its history, see simulate_history "
+            "and stick_slip_tensions; pass direction=None for the frictionless model)."
         )
     return d
 
@@ -557,8 +557,11 @@ def stick_slip_tensions(
     ``[T_{k-1} exp(-mu eta_k), T_{k-1} exp(mu eta_k)]`` of its new proximal neighbour (stuck, eq. (19)'s
     q_dot = 0 branch T(t^-1)), else it slides and takes the bound (eq. (19)'s q_dot != 0 branch, with the
     physical sign of departure 4).  Loading and unloading therefore give hysteresis loops; the result is
-    path-dependent.  This is the rigid-cable (inextensible) limit of a tendon-through-holes model: the
-    tension change travels from the actuator; cable stretch does not feed back on the sliding.
+    path-dependent.  This is the fixed-geometry limit of an elastic cable through the holes: at a fixed
+    pose a stuck span's tension depends on its own cable only, for every EA (the rigid-cable limit);
+    with a changing pose a stuck span's tension changes with its length, which this function ignores:
+    :func:`simulate_history` (``memory="elastic"``) models that and feeds the tensions back into the
+    pose.
 
     Parameters
     ----------
