@@ -21,12 +21,13 @@ PAPER = C.ContinuumRobot.paper()
 EA = PAPER.cable_axial_stiffness
 H = PAPER.segment_length / PAPER.disks_per_segment
 # Same physics as disk_equilibrium(drive=, direction=) when every hole slides: both meet DISK_TOLERANCE
-# (1e-10 N m on interval stiffnesses EI/h ~ 0.07 N m/rad: ~1.5e-9 rad); 1e-7 rad / 1e-8 m.  Tensions:
+# (1e-10 N m on interval stiffnesses EI/h ~ 0.16 N m/rad: ~1e-9 rad); 1e-7 rad / 1e-8 m.  Tensions:
 # both stop the column-shortening fixed point after COLUMN_PASSES = 8 passes of different maps (the
-# base tension there, every piece's tension here): measured 3e-6 N apart at 52 deg; 1e-5 N.
+# base tension there, every piece's tension here): measured 3e-10 N apart at 51 deg on the paper robot
+# (3e-6 N with the 0.8 mm core assumed before, whose column is softer); 1e-7 N.
 FULL_SLIP_ANGLE_TOL = 1e-7
 FULL_SLIP_TIP_TOL = 1e-8
-FULL_SLIP_TENSION_TOL = 1e-5
+FULL_SLIP_TENSION_TOL = 1e-7
 # A pose that stands still is the previous Newton solution unchanged (residual already below tolerance).
 STILL_TIP_TOL = 1e-12
 # The hole residual (N times h) meets 1e-10 N m: tensions on the cone bounds to ~6e-9 N.
@@ -124,7 +125,7 @@ def test_reversal_dead_band_matches_the_base_hole_cone():
     assert np.all(moved[inside] < STILL_TIP_TOL)
     assert np.all(h.state[n:][inside] == 0)
     assert np.all(moved[~inside] > 1e-9)
-    # the band in drive: only the free length stretches, dq = L_free dT / EA (~13 um at this pose)
+    # the band in drive: only the free length stretches, dq = L_free dT / EA (~11 um at this pose)
     width_q = PAPER.free_length * (t_rev - threshold) / EA
     assert inside.sum() == int(np.floor(width_q / 1e-6 + 1e-9))
     assert inside.sum() >= 5 and not inside[-1]
@@ -160,7 +161,7 @@ def test_held_cable_is_stuck():
     assert np.all(np.abs(h.slip[n:, 1]) <= C.STUCK_FLUX_TOL) and np.all(h.state[n:, 1] == 0)
     np.testing.assert_allclose(h.tension[n:, 1], h.tension[n - 1, 1], atol=1e-9)
     assert np.all(h.state[n:, 2] == -1)  # the paid-out cable slides out
-    assert np.linalg.norm(h.tip[-1] - h.tip[n - 1]) > 1e-5  # measured 83 um
+    assert np.linalg.norm(h.tip[-1] - h.tip[n - 1]) > 1e-5  # measured 79 um
     _check_cone(PAPER, h)
     # the sliding approximation lets the held cable slide (its tension follows the pose)
     hs = C.simulate_history(PAPER, np.concatenate([load, more]), memory="slip")
@@ -266,7 +267,8 @@ def test_two_segments():
     assert np.all(h.valid)
     _check_cone(two, h)
     assert np.all(h.slip[..., :3, 5:] == 0.0)  # beyond the cables' termination: no cable, no flux
-    np.testing.assert_allclose(h.psi[-1], [0.6, 0.3, 0.5, 2.0], atol=0.05)
+    # sanity only: the segment model's drive on the disk-wise robot with memory lands ~0.05 rad away
+    np.testing.assert_allclose(h.psi[-1], [0.6, 0.3, 0.5, 2.0], atol=0.1)
 
 
 def test_slip_mode_reports_the_implied_flux():
