@@ -378,6 +378,7 @@ def _hysteresis_section(res: StudyResult, out_dir: Path, progress: Progress) -> 
     q_band = np.concatenate([q[: HYSTERESIS_STEPS + 1], held])
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.6))
     rows = []
+    curves: list[tuple[np.ndarray, str, str]] = []
     n_steps, seconds = 0, 0.0
     all_valid = True
     for scale, color in zip(HYSTERESIS_FRICTION_SCALES, ("tab:red", "tab:orange", "k"), strict=True):
@@ -390,7 +391,7 @@ def _hysteresis_section(res: StudyResult, out_dir: Path, progress: Progress) -> 
         all_valid &= bool(np.all(h.valid) and np.all(hb.valid))
         theta = np.degrees(h.psi[:, 0])
         label = f"μ = {scale:g} × Table 1" if scale else "μ = 0"
-        axes[0].plot(q1 * 1e3, theta, color=color, lw=1.5, label=label)
+        curves.append((theta, color, label))
         axes[1].plot(q1 * 1e3, h.actuator_tension[:, 0], color=color, lw=1.5, label=label)
         n = HYSTERESIS_STEPS
         gap = np.max(np.abs(theta[n:][::-1] - theta[: n + 1]))
@@ -415,11 +416,15 @@ def _hysteresis_section(res: StudyResult, out_dir: Path, progress: Progress) -> 
                 predicted,
             ]
         )
+    # the loop is ~1 deg on a 52 deg bend: shown as the difference to the frictionless bend
+    theta_free = curves[HYSTERESIS_FRICTION_SCALES.index(0.0)][0]
+    for theta, color, label in curves:
+        axes[0].plot(q1 * 1e3, theta - theta_free, color=color, lw=1.5, label=label)
     for ax in axes:
         ax.set_xlabel("drive of cable 1, q₁ (mm; cables 2, 3 pay out q₁/2)")
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
-    axes[0].set_ylabel("bend angle θ (deg)")
+    axes[0].set_ylabel("bend θ − frictionless bend θ(μ = 0) (deg)")
     axes[0].set_title("Bend vs drive: load, unload (memory fed back into the pose)")
     axes[1].set_ylabel("actuator tension of cable 1 (N)")
     axes[1].set_title("Actuator tension vs drive over the cycle")
