@@ -49,7 +49,8 @@ DISK_FD_STEP = 6e-6
 """Central-difference step (rad) of the Newton matrix: eps^(1/3) for O(0.1) interval bends."""
 MEMORY_MAX_ITERATIONS = 40
 """Semi-smooth Newton iterations of one stick-slip history step (pose and hole fluxes together; the
-branch of every hole is re-read at each iterate; measured 2-8 per step)."""
+branch of every hole is re-read at each iterate; measured 5-8 per step on the study's load-unload
+cycle, 13 at most)."""
 MEMORY_FD_FLUX = 1e-8
 """Central-difference step (m) of the hole fluxes in the Newton matrix (tensions are linear in the
 flux up to the column shortening, so any small step works; 1e-8 m is ~1e-3 N of tension)."""

@@ -661,12 +661,13 @@ def stick_slip_tensions(
 # p >= 1 the span that starts at hole p - 1 (hole 0 the base plate, hole k >= 1 disk k).  The state is
 # the unstretched material m_p of every piece; its tension follows Hooke's law on the current length g_p,
 # T_p = EA (1 - m_p / g_p) (the linear law of the segment model's compatibility, so that full slip
-# reproduces disk_equilibrium(drive=...) exactly; T = EA (g/m - 1) differs at second order in the
-# strain, ~1e-6 relative).  In a step the actuator reels in dq; s_h is the material crossing hole h
-# toward the actuator (m_p gains s_p, loses s_{p-1}; s_{-1} = dq, the anchor s_K = 0).  Coulomb-capstan
-# at hole h: T_{h+1} / T_h in [exp(-mu eta_h), exp(+mu eta_h)]; s_h > 0 only at the lower bound (pulled
-# in, eq. (19)'s sliding branch with the physical sign), s_h < 0 only at the upper one, s_h = 0 (stuck,
-# eq. (19)'s T(t^-1) branch: the material, not the tension, is kept) anywhere inside.
+# reproduces disk_equilibrium(drive=...) exactly; T = EA (g/m - 1) is larger by the factor g/m =
+# 1 + eps, eps = T/EA <= 0.6 % at 15 N: a strain difference of eps^2, second order).  In a step the
+# actuator reels in dq; s_h is the material crossing hole h toward the actuator (m_p gains s_p, loses
+# s_{p-1}; s_{-1} = dq, the anchor s_K = 0).  Coulomb-capstan at hole h: T_{h+1} / T_h in
+# [exp(-mu eta_h), exp(+mu eta_h)]; s_h > 0 only at the lower bound (pulled in, eq. (19)'s sliding
+# branch with the physical sign), s_h < 0 only at the upper one, s_h = 0 (stuck, eq. (19)'s T(t^-1)
+# branch: the material, not the tension, is kept) anywhere inside.
 # paper 3, eq. (19): the print keeps the stuck TENSION T(t^-1) and gives no criterion for sticking;
 # here the stuck hole keeps the material on both sides (its span tensions then change elastically with
 # the pose) and sticks while its tension ratio lies inside the capstan cone.
