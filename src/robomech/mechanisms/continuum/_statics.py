@@ -52,7 +52,7 @@ def elastic_energy(robot: ContinuumRobot, psi: object) -> np.ndarray:
     >>> import numpy as np
     >>> from robomech.mechanisms import continuum as cr
     >>> np.round(cr.elastic_energy(cr.ContinuumRobot.paper(), np.array([0.5, 0.0])), 8)
-    np.float64(0.00167552)
+    np.float64(0.00409062)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
@@ -91,7 +91,7 @@ def elastic_gradient(robot: ContinuumRobot, psi: object) -> np.ndarray:
     >>> import numpy as np
     >>> from robomech.mechanisms import continuum as cr
     >>> cr.elastic_gradient(cr.ContinuumRobot.paper(), np.array([0.5, 0.0])).round(6)
-    array([0.006702, 0.      ])
+    array([0.016362, 0.      ])
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
@@ -222,7 +222,7 @@ def cable_tensions(
     >>> from robomech.mechanisms import continuum as cr
     >>> res = cr.cable_tensions(cr.ContinuumRobot.paper(), np.array([0.5, 0.0]))
     >>> res.tension.round(4), bool(res.taut), bool(res.residual < 1e-9)
-    (array([5.7688, 4.6573, 4.6573]), True, True)
+    (array([12.0483,  9.087 ,  9.087 ]), True, True)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
