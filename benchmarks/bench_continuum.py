@@ -6,6 +6,9 @@
   alternative checks on every run that it agrees with robomech's result to 1e-8.
 * group 2: forward kinematics, tip Jacobian and inverse kinematics over 10^6 samples, against a per-sample
   Python loop over the same function.
+* group 2: the stick-slip history with memory fed back into the pose (issue 16 item 3,
+  ``simulate_history(memory="elastic")``): a 20-step load-unload history of 8 drive directions as one
+  batch, against a per-sample loop (a history is sequential in time; the batch is what vectorises).
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from _harness import Workload
 N_KIN = 1_000_000
 N_ALT_KIN = 1000
 N_ALT_CAPSTAN = 100
+N_HISTORY = 8  # drive directions of the stick-slip history workload
 # Matched accuracy of the alternative (issue 9): both must agree with each other to 1e-8.
 MATCHED_ACCURACY = 1e-8
 IVP_RTOL = 1e-7  # loosest RK45 rtol that reaches 1e-8 on the grid (measured max error ~5e-9)
@@ -146,6 +150,26 @@ def workloads() -> list[Workload]:
             n_alt=N_ALT_KIN,
             alternative_name="per-sample loop, same function",
             target_speedup=100.0,
+        )
+    )
+
+    # stick-slip history: 8 bending planes, cable drives of a 1.5 mm pull and release, 10 + 10 steps
+    up = np.linspace(0.0, 1.0, 11)
+    ramp = np.concatenate([up, up[::-1][1:]])[:, None, None]  # (20 + 1, 1, 1)
+    beta = np.linspace(0.0, 2.0 * np.pi, N_HISTORY, endpoint=False)
+    q_end = 1.5e-3 * np.cos(beta[:, None] - robot.hole_angles[None, :])  # (8, 3) m
+    q_hist = ramp * q_end
+    out.append(
+        Workload(
+            name="continuum: stick-slip history step (memory='elastic'), batch of 8",
+            group="2",
+            run=lambda: C.simulate_history(robot, q_hist),
+            n=q_hist.shape[0] * N_HISTORY,
+            bytes_moved=q_hist.nbytes * 40,
+            alternative=lambda: [C.simulate_history(robot, q_hist[:, i]) for i in range(N_HISTORY)],
+            n_alt=q_hist.shape[0] * N_HISTORY,
+            alternative_name="per-sample loop, same function",
+            repeats=1,
         )
     )
     return out

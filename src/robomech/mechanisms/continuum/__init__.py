@@ -19,8 +19,9 @@ from ._compensation import (
     simulate_history,
     theoretical_drive,
 )
-from ._disks import DISK_MAX_ITERATIONS, DISK_TOLERANCE, DiskEquilibrium
+from ._disks import DISK_MAX_ITERATIONS, DISK_TOLERANCE, MEMORY_MAX_ITERATIONS, DiskEquilibrium
 from ._friction import (
+    STUCK_FLUX_TOL,
     FrictionEstimate,
     TensionHistory,
     capstan_coefficient,
@@ -71,9 +72,11 @@ __all__ = [
     "IDENTIFY_MU_MAX",
     "IDENTIFY_STIFFNESS_BOUNDS",
     "IK_TOLERANCE",
+    "MEMORY_MAX_ITERATIONS",
     "PULLEY_FIXED_POINT_ITERATIONS",
     "PULLEY_QUAD_NODES",
     "STICK_SLIP_TENSION_FLOOR",
+    "STUCK_FLUX_TOL",
     "ContinuumRobot",
     "DiskEquilibrium",
     "DriveResult",

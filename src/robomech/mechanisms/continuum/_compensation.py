@@ -14,9 +14,9 @@ import numpy as np
 
 from robomech._validation import as_array, broadcast_batch, check_choice, check_params
 
-from ._disks import DiskEquilibrium, _solve, _uniform_k
-from ._friction import _as_direction, _factors, _wrap, stick_slip_tensions
-from ._kinematics import CableModel, _fk, _segment_spans, _split, span_lengths
+from ._disks import DiskEquilibrium, _active, _memory_initial, _memory_step, _segment_psi, _solve, _uniform_k
+from ._friction import STUCK_FLUX_TOL, _as_direction, _factors, _wrap, stick_slip_tensions
+from ._kinematics import CableModel, _disk_T, _fk, _segment_spans, _split, span_lengths
 from ._params import ContinuumRobot
 from ._pulley import PULLEY_FIXED_POINT_ITERATIONS, Pulley, pulley_chain, pulley_stretch
 from ._statics import TensionResult, cable_tensions
@@ -63,6 +63,7 @@ COMPENSATION_FD_STEP = 1e-6  # rad, central difference of the segment ends in ps
 STICK_SLIP_TENSION_FLOOR = 1e-9
 
 CompensationMethod = Literal["paper", "disk"]
+HistoryMemory = Literal["elastic", "slip"]
 
 
 def _lengths_and_factors(robot, theta, beta, direction, model):
@@ -563,27 +564,39 @@ class HistoryResult:
     Attributes
     ----------
     psi : ndarray, shape (n_t, ..., 2 n)
-        Equilibrium pose at every step (rad).
+        Pose at every step (rad); with ``memory="elastic"`` the constant-curvature arc with each
+        segment's end-disk orientation (bend between the segment's base and end disk normals).
     tension : ndarray, shape (n_t, ..., 3 n)
-        Cable tension at the base plate (N, >= 0).
+        Cable tension between the actuator and the base plate (N, >= 0).
     actuator_tension : ndarray, shape (n_t, ..., 3 n)
         Tension at the actuator, beyond the pulley (N); equal to ``tension`` without a pulley.
     direction : ndarray, shape (n_t, ..., 3 n)
-        Sliding direction (+1 / -1) every cable had at each step: that of its last nonzero drive
-        increment (a cable whose drive stops keeps its sliding-state memory).
+        Sign of every cable's last nonzero drive increment (+1 pulled in, -1 paid out; +1 before it
+        moved).  With ``memory="slip"`` the sliding direction used at every hole; with ``"elastic"``
+        for information only (each hole's own state is ``state``).
     span_tension : ndarray, shape (n_t, ..., 3 n, n N)
-        Stick-slip span tensions with memory along the disks (N), :func:`stick_slip_tensions` fed with
-        the base tensions.
-    state : ndarray, shape (n_t, ..., 3 n, n N)
-        Stick-slip state of every span (as returned by :func:`stick_slip_tensions`).
+        Tension of every span (N, 0 beyond a cable's termination): with ``memory="elastic"`` those that
+        hold the pose; with ``"slip"`` :func:`stick_slip_tensions` fed with the base tensions afterwards.
+    state : ndarray of int, shape (n_t, ..., 3 n, n N)
+        Every hole in that step (the hole where each span starts): +1 cable sliding toward the actuator,
+        -1 away from it, 0 stuck.
     taut : ndarray of bool, shape (n_t, ...)
-        No cable went slack.
+        No cable (piece) went slack.
     converged : ndarray of bool, shape (n_t, ...)
-        Newton met ``SIM_TOLERANCE``.
+        The step's equilibrium met its tolerance (``SIM_TOLERANCE`` / ``DISK_TOLERANCE``).
     residual : ndarray, shape (n_t, ...)
-        Norm of the generalized-force residual (N m).
+        Norm of the equilibrium residual (N m; with ``"elastic"`` including the hole conditions, N
+        times the disk spacing).
     valid : ndarray of bool, shape (n_t, ...)
         ``taut & converged``.
+    tip : ndarray, shape (n_t, ..., 3)
+        Tip position (m, base frame).
+    bend : ndarray, shape (n_t, ..., n N, 2)
+        ``[theta_j, beta_j]`` (rad) of every disk interval (``"slip"``: the segment arcs spread evenly).
+    slip : ndarray, shape (n_t, ..., 3 n, n N)
+        Cable length that crossed every hole toward the actuator during the step (m; 0 where stuck).
+        ``"slip"``: the length implied by the sliding model's span lengths and tensions (its sign need
+        not agree with the assumed direction: the model does not enforce it).
     """
 
     psi: np.ndarray
@@ -596,6 +609,9 @@ class HistoryResult:
     converged: np.ndarray
     residual: np.ndarray
     valid: np.ndarray
+    tip: np.ndarray
+    bend: np.ndarray
+    slip: np.ndarray
 
 
 def simulate_history(
@@ -605,16 +621,31 @@ def simulate_history(
     times: object | None = None,
     model: CableModel = "chord",
     pulley: Pulley | None = None,
+    memory: HistoryMemory = "elastic",
 ) -> HistoryResult:
     """The simulated robot driven through a history ``q (n_t, ..., 3 n)`` (m, leading time axis).
 
-    Path-dependent (issue 16, paper 3 eq. (19) with memory): from the straight pretensioned pose
-    (q = 0), every cable slides in the direction of its drive increment q_i - q_{i-1} (+1 pulled in,
-    -1 paid out); where its increment is 0 it keeps its last direction (the friction state of its
-    last slip; +1 before it ever moved).  Each step is :func:`simulate` with that direction, started
-    from the previous pose.  Loading and unloading the same drive therefore meet the friction bounds
-    from opposite sides: hysteresis.  The span tensions with memory along the disks follow from
-    :func:`stick_slip_tensions`.
+    Path-dependent (issue 16 item 3, paper 3 eq. (19) with memory), from the straight pretensioned pose
+    (q = 0, every span at the pretension).
+
+    ``memory="elastic"`` (default): stick-slip with memory that the pose feels, on the disk-wise robot
+    (:func:`disk_equilibrium`: one arc per disk interval, chord spans, beam-column correction).  The
+    state is the unstretched cable material of every piece (the free length and each span between two
+    holes); a piece's tension follows Hooke's law on its current length, so a stuck span's tension
+    changes elastically with the pose, and the actuator changes the material of the free length.  At
+    every hole the ratio of the neighbouring span tensions lies in the capstan cone
+    ``[exp(-mu eta), exp(+mu eta)]`` (eta the wrap angle of the current pose): inside, the hole is
+    stuck (no material crosses it); on a bound it slides in the direction that bound says.  Each step
+    solves the pose and the material crossing every hole together (semi-smooth Newton, a primal-dual
+    active set on the holes' branches, from the previous step with every hole stuck).  Monotone
+    driving gives the full-slip equilibrium; at a reversal the pose stands still until the tensions
+    have crossed the friction cone (dead band); a cable held still is stuck.  Chord cables only, no
+    pulley.
+
+    ``memory="slip"`` (the earlier model, kept for the arc cables and the pulley): every cable slides
+    at every hole in the direction of its last nonzero drive increment (+1 before it moved), each step
+    is :func:`simulate` (segment-wise constant curvature) in those directions; the span tensions with
+    memory come from :func:`stick_slip_tensions` afterwards and do not act on the pose.
     Cables that would push are flagged per sample (``taut`` false), not raised.
 
     Parameters
@@ -628,38 +659,52 @@ def simulate_history(
         Strictly increasing time stamps (s); the quasi-static model does not use them beyond the
         check (rate-independent friction).  ``None``: no time stamps.
     model : {"chord", "arc"}, optional
-        Cable path model of the spans (straight chords between holes, or arcs); default ``"chord"``.
+        Cable path model of the spans (straight chords between holes, or arcs); default ``"chord"``
+        (``memory="elastic"`` needs ``"chord"``).
     pulley : Pulley, optional
-        Guide pulley at every actuator (eqs. (29)-(34)); ``None``: no pulley.
+        Guide pulley at every actuator (eqs. (29)-(34)); ``None``: no pulley (``memory="elastic"``
+        needs ``None``).
+    memory : {"elastic", "slip"}, optional
+        ``"elastic"`` (default): stick-slip fed back into the pose, see above; ``"slip"``: the sliding
+        approximation.
 
     Returns
     -------
     HistoryResult
         ``psi (n_t, ..., 2 n)``, ``tension``, ``actuator_tension``, ``direction (n_t, ..., 3 n)``,
-        ``span_tension``, ``state (n_t, ..., 3 n, n N)`` and the flags ``taut``, ``converged``,
-        ``valid`` and ``residual (n_t, ...)``.
+        ``span_tension``, ``state``, ``slip (n_t, ..., 3 n, n N)``, ``tip (n_t, ..., 3)``, ``bend
+        (n_t, ..., n N, 2)`` and the flags ``taut``, ``converged``, ``valid`` and ``residual (n_t, ...)``.
 
     Raises
     ------
     ValueError
         If ``robot`` is not a :class:`ContinuumRobot` or ``pulley`` not a :class:`Pulley`; ``q`` has no
         leading time axis, does not end in an axis of 3 n or is not real and finite; ``times`` has a
-        shape other than ``(n_t,)`` or is not strictly increasing; or ``model`` is unknown.
+        shape other than ``(n_t,)`` or is not strictly increasing; ``model`` or ``memory`` is unknown;
+        or ``memory="elastic"`` is combined with ``model="arc"`` or a pulley.
 
     Examples
     --------
     >>> import numpy as np
     >>> from robomech.mechanisms import continuum as cr
     >>> robot = cr.ContinuumRobot.paper()
-    >>> q = cr.compensated_drive(robot, np.array([0.5, 0.0])).q_compensated
-    >>> res = cr.simulate_history(robot, np.linspace(0.0, 1.0, 3)[:, None] * q)
-    >>> res.psi.shape, bool(res.valid.all())
-    ((3, 2), True)
+    >>> q = np.linspace(0.0, 1e-3, 3)[:, None] * np.array([1.0, -0.5, -0.5])   # pull cable 1 (m)
+    >>> res = cr.simulate_history(robot, np.concatenate([q, q[-2::-1]]))      # and release it
+    >>> res.psi.shape, bool(res.valid.all()), bool(res.psi[3, 0] > res.psi[1, 0])  # unloading above
+    ((5, 2), True, True)
     """
     check_params(robot, ContinuumRobot, "robot")
     if pulley is not None:
         check_params(pulley, Pulley, "pulley")
     check_choice(model, "model", ("arc", "chord"))
+    check_choice(memory, "memory", ("elastic", "slip"))
+    if memory == "elastic" and model != "chord":
+        raise ValueError(f"Expected model='chord' with memory='elastic' (chord spans), got {model!r}.")
+    if memory == "elastic" and pulley is not None:
+        raise ValueError(
+            "Expected pulley=None with memory='elastic' (the pulley's stick-slip is not modelled), got a "
+            "Pulley; use memory='slip'."
+        )
     qa = as_array(q, "q", (None, robot.n_cables))
     if qa.ndim < 2 or qa.shape[0] < 1:
         raise ValueError(
@@ -675,22 +720,79 @@ def simulate_history(
             )
         if np.any(np.diff(ts) <= 0.0):
             raise ValueError("Expected times strictly increasing, got a non-monotone history.")
+    if memory == "elastic":
+        return _elastic_history(robot, qa)
+    return _slip_history(robot, qa, model, pulley)
+
+
+def _drive_directions(qa: np.ndarray) -> np.ndarray:
+    """Sign of every cable's last nonzero drive increment, +1 before it moved, ``(n_t, ..., 3 n)``."""
+    d = np.ones(qa.shape[1:])
+    prev = np.zeros(qa.shape[1:])
+    out = np.empty_like(qa)
+    for i in range(qa.shape[0]):
+        dq = qa[i] - prev
+        d = np.where(dq > 0.0, 1.0, np.where(dq < 0.0, -1.0, d))
+        out[i] = d
+        prev = qa[i]
+    return out
+
+
+def _elastic_history(robot: ContinuumRobot, qa: np.ndarray) -> HistoryResult:
     batch = qa.shape[1:-1]
-    d = np.ones((*batch, robot.n_cables))
+    k, m, _ = _memory_initial(robot, batch)
     prev_q = np.zeros((*batch, robot.n_cables))
+    act = _active(robot)
+    rows = []
+    for i in range(qa.shape[0]):  # a history is sequential
+        st = _memory_step(robot, k, m, qa[i] - prev_q)
+        rows.append(st)
+        good = st.converged & np.all(np.isfinite(st.k), axis=-1)
+        # a sample that failed keeps its last good state (it is flagged; the batch goes on)
+        k = np.where(good[..., None], st.k, k)
+        m = np.where(good[..., None, None], st.material, m)
+        prev_q = np.where(good[..., None], qa[i], prev_q)
+    tp = np.stack([r.piece_tension for r in rows])
+    flux = np.stack([r.flux for r in rows])
+    disk_T = np.stack([r.disk_T for r in rows])
+    kk = np.stack([r.k for r in rows])
+    th, be = _k_to_psi(kk)
+    live = np.concatenate([np.ones((robot.n_cables, 1), dtype=bool), act], -1)
+    taut = np.all(np.where(live, tp >= 0.0, True), axis=(-2, -1))
+    conv = np.stack([r.converged for r in rows])
+    tension = np.maximum(tp[..., 0], 0.0)
+    # the state of a hole is the sign of the material that crossed it (0: stuck)
+    state = np.where(np.abs(flux) > STUCK_FLUX_TOL, np.sign(flux), 0.0).astype(int)
+    return HistoryResult(
+        psi=_segment_psi(robot, disk_T),
+        tension=tension,
+        actuator_tension=tension.copy(),
+        direction=_drive_directions(qa),
+        span_tension=np.where(act, np.maximum(tp[..., 1:], 0.0), 0.0),
+        state=state,
+        taut=taut,
+        converged=conv,
+        residual=np.stack([r.residual for r in rows]),
+        valid=taut & conv,
+        tip=disk_T[..., -1, :3, 3],
+        bend=np.stack([th, be], -1),
+        slip=flux,
+    )
+
+
+def _slip_history(
+    robot: ContinuumRobot, qa: np.ndarray, model: CableModel, pulley: Pulley | None
+) -> HistoryResult:
+    n_t = qa.shape[0]
+    dirs = _drive_directions(qa)
     psi_prev: np.ndarray | None = None
     rows = []
-    dirs = []
     for i in range(n_t):  # a history is sequential
-        dq = qa[i] - prev_q
-        d = np.where(dq > 0.0, 1.0, np.where(dq < 0.0, -1.0, d))
-        r = simulate(robot, qa[i], d, model=model, initial=psi_prev, pulley=pulley)
+        r = simulate(robot, qa[i], dirs[i], model=model, initial=psi_prev, pulley=pulley)
         rows.append(r)
-        dirs.append(d)
         # the next step starts from this pose where it is usable, else from the straight pose
         good = np.all(np.isfinite(r.psi), axis=-1, keepdims=True)
         psi_prev = np.where(good, r.psi, 0.0)
-        prev_q = qa[i]
     psi = np.stack([r.psi for r in rows])
     tension = np.stack([r.tension for r in rows])
     taut = np.stack([r.taut for r in rows])
@@ -698,17 +800,36 @@ def simulate_history(
     # stick_slip_tensions needs T > 0: a slack cable gets a floor value, its sample is flagged not taut
     floor = np.maximum(tension, STICK_SLIP_TENSION_FLOOR)
     hist = stick_slip_tensions(robot, np.nan_to_num(psi), np.nan_to_num(floor, nan=STICK_SLIP_TENSION_FLOOR))
+    theta, beta = psi[..., 0::2], psi[..., 1::2]
+    disk = _disk_T(robot, np.nan_to_num(theta), np.nan_to_num(beta))
+    N = robot.disks_per_segment
+    # the cable that crossed every hole, implied by the sliding model itself: every span holds
+    # ell (1 - T / EA) of cable at its fully sliding tension; s_h = -(change of the cable distal of h)
+    psi0 = np.nan_to_num(psi)
+    ell = span_lengths(robot, psi0, model)
+    span_t = np.nan_to_num(tension)[..., None] * _factors(
+        robot, _wrap(robot, psi0[..., 0::2], psi0[..., 1::2]), dirs
+    )
+    act = _active(robot)
+    mat = np.where(act, ell * (1.0 - span_t / robot.cable_axial_stiffness), 0.0)
+    h0 = robot.segment_length / N
+    rest = np.where(act, h0 * (1.0 - robot.pretension / robot.cable_axial_stiffness), 0.0)
+    dm = np.diff(np.concatenate([np.broadcast_to(rest, mat[:1].shape), mat]), axis=0)
+    slip = -np.cumsum(dm[..., ::-1], axis=-1)[..., ::-1]
     return HistoryResult(
         psi=psi,
         tension=tension,
         actuator_tension=np.stack([r.actuator_tension for r in rows]),
-        direction=np.stack(dirs),
+        direction=dirs,
         span_tension=hist.span_tension,
         state=hist.state,
         taut=taut,
         converged=conv,
         residual=np.stack([r.residual for r in rows]),
         valid=taut & conv,
+        tip=np.where(np.isfinite(psi).all(-1, keepdims=True), disk[..., -1, :3, 3], np.nan),
+        bend=np.stack([np.repeat(theta / N, N, axis=-1), np.repeat(beta, N, axis=-1)], -1),
+        slip=np.where(act, slip, 0.0),
     )
 
 

@@ -18,17 +18,18 @@ bend only.  Solved by Newton in bending-vector coordinates k_j = theta_j (cos be
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ._friction import _factors, _wrap_from_disks
+from ._friction import _factors, _hole_residual, _wrap_from_disks
 from ._kinematics import _dsinc_over_x, _segment_T, _sinc
 from ._params import ContinuumRobot
 
-__all__ = ["DISK_MAX_ITERATIONS", "DISK_TOLERANCE", "DiskEquilibrium"]
+__all__ = ["DISK_MAX_ITERATIONS", "DISK_TOLERANCE", "MEMORY_MAX_ITERATIONS", "DiskEquilibrium"]
 
 Array = NDArray[np.float64]
 
@@ -46,6 +47,13 @@ COLUMN_PASSES = 8
 """Fixed-point passes of the column shortening in drive mode (see _state)."""
 DISK_FD_STEP = 6e-6
 """Central-difference step (rad) of the Newton matrix: eps^(1/3) for O(0.1) interval bends."""
+MEMORY_MAX_ITERATIONS = 40
+"""Semi-smooth Newton iterations of one stick-slip history step (pose and hole fluxes together; the
+branch of every hole is re-read at each iterate; measured 5-8 per step on the study's load-unload
+cycle, 13 at most)."""
+MEMORY_FD_FLUX = 1e-8
+"""Central-difference step (m) of the hole fluxes in the Newton matrix (tensions are linear in the
+flux up to the column shortening, so any small step works; 1e-8 m is ~1e-3 N of tension)."""
 
 
 @dataclass(frozen=True)
@@ -160,30 +168,25 @@ def _k_split(k: Array) -> tuple[Array, Array]:
 Mode = Literal["tension", "drive"]
 
 
-def _state(
-    robot: ContinuumRobot, k: Array, load: Array, d: Array, mode: Mode
-) -> tuple[Array, Array, Array, Array, Array, Array]:
-    """Generalized force (..., 2 J) and (t_raw, P, ell, disk poses) at bending vectors ``k``."""
+def _geometry(robot: ContinuumRobot, k: Array) -> tuple[Array, Array, Array, Array, Array, Array]:
+    """Interval bends, chord lengths (0 beyond a cable's termination) and their derivatives, disk poses."""
     th, be = _k_split(k)
     ell, dth, dbe = _interval_spans(robot, th, be)
-    act = _active(robot)
-    ell = np.where(act, ell, 0.0)
-    T = _chain(robot, th, be)
-    P = np.where(act, _factors(robot, _wrap_from_disks(robot, T), d), 0.0)
+    ell = np.where(_active(robot), ell, 0.0)
+    return th, be, ell, dth, dbe, _chain(robot, th, be)
+
+
+def _path(robot: ContinuumRobot, th: Array, ell: Array, w: Array) -> Array:
+    """Cable paths: chords minus the column shape's extra shortening under span tensions ``w``."""
+    h = robot.segment_length / robot.disks_per_segment
+    u_path = 0.5 * h * np.sqrt(np.sum(np.maximum(w, 0.0), axis=-2) / robot.bending_stiffness)
+    return ell - np.where(_active(robot), _column_shortening(th, u_path, h)[..., None, :], 0.0)
+
+
+def _forces(robot: ContinuumRobot, k: Array, th: Array, be: Array, w: Array, dth: Array, dbe: Array) -> Array:
+    """Generalized force (..., 2 J) of the intervals under the span tensions ``w (..., 3 n, n N)``."""
     h = robot.segment_length / robot.disks_per_segment
     ei = robot.bending_stiffness
-    # The column shape shortens the interval more than its arc (see _column_shortening): in the cable
-    # paths only (the virtual work has it through the stiffness correction below).  In drive mode the
-    # compression depends on the tensions that depend on the paths: a fixed point (the shortening is
-    # ~1e-5 m, and 1e-5 m of path is ~0.1 N of tension); measured: after 5 passes the drive-mode round
-    # trip is off by 2e-5 N at 80 deg, after COLUMN_PASSES = 8 by 6e-8 N.
-    ell_path, t_raw = ell, load
-    for _ in range(1 if mode == "tension" else COLUMN_PASSES):
-        t_u = load if mode == "tension" else _tension_estimate(robot, ell_path, P, load)
-        u_path = 0.5 * h * np.sqrt(np.sum(np.maximum(t_u, 0.0)[..., :, None] * P, axis=-2) / ei)
-        ell_path = ell - np.where(act, _column_shortening(th, u_path, h)[..., None, :], 0.0)
-        t_raw = load if mode == "tension" else _tension_estimate(robot, ell_path, P, load)
-    w = np.maximum(t_raw, 0.0)[..., :, None] * P  # span tensions (a cable cannot push)
     # Beam-column correction: the cables compress the core between two disks by ~sum of the span
     # tensions; the arc's chord shortening in ell already softens the interval to EI (1 - u^2/3),
     # u = (h/2) sqrt(P/EI); the exact column under end moments has EI u / tan(u).  The difference is
@@ -196,41 +199,64 @@ def _state(
     F = np.empty_like(k)
     F[..., 0::2] = f_th * cb - f_bt * sb
     F[..., 1::2] = f_th * sb + f_bt * cb
-    return F, t_raw, P, ell_path, T, w
+    return F
 
 
-def _solve(robot: ContinuumRobot, k0: Array, load: Array, d: Array, mode: Mode) -> DiskEquilibrium:
-    """Newton with backtracking from ``k0 (..., 2 J)`` (all arrays already validated/broadcast)."""
+def _state(
+    robot: ContinuumRobot, k: Array, load: Array, d: Array, mode: Mode
+) -> tuple[Array, Array, Array, Array, Array, Array]:
+    """Generalized force (..., 2 J) and (t_raw, P, ell, disk poses) at bending vectors ``k``."""
+    th, be, ell, dth, dbe, T = _geometry(robot, k)
+    act = _active(robot)
+    P = np.where(act, _factors(robot, _wrap_from_disks(robot, T), d), 0.0)
+    # The column shape shortens the interval more than its arc (see _column_shortening): in the cable
+    # paths only (the virtual work has it through the stiffness correction below).  In drive mode the
+    # compression depends on the tensions that depend on the paths: a fixed point (the shortening is
+    # ~1e-5 m, and 1e-5 m of path is ~0.1 N of tension); measured: after 5 passes the drive-mode round
+    # trip is off by 2e-5 N at 80 deg, after COLUMN_PASSES = 8 by 6e-8 N.
+    ell_path, t_raw = ell, load
+    for _ in range(1 if mode == "tension" else COLUMN_PASSES):
+        t_u = load if mode == "tension" else _tension_estimate(robot, ell_path, P, load)
+        ell_path = _path(robot, th, ell, np.maximum(t_u, 0.0)[..., :, None] * P)
+        t_raw = load if mode == "tension" else _tension_estimate(robot, ell_path, P, load)
+    w = np.maximum(t_raw, 0.0)[..., :, None] * P  # span tensions (a cable cannot push)
+    return _forces(robot, k, th, be, w, dth, dbe), t_raw, P, ell_path, T, w
+
+
+def _newton(fun: Callable[[Array], Array], k0: Array) -> tuple[Array, NDArray[np.bool_]]:
+    """Newton with backtracking on ``fun(k) = 0`` from ``k0 (..., 2 J)``, central-difference Jacobian,
+    batched; returns (k, converged).  A singular or non-finite sample does not stop the others."""
     k = k0.copy()
     batch = k.shape[:-1]
     eye = np.eye(k.shape[-1])
     conv = np.zeros(batch, dtype=bool)
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
         for _ in range(DISK_MAX_ITERATIONS):
-            F = _state(robot, k, load, d, mode)[0]
+            F = fun(k)
             f0 = np.linalg.norm(F, axis=-1)
             conv = f0 < DISK_TOLERANCE
             if np.all(conv | ~np.isfinite(f0)):
                 break
-            cols = [
-                (
-                    _state(robot, k + DISK_FD_STEP * e, load, d, mode)[0]
-                    - _state(robot, k - DISK_FD_STEP * e, load, d, mode)[0]
-                )
-                / (2.0 * DISK_FD_STEP)
-                for e in eye
-            ]
+            h2 = 2.0 * DISK_FD_STEP
+            cols = [(fun(k + DISK_FD_STEP * e) - fun(k - DISK_FD_STEP * e)) / h2 for e in eye]
             Jm = np.nan_to_num(np.stack(cols, -1))
             # pinv: a singular Newton matrix in one sample must not abort the batch
             step = np.einsum("...ij,...j->...i", np.linalg.pinv(Jm), np.nan_to_num(F))
             scale = np.ones(batch)
             for _ in range(DISK_BACKTRACKS):
-                trial = np.linalg.norm(_state(robot, k - scale[..., None] * step, load, d, mode)[0], axis=-1)
+                trial = np.linalg.norm(fun(k - scale[..., None] * step), axis=-1)
                 worse = ~(trial < f0) & ~conv
                 if not np.any(worse):
                     break
                 scale = np.where(worse, 0.5 * scale, scale)
             k = np.where(conv[..., None], k, k - scale[..., None] * step)
+    return k, conv
+
+
+def _solve(robot: ContinuumRobot, k0: Array, load: Array, d: Array, mode: Mode) -> DiskEquilibrium:
+    """Newton with backtracking from ``k0 (..., 2 J)`` (all arrays already validated/broadcast)."""
+    k, _ = _newton(lambda kk: _state(robot, kk, load, d, mode)[0], k0)
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
         F, t_raw, P, ell, T, w = _state(robot, k, load, d, mode)
     res = np.linalg.norm(F, axis=-1)
     th, be = _k_split(k)
@@ -263,3 +289,170 @@ def _uniform_k(robot: ContinuumRobot, theta: Array, beta: Array) -> Array:
     th = np.repeat(theta / N, N, axis=-1)
     be = np.repeat(beta, N, axis=-1)
     return np.stack([th * np.cos(be), th * np.sin(be)], -1).reshape(*th.shape[:-1], 2 * th.shape[-1])
+
+
+# ---- stick-slip with memory fed back into the pose (issue 16 item 3) ------------------------------
+@dataclass(frozen=True)
+class MemoryStep:
+    """One step of the stick-slip history of the disk-wise robot (internal; see simulate_history).
+
+    ``k (..., 2 J)`` bending vectors, ``material (..., 3 n, 1 + n N)`` unstretched cable of every piece
+    (free length first), ``slide (..., 3 n, n N)`` branch of every hole (0 stuck, +-1 sliding at the lower /
+    upper capstan bound), ``piece_tension`` (N, may be < 0 where slack), ``flux`` material crossing every
+    hole toward the actuator in this step (m), ``wrap_mu`` mu eta of every hole, ``disk_T`` disk poses,
+    ``converged`` (residual below DISK_TOLERANCE), ``residual`` (N m, pose and holes).
+    """
+
+    k: Array
+    material: Array
+    slide: Array
+    piece_tension: Array
+    flux: Array
+    wrap_mu: Array
+    disk_T: Array
+    converged: NDArray[np.bool_]
+    residual: Array
+
+
+def _pieces(robot: ContinuumRobot, ell_path: Array) -> Array:
+    """Piece lengths (..., 3 n, 1 + n N): the free length, then the spans (1 beyond the termination: a
+    dummy piece of material 1 and tension 0, cut off by a stuck hole)."""
+    free = np.full((*ell_path.shape[:-1], 1), robot.free_length)
+    return np.concatenate([free, np.where(_active(robot), ell_path, 1.0)], -1)
+
+
+def _memory_initial(robot: ContinuumRobot, batch: tuple[int, ...]) -> tuple[Array, Array, Array]:
+    """Straight, pretensioned rest state: (k, material, slide) with every hole stuck."""
+    J = robot.n_segments * robot.disks_per_segment
+    h = robot.segment_length / robot.disks_per_segment
+    g = _pieces(robot, np.full((robot.n_cables, J), h))
+    live = np.concatenate([np.ones((robot.n_cables, 1), dtype=bool), _active(robot)], -1)
+    m = np.where(live, g * (1.0 - robot.pretension / robot.cable_axial_stiffness), 1.0)
+    k = np.zeros((*batch, 2 * J))
+    return k, np.broadcast_to(m, (*batch, *m.shape)).copy(), np.zeros((*batch, robot.n_cables, J))
+
+
+def _memory_eval(
+    robot: ContinuumRobot,
+    k: Array,
+    s: Array,
+    m_prev: Array,
+    dq: Array,
+    branch: Array | None = None,
+) -> tuple[Array, Array, Array, Array, Array, Array, Array]:
+    """Residual of one history step at bending vectors ``k (..., 2 J)`` and hole fluxes ``s (..., 3 n, n N)``.
+
+    The material moved by the fluxes gives every piece its tension, T = EA (1 - m / g) on its current
+    length g (chord minus the column shortening, whose dependence on the tensions is the fixed point
+    of ``_state`` in drive mode, the same passes); the interval equilibrium under the span tensions
+    (N m) and the hole complementarity (N, scaled by the interval length h to N m) form the residual.
+    Returns (residual (..., 2 J + 3 n n N), own branch, piece tensions, material, mu eta, disk poses,
+    generalized force).
+    """
+    th, be, ell, dth, dbe, T = _geometry(robot, k)
+    act = _active(robot)
+    a = robot.friction_array[:, None] * np.where(act, _wrap_from_disks(robot, T), 0.0)
+    ea = robot.cable_axial_stiffness
+    h = robot.segment_length / robot.disks_per_segment
+    s = np.where(act, s, 0.0)
+    # piece p gains the flux of the hole at its distal end (s_p) and loses that at its proximal end
+    # (s_{p-1}; the actuator reels in dq); the last active span ends at the anchor (s = 0 beyond it)
+    inflow = np.concatenate([s, np.zeros((*s.shape[:-1], 1))], -1)
+    outflow = np.concatenate([np.broadcast_to(dq[..., None], (*s.shape[:-1], 1)), s], -1)
+    m = m_prev + inflow - outflow
+    ell_path = ell
+    for _ in range(COLUMN_PASSES):
+        tp = ea * (1.0 - m / _pieces(robot, ell_path))
+        ell_path = _path(robot, th, ell, np.where(act, tp[..., 1:], 0.0))
+    tp = ea * (1.0 - m / _pieces(robot, ell_path))
+    tp = np.concatenate([tp[..., :1], np.where(act, tp[..., 1:], 0.0)], -1)
+    w = np.where(act, np.maximum(tp[..., 1:], 0.0), 0.0)  # a cable cannot push
+    F = _forces(robot, k, th, be, w, dth, dbe)
+    R, own = _hole_residual(tp, s, a, ea / h, None if branch is None else branch)
+    R = np.where(act, R, ea / h * s)  # holes beyond the termination: no flux
+    own = np.where(act, own, 0.0)
+    res = np.concatenate([F, (h * R).reshape(*R.shape[:-2], -1)], -1)
+    return res, own, tp, m, a, T, F
+
+
+def _memory_step(
+    robot: ContinuumRobot, k0: Array, m_prev: Array, dq: Array, *, fixed_pose: bool = False
+) -> MemoryStep:
+    """One quasi-static step of the history: the drive moves by ``dq (..., 3 n)`` from (k0, m_prev).
+
+    Pose and hole fluxes are solved together by a semi-smooth Newton method (a primal-dual active set:
+    at every iterate each hole's branch - stuck, sliding at the lower or the upper capstan bound - is
+    read from the iterate itself, the Newton matrix is the central difference of the residual on those
+    branches, backtracking on the true residual).  It starts from the previous pose with no flux: the
+    elastic predictor with every hole stuck.  ``fixed_pose``: the pose is held (only the cables move;
+    the rigid-geometry case of :func:`stick_slip_tensions`).
+    """
+    C, K = robot.n_cables, robot.n_segments * robot.disks_per_segment
+    J2 = k0.shape[-1]
+    batch = k0.shape[:-1]
+    n_s = C * K
+    x = np.concatenate([k0, np.zeros((*batch, n_s))], -1)
+    lo_idx = J2 if fixed_pose else 0
+    steps = np.concatenate([np.full(J2, DISK_FD_STEP), np.full(n_s, MEMORY_FD_FLUX)])
+
+    def fun(xx: Array, branch: Array | None = None, extra: int = 0) -> tuple[Array, Array]:
+        mp = m_prev.reshape(*batch, *(1,) * extra, C, K + 1)
+        d = dq.reshape(*batch, *(1,) * extra, C)
+        ss = xx[..., J2:].reshape(*xx.shape[:-1], C, K)
+        r, own = _memory_eval(robot, xx[..., :J2], ss, mp, d, branch)[:2]
+        return r[..., lo_idx:], own
+
+    conv = np.zeros(batch, dtype=bool)
+    n_x = J2 + n_s
+    E = np.eye(n_x)[lo_idx:] * steps[None, :]  # (n_free, n_x) perturbations
+    n_free = E.shape[0]
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        for _ in range(MEMORY_MAX_ITERATIONS):
+            r, own = fun(x)
+            f0 = np.linalg.norm(r, axis=-1)
+            conv = f0 < DISK_TOLERANCE
+            if np.all(conv | ~np.isfinite(f0)):
+                break
+            # all central differences in one batched evaluation (the perturbations as an extra axis)
+            X = np.concatenate([x[..., None, :] + E, x[..., None, :] - E], -2)
+            RR = fun(X, own[..., None, :, :], extra=1)[0]
+            diff = (RR[..., :n_free, :] - RR[..., n_free:, :]) / (2.0 * steps[lo_idx:, None])
+            Jm = np.nan_to_num(np.swapaxes(diff, -1, -2))
+            step = np.zeros_like(x)
+            step[..., lo_idx:] = np.einsum("...ij,...j->...i", np.linalg.pinv(Jm), np.nan_to_num(r))
+            scale = np.ones(batch)
+            for _ in range(DISK_BACKTRACKS):
+                trial = np.linalg.norm(fun(x - scale[..., None] * step)[0], axis=-1)
+                worse = ~(trial < f0) & ~conv
+                if not np.any(worse):
+                    break
+                scale = np.where(worse, 0.5 * scale, scale)
+            x = np.where(conv[..., None], x, x - scale[..., None] * step)
+        k, s = x[..., :J2], x[..., J2:].reshape(*batch, C, K)
+        r, own, tp, m, a, T, _ = _memory_eval(robot, k, s, m_prev, dq)
+    res = np.linalg.norm(r[..., lo_idx:], axis=-1)
+    finite = np.isfinite(res) & np.all(np.isfinite(x), axis=-1)
+    act = _active(robot)
+    return MemoryStep(
+        k=k,
+        material=m,
+        slide=own,
+        piece_tension=tp,
+        flux=np.where(act, s, 0.0),
+        wrap_mu=a,
+        disk_T=T,
+        converged=finite & (res < DISK_TOLERANCE),
+        residual=res,
+    )
+
+
+def _segment_psi(robot: ContinuumRobot, disk_T: Array) -> Array:
+    """``[theta_i, beta_i, ...]`` of the constant-curvature arc with each segment's end tangent: theta the
+    angle between the segment's base and end disk normals, beta the plane of that rotation."""
+    N = robot.disks_per_segment
+    R = disk_T[..., :3, :3]
+    base, end = R[..., 0:-1:N, :, :], R[..., N::N, :, :]
+    z = np.einsum("...ba,...b->...a", base, end[..., :, 2])  # end normal in the segment base frame
+    th = np.arctan2(np.sqrt(z[..., 0] ** 2 + z[..., 1] ** 2), z[..., 2])
+    be = np.arctan2(z[..., 1], z[..., 0])
+    return np.stack([th, be], -1).reshape(*th.shape[:-1], 2 * robot.n_segments)

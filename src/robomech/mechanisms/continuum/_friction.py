@@ -105,8 +105,8 @@ def _as_direction(robot: ContinuumRobot, direction: object | None, batch: tuple[
     if np.any(~sliding & (robot.friction_array > 0.0)):
         raise ValueError(
             "Expected direction +1 (pulled in) or -1 (paid out) for every cable with friction, got other "
-            "values (0 = sticking: eq. (19)'s stick-slip branch is not modelled; pass direction=None for "
-            "the frictionless model)."
+            "values (0 = sticking: a stuck cable's tension depends on its history, see simulate_history "
+            "and stick_slip_tensions; pass direction=None for the frictionless model)."
         )
     return d
 
@@ -564,8 +564,11 @@ def stick_slip_tensions(
     ``[T_{k-1} exp(-mu eta_k), T_{k-1} exp(mu eta_k)]`` of its new proximal neighbour (stuck, eq. (19)'s
     q_dot = 0 branch T(t^-1)), else it slides and takes the bound (eq. (19)'s q_dot != 0 branch, with the
     physical sign of departure 4).  Loading and unloading therefore give hysteresis loops; the result is
-    path-dependent.  This is the rigid-cable (inextensible) limit of a tendon-through-holes model: the
-    tension change travels from the actuator; cable stretch does not feed back on the sliding.
+    path-dependent.  This is the fixed-geometry limit of an elastic cable through the holes: at a fixed
+    pose a stuck span's tension depends on its own cable only, for every EA (the rigid-cable limit);
+    with a changing pose a stuck span's tension changes with its length, which this function ignores:
+    :func:`simulate_history` (``memory="elastic"``) models that and feeds the tensions back into the
+    pose.
 
     Parameters
     ----------
@@ -664,3 +667,44 @@ def stick_slip_tensions(
     last = n_spans - 1
     distal = np.take_along_axis(out, np.broadcast_to(last[:, None], (*out.shape[:-1], 1)), axis=-1)[..., 0]
     return TensionHistory(span_tension=out, state=state, distal=distal)
+
+
+# ---- stick-slip of an elastic cable through the holes (issue 16 item 3) ---------------------------
+# A cable is a chain of pieces: piece 0 the free length between the actuator and the base plate, piece
+# p >= 1 the span that starts at hole p - 1 (hole 0 the base plate, hole k >= 1 disk k).  The state is
+# the unstretched material m_p of every piece; its tension follows Hooke's law on the current length g_p,
+# T_p = EA (1 - m_p / g_p) (the linear law of the segment model's compatibility, so that full slip
+# reproduces disk_equilibrium(drive=...) exactly; T = EA (g/m - 1) is larger by the factor g/m =
+# 1 + eps, eps = T/EA <= 0.6 % at 15 N: a strain difference of eps^2, second order).  In a step the
+# actuator reels in dq; s_h is the material crossing hole h toward the actuator (m_p gains s_p, loses
+# s_{p-1}; s_{-1} = dq, the anchor s_K = 0).  Coulomb-capstan at hole h: T_{h+1} / T_h in
+# [exp(-mu eta_h), exp(+mu eta_h)]; s_h > 0 only at the lower bound (pulled in, eq. (19)'s sliding
+# branch with the physical sign), s_h < 0 only at the upper one, s_h = 0 (stuck, eq. (19)'s T(t^-1)
+# branch: the material, not the tension, is kept) anywhere inside.
+# paper 3, eq. (19): the print keeps the stuck TENSION T(t^-1) and gives no criterion for sticking;
+# here the stuck hole keeps the material on both sides (its span tensions then change elastically with
+# the pose) and sticks while its tension ratio lies inside the capstan cone.
+STUCK_FLUX_TOL = 1e-14
+"""A hole counts as sliding in a step when more than 1e-14 m of cable crossed it (the material per span
+is ~0.02 m, its rounding ~1e-18 m; the step's equilibrium leaves < 4e-14 m of flux at a stuck hole)."""
+
+
+def _hole_residual(
+    T: np.ndarray, s: np.ndarray, a: np.ndarray, c: float, branch: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Coulomb-capstan complementarity of every hole, ``(..., C, K)`` (N), and the branch it is on.
+
+    ``T (..., C, K + 1)`` piece tensions, ``s (..., C, K)`` hole fluxes (m), ``a`` mu eta, ``c`` (N/m) a
+    positive scale.  R = T_{h+1} - clip(T_{h+1} - c s_h, T_h e^{-a}, T_h e^{a}) is zero exactly when the
+    hole is stuck with its ratio in the cone (s = 0), or slides toward the actuator at the lower bound
+    (s > 0), or away at the upper one (s < 0).  ``branch``: 0 inside (R = c s), +1 below (R = T_{h+1} -
+    T_h e^{-a}), -1 above; given, R is evaluated on it (the smooth piece for the Newton matrix), else on
+    its own.  With a = 0 both bounds coincide and every branch gives R = T_{h+1} - T_h (no friction).
+    """
+    prox, dist = T[..., :-1], T[..., 1:]
+    lo, hi = prox * np.exp(-a), prox * np.exp(a)
+    z = dist - c * s
+    own = np.where(z < lo, 1.0, np.where(z > hi, -1.0, 0.0))
+    b = own if branch is None else branch
+    R = np.where(b == 0.0, c * s, np.where(b > 0.0, dist - lo, dist - hi))
+    return R, own
