@@ -183,3 +183,18 @@ def test_an_error_that_makes_the_parameters_invalid_is_a_failed_design():
     assert res["design_ok"].tolist() == [False, True]
     assert np.isnan(res["rms_error"][0]) and not res["assembles"][0]
     assert res["max_error"][1] == pytest.approx(0.0, abs=ROUNDING)  # no error: the nominal axis
+
+
+@pytest.mark.parametrize("block", [1, 7])
+def test_thruster_design_blocks_change_no_bit(monkeypatch, block):
+    # wide errors: some designs do not assemble, some are rejected by the parameter object (arc angle)
+    st = get_study("vectored-thrust-tolerance")
+    wide = with_variables(st, [Variable(v.name, unit="rad", kind="normal", sigma=0.5) for v in st.variables])
+    X = design_matrix(wide.variables, 300, "random", 1, 300)
+    monkeypatch.setattr(vts, "DESIGN_BLOCK", X.shape[0])
+    whole = wide.evaluate_rows(X, None)
+    assert 0 < whole["assembles"].sum() < X.shape[0] and not whole["design_ok"].all()
+    monkeypatch.setattr(vts, "DESIGN_BLOCK", block)
+    blocked = wide.evaluate_rows(X, None)
+    for k, v in whole.items():
+        assert v.tobytes() == blocked[k].tobytes(), k
