@@ -213,8 +213,8 @@ STUDY = DesignStudy(
     },
     poses_per_design=_P,
     default_sampler="random",
-    default_chunk=1024,  # ~1.3 s of work per task on one core (docs/performance.md)
-    default_designs=2048,
+    default_chunk=2048,  # ~1.2 s of work per task on one core in DESIGN_BLOCK blocks (docs/performance.md)
+    default_designs=4096,
     error_names=ERROR_NAMES,
     summarize=summarize,
 )
