@@ -4,7 +4,9 @@
 evaluations per second on one core, no Dask).
 
 ``python benchmarks/bench_explore.py`` (standalone, ~2 min on 2 idle cores): one LocalCluster of 1 and
-one of 2 single-threaded worker processes (``robomech.explore``'s own settings: ``WORKER_ENV``), a warm-up
+one of 2 single-threaded worker processes (``robomech.explore``'s own ``local_cluster``: ``WORKER_ENV``
+and ``LOCAL_CLUSTER_CONFIG``; ``--dask-defaults`` uses Dask's default settings instead, for an A/B of
+those settings), a warm-up
 sweep per study and worker count, then for each study the *same* sweep (``--chunks`` default-size chunks,
 the same designs) ``--repeats`` times on each cluster, alternating the clusters, reading back per sweep:
 
@@ -13,12 +15,20 @@ the same designs) ``--repeats`` times on each cluster, alternating the clusters,
   from the first task's start to the last task's stop (the steady state, without the sweep's one-off
   set-up: connecting, creating the store, the design matrix) and ``task overhead`` the worker-side time
   of a task outside the study's code (task duration minus the in-task work timer ``chunk_seconds``);
-- the client's time per chunk in ``ChunkWriter.write`` (the Zarr write of a finished chunk).
+- the client's time per chunk in ``ChunkWriter.write`` (the Zarr write of a finished chunk);
+- CPU accounting (psutil, user + system CPU seconds of every process before and after the sweep): this
+  process (client, both schedulers and the nannies), the cluster's worker processes and the other,
+  idle cluster's workers, against the in-task CPU of the chunks (``chunk_cpu_seconds``).  Unlike wall
+  time this does not depend on what else runs on the machine.
 
 Reported per study (medians over the repeats):
 
 - poses/s = designs x ``poses_per_design`` / T; set-up + tail = T - window (once per sweep);
 - efficiency ``T1 / (2 T2)`` (the acceptance figure) and the steady-state one ``window1 / (2 window2)``;
+- CPU efficiency = in-task CPU / CPU of all processes: the share of the CPU the sweep used that went
+  into the study's computation (the rest is Dask's and the client's work), a load-robust companion of
+  ``T1 / (2 T2)``; with the in-task CPU per chunk on 2 workers over that on 1 (the slow-down of the
+  study's own code when two processes share caches and memory bandwidth) it explains the efficiency;
 - overhead per chunk = (workers x window - sum of chunk work) / chunks: everything per chunk that is not
   the study's computation (scheduling, transfer, the worker's task wrapper, the client's receipt and
   Zarr write competing for the cores, and the 2-worker load imbalance), as a fraction of the mean chunk
@@ -28,7 +38,8 @@ Reported per study (medians over the repeats):
   (``concurrent.futures``, spawned with ``WORKER_ENV``), all by one process vs half each by two at once,
   ``ceiling = T1 / (2 T2)``.  On a machine whose two cores slow each other down (shared caches, memory
   bandwidth, a hypervisor's vCPUs) the ceiling is below 1 and no scheduler can beat it, so Dask's
-  efficiency is also reported relative to it (``efficiency / ceiling``: what Dask itself loses).
+  efficiency is also reported relative to it (``efficiency / ceiling``: what Dask itself loses);
+  ``--no-ceiling`` skips it (small A/B runs).
 """
 
 from __future__ import annotations
