@@ -15,13 +15,18 @@ import pytest
 from robomech.mechanisms.continuum import ContinuumRobot
 from robomech.verify import continuum as V
 from robomech.verify._cosserat import solve_static
-from robomech.verify._disk_rod import DISK_RK4_STEPS, DiskRobot, solve_disk_robot
+from robomech.verify._disk_rod import DISK_RK4_STEPS, DiskRobot, solve_disk_robot, straight_stability
 
 STEP_TOL_REL = 1e-5
 """Doubling the RK4 steps per disk interval moves the tip by less than this × L = 0.9 µm (expected ~0.3 µm
 from the measured 22 µm at 4 → 8 steps and RK4's h⁴)."""
 STRAIGHT_TOL = 1e-12
 """Equal tensions: the straight rod is exact; the solve reaches round-off of the O(1) states."""
+BUCKLING_REL_TOL = 2e-3
+"""The tension where the shooting Jacobian of the straight robot becomes singular vs the Euler load of one
+disk interval under the three cables' compression, pi² EI / (3 h²) per cable: measured 0.017 % (0.8 mm
+core) and 0.006 % (1.0 mm) apart, the minimum located to 0.01 N; 0.2 % is far below the other candidates
+(the chord sagitta bound 8 EI / (3 l²) is 19 % lower, a clamped interval 4x higher)."""
 
 
 @pytest.fixture(scope="module")
@@ -110,3 +115,44 @@ def test_disk_checks_have_teeth_a_1mm_hole_radius_error_fails(robot) -> None:
     )
     assert np.max(p0) / L > V.DISK_FRICTIONLESS_TOLERANCE.value
     assert math.isfinite(float(np.max(p0)))
+
+
+def _buckling_tension(robot: ContinuumRobot, euler: float) -> float:
+    """The tension per cable (N) where the smallest singular value of the straight robot's shooting
+    Jacobian has its minimum (a double zero: one buckling mode per bending plane)."""
+    from scipy.optimize import minimize_scalar
+
+    ref = V.disk_robot_for(dataclasses.replace(robot, friction=(0.0,) * robot.n_cables))
+    res = minimize_scalar(
+        lambda t: float(straight_stability(ref, t)),
+        bounds=(0.8 * euler, 1.2 * euler),
+        method="bounded",
+        options={"xatol": 0.01},
+    )
+    return float(res.x)
+
+
+@pytest.mark.parametrize("core_diameter", [0.8e-3, None])
+def test_the_straight_robot_buckles_at_the_euler_load_between_disks(robot, core_diameter) -> None:
+    """Issue 16: the 0.8 mm core assumed before buckles at 12.25 N per cable, inside the paper's range; the
+    paper robot's 1.0 mm core (None: ContinuumRobot.paper()) at 29.9 N, twice the 15 N of the range."""
+    rob = robot if core_diameter is None else dataclasses.replace(robot, core_diameter=core_diameter)
+    h = rob.segment_length / rob.disks_per_segment
+    euler = math.pi**2 * rob.bending_stiffness / (3.0 * h**2)
+    t_cr = _buckling_tension(rob, euler)
+    assert abs(t_cr / euler - 1.0) < BUCKLING_REL_TOL
+    ref = V.disk_robot_for(rob)
+    sv = straight_stability(ref, [3.0, t_cr, 1.1 * t_cr])
+    assert sv[1] < 0.05 * sv[0] and sv[1] < 0.3 * sv[2]  # a sharp dip, not a monotone decay
+    if core_diameter is None:
+        assert t_cr > 1.9 * 15.0
+
+
+def test_straight_stability_bad_input(robot) -> None:
+    ref = V.disk_robot_for(robot)
+    with pytest.raises(ValueError, match="tension"):
+        straight_stability(ref, -1.0)
+    with pytest.raises(ValueError, match="tension"):
+        straight_stability(ref, [np.nan])
+    with pytest.raises(ValueError, match="steps"):
+        straight_stability(ref, 1.0, steps=0)

@@ -174,7 +174,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
             " 1e-8 against a tight reference. SIMULATED, not measured: Section 5's 'experiments' run on a"
             " simulated robot whose ground truth is robomech's quasi-static model with straight cable "
             "chords, Coulomb friction at every disk hole with Table 1's μ, elastic Dyneema cables (E = "
-            "4.96 GPa, 0.8 mm) over the body and a 0.1 m free length, and a 0.8 mm NiTi core (E = 60 "
+            "4.96 GPa, 0.8 mm) over the body and a 0.1 m free length, and a 1.0 mm NiTi core (E = 60 "
             "GPa); those stiffnesses and lengths are not printed, so the error magnitudes depend on these"
             " assumed values. The compensation applied is the paper's: arc cable lengths (eq. (4)), "
             "virtual-work tensions with pretension and disk friction with the identified μ, cable stretch"
@@ -478,7 +478,7 @@ def _cosserat_section(res: StudyResult, out_dir: Path, progress: Progress) -> No
                 " θ under the tip load; the Cosserat rod with those tensions and that load gives the true "
                 f"shape. With no load the two agree to {1e3 * np.nanmax(table.position_error[:, 0]):.1e} mm "
                 "(constant curvature is exact there; `robomech verify continuum`). The core is the assumed "
-                "0.8 mm NiTi rod (EI = 1.2e-3 N m²), so already 0.1 N moves the tip by millimetres that "
+                "1.0 mm NiTi rod (EI = 2.9e-3 N m²), so already 0.1 N moves the tip by millimetres that "
                 "constant curvature misplaces by tens of percent."
             ),
         )

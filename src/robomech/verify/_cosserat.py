@@ -233,7 +233,7 @@ class TendonRod:
     def paper(
         cls,
         *,
-        rod_diameter: float = 0.8e-3,
+        rod_diameter: float = 1.0e-3,
         youngs_modulus: float = 60e9,
         poisson_ratio: float = 0.33,
         hole_radius: float = 4.0e-3,
@@ -243,9 +243,9 @@ class TendonRod:
 
         The one "paper robot" of robomech: the same unprinted values as
         ``robomech.mechanisms.continuum.ContinuumRobot.paper()`` (a test checks it): core diameter
-        0.8 mm, NiTi austenite E = 60 GPa (EI = 1.2e-3 N m²), ν = 0.33, cable-hole radius 4 mm.
-        (Before issue 16 this rod had a 1.0 mm core and 3.5 mm holes, so the docs' and the study's
-        error tables disagreed.)
+        1.0 mm, NiTi austenite E = 60 GPa (EI = 2.9e-3 N m²), ν = 0.33, cable-hole radius 4 mm.
+        (Issue 16: the 0.8 mm core assumed before buckles between the disks at 12 N pretension, inside
+        the paper's operating range; see ``ContinuumRobot.core_diameter``.)
         """
         return cls.from_round_rod(
             segment_lengths=(0.090,),

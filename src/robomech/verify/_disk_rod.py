@@ -50,6 +50,7 @@ __all__ = [
     "DiskRobot",
     "DiskSolution",
     "solve_disk_robot",
+    "straight_stability",
 ]
 
 DISK_RK4_STEPS = 12
@@ -252,69 +253,77 @@ class _Model:
             m = m + h / 6.0 * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2])
         return p, R, m
 
-    # -- cables
+    # -- cables (every function below takes leading batch dimensions: the Jacobian assembles all its
+    # perturbed columns in one call)
     def cables(self, P, Rd, t_act, direction):
-        """Disk poses P (J+1, 3), Rd (J+1, 3, 3) incl. the base plate -> span geometry and tensions."""
-        holes = P[None, :, :] + np.einsum("dab,cb->cda", Rd, self.r)  # (n_c, J+1, 3)
-        e = np.diff(holes, axis=1)  # (n_c, J, 3) span vectors
+        """Disk poses P (..., J+1, 3), Rd (..., J+1, 3, 3) incl. the base plate -> span geometry and
+        tensions (..., n_c, J)."""
+        holes = P[..., None, :, :] + np.einsum("...dab,cb->...cda", Rd, self.r)  # (..., n_c, J+1, 3)
+        e = np.diff(holes, axis=-2)  # (..., n_c, J, 3) span vectors
         ell = np.linalg.norm(e, axis=-1)
         a = e / ell[..., None]
-        incoming = np.concatenate([np.broadcast_to(_E3, (self.n_c, 1, 3)), a[:, :-1]], axis=1)
+        incoming = np.concatenate([np.broadcast_to(_E3, (*a.shape[:-2], 1, 3)), a[..., :-1, :]], axis=-2)
         # wrap angle at the hole where span d starts: angle between the incoming and outgoing directions
         eta = 2.0 * np.arctan2(np.linalg.norm(a - incoming, axis=-1), np.linalg.norm(a + incoming, axis=-1))
         eta = np.where(self.active, eta, 0.0)
-        factor = np.exp(-np.cumsum(direction[:, None] * self.mu[:, None] * eta, axis=1))
-        T = np.where(self.active, t_act[:, None] * factor, 0.0)  # (n_c, J) span tensions
+        factor = np.exp(-np.cumsum(direction[..., :, None] * self.mu[:, None] * eta, axis=-1))
+        T = np.where(self.active, t_act[..., :, None] * factor, 0.0)  # (..., n_c, J) span tensions
         return holes, a, ell, eta, T
 
     def disk_wrenches(self, Rd, a, T):
-        """Force and moment (about the backbone point) of all cables on disks 1..J, (J, 3) each."""
-        pull_out = np.concatenate([T[:, 1:, None] * a[:, 1:], np.zeros((self.n_c, 1, 3))], axis=1)
-        f_c = pull_out - T[..., None] * a  # (n_c, J, 3): on disk d+1 (index d)
+        """Force and moment (about the backbone point) of all cables on disks 1..J, (..., J, 3) each."""
+        zero = np.zeros((*T.shape[:-1], 1, 3))
+        pull_out = np.concatenate([T[..., 1:, None] * a[..., 1:, :], zero], axis=-2)
+        f_c = pull_out - T[..., None] * a  # (..., n_c, J, 3): on disk d+1 (index d)
         f_c = np.where(self.active[..., None], f_c, 0.0)
-        arm = np.einsum("dab,cb->cda", Rd[1:], self.r)
-        return f_c.sum(0), np.cross(arm, f_c).sum(0)
+        arm = np.einsum("...dab,cb->...cda", Rd[..., 1:, :, :], self.r)
+        return f_c.sum(-3), np.cross(arm, f_c).sum(-3)
 
 
 def _unpack(model: _Model, x: np.ndarray, Rbar: np.ndarray):
     J = model.J
-    X = x[: 12 * J].reshape(J, 12)
-    p, w, n, m = X[:, 0:3], X[:, 3:6], X[:, 6:9], X[:, 9:12]
+    X = x[..., : 12 * J].reshape(*x.shape[:-1], J, 12)
+    p, w, n, m = X[..., 0:3], X[..., 3:6], X[..., 6:9], X[..., 9:12]
     R = Rbar @ _expm(w)
-    return p, R, n, m, x[12 * J :]
+    return p, R, n, m, x[..., 12 * J :]
 
 
 def _assemble(model, x, Rbar, ends, F_tip, L_tip, direction, mode, load):
-    """Shooting residual from the unknowns ``x`` and the integrated interval ends ``(pe, Re, me)``.
-    mode 'tension': the actuator tensions are given (``load``); mode 'drive': ``load`` is the drive q
-    (nondimensional) and the tensions are the trailing unknowns."""
+    """Shooting residual (..., n_x) from the unknowns ``x (..., n_x)`` and the integrated interval ends
+    ``(pe, Re, me)``.  mode 'tension': the actuator tensions are given (``load``); mode 'drive': ``load``
+    is the drive q (nondimensional) and the tensions are the trailing unknowns."""
     p, R, n, m, xt = _unpack(model, x, Rbar)
+    batch = x.shape[:-1]
     pe, Re, me = ends
-    P = np.concatenate([np.zeros((1, 3)), pe], 0)  # disk positions from the end of each interval
-    Rd = np.concatenate([np.eye(3)[None], Re], 0)
+    P = np.concatenate([np.zeros((*batch, 1, 3)), pe], -2)  # disk positions from the end of each interval
+    Rd = np.concatenate([np.broadcast_to(np.eye(3), (*batch, 1, 3, 3)), Re], -3)
     t_act = load if mode == "tension" else np.maximum(xt, 0.0)
     _, a, ell, _, T = model.cables(P, Rd, t_act, direction)
     f, mo = model.disk_wrenches(Rd, a, T)
-    res = [p[0], (R[0] - np.eye(3))[[2, 0, 1], [1, 2, 0]]]  # base clamp (rotation: skew part)
+    R0 = R[..., 0, :, :] - np.eye(3)
+    res = [p[..., 0, :], R0[..., [2, 0, 1], [1, 2, 0]]]  # base clamp (rotation: skew part)
     # continuity at the interior disks: start of interval d = end of interval d-1
-    res.append((pe[:-1] - p[1:]).ravel())
-    dR = np.einsum("jba,jbc->jac", R[1:], Re[:-1])  # R_startᵀ R_end = I
+    res.append(pe[..., :-1, :] - p[..., 1:, :])
+    dR = np.einsum("...jba,...jbc->...jac", R[..., 1:, :, :], Re[..., :-1, :, :])  # R_startᵀ R_end = I
     res.append(
-        0.5 * np.stack([dR[:, 2, 1] - dR[:, 1, 2], dR[:, 0, 2] - dR[:, 2, 0], dR[:, 1, 0] - dR[:, 0, 1]], -1)
+        0.5
+        * np.stack(
+            [dR[..., 2, 1] - dR[..., 1, 2], dR[..., 0, 2] - dR[..., 2, 0], dR[..., 1, 0] - dR[..., 0, 1]], -1
+        )
     )
     # wrench jumps at disks 1..J: n(s⁻) = n(s⁺) + f; beyond the tip, n(s⁺) = F_tip, m(s⁺) = L_tip
-    n_plus = np.concatenate([n[1:], F_tip[None]], 0)
-    m_plus = np.concatenate([m[1:], L_tip[None]], 0)
+    n_plus = np.concatenate([n[..., 1:, :], np.broadcast_to(F_tip, (*batch, 1, 3))], -2)
+    m_plus = np.concatenate([m[..., 1:, :], np.broadcast_to(L_tip, (*batch, 1, 3))], -2)
     res.append(n - (n_plus + f))  # no distributed load: n is constant over an interval
     res.append(me - (m_plus + mo))
     if mode == "drive":
-        path = np.sum(ell * model.active, axis=1)
-        stretch = (t_act * model.lf + np.sum(T * ell, axis=1) - model.t0 * (model.lf + model.L0)) / model.ea
+        path = np.sum(ell * model.active, axis=-1)
+        stretch = (t_act * model.lf + np.sum(T * ell, axis=-1) - model.t0 * (model.lf + model.L0)) / model.ea
         gap = np.minimum(xt, 0.0) * SLACK_SCALE / model.ea  # slack cable: tension 0, path shorter
         # scaled by EA (a force, like the other residuals): unscaled, this stiff equation (~1e-3 of L
         # for a tension change of ~30 EI/L²) misled the Newton line search's merit function
         res.append(model.ea * (path - model.L0 + load - stretch - gap))
-    return np.concatenate([np.ravel(r) for r in res])
+    return np.concatenate([r.reshape(*batch, -1) for r in res], -1)
 
 
 def _ends(model, x, Rbar, steps):
@@ -326,37 +335,37 @@ def _jacobian(model, x, Rbar, steps, assemble):
     """Central-difference Jacobian exploiting the structure: the end of interval j depends only on
     interval j's 12 unknowns, so perturbing component c of every interval at once gives all their
     columns from one pair of integrations, and the 24 perturbed states plus the base state are
-    integrated together in one batched call; the cheap cable/assembly part is differenced per column."""
+    integrated together in one batched call; the cheap cable/assembly part is then evaluated for all
+    perturbed columns in one batched call (it was 24 J calls, 80 % of the time on 2-3 segments)."""
     J = model.J
-    jac = np.empty((x.size, x.size))
-    hcs = [FD_STEP * max(1.0, float(np.max(np.abs(x[c : 12 * J : 12])))) for c in range(12)]
+    n_rod = 12 * J
+    hcs = np.array([FD_STEP * max(1.0, float(np.max(np.abs(x[c:n_rod:12])))) for c in range(12)])
     xs = [x]
     for c in range(12):
         dx = np.zeros_like(x)
-        dx[c : 12 * J : 12] = hcs[c]
+        dx[c:n_rod:12] = hcs[c]
         xs += [x + dx, x - dx]
     parts = [_unpack(model, z, Rbar) for z in xs]
     p, R, n, m = (np.stack([q[i] for q in parts]) for i in range(4))
     ends = model.integrate(p, R, m, n, steps)  # (25, J, ...)
-    base = tuple(e[0] for e in ends)
-    for c in range(12):
-        plus = tuple(e[1 + 2 * c] for e in ends)
-        minus = tuple(e[2 + 2 * c] for e in ends)
-        for j in range(J):
-            i = 12 * j + c
-            e = np.zeros_like(x)
-            e[i] = hcs[c]
-            ep = tuple(b.copy() for b in base)
-            em = tuple(b.copy() for b in base)
-            for k in range(3):
-                ep[k][j], em[k][j] = plus[k][j], minus[k][j]
-            jac[:, i] = (assemble(x + e, ep) - assemble(x - e, em)) / (2.0 * hcs[c])
-    for i in range(12 * J, x.size):  # tension unknowns (drive mode): no integration involved
-        h = FD_STEP * max(1.0, abs(x[i]))
-        e = np.zeros_like(x)
-        e[i] = h
-        jac[:, i] = (assemble(x + e, base) - assemble(x - e, base)) / (2.0 * h)
-    return jac
+    cols = np.arange(n_rod)
+    j_of, c_of = cols // 12, cols % 12
+    h = np.concatenate([np.tile(hcs, J), FD_STEP * np.maximum(1.0, np.abs(x[n_rod:]))])
+    E = np.diag(h)  # (n_x, n_x): column i perturbed by h_i
+
+    def perturbed(offset):
+        out = []
+        for e in ends:
+            b = np.broadcast_to(e[0], (x.size, *e[0].shape)).copy()
+            b[cols, j_of] = e[offset + 2 * c_of, j_of]  # rod columns: interval j's end moved
+            out.append(b)
+        return tuple(out)
+
+    # row i of each: the residual with unknown i perturbed (the tension unknowns of drive mode involve
+    # no integration: their rows keep the base ends)
+    f_plus = assemble(x + E, perturbed(1))
+    f_minus = assemble(x - E, perturbed(2))
+    return ((f_plus - f_minus) / (2.0 * h[:, None])).T
 
 
 def _guess(model: _Model, t_act: np.ndarray, F_tip: np.ndarray, L_tip: np.ndarray):
@@ -473,6 +482,38 @@ def _solve_case(model, t_act, q, F_tip, L_tip, direction, mode, steps):
     if frac < 1.0:
         _, r = run(x, 1.0)  # residual of the full load at the last converged state
     return x, r, frac, Rbar
+
+
+def straight_stability(robot: DiskRobot, tension: object, *, steps: int = DISK_RK4_STEPS) -> np.ndarray:
+    """Smallest singular value of the shooting Jacobian (nondimensional) at the straight equilibrium
+    under equal tensions ``tension (*B,)`` (N) in every cable, frictionless.
+
+    The straight rod under equal tensions is an exact equilibrium at every tension; where this value
+    falls to 0 that equilibrium bifurcates (the robot buckles: a double zero, one per bending plane, so
+    the determinant touches 0 without changing sign).  Issue 16: with the 0.8 mm core assumed before,
+    the zero sits at 12.25 N per cable, = the Euler load pi² EI / h² of one disk interval under the
+    three cables' compression 3 T, inside the paper's 3-11 N range plus margin; see
+    ``docs/mechanisms/continuum_cosserat.md``."""
+    t = as_array(tension, "tension", ())
+    if np.any(t < 0):
+        raise ValueError(f"Expected tension >= 0, got min {t.min()!r}.")
+    if not (isinstance(steps, int) and steps >= 1):
+        raise ValueError(f"Expected steps an integer >= 1, got {steps!r}.")
+    model = _Model(robot)
+    fs = model.ei / model.L**2
+    zero = np.zeros(3)
+    out = np.empty(t.size)
+    for b, tb in enumerate(t.ravel()):
+        t_act = np.full(model.n_c, float(tb) / fs)
+        p, Rbar, n, m = _guess(model, t_act, zero, zero)
+        x = np.concatenate([p, np.zeros_like(p), n, m], 1).ravel()
+
+        def assemble(z, ends, t_act=t_act, Rbar=Rbar):
+            return _assemble(model, z, Rbar, ends, zero, zero, np.zeros(model.n_c), "tension", t_act)
+
+        jac = _jacobian(model, x, Rbar, steps, assemble)
+        out[b] = np.linalg.svd(jac, compute_uv=False)[-1]
+    return out.reshape(t.shape)
 
 
 def _as_direction(direction, n_c, batch):

@@ -82,7 +82,10 @@ def test_pulley_matches_scipy_integration_of_eq29(alpha, n, radius):
                 t_back, integral = _ivp_pulley(rho, alpha, n, pulley.wrap, t_act)
                 assert t_back == pytest.approx(t, rel=PULLEY_REL_TOL)
             dc = R * (integral - ROBOT.pretension * pulley.wrap) / ea
-            assert r.delta_pulley[i, j] == pytest.approx(dc, rel=PULLEY_REL_TOL, abs=1e-15)
+            # the integral's relative accuracy is absolute in delta: integral - T0 wrap cancels where the
+            # tension stays near the pretension (10 N paper robot)
+            tol = PULLEY_REL_TOL * R * integral / ea
+            assert r.delta_pulley[i, j] == pytest.approx(dc, rel=PULLEY_REL_TOL, abs=max(tol, 1e-15))
     base = c.compensated_drive(ROBOT, PSI, DIR)
     np.testing.assert_allclose(r.q_compensated - base.q_compensated, r.delta_pulley, rtol=1e-12, atol=1e-18)
 

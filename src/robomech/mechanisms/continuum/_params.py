@@ -37,7 +37,9 @@ class ContinuumRobot:
         Distance r of the cable holes from the core axis (m); not printed, default 4 mm. Must be well
         below ``segment_length`` (``n_segments * hole_radius < segment_length``).
     core_modulus, core_diameter : float
-        Young's modulus (Pa) and diameter (m) of the NiTi core; not printed (60 GPa, 0.8 mm).
+        Young's modulus (Pa) and diameter (m) of the NiTi core; not printed (60 GPa, 1.0 mm: EI =
+        2.9e-3 N m², chosen for stability, see ``core_diameter`` below and
+        ``docs/mechanisms/continuum_cosserat.md``).
     cable_modulus, cable_diameter : float
         Young's modulus (Pa) and diameter (m) of the Dyneema cable; paper: 4.96 GPa, 0.8 mm.
     friction : tuple of float
@@ -62,11 +64,17 @@ class ContinuumRobot:
     disks_per_segment: int = 5
     hole_radius: float = 0.004
     core_modulus: float = 60e9
-    core_diameter: float = 0.8e-3
+    # paper 3 prints no core diameter.  1.0 mm (EI = 2.9e-3 N m²) because the paper's robot runs stably
+    # at pretensions up to 11 N (Fig. 6; issue 16's range goes to 15 N): between two disks (h = 18 mm)
+    # the core is a column under the three cables' compression 3 T, so the straight robot buckles at
+    # T_cr = pi² EI / (3 h²) per cable (measured on the disk reference: 12.25 N with the 0.8 mm core
+    # assumed before, inside that range; 29.9 N with 1.0 mm, twice 15 N), and the chord sagitta's
+    # negative bending stiffness 3 T l_d² / 8 stays below EI up to 8 EI / (3 l_d²) = 24 N (10 N before).
+    core_diameter: float = 1.0e-3
     cable_modulus: float = 4.96e9
     cable_diameter: float = 0.8e-3
     friction: tuple[float, ...] = (0.26, 0.31, 0.28)
-    pretension: float = 5.0
+    pretension: float = 10.0
     free_length: float = 0.1
     cable_offset: float = math.pi / 3.0
 
