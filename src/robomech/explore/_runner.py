@@ -200,7 +200,7 @@ def dask_client(
     n = int(workers) if workers else (os.cpu_count() or 1)
     import dask.config
 
-    with dask.config.set(LOCAL_CLUSTER_CONFIG):  # the client's own settings too (read at creation)
+    with dask.config.set(LOCAL_CLUSTER_CONFIG):  # the Client is created under the same settings
         cluster = local_cluster(n)
         client = Client(cluster)
     try:
