@@ -45,6 +45,7 @@ Reported per study (medians over the repeats):
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import os
 import statistics
@@ -56,8 +57,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from robomech.explore import DesignStudy, design_matrix, get_study, open_results, run_sweep
 from robomech.explore import _runner as runner_mod
-from robomech.explore import design_matrix, get_study, open_results, run_sweep
 from robomech.explore._sampling import chunk_seed
 
 from _harness import Workload
@@ -70,6 +71,11 @@ REPEATS = 3
 SYNTHESIS_DESIGNS = 1_000_000
 
 
+def _one_chunk(st: DesignStudy, X: np.ndarray) -> None:
+    """One in-process chunk of ``st`` (chunk 0's seed, fresh each call)."""
+    st.evaluate_rows(X, chunk_seed(0, 0))
+
+
 def workloads() -> list[Workload]:
     out = []
     for name in STUDIES:
@@ -79,7 +85,7 @@ def workloads() -> list[Workload]:
             Workload(
                 name=f"explore: {name}, one chunk ({st.default_chunk} designs)",
                 group="x",
-                run=lambda st=st, X=X: st.evaluate_rows(X, chunk_seed(0, 0)),
+                run=functools.partial(_one_chunk, st, X),
                 n=st.default_chunk * st.poses_per_design,
                 bytes_moved=0,
                 repeats=2,
@@ -102,7 +108,8 @@ class _TimedWriter(runner_mod.ChunkWriter):
 def _cpu_seconds() -> dict[str, float]:
     """CPU seconds (user + system) so far of this process (the client, the schedulers and the nannies of
     both clusters) and of each of its descendants (the worker processes), keyed "client" and by pid."""
-    import psutil
+    # psutil (a dependency of dask.distributed) ships no type stubs.
+    import psutil  # type: ignore[import-untyped]
 
     me = psutil.Process()
     out = {"client": sum(me.cpu_times()[:2])}
