@@ -30,9 +30,20 @@ def _load_workloads(only: str | None) -> list[Workload]:
     return out
 
 
+# Significant digits of a ratio below 1 (a target of 1/3 prints as 0.33x, not as 0x).
+RATIO_SIGNIFICANT_BELOW_ONE = 2
+
+
 def _ratio(value: float | None, width: int, digits: int) -> str:
-    """A ratio as ``12.3x``, or a dash where there is none, right-aligned in ``width``."""
-    return ("—" if value is None else f"{value:.{digits}f}x").rjust(width)
+    """A ratio as ``12.3x`` (``digits`` decimals; below 1 with ``RATIO_SIGNIFICANT_BELOW_ONE`` significant
+    digits, ``0.33x``), or a dash where there is none, right-aligned in ``width``."""
+    if value is None:
+        text = "—"
+    elif abs(value) < 1.0:
+        text = f"{value:.{RATIO_SIGNIFICANT_BELOW_ONE}g}x"
+    else:
+        text = f"{value:.{digits}f}x"
+    return text.rjust(width)
 
 
 def main() -> int:

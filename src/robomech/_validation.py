@@ -8,7 +8,8 @@ result objects of each model.
 Helpers:
 
 - arrays: ``as_array`` (real float64, trailing shape, finiteness), ``check_finite``,
-  ``broadcast_batch``, ``finite_samples`` (per-sample finiteness mask for models that mask instead
+  ``broadcast_batch`` / ``broadcast_to_batch`` (batch shapes of several arguments that
+  must broadcast together), ``finite_samples`` (per-sample finiteness mask for models that mask instead
   of raising);
 - parameter objects: ``check_params`` (``Expected leg to be a SphericalLeg, got NoneType.``);
 - scalar options: ``check_real``, ``check_positive``, ``check_int``, ``check_bool``, ``check_choice``;
@@ -23,11 +24,13 @@ import numbers
 from collections.abc import Iterable, Sequence
 
 import numpy as np
+from numpy.typing import NDArray
 
 __all__ = [
     "MAX_MAGNITUDE",
     "as_array",
     "broadcast_batch",
+    "broadcast_to_batch",
     "check_bool",
     "check_choice",
     "check_finite",
@@ -244,16 +247,56 @@ def coerce_int_fields(
         object.__setattr__(obj, n, check_int(getattr(obj, n), prefix + n, low=low, high=high))
 
 
-def broadcast_batch(*arrays_and_tails: tuple) -> tuple[int, ...]:
-    """Broadcast the batch parts of several arrays: ``(array, n_core_dims)`` or
-    ``(array, n_core_dims, name)`` triples.
+Batched = tuple[NDArray[np.float64], int, str]
+"""One argument of :func:`broadcast_batch`: ``(array, n_core, name)``, ``n_core`` the number of its
+trailing core (non-batch) axes, ``name`` the argument's name in the public signature."""
 
-    Returns the common batch shape, or raises ``ValueError`` naming the arguments and their shapes.
+
+def _batch_parts(items: Sequence[Batched]) -> list[tuple[str, tuple[int, ...], tuple[int, ...]]]:
+    """``(name, batch shape, core shape)`` of each item (an array with fewer than ``n_core`` axes raises)."""
+    out = []
+    for a, n_core, name in items:
+        shape = tuple(int(d) for d in np.shape(a))
+        if len(shape) < n_core:
+            raise ValueError(f"Expected {name} to have at least {n_core} dimension(s), got shape {shape}.")
+        cut = len(shape) - n_core
+        out.append((name, shape[:cut], shape[cut:]))
+    return out
+
+
+def broadcast_batch(*items: Batched) -> tuple[int, ...]:
+    """The common batch shape of several arguments, each ``(array, n_core, name)``.
+
+    The batch part of an array is everything before its last ``n_core`` axes (its core, already
+    checked by :func:`as_array`); the batch parts must broadcast together (NumPy rules).  Call it at
+    the boundary of every public function that takes two or more batched arrays, right after their
+    ``as_array`` checks, so that a mismatch is reported in the arguments' names instead of as a bare
+    NumPy broadcasting error from inside a kernel::
+
+        broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
+        # ValueError: Expected q (..., 3) and qd (..., 3) with batch shapes (...) that broadcast
+        #             together, got batch shapes q (2,), qd (3,).
+
+    Scalars (``n_core=0`` arrays of shape ``()``) broadcast with everything.  Returns the common
+    batch shape.
     """
-    shapes = [t[0].shape[: t[0].ndim - t[1]] for t in arrays_and_tails]
+    parts = _batch_parts(items)
     try:
-        return tuple(np.broadcast_shapes(*shapes))
+        return tuple(int(d) for d in np.broadcast_shapes(*(b for _, b, _ in parts)))
     except ValueError as exc:
-        names = [t[2] if len(t) > 2 else f"argument {i + 1}" for i, t in enumerate(arrays_and_tails)]
-        parts = ", ".join(f"{n} {s}" for n, s in zip(names, shapes, strict=True))
-        raise ValueError(f"Expected batch shapes that broadcast together, got {parts}.") from exc
+        want = [f"{n} {_shape_text(c)}" for n, _, c in parts]
+        wanted = ", ".join(want[:-1]) + " and " + want[-1] if len(want) > 1 else want[0]
+        got = ", ".join(f"{n} {b}" for n, b, _ in parts)
+        raise ValueError(
+            f"Expected {wanted} with batch shapes (...) that broadcast together, got batch shapes {got}."
+        ) from exc
+
+
+def broadcast_to_batch(*items: Batched) -> tuple[NDArray[np.float64], ...]:
+    """:func:`broadcast_batch`, then every array broadcast to the common batch shape followed by its
+    own core shape (read-only views, as ``np.broadcast_to`` returns)."""
+    batch = broadcast_batch(*items)
+    return tuple(
+        np.broadcast_to(a, batch + core)
+        for (a, _, _), (_, _, core) in zip(items, _batch_parts(items), strict=True)
+    )

@@ -55,6 +55,14 @@ class Spec:
     ``slow``     mark the good call and its bad calls ``pytest.mark.slow``.
     ``empty_batch``  the good call with every array argument cut to an empty leading batch must
                  return (empty results), not raise; False where an array's leading axis is no batch.
+    ``unbatched``  array arguments that carry no batch axis (every axis is core: ``weights (6,)``,
+                 ``M (4, 4)``, a mechanism's ``screws (n, 6)``).  In a spec with two or more arrays every
+                 other array must have a batch in ``args`` (more axes than its core): the suite then
+                 gives one of them a batch that does not broadcast with the others' and expects a
+                 ValueError naming it, the other argument and the shape.
+    ``batch_core``  core dimensions for the batch tests where they differ from ``arrays`` (an argument
+                 masked per element of its last axis: ``wheel_rate (..., 6)`` is masked per wheel, core 0,
+                 but its batch is everything before the wheel axis, core 1).
     ``good_elsewhere``  for a call that takes minutes (a whole engine verification): the test file
                  that runs the good call; the contract suite then makes only the bad calls.
     """
@@ -71,6 +79,8 @@ class Spec:
     slow: bool = False
     good_elsewhere: str = ""
     empty_batch: bool = True
+    unbatched: tuple[str, ...] = ()
+    batch_core: Mapping[str, int] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.good_elsewhere and (self.masked or self.mask is not None):
@@ -80,11 +90,22 @@ class Spec:
         for a in self.masked:
             if a not in self.arrays:
                 raise ValueError(f"masked argument {a!r} must also be listed in arrays")
+        for a in (*self.unbatched, *self.batch_core):
+            if a not in self.arrays:
+                raise ValueError(f"unbatched / batch_core argument {a!r} must also be listed in arrays")
         if self.masked and self.mask is None:
             raise ValueError("a spec with masked arguments needs mask=")
         for a in (*self.arrays, *self.params, *self.options):
             if a not in self.args:
                 raise ValueError(f"argument {a!r} needs a good value in args")
+
+    def batched(self) -> tuple[str, ...]:
+        """The array arguments that carry a leading batch (all of ``arrays`` but ``unbatched``)."""
+        return tuple(a for a in self.arrays if a not in self.unbatched)
+
+    def core(self, arg: str) -> int:
+        """The number of core dimensions of ``arg`` for the batch tests."""
+        return self.batch_core.get(arg, self.arrays[arg])
 
 
 @dataclass(frozen=True)

@@ -345,3 +345,143 @@ def test_bad_option(name, opt, index):
     spec = ACTIVE[name]
     value = spec.options[opt][index]
     _expect_value_error(name, spec, {**spec.args, opt: value}, opt, repr(value))
+
+
+# --- batches of several arguments -----------------------------------------------------------------
+# docs/conventions.md: leading axes are batch axes and broadcast together (NumPy rules).  Arguments
+# whose batch shapes do not broadcast must be refused at the boundary naming them and their shapes
+# (``_validation.broadcast_batch``), never by a bare NumPy "operands could not be broadcast" from
+# inside a kernel.  Batch lengths of the mismatch: the argument under test gets 2, the others 3.
+MISMATCH_LENGTHS = (2, 3)
+
+
+def _names(msg: str, arg: str) -> bool:
+    return re.search(rf"(?<![\w]){re.escape(arg)}(?![\w])", msg) is not None
+
+
+def _batch_shape(value: Any, core: int) -> tuple[int, ...]:
+    shape = np.shape(value)
+    return tuple(shape[: len(shape) - core])
+
+
+def _with_last_batch_length(value: Any, core: int, n: int) -> np.ndarray:
+    """``value`` with its last batch axis (the one next to its core) resampled to length ``n``: samples
+    0, 1, 2, ... of the good call, cyclically, so every sample stays a valid input (a time series
+    stays increasing when it is long enough)."""
+    a = np.asarray(value)
+    axis = a.ndim - core - 1
+    return np.take(a, np.arange(n) % a.shape[axis], axis=axis)
+
+
+def test_every_array_of_a_multi_array_spec_is_batched_or_declared_unbatched():
+    """The information the mismatch test needs: in a spec with two or more array arguments, each one
+    either has a batch in the good call or is declared ``unbatched`` (a new spec cannot skip it)."""
+    bad = []
+    for n, s in sorted(ACTIVE.items()):
+        if len(s.arrays) < 2:
+            continue
+        for a in s.arrays:
+            batch = _batch_shape(s.args[a], s.core(a))
+            if a in s.unbatched and batch:
+                bad.append(f"{n}: {a} is listed in unbatched but has the batch {batch} in args ({WHERE[n]})")
+            elif a not in s.unbatched and not batch:
+                bad.append(
+                    f"{n}: give {a} a leading batch axis in args or list it in unbatched= ({WHERE[n]})"
+                )
+    head = "array arguments without batch information (tests/contract/README.md):\n  "
+    assert not bad, head + "\n  ".join(bad)
+
+
+@pytest.mark.parametrize(
+    ("name", "arg"),
+    [
+        pytest.param(n, a, marks=[pytest.mark.slow] if s.slow else [], id=f"{n}-{a}")
+        for n, s in sorted(ACTIVE.items())
+        if len(s.batched()) >= 2
+        for a in s.batched()
+    ],
+)
+def test_batches_that_do_not_broadcast(name, arg):
+    """``arg`` with a batch of 2 samples, every other batched argument with 3: a ValueError naming
+    ``arg``, another of the arguments and ``arg``'s shape."""
+    _check_mismatch(name, ACTIVE[name], arg)
+
+
+def _check_mismatch(name: str, spec: Spec, arg: str) -> None:
+    mine, theirs = MISMATCH_LENGTHS
+    args = dict(spec.args)
+    for a in spec.batched():
+        args[a] = _with_last_batch_length(spec.args[a], spec.core(a), mine if a == arg else theirs)
+    with pytest.raises(ValueError) as info:
+        _call(name, spec, args)
+    msg = str(info.value)
+    shape = np.shape(args[arg])
+    shapes = {shape[:k] for k in range(1, len(shape) + 1)}  # its shape, or its batch part by any core
+    what = f"{name}({arg} {np.shape(args[arg])} beside batches of {theirs})"
+    assert _names(msg, arg), f"{what}: the ValueError must name {arg!r}; got: {msg}"
+    assert "xpected" in msg, f"{what}: say what was expected and what was got; got: {msg}"
+    assert any(_names(msg, a) for a in spec.batched() if a != arg), (
+        f"{what}: the ValueError must also name the argument(s) {arg} does not broadcast with; got: {msg}"
+    )
+    assert any(str(s) in msg for s in shapes), f"{what}: the ValueError must give {arg}'s shape; got: {msg}"
+
+
+@pytest.mark.parametrize(
+    ("name", "arg"),
+    [
+        pytest.param(n, a, marks=[pytest.mark.slow] if s.slow else [], id=f"{n}-{a}")
+        for n, s in sorted(ACTIVE.items())
+        if not s.good_elsewhere
+        for a in s.arrays
+    ],
+)
+def test_an_extra_batch_axis(name, arg):
+    """One argument with an extra axis of 2 just before its core (``q (3, 2)`` -> ``(3, 2, 2)``): a
+    bigger batch, which the call either broadcasts (it returns) or refuses with a ValueError naming
+    the argument - never another exception (a bare NumPy broadcasting error from inside a kernel)."""
+    _check_extra_axis(name, ACTIVE[name], arg)
+
+
+def _check_extra_axis(name: str, spec: Spec, arg: str) -> None:
+    a = np.asarray(spec.args[arg])
+    b = np.stack([a, a], axis=a.ndim - spec.core(arg))
+    try:
+        _call(name, spec, {**spec.args, arg: b}, GOOD_CALL_SECONDS)
+    except ValueError as exc:
+        msg = str(exc)
+        assert _names(msg, arg), f"{name}({arg} {b.shape}): the ValueError must name {arg!r}; got: {msg}"
+        assert "xpected" in msg, f"{name}({arg} {b.shape}): say what was expected and got; got: {msg}"
+    except Exception as exc:  # any other exception is the defect under test
+        pytest.fail(
+            f"{name}({arg} {b.shape}): expected a result or a ValueError naming {arg!r}, "
+            f"got {type(exc).__name__}: {exc}"
+        )
+
+
+# The two checks above are not passed by accident: a function that leaves the mismatch to NumPy
+# fails them, the same function with the boundary check passes.
+def _unchecked(q, qd):
+    return np.asarray(q, dtype=float) * np.asarray(qd, dtype=float)
+
+
+def _checked(q, qd):
+    from robomech._validation import as_array, broadcast_batch
+
+    q, qd = as_array(q, "q", (3,)), as_array(qd, "qd", (3,))
+    broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
+    return q * qd
+
+
+_Q3 = np.arange(9.0).reshape(3, 3)
+
+
+@pytest.mark.parametrize("arg", ["q", "qd"])
+def test_the_batch_checks_fail_a_function_that_leaves_the_mismatch_to_numpy(arg):
+    spec = Spec(args={"q": _Q3, "qd": _Q3[::-1]}, arrays={"q": 1, "qd": 1}, call=_unchecked)
+    with pytest.raises(AssertionError, match="must name"):
+        _check_mismatch("unchecked", spec, arg)
+    with pytest.raises(AssertionError, match="must name"):  # NumPy's ValueError names no argument
+        _check_extra_axis("unchecked", spec, arg)
+    checked = Spec(args=spec.args, arrays=spec.arrays, call=_checked)
+    _check_mismatch("checked", checked, arg)
+    _check_extra_axis("checked", checked, arg)

@@ -377,6 +377,7 @@ def world_inertia(R: ArrayLike, inertia: ArrayLike) -> np.ndarray:
     """
     R = as_array(R, "R", (3, 3))
     Ic = as_array(inertia, "inertia", (3, 3))
+    broadcast_batch((R, 2, "R"), (Ic, 2, "inertia"))
     return R @ Ic @ np.swapaxes(R, -1, -2)
 
 
@@ -438,6 +439,15 @@ def com_inverse_dynamics(
     a0 = as_array(Jdot_qd, "Jdot_qd (B from mass)", (B, 6))
     qdd = as_array(qdd, "qdd (n from qd)", (n,))
     g = as_array(gravity, "gravity", (3,))
+    broadcast_batch(
+        (m, 1, "mass"),
+        (I, 3, "inertia"),
+        (J, 3, "J"),
+        (a0, 2, "Jdot_qd"),
+        (qd, 1, "qd"),
+        (qdd, 1, "qdd"),
+        (g, 1, "gravity"),
+    )
     if np.any(m < 0):
         raise ValueError(f"Expected mass >= 0, got min {float(np.min(m))}.")
     return _com_terms(m, I, J, a0, qd, qdd, g)
@@ -514,6 +524,7 @@ def com_kinetic_energy(mass: ArrayLike, inertia: ArrayLike, J: ArrayLike, qd: Ar
     qd = as_array(qd, "qd", (None,))
     I = as_array(inertia, "inertia (B from mass)", (B, 3, 3))
     J = as_array(J, "J (B from mass, n from qd)", (B, 6, qd.shape[-1]))
+    broadcast_batch((m, 1, "mass"), (I, 3, "inertia"), (J, 3, "J"), (qd, 1, "qd"))
     if np.any(m < 0):
         raise ValueError(f"Expected mass >= 0, got min {float(np.min(m))}.")
     V = np.einsum("...bin,...n->...bi", J, qd)

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from robomech._validation import as_array, check_int
+from robomech._validation import as_array, broadcast_batch, check_int
 
 from ._constraints import jacobian, residual
 from ._model import Mechanism
@@ -259,7 +259,7 @@ def forward_kinematics(
     qa = as_array(q_act, "q_act", (na,), finite=False)
     steps = check_int(steps, "steps", low=1)
     g0 = _guess(mech, guess, qa.shape[:-1])
-    batch = np.broadcast_shapes(qa.shape[:-1], g0.shape[:-1])
+    batch = broadcast_batch((qa, 1, "q_act"), (g0, 1, "guess"))
     qa_f = np.broadcast_to(qa, (*batch, na)).reshape(-1, na)
     q = np.array(np.broadcast_to(g0, (*batch, mech.nq)).reshape(-1, mech.nq))
     ok = np.all(np.isfinite(qa_f), axis=-1)
@@ -358,7 +358,7 @@ def inverse_kinematics(
         raise ValueError(f"Expected weights to be 6 non-negative numbers, not all zero, got {w!r}.")
     steps = check_int(steps, "steps", low=1)
     g0 = _guess(mech, guess, T.shape[:-2])
-    batch = np.broadcast_shapes(T.shape[:-2], g0.shape[:-1])
+    batch = broadcast_batch((T, 2, "T_target"), (g0, 1, "guess"))
     Tf = np.array(np.broadcast_to(T, (*batch, 4, 4)).reshape(-1, 4, 4))
     q = np.array(np.broadcast_to(g0, (*batch, mech.nq)).reshape(-1, mech.nq))
     ok = np.all(np.isfinite(Tf), axis=(-1, -2))

@@ -40,7 +40,7 @@ from typing import TypeVar
 
 import numpy as np
 
-from robomech._validation import as_array, check_bool
+from robomech._validation import as_array, broadcast_batch, check_bool
 from robomech.dynamics import _com_terms
 
 from ._assembly import check_mechanism, check_q, solve_closure
@@ -702,7 +702,9 @@ def _broadcast(mech, q, others: list[tuple[object, str, int]], qname: str = "q")
         if np.any(np.isfinite(n) & (n < 1e-9)):
             raise ValueError(f"Expected the quaternion {qname}[..., {a}:{a + 4}] to be non-zero.")
     arrs = [as_array(x, name, (n,), finite=False) for x, name, n in others]
-    batch = np.broadcast_shapes(qv.shape[:-1], *(a.shape[:-1] for a in arrs))
+    batch = broadcast_batch(
+        (qv, 1, qname), *((a, 1, name) for a, (_, name, _) in zip(arrs, others, strict=True))
+    )
     flat = [np.broadcast_to(qv, (*batch, mech.nq)).reshape(-1, mech.nq)]
     flat += [np.broadcast_to(a, (*batch, a.shape[-1])).reshape(-1, a.shape[-1]) for a in arrs]
     return batch, flat
@@ -1256,7 +1258,7 @@ def energy(mech: Mechanism, q: object, qd: object) -> tuple[np.ndarray, np.ndarr
     mech = check_mechanism(mech)
     q = check_q(mech, q)
     qd = as_array(qd, "qd", (mech.nv,))
-    batch = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1])
+    batch = broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     qf = np.broadcast_to(q, (*batch, mech.nq)).reshape(-1, mech.nq)
     qdf = np.broadcast_to(qd, (*batch, mech.nv)).reshape(-1, mech.nv)
     T, U = _energy_flat(mech, qf, qdf)

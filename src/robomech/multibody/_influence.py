@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_bool
+from robomech._validation import as_array, broadcast_batch, check_bool
 
 from ._assembly import check_mechanism, check_q
 from ._constraints import jacobian, jacobian_rate
@@ -449,7 +449,7 @@ def constraint_jacobian_rate(mech: Mechanism, q: object, qd: object) -> np.ndarr
     mech = check_mechanism(mech)
     q = check_q(mech, q)
     qd = as_array(qd, "qd", (mech.nv,))
-    batch = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1])
+    batch = broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     qf = np.broadcast_to(q, (*batch, mech.nq)).reshape(-1, mech.nq)
     qdf = np.broadcast_to(qd, (*batch, mech.nv)).reshape(-1, mech.nv)
     st = kinematics(mech.tree, qf)

@@ -469,5 +469,7 @@ def wrench_at(force: np.ndarray, point: np.ndarray, moment: np.ndarray | float =
     moment = as_array(moment, "moment")
     if moment.ndim and moment.shape[-1] != 3 and moment.size != 1:
         raise ValueError(f"Expected moment to have shape (..., 3) or be a scalar, got {moment.shape}.")
+    moment_batch = [(moment, 1, "moment")] if moment.ndim and moment.shape[-1] == 3 else []
+    broadcast_batch((force, 1, "force"), (point, 1, "point"), *moment_batch)
     m = np.cross(point, force) + moment
     return np.concatenate(np.broadcast_arrays(m, force), axis=-1)

@@ -190,6 +190,13 @@ def engine_trace(
         raise ValueError(
             f"Expected t (n,) and q, qd, qdd (n, 2), got {t.shape}, {q.shape}, {qd.shape}, {qdd.shape}."
         )
+    if omega_dot_model is not None:
+        omega_dot_model = as_array(omega_dot_model, "omega_dot_model", (3,))
+        if omega_dot_model.shape != (t.shape[0], 3):
+            raise ValueError(
+                f"Expected omega_dot_model (n, 3) at the n = {t.shape[0]} samples of t, q, qd, qdd, "
+                f"got {omega_dot_model.shape}."
+            )
     mech = vt.to_multibody(th)
     hinge = mech.closures[0]  # the RRR chain's s13 joint, a revolute closure rrr_arc2 -> platform
     s13_local = np.asarray(hinge.axis, dtype=float)

@@ -27,7 +27,7 @@ SPECS = {
     P + "lstsq.RANK_RTOL_FACTOR": CONSTANT,
     P + "lstsq.LstsqResult": RESULT_TYPE,
     P + "lstsq.solve": Spec(
-        args={"A": A, "b": B, "exact_cond": False, "weights": np.linspace(0.5, 2.0, 5)},
+        args={"A": A, "b": B, "exact_cond": False, "weights": np.tile(np.linspace(0.5, 2.0, 5), (3, 1))},
         arrays={"A": 2, "b": 1, "weights": 1},
         masked=("A", "b"),
         mask="ok",

@@ -20,7 +20,7 @@ SPECS = {
         args={
             "mass": np.array([1.0, 2.0]),
             "com": np.array([[0.1, 0, 0], [0, 0.2, 0]]),
-            "inertia_com": np.eye(3),
+            "inertia_com": np.stack([np.eye(3), 2.0 * np.eye(3)]),
         },
         arrays={"mass": 0, "com": 1, "inertia_com": 2},
         wrong_shapes={"mass": ((3,),)},

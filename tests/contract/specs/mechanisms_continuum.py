@@ -42,6 +42,14 @@ def _psi_model(default):
     )
 
 
+# a history of 3 steps (leading time axis) for a batch of 2 poses, started from the span tensions a
+# previous history left (> 0 on the active spans, 0 on the others)
+_SS_PSI = np.stack(
+    [np.array([[0.8, 0.0], [1.2, 0.0], [1.0, 0.0]]), np.array([[0.4, 0.3], [0.6, 0.3], [0.5, 0.3]])], 1
+)
+_SS_T = np.stack([np.array([[5.0, 5.0, 5.0], [9.0, 4.0, 4.0], [7.0, 5.0, 5.0]])] * 2, 1)
+_SS_INITIAL = c.stick_slip_tensions(ROBOT, _SS_PSI, _SS_T[::-1]).span_tension[-1]  # (2, 3, 5)
+
 SPECS = {
     P + "IK_TOLERANCE": CONSTANT,
     P + "IDENTIFY_MU_MAX": CONSTANT,
@@ -94,7 +102,7 @@ SPECS = {
         params=("robot",),
     ),
     P + "segment_transform": Spec(
-        args={"theta": PSI[:, 0], "beta": PSI[:, 1], "length": 0.09},
+        args={"theta": PSI[:, 0], "beta": PSI[:, 1], "length": np.array([0.09, 0.08, 0.1])},
         arrays={"theta": 0, "beta": 0, "length": 0},
         options={"length": (-0.1,)},
     ),
@@ -137,8 +145,15 @@ SPECS = {
         options={"model": BAD_MODEL, "method": ("segment", None, 1), "pulley": BAD_PULLEY},
     ),
     P + "simulate": Spec(
-        args={"robot": ROBOT, "q": Q, "direction": DIRECTION, "model": "chord", "pulley": PULLEY},
-        arrays={"q": 1, "direction": 1},
+        args={
+            "robot": ROBOT,
+            "q": Q,
+            "direction": DIRECTION,
+            "model": "chord",
+            "pulley": PULLEY,
+            "initial": PSI,
+        },
+        arrays={"q": 1, "direction": 1, "initial": 1},
         params=("robot",),
         mask="converged",
         options={"model": BAD_MODEL, "pulley": BAD_PULLEY},
@@ -161,17 +176,23 @@ SPECS = {
         },
     ),
     P + "capstan_coefficient": Spec(
-        args={"rho": np.array([2.0, 3.0]), "alpha": 1.0, "n": 0.5},
+        args={"rho": np.array([2.0, 3.0]), "alpha": np.array([1.0, 0.8]), "n": np.array([0.5, 1.0])},
         arrays={"rho": 0, "alpha": 0, "n": 0},
         options={"n": (0.0, -0.5, 1.5), "rho": (0.0,), "alpha": (-1.0,)},
     ),
     P + "capstan_tension_ratio": Spec(
-        args={"phi": np.array([0.5, 1.0]), "rho": np.array([2.0, 3.0]), "alpha": 1.0, "n": 0.5, "t_out": 1.0},
-        arrays={"phi": 0, "alpha": 0, "n": 0, "t_out": 0},
+        args={
+            "phi": np.array([0.5, 1.0]),
+            "rho": 2.5,  # an option (np.inf allowed): not cut to the empty batch
+            "alpha": np.array([1.0, 0.8]),
+            "n": np.array([0.5, 1.0]),
+            "t_out": np.array([1.0, 2.0]),
+        },
+        arrays={"phi": 0, "alpha": 0, "n": 0, "t_out": 0},  # rho: an option (np.inf is allowed)
         options={"n": (0.0, 1.5), "rho": (0.0, np.nan, None, "2"), "phi": (-1.0,), "t_out": (0.0,)},
     ),
     P + "classical_capstan_ratio": Spec(
-        args={"phi": np.array([0.5, 1.0]), "mu": 0.3}, arrays={"phi": 0, "mu": 0}
+        args={"phi": np.array([0.5, 1.0]), "mu": np.array([0.3, 0.1])}, arrays={"phi": 0, "mu": 0}
     ),
     P + "identify_friction": Spec(
         args={
@@ -186,12 +207,8 @@ SPECS = {
         options={"sigma_t": tuple(v for v in BAD_POSITIVE if v is not None)},
     ),
     P + "stick_slip_tensions": Spec(
-        args={
-            "robot": ROBOT,
-            "psi": np.array([[0.8, 0.0], [1.2, 0.0], [1.0, 0.0]]),
-            "t_act": np.array([[5.0, 5.0, 5.0], [9.0, 4.0, 4.0], [7.0, 5.0, 5.0]]),
-        },
-        arrays={"psi": 1, "t_act": 1},
+        args={"robot": ROBOT, "psi": _SS_PSI, "t_act": _SS_T, "initial": _SS_INITIAL},
+        arrays={"psi": 1, "t_act": 1, "initial": 2},
         params=("robot",),
         empty_batch=False,  # the leading axis is time: a history needs a first step
     ),

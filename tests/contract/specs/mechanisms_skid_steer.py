@@ -44,16 +44,24 @@ SPECS = {
         params=("robot",),
     ),
     P + "body_velocity": Spec(
-        args={"robot": ROBOT, "state": CFG, "measured": MEAS, "solver": "qr", "exact_cond": False},
-        arrays={"state": 1, "measured": 1},
+        args={
+            "robot": ROBOT,
+            "state": CFG,
+            "measured": MEAS,
+            "solver": "qr",
+            "exact_cond": False,
+            "measurement_sigma": np.full(MEAS.shape, 0.01),
+        },
+        arrays={"state": 1, "measured": 1, "measurement_sigma": 1},
         masked=("state", "measured"),
         mask="valid",
         params=("robot",),
         options={"solver": ("QR", None, 1), "exact_cond": BAD_BOOL},
     ),
     P + "dead_reckoning": Spec(
-        args={"twists": TWIST, "dt": 0.01, "T0": np.eye(4)},
-        arrays={"twists": 1, "T0": 2},
+        # twists (..., N, 6): a batch of 2 histories of N = 3 twists, each from its own start pose
+        args={"twists": np.stack([TWIST, -TWIST]), "dt": 0.01, "T0": np.stack([np.eye(4), np.eye(4)])},
+        arrays={"twists": 2, "T0": 2},
         wrong_shapes={"T0": ((3, 4),)},
         options={"dt": BAD_POSITIVE},
     ),
@@ -65,7 +73,11 @@ SPECS = {
         mask="turning",
     ),
     P + "wheel_lateral_velocity": Spec(
-        args={"yaw_rate": np.array([0.1, -0.2]), "wheel_x": np.array([0.3, 0.1]), "icr_x": 0.05},
+        args={
+            "yaw_rate": np.array([0.1, -0.2]),
+            "wheel_x": np.array([0.3, 0.1]),
+            "icr_x": np.array([0.05, 0.0]),
+        },
         arrays={"yaw_rate": 0, "wheel_x": 0, "icr_x": 0},
         wrong_shapes={"wheel_x": ((3,),)},
     ),

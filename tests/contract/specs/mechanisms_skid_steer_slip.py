@@ -86,6 +86,7 @@ SPECS = {
         mask="valid",
         params=("robot",),
         wrong_shapes={"wheel_rate": ((2, 5),)},
+        batch_core={"wheel_rate": 1},  # its batch is everything before the wheel axis
     ),
     P + "EncoderModel": Spec(args={"counts_per_rev": 1024}, options={"counts_per_rev": (*BAD_INT, 0, -5)}),
     P + "ImuModel": Spec(
@@ -96,6 +97,7 @@ SPECS = {
             "accel_bias": np.array([0.02, -0.01, 0.0]),
         },
         arrays={"gyro_bias": 1, "accel_bias": 1},
+        unbatched=("gyro_bias", "accel_bias"),  # fields of one sensor model
         options={"gyro_noise_density": BAD_NONNEGATIVE, "accel_noise_density": BAD_NONNEGATIVE},
         wrong_shapes={"gyro_bias": ((2, 3),)},
     ),
@@ -147,6 +149,7 @@ SPECS = {
             "icr_psd": 1e-4,
         },
         arrays={"t": 0, "v_right": 0, "v_left": 0, "gyro_z": 0, "initial_pose": 1},
+        unbatched=("initial_pose",),  # one start pose of the one history (t, v_right, ... share its N)
         params=("icr",),
         options={
             "sigma_track": BAD_POSITIVE,

@@ -28,4 +28,3 @@ SPECS = {
         wrong_shapes={"lengths": ((3,),)},
     ),
 }
-

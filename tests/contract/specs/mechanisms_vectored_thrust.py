@@ -85,6 +85,7 @@ SPECS = {
     P + "mechanism_mobility": Spec(
         args={"th": TH, "q": Q[0], "offsets": None, "ujoint_centre": (0.0, 0.0, 0.0)},
         arrays={"q": 1, "ujoint_centre": 1},
+        unbatched=("q", "ujoint_centre"),  # the mobility at one configuration
         params=("th",),
         options={"offsets": ({"s99": [0, 0, 0]},)},
     ),

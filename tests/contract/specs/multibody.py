@@ -36,11 +36,13 @@ SPECS = {
     P + "Joint": Spec(
         args={"name": "j", "type": "hinge", "axis": V3, "pos": V3, "ref": 0.1},
         arrays={"axis": 1, "pos": 1},
+        unbatched=("axis", "pos"),  # a joint's fields, one description
         options={"name": BAD_NAME, "type": ("cylindrical", 1, None), "ref": BAD_REAL},
     ),
     P + "Inertial": Spec(
         args={"mass": 1.0, "pos": V3, "quat": QUAT, "diaginertia": np.array([0.1, 0.2, 0.3])},
         arrays={"pos": 1, "quat": 1, "diaginertia": 1},
+        unbatched=("pos", "quat", "diaginertia"),  # description fields
         options={"mass": BAD_NONNEGATIVE},
     ),
     P + "Body": Spec(
@@ -53,6 +55,7 @@ SPECS = {
             "inertial": mb.Inertial(1.0, diaginertia=(0.1, 0.1, 0.1)),
         },
         arrays={"pos": 1, "quat": 1},
+        unbatched=("pos", "quat"),  # description fields
         options={
             "name": (*BAD_NAME, "world"),
             "parent": BAD_NAME,
@@ -63,6 +66,7 @@ SPECS = {
     P + "Site": Spec(
         args={"name": "s", "body": "b", "pos": V3, "quat": QUAT},
         arrays={"pos": 1, "quat": 1},
+        unbatched=("pos", "quat"),  # description fields
         options={"name": BAD_NAME, "body": BAD_NAME},
     ),
     P + "Closure": Spec(
@@ -79,6 +83,7 @@ SPECS = {
             "axis2": V3,
         },
         arrays={"anchor1": 1, "anchor2": 1, "relpos": 1, "relquat": 1, "axis": 1, "axis2": 1},
+        unbatched=("anchor1", "anchor2", "relpos", "relquat", "axis", "axis2"),  # description fields
         options={"name": BAD_NAME, "kind": ("ball", 3, None), "body1": BAD_NAME, "body2": (*BAD_NAME, "a")},
     ),
     P + "Coupling": Spec(
@@ -145,6 +150,7 @@ SPECS = {
             "steps": 1,
         },
         arrays={"T_target": 2, "guess": 1, "weights": 1},
+        unbatched=("weights",),  # one weighting of the 6 pose residuals for the whole batch
         masked=("T_target",),
         mask="converged",
         params=("mech",),
@@ -199,12 +205,13 @@ SPECS = {
             "rtol": 1e-8,
         },
         arrays={"q": 1, "reference": 1},
+        unbatched=("reference",),  # one reference configuration (the branch) for the whole batch
         params=("mech",),
         options={"site": (*BAD_STR, "nope"), "length": BAD_LENGTH, "rtol": (*BAD_REAL, 0.0, 1.0, -1.0)},
     ),
     P + "singularity_map": Spec(
-        args={"mech": MECH, "site": "coupler_point", "q_act": QA, "steps": 2},
-        arrays={"q_act": 1},
+        args={"mech": MECH, "site": "coupler_point", "q_act": QA, "guess": Q, "steps": 2},
+        arrays={"q_act": 1, "guess": 1},
         masked=("q_act",),
         mask="reachable",
         params=("mech",),

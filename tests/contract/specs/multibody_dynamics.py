@@ -65,8 +65,15 @@ SPECS = {
         params=("mech",),
     ),
     P + "simulate": Spec(
-        args={"mech": MECH, "q0": Q[:2], "qd_act0": QD[:2], "t": np.array([0.0, 0.01]), "gravity": True},
-        arrays={"q0": 1, "qd_act0": 1},
+        args={
+            "mech": MECH,
+            "q0": Q[:2],
+            "qd_act0": QD[:2],
+            "t": np.array([0.0, 0.01]),
+            "gravity": True,
+            "tau": np.array([[0.1], [0.0]]),  # held actuator torques (a callable is the other form)
+        },
+        arrays={"q0": 1, "qd_act0": 1, "tau": 1},
         params=("mech",),
         options={
             "t": (None, "x", np.array([0.0]), np.array([0.1, 0.0]), np.array([0.0, np.nan])),

@@ -24,6 +24,7 @@ EM = v_ol.build_model(LEG_OL)
 _Q2 = np.array([[0.1, 0.2], [0.0, -0.1]])
 _T = np.array([0.0, 0.5, 1.0])
 _TRAJ = v_vt.table1_trajectory(_T)
+_OMEGA_DOT = vt.angular_acceleration(TH, *_TRAJ).omega_dot  # (3, 3), the analytic model's
 
 SPECS = {
     **exempt("Check VerificationReport Verification", RECORD, P),
@@ -110,9 +111,17 @@ SPECS = {
         args={"th": TH, "actuated": False}, params=("th",), options={"actuated": BAD_BOOL}
     ),
     P + "vectored_thrust.engine_trace": Spec(
-        args={"th": TH, "t": _T, "q": _TRAJ[0], "qd": _TRAJ[1], "qdd": _TRAJ[2], "analytic": TH},
-        arrays={"t": 0, "q": 1, "qd": 1, "qdd": 1},
-        wrong_shapes={"t": ((2,),), "q": ((3, 3), (2, 2))},
+        args={
+            "th": TH,
+            "t": _T,
+            "q": _TRAJ[0],
+            "qd": _TRAJ[1],
+            "qdd": _TRAJ[2],
+            "omega_dot_model": _OMEGA_DOT,
+            "analytic": TH,
+        },
+        arrays={"t": 0, "q": 1, "qd": 1, "qdd": 1, "omega_dot_model": 1},
+        wrong_shapes={"t": ((2,),), "q": ((3, 3), (2, 2)), "omega_dot_model": ((3, 4), (2, 3))},
         params=("th", "analytic"),
     ),
     P + "vectored_thrust.run": Spec(

@@ -12,7 +12,7 @@ from typing import Literal
 
 import numpy as np
 
-from robomech._validation import as_array, check_choice, check_params
+from robomech._validation import as_array, broadcast_batch, check_choice, check_params
 
 from ._disks import DiskEquilibrium, _solve, _uniform_k
 from ._friction import _as_direction, _factors, _wrap, stick_slip_tensions
@@ -136,6 +136,7 @@ def cable_elongation(
     theta, beta = _split(robot, psi)
     t = as_array(tension, "tension", (robot.n_cables,))
     d = _as_direction(robot, direction, theta.shape[:-1])
+    broadcast_batch((theta, 1, "psi"), (t, 1, "tension"), (d, 1, "direction"))
     ell, P = _lengths_and_factors(robot, theta, beta, d, model)
     return _elongation(robot, ell, P, t, model)
 
@@ -292,6 +293,11 @@ def compensated_drive(
         check_params(pulley, Pulley, "pulley")
     theta, beta = _split(robot, psi)
     psi_a = np.stack([theta, beta], -1).reshape(*theta.shape[:-1], 2 * theta.shape[-1])
+    broadcast_batch(
+        (theta, 1, "psi"),
+        *([] if direction is None else [(_as_direction(robot, direction, ()), 1, "direction")]),
+        *([] if wrench is None else [(as_array(wrench, "wrench", (6,)), 1, "wrench")]),
+    )
     if method == "disk":
         if model != "chord":
             raise ValueError(f"Expected model='chord' with method='disk' (chord spans), got {model!r}.")
@@ -473,6 +479,13 @@ def simulate(
     qa = as_array(q, "q", (robot.n_cables,))
     batch = qa.shape[:-1]
     d = _as_direction(robot, direction, batch)
+    n_init = (2 * robot.n_segments,)
+    th_init = [] if initial is None else [(as_array(initial, "initial", n_init), 1, "initial")]
+    if broadcast_batch((qa, 1, "q"), (d, 1, "direction"), *th_init) != batch:
+        got = ", ".join(f"{nm} {a.shape[:-1]}" for a, _, nm in [(d, 1, "direction"), *th_init])
+        raise ValueError(
+            f"Expected direction and initial with batch shapes that broadcast to q's {batch}, got {got}."
+        )
     n = robot.n_segments
     if initial is None:
         # Rigid arc cables: q_c = r sum_{m <= seg(c)} k_m . (cos s_c, sin s_c); least squares for k.
@@ -657,7 +670,9 @@ def simulate_history(
     if times is not None:
         ts = as_array(times, "times", (None,))
         if ts.shape != (n_t,):
-            raise ValueError(f"Expected times of shape ({n_t},) (one per drive sample), got {ts.shape}.")
+            raise ValueError(
+                f"Expected times of shape ({n_t},) (one per drive sample of q {qa.shape}), got {ts.shape}."
+            )
         if np.any(np.diff(ts) <= 0.0):
             raise ValueError("Expected times strictly increasing, got a non-monotone history.")
     batch = qa.shape[1:-1]
@@ -803,13 +818,16 @@ def disk_equilibrium(
         mode = "drive"
     batch = load.shape[:-1]
     if initial is not None:
-        th0, be0 = _split(robot, initial, "initial")
-        batch = np.broadcast_shapes(batch, th0.shape[:-1])
+        init = as_array(initial, "initial", (2 * robot.n_segments,))
+        th0, be0 = _split(robot, init, "initial")
+        batch = broadcast_batch((load, 1, mode), (init, 1, "initial"))
+        with_initial = [(init, 1, "initial")]
     else:
         th0 = np.zeros((*batch, robot.n_segments))
         be0 = np.zeros_like(th0)
+        with_initial = []
     d = _as_direction(robot, direction, batch)
-    batch = np.broadcast_shapes(batch, d.shape[:-1])
+    batch = broadcast_batch((load, 1, mode), *with_initial, (d, 1, "direction"))
     k0 = np.broadcast_to(
         _uniform_k(robot, th0, be0), (*batch, 2 * robot.n_segments * robot.disks_per_segment)
     )

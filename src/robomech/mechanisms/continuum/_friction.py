@@ -161,6 +161,7 @@ def friction_factors(robot: ContinuumRobot, psi: object, direction: object | Non
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     d = _as_direction(robot, direction, theta.shape[:-1])
+    broadcast_batch((theta, 1, "psi"), (d, 1, "direction"))
     return _factors(robot, _wrap(robot, theta, beta), d)
 
 
@@ -220,6 +221,7 @@ def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np
     np.float64(36.6667)
     """
     rho, alpha, n = as_array(rho, "rho"), as_array(alpha, "alpha"), as_array(n, "n")
+    broadcast_batch((rho, 0, "rho"), (alpha, 0, "alpha"), (n, 0, "n"))
     if np.any(rho <= 0.0) or np.any(alpha <= 0.0) or np.any(n <= 0.0) or np.any(n > 1.0):
         bad = "rho" if np.any(rho <= 0.0) else "alpha" if np.any(alpha <= 0.0) else "n"
         raise ValueError(f"Expected rho > 0, alpha > 0 and n in (0, 1], got an invalid {bad}.")
@@ -253,7 +255,9 @@ def classical_capstan_ratio(phi: object, mu: object) -> np.ndarray:
     >>> np.round(cr.classical_capstan_ratio(np.pi, 0.1), 4)
     np.float64(1.3691)
     """
-    return np.exp(as_array(mu, "mu") * as_array(phi, "phi"))
+    mu_a, phi_a = as_array(mu, "mu"), as_array(phi, "phi")
+    broadcast_batch((phi_a, 0, "phi"), (mu_a, 0, "mu"))
+    return np.exp(mu_a * phi_a)
 
 
 def _accuracy_step(rho: np.ndarray, c: np.ndarray) -> np.ndarray:
@@ -351,6 +355,9 @@ def capstan_tension_ratio(
     alpha_a = as_array(alpha, "alpha")
     n_a = as_array(n, "n")
     t_a = as_array(t_out, "t_out")
+    broadcast_batch(
+        (phi_a, 0, "phi"), (rho_a, 0, "rho"), (alpha_a, 0, "alpha"), (n_a, 0, "n"), (t_a, 0, "t_out")
+    )
     if np.any(phi_a < 0.0):
         raise ValueError("Expected phi >= 0, got a negative wrap angle.")
     if np.any(np.isnan(rho_a)) or np.any(rho_a <= 0.0):
@@ -606,29 +613,35 @@ def stick_slip_tensions(
         )
     if p.shape[0] != t.shape[0] or p.shape[0] < 1:
         raise ValueError(
-            f"Expected psi and t_act with one common time length >= 1, got {p.shape[0]} and {t.shape[0]}."
+            f"Expected psi and t_act with one common time length >= 1, got psi {p.shape} and t_act {t.shape}."
         )
     if np.any(t <= 0.0):
         raise ValueError(
             "Expected t_act > 0 at every step (a cable at or below zero tension is slack and has no friction "
             f"state), got min {t.min()!r} N."
         )
+    n_spans = robot.disks_per_segment * (robot.cable_segment + 1)
+    active = np.arange(robot.n_segments * robot.disks_per_segment)[None, :] < n_spans[:, None]
+    init = None if initial is None else as_array(initial, "initial", active.shape)
+    # the batch axes follow the time axis: align them from the right (NumPy rules) after it; an
+    # initial state (no time axis) may extend the history's batch
+    k = max(p.ndim - 2, t.ndim - 2, 0 if init is None else init.ndim - 2)
+    p = p.reshape(p.shape[0], *(1,) * (k + 2 - p.ndim), *p.shape[1:])
+    t = t.reshape(t.shape[0], *(1,) * (k + 2 - t.ndim), *t.shape[1:])
+    with_initial = [] if init is None else [(init, 2, "initial")]
+    batch = broadcast_batch((p[0], 1, "psi"), (t[0], 1, "t_act"), *with_initial)
     theta, beta = _split(robot, p)
     eta = _wrap(robot, theta, beta)  # (n_t, ..., 3n, nN)
     n_t = p.shape[0]
-    batch = np.broadcast_shapes(eta.shape[1:-2], t.shape[1:-1])
     eta = np.broadcast_to(eta, (n_t, *batch, *eta.shape[-2:]))
     t = np.broadcast_to(t, (n_t, *batch, robot.n_cables))
-    n_spans = robot.disks_per_segment * (robot.cable_segment + 1)
-    active = np.arange(robot.n_segments * robot.disks_per_segment)[None, :] < n_spans[:, None]
     mu = robot.friction_array[:, None]
-    if initial is None:
+    if init is None:
         prev = np.where(active, t[0][..., None], 0.0)
     else:
-        prev = as_array(initial, "initial", active.shape)
-        if np.any(prev[..., active] <= 0.0):
+        if np.any(init[..., active] <= 0.0):
             raise ValueError("Expected initial span tensions > 0 on every active span.")
-        prev = np.where(active, np.broadcast_to(prev, (*batch, *active.shape)), 0.0)
+        prev = np.where(active, np.broadcast_to(init, (*batch, *active.shape)), 0.0)
     out = np.zeros((n_t, *batch, *active.shape))
     state = np.zeros(out.shape, dtype=int)
     K = active.shape[-1]

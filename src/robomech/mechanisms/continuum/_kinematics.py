@@ -13,7 +13,7 @@ from typing import Literal
 
 import numpy as np
 
-from robomech._validation import as_array, check_params
+from robomech._validation import as_array, broadcast_batch, check_params
 from robomech.spatial import SMALL_ANGLE
 
 # the unvalidated kernel: inputs are validated once at this module's public boundary
@@ -267,6 +267,7 @@ def segment_transform(theta: object, beta: object, length: object) -> np.ndarray
     t = as_array(theta, "theta")
     b = as_array(beta, "beta")
     ln = as_array(length, "length")
+    broadcast_batch((t, 0, "theta"), (b, 0, "beta"), (ln, 0, "length"))
     if np.any(ln < 0.0):
         raise ValueError("Expected length >= 0, got a negative value.")
     return _segment_T(t, b, ln)

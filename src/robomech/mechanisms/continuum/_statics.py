@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_params, check_positive
+from robomech._validation import as_array, broadcast_batch, check_params, check_positive
 
 from ._friction import _as_direction, _factors, _wrap
 from ._kinematics import CableModel, _span_jac, _split, _tip_jacobian
@@ -52,7 +52,7 @@ def elastic_energy(robot: ContinuumRobot, psi: object) -> np.ndarray:
     >>> import numpy as np
     >>> from robomech.mechanisms import continuum as cr
     >>> np.round(cr.elastic_energy(cr.ContinuumRobot.paper(), np.array([0.5, 0.0])), 8)
-    np.float64(0.00167552)
+    np.float64(0.00409062)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
@@ -91,7 +91,7 @@ def elastic_gradient(robot: ContinuumRobot, psi: object) -> np.ndarray:
     >>> import numpy as np
     >>> from robomech.mechanisms import continuum as cr
     >>> cr.elastic_gradient(cr.ContinuumRobot.paper(), np.array([0.5, 0.0])).round(6)
-    array([0.006702, 0.      ])
+    array([0.016362, 0.      ])
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
@@ -222,17 +222,18 @@ def cable_tensions(
     >>> from robomech.mechanisms import continuum as cr
     >>> res = cr.cable_tensions(cr.ContinuumRobot.paper(), np.array([0.5, 0.0]))
     >>> res.tension.round(4), bool(res.taut), bool(res.residual < 1e-9)
-    (array([5.7688, 4.6573, 4.6573]), True, True)
+    (array([12.0483,  9.087 ,  9.087 ]), True, True)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     batch = theta.shape[:-1]
     d = _as_direction(robot, direction, batch)
+    W = None if wrench is None else as_array(wrench, "wrench", (6,))
+    broadcast_batch((theta, 1, "psi"), (d, 1, "direction"), *([] if W is None else [(W, 1, "wrench")]))
     T0 = robot.pretension if pretension is None else check_positive(pretension, "pretension", allow_zero=True)
     G = _effective_jacobian(robot, theta, beta, d, model)
     rhs = _grad_u(robot, theta)
-    if wrench is not None:
-        W = as_array(wrench, "wrench", (6,))
+    if W is not None:
         Jx = _tip_jacobian(robot, theta, beta)
         rhs = rhs - np.einsum("...ij,...i->...j", Jx, W)
     Gt = np.swapaxes(G, -1, -2)  # (..., 2n, 3n)

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_params
+from robomech._validation import as_array, broadcast_batch, check_params
 from robomech.kinematics import jacobian_space, poe_fk
 from robomech.spatial import inverse_transform, log_se3, screw_from_axis
 
@@ -168,7 +168,7 @@ def thigh_closure(leg: OmniLeg, alpha: object, beta: object) -> ThighClosure:
     check_params(leg, OmniLeg, "leg")
     a = as_array(alpha, "alpha")
     b = as_array(beta, "beta")
-    batch = np.broadcast_shapes(a.shape, b.shape)
+    batch = broadcast_batch((a, 0, "alpha"), (b, 0, "beta"))
     S, M = chain_screws(leg)
     theta = np.zeros((*batch, 3, 4))
     passive = [(0, 1), (0, 2), (0, 3), (1, 1), (1, 2), (1, 3), (2, 0), (2, 1), (2, 2), (2, 3)]

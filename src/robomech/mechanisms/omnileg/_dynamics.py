@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_bool, check_params
+from robomech._validation import as_array, broadcast_batch, check_bool, check_params
 
 from . import _jet as jt
 from ._chains import shank_frames
@@ -413,12 +413,15 @@ def inverse_dynamics(
     q = as_array(q, "q", (3,))
     qd = as_array(qd, "qd", (3,))
     qdd = as_array(qdd, "qdd", (3,))
+    F = None if foot_force is None else as_array(foot_force, "foot_force", (3,))
+    with_F = [] if F is None else [(F, 1, "foot_force")]
+    full = broadcast_batch((q, 1, "q"), (qd, 1, "qd"), (qdd, 1, "qdd"), *with_F)
+    q = np.broadcast_to(q, (*full, 3))  # a foot_force batch may extend the motion's
     batch, (qf, qdf, qddf) = _flat(q, qd, qdd)
     t = _terms_chunked(leg, qf, qdf, qddf, paper_drive=bool(paper_as_printed))
     vel = t.tau_motion - np.einsum("nij,nj->ni", t.M, qddf)
     foot = np.zeros_like(t.tau_motion)
-    if foot_force is not None:
-        F = as_array(foot_force, "foot_force", (3,))
+    if F is not None:
         F = np.broadcast_to(F, (*batch, 3)).reshape(-1, 3)
         foot = -np.einsum("nij,ni->nj", jacobian(leg, qf), F)
     tau = t.tau_motion + t.tau_gravity + foot
@@ -526,6 +529,7 @@ def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     qd = as_array(qd, "qd", (3,))
+    broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     batch, (qf, qdf) = _flat(q, qd)
     t = _terms_chunked(leg, qf, qdf, np.zeros_like(qf))
     return t.kinetic.reshape(batch), t.potential.reshape(batch)
@@ -569,6 +573,7 @@ def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     F = as_array(force, "force", (3,))
+    broadcast_batch((q, 1, "q"), (F, 1, "force"))
     return -np.einsum("...ij,...i->...j", jacobian(leg, q), F)  # paper 2, eq. (50): +Jᵀ F_f, F_f = -F
 
 
@@ -632,6 +637,7 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     tau = as_array(tau, "tau", (3,))
+    broadcast_batch((q, 1, "q"), (tau, 1, "tau"))
     J = jacobian(leg, q)
     U, s, Vt = np.linalg.svd(J)
     rcond = s[..., -1] / s[..., 0]

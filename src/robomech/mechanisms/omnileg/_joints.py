@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_params
+from robomech._validation import as_array, broadcast_batch, check_params
 
 from . import _jet as jt
 from ._params import OmniLeg
@@ -87,7 +87,7 @@ def joint_motion(leg: OmniLeg, q: object, qd: object, qdd: object) -> JointMotio
     q = as_array(q, "q", (3,))
     qd = as_array(qd, "qd", (3,))
     qdd = as_array(qdd, "qdd", (3,))
-    batch = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1])
+    batch = broadcast_batch((q, 1, "q"), (qd, 1, "qd"), (qdd, 1, "qdd"))
     flat = [np.ascontiguousarray(np.broadcast_to(a, (*batch, 3)).reshape(-1, 3)) for a in (q, qd, qdd)]
     alpha, beta, gamma = jt.Jet.variables(*flat)
     ta, tb = jt.tan(alpha), jt.tan(beta)

@@ -16,7 +16,7 @@ from functools import cached_property
 
 import numpy as np
 
-from robomech._validation import as_array, check_params
+from robomech._validation import as_array, broadcast_batch, check_params
 
 from ._params import OmniLeg
 
@@ -94,6 +94,7 @@ def thigh_direction(alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
     array([ 0., -0.,  1.])
     """
     a, b = as_array(alpha, "alpha"), as_array(beta, "beta")
+    broadcast_batch((a, 0, "alpha"), (b, 0, "beta"))
     ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
     inv = 1.0 / np.sqrt(ca * ca + (cb * sa) ** 2)
     return np.stack([sb * ca * inv, -cb * sa * inv, cb * ca * inv], axis=-1)
@@ -173,6 +174,7 @@ def passive_angles(leg: OmniLeg, alpha: object, beta: object) -> tuple[np.ndarra
     check_params(leg, OmniLeg, "leg")
     a = as_array(alpha, "alpha")
     b = as_array(beta, "beta")
+    broadcast_batch((a, 0, "alpha"), (b, 0, "beta"))
     theta12 = np.arctan2(np.sin(a) * np.cos(b), np.cos(a))  # paper 2, eq. (12), cos α multiplied through
     theta22 = -np.arctan2(np.sin(b) * np.cos(a), np.cos(b))  # paper 2, eq. (12): printed +; closure gives -
     return theta12, theta22
@@ -318,6 +320,7 @@ def foot_velocity(leg: OmniLeg, q: object, qd: object) -> np.ndarray:
     """
     check_params(leg, OmniLeg, "leg")
     qd = as_array(qd, "qd", (3,))
+    broadcast_batch((_q(q), 1, "q"), (qd, 1, "qd"))
     return np.einsum("...ij,...j->...i", jacobian(leg, q), qd)
 
 
@@ -349,6 +352,7 @@ def foot_acceleration(leg: OmniLeg, q: object, qd: object, qdd: object) -> np.nd
     check_params(leg, OmniLeg, "leg")
     qd = as_array(qd, "qd", (3,))
     qdd = as_array(qdd, "qdd", (3,))
+    broadcast_batch((_q(q), 1, "q"), (qd, 1, "qd"), (qdd, 1, "qdd"))
     return np.einsum("...ij,...j->...i", jacobian(leg, q), qdd) + np.einsum(
         "...ijk,...j,...k->...i", hessian(leg, q), qd, qd
     )

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_params, check_real
+from robomech._validation import as_array, broadcast_batch, check_params, check_real
 
 from ._dynamics import SINGULAR_RCOND
 from ._kinematics import hessian, jacobian
@@ -126,13 +126,8 @@ def joint_rates(
     pd = as_array(foot_velocity, "foot_velocity", (3,))
     pdd = None if foot_acceleration is None else as_array(foot_acceleration, "foot_acceleration", (3,))
     damping = check_real(damping, "damping", low=0.0)
-    shapes = [q.shape[:-1], pd.shape[:-1]] + ([] if pdd is None else [pdd.shape[:-1]])
-    try:
-        batch = np.broadcast_shapes(*shapes)
-    except ValueError as exc:
-        raise ValueError(
-            f"Expected q, foot_velocity, foot_acceleration to broadcast, got batch shapes {shapes}."
-        ) from exc
+    with_pdd = [] if pdd is None else [(pdd, 1, "foot_acceleration")]
+    batch = broadcast_batch((q, 1, "q"), (pd, 1, "foot_velocity"), *with_pdd)
     q = np.broadcast_to(q, (*batch, 3))
     pd = np.broadcast_to(pd, (*batch, 3))
     # an overflowing sample (|ṗ| ~ 1e300) becomes non-finite and is flagged below, not warned about

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_int, check_params
+from robomech._validation import as_array, broadcast_to_batch, check_int, check_params
 from robomech.analysis.workspace import grid, singularity_map
 
 from ._dynamics import SINGULAR_RCOND
@@ -195,12 +195,7 @@ def singular_surface(leg: OmniLeg, alpha: object, beta: object) -> np.ndarray:
     _leg(leg)
     a = as_array(alpha, "alpha")
     b = as_array(beta, "beta")
-    try:
-        a, b = np.broadcast_arrays(a, b)
-    except ValueError as exc:
-        raise ValueError(
-            f"Expected alpha and beta to broadcast, got shapes {a.shape} and {b.shape}."
-        ) from exc
+    a, b = broadcast_to_batch((a, 0, "alpha"), (b, 0, "beta"))
     return forward_kinematics(leg, np.stack([a, b, np.zeros_like(a)], -1))
 
 

@@ -23,7 +23,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from robomech._validation import as_array, check_params, check_positive, coerce_float_fields
+from robomech._validation import (
+    as_array,
+    broadcast_batch,
+    broadcast_to_batch,
+    check_params,
+    check_positive,
+    coerce_float_fields,
+)
 from robomech.analysis import lstsq
 
 from ._chains import N_WHEELS, WHEEL_SIDE, WHEELS, contact_frames
@@ -138,10 +145,7 @@ def icr_velocity(model: ICRModel, v_right: ArrayLike, v_left: ArrayLike) -> Plan
     check_params(model, ICRModel, "model")
     vr = as_array(v_right, "v_right", finite="mask")
     vl = as_array(v_left, "v_left", finite="mask")
-    try:
-        vr, vl = np.broadcast_arrays(vr, vl)
-    except ValueError as exc:
-        raise ValueError(f"Expected v_right and v_left to broadcast, got {vr.shape} and {vl.shape}.") from exc
+    vr, vl = broadcast_to_batch((vr, 0, "v_right"), (vl, 0, "v_left"))
     valid = np.isfinite(vr) & np.isfinite(vl)
     vr, vl = np.where(valid, vr, 0.0), np.where(valid, vl, 0.0)
     d = model.y_left - model.y_right
@@ -308,11 +312,12 @@ def identify_icr(
         )
     if V.shape != (*vr.shape, 3):
         raise ValueError(
-            f"Expected body_velocity to have shape {(*vr.shape, 3)} (one N: one sample rate), got {V.shape}."
+            f"Expected body_velocity to have shape {(*vr.shape, 3)} like v_right {vr.shape} (one N: one "
+            f"sample rate), got {V.shape}."
         )
     w = np.ones(vr.shape) if weights is None else as_array(weights, "weights")
     if w.shape != vr.shape:
-        raise ValueError(f"Expected weights to have shape {vr.shape}, got {w.shape}.")
+        raise ValueError(f"Expected weights to have shape {vr.shape} like v_right, got {w.shape}.")
     if np.any(w < 0):
         raise ValueError(f"Expected weights >= 0, got {int(np.sum(w < 0))} negative value(s).")
     used = np.isfinite(vr) & np.isfinite(vl) & np.all(np.isfinite(V), axis=-1)
@@ -399,6 +404,7 @@ def wheel_slip(
         q[[3, 7]] = robot.rear_wheel_drop
     else:
         q = as_array(config, "config", (8,))
+    broadcast_batch((w, 1, "wheel_rate"), (V, 1, "body_velocity"), (q, 1, "config"))
     p = contact_frames(robot, q)[..., :3, 3]  # (..., 6, 3)
     vx, vy, r = V[..., 0:1], V[..., 1:2], V[..., 2:3]
     ground = vx - r * p[..., 1]

@@ -374,7 +374,10 @@ def planar_ekf(
             continue
         arr = np.asarray(a)
         if arr.dtype != bool or arr.shape != (n,):
-            raise ValueError(f"Expected {name} a bool array of shape ({n},), got {arr.dtype} {arr.shape}.")
+            raise ValueError(
+                f"Expected {name} a bool array of shape ({n},) (one flag per sample of t), "
+                f"got {arr.dtype} {arr.shape}."
+            )
         oks[name] = arr
     hist = {}
     for a, name, ok in (

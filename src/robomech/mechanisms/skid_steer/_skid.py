@@ -223,7 +223,7 @@ def dead_reckoning(twists: ArrayLike, dt: float, T0: ArrayLike | None = None) ->
     h = check_positive(dt, "dt")
     n = V.shape[-2]
     T0a = np.eye(4) if T0 is None else as_array(T0, "T0", (4, 4))
-    out = np.empty((*np.broadcast_shapes(V.shape[:-2], T0a.shape[:-2]), n, 4, 4))
+    out = np.empty((*broadcast_batch((V, 2, "twists"), (T0a, 2, "T0")), n, 4, 4))
     out[..., 0, :, :] = T0a
     if n == 1:
         return out

@@ -180,6 +180,7 @@ def wheel_measurements(
     q = as_array(config, "config", (CONFIG_SIZE,))
     V = as_array(twist, "twist", (6,))
     qd = as_array(config_rate, "config_rate", (CONFIG_SIZE,))
+    broadcast_batch((q, 1, "config"), (V, 1, "twist"), (qd, 1, "config_rate"))
     p, alpha, G = _linear_columns(robot, q)
     w_B, v_B = V[..., None, :3], V[..., None, 3:]
     v = v_B + np.cross(w_B, p)  # (..., 6, 3)

@@ -34,7 +34,15 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from robomech._validation import as_array, check_bool, check_int, check_params, check_real, finite_samples
+from robomech._validation import (
+    as_array,
+    broadcast_batch,
+    check_bool,
+    check_int,
+    check_params,
+    check_real,
+    finite_samples,
+)
 
 from ._kinematics import LENGTH_FLOOR, _rotation
 from ._params import SphericalLeg
@@ -175,11 +183,8 @@ def _check_state(q: object, qd: object, qdd: object = _NO_QDD):
     qa = as_array(q, "q", (2,))
     qda = as_array(qd, "qd", (2,))
     qdda = None if qdd is _NO_QDD else as_array(qdd, "qdd", (2,))
-    shapes = [x.shape for x in (qa, qda, qdda) if x is not None]
-    try:
-        shape = np.broadcast_shapes(*shapes)
-    except ValueError as exc:
-        raise ValueError(f"Expected q, qd, qdd to broadcast, got shapes {shapes}.") from exc
+    with_qdd = [] if qdda is None else [(qdda, 1, "qdd")]
+    shape = (*broadcast_batch((qa, 1, "q"), (qda, 1, "qd"), *with_qdd), 2)
     out = [np.broadcast_to(qa, shape), np.broadcast_to(qda, shape)]
     if qdda is not None:
         out.append(np.broadcast_to(qdda, shape))
@@ -286,6 +291,8 @@ def generalized_forces(
     check_params(leg, SphericalLeg, "leg")
     qa, qda, qdda = _check_state(q, qd, qdd)
     w = None if platform_wrench is None else as_array(platform_wrench, "platform_wrench", (6,))
+    if w is not None:
+        broadcast_batch((qa, 1, "q, qd, qdd"), (w, 1, "platform_wrench"))
     cardan = not check_bool(paper_as_printed, "paper_as_printed")
     return _generalized(leg, _motion(leg, qa, qda, qdda, cardan), w)
 
@@ -482,6 +489,7 @@ def distribute_forces(
     """
     J = as_array(J, "J", (3, 2), finite=False)
     t = as_array(tau, "tau", (2,), finite=False)
+    broadcast_batch((J, 2, "J"), (t, 1, "tau"))
     bound = check_real(sigma_min_bound, "sigma_min_bound", low=0.0)  # m/rad
     # non-finite samples: zeroed before any arithmetic (then flagged by ok below), never propagated
     good = finite_samples(J, 2)[..., None] & finite_samples(t, 1)[..., None]
@@ -638,6 +646,8 @@ def inverse_dynamics(
     check_params(leg, SphericalLeg, "leg")
     qa, qda, qdda = _check_state(q, qd, qdd)
     w = None if platform_wrench is None else as_array(platform_wrench, "platform_wrench", (6,))
+    if w is not None:
+        broadcast_batch((qa, 1, "q, qd, qdd"), (w, 1, "platform_wrench"))
     cardan = not check_bool(paper_as_printed, "paper_as_printed")
     m = _motion(leg, qa, qda, qdda, cardan)
     tau = _generalized(leg, m, w)

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_bool, check_int, check_params
+from robomech._validation import as_array, broadcast_to_batch, check_bool, check_int, check_params
 
 # the unvalidated kernel: inputs are validated once at this module's public boundary
 from robomech.spatial._so3 import _sincos as sincos
@@ -82,12 +82,7 @@ def _chunked(kernel, inputs: tuple[np.ndarray, ...], outputs: tuple[np.ndarray, 
 def _angles(alpha: object, beta: object) -> tuple[np.ndarray, np.ndarray]:
     a = as_array(alpha, "alpha")
     b = as_array(beta, "beta")
-    try:
-        a, b = np.broadcast_arrays(a, b)
-    except ValueError as exc:
-        raise ValueError(
-            f"Expected alpha and beta to broadcast, got shapes {a.shape} and {b.shape}."
-        ) from exc
+    a, b = broadcast_to_batch((a, 0, "alpha"), (b, 0, "beta"))
     return a, b
 
 
@@ -831,12 +826,7 @@ def leg_rates(
     qa = as_array(q, "q", (2,))
     qda = as_array(qd, "qd", (2,))
     qdda = as_array(qdd, "qdd", (2,))
-    try:
-        qa, qda, qdda = np.broadcast_arrays(qa, qda, qdda)
-    except ValueError as exc:
-        raise ValueError(
-            f"Expected q, qd, qdd to broadcast, got shapes {qa.shape}, {qda.shape}, {qdda.shape}."
-        ) from exc
+    qa, qda, qdda = broadcast_to_batch((qa, 1, "q"), (qda, 1, "qd"), (qdda, 1, "qdd"))
     a, b = qa[..., 0], qa[..., 1]
     sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
     qq, dq, d2q = _derivatives(leg, sa, ca, sb, cb)

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_params, check_real
+from robomech._validation import as_array, broadcast_batch, check_params, check_real
 
 from ._kinematics import _chunked, _jacobian, _q, angular_acceleration
 from ._params import VectoredThruster
@@ -150,11 +150,8 @@ def inverse_rates(
     w = as_array(omega, "omega", (3,))
     wd = None if omega_dot is None else as_array(omega_dot, "omega_dot", (3,))
     lam_rel = _check_damping(damping)
-    shapes = [q.shape[:-1], w.shape[:-1]] + ([] if wd is None else [wd.shape[:-1]])
-    try:
-        batch = np.broadcast_shapes(*shapes)
-    except ValueError as exc:
-        raise ValueError(f"Expected q, omega, omega_dot to broadcast, got batch shapes {shapes}.") from exc
+    with_wd = [] if wd is None else [(wd, 1, "omega_dot")]
+    batch = broadcast_batch((q, 1, "q"), (w, 1, "omega"), *with_wd)
     q = np.broadcast_to(q, (*batch, 2))
     w = np.broadcast_to(w, (*batch, 3))
     # an overflowing sample (|ω| ~ 1e300) becomes non-finite and is flagged below, not warned about
@@ -264,12 +261,7 @@ def static_torques(th: VectoredThruster, q: object, wrench: object) -> StaticsRe
     _check_thruster(th)
     q = _q(q)
     wr = as_array(wrench, "wrench", (6,))
-    try:
-        batch = np.broadcast_shapes(q.shape[:-1], wr.shape[:-1])
-    except ValueError as exc:
-        raise ValueError(
-            f"Expected q and wrench to broadcast, got batch shapes {q.shape[:-1]} and {wr.shape[:-1]}."
-        ) from exc
+    batch = broadcast_batch((q, 1, "q"), (wr, 1, "wrench"))
     q = np.broadcast_to(q, (*batch, 2))
     m = np.broadcast_to(wr[..., :3], (*batch, 3))
     jr = _chunked(_jacobian, th, np.ascontiguousarray(q))

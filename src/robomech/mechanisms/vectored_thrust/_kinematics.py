@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
-from robomech._validation import as_array, check_params
+from robomech._validation import as_array, broadcast_batch, check_params
 from robomech.spatial import lie_bracket
 
 # the unvalidated kernel: inputs are validated once at this module's public boundary
@@ -440,6 +440,7 @@ def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
     0.0
     """
     arrs = [as_array(v, name, (3,)) for v, name in ((a1, "a1"), (b1, "b1"), (a2, "a2"), (b2, "b2"))]
+    broadcast_batch(*((v, 1, name) for v, name in zip(arrs, ("a1", "b1", "a2", "b2"), strict=True)))
     return _arc_clearance(*(_split(v) for v in arrs))
 
 
@@ -836,6 +837,7 @@ def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
     """
     check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
+    broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     ax = _axes(th, q)
     x = _rates(ax, qd)
     return PassiveResult(values=np.where(ax.valid[..., None], x, np.nan), valid=ax.valid)
@@ -953,6 +955,7 @@ def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityRes
     """
     check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
+    broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     jr = _jacobian(th, q)
     return VelocityResult(omega=np.einsum("...ij,...j->...i", jr.J, qd), valid=jr.valid)
 
@@ -997,6 +1000,7 @@ def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: objec
     """
     check_params(th, VectoredThruster, "th")
     q, qd, qdd = _q(q), as_array(qd, "qd", (2,)), as_array(qdd, "qdd", (2,))
+    broadcast_batch((q, 1, "q"), (qd, 1, "qd"), (qdd, 1, "qdd"))
     ax = _axes(th, q)
     s13 = np.where(ax.valid[..., None], ax.s13, 0.0)
     axv = JointAxes(ax.s11, ax.s12, s13, ax.s21, ax.s22, ax.s0, ax.distance, ax.valid)

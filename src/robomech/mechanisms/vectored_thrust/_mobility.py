@@ -186,6 +186,8 @@ def mechanism_mobility(
     plat = platform_mobility(th, q, offsets)
     qa = as_array(q, "q", (2,))
     c = as_array(ujoint_centre, "ujoint_centre", (3,))
+    if c.ndim != 1:
+        raise ValueError(f"Expected ujoint_centre to have shape (3,), got {c.shape}.")
     s0 = _axes(th, qa).s0
     # The universal-joint cross: first axis fixed to the motor shaft (X at the current motor angle 0),
     # second axis perpendicular to it and to the propeller shaft.
