@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from ._optimize import optimize_nsga2
 from ._pareto import pareto_front
-from ._runner import SchedulerUnreachable, SweepSummary, run_sweep
+from ._runner import SchedulerUnreachable, SweepSummary, local_cluster, run_sweep
 from ._sampling import SAMPLERS, chunk_seed, design_matrix
 from ._store import StoreMismatch, open_results
 from ._study import DesignStudy, Metric, Objective, Variable, with_variables
@@ -30,6 +30,7 @@ __all__ = [
     "chunk_seed",
     "design_matrix",
     "get_study",
+    "local_cluster",
     "open_results",
     "optimize_nsga2",
     "pareto_front",

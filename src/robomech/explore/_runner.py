@@ -211,14 +211,43 @@ def dask_client(
 
 
 def local_cluster(workers: int) -> LocalCluster:
-    """The sweeps' LocalCluster: ``workers`` single-threaded worker processes (each with a nanny, which
-    restarts it if it dies) on 127.0.0.1, :data:`WORKER_ENV` and :data:`LOCAL_CLUSTER_CONFIG`."""
+    """The sweeps' local Dask cluster, for sweeps that share one cluster (a report, a notebook).
+
+    ``workers`` single-threaded worker processes (each with a nanny, which restarts it if it dies) on
+    127.0.0.1 only, with ``WORKER_ENV`` (one thread per BLAS/OpenMP/numba) and
+    ``LOCAL_CLUSTER_CONFIG`` (Dask's background work cut: no worker profiler, 1 s scheduler tick and
+    memory monitor, 5 s system monitor; measured in ``docs/performance.md``).  :func:`run_sweep` without a
+    ``client`` builds the same cluster itself.
+
+    Parameters
+    ----------
+    workers : int
+        Number of worker processes (>= 1).
+
+    Returns
+    -------
+    distributed.LocalCluster
+        A running cluster; use it as a context manager (or call ``close()``) so that its processes stop.
+
+    Raises
+    ------
+    ValueError
+        If ``workers`` is not an integer >= 1.
+
+    Examples
+    --------
+    >>> from distributed import Client
+    >>> from robomech.explore import get_study, local_cluster, run_sweep
+    >>> with local_cluster(2) as cluster, Client(cluster) as client:  # doctest: +SKIP
+    ...     s = run_sweep(get_study("omnileg-synthesis"), "out.zarr", designs=64, client=client)
+    """
+    n = check_int(workers, "workers", low=1)
     import dask.config
     from distributed import LocalCluster
 
     with dask.config.set(LOCAL_CLUSTER_CONFIG):
         return LocalCluster(
-            n_workers=check_int(workers, "workers", low=1),
+            n_workers=n,
             threads_per_worker=1,
             processes=True,
             host="127.0.0.1",

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from robomech.explore import get_study, run_sweep
+from robomech.explore import get_study, local_cluster, run_sweep
 
 from ._core import Figure, Progress, Study, StudyResult, Table
 from ._sweep import sweep_result
@@ -19,7 +19,7 @@ DEMO_WORKERS = 2
 
 
 def run(out_dir: Path, progress: Progress) -> StudyResult:
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     res = StudyResult(
         name="sweep-demo",
@@ -34,13 +34,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     summaries = {}
     progress.step(f"LocalCluster of {DEMO_WORKERS} worker processes on 127.0.0.1")
     with (
-        LocalCluster(
-            n_workers=DEMO_WORKERS,
-            threads_per_worker=1,
-            host="127.0.0.1",
-            dashboard_address="127.0.0.1:0",
-            silence_logs=40,
-        ) as cluster,
+        local_cluster(DEMO_WORKERS) as cluster,  # the sweeps' own settings (explore.local_cluster)
         Client(cluster) as client,
     ):
         for name, n, chunk in DEMO:

@@ -53,6 +53,15 @@ _RUNTIME = {
     "seed": BAD_SEED,
 }
 
+
+def _cluster_started_and_closed(workers):
+    """local_cluster's good call: start the cluster, count its workers, stop every process it started."""
+    from robomech.explore import local_cluster
+
+    with local_cluster(workers) as cluster:
+        return len(cluster.workers)
+
+
 SPECS = {
     P + "SAMPLERS": CONSTANT,
     P + "SweepSummary": RESULT_TYPE,
@@ -110,6 +119,9 @@ SPECS = {
             "seed": BAD_SEED,
             "chunk": (None, "4", True, 0),
         },
+    ),
+    P + "local_cluster": Spec(
+        args={"workers": 1}, options={"workers": BAD_COUNT}, call=_cluster_started_and_closed, slow=True
     ),
     P + "get_study": Spec(args={"name": "omnileg-synthesis"}, options={"name": ("no-such-study", None, 1)}),
     P + "with_variables": Spec(
