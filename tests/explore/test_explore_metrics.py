@@ -183,3 +183,36 @@ def test_an_error_that_makes_the_parameters_invalid_is_a_failed_design():
     assert res["design_ok"].tolist() == [False, True]
     assert np.isnan(res["rms_error"][0]) and not res["assembles"][0]
     assert res["max_error"][1] == pytest.approx(0.0, abs=ROUNDING)  # no error: the nominal axis
+
+
+@pytest.mark.parametrize("block", [1, 7])
+def test_thruster_design_blocks_change_no_bit(monkeypatch, block):
+    # wide errors: some designs do not assemble, some are rejected by the parameter object (arc angle)
+    st = get_study("vectored-thrust-tolerance")
+    wide = with_variables(st, [Variable(v.name, unit="rad", kind="normal", sigma=0.5) for v in st.variables])
+    X = design_matrix(wide.variables, 300, "random", 1, 300)
+    monkeypatch.setattr(vts, "DESIGN_BLOCK", X.shape[0])
+    whole = wide.evaluate_rows(X, None)
+    assert 0 < whole["assembles"].sum() < X.shape[0] and not whole["design_ok"].all()
+    monkeypatch.setattr(vts, "DESIGN_BLOCK", block)
+    blocked = wide.evaluate_rows(X, None)
+    for k, v in whole.items():
+        assert v.tobytes() == blocked[k].tobytes(), k
+
+
+def test_spherical_leg_fig5b_metrics_match_the_definition_for_every_design():
+    # the study runs the dynamics only where the motion is kinematically feasible: check against the
+    # definition evaluated in full (stroke limits, no dl3/dalpha sign change, dynamics valid) per design
+    X = design_matrix(sls.STUDY.variables, 32, "sobol", 4, 32)
+    res = sls.STUDY.evaluate_rows(X, None)
+    q, qd, qdd = sl.fig5_motion("b", np.arange(0.0, 25.0 + 1e-9, 0.1))
+    for i, row in enumerate(X):
+        leg = dataclasses.replace(sl.SphericalLeg.paper(), R=row[0], r=row[1], h=row[2])
+        path = sl.workspace_map(leg, q[:, 0], q[:, 1])
+        s = np.sign(path.dl3_dalpha)
+        dyn = sl.inverse_dynamics(leg, q, qd, qdd, driven_legs=sl.PAPER_DRIVEN_LEGS)
+        ok = path.reachable.all() and dyn.valid.all() and np.all(s == s[0]) and s[0] != 0
+        assert res["fig5b_ok"][i] == ok, i
+        expected = np.max(np.abs(dyn.leg_forces)) if ok else np.nan
+        np.testing.assert_array_equal(res["peak_force"][i], expected)
+    assert 0 < res["fig5b_ok"].sum() < X.shape[0]  # both kinds of design are in the sample

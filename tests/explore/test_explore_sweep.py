@@ -330,11 +330,23 @@ def test_chunk_writer_writes_rows_then_the_flag_and_refuses_unknown_arrays(tmp_p
 def test_local_cluster_workers_are_single_threaded_for_every_threaded_library():
     import os
 
-    from robomech.explore._runner import WORKER_ENV, dask_client
+    import dask.config
+
+    from robomech.explore._runner import LOCAL_CLUSTER_CONFIG, WORKER_ENV, dask_client
 
     with dask_client(workers=1) as c:
         env = c.run(lambda: {k: os.environ.get(k) for k in WORKER_ENV})
         assert list(env.values()) == [WORKER_ENV]
+        # the background settings reach the worker process (through its nanny) and the scheduler
+        cfg = c.run(lambda: {k: dask.config.get(k) for k in LOCAL_CLUSTER_CONFIG})
+        assert list(cfg.values()) == [LOCAL_CLUSTER_CONFIG]
+        # the scheduler lives in this process: its tick callback was made while the settings were set
+        tick_ms = c.run_on_scheduler(
+            lambda dask_scheduler: dask_scheduler.periodic_callbacks["tick"].callback_time
+        )
+        assert tick_ms == 1000.0
+        profiling = c.run(lambda dask_worker: "profile" in dask_worker.periodic_callbacks)
+        assert list(profiling.values()) == [False]
         assert c.scheduler_info()["workers"] and all(
             w["nthreads"] == 1 for w in c.scheduler_info()["workers"].values()
         )

@@ -33,7 +33,7 @@ from ._store import ChunkWriter, open_store, prepare_store, store_array
 from ._study import DesignStudy, Variable, check_variables, with_variables
 
 if TYPE_CHECKING:
-    from distributed import Client
+    from distributed import Client, LocalCluster
 
 __all__ = ["SchedulerUnreachable", "SweepSummary", "evaluate_chunk", "run_sweep"]
 
@@ -48,6 +48,25 @@ WORKER_ENV = {
     "MKL_NUM_THREADS": "1",
     "OPENBLAS_NUM_THREADS": "1",
     "NUMBA_NUM_THREADS": "1",
+}
+# Dask settings of the LocalCluster (scheduler, nannies, workers and client; each server reads them when
+# it is created, a nanny hands its snapshot to the worker process it starts and restarts): Dask's
+# periodic background work, which on a 2-core machine takes CPU from the chunks.  CPU of an idle
+# 2-worker cluster measured per process (psutil, ms of CPU per s of wall time; docs/performance.md):
+# client process (scheduler + nannies + client) 52, each worker 37, i.e. 126 ms/s = 6 % of two cores;
+# with these four settings 10 and 3 + 3 (16 ms/s).  None of them is used by a sweep.
+LOCAL_CLUSTER_CONFIG: dict[str, object] = {
+    # the statistical profiler (dashboard "Profile" page) samples each worker's threads every 10 ms,
+    # taking the GIL from the running chunk: alone, 37 -> 20 ms/s per idle worker
+    "distributed.worker.profile.enabled": False,
+    # event-loop health check of every server (blocked-loop warnings), 20 ms by default: alone, the
+    # client process 52 -> 20 ms/s
+    "distributed.admin.tick.interval": "1s",
+    # nanny's and worker's memory check (spill/pause/terminate thresholds), 100 ms by default: a worker
+    # past its memory limit is still stopped, within a second instead of 0.1 s
+    "distributed.worker.memory.monitor-interval": "1s",
+    # per-server psutil sample (CPU, memory, network, disk) for the dashboard, 500 ms by default
+    "distributed.admin.system-monitor.interval": "5s",
 }
 
 
@@ -159,7 +178,7 @@ def dask_client(
     scheduler: str | None = None, workers: int | None = None, timeout: float = CONNECT_TIMEOUT
 ) -> Iterator[Client]:
     """A ``distributed.Client``: to ``scheduler`` if given, else to a new LocalCluster (closed after)."""
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     if scheduler:
         if not isinstance(scheduler, str) or "://" not in scheduler:
@@ -179,21 +198,34 @@ def dask_client(
             client.close()
         return
     n = int(workers) if workers else (os.cpu_count() or 1)
-    cluster = LocalCluster(
-        n_workers=n,
-        threads_per_worker=1,
-        processes=True,
-        host="127.0.0.1",
-        dashboard_address="127.0.0.1:0",  # loopback, any free port (None would mean :8787 on every interface)
-        silence_logs=40,
-        env=WORKER_ENV,  # passed to each worker's Nanny: set before the worker process imports numpy
-    )
-    client = Client(cluster)
+    import dask.config
+
+    with dask.config.set(LOCAL_CLUSTER_CONFIG):  # the Client is created under the same settings
+        cluster = local_cluster(n)
+        client = Client(cluster)
     try:
         yield client
     finally:
         client.close()
         cluster.close()
+
+
+def local_cluster(workers: int) -> LocalCluster:
+    """The sweeps' LocalCluster: ``workers`` single-threaded worker processes (each with a nanny, which
+    restarts it if it dies) on 127.0.0.1, :data:`WORKER_ENV` and :data:`LOCAL_CLUSTER_CONFIG`."""
+    import dask.config
+    from distributed import LocalCluster
+
+    with dask.config.set(LOCAL_CLUSTER_CONFIG):
+        return LocalCluster(
+            n_workers=check_int(workers, "workers", low=1),
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address="127.0.0.1:0",  # loopback, any free port (None: :8787 on every interface)
+            silence_logs=40,
+            env=WORKER_ENV,  # passed to each worker's Nanny: set before the worker process imports numpy
+        )
 
 
 class _Bar:
