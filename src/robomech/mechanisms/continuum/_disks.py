@@ -3,10 +3,11 @@
 Paper 3 models each segment as one arc (eqs. (1)-(4)) and multiplies the tensions by one friction
 factor per segment (eq. (24)).  With friction at the holes the span tensions fall (pulled cable) or
 rise (paid-out cables) from disk to disk, so the bending moment and the curvature do too: measured on
-the disk-resolved Cosserat reference, a 45 deg bend at beta = 0 with Table 1 mu bends the five
-intervals by 13.4, 10.5, 8.2, 6.4 and 4.9 deg instead of 9 deg each.  The segment-wise model cannot
-represent that shape, which puts the tip ~5 mm away from the arc's tip for the same total bend, and the
-paper's compensation (adding the stretch delta, eq. (37)) makes it worse (5.3 -> 6.6 mm).
+the disk-resolved Cosserat reference (paper robot: 1.0 mm core, 10 N pretension), the tensions of a
+45 deg arc at beta = 0 with Table 1 mu bend the five intervals by 12.5, 10.2, 8.3, 6.8 and 5.6 deg
+(43.3 deg in all) instead of equally.  The segment-wise model cannot represent that shape, which puts the
+tip 5.3 mm away from the arc's tip for the same total bend, and the paper's compensation (adding the
+stretch delta, eq. (37)) makes the drive's tip error worse (2.16 -> 5.29 mm).
 
 This module relaxes constant curvature to one arc per disk interval (the same cable chords, wrap angles,
 capstan friction and elastic cables as the segment model, see :mod:`._compensation`); it reduces to the
@@ -213,7 +214,8 @@ def _state(
     # paths only (the virtual work has it through the stiffness correction below).  In drive mode the
     # compression depends on the tensions that depend on the paths: a fixed point (the shortening is
     # ~1e-5 m, and 1e-5 m of path is ~0.1 N of tension); measured: after 5 passes the drive-mode round
-    # trip is off by 2e-5 N at 80 deg, after COLUMN_PASSES = 8 by 6e-8 N.
+    # trip is off by 2e-7 N at 80 deg, after COLUMN_PASSES = 8 by 1e-9 N (paper robot, 1.0 mm core at
+    # 10 N; 2e-5 / 6e-8 N with the 0.8 mm core at 5 N before issue 16).
     ell_path, t_raw = ell, load
     for _ in range(1 if mode == "tension" else COLUMN_PASSES):
         t_u = load if mode == "tension" else _tension_estimate(robot, ell_path, P, load)
