@@ -38,6 +38,7 @@ __all__ = [
     "IKResult",
     "JacobianResult",
     "JointAxes",
+    "LinkClearanceResult",
     "PassiveResult",
     "RotationResult",
     "VelocityResult",
@@ -143,6 +144,23 @@ class JointAxes:
     s0: np.ndarray  # propeller shaft (the platform's third axis)
     distance: np.ndarray  # (...,) |s22 x s12|: distance to the singularity, in [0, 1]
     valid: np.ndarray  # (...,) distance > SINGULAR_TOL
+
+
+@dataclass(frozen=True)
+class LinkClearanceResult:
+    """The interference clearance of :func:`link_clearance` per sample.
+
+    Attributes
+    ----------
+    clearance : ndarray, shape (...)
+        Angular clearance (rad) between the 45 deg arc and the fixing device; NaN where not ``valid``.
+    valid : ndarray of bool, shape (...)
+        The configuration is not singular (``|s12 x s22| > SINGULAR_TOL``: the fixing device's arc
+        exists), so the clearance is defined.
+    """
+
+    clearance: np.ndarray
+    valid: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -499,10 +517,12 @@ def _interference_unmasked(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
     return np.where(valid, np.where(crosses, 0.0, ends), np.nan)
 
 
-def link_clearance(th: VectoredThruster, q: object) -> np.ndarray:
+def link_clearance(th: VectoredThruster, q: object) -> LinkClearanceResult:
     """Angular clearance (rad) between the RRR chain's 45 deg arc and the fixing device at ``q (..., 2)``.
 
-    Section 4.1 (2).  NaN where the configuration is singular (covered by ``joint_axes(...).valid``).
+    Section 4.1 (2).  Where the configuration is singular (``|s12 x s22| <= SINGULAR_TOL``, the same
+    samples as ``joint_axes(...).valid`` False) the fixing device's arc does not exist: ``clearance`` is
+    NaN there and ``valid`` False.
 
     Parameters
     ----------
@@ -513,16 +533,26 @@ def link_clearance(th: VectoredThruster, q: object) -> np.ndarray:
 
     Returns
     -------
-    ndarray, shape (...)
-        Clearance (rad) on the unit sphere about O; compare with ``th.interference_clearance``.
+    LinkClearanceResult
+        ``clearance`` (rad, on the unit sphere about O; compare with ``th.interference_clearance``) and
+        ``valid``, each of shape (...).
 
     Raises
     ------
     ValueError
         If ``th`` is not a :class:`VectoredThruster` or ``q`` is not a finite real array of shape (..., 2).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import vectored_thrust as vt
+    >>> r = vt.link_clearance(vt.VectoredThruster.paper(), [[0.0, 0.2], [0.0, np.pi / 4]])
+    >>> r.valid
+    array([ True, False])
     """
     check_params(th, VectoredThruster, "th")
-    return _interference(th, _q(q))
+    c = _interference(th, _q(q))
+    return LinkClearanceResult(clearance=c, valid=np.isfinite(c))
 
 
 def _theta_cs(th: VectoredThruster, q: np.ndarray) -> tuple[np.ndarray, ...]:
