@@ -26,8 +26,8 @@ SPECS = {
     P + "DEXTERITY_TOL": CONSTANT,
     P + "SINGULAR_TOL": CONSTANT,
     **exempt(
-        "AccelerationResult FKResult IKResult JacobianResult JointAxes LinkClearanceResult MechanismMobility PassiveResult"
-        " RotationResult VelocityResult WorkspaceMap",
+        "AccelerationResult FKResult IKResult JacobianResult JointAxes LinkClearanceResult MechanismMobility"
+        " PassiveResult RotationResult VelocityResult WorkspaceMap",
         RESULT_TYPE,
         P,
     ),
