@@ -467,7 +467,7 @@ def wrench_at(force: np.ndarray, point: np.ndarray, moment: np.ndarray | None = 
 
     Examples
     --------
-    >>> wrench_at([0.0, 0.0, -10.0], [1.0, 0.0, 0.0])  # 10 N down at x = 1 m
+    >>> wrench_at([0.0, 0.0, -10.0], [1.0, 0.0, 0.0]) + 0.0  # 10 N down at x = 1 m
     array([  0.,  10.,   0.,   0.,   0., -10.])
     """
     force = as_array(force, "force", (3,))
