@@ -867,10 +867,11 @@ def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
     """
     check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
-    broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
+    batch = broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     ax = _axes(th, q)
     x = _rates(ax, qd)
-    return PassiveResult(values=np.where(ax.valid[..., None], x, np.nan), valid=ax.valid)
+    valid = np.broadcast_to(ax.valid, batch)  # the mask has the batch of every argument
+    return PassiveResult(values=np.where(valid[..., None], x, np.nan), valid=valid)
 
 
 def _jacobian(th: VectoredThruster, q: np.ndarray) -> JacobianResult:
@@ -985,9 +986,10 @@ def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityRes
     """
     check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
-    broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
+    batch = broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     jr = _jacobian(th, q)
-    return VelocityResult(omega=np.einsum("...ij,...j->...i", jr.J, qd), valid=jr.valid)
+    valid = np.broadcast_to(jr.valid, batch)  # the mask has the batch of every argument
+    return VelocityResult(omega=np.einsum("...ij,...j->...i", jr.J, qd), valid=valid)
 
 
 def _screw(s: np.ndarray) -> np.ndarray:
@@ -1030,7 +1032,7 @@ def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: objec
     """
     check_params(th, VectoredThruster, "th")
     q, qd, qdd = _q(q), as_array(qd, "qd", (2,)), as_array(qdd, "qdd", (2,))
-    broadcast_batch((q, 1, "q"), (qd, 1, "qd"), (qdd, 1, "qdd"))
+    batch = broadcast_batch((q, 1, "q"), (qd, 1, "qd"), (qdd, 1, "qdd"))
     ax = _axes(th, q)
     s13 = np.where(ax.valid[..., None], ax.s13, 0.0)
     axv = JointAxes(ax.s11, ax.s12, s13, ax.s21, ax.s22, ax.s0, ax.distance, ax.valid)
@@ -1050,12 +1052,13 @@ def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: objec
     b0 = lie_rrr[..., :3] - lie_rr[..., :3]
     acc0, _ = _solve3(ax.s22, -ax.s12, -s13, b0)
     vp = acc0[..., 0:1] * ax.s22 + lie_rr[..., :3]
-    m = ax.valid[..., None]
+    valid = np.broadcast_to(ax.valid, batch)  # the mask has the batch of every argument
+    m = valid[..., None]
     nan = np.nan
     return AccelerationResult(
         omega=np.where(m, omega, nan),
         omega_dot=np.where(m, omega_dot, nan),
         passive_acc=np.where(m, acc, nan),
         velocity_product=np.where(m, vp, nan),
-        valid=ax.valid,
+        valid=valid,
     )
