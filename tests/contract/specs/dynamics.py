@@ -18,6 +18,7 @@ SPECS = {
     P + "DynamicsTerms": RESULT_TYPE,
     P + "ActuatorForces": RESULT_TYPE,
     P + "ACTUATION_RESIDUAL_RTOL": CONSTANT,
+    P + "INERTIA_RTOL": CONSTANT,
     P + "spatial_inertia": Spec(
         args={
             "mass": np.array([1.0, 2.0]),
@@ -26,7 +27,11 @@ SPECS = {
         },
         arrays={"mass": 0, "com": 1, "inertia_com": 2},
         wrong_shapes={"mass": ((3,),)},
-        options={"mass": (-1.0,)},
+        # an indefinite and an asymmetric inertia: no mass has them
+        options={
+            "mass": (-1.0,),
+            "inertia_com": (np.diag([1.0, 1.0, -1.0]), np.array([[1.0, 0.5, 0], [0, 1, 0], [0, 0, 1]])),
+        },
     ),
     P + "mass_matrix": Spec(
         args={"G": G2, "J": J},
