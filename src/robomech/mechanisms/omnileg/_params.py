@@ -353,7 +353,7 @@ class OmniLeg:
     gamma_min, gamma_max : float, optional
         Range of the crank angle γ (rad), ``-π/2 < gamma_min < gamma_max < π/2``; default 0 and 85°.
     knee_to_crank : float, optional
-        Depth of the C_i joints below O0' (m), in [0, L5]; default 0.03 m.
+        Depth of the C_i joints below O0' (m), in [0, L5) (the foot point lies below); default 0.03 m.
     shank_radius : float, optional
         Radius of the C_i and E_i circles (m), > 0; default 0.025 m.
     shank_azimuth : float, optional
@@ -405,9 +405,9 @@ class OmniLeg:
                 raise ValueError(f"Expected OmniLeg.{name} > 0 and finite, got {getattr(self, name)!r}.")
             object.__setattr__(self, name, v)
         h = _real(self.knee_to_crank, "OmniLeg.knee_to_crank")
-        if not (math.isfinite(h) and 0 <= h <= self.L5):
+        if not (math.isfinite(h) and 0 <= h < self.L5):  # the foot rod below the cranks needs a length
             raise ValueError(
-                f"Expected OmniLeg.knee_to_crank in [0, L5 = {self.L5}], got {self.knee_to_crank!r}."
+                f"Expected OmniLeg.knee_to_crank in [0, L5 = {self.L5}), got {self.knee_to_crank!r}."
             )
         object.__setattr__(self, "knee_to_crank", h)
         for name in ("alpha_max", "beta_max"):
