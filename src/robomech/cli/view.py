@@ -32,7 +32,9 @@ def _add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--port", type=_port, default=None, help="TCP port on 127.0.0.1 (default: a free one)")
     p.add_argument("--no-browser", action="store_true", help="do not open the page in a web browser")
-    p.add_argument("--site", default=None, help="output site of the singularity measures (default: the first)")
+    p.add_argument(
+        "--site", default=None, help="output site of the singularity measures (default: the first)"
+    )
 
 
 def _describe(target: str):
@@ -48,14 +50,14 @@ def _describe(target: str):
 
 
 def _description() -> str:
-    from robomech.multibody.gallery import NAMES
+    from robomech import multibody as mb
 
     return (
         "Serve a live 3-D view of MECHANISM on http://127.0.0.1:PORT: one slider per actuated joint\n"
         "re-assembles it, the singularity measures of an output site update live, and a button\n"
         "downloads a screenshot.  Stop with Ctrl-C.\n\n"
         "MECHANISM: spherical-leg, omnileg, vectored-thrust (paper descriptions), "
-        f"{', '.join(NAMES)} (gallery), or an MJCF file."
+        f"{', '.join(mb.gallery.NAMES)} (gallery), or an MJCF file."
     )
 
 

@@ -14,6 +14,8 @@ exact, batched kinematics with nothing derived by hand::
     m = mb.mobility(mech)                                # .dof, .redundant_constraints, .gruebler_kutzbach
     s = mb.singularities(mech, fk.q, "tip")              # type I / II / constraint, measures in metres
     mb.draw(mech, fk.q[0])                               # matplotlib wireframe
+    mb.animate(mech, fk.q, "motion.gif")                 # a GIF (or .mp4 with ffmpeg) along q (nt, nq)
+    mb.view(mech)                                        # live 3-D in the browser (robomech.viewer)
 
 Coordinates: ``q`` is MuJoCo's ``qpos`` (nq; ``[w, x, y, z]`` quaternions for ball/free joints) and
 every matrix "over all coordinates" has one column per *velocity* coordinate (MuJoCo's ``qvel``, nv:
@@ -46,7 +48,8 @@ from __future__ import annotations
 
 from . import gallery
 from ._assembly import CONVERGED_RTOL, FKResult, IKResult, forward_kinematics, inverse_kinematics
-from ._draw import body_segments, draw
+from ._animate import animate
+from ._draw import body_segments, draw, view
 from ._dynamics import (
     ForwardDynamicsResult,
     InverseDynamicsResult,
@@ -96,6 +99,7 @@ __all__ = [
     "Site",
     "SiteWrenchResult",
     "StaticsResult",
+    "animate",
     "body_segments",
     "constraint_jacobian",
     "constraint_jacobian_rate",
@@ -119,4 +123,5 @@ __all__ = [
     "site_wrench",
     "statics",
     "to_mjcf",
+    "view",
 ]

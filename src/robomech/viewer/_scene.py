@@ -143,9 +143,7 @@ def build_scene(mech: Mechanism) -> Scene:
             if j.type == "free":
                 continue
             ax = np.asarray(j.axis, float) if j.type in ("hinge", "slide") else None
-            joints.append(
-                JointMark(i, j.name, j.type, np.asarray(j.pos, float), ax, j.name in mech.actuated)
-            )
+            joints.append(JointMark(i, j.name, j.type, np.asarray(j.pos, float), ax, j.name in mech.actuated))
     for c in mech.closures:
         b1, b2 = tree.body_index(c.body1), tree.body_index(c.body2)
         pts[b1].append((np.asarray(c.anchor1 if c.kind != "rigid" else c.relpos, float), None))

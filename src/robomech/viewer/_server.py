@@ -116,7 +116,9 @@ class Viewer:
         self._closed = threading.Event()
         self._addr = [mech.qpos_address(j) for j in mech.actuated]
         with contextlib.redirect_stdout(io.StringIO()):  # viser prints a banner; the caller prints the URL
-            self._server = viser.ViserServer(host=HOST, port=port, label=f"robomech: {mech.name}", verbose=False)
+            self._server = viser.ViserServer(
+                host=HOST, port=port, label=f"robomech: {mech.name}", verbose=False
+            )
         self.port = int(self._server.get_port())
         self.url = f"http://{HOST}:{self.port}"
         self._nodes: list[tuple[Any, tuple[int, int, int]]] = []  # (handle, normal colour)
@@ -141,7 +143,10 @@ class Viewer:
             )
         self._body_axes = [
             srv.scene.add_frame(
-                f"/bodies/{b}_{name}/frame", axes_length=TRIAD_FRACTION * L, axes_radius=L / 300, visible=False
+                f"/bodies/{b}_{name}/frame",
+                axes_length=TRIAD_FRACTION * L,
+                axes_radius=L / 300,
+                visible=False,
             )
             for b, name in enumerate(sc.body_names)
             if b > 0
@@ -324,7 +329,9 @@ class Viewer:
             ratio = float(np.max(delta / scale)) if delta.size and np.all(np.isfinite(delta)) else 1.0
             steps = int(min(MAX_STAGES, max(1, math.ceil(ratio))))
             fk = mb.forward_kinematics(self.mech, qa, start, steps=steps)
-            pose = self._evaluate(fk.q, converged=bool(fk.converged), residual=float(fk.residual), note="slider")
+            pose = self._evaluate(
+                fk.q, converged=bool(fk.converged), residual=float(fk.residual), note="slider"
+            )
             self._commit(pose)
             self._sync_sliders(qa)
             return pose
@@ -360,7 +367,9 @@ class Viewer:
     def _show_frame(self, k: int) -> None:
         if self._path is None or self._syncing:
             return
-        when = f"t = {self._times[k]:.3f} s" if self._times is not None else f"frame {k + 1}/{len(self._path)}"
+        when = (
+            f"t = {self._times[k]:.3f} s" if self._times is not None else f"frame {k + 1}/{len(self._path)}"
+        )
         self._show_q(self._path[k], f"playback, {when}")
 
     def _toggle_play(self) -> None:
@@ -518,7 +527,9 @@ def view(
             raise ValueError("Expected times only with a path, got times without path.")
         tt = as_array(times, "times")
         if tt.shape != (qs.shape[0],):
-            raise ValueError(f"Expected times to have shape ({qs.shape[0]},) (one per frame), got {tt.shape}.")
+            raise ValueError(
+                f"Expected times to have shape ({qs.shape[0]},) (one per frame), got {tt.shape}."
+            )
     if port is None:
         port = _free_port()
     port = check_int(port, "port", low=1, high=65535)
