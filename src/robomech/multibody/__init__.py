@@ -47,8 +47,8 @@ are the compiled arrays, cached on the frozen mechanism:
 from __future__ import annotations
 
 from . import gallery
-from ._assembly import CONVERGED_RTOL, FKResult, IKResult, forward_kinematics, inverse_kinematics
 from ._animate import animate
+from ._assembly import CONVERGED_RTOL, FKResult, IKResult, forward_kinematics, inverse_kinematics
 from ._draw import body_segments, draw, view
 from ._dynamics import (
     ForwardDynamicsResult,
