@@ -58,6 +58,7 @@ LAZY_ONLY = {
     ("multibody", "_mjcf.py"): {"mujoco"},
     ("multibody", "_draw.py"): {"matplotlib"},
     ("multibody", "_animate.py"): {"matplotlib", "PIL"},
+    ("multibody", "_repr.py"): {"matplotlib"},
     ("viewer", "_server.py"): {"viser", "imageio", "webbrowser"},
 }
 # The web stack of the viewer: only robomech.viewer imports it, and only inside functions.

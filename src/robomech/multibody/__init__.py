@@ -76,7 +76,23 @@ from ._influence import (
 from ._mjcf import from_mjcf, to_mjcf
 from ._mobility import MobilityReport, mobility
 from ._model import Body, Builder, Closure, Coupling, Inertial, Joint, Mechanism, Site
+from ._repr import install_compact_repr
 from ._singularity import SingularityMapResult, SingularityResult, singularities, singularity_map
+
+# Results print their fields' shapes, masks as counts and ranges, not their arrays (notebooks).
+install_compact_repr(
+    FKResult,
+    IKResult,
+    Influence,
+    MobilityReport,
+    SingularityResult,
+    SingularityMapResult,
+    InverseDynamicsResult,
+    StaticsResult,
+    SiteWrenchResult,
+    ForwardDynamicsResult,
+    SimulationResult,
+)
 
 __all__ = [
     "CONVERGED_RTOL",

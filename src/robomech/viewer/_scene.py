@@ -3,11 +3,13 @@
 A body is drawn as the links joining the points it carries, all fixed in its frame: where it hangs
 on its parent (its first joint's anchor), where its children hang on it, its closure anchors and its
 sites; each becomes a cylinder from the body's root to the point (the star of
-:func:`robomech.multibody.body_segments`).  A link whose two ends coincide (a spherical mechanism,
-whose joint axes all meet at the centre) is drawn instead between points on the two joints' axes, at
-``ARC_RADIUS_FRACTION`` of the characteristic length from the anchors, so such a body is a visible
-rod joining its two axes.  Joints are drawn as spheres at their anchors with their axes as short
-segments; sites and body frames as small triads.
+:func:`robomech.multibody.body_segments`). A link whose two ends coincide at the centre of a
+spherical linkage (a point where ``SPHERICAL_HINGES`` or more hinge axes meet) is drawn instead
+between points on the two hinges' axes, at ``ARC_RADIUS_FRACTION`` of the characteristic length from
+the centre, so such a body is a visible rod joining its two axes; other coincident ends (the two
+hinges of a cardan joint, a slider's zero stroke) are not links and are not drawn. Joints are drawn
+as spheres at their anchors with their axes as short segments; sites and body frames as small
+triads.
 
 A child's anchor in its parent's frame is ``T_off @ pos`` (the child's frame at zero joint
 coordinate, times the joint's anchor): a hinge or ball turns about that point and a slide starts
@@ -28,6 +30,9 @@ from robomech.multibody._tree import body_poses
 # A link shorter than this fraction of the characteristic length has coincident ends: it is drawn
 # between its joints' axes instead (a spherical linkage), or not at all when neither end has an axis.
 COINCIDENT_FRACTION = 1e-6
+# Hinges whose anchors coincide at one point: from this many on, the point is a spherical linkage's
+# centre (a cardan joint has two; a spherical 3-R chain or a vectored-thrust gimbal three or more).
+SPHERICAL_HINGES = 3
 # Distance from the anchor, along the joint axis, of the ends of a spherical link, as a fraction of
 # the characteristic length (a rod well inside the mechanism's extent, clear of the joint spheres).
 ARC_RADIUS_FRACTION = 0.5
@@ -133,7 +138,7 @@ def build_scene(mech: Mechanism) -> Scene:
         if j0 is None or j0.type == "free":
             pts[i].insert(0, (np.zeros(3), None))
         else:
-            axis = np.asarray(j0.axis, float) if j0.type in ("hinge", "slide") else None
+            axis = np.asarray(j0.axis, float) if j0.type == "hinge" else None
             pts[i].insert(0, (np.asarray(j0.pos, float), axis))
             held = np.asarray(tree.T_off[i])  # the child's frame in the parent's at zero coordinate
             p_parent = held[:3, :3] @ np.asarray(j0.pos, float) + held[:3, 3]
@@ -154,6 +159,8 @@ def build_scene(mech: Mechanism) -> Scene:
         T = np.asarray(tree.T_site[s], float)
         pts[b].append((T[:3, 3], None))
         sites.append(SiteMark(b, name, T))
+    centres = _spherical_centres(mech)
+    T0 = poses(mech, np.asarray(mech.q0, float))
     links = []
     for i in range(1, nb):
         if len(pts[i]) < 2:
@@ -162,7 +169,9 @@ def build_scene(mech: Mechanism) -> Scene:
         for p, axis in rest:
             a, b = root, p
             if np.linalg.norm(b - a) < COINCIDENT_FRACTION * L:
-                if root_axis is None and axis is None:
+                at = T0[i, :3, :3] @ root + T0[i, :3, 3]
+                central = any(np.linalg.norm(at - c) < COINCIDENT_FRACTION * L for c in centres)
+                if not central or (root_axis is None and axis is None):
                     continue
                 r = ARC_RADIUS_FRACTION * L
                 a = root + r * root_axis if root_axis is not None else root
@@ -178,6 +187,19 @@ def build_scene(mech: Mechanism) -> Scene:
         colour=_chain_colours(mech),
         length=L,
     )
+
+
+def _spherical_centres(mech: Mechanism) -> list[NDArray[np.float64]]:
+    """World points (at ``q0``) where ``SPHERICAL_HINGES`` or more hinge anchors coincide."""
+    T = poses(mech, np.asarray(mech.q0, float))
+    pts = [
+        T[i, :3, :3] @ np.asarray(j.pos, float) + T[i, :3, 3]
+        for i, body in enumerate(mech.bodies, start=1)
+        for j in body.joints
+        if j.type == "hinge"
+    ]
+    tol = COINCIDENT_FRACTION * float(mech.length)
+    return [p for p in pts if sum(np.linalg.norm(p - o) < tol for o in pts) >= SPHERICAL_HINGES]
 
 
 def poses(mech: Mechanism, q: NDArray[np.float64]) -> NDArray[np.float64]:

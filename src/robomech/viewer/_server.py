@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 from robomech import multibody as mb
 from robomech._validation import as_array, check_int
 from robomech.multibody._assembly import check_mechanism, check_q
+from robomech.multibody._repr import compact_repr
 
 from ._scene import (
     AXIS_LENGTH_FRACTION,
@@ -56,6 +57,8 @@ class Pose:
     """What the viewer shows: configuration ``q (nq,)``, actuated ``q_act``, whether it assembled,
     its closure residual (m), the singularity measures of the output site (None without a site) and
     a one-line status."""
+
+    __repr__ = compact_repr
 
     q: NDArray[np.float64]
     q_act: NDArray[np.float64]
@@ -176,7 +179,11 @@ class Viewer:
                 seg = np.array([[j.pos - half, j.pos + half]])
                 self._axes.append(
                     srv.scene.add_line_segments(
-                        f"{parent}/axis_{j.name}", points=seg, colors=np.array(colour), line_width=3.0
+                        f"{parent}/axis_{j.name}",
+                        points=seg,
+                        colors=np.array(colour),
+                        thickness=3.0,
+                        thickness_units="screen",
                     )
                 )
         self._sites = []
@@ -519,7 +526,8 @@ def view(
         if qs.ndim != 2:
             raise ValueError(f"Expected path to be one simulated motion (q (nt, nq)), got q {qs.shape}.")
     elif path is not None:
-        qs = check_q(mech, as_array(path, "path", (mech.nq,)))
+        # non-finite frames are allowed (a simulation after its failure): shown as not assembled
+        qs = as_array(path, "path", (mech.nq,), finite=False)
         if qs.ndim != 2 or qs.shape[0] < 1:
             raise ValueError(f"Expected path to have shape (nt, {mech.nq}), got {qs.shape}.")
     if times is not None:
