@@ -170,3 +170,16 @@ def test_cli_rejects_bad_input_with_exit_2(tmp_path):
         )  # fmt: skip
         assert r.returncode == 2, (argv, r.stdout, r.stderr)
         assert needle in r.stderr and "Traceback" not in r.stderr
+
+
+def test_the_viewer_methods_validate_their_input(delta_viewer):
+    v = delta_viewer
+    for bad in (np.zeros(2), np.zeros((2, 3)), "x", [np.nan, 0.0, 0.0]):
+        with pytest.raises(ValueError, match="q_act"):
+            v.set_q_act(bad)
+    with pytest.raises(ValueError, match="q"):
+        v.set_q(np.zeros(3))
+    with pytest.raises(ValueError, match="width"):
+        v.screenshot("x.png", width=0)
+    with pytest.raises(ValueError, match="path to play"):
+        v.play()
