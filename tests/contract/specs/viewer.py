@@ -13,7 +13,7 @@ from robomech import viewer
 MECH = mb.gallery.load("four_bar")
 Q = mb.forward_kinematics(MECH, np.array([[0.2], [-0.4], [0.6]])).q  # (3, 3) assembled frames
 OUT = Path(tempfile.mkdtemp(prefix="robomech-animate-"))
-BAD_PORT = tuple(v for v in BAD_INT if v is not None) + (0, -1, 70000)  # None: a free port
+BAD_PORT = (*(v for v in BAD_INT if v is not None), 0, -1, 70000)  # None: a free port
 
 
 def _started_and_stopped(view):
@@ -85,5 +85,5 @@ SPECS = {
         },
         finite_result=False,
         empty_batch=False,
-    ),  # fmt: skip
+    ),
 }
