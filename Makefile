@@ -10,7 +10,7 @@ REPORTS ?=
 # A second venv with `pip install .` and no extras: what a user without MuJoCo gets.
 MINIMAL := .venv-minimal
 
-.PHONY: install run test test-slow test-all bench verify lint typecheck docs check-minimal clean
+.PHONY: install install-browser run test test-slow test-all bench verify lint typecheck docs check-minimal clean
 
 install: $(STAMP)
 
@@ -23,6 +23,13 @@ $(STAMP): pyproject.toml
 $(DOCS_STAMP): $(STAMP)
 	$(BIN)/python -m pip install --quiet -e ".[verify,explore,test,docs]"
 	touch $(DOCS_STAMP)
+
+# Debian's headless Chromium, which the viewer's browser test (tests/viewer) drives with playwright
+# (playwright's own browser download is not used); nothing to do where it is installed.
+CHROMIUM ?= /usr/bin/chromium-headless-shell
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+install-browser:
+	@test -x $(CHROMIUM) || { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium-headless-shell; }
 
 run: install
 	$(BIN)/robomech reproduce --out $(OUT)
