@@ -17,6 +17,7 @@ from robomech.mechanisms import continuum as C
 from robomech.verify import continuum as V
 
 from ._core import Progress, Study, StudyResult, Table, comparison_table
+from ._papers import PAPERS, cite
 from ._plot import plt, save_figure
 
 # Simulated sensors (paper 3, Section 5): JLBS-MD 10 kg load cells, 0.05 % of full scale ~ 0.05 N;
@@ -165,8 +166,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     res = StudyResult(
         name="continuum",
         title="Paper 3: cable-driven continuum robot — capstan friction, statics and drive compensation",
-        source="Qi, Zhang, Pei, Chen, Wu: Drive error compensation of continuum manipulator based on force "
-        "transfer model, Trans. CSAM 54(1), 2023 (doi:10.6041/j.issn.1000-1298.2023.01.041)",
+        source=cite(3),
         summary=(
             "Exact: the constant-curvature kinematics (eqs. (1)-(6), with eq. (1)'s misprinted element "
             "corrected), cable lengths (arc model of eq. (4) and straight chords between disks), "
@@ -610,6 +610,6 @@ def _cosserat_section(res: StudyResult, out_dir: Path, progress: Progress) -> No
 STUDY = Study(
     name="continuum",
     title="Paper 3: cable-driven continuum robot (capstan friction, statics, compensation)",
-    source="Qi et al., Trans. CSAM 54(1), 2023",
+    source=PAPERS[3].short(),
     run=run,
 )

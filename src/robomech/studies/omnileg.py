@@ -22,6 +22,7 @@ from robomech.verify import omnileg as engine_check
 
 from ._animate import Animation, animation_figure
 from ._core import Progress, Study, StudyResult, Table, comparison_table
+from ._papers import PAPERS, cite
 from ._plot import plt, save_figure
 
 # Fig. 11: external force on the foot during 0-1 s of eq. (52), N (paper 2, Section 4).
@@ -123,7 +124,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     res = StudyResult(
         name="omnileg",
         title="Paper 2: the OmniLeg serial-parallel leg — kinematics and dynamics",
-        source="Xu, Lu, Zhu, Luo, China Mechanical Engineering 36(4), 2025 (paper 2)",
+        source=cite(2),
     )
     tables: list[Table] = []
 
@@ -687,7 +688,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
 STUDY = Study(
     name="omnileg",
     title="Paper 2: OmniLeg serial-parallel leg",
-    source="Xu et al., China Mechanical Engineering 36(4), 2025",
+    source=PAPERS[2].short(),
     run=run,
     requires=("mujoco",),  # the engine overlays (robomech.verify); skipped without robomech[verify]
 )

@@ -17,6 +17,7 @@ from robomech.mechanisms import spherical_leg as sl
 
 from ._animate import Animation, animation_figure
 from ._core import Progress, Study, StudyResult, Table, comparison_table
+from ._papers import PAPERS, cite
 from ._plot import plt, save_figure
 
 PI = np.pi
@@ -526,7 +527,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     res = StudyResult(
         name="spherical-leg",
         title="Paper 1: the 2RUHU-RUPR-RUR spherical parallel leg",
-        source="Chen et al., Optics and Precision Engineering 27(8), 2019 (1-spherical-parallel-leg.txt)",
+        source=cite(1),
     )
     progress.step("Table 1 and forward-solution accuracy")
     _table1(leg, res)
@@ -586,6 +587,6 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
 STUDY = Study(
     name="spherical-leg",
     title="Paper 1: spherical parallel leg — exact kinematics, dynamics, singularity",
-    source="Optics and Precision Engineering 27(8), 2019",
+    source=PAPERS[1].short(),
     run=run,
 )

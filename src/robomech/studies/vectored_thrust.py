@@ -17,6 +17,7 @@ from robomech.mechanisms import vectored_thrust as vt
 
 from ._animate import Animation, animation_figure
 from ._core import Figure, Progress, Study, StudyResult, Table, comparison_table
+from ._papers import PAPERS, cite
 from ._plot import plt, save_figure
 
 MAP_SAMPLES = 401  # per input axis for the workspace and singularity maps (~160k samples each)
@@ -112,8 +113,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     res = StudyResult(
         name="vectored-thrust",
         title="Paper 5: RRR-RR vectored-thrust spherical mechanism",
-        source="Xu, Li, Chen, Zhang, Gao, Robot 38(6), 2016 "
-        "(shared/papers/5-vectored-thrust-spherical-mechanism.txt)",
+        source=cite(5),
     )
 
     # -- mobility ---------------------------------------------------------------------------------------
@@ -554,7 +554,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
 STUDY = Study(
     name="vectored-thrust",
     title="Paper 5: vectored-thrust spherical mechanism",
-    source="Robot 38(6), 2016",
+    source=PAPERS[5].short(),
     run=run,
     requires=("mujoco",),  # the engine overlays (robomech.verify); skipped without robomech[verify]
 )
