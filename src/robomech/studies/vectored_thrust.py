@@ -12,6 +12,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+from matplotlib.lines import Line2D
 
 from robomech.mechanisms import vectored_thrust as vt
 
@@ -108,6 +109,19 @@ def table1_animation(th: vt.VectoredThruster, out_dir: Path) -> tuple[Animation,
     return anim, {"max_tip_error_m": float(np.max(np.abs(anim.site - tip)))}
 
 
+def _legend_with_styles(ax, styles, fontsize) -> None:
+    """One legend entry per coloured line (its label) and one per line style, in black: a source
+    (analytic, MuJoCo, ...) is named once, not once per component."""
+    handles, labels = ax.get_legend_handles_labels()
+    for style, label in styles:
+        if style in ("-", ":", "--", "-."):
+            handles.append(Line2D([], [], color="k", ls=style, lw=1.5))
+        else:
+            handles.append(Line2D([], [], color="k", ls="", marker=style, ms=4, mfc="none"))
+        labels.append(label)
+    ax.legend(handles, labels, ncol=4, fontsize=fontsize, loc="upper center", bbox_to_anchor=(0.5, -0.15))
+
+
 def run(out_dir: Path, progress: Progress) -> StudyResult:
     th = vt.VectoredThruster.paper()
     res = StudyResult(
@@ -199,14 +213,20 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         s=2,
         c=np.degrees(wm.tilt[::4, ::4][rch]),
         cmap="viridis",
-        label="reachable",
     )
-    fig.colorbar(sc, ax=a1, shrink=0.6, label="tilt from Z (deg)")
+    fig.colorbar(sc, ax=a1, shrink=0.6, pad=0.12, label="tilt from Z (deg)")
     a1.set_xlabel("x (mm)")
     a1.set_ylabel("y (mm)")
-    a1.set_zlabel("z (mm)")
-    a1.set_title("Fig. 5: propeller tip workspace (inputs over Table 1 ranges)")
-    a1.legend(loc="upper left", fontsize=8)
+    a1.set_zlabel("z (mm)", labelpad=4)
+    a1.set_box_aspect(None, zoom=0.9)  # room for the z label beside the colour bar
+    a1.set_title("propeller tip workspace (inputs over the Table 1 ranges)")
+    # the reachable points are coloured by tilt: their legend marker says so instead of one colour
+    reach_marker = Line2D([], [], ls="", marker="o", ms=4, mfc=plt.get_cmap("viridis")(0.6), mec="none")
+    gray_marker = Line2D([], [], ls="", marker="o", ms=4, mfc="lightgray", mec="none")
+    a1.legend(
+        [gray_marker, reach_marker], ["beyond U-joint limit", "reachable (colour: tilt)"],
+        loc="upper left", fontsize=8,
+    )  # fmt: skip
     a2 = fig.add_subplot(1, 2, 2)
     for mask, c, lab in (
         (~wm.reachable, "lightgray", "beyond U-joint limit"),
@@ -245,7 +265,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     b2.set_aspect("equal")
     b2.set_xlabel("x (mm)")
     b2.set_ylabel("y (mm)")
-    b2.set_title("Fig. 6: reachable tip points on the 80 mm sphere (top view)")
+    b2.set_title("reachable tip points on the 80 mm sphere (top view)")
     b2.legend(fontsize=8)
     res.figures.append(
         save_figure(
@@ -273,17 +293,15 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     colors = ("tab:blue", "tab:orange", "tab:green")
     fig, ax = plt.subplots(figsize=(10, 5.5))
     for k in range(3):
-        ax.plot(t, acc.omega[:, k], color=colors[k], label=f"{labels[k]} analytic")
-        ax.plot(
-            t[idx], tr.omega_engine[:, k], "o", color=colors[k], ms=4, mfc="none", label=f"{labels[k]} MuJoCo"
-        )
+        ax.plot(t, acc.omega[:, k], color=colors[k], label=labels[k])
+        ax.plot(t[idx], tr.omega_engine[:, k], "o", color=colors[k], ms=4, mfc="none")
     ax.fill_between(
         t, 0, 1, where=over, transform=ax.get_xaxis_transform(), color="red", alpha=0.08, label="tilt > 45°"
     )
     ax.set_xlabel("time t (s)")
     ax.set_ylabel("platform angular velocity (rad/s)")
-    ax.set_title("Fig. 7: angular velocity along q1 = (π/4) sin t, q2 = −(π/4) sin t")
-    ax.legend(ncol=4, fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.15))
+    ax.set_title("angular velocity along q1 = (π/4) sin t, q2 = −(π/4) sin t")
+    _legend_with_styles(ax, [("-", "analytic"), ("o", "MuJoCo")], fontsize=8)
     ax.grid(True, alpha=0.3)
     res.figures.append(
         save_figure(
@@ -295,20 +313,17 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     )
     fig, ax = plt.subplots(figsize=(10, 5.5))
     for k in range(3):
-        ax.plot(
-            t, acc.omega_dot[:, k], color=colors[k], label=f"{labels[k].replace('ω', 'ω̇')} Lie-bracket model"
-        )
-        ax.plot(t[idx], tr.omega_dot_engine[:, k], "o", color=colors[k], ms=4, mfc="none", label="MuJoCo")
-        ax.plot(
-            t, printed_style[:, k], ":", color=colors[k], lw=1, label="eq. (32) style (no velocity products)"
-        )
+        ax.plot(t, acc.omega_dot[:, k], color=colors[k], label=labels[k].replace("ω", "ω̇"))
+        ax.plot(t[idx], tr.omega_dot_engine[:, k], "o", color=colors[k], ms=4, mfc="none")
+        ax.plot(t, printed_style[:, k], ":", color=colors[k], lw=1)
     ax.fill_between(
         t, 0, 1, where=over, transform=ax.get_xaxis_transform(), color="red", alpha=0.08, label="tilt > 45°"
     )
     ax.set_xlabel("time t (s)")
     ax.set_ylabel("platform angular acceleration (rad/s²)")
-    ax.set_title("Fig. 8: angular acceleration along the Table 1 trajectory")
-    ax.legend(ncol=4, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.15))
+    ax.set_title("angular acceleration along the Table 1 trajectory")
+    styles = [("-", "Lie-bracket model"), ("o", "MuJoCo"), (":", "eq. (32) style (no velocity products)")]
+    _legend_with_styles(ax, styles, fontsize=7)
     ax.grid(True, alpha=0.3)
     res.figures.append(
         save_figure(
@@ -435,7 +450,8 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         if lim:
             axp.set_xlim(-lim, lim)
             axp.set_ylim(-lim, lim)
-        axp.legend(fontsize=7, loc="lower left")
+        # below the map: inside it, the legend would hide a singular curve
+        axp.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
     res.figures.append(
         save_figure(
             fig,
