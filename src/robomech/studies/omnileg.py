@@ -271,7 +271,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         axs[j].grid(True, alpha=0.3)
         axs[j].legend(fontsize=8)
     axs[-1].set_xlabel("time t (s)")
-    axs[0].set_title("Fig. 11 — motor torques along eq. (52), 0–2 s")
+    axs[0].set_title("motor torques along eq. (52), 0–2 s")
     res.figures.append(
         save_figure(
             fig,
@@ -300,7 +300,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         axs[2].plot(sim["t"], np.degrees(drift), color=col,
                     ls=("-", "--", "-")[j], label=("α", "β (= α in eq. (52))", "γ")[j])  # fmt: skip
     axs[0].set_ylabel("torque (N·m)")
-    axs[0].set_title("Fig. 11 vs engine: analytic torques and MuJoCo inverse dynamics (force in 0–1 s)")
+    axs[0].set_title("analytic torques and MuJoCo inverse dynamics (force in 0–1 s)")
     axs[1].set_ylabel("|analytic − engine| (N·m)")
     axs[2].set_ylabel("drift (deg)")
     axs[2].set_xlabel("time t (s)")
@@ -365,7 +365,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         axs[j].grid(True, alpha=0.3)
     axs[0].legend(["motor torque (shaded: stance, 30 N ground reaction)"], fontsize=8)
     axs[-1].set_xlabel("time t (s)")
-    axs[0].set_title("Fig. 19 — motor torques of the gait eq. (53): swing, stance, swing, ...")
+    axs[0].set_title("motor torques of the gait eq. (53): swing, stance, swing, ...")
     res.figures.append(
         save_figure(
             fig,

@@ -499,7 +499,7 @@ def _figures(
         ax.legend(loc="upper right", fontsize=7)
     for ax in axes[-1]:
         ax.set_xlabel("time (s)")
-    fig.suptitle("Body twist in body axes: estimated vs true (cf. paper Fig. 7)")
+    fig.suptitle("Body twist in body axes: estimated vs true")
     res.figures.append(
         save_figure(fig, out_dir, "body_velocity", "Body velocity estimated vs true (cf. Fig. 7)")
     )

@@ -219,7 +219,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     a1.set_ylabel("y (mm)")
     a1.set_zlabel("z (mm)", labelpad=4)
     a1.set_box_aspect(None, zoom=0.9)  # room for the z label beside the colour bar
-    a1.set_title("propeller tip workspace (inputs over the Table 1 ranges)")
+    a1.set_title("propeller tip workspace (Table 1 input ranges)")
     # the reachable points are coloured by tilt: their legend marker says so instead of one colour
     reach_marker = Line2D([], [], ls="", marker="o", ms=4, mfc=plt.get_cmap("viridis")(0.6), mec="none")
     gray_marker = Line2D([], [], ls="", marker="o", ms=4, mfc="lightgray", mec="none")
@@ -450,8 +450,9 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         if lim:
             axp.set_xlim(-lim, lim)
             axp.set_ylim(-lim, lim)
-        # below the map: inside it, the legend would hide a singular curve
-        axp.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
+        if lim is None:  # one legend, below the first map (inside, it would hide a singular curve);
+            # grey so that the white outline shows
+            axp.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, facecolor="0.8")
     res.figures.append(
         save_figure(
             fig,
