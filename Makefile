@@ -61,8 +61,10 @@ typecheck: install
 	$(BIN)/mypy
 
 # The documentation site; -W: a warning is an error, -n: every cross-reference must resolve.
-# It runs examples/*.py and reproduces the fast studies for their pages (docs/conf.py);
-# `make docs REPORTS=out` shows every report of an earlier `make run` instead.
+# docs/conf.py writes an API page per public name, runs examples/*.py (sphinx-gallery), draws the
+# gallery mechanisms and reproduces the fast studies for their pages; `make docs REPORTS=out` also
+# shows the slow studies' reports of an earlier `make run`.  Math is rendered by MathJax served from
+# the site itself: the first build installs it from npm (Node.js) into docs/_build/npm.
 docs: $(DOCS_STAMP)
 	ROBOMECH_DOCS_REPORTS=$(REPORTS) $(BIN)/sphinx-build -W --keep-going -n -q -b html docs docs/_build/html
 	@echo "docs: open docs/_build/html/index.html"
