@@ -253,7 +253,8 @@ def _api_pages() -> None:
 # One page per registered study (docs/papers.md).  The fast studies are reproduced from this
 # checkout by `robomech reproduce` during the build and reused by later builds until a source file
 # changes (together about 25 s on this 2-core machine, after the first-use compile); the slow
-# ones (continuum and skid-steer take 10-12 minutes each) get a page that says what the study reproduces and how to get its
+# ones (continuum and skid-steer take 10-12 minutes each) get a page that says what the study
+# reproduces and how to get its
 # report.  With ROBOMECH_DOCS_REPORTS=DIR (`make docs REPORTS=out` after `make run`) every study
 # folder of that `robomech reproduce --out DIR` is shown as well.
 FAST_STUDIES = ("demo", "spherical-leg", "vectored-thrust", "omnileg", "sweep-demo")
