@@ -43,6 +43,10 @@ class Spec:
     ``masked``   array arguments whose non-finite samples are flagged instead: NaN/inf at one sample
                  must give ``mask`` False at exactly that sample, the other samples unchanged (the
                  argument's batch shape must equal the result mask's shape).
+    ``nan_rows`` array arguments that take the library's own failed samples (NaN rows, e.g. the ``q`` of
+                 a non-converged ``forward_kinematics`` sample): a NaN at one sample must give NaN
+                 (float) or False (bool) at exactly that sample of every result array with the
+                 argument's batch shape, the other samples unchanged; ±inf and 1e300 still raise.
     ``mask``     the result's per-sample mask: attribute name, index into a returned tuple, or a
                  function of the result (e.g. ``lambda r: np.isfinite(r[1])``).
     ``params``   parameter-object arguments: None, a str and a foreign object must raise naming them.
@@ -70,6 +74,7 @@ class Spec:
     args: Mapping[str, Any]
     arrays: Mapping[str, int] = field(default_factory=dict)
     masked: tuple[str, ...] = ()
+    nan_rows: tuple[str, ...] = ()
     mask: str | int | Callable[[Any], Any] | None = None
     params: tuple[str, ...] = ()
     options: Mapping[str, tuple[Any, ...]] = field(default_factory=dict)
@@ -87,7 +92,7 @@ class Spec:
             raise ValueError("a spec with good_elsewhere cannot check masks (they need the good call)")
         if self.good_elsewhere and not (HERE.parent.parent / self.good_elsewhere).exists():
             raise ValueError(f"good_elsewhere names a missing test file: {self.good_elsewhere}")
-        for a in self.masked:
+        for a in (*self.masked, *self.nan_rows):
             if a not in self.arrays:
                 raise ValueError(f"masked argument {a!r} must also be listed in arrays")
         for a in (*self.unbatched, *self.batch_core):

@@ -173,6 +173,39 @@ def _check_masked(
         )
 
 
+def _check_nan_row(name: str, spec: Spec, arg: str, args: dict[str, Any], flat_index: int) -> None:
+    """A NaN at one sample of a ``nan_rows`` argument: that sample is non-finite (NaN, or inf for a
+    residual) / False in every result array of the argument's batch shape, the other samples are
+    those of the good call."""
+    good = _good(name, spec)
+    a = np.asarray(spec.args[arg], dtype=float)
+    core = spec.arrays[arg]
+    batch = a.shape[: a.ndim - core]
+    sample = flat_index // int(np.prod(a.shape[a.ndim - core :], dtype=int))
+    res = _call(name, spec, args)
+    good_arrays = dict(_arrays_of(good))
+    n = int(np.prod(batch, dtype=int))
+    seen = 0
+    for label, v in _arrays_of(res):
+        g = good_arrays.get(label)
+        if g is None or v.shape != g.shape or v.shape[: len(batch)] != batch or v.size == 0:
+            continue
+        seen += 1
+        rows, grows = v.reshape(n, -1), g.reshape(n, -1)
+        failed = ~np.isfinite(rows[sample]) if v.dtype.kind == "f" else ~rows[sample].astype(bool)
+        if v.dtype.kind in "fb":
+            assert np.all(failed), f"{name}: a NaN {arg} sample {sample} gives a non-NaN / True {label}"
+        keep = np.arange(n) != sample
+        assert np.allclose(
+            rows[keep].astype(float),
+            grows[keep].astype(float),
+            rtol=SAME_RTOL,
+            atol=SAME_ATOL,
+            equal_nan=True,
+        ), f"{name}: a NaN {arg} sample changed {label} of good samples"
+    assert seen, f"spec of {name}: no result array has the batch shape {batch} of {arg}"
+
+
 def _variants(name: str, spec: Spec, arg: str) -> list[tuple[str, Any]]:
     a = np.array(spec.args[arg], dtype=float)
     out = []
@@ -251,6 +284,8 @@ def test_bad_array(name, arg, variant):
     args = {**spec.args, arg: value}
     if arg in spec.masked and variant in ("nan", "inf", "-inf", "1e300"):
         _check_masked(name, spec, arg, args, 0, must_mask=variant != "1e300")
+    elif arg in spec.nan_rows and variant == "nan":
+        _check_nan_row(name, spec, arg, args, 0)
     else:
         _expect_value_error(name, spec, args, arg, variant)
 
@@ -277,6 +312,8 @@ def test_bad_element_anywhere(name, arg):
         args = {**spec.args, arg: b}
         if arg in spec.masked:
             _check_masked(name, spec, arg, args, k, must_mask=not np.isfinite(v))
+        elif arg in spec.nan_rows and np.isnan(v):
+            _check_nan_row(name, spec, arg, args, k)
         else:
             _expect_value_error(name, spec, args, arg, f"non-finite at flat index {k}")
 

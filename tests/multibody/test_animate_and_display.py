@@ -66,7 +66,13 @@ def test_results_print_compactly_and_stay_dataclasses():
     assert f"converged={int(fk.converged.sum())}/200 True" in text
     assert len(text) < 300 and "\n" not in text
     assert dataclasses.replace(fk, iterations=fk.iterations).q is fk.q  # still a dataclass
-    assert [f.name for f in dataclasses.fields(fk)] == ["q", "residual", "converged", "iterations"]
+    assert [f.name for f in dataclasses.fields(fk)] == [
+        "q",
+        "residual",
+        "converged",
+        "iterations",
+        "mode_changed",
+    ]
     s = mb.singularities(MECH, fk.q[fk.converged][:5], "coupler_point")
     assert repr(s).startswith("SingularityResult(sigma_I=float64(5,)")
 

@@ -266,8 +266,9 @@ def test_bad_input_raises_naming_the_argument():
         mb.forward_kinematics(FOUR_BAR, np.zeros((3, 2)))
     with pytest.raises(ValueError, match="mech"):
         mb.forward_kinematics("four_bar", np.zeros(1))
-    with pytest.raises(ValueError, match="q"):
-        mb.site_pose(FOUR_BAR, np.full(3, np.nan), "coupler_point")
+    with pytest.raises(ValueError, match="q"):  # inf is a wrong input; NaN a failed sample (chains)
+        mb.site_pose(FOUR_BAR, np.full(3, np.inf), "coupler_point")
+    assert np.isnan(mb.site_pose(FOUR_BAR, np.full(3, np.nan), "coupler_point")).all()
     with pytest.raises(ValueError, match="site"):
         mb.site_jacobian(FOUR_BAR, FOUR_BAR.q0, "nope")
     with pytest.raises(ValueError, match="T_target"):

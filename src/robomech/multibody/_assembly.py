@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from robomech._validation import as_array, broadcast_batch, check_int
+from robomech._validation import MAX_MAGNITUDE, as_array, broadcast_batch, check_int
 
 from ._constraints import jacobian, residual
 from ._model import Mechanism
@@ -64,16 +64,100 @@ def check_mechanism(mech: object) -> Mechanism:
     return mech
 
 
-def check_q(mech: Mechanism, q: object, name: str = "q") -> np.ndarray:  # a validator: any input
-    """``q (..., nq)`` finite, quaternions non-zero; returns it with quaternions normalised."""
-    q = as_array(q, name, (mech.nq,))
+def check_q(mech: Mechanism, q: object, name: str = "q", *, nan_rows: bool = False) -> np.ndarray:
+    """``q (..., nq)`` finite, quaternions non-zero; returns it with quaternions normalised.
+
+    ``nan_rows=True`` is the rule of the batched analysis functions (docs/conventions.md, "Failed
+    samples chain"): a sample with a NaN entry is a failed sample of an earlier call (what
+    :func:`forward_kinematics` returns where it did not converge); the whole row is set to NaN and
+    the caller gives NaN / False for it (:func:`on_rows`).  ±inf and magnitudes above
+    ``MAX_MAGNITUDE`` are refused either way: they are no failed sample but a wrong input.
+    """
+    q = as_array(q, name, (mech.nq,), finite=not nan_rows)
+    if nan_rows:
+        wrong = ~np.isnan(q) & ~(np.abs(q) <= MAX_MAGNITUDE)
+        if np.any(wrong):
+            raise ValueError(
+                f"Expected {name} finite with |value| <= {MAX_MAGNITUDE:g} (NaN marks a failed sample), "
+                f"got {q[wrong].flat[0]:g}."
+            )
+        q = np.where(np.isnan(q).any(axis=-1, keepdims=True), np.nan, q)
     for a in mech.tree.quat_adr:
         n = np.linalg.norm(q[..., a : a + 4], axis=-1)
         if np.any(n < 1e-9):
             raise ValueError(
-                f"Expected the quaternion {name}[..., {a}:{a + 4}] to be non-zero, got norm {n.min()}."
+                f"Expected the quaternion {name}[..., {a}:{a + 4}] to be non-zero, got norm {np.nanmin(n)}."
             )
     return normalize_quaternions(mech.tree, q)
+
+
+def on_rows(mech: Mechanism, qf: np.ndarray, compute: Callable[[np.ndarray], tuple], *others: np.ndarray):
+    """``compute(q_rows, *other_rows)`` on the samples of ``qf (N, nq)`` without NaN only.
+
+    Returns ``(ok (N,), outputs)`` with each output (leading axis N) NaN (float), False (bool) or 0
+    (int) at the failed samples.  A batch without failed samples is computed as it is (the very
+    same call), so good samples never depend on their failed neighbours.
+    """
+    ok = ~np.isnan(qf).any(axis=-1)
+    if ok.all():
+        return ok, compute(qf, *others)
+    idx = np.flatnonzero(ok)
+    probe = idx.size == 0  # no good sample: compute one at q0 for the output shapes, then drop it
+    rows = np.arange(1) if probe else idx
+    q_in = mech.tree.q0[None].copy() if probe else qf[idx]
+    res = compute(q_in, *(o[np.zeros(1, int)] if probe else o[rows] for o in others))
+    out = []
+    for r in res:
+        r = np.asarray(r)
+        fill: object = np.nan if r.dtype.kind in "fc" else (False if r.dtype.kind == "b" else 0)
+        full = np.full((qf.shape[0], *r.shape[1:]), fill, dtype=r.dtype)
+        if not probe:
+            full[idx] = r
+        out.append(full)
+    return ok, tuple(out)
+
+
+# Singular values of the passive block below this fraction of the largest are the start's idle or
+# redundant directions: left out of the assembly-mode determinant (they carry no mode).
+MODE_RANK_RTOL = 1e-8
+# Largest number of continuation stages: each stage is a full Newton solve of the batch; a million
+# stages of one sample already take minutes, and 10**4 stages of 1e-4 of the move suffice for any
+# path the gallery needs.
+MAX_STEPS = 10_000
+
+
+def _passive_block(mech: Mechanism, q: np.ndarray) -> np.ndarray:
+    tree = mech.tree
+    K = jacobian(mech.constraints, tree, kinematics(tree, q), q)
+    return K[..., np.setdiff1d(np.arange(tree.nv), tree.act_dof)]
+
+
+def assembly_mode_sign(mech: Mechanism, q_start: np.ndarray, q_end: np.ndarray) -> np.ndarray:
+    """Sign (+1, -1; 0 where undefined) of ``det(U^T K_p(q_end) V)`` with ``K_p(q_start) = U S V^T``.
+
+    ``K_p`` is the passive block of the constraint Jacobian; ``U``, ``V`` its singular vectors at
+    ``q_start (N, nq)`` restricted to the non-zero singular values.  At ``q_start`` the determinant is
+    the product of those singular values (positive); it vanishes exactly where ``K_p`` loses rank (a
+    type II singularity), so a negative sign at ``q_end`` says ``q_end`` is on another assembly mode
+    (five-bar elbow flipped, a 3-UPU platform in its rotating mode).  0 where a configuration is not
+    finite or the mechanism has no passive block.
+    """
+    N = q_start.shape[0]
+    ok = np.all(np.isfinite(q_start), axis=-1) & np.all(np.isfinite(q_end), axis=-1)
+    out = np.zeros(N)
+    if not ok.any():
+        return out
+    K0 = _passive_block(mech, q_start[ok])
+    K1 = _passive_block(mech, q_end[ok])
+    if K0.shape[1] == 0 or K0.shape[2] == 0:
+        return out
+    U, sv, Vt = np.linalg.svd(K0, full_matrices=False)
+    keep = sv > MODE_RANK_RTOL * sv[:, :1]
+    M = U.swapaxes(-1, -2) @ K1 @ Vt.swapaxes(-1, -2)
+    both = keep[:, :, None] & keep[:, None, :]
+    M = np.where(both, M, np.eye(M.shape[-1]))
+    out[ok] = np.where(keep[:, 0], np.sign(np.linalg.det(M)), 0.0)
+    return out
 
 
 def solve_closure(
@@ -169,12 +253,18 @@ class FKResult:
         ``residual <= CONVERGED_RTOL * L``.
     iterations : ndarray of int, shape (...)
         The Levenberg-Marquardt iterations used.
+    mode_changed : ndarray of bool, shape (...)
+        The solution is on another assembly mode than the start (the guess, or the previous
+        continuation stage): the passive block of the constraint Jacobian, written in the start's
+        singular vectors, changed the sign of its determinant (:func:`assembly_mode_sign`), so the
+        solver crossed a type II singularity.  ``converged`` is False there.
     """
 
     q: np.ndarray
     residual: np.ndarray
     converged: np.ndarray
     iterations: np.ndarray
+    mode_changed: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -210,11 +300,7 @@ class IKResult:
 def _guess(mech: Mechanism, guess: ArrayLike | None, batch: tuple[int, ...]) -> np.ndarray:
     if guess is None:
         return np.broadcast_to(mech.tree.q0, (*batch, mech.nq))
-    g = as_array(guess, "guess", (mech.nq,))
-    for a in mech.tree.quat_adr:
-        if np.any(np.linalg.norm(g[..., a : a + 4], axis=-1) < 1e-9):
-            raise ValueError(f"Expected the quaternion guess[..., {a}:{a + 4}] to be non-zero.")
-    return normalize_quaternions(mech.tree, g)
+    return check_q(mech, guess, "guess", nan_rows=True)  # a failed sample's q: that sample is masked
 
 
 def forward_kinematics(
@@ -226,7 +312,9 @@ def forward_kinematics(
     ``mech.q0``) and the solution is the assembly branch connected to it.  ``steps > 1`` moves the
     inputs from the guess's values to ``q_act`` in that many equal stages (continuation), which
     keeps the branch over large moves; along a trajectory pass the previous solution as the guess.
-    Non-finite inputs give ``converged = False`` and NaN for that sample only.
+    Non-finite ``q_act`` (and magnitudes above 1e100), a NaN row of ``guess`` (a failed sample of an
+    earlier call) and a solution on another assembly mode than the start (``mode_changed``) give
+    ``converged = False`` for that sample only (NaN ``q`` for the first two).
 
     Parameters
     ----------
@@ -237,7 +325,7 @@ def forward_kinematics(
     guess : array_like, shape (..., nq), optional
         Start of the passive coordinates (default ``mech.q0``); broadcasts with ``q_act``.
     steps : int, optional
-        Continuation stages from the guess's inputs to ``q_act`` (``>= 1``).
+        Continuation stages from the guess's inputs to ``q_act`` (``1 <= steps <= MAX_STEPS``, 10 000).
 
     Returns
     -------
@@ -257,18 +345,21 @@ def forward_kinematics(
     tree = mech.tree
     na = len(mech.actuated)
     qa = as_array(q_act, "q_act", (na,), finite=False)
-    steps = check_int(steps, "steps", low=1)
+    qa = np.where(np.abs(qa) <= MAX_MAGNITUDE, qa, np.nan)  # inf, 1e300: masked like NaN
+    steps = check_int(steps, "steps", low=1, high=MAX_STEPS)
     g0 = _guess(mech, guess, qa.shape[:-1])
     batch = broadcast_batch((qa, 1, "q_act"), (g0, 1, "guess"))
     qa_f = np.broadcast_to(qa, (*batch, na)).reshape(-1, na)
     q = np.array(np.broadcast_to(g0, (*batch, mech.nq)).reshape(-1, mech.nq))
-    ok = np.all(np.isfinite(qa_f), axis=-1)
+    ok = np.all(np.isfinite(qa_f), axis=-1) & np.all(np.isfinite(q), axis=-1)
     q[~ok] = tree.q0
     start = q[:, tree.act_qadr].copy()
     target = np.where(ok[:, None], qa_f, start)
     free = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
     iters = np.zeros(q.shape[0], dtype=int)
+    flipped = np.zeros(q.shape[0], dtype=bool)
     for s in range(1, steps + 1):
+        q_prev = q.copy()
         q[:, tree.act_qadr] = start + (target - start) * (s / steps)
         if q.shape[0] >= COMPILED_MIN:  # same algorithm, compiled per sample (see _compiled.py)
             from ._compiled import compiled_fk
@@ -277,7 +368,9 @@ def forward_kinematics(
         else:
             q, rc, _, it = solve_closure(mech, q, free)
         iters += it
-    conv = ok & (rc <= CONVERGED_RTOL * tree.length)
+        flipped |= assembly_mode_sign(mech, q_prev, q) < 0
+    flipped &= ok
+    conv = ok & (rc <= CONVERGED_RTOL * tree.length) & ~flipped
     q = np.where(ok[:, None], q, np.nan)
     rc = np.where(ok, rc, np.nan)
     return FKResult(
@@ -285,6 +378,7 @@ def forward_kinematics(
         residual=rc.reshape(batch),
         converged=conv.reshape(batch),
         iterations=iters.reshape(batch),
+        mode_changed=flipped.reshape(batch),
     )
 
 
@@ -356,7 +450,7 @@ def inverse_kinematics(
     w = np.ones(6) if weights is None else as_array(weights, "weights", (6,))
     if w.ndim != 1 or np.any(w < 0) or not np.any(w > 0):
         raise ValueError(f"Expected weights to be 6 non-negative numbers, not all zero, got {w!r}.")
-    steps = check_int(steps, "steps", low=1)
+    steps = check_int(steps, "steps", low=1, high=MAX_STEPS)
     g0 = _guess(mech, guess, T.shape[:-2])
     batch = broadcast_batch((T, 2, "T_target"), (g0, 1, "guess"))
     Tf = np.array(np.broadcast_to(T, (*batch, 4, 4)).reshape(-1, 4, 4))

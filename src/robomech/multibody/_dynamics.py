@@ -43,7 +43,7 @@ import numpy as np
 from robomech._validation import as_array, broadcast_batch, check_bool
 from robomech.dynamics import _com_terms
 
-from ._assembly import check_mechanism, check_q, solve_closure
+from ._assembly import check_mechanism, check_q, on_rows, solve_closure
 from ._constraints import jacobian
 from ._influence import PASSIVE_RANK_RTOL, _pinv
 from ._model import Mechanism
@@ -1256,12 +1256,12 @@ def energy(mech: Mechanism, q: object, qd: object) -> tuple[np.ndarray, np.ndarr
     ((), 0.0)
     """
     mech = check_mechanism(mech)
-    q = check_q(mech, q)
+    q = check_q(mech, q, nan_rows=True)  # a failed sample (NaN row) gives NaN energies
     qd = as_array(qd, "qd", (mech.nv,))
     batch = broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     qf = np.broadcast_to(q, (*batch, mech.nq)).reshape(-1, mech.nq)
     qdf = np.broadcast_to(qd, (*batch, mech.nv)).reshape(-1, mech.nv)
-    T, U = _energy_flat(mech, qf, qdf)
+    _, (T, U) = on_rows(mech, qf, lambda qs, qds: _energy_flat(mech, qs, qds), qdf)
     return np.reshape(T, batch), np.reshape(U, batch)
 
 

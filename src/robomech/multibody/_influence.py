@@ -23,7 +23,7 @@ import numpy as np
 
 from robomech._validation import as_array, broadcast_batch, check_bool
 
-from ._assembly import check_mechanism, check_q
+from ._assembly import check_mechanism, check_q, on_rows
 from ._constraints import jacobian, jacobian_rate
 from ._model import Mechanism
 from ._tree import frame_jacobian, frame_jacobian_rate, kinematics, screw_rates
@@ -130,7 +130,7 @@ def _site_index(mech: Mechanism, site: object) -> int:
 
 
 def _flat(mech: Mechanism, q: object) -> tuple[np.ndarray, tuple[int, ...]]:
-    q = check_q(mech, q)
+    q = check_q(mech, q, nan_rows=True)  # a NaN sample (a failed FK sample) gives NaN out: on_rows
     return q.reshape(-1, mech.nq), q.shape[:-1]
 
 
@@ -176,7 +176,15 @@ def influence(mech: Mechanism, q: object, *, second_order: bool = True) -> Influ
     mech = check_mechanism(mech)
     second_order = check_bool(second_order, "second_order")
     qf, batch = _flat(mech, q)
-    _, _, G, dG, _, (rank, npas, cons, smin, cond) = _influence_flat(mech, qf, second_order)
+    npas = mech.tree.nv - len(mech.tree.act_dof)
+
+    def run(qs: np.ndarray) -> tuple:
+        _, _, G, dG, _, (rank, _, cons, smin, cond) = _influence_flat(mech, qs, second_order)
+        return (G, rank, cons, smin, cond) + (() if dG is None else (dG,))
+
+    _, res = on_rows(mech, qf, run)
+    G, rank, cons, smin, cond = res[:5]
+    dG = res[5] if len(res) > 5 else None
     nv, na = G.shape[-2:]
     return Influence(
         G=G.reshape(*batch, nv, na),
@@ -226,7 +234,9 @@ def site_pose(mech: Mechanism, q: object, site: str) -> np.ndarray:
     qf, batch = _flat(mech, q)
     from ._tree import body_poses
 
-    T = body_poses(mech.tree, qf)[:, mech.tree.site_body[si]] @ mech.tree.T_site[si]
+    _, (T,) = on_rows(
+        mech, qf, lambda qs: (body_poses(mech.tree, qs)[:, mech.tree.site_body[si]] @ mech.tree.T_site[si],)
+    )
     return T.reshape(*batch, 4, 4)
 
 
@@ -272,16 +282,18 @@ def site_jacobian(mech: Mechanism, q: object, site: str) -> np.ndarray:
     tree = mech.tree
     from ._assembly import COMPILED_MIN
 
-    if qf.shape[0] >= COMPILED_MIN:  # same formulas, compiled per sample (see _compiled.py)
-        from ._compiled import compiled_site_jacobian
+    def run(qs: np.ndarray) -> tuple:
+        if qs.shape[0] >= COMPILED_MIN:  # same formulas, compiled per sample (see _compiled.py)
+            from ._compiled import compiled_site_jacobian
 
-        J = compiled_site_jacobian(mech, qf, si)
-        return J.reshape(*batch, 6, J.shape[-1])
-    state, _, G, _, _, _ = _influence_flat(mech, qf, False)
-    b = tree.site_body[si]
-    p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
-    J = frame_jacobian(tree, state, b, p) @ G
-    return J.reshape(*batch, 6, G.shape[-1])
+            return (compiled_site_jacobian(mech, qs, si),)
+        state, _, G, _, _, _ = _influence_flat(mech, qs, False)
+        b = tree.site_body[si]
+        p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
+        return (frame_jacobian(tree, state, b, p) @ G,)
+
+    _, (J,) = on_rows(mech, qf, run)
+    return J.reshape(*batch, 6, J.shape[-1])
 
 
 def site_hessian(mech: Mechanism, q: object, site: str) -> np.ndarray:
@@ -324,15 +336,19 @@ def site_hessian(mech: Mechanism, q: object, site: str) -> np.ndarray:
     si = _site_index(mech, site)
     qf, batch = _flat(mech, q)
     tree = mech.tree
-    state, _, G, dG, Sd, _ = _influence_flat(mech, qf, True)
-    na = G.shape[-1]
+    na = len(tree.act_dof)
     if na == 0:
         return np.zeros((*batch, 6, 0, 0))
-    b = tree.site_body[si]
-    p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
-    Jf = frame_jacobian(tree, state, b, p)
-    Jfd = frame_jacobian_rate(tree, state, Sd, b, p, G.swapaxes(-1, -2))  # (N, na_k, 6, nv)
-    Hk = Jfd @ G[:, None] + Jf[:, None] @ dG.transpose(0, 3, 1, 2)  # (N, k, 6, j)
+
+    def run(qs: np.ndarray) -> tuple:
+        state, _, G, dG, Sd, _ = _influence_flat(mech, qs, True)
+        b = tree.site_body[si]
+        p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
+        Jf = frame_jacobian(tree, state, b, p)
+        Jfd = frame_jacobian_rate(tree, state, Sd, b, p, G.swapaxes(-1, -2))  # (N, na_k, 6, nv)
+        return (Jfd @ G[:, None] + Jf[:, None] @ dG.transpose(0, 3, 1, 2),)  # (N, k, 6, j)
+
+    _, (Hk,) = on_rows(mech, qf, run)
     return Hk.transpose(0, 2, 3, 1).reshape(*batch, 6, na, na)
 
 
@@ -370,8 +386,9 @@ def constraint_residual(mech: Mechanism, q: object) -> np.ndarray:
 
     mech = check_mechanism(mech)
     qf, batch = _flat(mech, q)
-    st = kinematics(mech.tree, qf)
-    r = residual(mech.constraints, mech.tree, st, qf)
+    _, (r,) = on_rows(
+        mech, qf, lambda qs: (residual(mech.constraints, mech.tree, kinematics(mech.tree, qs), qs),)
+    )
     return r.reshape(*batch, r.shape[-1])
 
 
@@ -408,8 +425,9 @@ def constraint_jacobian(mech: Mechanism, q: object) -> np.ndarray:
     """
     mech = check_mechanism(mech)
     qf, batch = _flat(mech, q)
-    st = kinematics(mech.tree, qf)
-    K = jacobian(mech.constraints, mech.tree, st, qf)
+    _, (K,) = on_rows(
+        mech, qf, lambda qs: (jacobian(mech.constraints, mech.tree, kinematics(mech.tree, qs), qs),)
+    )
     return K.reshape(*batch, *K.shape[1:])
 
 
@@ -447,12 +465,15 @@ def constraint_jacobian_rate(mech: Mechanism, q: object, qd: object) -> np.ndarr
     (3, 3)
     """
     mech = check_mechanism(mech)
-    q = check_q(mech, q)
+    q = check_q(mech, q, nan_rows=True)
     qd = as_array(qd, "qd", (mech.nv,))
     batch = broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     qf = np.broadcast_to(q, (*batch, mech.nq)).reshape(-1, mech.nq)
     qdf = np.broadcast_to(qd, (*batch, mech.nv)).reshape(-1, mech.nv)
-    st = kinematics(mech.tree, qf)
-    Sd = screw_rates(mech.tree, st, qdf)
-    Kd = jacobian_rate(mech.constraints, mech.tree, st, Sd, qf, qdf)
+
+    def run(qs: np.ndarray, qds: np.ndarray) -> tuple:
+        st = kinematics(mech.tree, qs)
+        return (jacobian_rate(mech.constraints, mech.tree, st, screw_rates(mech.tree, st, qds), qs, qds),)
+
+    _, (Kd,) = on_rows(mech, qf, run, qdf)
     return Kd.reshape(*batch, *Kd.shape[1:])

@@ -32,7 +32,16 @@ from numpy.typing import ArrayLike
 from robomech._validation import as_array, check_int, check_positive, check_real
 from robomech.analysis import workspace
 
-from ._assembly import FKResult, IKResult, check_mechanism, check_q, forward_kinematics, inverse_kinematics
+from ._assembly import (
+    MAX_STEPS,
+    FKResult,
+    IKResult,
+    check_mechanism,
+    check_q,
+    forward_kinematics,
+    inverse_kinematics,
+    on_rows,
+)
 from ._influence import _influence_flat
 from ._mobility import mobility
 from ._model import Mechanism
@@ -136,7 +145,7 @@ def singularities(
     if not isinstance(site, str):
         raise ValueError(f"Expected site to be a site name (str), got {type(site).__name__}.")
     si = tree.site_index(site)
-    q = check_q(mech, q)
+    q = check_q(mech, q, nan_rows=True)  # NaN samples (failed FK samples): NaN measures, flags False
     L = tree.length if length is None else check_positive(length, "length")
     rtol = check_real(rtol, "rtol", low=0.0, high=1.0, low_open=True, high_open=True)
     if reference is not None:
@@ -145,34 +154,42 @@ def singularities(
             raise ValueError(f"Expected reference to have shape ({mech.nq},), got {reference.shape}.")
     ref = mobility(mech, reference)
     batch = q.shape[:-1]
-    qf = q.reshape(-1, mech.nq)
-    state, K, G, _, _, _ = _influence_flat(mech, qf, False)
-    col = np.where(tree.dof_translational, 1.0, L)  # hinge columns times L -> metres
-    rows = np.array([L, L, L, 1.0, 1.0, 1.0])
-    act = tree.act_dof
-    pas = np.setdiff1d(np.arange(tree.nv), act)
-    Ks = K * col  # K rows are already lengths
-    sK = np.linalg.svd(Ks, compute_uv=False) if Ks.shape[1] and Ks.shape[2] else np.zeros((len(qf), 0))
-    sP = np.linalg.svd(Ks[..., pas], compute_uv=False) if Ks.shape[1] and len(pas) else np.zeros((len(qf), 0))
-    b = tree.site_body[si]
-    p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
-    Jf = frame_jacobian(tree, state, b, p)
-    # input-output Jacobian per scaled input rate: G maps unscaled rates; hinge inputs are per rad
-    J = rows[:, None] * (Jf @ G) / col[act]
-    sJ = np.linalg.svd(J, compute_uv=False) if len(act) else np.zeros((len(qf), 0))
-    idle_locked = ref.locked_dof  # motions of a generic configuration with every input locked
-    sigma_I = _kth(sJ, ref.dof)
-    sigma_II = _kth(sP, len(pas) - idle_locked)
-    sigma_C = _kth(sK, ref.rank)
 
-    def cond(sig: np.ndarray, smax: np.ndarray) -> np.ndarray:
-        # reference: the largest singular value, or L if larger (a one-input J has a single value)
-        ok = sig > 0
-        return np.where(ok, np.maximum(smax, L) / np.where(ok, sig, 1.0), np.inf)
+    def run(qf: np.ndarray) -> tuple:
+        state, K, G, _, _, _ = _influence_flat(mech, qf, False)
+        col = np.where(tree.dof_translational, 1.0, L)  # hinge columns times L -> metres
+        rows = np.array([L, L, L, 1.0, 1.0, 1.0])
+        act = tree.act_dof
+        pas = np.setdiff1d(np.arange(tree.nv), act)
+        Ks = K * col  # K rows are already lengths
+        sK = np.linalg.svd(Ks, compute_uv=False) if Ks.shape[1] and Ks.shape[2] else np.zeros((len(qf), 0))
+        sP = (
+            np.linalg.svd(Ks[..., pas], compute_uv=False)
+            if Ks.shape[1] and len(pas)
+            else np.zeros((len(qf), 0))
+        )
+        b = tree.site_body[si]
+        p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
+        Jf = frame_jacobian(tree, state, b, p)
+        # input-output Jacobian per scaled input rate: G maps unscaled rates; hinge inputs are per rad
+        J = rows[:, None] * (Jf @ G) / col[act]
+        sJ = np.linalg.svd(J, compute_uv=False) if len(act) else np.zeros((len(qf), 0))
+        idle_locked = ref.locked_dof  # motions of a generic configuration with every input locked
+        sigma_I = _kth(sJ, ref.dof)
+        sigma_II = _kth(sP, len(pas) - idle_locked)
+        sigma_C = _kth(sK, ref.rank)
 
-    cI = cond(sigma_I, sJ[:, 0] if sJ.shape[1] else np.ones(len(qf)))
-    cII = cond(sigma_II, sP[:, 0] if sP.shape[1] else np.ones(len(qf)))
-    cC = cond(sigma_C, sK[:, 0] if sK.shape[1] else np.ones(len(qf)))
+        def cond(sig: np.ndarray, smax: np.ndarray) -> np.ndarray:
+            # reference: the largest singular value, or L if larger (a one-input J has a single value)
+            ok = sig > 0
+            return np.where(ok, np.maximum(smax, L) / np.where(ok, sig, 1.0), np.inf)
+
+        cI = cond(sigma_I, sJ[:, 0] if sJ.shape[1] else np.ones(len(qf)))
+        cII = cond(sigma_II, sP[:, 0] if sP.shape[1] else np.ones(len(qf)))
+        cC = cond(sigma_C, sK[:, 0] if sK.shape[1] else np.ones(len(qf)))
+        return sigma_I, sigma_II, sigma_C, cI, cII, cC
+
+    _, (sigma_I, sigma_II, sigma_C, cI, cII, cC) = on_rows(mech, q.reshape(-1, mech.nq), run)
     tI, tII, tC = cI > 1 / rtol, cII > 1 / rtol, cC > 1 / rtol
 
     def sh(x: np.ndarray) -> np.ndarray:
@@ -278,7 +295,7 @@ def singularity_map(
     if not isinstance(site, str):
         raise ValueError(f"Expected site to be a site name (str), got {type(site).__name__}.")
     mech.tree.site_index(site)
-    steps = check_int(steps, "steps", low=1)
+    steps = check_int(steps, "steps", low=1, high=MAX_STEPS)
     if length is not None:
         check_positive(length, "length")
     if (q_act is None) == (T is None):

@@ -90,7 +90,9 @@ def assemble_path(mech: mb.Mechanism, q_act: ArrayLike) -> mb.FKResult:
     if qa.ndim != 2 or qa.shape[0] < 1:
         raise ValueError(f"Expected q_act to have shape (nt, {len(mech.actuated)}), got {qa.shape}.")
     fk = mb.forward_kinematics(mech, qa, steps=CONTINUATION_STEPS)
-    q, res, conv, it = (np.array(a) for a in (fk.q, fk.residual, fk.converged, fk.iterations))
+    q, res, conv, it, mc = (
+        np.array(a) for a in (fk.q, fk.residual, fk.converged, fk.iterations, fk.mode_changed)
+    )
     if qa.shape[0] > 1:
         again = mb.forward_kinematics(mech, qa[1:], q[:-1])
         off = np.max(np.abs(again.q - q[1:]), axis=-1) > BRANCH_TOL
@@ -98,8 +100,14 @@ def assemble_path(mech: mb.Mechanism, q_act: ArrayLike) -> mb.FKResult:
         if np.any(off):
             for k in range(int(np.argmax(off)) + 1, qa.shape[0]):  # frame by frame from the first jump
                 r = mb.forward_kinematics(mech, qa[k], q[k - 1])
-                q[k], res[k], conv[k], it[k] = r.q, r.residual, r.converged, r.iterations
-    return mb.FKResult(q=q, residual=res, converged=conv, iterations=it)
+                q[k], res[k], conv[k], it[k], mc[k] = (
+                    r.q,
+                    r.residual,
+                    r.converged,
+                    r.iterations,
+                    r.mode_changed,
+                )
+    return mb.FKResult(q=q, residual=res, converged=conv, iterations=it, mode_changed=mc)
 
 
 def animation_figure(

@@ -136,9 +136,10 @@ SPECS = {
         args={"mech": MECH, "q_act": QA, "guess": Q, "steps": 1},
         arrays={"q_act": 1, "guess": 1},
         masked=("q_act",),
+        nan_rows=("guess",),  # a failed sample's q as the guess: that sample is masked
         mask="converged",
         params=("mech",),
-        options={"steps": BAD_STEPS},
+        options={"steps": (*BAD_STEPS, 10**7)},  # 10**7 stages: beyond MAX_STEPS, refused
     ),
     P + "inverse_kinematics": Spec(
         args={
@@ -150,6 +151,7 @@ SPECS = {
             "steps": 1,
         },
         arrays={"T_target": 2, "guess": 1, "weights": 1},
+        nan_rows=("guess",),
         unbatched=("weights",),  # one weighting of the 6 pose residuals for the whole batch
         masked=("T_target",),
         mask="converged",
@@ -160,32 +162,40 @@ SPECS = {
     P + "site_pose": Spec(
         args={"mech": MECH, "q": Q, "site": "coupler_point"},
         arrays={"q": 1},
+        nan_rows=("q",),  # a failed FK sample chains: NaN out at that sample
         params=("mech",),
         options={"site": (*BAD_STR, "nope")},
     ),
     P + "site_jacobian": Spec(
         args={"mech": MECH, "q": Q, "site": "coupler_point"},
         arrays={"q": 1},
+        nan_rows=("q",),  # a failed FK sample chains: NaN out at that sample
         params=("mech",),
         options={"site": (*BAD_STR, "nope")},
     ),
     P + "site_hessian": Spec(
         args={"mech": MECH, "q": Q, "site": "coupler_point"},
         arrays={"q": 1},
+        nan_rows=("q",),  # a failed FK sample chains: NaN out at that sample
         params=("mech",),
         options={"site": (*BAD_STR, "nope")},
     ),
     P + "influence": Spec(
         args={"mech": MECH, "q": Q, "second_order": True},
         arrays={"q": 1},
+        nan_rows=("q",),
         params=("mech",),
         options={"second_order": BAD_BOOL},
         finite_result=False,
     ),
-    P + "constraint_residual": Spec(args={"mech": MECH, "q": Q}, arrays={"q": 1}, params=("mech",)),
-    P + "constraint_jacobian": Spec(args={"mech": MECH, "q": Q}, arrays={"q": 1}, params=("mech",)),
+    P + "constraint_residual": Spec(
+        args={"mech": MECH, "q": Q}, arrays={"q": 1}, nan_rows=("q",), params=("mech",)
+    ),
+    P + "constraint_jacobian": Spec(
+        args={"mech": MECH, "q": Q}, arrays={"q": 1}, nan_rows=("q",), params=("mech",)
+    ),
     P + "constraint_jacobian_rate": Spec(
-        args={"mech": MECH, "q": Q, "qd": QD}, arrays={"q": 1, "qd": 1}, params=("mech",)
+        args={"mech": MECH, "q": Q, "qd": QD}, arrays={"q": 1, "qd": 1}, nan_rows=("q",), params=("mech",)
     ),
     # ---- mobility, singularities, maps -------------------------------------------------------------
     P + "mobility": Spec(
@@ -205,7 +215,8 @@ SPECS = {
             "rtol": 1e-8,
         },
         arrays={"q": 1, "reference": 1},
-        unbatched=("reference",),  # one reference configuration (the branch) for the whole batch
+        unbatched=("reference",),
+        nan_rows=("q",),  # one reference configuration (the branch) for the whole batch
         params=("mech",),
         options={"site": (*BAD_STR, "nope"), "length": BAD_LENGTH, "rtol": (*BAD_REAL, 0.0, 1.0, -1.0)},
     ),
@@ -213,9 +224,10 @@ SPECS = {
         args={"mech": MECH, "site": "coupler_point", "q_act": QA, "guess": Q, "steps": 2},
         arrays={"q_act": 1, "guess": 1},
         masked=("q_act",),
+        nan_rows=("guess",),  # a failed sample's q as the guess: that sample is masked
         mask="reachable",
         params=("mech",),
-        options={"site": (*BAD_STR, "nope"), "steps": BAD_STEPS},
+        options={"site": (*BAD_STR, "nope"), "steps": (*BAD_STEPS, 10**7)},
     ),
     # ---- drawing -----------------------------------------------------------------------------------
     P + "body_segments": Spec(
