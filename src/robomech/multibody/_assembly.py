@@ -126,6 +126,37 @@ MODE_RANK_RTOL = 1e-8
 MAX_STEPS = 10_000
 
 
+# A description whose closures still miss by more than this fraction of the characteristic length
+# after a full assembly attempt from the reference (every coordinate free) cannot assemble near it:
+# a typo'd anchor (900 for 0.9) misses by O(1000) L, an MJCF typed with 4 digits by ~1e-4 L but it
+# then assembles to ~1e-12 L.
+ASSEMBLY_CHECK_RTOL = 1e-6
+
+
+def check_assembles(mech: Mechanism, what: str = "the description") -> None:
+    """Raise ValueError when ``mech``'s closures cannot assemble near the reference configuration.
+
+    The closures are solved from ``mech.q0`` with every velocity coordinate free (actuated ones
+    too); a residual above ``ASSEMBLY_CHECK_RTOL * L`` after that attempt names the closures (and
+    couplings) that stay open.  A reference that is off the closure but assemblable passes.
+    """
+    cs = mech.constraints
+    if cs.m == 0:
+        return
+    tree = mech.tree
+    q, rc, _, _ = solve_closure(mech, mech.q0[None].copy(), np.arange(tree.nv))
+    tol = ASSEMBLY_CHECK_RTOL * tree.length
+    if np.isfinite(rc[0]) and rc[0] <= tol:
+        return
+    r = np.abs(residual(cs, tree, kinematics(tree, q), q)[0])
+    owners = sorted({cs.row_owner[i] for i in np.flatnonzero(~(r <= tol))})
+    raise ValueError(
+        f"Expected {what} to assemble: closure(s) {', '.join(map(repr, owners))} still miss by "
+        f"{np.nanmax(r):.3g} m after an assembly attempt from the reference configuration "
+        f"(tolerance {tol:.3g} m); check their anchors, axes and the bodies' positions."
+    )
+
+
 def _passive_block(mech: Mechanism, q: np.ndarray) -> np.ndarray:
     tree = mech.tree
     K = jacobian(mech.constraints, tree, kinematics(tree, q), q)

@@ -100,8 +100,12 @@ def draw(
     mech = check_mechanism(mech)
     q = mech.q0 if q is None else q
     segs = body_segments(mech, q)
-    if not isinstance(color, str):
-        raise ValueError(f"Expected color to be a matplotlib colour string, got {color!r}.")
+    from matplotlib.colors import is_color_like
+
+    if not isinstance(color, str) or not is_color_like(color):
+        raise ValueError(
+            f"Expected color to be a matplotlib colour string ('C0', 'red', '#1f77b4'), got {color!r}."
+        )
     if title is not None and not isinstance(title, str):
         raise ValueError(f"Expected title to be None or a string, got {title!r}.")
     qn = check_q(mech, q)

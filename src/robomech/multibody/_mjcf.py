@@ -11,6 +11,7 @@ MuJoCo is an optional dependency (``pip install robomech[verify]``): only :func:
 from __future__ import annotations
 
 import os
+import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -98,6 +99,20 @@ def from_mjcf(path_or_xml: str | os.PathLike) -> Mechanism:
     >>> mech.actuated, mech.nq, [b.name for b in mech.bodies]
     (('theta2',), 3, ['crank', 'coupler', 'rocker'])
     """
+    try:
+        mech = _read(path_or_xml)
+    except UnicodeDecodeError as exc:  # MuJoCo hands names over as UTF-8 bytes
+        raise ValueError(
+            "Expected path_or_xml to be UTF-8 encoded MJCF (MuJoCo reads names as UTF-8), got a name "
+            f"that is not UTF-8 ({exc.reason} at byte {exc.start}): save the file as UTF-8."
+        ) from exc
+    from ._assembly import check_assembles
+
+    check_assembles(mech, "path_or_xml")
+    return mech
+
+
+def _read(path_or_xml: str | os.PathLike) -> Mechanism:
     if not isinstance(path_or_xml, str | os.PathLike):
         raise ValueError(f"Expected path_or_xml to be a path or MJCF text, got {type(path_or_xml).__name__}.")
     mujoco = _import_mujoco()
@@ -110,7 +125,8 @@ def from_mjcf(path_or_xml: str | os.PathLike) -> Mechanism:
     for what, n in unsupported:
         if n:
             raise ValueError(
-                f"Unsupported MJCF element for robomech.multibody: {n} {what}(s) (they change the mechanism)."
+                f"Expected path_or_xml without {what}s (robomech.multibody does not support them: they "
+                f"change the mechanism), got {n} {what}(s)."
             )
 
     def nm(obj, prefix: str, i: int) -> str:
@@ -209,13 +225,17 @@ def from_mjcf(path_or_xml: str | os.PathLike) -> Mechanism:
             couplings.append(Coupling(name, jnt_names[o1], jnt_names[o2] if o2 >= 0 else None, tuple(d[0:5])))
         else:
             kind = {int(getattr(eq, k)): k for k in dir(eq) if k.startswith("mjEQ_")}.get(eq_typ, str(eq_typ))
-            raise ValueError(f"Unsupported MJCF equality for robomech.multibody: {kind} ({name!r}).")
+            raise ValueError(
+                "Expected path_or_xml with connect, weld and joint equalities only (robomech.multibody "
+                f"supports those), got equality {name!r} of type {kind}."
+            )
     actuated = []
     for a in range(m.nu):
         if int(m.actuator_trntype[a]) != int(mujoco.mjtTrn.mjTRN_JOINT):
             raise ValueError(
-                f"Unsupported MJCF actuator for robomech.multibody: {m.actuator(a).name or a!r} "
-                "(only joint transmissions are supported)."
+                f"Expected path_or_xml with joint actuators only (robomech.multibody supports joint "
+                f"transmissions), got actuator {m.actuator(a).name or f'number {a} (unnamed)'!r} with a "
+                f"{mujoco.mjtTrn(int(m.actuator_trntype[a])).name} transmission."
             )
         actuated.append(jnt_names[m.actuator_trnid[a, 0]])
     name = m.names[: m.names.index(b"\0")].decode() if m.names else "mechanism"
@@ -267,6 +287,9 @@ def to_mjcf(mech: Mechanism, *, comment: str | None = None) -> str:
         raise ValueError(f"Expected mech to be a robomech.multibody.Mechanism, got {type(mech).__name__}.")
     if comment is not None and not isinstance(comment, str):
         raise ValueError(f"Expected comment to be None or a string, got {comment!r}.")
+    bad = sorted({c for c in comment or "" if (ord(c) < 32 and c not in "\t\n\r") or c in "\ufffe\uffff"})
+    if bad:  # XML 1.0 has no such characters: the file could not be read back
+        raise ValueError(f"Expected comment to hold no control characters (XML cannot), got {bad!r}.")
     tree = mech.tree
     L = tree.length
     radius = 0.02 * L
@@ -372,4 +395,27 @@ def to_mjcf(mech: Mechanism, *, comment: str | None = None) -> str:
         for a in mech.actuated:
             ET.SubElement(act, "general", name=f"act_{a}", joint=a)
     ET.indent(root)
-    return ET.tostring(root, encoding="unicode")
+    xml = ET.tostring(root, encoding="unicode")
+    _check_mujoco_accepts(mech, xml)
+    return xml
+
+
+def _check_mujoco_accepts(mech: Mechanism, xml: str) -> None:
+    """Refuse to export MJCF that MuJoCo would reject for a massless moving body (checked by MuJoCo
+    itself where it is installed: its rule depends on the subtree, not on one body)."""
+    try:
+        import mujoco
+    except ImportError:  # pragma: no cover - without the optional extra nothing can check the file
+        return
+    try:
+        mujoco.MjModel.from_xml_string(xml)
+    except ValueError as exc:
+        msg = str(exc)
+        if "mass and inertia" not in msg:
+            raise
+        found = re.search(r"Element name '([^']*)'", msg)
+        body = found.group(1) if found else "?"
+        raise ValueError(
+            f"Expected mech's moving bodies to have mass and inertia (MuJoCo rejects the exported "
+            f"file otherwise), got body {body!r} without: give it an Inertial(mass, diaginertia=...)."
+        ) from exc

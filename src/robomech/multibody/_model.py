@@ -352,6 +352,11 @@ class Coupling:
         _name(self.joint1, f"joint1 of coupling {self.name!r}")
         if self.joint2 is not None:
             _name(self.joint2, f"joint2 of coupling {self.name!r}")
+            if self.joint2 == self.joint1:
+                raise ValueError(
+                    f"Expected joint2 of coupling {self.name!r} to differ from joint1, "
+                    f"got {self.joint2!r} twice (a joint coupled to itself)."
+                )
         object.__setattr__(self, "polycoef", _vec(self.polycoef, 5, f"polycoef of coupling {self.name!r}"))
 
 
@@ -612,17 +617,17 @@ class Builder:
     @staticmethod
     def hinge(name: str, axis: Vector = (0, 0, 1), pos: Vector = (0, 0, 0), ref: float = 0.0) -> Joint:
         """A hinge ``Joint`` about ``axis`` (body frame) through ``pos`` (m), zero at ``ref`` (rad)."""
-        return Joint(name, "hinge", tuple(axis), tuple(pos), ref)
+        return Joint(name, "hinge", _vec(axis, 3, "axis"), _vec(pos, 3, "pos"), ref)
 
     @staticmethod
     def slide(name: str, axis: Vector = (0, 0, 1), pos: Vector = (0, 0, 0), ref: float = 0.0) -> Joint:
         """A slide ``Joint`` along ``axis`` (body frame), zero at ``ref`` (m)."""
-        return Joint(name, "slide", tuple(axis), tuple(pos), ref)
+        return Joint(name, "slide", _vec(axis, 3, "axis"), _vec(pos, 3, "pos"), ref)
 
     @staticmethod
     def ball(name: str, pos: Vector = (0, 0, 0)) -> Joint:
         """A ball ``Joint`` centred at ``pos`` (body frame, m): 4 ``qpos`` (quaternion), 3 ``qvel``."""
-        return Joint(name, "ball", (0.0, 0.0, 1.0), tuple(pos))
+        return Joint(name, "ball", (0.0, 0.0, 1.0), _vec(pos, 3, "pos"))
 
     @staticmethod
     def free(name: str) -> Joint:
@@ -633,15 +638,17 @@ class Builder:
     def universal(name: str, axis1: Vector, axis2: Vector, pos: Vector = (0, 0, 0)) -> tuple[Joint, Joint]:
         """A universal joint as two hinges through one point (``name_1`` then ``name_2``)."""
         return (
-            Joint(f"{name}_1", "hinge", tuple(axis1), tuple(pos)),
-            Joint(f"{name}_2", "hinge", tuple(axis2), tuple(pos)),
+            Joint(f"{name}_1", "hinge", _vec(axis1, 3, "axis1"), _vec(pos, 3, "pos")),
+            Joint(f"{name}_2", "hinge", _vec(axis2, 3, "axis2"), _vec(pos, 3, "pos")),
         )
 
     def helical(self, name: str, axis: Vector, pitch: float, pos: Vector = (0, 0, 0)) -> tuple[Joint, Joint]:
         """A helical joint: hinge ``name_r`` and slide ``name_p`` coupled by ``p = pitch * theta`` (m/rad)."""
-        r = Joint(f"{name}_r", "hinge", tuple(axis), tuple(pos))
-        p = Joint(f"{name}_p", "slide", tuple(axis), tuple(pos))
-        self._couplings.append(Coupling(name, p.name, r.name, (0.0, float(pitch), 0.0, 0.0, 0.0)))
+        pitch = check_real(pitch, "pitch")
+        axis, pos = _vec(axis, 3, "axis"), _vec(pos, 3, "pos")
+        r = Joint(f"{name}_r", "hinge", axis, pos)
+        p = Joint(f"{name}_p", "slide", axis, pos)
+        self._couplings.append(Coupling(name, p.name, r.name, (0.0, pitch, 0.0, 0.0, 0.0)))
         return r, p
 
     # elements
@@ -655,15 +662,19 @@ class Builder:
         inertial: Inertial | None = None,
     ) -> str:
         """Add a body (parents before children); ``inertial=None`` lets MJCF export derive it from geoms."""
+        if joints is None or isinstance(joints, str | bytes) or not isinstance(joints, Sequence):
+            raise ValueError(f"Expected joints to be a sequence of Joint, got {type(joints).__name__}.")
         flat: list[Joint] = []
         for j in joints:
             flat.extend(j if isinstance(j, tuple) else (j,))
-        self._bodies.append(Body(name, parent, tuple(pos), tuple(quat), tuple(flat), inertial))
+        self._bodies.append(
+            Body(name, parent, _vec(pos, 3, "pos"), _vec(quat, 4, "quat"), tuple(flat), inertial)
+        )
         return name
 
     def site(self, name: str, body: str, pos: Vector = (0, 0, 0), quat: Vector = (1, 0, 0, 0)) -> str:
         """Add a site on ``body`` at ``pos`` (m), ``quat`` ``[w, x, y, z]`` (body frame); returns the name."""
-        self._sites.append(Site(name, body, tuple(pos), tuple(quat)))
+        self._sites.append(Site(name, body, _vec(pos, 3, "pos"), _vec(quat, 4, "quat")))
         return name
 
     def connect(
@@ -675,7 +686,8 @@ class Builder:
         anchor2: Vector | None = None,
     ) -> None:
         """Point closure (MuJoCo ``connect``): ``anchor2`` defaults to the coincident point at q0."""
-        self._closures.append(("point", name, body1, body2, tuple(anchor1), anchor2, None))
+        a2 = None if anchor2 is None else _vec(anchor2, 3, "anchor2")
+        self._closures.append(("point", name, body1, body2, _vec(anchor1, 3, "anchor1"), a2, None))
 
     def revolute(
         self,
@@ -687,7 +699,9 @@ class Builder:
         anchor2: Vector | None = None,
     ) -> None:
         """Hinge closure: as :meth:`connect`, and ``axis`` (body1 frame) fixed in body2."""
-        self._closures.append(("revolute", name, body1, body2, tuple(anchor1), anchor2, tuple(axis)))
+        a2 = None if anchor2 is None else _vec(anchor2, 3, "anchor2")
+        a1, ax = _vec(anchor1, 3, "anchor1"), _vec(axis, 3, "axis")
+        self._closures.append(("revolute", name, body1, body2, a1, a2, ax))
 
     def weld(
         self,
@@ -702,13 +716,19 @@ class Builder:
         rel = (
             None
             if relpos is None
-            else (tuple(relpos), tuple(relquat if relquat is not None else (1, 0, 0, 0)))
+            else (
+                _vec(relpos, 3, "relpos"),
+                _vec(relquat if relquat is not None else (1, 0, 0, 0), 4, "relquat"),
+            )
         )
-        self._closures.append(("rigid", name, body1, body2, tuple(anchor2), rel, None))
+        self._closures.append(("rigid", name, body1, body2, _vec(anchor2, 3, "anchor2"), rel, None))
 
     def couple(self, name: str, joint1: str, joint2: str | None, polycoef: Vector) -> None:
         """Add a :class:`Coupling` (``polycoef`` padded with zeros to 5 coefficients)."""
-        c = tuple(polycoef) + (0.0,) * (5 - len(polycoef))
+        pc = as_array(polycoef, "polycoef", (None,))
+        if pc.ndim != 1 or not 1 <= pc.shape[0] <= 5:
+            raise ValueError(f"Expected polycoef to have 1 to 5 coefficients, got shape {pc.shape}.")
+        c = tuple(float(v) for v in pc) + (0.0,) * (5 - pc.shape[0])
         self._couplings.append(Coupling(name, joint1, joint2, c))
 
     def actuate(self, *joints: str) -> None:
@@ -760,7 +780,7 @@ class Builder:
                         name, "rigid", b1, b2, anchor2=tuple(a), relpos=tuple(relpos), relquat=tuple(relquat)
                     )
                 )
-        return Mechanism(
+        mech = Mechanism(
             tuple(self._bodies),
             tuple(closures),
             tuple(self._couplings),
@@ -769,6 +789,10 @@ class Builder:
             self.gravity,
             self.name,
         )
+        from ._assembly import check_assembles
+
+        check_assembles(mech, f"mechanism {self.name!r}")
+        return mech
 
 
 # A rotation matrix must satisfy R^T R = I and det R = +1 to this tolerance: composed transforms are

@@ -237,7 +237,7 @@ SPECS = {
         args={"mech": MECH, "q": Q[0], "color": "C1", "title": "t", "ax": None},
         arrays={"q": 1},
         params=("mech",),
-        options={"color": BAD_STR, "title": (1, 1.5), "ax": (1, "axes")},
+        options={"color": (*BAD_STR, "notacolor"), "title": (1, 1.5), "ax": (1, "axes")},
         wrong_shapes={"q": ((2, 3),)},
         finite_result=False,
     ),
