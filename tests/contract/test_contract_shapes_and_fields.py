@@ -22,10 +22,8 @@ import inspect
 import numpy as np
 import pytest
 from contract_spec import Spec
-from test_contract import ACTIVE as ALL_ACTIVE
-from test_contract import GOOD_CALL_SECONDS, _call, _mask_of, _names, _target
+from test_contract import ACTIVE, GOOD_CALL_SECONDS, _call, _mask_of, _names, _target
 
-ACTIVE = ALL_ACTIVE
 # Known failures of the field rule, in packages other engineers are changing: strict xfails, so each
 # turns into a failure (remove it here) the day its dataclass checks the field.
 FIELD_XFAIL = {
