@@ -22,6 +22,7 @@ Exit codes
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import traceback
 from collections.abc import Callable, Sequence
@@ -97,6 +98,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     >>> main(["verify", "no-such-mechanism"])  # the message goes to stderr
     2
     """
+    if "matplotlib" not in sys.modules:
+        # the command writes figures to files and shows none: matplotlib's Agg backend, chosen for
+        # this process (and the workers it starts) here, never by a library import
+        os.environ["MPLBACKEND"] = "agg"
     try:
         parser = build_parser()
         args = parser.parse_args(argv)  # exits 2 on a usage error, 0 after --help/--version

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+from robomech._progress import show_bars
+
 from ._core import (
     EXIT_CHECK_FAILED,
     EXIT_OK,
@@ -67,6 +69,7 @@ def _run(args: argparse.Namespace) -> int:
         if why:
             raise CliError(f"{n} cannot run here: {why}")
     announce_compiles(enabled=not args.quiet)
+    show_bars(not args.quiet)  # stage bars on a terminal (robomech._progress)
     report = VerificationReport()
     try:
         report.checks.extend(run_generic(generic))

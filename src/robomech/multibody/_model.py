@@ -514,6 +514,12 @@ class Mechanism:
         """The characteristic length (m) that makes rotations and translations commensurate."""
         return self.tree.length
 
+    def _repr_png_(self) -> bytes:
+        """Jupyter's picture of the mechanism: its wireframe at ``q0`` (Agg canvas, no pyplot)."""
+        from ._repr import mechanism_png
+
+        return mechanism_png(self)
+
     def site(self, name: str) -> Site:
         for s in self.sites:
             if s.name == name:

@@ -12,11 +12,13 @@ import math
 from pathlib import Path
 
 import numpy as np
+from matplotlib.lines import Line2D
 
 from robomech.mechanisms import vectored_thrust as vt
 
 from ._animate import Animation, animation_figure
 from ._core import Figure, Progress, Study, StudyResult, Table, comparison_table
+from ._papers import PAPERS, cite
 from ._plot import plt, save_figure
 
 MAP_SAMPLES = 401  # per input axis for the workspace and singularity maps (~160k samples each)
@@ -130,13 +132,25 @@ def _platform_motion_by_differences(th: vt.VectoredThruster, t: np.ndarray, q_of
     return omega(t), (omega(t + FD_STEP) - omega(t - FD_STEP)) / (2.0 * FD_STEP)
 
 
+def _legend_with_styles(ax, styles, fontsize) -> None:
+    """One legend entry per coloured line (its label) and one per line style, in black: a source
+    (analytic, MuJoCo, ...) is named once, not once per component."""
+    handles, labels = ax.get_legend_handles_labels()
+    for style, label in styles:
+        if style in ("-", ":", "--", "-."):
+            handles.append(Line2D([], [], color="k", ls=style, lw=1.5))
+        else:
+            handles.append(Line2D([], [], color="k", ls="", marker=style, ms=4, mfc="none"))
+        labels.append(label)
+    ax.legend(handles, labels, ncol=4, fontsize=fontsize, loc="upper center", bbox_to_anchor=(0.5, -0.15))
+
+
 def run(out_dir: Path, progress: Progress) -> StudyResult:
     th = vt.VectoredThruster.paper()
     res = StudyResult(
         name="vectored-thrust",
         title="Paper 5: RRR-RR vectored-thrust spherical mechanism",
-        source="Xu, Li, Chen, Zhang, Gao, Robot 38(6), 2016 "
-        "(shared/papers/5-vectored-thrust-spherical-mechanism.txt)",
+        source=cite(5),
     )
 
     # -- mobility ---------------------------------------------------------------------------------------
@@ -222,14 +236,20 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         s=2,
         c=np.degrees(wm.tilt[::4, ::4][rch]),
         cmap="viridis",
-        label="reachable",
     )
-    fig.colorbar(sc, ax=a1, shrink=0.6, label="tilt from Z (deg)")
+    fig.colorbar(sc, ax=a1, shrink=0.6, pad=0.12, label="tilt from Z (deg)")
     a1.set_xlabel("x (mm)")
     a1.set_ylabel("y (mm)")
-    a1.set_zlabel("z (mm)")
-    a1.set_title("Fig. 5: propeller tip workspace (inputs over Table 1 ranges)")
-    a1.legend(loc="upper left", fontsize=8)
+    a1.set_zlabel("z (mm)", labelpad=4)
+    a1.set_box_aspect(None, zoom=0.9)  # room for the z label beside the colour bar
+    a1.set_title("propeller tip workspace (Table 1 input ranges)")
+    # the reachable points are coloured by tilt: their legend marker says so instead of one colour
+    reach_marker = Line2D([], [], ls="", marker="o", ms=4, mfc=plt.get_cmap("viridis")(0.6), mec="none")
+    gray_marker = Line2D([], [], ls="", marker="o", ms=4, mfc="lightgray", mec="none")
+    a1.legend(
+        [gray_marker, reach_marker], ["beyond U-joint limit", "reachable (colour: tilt)"],
+        loc="upper left", fontsize=8,
+    )  # fmt: skip
     a2 = fig.add_subplot(1, 2, 2)
     for mask, c, lab in (
         (~wm.reachable, "lightgray", "beyond U-joint limit"),
@@ -268,7 +288,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     b2.set_aspect("equal")
     b2.set_xlabel("x (mm)")
     b2.set_ylabel("y (mm)")
-    b2.set_title("Fig. 6: reachable tip points on the 80 mm sphere (top view)")
+    b2.set_title("reachable tip points on the 80 mm sphere (top view)")
     b2.legend(fontsize=8)
     res.figures.append(
         save_figure(
@@ -296,17 +316,15 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     colors = ("tab:blue", "tab:orange", "tab:green")
     fig, ax = plt.subplots(figsize=(10, 5.5))
     for k in range(3):
-        ax.plot(t, acc.omega[:, k], color=colors[k], label=f"{labels[k]} analytic")
-        ax.plot(
-            t[idx], tr.omega_engine[:, k], "o", color=colors[k], ms=4, mfc="none", label=f"{labels[k]} MuJoCo"
-        )
+        ax.plot(t, acc.omega[:, k], color=colors[k], label=labels[k])
+        ax.plot(t[idx], tr.omega_engine[:, k], "o", color=colors[k], ms=4, mfc="none")
     ax.fill_between(
         t, 0, 1, where=over, transform=ax.get_xaxis_transform(), color="red", alpha=0.08, label="tilt > 45°"
     )
     ax.set_xlabel("time t (s)")
     ax.set_ylabel("platform angular velocity (rad/s)")
-    ax.set_title("Fig. 7: angular velocity along q1 = (π/4) sin t, q2 = −(π/4) sin t")
-    ax.legend(ncol=4, fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.15))
+    ax.set_title("angular velocity along q1 = (π/4) sin t, q2 = −(π/4) sin t")
+    _legend_with_styles(ax, [("-", "analytic"), ("o", "MuJoCo")], fontsize=8)
     ax.grid(True, alpha=0.3)
     res.figures.append(
         save_figure(
@@ -318,20 +336,17 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     )
     fig, ax = plt.subplots(figsize=(10, 5.5))
     for k in range(3):
-        ax.plot(
-            t, acc.omega_dot[:, k], color=colors[k], label=f"{labels[k].replace('ω', 'ω̇')} Lie-bracket model"
-        )
-        ax.plot(t[idx], tr.omega_dot_engine[:, k], "o", color=colors[k], ms=4, mfc="none", label="MuJoCo")
-        ax.plot(
-            t, printed_style[:, k], ":", color=colors[k], lw=1, label="eq. (32) style (no velocity products)"
-        )
+        ax.plot(t, acc.omega_dot[:, k], color=colors[k], label=labels[k].replace("ω", "ω̇"))
+        ax.plot(t[idx], tr.omega_dot_engine[:, k], "o", color=colors[k], ms=4, mfc="none")
+        ax.plot(t, printed_style[:, k], ":", color=colors[k], lw=1)
     ax.fill_between(
         t, 0, 1, where=over, transform=ax.get_xaxis_transform(), color="red", alpha=0.08, label="tilt > 45°"
     )
     ax.set_xlabel("time t (s)")
     ax.set_ylabel("platform angular acceleration (rad/s²)")
-    ax.set_title("Fig. 8: angular acceleration along the Table 1 trajectory")
-    ax.legend(ncol=4, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.15))
+    ax.set_title("angular acceleration along the Table 1 trajectory")
+    styles = [("-", "Lie-bracket model"), ("o", "MuJoCo"), (":", "eq. (32) style (no velocity products)")]
+    _legend_with_styles(ax, styles, fontsize=7)
     ax.grid(True, alpha=0.3)
     res.figures.append(
         save_figure(
@@ -464,7 +479,9 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         if lim:
             axp.set_xlim(-lim, lim)
             axp.set_ylim(-lim, lim)
-        axp.legend(fontsize=7, loc="lower left")
+        if lim is None:  # one legend, below the first map (inside, it would hide a singular curve);
+            # grey so that the white outline shows
+            axp.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, facecolor="0.8")
     res.figures.append(
         save_figure(
             fig,
@@ -584,7 +601,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
 STUDY = Study(
     name="vectored-thrust",
     title="Paper 5: vectored-thrust spherical mechanism",
-    source="Robot 38(6), 2016",
+    source=PAPERS[5].short(),
     run=run,
     requires=("mujoco",),  # the engine overlays (robomech.verify); skipped without robomech[verify]
 )
