@@ -72,6 +72,7 @@ from ._influence import (
 )
 from ._mjcf import from_mjcf, to_mjcf
 from ._mobility import MobilityReport, mobility
+from ._rnea import generalized_forces, mass_matrix
 from ._model import Body, Builder, Closure, Coupling, Inertial, Joint, Mechanism, Site
 from ._singularity import SingularityMapResult, SingularityResult, singularities, singularity_map
 
@@ -106,9 +107,11 @@ __all__ = [
     "forward_kinematics",
     "from_mjcf",
     "gallery",
+    "generalized_forces",
     "influence",
     "inverse_dynamics",
     "inverse_kinematics",
+    "mass_matrix",
     "mobility",
     "simulate",
     "singularities",
