@@ -180,7 +180,7 @@ GRAM_REFINE_COND = 1e2
 GRAM_REFINE2_COND = 1e4
 
 
-def _passive_inverse(Kp: np.ndarray, rank0: int):
+def _passive_inverse(Kp: np.ndarray, rank0: int, length: float = 1.0):
     """Pseudo-inverse of the passive block ``Kp (N, m, n)`` with (rank, sigma_min, cond) per sample.
 
     Fast path where the generic rank is ``min(m, n)`` (no idle motion *and* redundant rows at once):
@@ -193,7 +193,7 @@ def _passive_inverse(Kp: np.ndarray, rank0: int):
     """
     N, m, n = Kp.shape
     if m == 0 or n == 0 or rank0 != min(m, n):
-        return _pinv(Kp)
+        return _pinv(Kp, length)
     wide = m <= n
     KT = Kp.swapaxes(-1, -2)
     Gm = Kp @ KT if wide else KT @ Kp
@@ -201,7 +201,7 @@ def _passive_inverse(Kp: np.ndarray, rank0: int):
         try:
             Gi = np.linalg.inv(Gm)
         except np.linalg.LinAlgError:
-            return _pinv(Kp)
+            return _pinv(Kp, length)
         P = KT @ Gi if wide else Gi @ KT
         ni = np.linalg.norm(Gi, 1, axis=(-2, -1))
         cond = np.sqrt(np.linalg.norm(Gm, 1, axis=(-2, -1)) * ni)
@@ -215,9 +215,41 @@ def _passive_inverse(Kp: np.ndarray, rank0: int):
     rank = np.full(N, rank0)
     bad = ~(np.isfinite(cond) & (cond <= GRAM_COND_MAX) & np.all(np.isfinite(P), axis=(-1, -2)))
     if np.any(bad):
-        Pb, rb, sb, cb = _pinv(Kp[bad])
+        Pb, rb, sb, cb = _pinv(Kp[bad], length)
         P[bad], rank[bad], smin[bad], cond[bad] = Pb, rb, sb, cb
     return P, rank, smin, cond
+
+
+def _rank_measures(Kp: np.ndarray, rank0: int, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(sigma_min, cond)`` of ``Kp (N, m, n)`` against the mechanism's generic passive rank ``rank0``:
+    the ``rank0``-th singular value and ``s_1`` over it (inf where it is zero).  A truncated
+    pseudo-inverse keeps only the non-zero values, so its own ratio is 1 at a rank drop (a type II
+    singularity); this is the measure reported wherever a sample is not valid.  An empty block or a
+    generic rank 0: ``(length, 1)`` as in ``_influence._pinv``."""
+    N, m, n = Kp.shape
+    if m == 0 or n == 0 or rank0 == 0:
+        return np.full(N, float(length)), np.ones(N)
+    s = np.linalg.svd(np.where(np.isfinite(Kp), Kp, 0.0), compute_uv=False)
+    sr = s[:, rank0 - 1] if s.shape[1] >= rank0 else np.zeros(N)
+    cond = np.where(sr > 0, s[:, 0] / np.where(sr > 0, sr, 1.0), np.inf)
+    return sr, cond
+
+
+# A configuration given to a dynamics function must satisfy the closures: its largest closure row at most
+# CLOSURE_RTOL * L.  100 times the assembly's CONVERGED_RTOL, so that every configuration that
+# forward_kinematics, inverse_kinematics or simulate report converged passes, while one off the closure
+# manifold (a passive joint moved by hand, a q typed with a few digits) gives forces of no meaning and
+# is flagged: the forces' relative error grows like the residual over L.
+CLOSURE_RTOL = 1e-8
+
+
+def _closure_error(mech: Mechanism, state, q: np.ndarray) -> np.ndarray:
+    """Largest closure row ``max |phi(q)|`` (m) per sample; 0 for a tree."""
+    from ._constraints import residual
+
+    if mech.constraints.m == 0:
+        return np.zeros(q.shape[0])
+    return np.max(np.abs(residual(mech.constraints, mech.tree, state, q)), axis=-1)
 
 
 def _reference3(mech: Mechanism) -> tuple[int, int, int]:
@@ -469,7 +501,8 @@ class InverseDynamicsResult:
         applied).  NaN where not ``valid``.
     M_a : ndarray, shape (..., n_act, n_act)
         Mass matrix in actuator space, ``G^T M G`` (kg m^2, kg); with redundant actuation the
-        distributed ``Pi G^T M G``, ``Pi`` the stated rule's projector.
+        distributed ``Pi G^T M G``, ``Pi`` the stated rule's projector.  From full rates ``qd``,
+        ``B M B^T`` with ``tau = B f`` the rule applied to the generalized forces ``f``.
     velocity_terms : ndarray, shape (..., n_act)
         Coriolis and centrifugal share of ``tau`` (N m or N).
     gravity_terms : ndarray, shape (..., n_act)
@@ -486,10 +519,20 @@ class InverseDynamicsResult:
     sigma_min : ndarray, shape (...)
         Smallest kept singular value of the passive constraint block (m).
     admissibility : ndarray, shape (...)
-        Closure error of the prescribed motion, relative (above ``ADMISSIBLE_RTOL``: not valid).
+        How far the motion is from one the actuators can produce, relative: the closure error of the
+        prescribed rates and accelerations and, with fewer actuators than degrees of freedom, the
+        size of ``unactuated`` over that of the generalized forces (above ``ADMISSIBLE_RTOL``: not
+        valid).
+    unactuated : ndarray, shape (..., nv)
+        The generalized force (``qvel`` order) the unactuated coordinates would need for the motion
+        (a floating base: the base wrench, force in world axes then torque in body axes): the
+        minimum-norm force doing the virtual work the actuators cannot, over every admissible motion.
+        Zero where the actuators determine the motion.
+    closure : ndarray, shape (...)
+        Largest closure row of the input ``q`` (m); above ``CLOSURE_RTOL * L`` the sample is not valid.
     valid : ndarray of bool, shape (...)
-        False at a singular configuration, an inadmissible motion or a non-finite input; the forces
-        are NaN there.
+        False at a singular configuration, an inadmissible motion, an unassembled ``q`` or a
+        non-finite input; the forces are NaN there.
     """
 
     tau: np.ndarray
@@ -502,6 +545,8 @@ class InverseDynamicsResult:
     cond: np.ndarray
     sigma_min: np.ndarray
     admissibility: np.ndarray
+    unactuated: np.ndarray
+    closure: np.ndarray
     valid: np.ndarray
 
 
@@ -542,7 +587,7 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
     N = q.shape[0]
     state = kinematics(tree, q)
     K = _constraint_matrix(mech, state, q)
-    P, rank, smin, cond = _passive_inverse(K[..., pas], rank0)
+    P, rank, smin, cond = _passive_inverse(K[..., pas], rank0, tree.length)
     G = np.zeros((N, tree.nv, na))
     G[:, act, np.arange(na)] = 1.0
     G[:, pas] = -P @ K[..., act]
@@ -705,8 +750,9 @@ def _broadcast(mech, q, others: list[tuple[object, str, int]], qname: str = "q")
     batch = broadcast_batch(
         (qv, 1, qname), *((a, 1, name) for a, (_, name, _) in zip(arrs, others, strict=True))
     )
-    flat = [np.broadcast_to(qv, (*batch, mech.nq)).reshape(-1, mech.nq)]
-    flat += [np.broadcast_to(a, (*batch, a.shape[-1])).reshape(-1, a.shape[-1]) for a in arrs]
+    n = int(np.prod(batch))  # explicit: reshape(-1, 0) of an empty trailing axis is ambiguous
+    flat = [np.broadcast_to(qv, (*batch, mech.nq)).reshape(n, mech.nq)]
+    flat += [np.broadcast_to(a, (*batch, a.shape[-1])).reshape(n, a.shape[-1]) for a in arrs]
     return batch, flat
 
 
@@ -734,6 +780,9 @@ def _sanitize(mech, flat: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray
 
 
 def _shape(d: dict, batch, ok: np.ndarray, nan_keys) -> dict:
+    # "_computed" (optional): where the forces are the right answer to a question that has one even if
+    # the sample is not valid (an underactuated motion: the least-squares forces); elsewhere "valid"
+    computed = d.pop("_computed", d["valid"])
     # a sample whose results overflowed (inputs of 1e300, say) is not valid
     for v in d.values():
         v = np.asarray(v)
@@ -745,7 +794,7 @@ def _shape(d: dict, batch, ok: np.ndarray, nan_keys) -> dict:
         if k == "valid":
             v = v & ok
         elif k in nan_keys:
-            bad = ~(d["valid"] & ok)
+            bad = ~(computed & ok)
             v = np.where(bad.reshape(-1, *(1,) * (v.ndim - 1)), np.nan, v)
         elif v.dtype.kind == "f":
             v = np.where(ok.reshape(-1, *(1,) * (v.ndim - 1)), v, np.nan)
@@ -756,38 +805,201 @@ def _shape(d: dict, batch, ok: np.ndarray, nan_keys) -> dict:
 _FORCE_KEYS = ("tau", "M_a", "velocity_terms", "gravity_terms", "external_terms")
 
 
+def _null_basis(mech: Mechanism, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Orthonormal basis ``(N, nv, d)`` of the admissible velocities ``null(K)`` at the mechanism's
+    generic rank of ``K``, and ``s_1 / s_r`` of ``K`` (N,): 1 for a tree (the identity basis)."""
+    N, m, nv = K.shape
+    r = _rank_K(mech) if m else 0
+    if r == 0:
+        return np.broadcast_to(np.eye(nv), (N, nv, nv)), np.ones(N)
+    _, s, Vt = np.linalg.svd(K, full_matrices=True)
+    sr = s[:, r - 1]
+    cond = np.where(sr > 0, s[:, 0] / np.where(sr > 0, sr, 1.0), np.inf)
+    return Vt[:, r:].swapaxes(-1, -2), cond
+
+
+def _inverse_full_flat(mech, q, qd, qdd, wr, weights, gravity=True):
+    """Inverse dynamics from every coordinate's rates and accelerations (any kinematic class).
+
+    With ``Nb`` an orthonormal basis of the admissible velocities and ``f = M qdd + c + g - J_s^T W`` the
+    tree's generalized forces (:mod:`._rnea`), virtual work over every admissible motion asks
+    ``Nb^T E tau = Nb^T f``; ``tau = B f`` is its least-squares solution (minimum norm, or minimum
+    ``sum tau_i^2 / w_i``), and what no actuator force can do, ``Nb (Nb^T f - Nb^T E tau)``, is the
+    force the unactuated coordinates would need.  Where the actuators determine the motion this is
+    ``G^T f`` of :func:`_inverse_flat`."""
+    from ._rnea import _crba_flat, _rnea_flat
+
+    tree = mech.tree
+    N, nv = q.shape[0], tree.nv
+    act = tree.act_dof
+    na = len(act)
+    L = tree.length
+    state = kinematics(tree, q)
+    z = np.zeros_like(qd)
+    gv = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
+    M = _crba_flat(mech, q)
+    parts = (
+        _mv(M, qdd),
+        _rnea_flat(mech, q, qd, z, np.zeros(3)),
+        _rnea_flat(mech, q, z, z, gv),
+        _site_terms(mech, state, wr),
+    )
+    f = parts[0] + parts[1] + parts[2] + parts[3]
+    K = _constraint_matrix(mech, state, q)
+    Nb, condK = _null_basis(mech, K)
+    NbT = Nb.swapaxes(-1, -2)
+    Na = Nb[:, act]  # (N, na, d): the actuated rows of the admissible motions
+    ws = np.ones(na) if weights is None else np.sqrt(weights)
+    A = NbT[:, :, act] * ws  # (N, d, na)
+    d = Nb.shape[-1]
+    if na and d:
+        sA = np.linalg.svd(A, compute_uv=False)
+        smin = sA[:, -1]
+        cond_a = np.where(smin > RANK_RTOL * sA[:, 0], sA[:, 0] / np.where(smin > 0, smin, 1.0), np.inf)
+        B = ws[:, None] * (np.linalg.pinv(A, rcond=RANK_RTOL) @ NbT)  # (N, na, nv)
+    else:
+        smin, cond_a = np.ones(N), np.ones(N)
+        B = np.zeros((N, na, nv))
+    tau_parts = [_mv(B, x) for x in parts]
+    tau = tau_parts[0] + tau_parts[1] + tau_parts[2] + tau_parts[3]
+    b = _mv(NbT, f)
+    unact = _mv(Nb, b - _mv(Na.swapaxes(-1, -2), tau))
+    # relative to the largest of the inertial, velocity, gravity and external terms (their sum is ~0 on a
+    # free motion, whose rounding must not count as a force the actuators cannot give)
+    scale = np.max(np.abs(np.stack(parts)), axis=(0, -1)) if nv else np.zeros(N)
+    e_force = np.max(np.abs(unact), axis=-1) / np.maximum(scale, 1e-300) if nv else np.zeros(N)
+    Sd = _screw_rates(tree, state, qd)
+    kdq = _kdot_qd(mech, state, q, qd, Sd)
+    sv = np.max(np.abs(qd), axis=-1) if nv else np.zeros(N)
+    sa = np.max(np.abs(qdd), axis=-1) + sv * sv if nv else np.zeros(N)
+    if K.shape[1]:
+        e1 = np.max(np.abs(_mv(K, qd)), axis=-1) / (L * np.maximum(sv, RATE_FLOOR))
+        e2 = np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
+        adm = np.maximum(np.maximum(e1, e2), e_force)
+    else:
+        adm = e_force
+    M_a = B @ M @ B.swapaxes(-1, -2)
+    cond = np.maximum(condK, cond_a)
+    fin = np.all(np.isfinite(tau), axis=-1) & np.all(np.isfinite(M_a), axis=(-1, -2))
+    computed = fin & (cond <= SINGULAR_COND)
+    return dict(
+        _computed=computed,
+        tau=tau,
+        M_a=M_a,
+        velocity_terms=tau_parts[1],
+        gravity_terms=tau_parts[2],
+        external_terms=tau_parts[3],
+        qd=np.array(qd),
+        qdd=np.array(qdd),
+        cond=cond,
+        sigma_min=L * smin,
+        admissibility=adm,
+        unactuated=unact,
+        valid=computed & (adm <= ADMISSIBLE_RTOL),
+    )
+
+
+def _finish_inverse(mech: Mechanism, q: np.ndarray, d: dict, actuated_mode: bool) -> dict:
+    """The checks common to both inverse-dynamics paths (numpy and compiled, so that a sample's flags do
+    not depend on the batch size): the closure of the input ``q``; in actuator mode a zero
+    ``unactuated`` force, the empty passive block's measures and, where a sample is not valid, the
+    rank measures against the generic rank (``_rank_measures``: a type II singularity has cond inf)."""
+    from ._tree import TreeState
+
+    tree = mech.tree
+    N = q.shape[0]
+    state = kinematics(tree, q)
+    d["closure"] = _closure_error(mech, state, q)
+    if actuated_mode:
+        d["unactuated"] = np.zeros((N, tree.nv))
+        pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
+        if mech.constraints.m == 0 or len(pas) == 0:
+            d["sigma_min"], d["cond"] = np.full(N, tree.length), np.ones(N)
+        else:
+            bad = np.flatnonzero(~d["valid"])
+            if bad.size:
+                sub = TreeState(T=state.T[bad], S=state.S[bad])
+                K = _constraint_matrix(mech, sub, q[bad])
+                d["sigma_min"][bad], d["cond"][bad] = _rank_measures(K[..., pas], _reference(mech)[0], tree.length)
+    assembled = d["closure"] <= CLOSURE_RTOL * tree.length
+    d["valid"] = d["valid"] & assembled
+    if "_computed" in d:
+        d["_computed"] = d["_computed"] & assembled
+    return d
+
+
+def _determined(mech: Mechanism) -> bool:
+    """The actuated rates determine every coordinate's rate (at least one actuator per degree of freedom)."""
+    _, dof = _reference(mech)
+    na = len(mech.actuated)
+    return na > 0 and na >= dof
+
+
+def _rates_mode(mech: Mechanism, fn: str, act: tuple[str, object], full: tuple[str, object]) -> bool:
+    """True: the actuated-rates form (``act``), False: the full-velocity form (``full``); checks that
+    exactly one is given and that the actuated form is only used where the actuators determine the motion."""
+    (an, av), (fname, fv) = act, full
+    if (av is None) == (fv is None):
+        raise ValueError(
+            f"Expected exactly one of {an} (..., n_act) and {fname}= (..., nv) in {fn}, got "
+            f"{'both' if av is not None else 'neither'}."
+        )
+    if av is not None and not _determined(mech):
+        _, dof = _reference(mech)
+        raise ValueError(
+            f"Expected {fname}= (every coordinate's rate, (..., {mech.nv})) for this mechanism: its "
+            f"{len(mech.actuated)} actuated joint(s) do not determine its {dof} degree(s) of freedom, "
+            f"so {an} cannot give the state."
+        )
+    return av is not None
+
+
 def inverse_dynamics(
     mech: Mechanism,
     q: object,
-    qd_act: object,
-    qdd_act: object,
+    qd_act: object = None,
+    qdd_act: object = None,
     *,
+    qd: object = None,
+    qdd: object = None,
     wrenches: Mapping[str, object] | None = None,
     weights: object = None,
     gravity: bool = True,
 ) -> InverseDynamicsResult:
-    """Actuator forces for the motion ``(q, qd_act, qdd_act)`` of any described closed chain.
+    """Actuator forces for the motion ``(q, qd_act, qdd_act)`` (or ``(q, qd, qdd)``) of any described mechanism.
 
     ``q (..., nq)`` an assembled configuration (from :func:`forward_kinematics` /
     :func:`inverse_kinematics`), ``qd_act``, ``qdd_act (..., n_act)`` the actuated joints' rates and
-    accelerations in actuator order; ``wrenches`` maps site names to wrenches ``[m; f] (..., 6)``
-    applied *to* the mechanism at the site (world axes, moment about the site point); gravity from
-    ``mech.gravity`` (MJCF ``<option gravity>``) unless ``gravity=False``.  ``weights (n_act,)``: the
-    redundant-actuation rule (module docstring; default minimum norm).  Actuator ``gear`` is not
-    applied: ``tau`` is the generalized force at each actuated joint.  Batched over any leading shape;
-    non-finite samples and singular configurations give ``valid = False`` and NaN forces.
+    accelerations in actuator order — where the actuators determine the motion (closed chains actuated
+    in every degree of freedom, open chains and trees actuated at every joint); for any mechanism,
+    every coordinate's rates and accelerations ``qd=``, ``qdd= (..., nv)`` instead (fewer actuators
+    than degrees of freedom, none, a floating base).  ``wrenches`` maps site names to wrenches
+    ``[m; f] (..., 6)`` applied *to* the mechanism at the site (world axes, moment about the site
+    point); gravity from ``mech.gravity`` (MJCF ``<option gravity>``) unless ``gravity=False``.
+    ``weights (n_act,)``: the redundant-actuation rule (module docstring; default minimum norm).
+    Actuator ``gear`` is not applied: ``tau`` is the generalized force at each actuated joint.  With
+    fewer actuators than degrees of freedom ``tau`` is the least-squares best and ``unactuated`` what
+    the unactuated coordinates would need (a floating base: the base wrench); the sample is valid only
+    where that is zero.  Batched over any leading shape; non-finite samples, unassembled ``q`` and
+    singular configurations give ``valid = False`` and NaN forces.
 
     Parameters
     ----------
     mech : Mechanism
-        The described mechanism, actuated in every degree of freedom.
+        The described mechanism.
     q : array_like, shape (..., nq)
-        Assembled configurations (MuJoCo ``qpos``).
-    qd_act : array_like, shape (..., n_act)
+        Assembled configurations (MuJoCo ``qpos``): the closure residual must be below
+        ``CLOSURE_RTOL * L``.
+    qd_act : array_like, shape (..., n_act), optional
         Actuated joints' rates in actuator order (rad/s or m/s); must be admissible (with redundant
-        actuation, in the consistent subspace), else ``valid`` is False.
-    qdd_act : array_like, shape (..., n_act)
+        actuation, in the consistent subspace), else ``valid`` is False.  Exactly one of ``qd_act``
+        (with ``qdd_act``) and ``qd`` (with ``qdd``).
+    qdd_act : array_like, shape (..., n_act), optional
         Actuated joints' accelerations (rad/s^2 or m/s^2).
+    qd : array_like, shape (..., nv), optional
+        Every coordinate's rate (MuJoCo ``qvel``; rad/s, m/s), admissible (``K qd = 0``).
+    qdd : array_like, shape (..., nv), optional
+        Every coordinate's acceleration (``qacc``; rad/s^2, m/s^2), admissible.
     wrenches : mapping of str to array_like, shape (..., 6), optional
         Site name -> wrench ``[m; f]`` applied *to* the mechanism at that site (world axes, moment
         about the site point; N m, N).  Default None: no external wrench.
@@ -801,15 +1013,18 @@ def inverse_dynamics(
     -------
     InverseDynamicsResult
         ``tau``, ``M_a``, ``velocity_terms``, ``gravity_terms``, ``external_terms``, every coordinate's
-        ``qd`` and ``qdd``, the per-sample ``cond``, ``sigma_min``, ``admissibility`` and ``valid``.
+        ``qd`` and ``qdd``, the per-sample ``cond``, ``sigma_min``, ``admissibility``, ``unactuated``,
+        ``closure`` and ``valid``.
 
     Raises
     ------
     ValueError
-        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, an array is not
-        real of the stated shape (non-finite values are allowed and masked), a quaternion in ``q`` is
-        zero, the batch shapes do not broadcast, ``wrenches`` is not a mapping of site names,
-        ``weights`` is not ``n_act`` non-negative numbers (not all zero), or ``gravity`` is not a bool.
+        If ``mech`` is not a Mechanism, not exactly one of ``qd_act`` / ``qd`` is given (with its
+        acceleration), ``qd_act`` is given for a mechanism whose actuators do not determine its
+        motion, an array is not real of the stated shape (non-finite values are allowed and masked),
+        a quaternion in ``q`` is zero, the batch shapes do not broadcast, ``wrenches`` is not a mapping
+        of site names, ``weights`` is not ``n_act`` non-negative numbers (not all zero), or ``gravity``
+        is not a bool.
 
     Examples
     --------
@@ -822,24 +1037,43 @@ def inverse_dynamics(
     ((1,), (1, 1), True)
     """
     mech = check_mechanism(mech)
-    _fully_actuated(mech)
     gravity = check_bool(gravity, "gravity")
+    act_mode = _rates_mode(mech, "inverse_dynamics", ("qd_act", qd_act), ("qd", qd))
+    if act_mode and qdd_act is None:
+        raise ValueError("Expected qdd_act (..., n_act) with qd_act, got None.")
+    if not act_mode and qdd is None:
+        raise ValueError("Expected qdd= (..., nv) with qd=, got None.")
+    if act_mode and qdd is not None or not act_mode and qdd_act is not None:
+        raise ValueError("Expected qdd_act with qd_act, or qdd= with qd=, not a mix of the two forms.")
     w = _check_weights(mech, weights)
-    na = len(mech.actuated)
-    arrays = [(qd_act, "qd_act", na), (qdd_act, "qdd_act", na)]
+    na, nv = len(mech.actuated), mech.nv
+    if act_mode:
+        arrays = [(qd_act, "qd_act", na), (qdd_act, "qdd_act", na)]
+    else:
+        arrays = [(qd, "qd", nv), (qdd, "qdd", nv)]
     names, batch, ok, flat = _site_inputs(mech, q, arrays, wrenches)
     n = flat[0].shape[0]
-
-    def fn(qf, qdf, qddf, *ws, **kw):
-        return _inverse_flat(mech, qf, qdf, qddf, dict(zip(names, ws, strict=True)), w, gravity)
-
     from . import _assembly
 
-    if n >= _assembly.COMPILED_MIN:  # same formulas, compiled per sample (_compiled.inv_dyn)
-        d = _inverse_compiled(
-            mech, flat[0], flat[1], flat[2], dict(zip(names, flat[3:], strict=True)), w, gravity
-        )
+    if not act_mode:
+
+        def fn_full(qf, qdf, qddf, *ws):
+            d = _inverse_full_flat(mech, qf, qdf, qddf, dict(zip(names, ws, strict=True)), w, gravity)
+            return _finish_inverse(mech, qf, d, False)
+
+        d = _run_chunked(fn_full, n, flat)
+    elif n >= _assembly.COMPILED_MIN:  # same formulas, compiled per sample (_compiled.inv_dyn)
+        with np.errstate(all="ignore"):
+            d = _inverse_compiled(
+                mech, flat[0], flat[1], flat[2], dict(zip(names, flat[3:], strict=True)), w, gravity
+            )
+            d = _finish_inverse(mech, flat[0], d, True)
     else:
+
+        def fn(qf, qdf, qddf, *ws):
+            d = _inverse_flat(mech, qf, qdf, qddf, dict(zip(names, ws, strict=True)), w, gravity)
+            return _finish_inverse(mech, qf, d, True)
+
         d = _run_chunked(fn, n, flat)
     return InverseDynamicsResult(**_shape(d, batch, ok, _FORCE_KEYS))
 
@@ -1080,15 +1314,28 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
     Mc = Pn @ M @ Pn + (np.eye(nv) - Pn)
     rhs = _mv(Pn, f - _mv(M, qdd_p))
     if want_cond:
-        s = np.linalg.svd(Mc, compute_uv=False)
-        cond = s[:, 0] / np.maximum(s[:, -1], 1e-300)
+        s = np.linalg.svd(np.where(np.isfinite(Mc), Mc, 0.0), compute_uv=False)
+        # a zero matrix (every body massless) has no condition number: inf, never "0"
+        cond = np.where(s[:, -1] > 0, s[:, 0] / np.where(s[:, -1] > 0, s[:, -1], 1.0), np.inf) if nv else np.ones(N)
     else:
         cond = np.ones(N)
+    return qdd_p + _solve_each(Mc, rhs), cond, K, kdq
+
+
+def _solve_each(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``A x = b`` per sample (N, n, n), LAPACK ``gesv`` on each matrix: a sample's result never depends on
+    the others.  An exactly singular matrix (a massless motion) makes numpy's batched solve raise for the
+    whole batch; the samples are then solved one by one and the singular ones get NaN."""
     try:
-        u = np.linalg.solve(Mc, rhs[..., None])[..., 0]
-    except np.linalg.LinAlgError:  # a massless motion somewhere in the batch: minimum-norm there
-        u = _mv(np.linalg.pinv(Mc, rcond=RANK_RTOL), rhs)
-    return qdd_p + u, cond, K, kdq
+        return np.linalg.solve(A, b[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        out = np.full(b.shape, np.nan)
+        for i in range(A.shape[0]):
+            try:
+                out[i] = np.linalg.solve(A[i], b[i])
+            except np.linalg.LinAlgError:
+                pass
+        return out
 
 
 @dataclass(frozen=True)
@@ -1102,14 +1349,18 @@ class ForwardDynamicsResult:
     qdd : ndarray, shape (..., nv)
         Every tree coordinate's acceleration (MuJoCo ``qvel`` order); NaN where not ``valid``.
     qd : ndarray, shape (..., nv)
-        Every tree coordinate's rate, ``G qd_act`` (rad/s, m/s).
+        Every tree coordinate's rate, ``G qd_act`` or the given ``qd`` (rad/s, m/s).
     cond : ndarray, shape (...)
-        Condition number of the constrained mass matrix (large: a nearly massless motion).
+        Condition number of the constrained mass matrix (large: a nearly massless motion; inf: a
+        massless one), or of the passive constraint block if larger (``qd_act`` form).
     admissibility : ndarray, shape (...)
-        Closure error ``|K qdd + Kdot qd|`` of the resulting acceleration, relative.
+        Closure error of the given rates ``|K qd|`` and of the resulting acceleration
+        ``|K qdd + Kdot qd|``, relative.
+    closure : ndarray, shape (...)
+        Largest closure row of the input ``q`` (m); above ``CLOSURE_RTOL * L`` the sample is not valid.
     valid : ndarray of bool, shape (...)
-        False at a singular configuration, a rank-deficient mass matrix, an inadmissible result or a
-        non-finite input.
+        False at a singular configuration, a singular (e.g. massless) mass matrix, an inadmissible
+        result, an unassembled ``q`` or a non-finite input.
     """
 
     qdd_act: np.ndarray
@@ -1117,35 +1368,43 @@ class ForwardDynamicsResult:
     qd: np.ndarray
     cond: np.ndarray
     admissibility: np.ndarray
+    closure: np.ndarray
     valid: np.ndarray
 
 
 def forward_dynamics(
     mech: Mechanism,
     q: object,
-    qd_act: object,
-    tau: object,
+    qd_act: object = None,
+    tau: object = None,
     *,
+    qd: object = None,
     wrenches: Mapping[str, object] | None = None,
     gravity: bool = True,
 ) -> ForwardDynamicsResult:
-    """Accelerations under actuator forces ``tau (..., n_act)`` at ``(q, qd_act)`` (idle motions at rest).
+    """Accelerations under actuator forces ``tau (..., n_act)`` at ``(q, qd_act)`` or ``(q, qd)``.
 
     The inverse of :func:`inverse_dynamics`: ``forward_dynamics(mech, q, qd, inverse_dynamics(mech, q,
-    qd, qdd).tau).qdd_act == qdd`` wherever both are valid (idle motions decoupled).  The rates of the
-    passive coordinates are ``qd = G qd_act``; the closure is a constraint on the tree accelerations
-    (``K qdd = -Kdot qd``, module docstring).
+    qd, qdd).tau).qdd_act == qdd`` wherever both are valid (idle motions decoupled).  Where the
+    actuators determine the motion, the state is ``(q, qd_act)`` and the passive coordinates' rates are
+    ``qd = G qd_act`` (idle motions at rest); for any mechanism — and necessarily where the actuators
+    do not determine it (fewer actuators than degrees of freedom, none, a floating base) — every
+    coordinate's rate ``qd= (..., nv)`` instead.  The closure is a constraint on the tree
+    accelerations (``K qdd = -Kdot qd``, module docstring).
 
     Parameters
     ----------
     mech : Mechanism
-        The described mechanism, actuated in every degree of freedom.
+        The described mechanism.
     q : array_like, shape (..., nq)
-        Assembled configurations (MuJoCo ``qpos``).
-    qd_act : array_like, shape (..., n_act)
-        Actuated joints' rates in actuator order (rad/s or m/s).
-    tau : array_like, shape (..., n_act)
-        Generalized forces at the actuated joints (N m or N; actuator ``gear`` not applied).
+        Assembled configurations (MuJoCo ``qpos``; closure residual below ``CLOSURE_RTOL * L``).
+    qd_act : array_like, shape (..., n_act), optional
+        Actuated joints' rates in actuator order (rad/s or m/s).  Exactly one of ``qd_act`` and ``qd``.
+    tau : array_like, shape (..., n_act), optional
+        Generalized forces at the actuated joints (N m or N; actuator ``gear`` not applied); default
+        None: no actuator force.
+    qd : array_like, shape (..., nv), optional
+        Every coordinate's rate (MuJoCo ``qvel``; rad/s, m/s), admissible (``K qd = 0``).
     wrenches : mapping of str to array_like, shape (..., 6), optional
         Site name -> wrench ``[m; f]`` applied *to* the mechanism at that site (world axes, moment
         about the site point; N m, N).  Default None: no external wrench.
@@ -1156,13 +1415,14 @@ def forward_dynamics(
     -------
     ForwardDynamicsResult
         ``qdd_act (..., n_act)``, every coordinate's ``qdd`` and ``qd (..., nv)``, and per sample
-        ``cond``, ``admissibility`` and ``valid`` (accelerations NaN where not valid).
+        ``cond``, ``admissibility``, ``closure`` and ``valid`` (accelerations NaN where not valid).
 
     Raises
     ------
     ValueError
-        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, an array is not
-        real of the stated shape (non-finite values are masked), a quaternion in ``q`` is zero, the
+        If ``mech`` is not a Mechanism, not exactly one of ``qd_act`` and ``qd`` is given,
+        ``qd_act`` is given for a mechanism whose actuators do not determine its motion, an array is
+        not real of the stated shape (non-finite values are masked), a quaternion in ``q`` is zero, the
         batch shapes do not broadcast, ``wrenches`` is not a mapping of site names, or ``gravity`` is
         not a bool.
 
@@ -1178,39 +1438,68 @@ def forward_dynamics(
     (True, True)
     """
     mech = check_mechanism(mech)
-    _fully_actuated(mech)
     gravity = check_bool(gravity, "gravity")
-    na = len(mech.actuated)
-    names, batch, ok, flat = _site_inputs(mech, q, [(qd_act, "qd_act", na), (tau, "tau", na)], wrenches)
+    act_mode = _rates_mode(mech, "forward_dynamics", ("qd_act", qd_act), ("qd", qd))
+    na, nv = len(mech.actuated), mech.nv
+    rates = (qd_act, "qd_act", na) if act_mode else (qd, "qd", nv)
+    tau_in = np.zeros(na) if tau is None else tau
+    names, batch, ok, flat = _site_inputs(mech, q, [rates, (tau_in, "tau", na)], wrenches)
     rank0, _ = _reference(mech)
     tree = mech.tree
     pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
+    L = tree.length
 
-    def fn(qf, qdf, tf, *ws):
+    def fn(qf, rf, tf, *ws):
         state = kinematics(tree, qf)
         K = jacobian(mech.constraints, tree, state, qf)
-        P, rank, _, cK = _pinv(K[..., pas])
-        qd = np.zeros((qf.shape[0], tree.nv))
-        qd[:, tree.act_dof] = qdf
-        qd[:, pas] = -np.einsum("nij,njk,nk->ni", P, K[..., tree.act_dof], qdf)
+        n = qf.shape[0]
+        if act_mode:
+            P, rank, _, cK = _pinv(K[..., pas], L)
+            qd_f = np.zeros((n, tree.nv))
+            qd_f[:, tree.act_dof] = rf
+            qd_f[:, pas] = -np.einsum("nij,njk,nk->ni", P, K[..., tree.act_dof], rf)
+            reg = (rank >= rank0) & (cK <= SINGULAR_COND)
+            e1 = np.zeros(n)
+        else:
+            qd_f = rf
+            reg = np.ones(n, dtype=bool)
+            cK = np.ones(n)
+            sv = np.max(np.abs(qd_f), axis=-1) if tree.nv else np.zeros(n)
+            e1 = (
+                np.max(np.abs(_mv(K, qd_f)), axis=-1) / (L * np.maximum(sv, RATE_FLOOR))
+                if K.shape[1]
+                else np.zeros(n)
+            )
         qdd, cond, K, kdq = _forward_full(
-            mech, qf, qd, tf, dict(zip(names, ws, strict=True)), gravity, want_cond=True
+            mech, qf, qd_f, tf, dict(zip(names, ws, strict=True)), gravity, want_cond=True
         )
-        L = tree.length
-        sa = np.max(np.abs(qdd), axis=-1) + np.max(np.abs(qd), axis=-1) ** 2 if tree.nv else 0.0
-        adm = (
+        sa = np.max(np.abs(qdd), axis=-1) + np.max(np.abs(qd_f), axis=-1) ** 2 if tree.nv else 0.0
+        e2 = (
             np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
             if K.shape[1]
-            else np.zeros(qf.shape[0])
+            else np.zeros(n)
         )
+        adm = np.maximum(e1, np.where(np.isfinite(e2), e2, np.inf))
+        closure = _closure_error(mech, state, qf)
         valid = (
-            (rank >= rank0)
-            & (cK <= SINGULAR_COND)
+            reg
             & (cond < 1.0 / RANK_RTOL)
             & (adm <= ADMISSIBLE_RTOL)
+            & (closure <= CLOSURE_RTOL * L)
             & np.all(np.isfinite(qdd), axis=-1)
         )
-        return dict(qdd_act=qdd[:, tree.act_dof], qdd=qdd, qd=qd, cond=cond, admissibility=adm, valid=valid)
+        if act_mode and np.any(~reg):  # a singular passive block: its measure against the generic rank
+            bad = np.flatnonzero(~reg)
+            cond[bad] = np.maximum(cond[bad], _rank_measures(K[bad][..., pas], rank0, L)[1])
+        return dict(
+            qdd_act=qdd[:, tree.act_dof],
+            qdd=qdd,
+            qd=np.array(qd_f),
+            cond=cond,
+            admissibility=adm,
+            closure=closure,
+            valid=valid,
+        )
 
     d = _run_chunked(fn, flat[0].shape[0], flat)
     return ForwardDynamicsResult(**_shape(d, batch, ok, ("qdd_act", "qdd")))
@@ -1354,82 +1643,116 @@ def _project(mech, q, qd):
     return q, qd, rc
 
 
-def _simulate_flat(mech, q0, qd0, t, tau_fn, gravity):
+class _SampleFailed(Exception):
+    """A sample's integration cannot go on (non-finite state, force or acceleration)."""
+
+
+def _callback_forces(tau_fn, tt, q, qd, na: int) -> np.ndarray:
+    """Call ``tau_fn(t, q (1, nq), qd (1, nv))`` and check its return: ``(n_act,)`` or ``(1, n_act)`` reals."""
+    out = tau_fn(tt, q, qd)
+    try:
+        a = np.asarray(out, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(
+            f"Expected the tau callback to return {na} real force(s) per sample, shape (1, {na}), "
+            f"got {type(out).__name__}."
+        ) from exc
+    if a.shape not in ((na,), (1, na)) and not (na == 0 and a.size == 0):
+        raise ValueError(
+            f"Expected the tau callback to return shape (1, {na}) (or ({na},)) for the one sample it "
+            f"is given, got shape {a.shape}."
+        )
+    return a.reshape(1, na)
+
+
+def _simulate_one(mech, q0, qd0, t, tau_fn, gravity):
+    """One sample's trajectory (its own ``solve_ivp`` run: step sizes and error control are its own, so
+    no other sample can change it).  Returns ``Q (nt, nq), QD (nt, nv), W (nt,), RC (nt,), ok``."""
     from scipy.integrate import solve_ivp
 
     tree = mech.tree
-    N, nq, nv = q0.shape[0], tree.nq, tree.nv
+    nq, nv = tree.nq, tree.nv
     na = len(tree.act_dof)
 
-    def unpack(y):
-        Y = y.reshape(N, nq + nv + 1)
-        return Y[:, :nq], Y[:, nq : nq + nv], Y[:, -1]
-
-    def forces(tt, q, qd):
-        if tau_fn is None:
-            return np.zeros((N, na))
-        return np.broadcast_to(np.asarray(tau_fn(tt, q, qd), float), (N, na))
-
     def rhs(tt, y):
-        q, qd, _ = unpack(y)
+        q, qd = y[None, :nq], y[None, nq : nq + nv]
         qn = normalize_quaternions(tree, q) if tree.quat_adr else q
-        tau = forces(tt, qn, qd)
-        qdd, _, _, _ = _forward_full(mech, qn, qd, tau, None, gravity)
+        tau = np.zeros((1, na)) if tau_fn is None else tau_fn(tt, qn, qd)
+        if not np.all(np.isfinite(tau)):
+            raise _SampleFailed
+        try:
+            qdd, _, _, _ = _forward_full(mech, qn, qd, tau, None, gravity)
+        except np.linalg.LinAlgError as exc:  # a non-finite state reached the SVD
+            raise _SampleFailed from exc
+        if not np.all(np.isfinite(qdd)):  # a singular (massless) motion: no acceleration exists
+            raise _SampleFailed
         power = np.sum(tau * qd[:, tree.act_dof], axis=-1)
-        return np.concatenate([_qpos_rate(tree, qn, qd), qdd, power[:, None]], axis=-1).ravel()
+        return np.concatenate([_qpos_rate(tree, qn, qd)[0], qdd[0], power])
 
     nt = len(t)
-    Q = np.empty((N, nt, nq))
-    QD = np.empty((N, nt, nv))
-    W = np.zeros((N, nt))
-    RC = np.zeros((N, nt))
-    q, qd, rc = _project(mech, q0, qd0)
-    Q[:, 0], QD[:, 0], RC[:, 0] = q, qd, rc
-    ok = True
-    for i in range(1, nt):
-        y0 = np.concatenate([q, qd, W[:, i - 1 : i]], axis=-1).ravel()
-        sol = solve_ivp(rhs, (t[i - 1], t[i]), y0, method="DOP853", rtol=SIM_RTOL, atol=SIM_ATOL)
-        if not sol.success or not np.all(np.isfinite(sol.y[:, -1])):
-            ok = False
-            Q[:, i:], QD[:, i:], W[:, i:], RC[:, i:] = np.nan, np.nan, np.nan, np.inf
-            break
-        q, qd, w = unpack(sol.y[:, -1])
-        q, qd, rc = _project(mech, normalize_quaternions(tree, q), qd)
-        Q[:, i], QD[:, i], W[:, i], RC[:, i] = q, qd, w, rc
-    return Q, QD, W, RC, ok
+    Q = np.full((nt, nq), np.nan)
+    QD = np.full((nt, nv), np.nan)
+    W = np.full(nt, np.nan)
+    RC = np.full(nt, np.inf)
+    q, qd, rc = _project(mech, q0[None], qd0[None])
+    Q[0], QD[0], W[0], RC[0] = q[0], qd[0], 0.0, rc[0]
+    with np.errstate(all="ignore"):
+        for i in range(1, nt):
+            y0 = np.concatenate([Q[i - 1], QD[i - 1], W[i - 1 : i]])
+            try:
+                sol = solve_ivp(rhs, (t[i - 1], t[i]), y0, method="DOP853", rtol=SIM_RTOL, atol=SIM_ATOL)
+            except _SampleFailed:
+                return Q, QD, W, RC, False
+            if not sol.success or not np.all(np.isfinite(sol.y[:, -1])):
+                return Q, QD, W, RC, False
+            y = sol.y[:, -1]
+            try:
+                q, qd, rc = _project(mech, normalize_quaternions(tree, y[None, :nq]), y[None, nq : nq + nv])
+            except np.linalg.LinAlgError:
+                return Q, QD, W, RC, False
+            Q[i], QD[i], W[i], RC[i] = q[0], qd[0], y[-1], rc[0]
+    return Q, QD, W, RC, True
 
 
 def simulate(
     mech: Mechanism,
     q0: object,
-    qd_act0: object,
-    t: object,
+    qd_act0: object = None,
+    t: object = None,
     *,
+    qd0: object = None,
     tau: object = None,
     gravity: bool = True,
 ) -> SimulationResult:
-    """Integrate the closed chain from ``(q0 (..., nq), qd_act0 (..., n_act))`` to the output times ``t``.
+    """Integrate the mechanism from ``(q0, qd_act0)`` (or ``(q0, qd0)``) to the output times ``t``.
 
-    ``tau`` the actuator forces: None (passive motion), an array ``(..., n_act)`` held constant, or a
-    callable ``tau(t, q (N, nq), qd (N, nv)) -> (N, n_act)`` over the flattened batch.  The state is
-    every tree coordinate (idle motions included) integrated by ``scipy.integrate.solve_ivp`` (DOP853,
-    ``SIM_RTOL = 1e-10``, ``SIM_ATOL = 1e-12``) between consecutive output times, projected back onto the
-    constraint manifold at each of them.  Batched over initial conditions (one ODE system; a batch
-    whose integration fails is retried sample by sample so that one bad sample does not spoil the rest).
+    The initial rates: ``qd_act0 (..., n_act)`` where the actuators determine the motion (the other
+    coordinates start at ``qd = G qd_act0``), or every coordinate's rate ``qd0= (..., nv)`` for any
+    mechanism (necessarily where the actuators do not determine the motion: fewer actuators than
+    degrees of freedom, none, a floating base).  ``tau`` the actuator forces: None (passive motion),
+    an array ``(..., n_act)`` held constant, or a callable ``tau(t, q (1, nq), qd (1, nv)) -> (1, n_act)``
+    called for one sample at a time.  The state is every tree coordinate (idle motions included),
+    integrated by ``scipy.integrate.solve_ivp`` (DOP853, ``SIM_RTOL = 1e-10``, ``SIM_ATOL = 1e-12``)
+    between consecutive output times and projected back onto the constraint manifold at each of them.
+    Every sample is integrated on its own (its own steps and error control): one sample's state
+    never changes another's, and a sample that fails (a massless motion without acceleration, a
+    non-finite force from the callback) stops alone with ``success = False``.
 
     Parameters
     ----------
     mech : Mechanism
-        The described mechanism, actuated in every degree of freedom.
+        The described mechanism.
     q0 : array_like, shape (..., nq)
         Initial configurations (MuJoCo ``qpos``); projected onto the closure before the start.
-    qd_act0 : array_like, shape (..., n_act)
-        Initial actuated rates (rad/s or m/s); the other coordinates start at ``qd = G qd_act0``.
+    qd_act0 : array_like, shape (..., n_act), optional
+        Initial actuated rates (rad/s or m/s).  Exactly one of ``qd_act0`` and ``qd0``.
     t : array_like, shape (nt,)
-        Strictly increasing output times (s), at least two; the first is the start time.
+        Strictly increasing output times (s), at least two; the first is the start time.  Required.
+    qd0 : array_like, shape (..., nv), optional
+        Every coordinate's initial rate (``qvel``; rad/s, m/s), projected onto the admissible ones.
     tau : None, array_like of shape (..., n_act), or callable, optional
         Actuator forces (N m or N): None (default, no actuator force), constant forces, or
-        ``tau(t, q (N, nq), qd (N, nv)) -> (N, n_act)`` over the flattened batch.
+        ``tau(t, q (1, nq), qd (1, nv)) -> (1, n_act)`` (or ``(n_act,)``) for the sample it is given.
     gravity : bool, optional
         Apply ``mech.gravity`` (MJCF ``<option gravity>``, m/s^2); default True.
 
@@ -1443,9 +1766,11 @@ def simulate(
     Raises
     ------
     ValueError
-        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, ``t`` is not at
-        least two increasing times, an array is not real of the stated shape, ``q0`` or ``qd_act0`` is
-        not finite or exceeds ``MAX_STATE``, or ``gravity`` is not a bool.
+        If ``mech`` is not a Mechanism, not exactly one of ``qd_act0`` and ``qd0`` is given,
+        ``qd_act0`` is given for a mechanism whose actuators do not determine its motion, ``t`` is not
+        at least two increasing times, an array is not real of the stated shape, ``q0`` or the initial
+        rates are not finite or exceed ``MAX_STATE``, ``gravity`` is not a bool, or the ``tau``
+        callback returns something other than ``(1, n_act)`` real forces.
 
     Examples
     --------
@@ -1458,68 +1783,70 @@ def simulate(
     ((3, 3), (3, 1), True)
     """
     mech = check_mechanism(mech)
-    _fully_actuated(mech)
     gravity = check_bool(gravity, "gravity")
+    act_mode = _rates_mode(mech, "simulate", ("qd_act0", qd_act0), ("qd0", qd0))
     tree = mech.tree
     na = len(mech.actuated)
+    if t is None:
+        raise ValueError("Expected t to be increasing output times (at least 2), got None.")
     t = as_array(t, "t", (None,))
     if t.ndim != 1 or t.shape[0] < 2 or np.any(np.diff(t) <= 0):
         raise ValueError(f"Expected t to be increasing output times (at least 2), got shape {t.shape}.")
     tau_arr = None
     if tau is not None and not callable(tau):
         tau_arr = as_array(tau, "tau", (na,))
+    rates = (qd_act0, "qd_act0", na) if act_mode else (qd0, "qd0", tree.nv)
     batch, flat = _broadcast(
         mech,
         q0,
-        [(qd_act0, "qd_act0", na)] + ([(tau_arr, "tau", na)] if tau_arr is not None else []),
+        [rates] + ([(tau_arr, "tau", na)] if tau_arr is not None else []),
         qname="q0",
     )
-    q0f, qa0 = flat[0], flat[1]
-    for x, nm in ((q0f, "q0"), (qa0, "qd_act0")):
+    q0f, r0 = flat[0], flat[1]
+    for x, nm in ((q0f, "q0"), (r0, rates[1])):
         # an initial state is simulated, not masked: it must be finite and of physical size
         if not np.all(np.isfinite(x)) or np.any(np.abs(x) > MAX_STATE):
             raise ValueError(f"Expected {nm} finite with |value| <= {MAX_STATE:g}, got NaN, inf or more.")
     q0f = normalize_quaternions(tree, q0f)
     N = q0f.shape[0]
-    # the initial rates of every coordinate: qd = G qd_act0 (idle motions at rest)
-    from ._influence import _influence_flat
+    if act_mode:  # the initial rates of every coordinate: qd = G qd_act0 (idle motions at rest)
+        from ._influence import _influence_flat
 
-    _, _, G, _, _, _ = _influence_flat(mech, q0f, False)
-    qd0 = _mv(G, qa0)
-    tau_fn: Callable[..., object] | None
-    if tau_arr is not None:
-        tv = flat[2]
-
-        def _held(tt, q, qd, tv=tv):
-            return tv if q.shape[0] == tv.shape[0] else tv[: q.shape[0]]
-
-        tau_fn = _held
+        _, _, G, _, _, _ = _influence_flat(mech, q0f, False)
+        qd0f = _mv(G, r0)
     else:
-        tau_fn = tau if callable(tau) else None
-    Q, QD, W, RC, ok = _simulate_flat(mech, q0f, qd0, t, tau_fn, gravity)
-    success = np.full(N, ok)
-    if not ok and N > 1:
-        for i in range(N):
-            fn_i = None
-            if tau_arr is not None:
-                fn_i = lambda tt, q, qd, v=flat[2][i : i + 1]: v  # noqa: E731
-            elif callable(tau):
-                fn_i = lambda tt, q, qd, i=i: np.asarray(tau(tt, q, qd), dtype=float).reshape(-1, na)[:1]  # noqa: E731
-            Qi, QDi, Wi, RCi, oki = _simulate_flat(mech, q0f[i : i + 1], qd0[i : i + 1], t, fn_i, gravity)
-            Q[i], QD[i], W[i], RC[i], success[i] = Qi[0], QDi[0], Wi[0], RCi[0], oki
+        qd0f = np.array(r0)
+    nt = len(t)
+    Q = np.empty((N, nt, tree.nq))
+    QD = np.empty((N, nt, tree.nv))
+    W = np.empty((N, nt))
+    RC = np.empty((N, nt))
+    success = np.zeros(N, dtype=bool)
+    for i in range(N):
+        fn_i: Callable[..., np.ndarray] | None = None
+        if tau_arr is not None:
+            held = flat[2][i : i + 1]
+            fn_i = lambda tt, q, qd, v=held: v  # noqa: E731
+        elif callable(tau):
+            fn_i = lambda tt, q, qd: _callback_forces(tau, tt, q, qd, na)  # noqa: E731
+        Q[i], QD[i], W[i], RC[i], success[i] = _simulate_one(mech, q0f[i], qd0f[i], t, fn_i, gravity)
     from ._assembly import CONVERGED_RTOL
 
-    nt = len(t)
     Tk, U = _energy_flat(mech, np.nan_to_num(Q.reshape(-1, tree.nq)), np.nan_to_num(QD.reshape(-1, tree.nv)))
     Tk, U = Tk.reshape(N, nt), U.reshape(N, nt)
     E = Tk + U - W
-    drift = np.max(np.abs(E - E[:, :1]), axis=-1)
-    scale = np.maximum.reduce([np.max(Tk, -1), np.max(np.abs(U - U[:, :1]), -1), np.max(np.abs(W), -1)])
-    rel = drift / np.maximum(scale, 1e-300)
+    with np.errstate(all="ignore"):
+        drift = np.max(np.abs(E - E[:, :1]), axis=-1)
+        scale = np.maximum.reduce(
+            [np.max(Tk, -1), np.max(np.abs(U - U[:, :1]), -1), np.max(np.abs(W), -1)]
+        )
+        rel = drift / np.maximum(scale, 1e-300)
     success &= np.all(np.isfinite(Q), axis=(-1, -2)) & np.all(RC <= CONVERGED_RTOL * tree.length, axis=-1)
     bad = ~success
     drift = np.where(bad, np.nan, drift)
     rel = np.where(bad, np.nan, rel)
+    Tk = np.where(np.isfinite(Q).all(-1), Tk, np.nan)
+    U = np.where(np.isfinite(Q).all(-1), U, np.nan)
 
     def rs(x, *tail):
         return np.reshape(x, (*batch, *tail))

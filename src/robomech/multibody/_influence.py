@@ -82,11 +82,14 @@ class Influence:
     cond: np.ndarray
 
 
-def _pinv(Kp: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+# An empty passive block (an open chain or tree: no closure rows, or no passive coordinate) cannot lose
+# rank: its measures are those of the best-conditioned block, cond 1 and sigma_min = the characteristic
+# length (the singular value of a unit passive column at distance L), finite like every other sample's.
+def _pinv(Kp: np.ndarray, length: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Batched pseudo-inverse of ``Kp (N, m, n)`` with its rank, smallest kept singular value, cond."""
     N, m, n = Kp.shape
     if m == 0 or n == 0:
-        return np.zeros((N, n, m)), np.zeros(N, dtype=int), np.full(N, np.inf), np.ones(N)
+        return np.zeros((N, n, m)), np.zeros(N, dtype=int), np.full(N, float(length)), np.ones(N)
     U, s, Vt = np.linalg.svd(Kp, full_matrices=False)
     cut = PASSIVE_RANK_RTOL * s[:, :1]
     keep = s > cut
@@ -106,7 +109,7 @@ def _influence_flat(mech: Mechanism, q: np.ndarray, second: bool):
     na = len(tree.act_dof)
     act = tree.act_dof
     pas = np.setdiff1d(np.arange(tree.nv), act)
-    P, rank, smin, cond = _pinv(K[..., pas])
+    P, rank, smin, cond = _pinv(K[..., pas], tree.length)
     G = np.zeros((N, tree.nv, na))
     G[:, act, np.arange(na)] = 1.0
     G[:, pas] = -P @ K[..., act]
