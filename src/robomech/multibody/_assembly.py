@@ -217,6 +217,22 @@ def _guess(mech: Mechanism, guess: ArrayLike | None, batch: tuple[int, ...]) -> 
     return normalize_quaternions(mech.tree, g)
 
 
+def floating_base_dofs(mech: Mechanism) -> np.ndarray:
+    """Velocity coordinates of the free joints that float a whole sub-mechanism (no closure ties their
+    body's subtree to anything outside it): moving them moves the closures rigidly, so assembly holds
+    them at the guess (a free joint closed by connects, a Delta's platform, is a passive coordinate)."""
+    tree = mech.tree
+    out: list[int] = []
+    for k in range(len(tree.jnt_names)):
+        if tree.jnt_type[k] != 3:
+            continue
+        d0 = int(tree.jnt_dadr[k])
+        sub = {tree.body_names[b] for b in range(len(tree.body_names)) if tree.A[b, d0]}
+        if all((c.body1 in sub) == (c.body2 in sub) for c in mech.closures):
+            out.extend(range(d0, d0 + 6))
+    return np.array(out, dtype=int)
+
+
 def forward_kinematics(
     mech: Mechanism, q_act: ArrayLike, guess: ArrayLike | None = None, *, steps: int = 1
 ) -> FKResult:
@@ -226,7 +242,10 @@ def forward_kinematics(
     ``mech.q0``) and the solution is the assembly branch connected to it.  ``steps > 1`` moves the
     inputs from the guess's values to ``q_act`` in that many equal stages (continuation), which
     keeps the branch over large moves; along a trajectory pass the previous solution as the guess.
-    Non-finite inputs give ``converged = False`` and NaN for that sample only.
+    Non-finite inputs give ``converged = False`` and NaN for that sample only.  A free joint that
+    floats a whole sub-mechanism (a floating-base robot) is a coordinate like the actuated ones: held
+    at the guess, never moved by the assembly.  Without actuators, ``q_act`` has shape ``(..., 0)`` and
+    the passive chain is assembled from the guess.
 
     Parameters
     ----------
@@ -260,13 +279,14 @@ def forward_kinematics(
     steps = check_int(steps, "steps", low=1)
     g0 = _guess(mech, guess, qa.shape[:-1])
     batch = broadcast_batch((qa, 1, "q_act"), (g0, 1, "guess"))
-    qa_f = np.broadcast_to(qa, (*batch, na)).reshape(-1, na)
-    q = np.array(np.broadcast_to(g0, (*batch, mech.nq)).reshape(-1, mech.nq))
+    n = int(np.prod(batch))  # explicit: reshape(-1, 0) is ambiguous for a mechanism without actuators
+    qa_f = np.broadcast_to(qa, (*batch, na)).reshape(n, na)
+    q = np.array(np.broadcast_to(g0, (*batch, mech.nq)).reshape(n, mech.nq))
     ok = np.all(np.isfinite(qa_f), axis=-1)
     q[~ok] = tree.q0
     start = q[:, tree.act_qadr].copy()
     target = np.where(ok[:, None], qa_f, start)
-    free = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
+    free = np.setdiff1d(np.arange(tree.nv), np.concatenate([tree.act_dof, floating_base_dofs(mech)]))
     iters = np.zeros(q.shape[0], dtype=int)
     for s in range(1, steps + 1):
         q[:, tree.act_qadr] = start + (target - start) * (s / steps)
