@@ -72,8 +72,8 @@ from ._influence import (
 )
 from ._mjcf import from_mjcf, to_mjcf
 from ._mobility import MobilityReport, mobility
-from ._rnea import generalized_forces, mass_matrix
 from ._model import Body, Builder, Closure, Coupling, Inertial, Joint, Mechanism, Site
+from ._rnea import generalized_forces, mass_matrix
 from ._singularity import SingularityMapResult, SingularityResult, singularities, singularity_map
 
 __all__ = [

@@ -40,7 +40,7 @@ from typing import TypeVar
 
 import numpy as np
 
-from robomech._validation import as_array, broadcast_batch, check_bool
+from robomech._validation import MAX_MAGNITUDE, as_array, broadcast_batch, check_bool
 from robomech.dynamics import _com_terms
 
 from ._assembly import check_mechanism, check_q, solve_closure
@@ -769,7 +769,10 @@ def _site_inputs(mech, q, arrays, wrenches):
 
 
 def _sanitize(mech, flat: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray]]:
+    # a sample with an entry beyond MAX_MAGNITUDE (1e300, say) would overflow in products: masked like NaN
     ok = _finite_rows(*flat)
+    for a in flat:
+        ok &= np.all(np.abs(np.where(np.isfinite(a), a, 0.0)) <= MAX_MAGNITUDE, axis=-1)
     out = []
     for i, a in enumerate(flat):
         a = np.array(a, dtype=float)
@@ -780,22 +783,29 @@ def _sanitize(mech, flat: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray
 
 
 def _shape(d: dict, batch, ok: np.ndarray, nan_keys) -> dict:
+    """Reshape the flat results to ``batch``.  ``ok``: the input rows were finite.  A sample with any
+    non-finite result (inputs of 1e300 overflowing, say; a massless motion's acceleration) is not valid;
+    ``nan_keys`` (the forces or accelerations) are NaN where not valid, the other fields (measures such
+    as an infinite condition number) keep their values but for non-finite input rows (NaN)."""
     # "_computed" (optional): where the forces are the right answer to a question that has one even if
     # the sample is not valid (an underactuated motion: the least-squares forces); elsewhere "valid"
     computed = d.pop("_computed", d["valid"])
-    # a sample whose results overflowed (inputs of 1e300, say) is not valid
-    for v in d.values():
+    fin = ok.copy()
+    for k, v in d.items():
         v = np.asarray(v)
-        if v.dtype.kind == "f" and v.shape[:1] == ok.shape:
-            ok = ok & np.all(np.isfinite(v.reshape(v.shape[0], int(np.prod(v.shape[1:])))), axis=-1)
+        if k != "valid" and v.dtype.kind == "f" and v.shape[:1] == ok.shape:
+            fin &= np.all(np.isfinite(v.reshape(v.shape[0], int(np.prod(v.shape[1:])))), axis=-1)
+    keep = np.asarray(computed) & ok
+    for k in nan_keys:  # a computed, finite force stays even where a measure is not finite
+        v = np.asarray(d[k])
+        keep &= np.all(np.isfinite(v.reshape(v.shape[0], int(np.prod(v.shape[1:])))), axis=-1)
     res = {}
     for k, v in d.items():
         v = np.array(v)
         if k == "valid":
-            v = v & ok
+            v = v & fin
         elif k in nan_keys:
-            bad = ~(computed & ok)
-            v = np.where(bad.reshape(-1, *(1,) * (v.ndim - 1)), np.nan, v)
+            v = np.where(keep.reshape(-1, *(1,) * (v.ndim - 1)), v, np.nan)
         elif v.dtype.kind == "f":
             v = np.where(ok.reshape(-1, *(1,) * (v.ndim - 1)), v, np.nan)
         res[k] = np.reshape(v, (*batch, *v.shape[1:]))
@@ -920,7 +930,9 @@ def _finish_inverse(mech: Mechanism, q: np.ndarray, d: dict, actuated_mode: bool
             if bad.size:
                 sub = TreeState(T=state.T[bad], S=state.S[bad])
                 K = _constraint_matrix(mech, sub, q[bad])
-                d["sigma_min"][bad], d["cond"][bad] = _rank_measures(K[..., pas], _reference(mech)[0], tree.length)
+                d["sigma_min"][bad], d["cond"][bad] = _rank_measures(
+                    K[..., pas], _reference(mech)[0], tree.length
+                )
     assembled = d["closure"] <= CLOSURE_RTOL * tree.length
     d["valid"] = d["valid"] & assembled
     if "_computed" in d:
@@ -966,7 +978,7 @@ def inverse_dynamics(
     weights: object = None,
     gravity: bool = True,
 ) -> InverseDynamicsResult:
-    """Actuator forces for the motion ``(q, qd_act, qdd_act)`` (or ``(q, qd, qdd)``) of any described mechanism.
+    """Actuator forces for the motion ``(q, qd_act, qdd_act)`` or ``(q, qd, qdd)`` of any described mechanism.
 
     ``q (..., nq)`` an assembled configuration (from :func:`forward_kinematics` /
     :func:`inverse_kinematics`), ``qd_act``, ``qdd_act (..., n_act)`` the actuated joints' rates and
@@ -1043,7 +1055,7 @@ def inverse_dynamics(
         raise ValueError("Expected qdd_act (..., n_act) with qd_act, got None.")
     if not act_mode and qdd is None:
         raise ValueError("Expected qdd= (..., nv) with qd=, got None.")
-    if act_mode and qdd is not None or not act_mode and qdd_act is not None:
+    if (act_mode and qdd is not None) or (not act_mode and qdd_act is not None):
         raise ValueError("Expected qdd_act with qd_act, or qdd= with qd=, not a mix of the two forms.")
     w = _check_weights(mech, weights)
     na, nv = len(mech.actuated), mech.nv
@@ -1316,7 +1328,11 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
     if want_cond:
         s = np.linalg.svd(np.where(np.isfinite(Mc), Mc, 0.0), compute_uv=False)
         # a zero matrix (every body massless) has no condition number: inf, never "0"
-        cond = np.where(s[:, -1] > 0, s[:, 0] / np.where(s[:, -1] > 0, s[:, -1], 1.0), np.inf) if nv else np.ones(N)
+        cond = (
+            np.where(s[:, -1] > 0, s[:, 0] / np.where(s[:, -1] > 0, s[:, -1], 1.0), np.inf)
+            if nv
+            else np.ones(N)
+        )
     else:
         cond = np.ones(N)
     return qdd_p + _solve_each(Mc, rhs), cond, K, kdq
@@ -1648,7 +1664,7 @@ class _SampleFailed(Exception):
 
 
 def _callback_forces(tau_fn, tt, q, qd, na: int) -> np.ndarray:
-    """Call ``tau_fn(t, q (1, nq), qd (1, nv))`` and check its return: ``(n_act,)`` or ``(1, n_act)`` reals."""
+    """Call ``tau_fn(t, q (1, nq), qd (1, nv))``; check its return: ``(n_act,)`` or ``(1, n_act)`` reals."""
     out = tau_fn(tt, q, qd)
     try:
         a = np.asarray(out, dtype=float)
@@ -1837,9 +1853,7 @@ def simulate(
     E = Tk + U - W
     with np.errstate(all="ignore"):
         drift = np.max(np.abs(E - E[:, :1]), axis=-1)
-        scale = np.maximum.reduce(
-            [np.max(Tk, -1), np.max(np.abs(U - U[:, :1]), -1), np.max(np.abs(W), -1)]
-        )
+        scale = np.maximum.reduce([np.max(Tk, -1), np.max(np.abs(U - U[:, :1]), -1), np.max(np.abs(W), -1)])
         rel = drift / np.maximum(scale, 1e-300)
     success &= np.all(np.isfinite(Q), axis=(-1, -2)) & np.all(RC <= CONVERGED_RTOL * tree.length, axis=-1)
     bad = ~success

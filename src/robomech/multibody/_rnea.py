@@ -89,7 +89,7 @@ def _apply_inertia(m: np.ndarray, c: np.ndarray, Ic: np.ndarray, X: np.ndarray) 
 
 
 def _rnea_flat(mech: Mechanism, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, g: np.ndarray) -> np.ndarray:
-    """Tree inverse dynamics ``(N, nv)`` at normalised ``q (N, nq)``, ``qd``, ``qdd (N, nv)``, gravity ``g (3,)``."""
+    """Tree inverse dynamics ``(N, nv)`` at normalised ``q (N, nq)``, ``qd``, ``qdd (N, nv)``, gravity g."""
     tree = mech.tree
     N, nb = q.shape[0], len(tree.body_names)
     st = kinematics(tree, q)
@@ -111,7 +111,9 @@ def _rnea_flat(mech: Mechanism, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, 
             elif typ == 2:  # ball: axes of the frame after it (local angular velocity)
                 aj = aj + np.einsum("nkx,nk->nx", _motion_cross((v + vj)[:, None], Sk), qd[:, da : da + 3])
             else:  # free: translation axes fixed in the world, rotation axes the body's own
-                aj = aj + np.einsum("nkx,nk->nx", _motion_cross(vj[:, None], Sk[:, 3:]), qd[:, da + 3 : da + 6])
+                aj = aj + np.einsum(
+                    "nkx,nk->nx", _motion_cross(vj[:, None], Sk[:, 3:]), qd[:, da + 3 : da + 6]
+                )
             v, a = v + vj, a + aj
         V[:, b], A[:, b] = v, a
     m, c, Ic = _world_inertia(body_inertias(mech), st.T)
@@ -148,7 +150,9 @@ def _flat_inputs(mech: Mechanism, q: object, others: list[tuple[object, str]]):
     for a in mech.tree.quat_adr:
         nrm = np.linalg.norm(qv[..., a : a + 4], axis=-1)
         if np.any(np.isfinite(nrm) & (nrm < 1e-9)):
-            raise ValueError(f"Expected the quaternion q[..., {a}:{a + 4}] to be non-zero, got norm {nrm.min()}.")
+            raise ValueError(
+                f"Expected the quaternion q[..., {a}:{a + 4}] to be non-zero, got norm {nrm.min()}."
+            )
     arrs = [as_array(x, name, (mech.nv,), finite="mask") for x, name in others]
     batch = broadcast_batch((qv, 1, "q"), *((a, 1, name) for a, (_, name) in zip(arrs, others, strict=True)))
     flat = [np.broadcast_to(qv, (*batch, mech.nq)).reshape(-1, mech.nq)]
@@ -164,7 +168,7 @@ def _flat_inputs(mech: Mechanism, q: object, others: list[tuple[object, str]]):
 def generalized_forces(
     mech: Mechanism, q: object, qd: object, qdd: object, *, gravity: bool = True
 ) -> np.ndarray:
-    """The spanning tree's inverse dynamics ``M(q) qdd + c(q, qd) + g(q)`` over every coordinate: ``(..., nv)``.
+    """The spanning tree's inverse dynamics ``M(q) qdd + c(q, qd) + g(q)``, every coordinate: ``(..., nv)``.
 
     The generalized forces (MuJoCo ``qfrc``, ``qvel`` order) that produce the accelerations ``qdd`` at
     ``(q, qd)`` with the loop closures *not* applied (no constraint forces; MuJoCo ``mj_rne`` with

@@ -116,7 +116,9 @@ def _rows(output: object) -> tuple[int, ...]:
         rows = tuple(int(r) for r in output)  # type: ignore[union-attr]
         exact = all(float(r) == int(r) and not isinstance(r, bool) for r in output)  # type: ignore[union-attr]
     except (TypeError, ValueError):
-        raise ValueError(f"Expected output to be a name or a sequence of row indices 0..5, got {output!r}.") from None
+        raise ValueError(
+            f"Expected output to be a name or a sequence of row indices 0..5, got {output!r}."
+        ) from None
     if not rows or not exact or len(set(rows)) != len(rows) or min(rows) < 0 or max(rows) > 5:
         raise ValueError(f"Expected output to be distinct row indices 0..5 of [ω; ṗ], got {output!r}.")
     return rows
@@ -134,7 +136,9 @@ def _scaled_output_jacobian(mech: Mechanism, qf: np.ndarray, si: int, L: float, 
     return state, K, G, col, J
 
 
-def _generic_output_rank(mech: Mechanism, si: int, L: float, rows: tuple[int, ...], ref_q, rtol: float) -> int:
+def _generic_output_rank(
+    mech: Mechanism, si: int, L: float, rows: tuple[int, ...], ref_q, rtol: float
+) -> int:
     """Rank of the scaled input-output Jacobian's ``rows`` at a generic configuration: the largest over the
     reference and GENERIC_SAMPLES assembled neighbours (fixed seed), cached per mechanism."""
     key = ("_sing_generic_rank", si, float(L), rows, None if ref_q is None else ref_q.tobytes(), float(rtol))
@@ -225,7 +229,7 @@ def singularities(
     batch = q.shape[:-1]
     qf = q.reshape(-1, mech.nq)
     # input-output Jacobian per scaled input rate: G maps unscaled rates; hinge inputs are per rad
-    state, K, G, col, J = _scaled_output_jacobian(mech, qf, si, L, out_rows)
+    state, K, _, col, J = _scaled_output_jacobian(mech, qf, si, L, out_rows)
     act = tree.act_dof
     pas = np.setdiff1d(np.arange(tree.nv), act)
     Ks = K * col  # K rows are already lengths
@@ -397,7 +401,11 @@ def singularity_map(
 
     sing = SingularityResult(
         **{
-            f: (mask(getattr(s, f), nan) if f.startswith(("sigma", "cond", "closure")) else mask(getattr(s, f), False))
+            f: (
+                mask(getattr(s, f), nan)
+                if f.startswith(("sigma", "cond", "closure"))
+                else mask(getattr(s, f), False)
+            )
             for f in (
                 "sigma_I",
                 "sigma_II",
