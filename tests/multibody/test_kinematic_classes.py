@@ -504,3 +504,49 @@ def test_point_output_type_one_singularity():
         mb.singularities(mech, q, "tip", output="speed")
     with pytest.raises(ValueError, match="output"):
         mb.singularities(mech, q, "tip", output=(3, 3))
+
+
+def _five_bar_by_lengths(base: float):
+    """A five-bar typed by link lengths (proximal 0.4 m, distal 0.6 m) with every link along x: the
+    closure anchors (both given) are ``base + 0.9`` m apart at the description's own pose."""
+    b = mb.Builder("five_bar_by_lengths")
+    inertial = mb.Inertial(0.2, pos=(0.2, 0, 0), diaginertia=(1e-3,) * 3)
+    b.body("l1", joints=[b.hinge("t1")], inertial=inertial)
+    b.body("l2", parent="l1", pos=(0.4, 0, 0), joints=[b.hinge("p1")], inertial=inertial)
+    b.body("r1", pos=(base, 0, 0), joints=[b.hinge("t2")], inertial=inertial)
+    b.body("r2", parent="r1", pos=(0.4, 0, 0), joints=[b.hinge("p2")], inertial=inertial)
+    b.site("tip", "l2", pos=(0.6, 0, 0))
+    b.connect("P", "l2", "r2", anchor1=(0.6, 0, 0), anchor2=(0.6, 0, 0))
+    b.actuate("t1", "t2")
+    return b
+
+
+def test_unassembled_description_is_assembled_at_load():
+    mech = _five_bar_by_lengths(0.5).build()
+    tree = mech.tree
+    assert not np.allclose(mech.q0, tree.q0)  # the description's own pose is not closed ...
+    res = mb.constraint_residual(mech, mech.q0)
+    assert np.max(np.abs(res)) < _assembly.CONVERGED_RTOL * mech.length  # ... its reference is
+    m = mb.mobility(mech)
+    assert m.dof == 2 and not m.singular
+    s = mb.singularities(mech, mech.q0, "tip")
+    assert not s.singular and s.assembled
+    fk = mb.forward_kinematics(mech, mech.q0[tree.act_qadr] + 0.05)
+    assert fk.converged
+    r = mb.inverse_dynamics(mech, fk.q, [0.1, -0.2], [0.3, 0.0])
+    assert r.valid
+    # the assembly nearest to the typed pose: the elbow-up/down branch the LM reaches first, every
+    # coordinate within the 0.5 rad-capped path from the sketch (a few radians at most)
+    assert np.max(np.abs(mech.q0 - tree.q0)) < np.pi
+
+
+def test_description_that_cannot_assemble_is_refused_at_load():
+    with pytest.raises(ValueError, match=r"assemble.*residual"):
+        _five_bar_by_lengths(3.0).build()  # legs of 1 m cannot meet across 3 m
+    xml = mb.to_mjcf(dataclasses.replace(_five_bar_by_lengths(0.5).build(), closures=()))
+    xml = xml.replace(
+        "</mujoco>",
+        '<equality><connect body1="l2" body2="r2" anchor="0.6 0 0"/></equality></mujoco>',
+    )
+    mech = mb.from_mjcf(xml)  # MuJoCo resolves the anchor at qpos0: assembled by construction
+    assert np.array_equal(mech.q0, mech.tree.q0)

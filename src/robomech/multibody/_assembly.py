@@ -209,7 +209,7 @@ class IKResult:
 
 def _guess(mech: Mechanism, guess: ArrayLike | None, batch: tuple[int, ...]) -> np.ndarray:
     if guess is None:
-        return np.broadcast_to(mech.tree.q0, (*batch, mech.nq))
+        return np.broadcast_to(mech.q0, (*batch, mech.nq))  # the assembled reference
     g = as_array(guess, "guess", (mech.nq,))
     for a in mech.tree.quat_adr:
         if np.any(np.linalg.norm(g[..., a : a + 4], axis=-1) < 1e-9):

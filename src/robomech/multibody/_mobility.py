@@ -242,7 +242,7 @@ def mobility(mech: Mechanism, q: ArrayLike | None = None, *, platform: str | Non
             f"Expected platform to be None or a body name among {list(tree.body_names[1:])}, "
             f"got {platform!r}."
         )
-    q = tree.q0 if q is None else check_q(mech, q)
+    q = mech.q0 if q is None else check_q(mech, q)  # the assembled reference
     if q.ndim != 1:
         raise ValueError(f"Expected q to have shape ({mech.nq},) (one configuration), got {q.shape}.")
     q = q[None]

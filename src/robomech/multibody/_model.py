@@ -504,10 +504,17 @@ class Mechanism:
     def nv(self) -> int:
         return self.tree.nv
 
+    @cached_property
+    def _assembled_q0(self) -> np.ndarray:
+        from ._reference import assembled_reference
+
+        return assembled_reference(self)
+
     @property
     def q0(self) -> np.ndarray:
-        """Reference configuration (MuJoCo's qpos0), (nq,)."""
-        return self.tree.q0.copy()
+        """Reference configuration, (nq,): MuJoCo's qpos0 if it satisfies the closures, else the
+        assembly nearest to it (``_reference``; a description that cannot assemble raises ValueError)."""
+        return self._assembled_q0.copy()
 
     @property
     def length(self) -> float:
@@ -764,7 +771,7 @@ class Builder:
                         name, "rigid", b1, b2, anchor2=tuple(a), relpos=tuple(relpos), relquat=tuple(relquat)
                     )
                 )
-        return Mechanism(
+        mech = Mechanism(
             tuple(self._bodies),
             tuple(closures),
             tuple(self._couplings),
@@ -773,6 +780,8 @@ class Builder:
             self.gravity,
             self.name,
         )
+        mech.q0  # noqa: B018 - assemble the reference now: a description that cannot assemble raises here
+        return mech
 
 
 # A rotation matrix must satisfy R^T R = I and det R = +1 to this tolerance: composed transforms are
