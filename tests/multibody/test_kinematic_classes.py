@@ -550,3 +550,22 @@ def test_description_that_cannot_assemble_is_refused_at_load():
     )
     mech = mb.from_mjcf(xml)  # MuJoCo resolves the anchor at qpos0: assembled by construction
     assert np.array_equal(mech.q0, mech.tree.q0)
+
+
+# MuJoCo's RK4 at 1e-4 s against DOP853 at rtol 1e-10 over 0.1 s: both ~1e-12 here; 1e-8 is a margin.
+RK4_TOL = 1e-8
+
+
+def test_floating_quadruped_simulation_equals_mujoco_rk4():
+    mech = MECH["quadruped"]
+    rng = np.random.default_rng(8)
+    qd0 = 0.5 * rng.standard_normal(mech.nv)
+    sim = mb.simulate(mech, mech.q0, t=[0.0, 0.1], qd0=qd0, tau=0.1 * np.ones(12))
+    assert sim.success and sim.energy_drift_rel < 1e-8
+    m = mujoco.MjModel.from_xml_string(QUAD)
+    m.opt.timestep, m.opt.integrator = 1e-4, mujoco.mjtIntegrator.mjINT_RK4
+    d = mujoco.MjData(m)
+    d.qpos[:], d.qvel[:], d.ctrl[:] = mech.q0, qd0, 0.1
+    for _ in range(1000):
+        mujoco.mj_step(m, d)
+    assert np.max(np.abs(d.qpos - sim.q[1])) < RK4_TOL and np.max(np.abs(d.qvel - sim.qd[1])) < RK4_TOL
