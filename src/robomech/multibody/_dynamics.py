@@ -1,4 +1,4 @@
-"""Closed-chain dynamics in actuator space for any described mechanism (issue 13).
+"""Dynamics of any described mechanism: closed chains in actuator space, and every other kinematic class.
 
 The spanning tree's rigid-body dynamics (Newton-Euler of every body about its centre of mass,
 :func:`robomech.dynamics.com_inverse_dynamics`) over the tree's velocity coordinates ``qd (nv)``,
@@ -29,7 +29,13 @@ Forward dynamics works on the tree coordinates with the closure as a constraint 
 included, as the engine has them): ``qdd = qdd_p + u``, ``K qdd_p = -Kdot qd`` (minimum norm), ``u`` in
 ``null(K)`` from ``P (M u - f) = 0`` with ``P = I - K^+ K``.  :func:`simulate` integrates ``(q, qd)`` with
 ``scipy.integrate.solve_ivp`` and projects back onto the constraint manifold (positions by the
-closure Newton iteration, velocities onto ``null(K)``) at every output time.
+closure Newton iteration, velocities onto ``null(K)``) at every output time, every sample on its own.
+
+Where the actuated rates do not determine the state (fewer actuators than degrees of freedom, none, a
+floating base) the functions take every coordinate's rate ``qd (nv)`` instead of ``qd_act``;
+inverse dynamics then solves virtual work over an orthonormal basis ``Nb`` of ``null(K)`` in least
+squares, ``Nb^T E tau = Nb^T f`` with ``f`` the tree's generalized forces (:mod:`._rnea`), and reports
+``Nb (Nb^T f - Nb^T E tau)``, what the unactuated coordinates would need (``_inverse_full_flat``).
 """
 
 from __future__ import annotations
@@ -1291,7 +1297,8 @@ def site_wrench(
             res = np.linalg.norm(np.einsum("nik,ni->nk", J, W) - rhs, axis=-1)
             smin = s[:, -1] if na <= 6 else s[:, 5]
             cond = smax[:, 0] / np.maximum(smin, 1e-300)
-            valid = st["valid"] & (cond <= SINGULAR_COND) & np.all(np.isfinite(W), axis=-1)
+            assembled = _closure_error(mech, state, qc) <= CLOSURE_RTOL * L
+            valid = st["valid"] & assembled & (cond <= SINGULAR_COND) & np.all(np.isfinite(W), axis=-1)
             for k, v in zip(out, (W, res, smin, cond, valid), strict=True):
                 out[k].append(v)
     d = {k: np.concatenate(v)[: 0 if empty else None] for k, v in out.items()}

@@ -323,6 +323,7 @@ def singularity_map(
     steps: int = 4,
     ik_weights: ArrayLike | None = None,
     length: float | None = None,
+    output: str | tuple[int, ...] = "pose",
 ) -> SingularityMapResult:
     """Workspace / dexterity / singularity maps over a grid of inputs ``q_act (..., n_act)`` (FK) or
     of site targets ``T (..., 4, 4)`` (IK), e.g. from :func:`robomech.analysis.workspace.grid`.
@@ -345,6 +346,8 @@ def singularity_map(
         Error-row weights of the IK solves (:func:`inverse_kinematics`).
     length : float, optional
         Characteristic length (m).
+    output : str or sequence of int, optional
+        The output of the type I test, as in :func:`singularities` (default ``"pose"``).
 
     Returns
     -------
@@ -366,6 +369,7 @@ def singularity_map(
         raise ValueError(f"Expected site to be a site name (str), got {type(site).__name__}.")
     mech.tree.site_index(site)
     steps = check_int(steps, "steps", low=1)
+    _rows(output)  # checked before any solve
     if length is not None:
         check_positive(length, "length")
     if (q_act is None) == (T is None):
@@ -379,7 +383,7 @@ def singularity_map(
         r = inverse_kinematics(mech, site, T, guess, weights=ik_weights, steps=steps)
     ok = r.converged
     q = np.where(ok[..., None], r.q, mech.tree.q0)
-    s = singularities(mech, q, site, length=length)
+    s = singularities(mech, q, site, output=output, length=length)
     tree = mech.tree
     L = s.length
     qf = q.reshape(-1, mech.nq)
