@@ -19,6 +19,7 @@ from robomech._validation import as_array, broadcast_batch, check_int
 
 from ._constraints import jacobian, residual
 from ._model import Mechanism
+from ._options import CONVERGED_RTOL, MAX_ITER, MAX_STEP, MU_MAX, MU_MIN, MU_START, STOP_RTOL
 from ._tree import TreeState, frame_jacobian, integrate, kinematics, normalize_quaternions
 
 __all__ = [
@@ -32,30 +33,7 @@ __all__ = [
     "solve_closure",
 ]
 
-# A configuration is assembled when every closure row is below CONVERGED_RTOL * L (L the
-# characteristic length): 1e-10 m for a 1 m mechanism, far below any manufacturing tolerance and
-# well above the ~1e-15 L where Newton's quadratic convergence stops (rounding).
-CONVERGED_RTOL = 1e-10
-# A sample stops iterating once its residual is below STOP_RTOL * L: a few ulps of the coordinates.
-STOP_RTOL = 1e-14
-# Levenberg–Marquardt damping, relative to the mean diagonal of K^T K.  Start nearly at Gauss–Newton
-# (quadratic convergence near a solution); x10 on a rejected step, /10 on an accepted one; a sample
-# whose damping exceeds MU_MAX takes steps of relative size < 1e-10: it has stalled and stops.
-MU_START = 1e-8
-MU_MIN = 1e-14
-MU_MAX = 1e10
-# Largest step per iteration, in radians (translations divided by L): Gauss–Newton far from a
-# solution can take steps of many radians and land on another assembly branch; capping the step keeps
-# the iteration on the branch connected to the guess (0.5 rad: the closure equations are nearly
-# linear over such a step) at the cost of a few more iterations for large moves.  Only coordinates
-# that move a closure point or the IK site are capped.
-MAX_STEP = 0.5
-# Batches of at least this many samples run the assembly in the compiled kernels of _compiled.py
-# (the same algorithm per sample); smaller ones in numpy, with no compilation.
-COMPILED_MIN = 256
-# Iterations per continuation stage: from the reference configuration Newton takes 4-8 iterations on
-# the gallery; 60 leaves room for the damped steps far from a solution before a sample is given up.
-MAX_ITER = 60
+# (tolerances and iteration limits: _options)
 
 
 def check_mechanism(mech: object) -> Mechanism:
@@ -86,8 +64,15 @@ def solve_closure(
     """LM on the closure rows (plus ``extra(state, q, idx) -> (r, J)`` rows) over the coordinates ``free``.
 
     ``q (N, nq)`` start (normalised); ``free`` indices of velocity coordinates that may move.
-    Returns ``q, closure residual (N,) max-abs, total residual (N,), iterations (N,)``.
+    Returns ``q, closure residual (N,) max-abs, total residual (N,), iterations (N,)``.  Without extra
+    rows (assembly) this is the compiled kernel (``_compiled.fk_block``), the same iteration per sample;
+    the numpy iteration here serves the rows that only inverse kinematics adds.
     """
+    if extra is None and max_iter == MAX_ITER:
+        from ._compiled import compiled_fk  # numba loads on the first kernel call, not at import
+
+        q, rc, it, res = compiled_fk(mech, q, np.asarray(free))
+        return q, rc, res, it
     tree, cs = mech.tree, mech.constraints
     N = q.shape[0]
     nf = len(free)
@@ -288,14 +273,11 @@ def forward_kinematics(
     target = np.where(ok[:, None], qa_f, start)
     free = np.setdiff1d(np.arange(tree.nv), np.concatenate([tree.act_dof, floating_base_dofs(mech)]))
     iters = np.zeros(q.shape[0], dtype=int)
+    from ._compiled import compiled_fk  # numba loads on the first kernel call, not at import
+
     for s in range(1, steps + 1):
         q[:, tree.act_qadr] = start + (target - start) * (s / steps)
-        if q.shape[0] >= COMPILED_MIN:  # same algorithm, compiled per sample (see _compiled.py)
-            from ._compiled import compiled_fk
-
-            q, rc, it = compiled_fk(mech, q, free)
-        else:
-            q, rc, _, it = solve_closure(mech, q, free)
+        q, rc, it, _ = compiled_fk(mech, q, free)  # the one implementation, any batch size
         iters += it
     conv = ok & (rc <= CONVERGED_RTOL * tree.length)
     q = np.where(ok[:, None], q, np.nan)

@@ -1,128 +1,34 @@
-"""Compiled (numba) per-sample kernels for large batches: FK, site Jacobians, inverse dynamics.
+"""The compiled (numba) per-sample kernels: assembly (FK), site Jacobians, inverse dynamics.
 
-The same algorithms as the numpy path (``_tree``, ``_constraints``, ``_assembly``, ``_influence``,
-``_dynamics``), written per sample in one loop over the batch: tree kinematics, closure residual and
-velocity constraint matrix, the Levenberg–Marquardt assembly with the same damping, step cap and
-stopping rules, ``G = [I; -K_p^+ K_a]`` with the site's ``[ω; ṗ]`` Jacobian, and the closed-chain
-inverse dynamics of ``_dynamics._inverse_flat`` (:func:`inv_dyn`: passive pseudo-inverse, screw rates,
-``K̇ q̇``, the bodies' Newton–Euler terms through ``G``, site wrenches, the redundant-actuation rule and
-the same validity flags).  A numpy batch pays one Python-level operation per body and per closure on
-arrays of the whole batch; here every sample stays in cache.  The mechanism is passed packed, as the
-named tuples :class:`Tables` and :class:`DynTables`.  The tests check that both paths agree to
-rounding.  This module (and numba) loads on the first large call.
+The one implementation of each of these algorithms, for every batch size (batch 1 included): tree
+kinematics, closure residual and velocity constraint matrix (the formulas of ``_tree`` and
+``_constraints``, written per sample), the Levenberg–Marquardt assembly (damping, step cap and
+stopping rules of ``_options``), ``G = [I; -K_p^+ K_a]`` by the SVD pseudo-inverse with the site's
+``[ω; ṗ]`` Jacobian, and the closed-chain inverse dynamics (:func:`inv_dyn`: passive pseudo-inverse,
+screw rates, ``K̇ q̇``, the bodies' Newton–Euler terms through ``G``, site wrenches, the
+redundant-actuation rule and the validity flags).  Every sample stays in cache; large batches run in
+parallel over the cores (``numba.prange``).  The mechanism is passed packed, as the named tuples
+``_compile.Tables`` and ``_compile.DynTables`` of its compiled model.  The numpy formulation stays in
+the tests as the reference (tests/multibody/_reference.py).
 """
 
 from __future__ import annotations
 
-from typing import NamedTuple
-
 import numpy as np
-from numpy.typing import NDArray
 
 from robomech._numba import import_numba
 
-from ._assembly import COMPILED_MIN, MAX_ITER, MAX_STEP, MU_MAX, MU_MIN, MU_START, STOP_RTOL
-from ._influence import PASSIVE_RANK_RTOL
-from ._model import Mechanism
+from . import _options as opt
+from ._compile import compile_model
 
-__all__ = [
-    "COMPILED_MIN",
-    "DynTables",
-    "Tables",
-    "compiled_fk",
-    "compiled_site_jacobian",
-    "inv_dyn",
-    "tables",
-]
+__all__ = ["compiled_fk", "compiled_site_jacobian", "inv_dyn"]
 
-# this module is imported on the first large batch only; the kernel cache lives in robomech's cache dir
 numba = import_numba()
 
-
-class Tables(NamedTuple):
-    """The mechanism packed for the kernels (one argument instead of ~20 arrays; numba types it as a
-    named tuple, so the kernels read ``t.parent``, ``t.A``, ...).  Built once per mechanism
-    (``Mechanism.compiled_tables``)."""
-
-    parent: NDArray[np.int64]
-    T_off: NDArray[np.float64]
-    j0: NDArray[np.int64]  # (nb + 1,) joints of body b are j0[b]:j0[b + 1]
-    jtype: NDArray[np.int64]
-    jqadr: NDArray[np.int64]
-    jdadr: NDArray[np.int64]
-    jpos: NDArray[np.float64]
-    jaxis: NDArray[np.float64]
-    jref: NDArray[np.float64]
-    A: NDArray[np.float64]  # (nb, nv) coordinate k moves body b
-    C: NDArray[np.float64]  # (nv, nv) coordinate j moves the carrier frame of coordinate k
-    dof_tr: NDArray[np.bool_]
-    # closure rows
-    pp: NDArray[np.int64]  # (np, 3) int: b1, b2, first row
-    px: NDArray[np.float64]  # (np, 2, 3) local points
-    rr: NDArray[np.int64]  # (nr, 3) int: b1, b2, first row
-    rR: NDArray[np.float64]  # (nr, 3, 3)
-    cc: NDArray[np.int64]  # (nc, 5) int: d1, q1, d2, q2, row
-    cf: NDArray[np.float64]  # (nc, 8) float: ref1, ref2, c0..c4, scale
-    geom_row: NDArray[np.bool_]  # (m,) bool
-    m: int
-    L: float
-
-
-def tables(mech: Mechanism) -> Tables:
-    tree, cs = mech.tree, mech.constraints
-    nb = len(tree.body_names)
-    j0 = np.zeros(nb + 1, dtype=np.int64)
-    for b in range(nb):
-        j0[b + 1] = j0[b] + len(tree.body_jnts[b])
-    pp, px, rr, rR, cc, cf = [], [], [], [], [], []
-    row = 0
-    for k, d in cs.blocks:
-        if k == "point":
-            b1, x1, b2, x2 = d
-            pp.append((b1, b2, row))
-            px.append((x1[:3], x2[:3]))
-            row += 3
-        elif k == "rot":
-            b1, R, b2 = d
-            rr.append((b1, b2, row))
-            rR.append(R)
-            row += 3
-        else:
-            d1, q1, ref1, d2, q2, ref2, c, s = d
-            cc.append((d1, q1, d2, q2, row))
-            cf.append((ref1, ref2, *c, s))
-            row += 1
-    return Tables(
-        parent=tree.parent.astype(np.int64),
-        T_off=np.ascontiguousarray(tree.T_off),
-        j0=j0,
-        jtype=tree.jnt_type.astype(np.int64),
-        jqadr=tree.jnt_qadr.astype(np.int64),
-        jdadr=tree.jnt_dadr.astype(np.int64),
-        jpos=np.ascontiguousarray(tree.jnt_pos),
-        jaxis=np.ascontiguousarray(tree.jnt_axis),
-        jref=tree.jnt_ref.astype(float),
-        A=np.ascontiguousarray(tree.A),
-        C=np.ascontiguousarray(tree.C),
-        dof_tr=tree.dof_translational.astype(np.bool_),
-        pp=np.array(pp, dtype=np.int64).reshape(-1, 3),
-        px=np.array(px, dtype=float).reshape(-1, 2, 3),
-        rr=np.array(rr, dtype=np.int64).reshape(-1, 3),
-        rR=np.array(rR, dtype=float).reshape(-1, 3, 3),
-        cc=np.array(cc, dtype=np.int64).reshape(-1, 5),
-        cf=np.array(cf, dtype=float).reshape(-1, 8),
-        geom_row=np.array([k != "coupling" for k in cs.row_kind], dtype=np.bool_),
-        m=cs.m,
-        L=float(tree.length),
-    )
-
-
 _nj = numba.njit(cache=True, error_model="numpy")
-# Site Jacobian: Tikhonov weight of the passive normal equations relative to their mean diagonal,
-# and the refinement steps that remove its bias (each multiplies it by eps / sigma^2 <= 1e-8 / 1e-4
-# for sigma_min / sigma_max >= 1e-2; three solves leave ~1e-18 relative).
-REG = 1e-8
-REFINE = 2
+# Samples per parallel task: large enough that a task's scratch arrays are allocated rarely, small
+# enough that two cores share a batch of a few thousand evenly.
+BLOCK = 64
 
 
 @_nj
@@ -357,15 +263,18 @@ def integrate(q, dv, jtype, jqadr, jdadr, out):  # pragma: no cover
         out[o], out[o + 1], out[o + 2], out[o + 3] = nw / n, nx / n, ny / n, nz / n
 
 
-@numba.njit(cache=True, error_model="numpy")
-def fk(Q, free, wstep, t, max_iter, stop2, mu0, mu_min, mu_max, max_step, rc_out, it_out):  # pragma: no cover
-    N, nq = Q.shape
+@_nj
+def fk_block(
+    Q, lo, hi, free, wstep, t, max_iter, stop2, mu0, mu_min, mu_max, max_step, rc_out, it_out, cost_out
+):  # pragma: no cover
+    """The Levenberg–Marquardt closure solve of samples ``lo:hi`` of ``Q (N, nq)``, in place."""
+    nq = Q.shape[1]
     nb = t.parent.shape[0]
     nv = t.A.shape[1]
     nf = free.shape[0]
     m, geom_row = t.m, t.geom_row
     jtype, jqadr, jdadr = t.jtype, t.jqadr, t.jdadr
-    for n in numba.prange(N):
+    for n in range(lo, hi):
         q = Q[n].copy()
         T = np.empty((nb, 4, 4))
         S = np.zeros((nv, 6))
@@ -446,73 +355,74 @@ def fk(Q, free, wstep, t, max_iter, stop2, mu0, mu_min, mu_max, max_step, rc_out
             rc = max(rc, abs(r[i]))
         rc_out[n] = rc if finite else np.inf
         it_out[n] = it
+        cost_out[n] = cost if finite else np.inf
 
 
-@numba.njit(cache=True, error_model="numpy")
-def site_jac(Q, act, pas, sb, Tsite, t, rtol, J_out):  # pragma: no cover
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def fk_par(
+    Q, free, wstep, t, max_iter, stop2, mu0, mu_min, mu_max, max_step, rc_out, it_out, cost_out
+):  # pragma: no cover
+    """:func:`fk_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
     N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        fk_block(
+            Q,
+            k * BLOCK,
+            min(N, (k + 1) * BLOCK),
+            free,
+            wstep,
+            t,
+            max_iter,
+            stop2,
+            mu0,
+            mu_min,
+            mu_max,
+            max_step,
+            rc_out,
+            it_out,
+            cost_out,
+        )
+
+
+@_nj
+def site_jac_block(Q, lo, hi, act, pas, sb, Tsite, t, rtol, J_out):  # pragma: no cover
+    """``J = J_f G`` of the site (body ``sb``, pose ``Tsite`` in it) for samples ``lo:hi`` of ``Q``.
+
+    ``G = [I; -K_p^+ K_a]`` with the SVD pseudo-inverse of ``K_p`` (:func:`svd_pinv`, singular values
+    below ``rtol`` times the largest dropped): the minimum-norm passive rates, as :func:`influence`."""
     nb = t.parent.shape[0]
     A, m = t.A, t.m
     nv = A.shape[1]
     na, npas = act.shape[0], pas.shape[0]
-    for n in numba.prange(N):
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    r = np.empty(m)
+    K = np.empty((m, nv))
+    G = np.zeros((nv, na))
+    Kp = np.empty((m, npas))
+    P = np.empty((npas, m))
+    for n in range(lo, hi):
         q = Q[n]
-        T = np.empty((nb, 4, 4))
-        S = np.zeros((nv, 6))
-        r = np.empty(m)
-        K = np.empty((m, nv))
         kin(q, t, T, S)
         resjac(q, t, T, S, r, K, True)
-        G = np.zeros((nv, na))
+        G[:, :] = 0.0
         for j in range(na):
             G[act[j], j] = 1.0
         if m > 0 and npas > 0:
-            Kp = np.empty((m, npas))
-            Ka = np.empty((m, na))
             for i in range(m):
                 for j in range(npas):
                     Kp[i, j] = K[i, pas[j]]
-                for j in range(na):
-                    Ka[i, j] = K[i, act[j]]
-            # least-squares passive rates: K_p^T K_p + eps I factored once, then refined twice
-            # (x += M^-1 K_p^T (b - K_p x)), which converges to the least-squares solution at the rate
-            # eps / (sigma^2 + eps) per step; idle directions (sigma = 0) keep a component of order
-            # rounding / eps that moves no site, so the site Jacobian is the numpy path's (SVD) one.
-            M = Kp.T @ Kp
-            tr = 0.0
-            for i in range(npas):
-                tr += M[i, i]
-            eps = REG * tr / npas + 1e-300
-            for i in range(npas):
-                M[i, i] += eps
-            chol_factor(M)
-            b = np.empty(m)
-            b_tmp = np.empty(m)
-            rhs = np.empty(npas)
-            x = np.empty(npas)
-            dxr = np.empty(npas)
+            svd_pinv(Kp, rtol, P)
             for j in range(na):
-                for i in range(m):
-                    b[i] = -Ka[i, j]
-                x[:] = 0.0
-                for _ in range(REFINE + 1):
-                    for i in range(m):
-                        acc = b[i]
-                        for c in range(npas):
-                            acc -= Kp[i, c] * x[c]
-                        b_tmp[i] = acc  # residual b - K_p x
-                    for c in range(npas):
-                        acc = 0.0
-                        for i in range(m):
-                            acc += Kp[i, c] * b_tmp[i]
-                        rhs[c] = acc
-                    chol_subst(M, rhs, dxr)
-                    for c in range(npas):
-                        x[c] += dxr[c]
+                aj = act[j]
                 for i in range(npas):
-                    G[pas[i], j] = x[i]
-        Ts = T[sb] @ Tsite
-        p0, p1, p2 = Ts[0, 3], Ts[1, 3], Ts[2, 3]
+                    acc = 0.0
+                    for c in range(m):
+                        acc += P[i, c] * K[c, aj]
+                    G[pas[i], j] = -acc
+        p0 = T[sb, 0, 3] + T[sb, 0, 0] * Tsite[0, 3] + T[sb, 0, 1] * Tsite[1, 3] + T[sb, 0, 2] * Tsite[2, 3]
+        p1 = T[sb, 1, 3] + T[sb, 1, 0] * Tsite[0, 3] + T[sb, 1, 1] * Tsite[1, 3] + T[sb, 1, 2] * Tsite[2, 3]
+        p2 = T[sb, 2, 3] + T[sb, 2, 0] * Tsite[0, 3] + T[sb, 2, 1] * Tsite[1, 3] + T[sb, 2, 2] * Tsite[2, 3]
         for j in range(na):
             for i in range(6):
                 J_out[n, i, j] = 0.0
@@ -520,43 +430,29 @@ def site_jac(Q, act, pas, sb, Tsite, t, rtol, J_out):  # pragma: no cover
             if A[sb, k] == 0.0:
                 continue
             w0, w1, w2 = S[k, 0], S[k, 1], S[k, 2]
-            col = (
-                w0,
-                w1,
-                w2,
-                S[k, 3] + w1 * p2 - w2 * p1,
-                S[k, 4] + w2 * p0 - w0 * p2,
-                S[k, 5] + w0 * p1 - w1 * p0,
-            )
+            c3 = S[k, 3] + w1 * p2 - w2 * p1
+            c4 = S[k, 4] + w2 * p0 - w0 * p2
+            c5 = S[k, 5] + w0 * p1 - w1 * p0
             for j in range(na):
                 g = G[k, j]
                 if g != 0.0:
-                    for i in range(6):
-                        J_out[n, i, j] += col[i] * g
+                    J_out[n, 0, j] += w0 * g
+                    J_out[n, 1, j] += w1 * g
+                    J_out[n, 2, j] += w2 * g
+                    J_out[n, 3, j] += c3 * g
+                    J_out[n, 4, j] += c4 * g
+                    J_out[n, 5, j] += c5 * g
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def site_jac_par(Q, act, pas, sb, Tsite, t, rtol, J_out):  # pragma: no cover
+    """:func:`site_jac_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        site_jac_block(Q, k * BLOCK, min(N, (k + 1) * BLOCK), act, pas, sb, Tsite, t, rtol, J_out)
 
 
 # ----------------------------------------------------------------------------- inverse dynamics
-class DynTables(NamedTuple):
-    """What the inverse-dynamics kernel needs beyond :class:`Tables` (built once per mechanism)."""
-
-    bidx: NDArray[np.int64]  # (B,) bodies with mass or inertia
-    mass: NDArray[np.float64]  # (B,)
-    com: NDArray[np.float64]  # (B, 3) body frame
-    inertia: NDArray[np.float64]  # (B, 3, 3) about the com, body axes
-    act: NDArray[np.int64]  # (na,) actuated velocity coordinates
-    pas: NDArray[np.int64]  # (npas,) the others
-    rank0: int  # generic rank of K_p
-    dof: int  # mobility
-    gram_cond_max: float  # _dynamics.GRAM_COND_MAX
-    gram_refine_cond: float  # _dynamics.GRAM_REFINE_COND
-    gram_refine2_cond: float  # _dynamics.GRAM_REFINE2_COND
-    pinv_rtol: float  # _influence.PASSIVE_RANK_RTOL
-    rank_rtol: float  # _dynamics.RANK_RTOL
-    singular_cond: float  # _dynamics.SINGULAR_COND
-    admissible_rtol: float  # _dynamics.ADMISSIBLE_RTOL
-    rate_floor: float  # _dynamics.RATE_FLOOR
-
-
 @_nj
 def _cross_into(a0, a1, a2, b0, b1, b2, out, o):  # pragma: no cover - compiled
     out[o] = a1 * b2 - a2 * b1
@@ -735,8 +631,10 @@ def passive_solve(Kp, Gi, P, mode, nref, b, x, res, dx, tmp):  # pragma: no cove
             x[i] += dx[i]
 
 
-@numba.njit(cache=True, error_model="numpy")
-def inv_dyn(
+@_nj
+def inv_dyn_block(
+    lo,
+    hi,
     Q,
     QD,
     QDD,
@@ -759,8 +657,7 @@ def inv_dyn(
     adm_o,
     valid_o,
 ):  # pragma: no cover - compiled
-    """``_dynamics._inverse_flat`` per sample (same formulas; see there for the derivation)."""
-    N = Q.shape[0]
+    """The closed-chain inverse dynamics of samples ``lo:hi`` (derivation: ``_dynamics``' docstring)."""
     nb = t.parent.shape[0]
     A, C, m, L = t.A, t.C, t.m, t.L
     nv = A.shape[1]
@@ -807,7 +704,7 @@ def inv_dyn(
     ext = np.empty(nv)
     KG = np.empty((m, na))
     tmpm = np.empty(m)
-    for n in range(N):
+    for n in range(lo, hi):
         q = Q[n]
         qa = QD[n]
         qdda = QDD[n]
@@ -1100,53 +997,125 @@ def inv_dyn(
         valid_o[n] = ok and fin and rank >= d.rank0 and cond <= d.singular_cond and adm <= d.admissible_rtol
 
 
-def _kernels():
-    return fk, site_jac
-
-
-def compiled_fk(mech, q: np.ndarray, free: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The LM closure solve of ``solve_closure`` (no extra rows) on ``q (N, nq)`` in place: (q, rc, iters)."""
-    t = mech.compiled_tables
-    fk, _ = _kernels()
-    tree = mech.tree
-    Q = np.ascontiguousarray(q, dtype=float).copy()
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def inv_dyn_par(
+    Q,
+    QD,
+    QDD,
+    W,
+    wsb,
+    wT,
+    gv,
+    wts,
+    t,
+    d,
+    tau_o,
+    Ma_o,
+    vel_o,
+    grav_o,
+    ex_o,
+    qd_o,
+    qdd_o,
+    cond_o,
+    smin_o,
+    adm_o,
+    valid_o,
+):  # pragma: no cover - compiled
+    """:func:`inv_dyn_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
     N = Q.shape[0]
-    rc, it = np.empty(N), np.zeros(N, dtype=np.int64)
-    wstep = np.where(tree.dof_translational, 1.0 / tree.length, 1.0)[free].astype(float)
-    fk(
-        Q,
-        free.astype(np.int64),
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        inv_dyn_block(
+            k * BLOCK,
+            min(N, (k + 1) * BLOCK),
+            Q,
+            QD,
+            QDD,
+            W,
+            wsb,
+            wT,
+            gv,
+            wts,
+            t,
+            d,
+            tau_o,
+            Ma_o,
+            vel_o,
+            grav_o,
+            ex_o,
+            qd_o,
+            qdd_o,
+            cond_o,
+            smin_o,
+            adm_o,
+            valid_o,
+        )
+
+
+def inv_dyn(*args) -> None:
+    """:func:`inv_dyn_block` on every sample: one block in this thread for a small batch, in parallel
+    blocks for a large one (the same per-sample code either way: results do not depend on the batch)."""
+    N = args[0].shape[0]
+    if N <= BLOCK:
+        inv_dyn_block(0, N, *args)
+    else:
+        inv_dyn_par(*args)
+
+
+def compiled_fk(
+    mech, q: np.ndarray, free: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The closure solve on ``q (N, nq)`` over the velocity coordinates ``free``: (q, rc, iterations,
+    total residual ``sqrt(sum r^2)``), ``rc`` the largest closure row (m)."""
+    model = compile_model(mech)
+    t = model.tables
+    tree = model.tree
+    Q = np.array(q, dtype=np.float64, order="C")
+    N = Q.shape[0]
+    rc, it, cost = np.empty(N), np.zeros(N, dtype=np.int64), np.empty(N)
+    key = ("fk_wstep", free.tobytes())
+    wstep = model.cache.get(key)
+    if wstep is None:
+        wstep = model.cache[key] = np.where(tree.dof_translational, 1.0 / tree.length, 1.0)[free].astype(
+            float
+        )
+    args = (
+        np.ascontiguousarray(free, dtype=np.int64),
         wstep,
         t,
-        MAX_ITER,
-        (STOP_RTOL * t.L) ** 2,
-        MU_START,
-        MU_MIN,
-        MU_MAX,
-        MAX_STEP,
+        opt.MAX_ITER,
+        (opt.STOP_RTOL * t.L) ** 2,
+        opt.MU_START,
+        opt.MU_MIN,
+        opt.MU_MAX,
+        opt.MAX_STEP,
         rc,
         it,
+        cost,
     )
-    return Q, rc, it
+    if N <= BLOCK:
+        fk_block(Q, 0, N, *args)
+    else:
+        fk_par(Q, *args)
+    return Q, rc, it, np.sqrt(cost)
 
 
 def compiled_site_jacobian(mech, q: np.ndarray, site: int) -> np.ndarray:
-    """``J (N, 6, n_act)`` of site index ``site`` at ``q (N, nq)`` (the numpy path's ``site_jacobian``)."""
-    t = mech.compiled_tables
-    _, sj = _kernels()
-    tree = mech.tree
-    act = tree.act_dof.astype(np.int64)
-    pas = np.setdiff1d(np.arange(tree.nv), act).astype(np.int64)
-    Q = np.ascontiguousarray(q, dtype=float)
-    J = np.empty((Q.shape[0], 6, len(act)))
-    sj(
-        Q,
-        act,
-        pas,
+    """``J (N, 6, n_act)`` of site index ``site`` at ``q (N, nq)`` (:func:`site_jac_block`)."""
+    model = compile_model(mech)
+    tree = model.tree
+    Q = np.ascontiguousarray(q, dtype=np.float64)
+    J = np.empty((Q.shape[0], 6, len(model.act)))
+    args = (
+        model.act,
+        model.pas,
         int(tree.site_body[site]),
         np.ascontiguousarray(tree.T_site[site]),
-        t,
-        PASSIVE_RANK_RTOL,
+        model.tables,
+        opt.PASSIVE_RANK_RTOL,
         J,
     )
+    if Q.shape[0] <= BLOCK:
+        site_jac_block(Q, 0, Q.shape[0], *args)
+    else:
+        site_jac_par(Q, *args)
     return J

@@ -50,15 +50,25 @@ from robomech._validation import MAX_MAGNITUDE, as_array, broadcast_batch, check
 from robomech.dynamics import _com_terms
 
 from ._assembly import check_mechanism, check_q, solve_closure
+from ._compile import Bodies, compile_model
 from ._constraints import jacobian
-from ._influence import PASSIVE_RANK_RTOL, _pinv
+from ._influence import _pinv
 from ._model import Mechanism
+from ._options import (
+    ADMISSIBLE_RTOL,
+    CLOSURE_RTOL,
+    GRAM_COND_MAX,
+    GRAM_REFINE2_COND,
+    GRAM_REFINE_COND,
+    RANK_RTOL,
+    RATE_FLOOR,
+    SINGULAR_COND,
+)
 from ._tree import (
     frame_jacobian,
     kinematics,
     normalize_quaternions,
     quat_mul,
-    quat_to_matrix,
 )
 
 __all__ = [
@@ -77,22 +87,6 @@ __all__ = [
     "statics",
 ]
 
-# A configuration is flagged singular when the passive block K_p of the constraint Jacobian has a
-# condition number above SINGULAR_COND (or lost rank against the reference configuration): actuator
-# forces grow like cond, and the closure is only solved to CONVERGED_RTOL = 1e-10 relative, so beyond
-# 1e6 the forces would carry relative errors of order 1e-4 from the geometry alone — and they are
-# physically unbounded as cond -> inf.  Such samples get valid = False and NaN forces.
-SINGULAR_COND = 1e6
-# The prescribed motion must be admissible: |K qd| and |K qdd + Kdot qd| below ADMISSIBLE_RTOL times
-# their scale (L |qd|, L (|qdd| + |qd|^2)).  Rounding leaves ~1e-15; an inconsistent rate of a
-# redundantly actuated mechanism (or a rank drop) gives O(1).
-ADMISSIBLE_RTOL = 1e-8
-# ... and below RATE_FLOOR (1/s, 1/s^2) of motion the scale is RATE_FLOOR: at rest the test is absolute
-# (1e-8 L per s^2), not relative to zero.
-RATE_FLOOR = 1.0
-# Rank decisions on K G (redundant actuation) and on the forward-dynamics matrices: singular values
-# below this fraction of the largest are zero (the same reasoning as PASSIVE_RANK_RTOL).
-RANK_RTOL = PASSIVE_RANK_RTOL
 # Samples per block in the batched kernels: bounds the (N, bodies, 6, nv) temporaries to ~100 MB.
 CHUNK = 2048
 
@@ -107,43 +101,16 @@ def _mv(A: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 def _cache(mech: Mechanism, key: str, make: Callable[[], _T]) -> _T:
-    d = mech.__dict__  # frozen dataclass: cached_property writes here too
+    d = compile_model(mech).cache  # the compiled model's, never the frozen description
     if key not in d:
         d[key] = make()
     out: _T = d[key]
     return out
 
 
-@dataclass(frozen=True)
-class _Bodies:
-    idx: np.ndarray  # (B,) tree body indices with mass or inertia
-    mass: np.ndarray  # (B,)
-    com: np.ndarray  # (B, 3) body frame
-    inertia: np.ndarray  # (B, 3, 3) about the com, body axes
-
-
-def _bodies(mech: Mechanism) -> _Bodies:
-    def make() -> _Bodies:
-        idx, m, c, inn = [], [], [], []
-        for i, b in enumerate(mech.bodies, start=1):
-            if b.inertial is None:
-                continue
-            it = b.inertial
-            if it.mass == 0 and max(it.diaginertia) == 0:
-                continue
-            Ri = quat_to_matrix(np.asarray(it.quat))
-            idx.append(i)
-            m.append(it.mass)
-            c.append(it.pos)
-            inn.append(Ri @ np.diag(it.diaginertia) @ Ri.T)
-        return _Bodies(
-            np.array(idx, dtype=int),
-            np.array(m, float),
-            np.array(c, float).reshape(-1, 3),
-            np.array(inn, float).reshape(-1, 3, 3),
-        )
-
-    return _cache(mech, "_dyn_bodies", make)
+def _bodies(mech: Mechanism) -> Bodies:
+    """The bodies with mass or inertia, from the compiled model."""
+    return compile_model(mech).bodies
 
 
 def _reference(mech: Mechanism) -> tuple[int, int]:
@@ -171,19 +138,6 @@ def _pinv_rank(K: np.ndarray, r: int) -> tuple[np.ndarray, np.ndarray]:
     sinv[:, :r] = 1.0 / np.where(ok[:, None], s[:, :r], 1.0)
     P = np.einsum("nji,nj,nkj->nik", Vt, sinv, U)
     return P, np.where(ok, s[:, 0] / np.where(ok, sr, 1.0), np.inf)
-
-
-# Below this 1-norm condition estimate of K_p the Gram-matrix inverse (with refinement) is used; above it
-# the sample is recomputed with the SVD pseudo-inverse (exact rank decision).  The Gram matrix squares
-# the condition number: its inverse carries ~cond^2 eps relative error, and each refinement step
-# (x += P0 (b - K_p x)) multiplies the error by ~cond^2 eps again.  SINGULAR_COND: beyond it the sample
-# is invalid anyway, and the estimate bounds the 2-norm condition number from above (within sqrt(rank)),
-# so a sample judged by the estimate is never wrongly valid.
-GRAM_COND_MAX = SINGULAR_COND
-# Refinement steps: one above GRAM_REFINE_COND (below it cond^2 eps < 1e-12), two above
-# GRAM_REFINE2_COND (at cond 1e6: 1e-4 -> 1e-8 -> 1e-12, below the inherent cond eps ~ 1e-10).
-GRAM_REFINE_COND = 1e2
-GRAM_REFINE2_COND = 1e4
 
 
 def _passive_inverse(Kp: np.ndarray, rank0: int, length: float = 1.0):
@@ -241,14 +195,6 @@ def _rank_measures(Kp: np.ndarray, rank0: int, length: float) -> tuple[np.ndarra
     return sr, cond
 
 
-# A configuration given to a dynamics function must satisfy the closures: its largest closure row at most
-# CLOSURE_RTOL * L.  100 times the assembly's CONVERGED_RTOL, so that every configuration that
-# forward_kinematics, inverse_kinematics or simulate report converged passes, while one off the closure
-# manifold (a passive joint moved by hand, a q typed with a few digits) gives forces of no meaning and
-# is flagged: the forces' relative error grows like the residual over L.
-CLOSURE_RTOL = 1e-8
-
-
 def _closure_error(mech: Mechanism, state, q: np.ndarray) -> np.ndarray:
     """Largest closure row ``max |phi(q)|`` (m) per sample; 0 for a tree."""
     from ._constraints import residual
@@ -259,21 +205,13 @@ def _closure_error(mech: Mechanism, state, q: np.ndarray) -> np.ndarray:
 
 
 def _reference3(mech: Mechanism) -> tuple[int, int, int]:
-    def make() -> tuple[int, int, int]:
-        from ._mobility import mobility
-
-        tree = mech.tree
-        pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
-        mob = mobility(mech)
-        # the passive block has full column rank but for the idle motions (computed, not taken from q0,
-        # which may itself be singular); K's generic rank leaves the DOF and the idle motions free
-        return len(pas) - int(mob.idle_dof), int(mob.dof), int(tree.nv - mob.dof - mob.idle_dof)
-
-    return _cache(mech, "_dyn_reference", make)
+    """(generic passive rank, mobility DOF, generic rank of K): the compiled model's reference rank."""
+    m = compile_model(mech)
+    return m.rank0, m.dof, m.rank_K
 
 
 # ----------------------------------------------------------------------------- tree kernels
-def _com_jacobians(tree, state, bd: _Bodies, qd: np.ndarray | None, Sd: np.ndarray | None):
+def _com_jacobians(tree, state, bd: Bodies, qd: np.ndarray | None, Sd: np.ndarray | None):
     """Centre-of-mass points (N, B, 3), Jacobians (N, B, 6, nv) and ``Jdot qd`` (N, B, 6)."""
     T = state.T[:, bd.idx]
     p = (T[..., :3, :3] @ bd.com[:, :, None])[..., 0] + T[..., :3, 3]
@@ -301,7 +239,7 @@ def _cross_rows(a: np.ndarray, p: np.ndarray) -> np.ndarray:
     return np.stack([a1 * z - a2 * y, a2 * x - a0 * z, a0 * y - a1 * x], axis=-2)
 
 
-def _com_projected(tree, state, bd: _Bodies, qd, Sd, G, extra_qdd):
+def _com_projected(tree, state, bd: Bodies, qd, Sd, G, extra_qdd):
     """Centre-of-mass Jacobians through G, ``J_b G (N, B, 6, na)``, and the accelerations
     ``Jdot_b qd + J_b extra_qdd (N, B, 6)`` — without the (N, B, 6, nv) Jacobians' cross products."""
     T = state.T[:, bd.idx]
@@ -333,11 +271,8 @@ def _screw_rates(tree, state, qd: np.ndarray) -> np.ndarray:
 
 
 def _path(tree, b: int) -> np.ndarray:
-    """Indices of the velocity coordinates that move body ``b`` (cached on the compiled tree)."""
-    cache = tree.__dict__.setdefault("_dyn_paths", {})
-    if b not in cache:
-        cache[b] = np.flatnonzero(tree.A[b])
-    return cache[b]
+    """Indices of the velocity coordinates that move body ``b`` (``Tree.dof_paths``, compiled once)."""
+    return tree.dof_paths[b]
 
 
 def _constraint_matrix(mech: Mechanism, state, q: np.ndarray) -> np.ndarray:
@@ -649,46 +584,13 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
     )
 
 
-def _dyn_tables(mech: Mechanism):
-    """The compiled kernel's per-mechanism tables (``_compiled.DynTables``), built once."""
-
-    def make():
-        from ._compiled import DynTables
-
-        tree = mech.tree
-        bd = _bodies(mech)
-        rank0, dof = _reference(mech)
-        act = tree.act_dof.astype(np.int64)
-        return DynTables(
-            bidx=bd.idx.astype(np.int64),
-            mass=np.ascontiguousarray(bd.mass, dtype=float),
-            com=np.ascontiguousarray(bd.com, dtype=float),
-            inertia=np.ascontiguousarray(bd.inertia, dtype=float),
-            act=act,
-            pas=np.setdiff1d(np.arange(tree.nv), act).astype(np.int64),
-            rank0=int(rank0),
-            dof=int(dof),
-            gram_cond_max=float(GRAM_COND_MAX),
-            gram_refine_cond=float(GRAM_REFINE_COND),
-            gram_refine2_cond=float(GRAM_REFINE2_COND),
-            pinv_rtol=float(PASSIVE_RANK_RTOL),
-            rank_rtol=float(RANK_RTOL),
-            singular_cond=float(SINGULAR_COND),
-            admissible_rtol=float(ADMISSIBLE_RTOL),
-            rate_floor=float(RATE_FLOOR),
-        )
-
-    return _cache(mech, "_dyn_compiled_tables", make)
-
-
 def _inverse_compiled(mech, q, qd_a, qdd_a, wr, weights, gravity=True) -> dict[str, np.ndarray]:
     """:func:`_inverse_flat` by the compiled per-sample kernel (``_compiled.inv_dyn``): same formulas,
     same flags; the tests check both paths agree to rounding."""
     from ._compiled import inv_dyn
 
-    tree = mech.tree
-    t = mech.compiled_tables
-    d = _dyn_tables(mech)
+    model = compile_model(mech)
+    tree, t, d = model.tree, model.tables, model.dyn
     N, nv, na = q.shape[0], tree.nv, len(tree.act_dof)
     sites = list(wr)
     W = np.zeros((N, len(sites), 6))
@@ -1071,8 +973,6 @@ def inverse_dynamics(
         arrays = [(qd, "qd", nv), (qdd, "qdd", nv)]
     names, batch, ok, flat = _site_inputs(mech, q, arrays, wrenches)
     n = flat[0].shape[0]
-    from . import _assembly
-
     if not act_mode:
 
         def fn_full(qf, qdf, qddf, *ws):
@@ -1080,19 +980,12 @@ def inverse_dynamics(
             return _finish_inverse(mech, qf, d, False)
 
         d = _run_chunked(fn_full, n, flat)
-    elif n >= _assembly.COMPILED_MIN:  # same formulas, compiled per sample (_compiled.inv_dyn)
+    else:  # the one implementation, compiled per sample (_compiled.inv_dyn), any batch size
         with np.errstate(all="ignore"):
             d = _inverse_compiled(
                 mech, flat[0], flat[1], flat[2], dict(zip(names, flat[3:], strict=True)), w, gravity
             )
             d = _finish_inverse(mech, flat[0], d, True)
-    else:
-
-        def fn(qf, qdf, qddf, *ws):
-            d = _inverse_flat(mech, qf, qdf, qddf, dict(zip(names, ws, strict=True)), w, gravity)
-            return _finish_inverse(mech, qf, d, True)
-
-        d = _run_chunked(fn, n, flat)
     return InverseDynamicsResult(**_shape(d, batch, ok, _FORCE_KEYS))
 
 
@@ -1281,7 +1174,7 @@ def site_wrench(
             qc, tc = qf[i : i + CHUNK], tf[i : i + CHUNK]
             n = qc.shape[0]
             z = np.zeros((n, na))
-            st = _inverse_flat(mech, qc, z, z, {}, None, gravity)
+            st = _inverse_compiled(mech, qc, z, z, {}, None, gravity)
             state, _, G, _, _, _ = _influence_flat(mech, qc, False)
             b = tree.site_body[si]
             p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]

@@ -26,6 +26,7 @@ from robomech._validation import as_array, broadcast_batch, check_bool
 from ._assembly import check_mechanism, check_q
 from ._constraints import jacobian, jacobian_rate
 from ._model import Mechanism
+from ._options import PASSIVE_RANK_RTOL
 from ._tree import frame_jacobian, frame_jacobian_rate, kinematics, screw_rates
 
 __all__ = [
@@ -40,10 +41,6 @@ __all__ = [
     "site_pose",
 ]
 
-# Singular values of K_p below PASSIVE_RANK_RTOL * sigma_max are zero in the pseudo-inverse: K_p is
-# built from unit screws times lengths of order L, so rounding leaves ~1e-15 relative; a genuine
-# (non-singular) passive direction of a well-posed mechanism is far above 1e-10.
-PASSIVE_RANK_RTOL = 1e-10
 
 
 @dataclass(frozen=True)
@@ -272,19 +269,10 @@ def site_jacobian(mech: Mechanism, q: object, site: str) -> np.ndarray:
     mech = check_mechanism(mech)
     si = _site_index(mech, site)
     qf, batch = _flat(mech, q)
-    tree = mech.tree
-    from ._assembly import COMPILED_MIN
+    from ._compiled import compiled_site_jacobian  # numba loads on the first kernel call
 
-    if qf.shape[0] >= COMPILED_MIN:  # same formulas, compiled per sample (see _compiled.py)
-        from ._compiled import compiled_site_jacobian
-
-        J = compiled_site_jacobian(mech, qf, si)
-        return J.reshape(*batch, 6, J.shape[-1])
-    state, _, G, _, _, _ = _influence_flat(mech, qf, False)
-    b = tree.site_body[si]
-    p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
-    J = frame_jacobian(tree, state, b, p) @ G
-    return J.reshape(*batch, 6, G.shape[-1])
+    J = compiled_site_jacobian(mech, qf, si)
+    return J.reshape(*batch, 6, J.shape[-1])
 
 
 def site_hessian(mech: Mechanism, q: object, site: str) -> np.ndarray:

@@ -42,7 +42,9 @@ class BodyInertias:
 
 def body_inertias(mech: Mechanism) -> BodyInertias:
     """The tree's mass properties (bodies without an ``Inertial`` are massless), built once per mechanism."""
-    d = mech.__dict__  # the frozen description's cache slot, as cached_property uses
+    from ._compile import compile_model
+
+    d = compile_model(mech).cache  # the compiled model's, never the frozen description
     out = d.get("_rnea_inertias")
     if out is None:
         nb = len(mech.bodies) + 1

@@ -33,6 +33,7 @@ from robomech._validation import as_array, check_int, check_positive, check_real
 from robomech.analysis import workspace
 
 from ._assembly import FKResult, IKResult, check_mechanism, check_q, forward_kinematics, inverse_kinematics
+from ._compile import compile_model
 from ._influence import _influence_flat
 from ._mobility import mobility
 from ._model import Mechanism
@@ -142,7 +143,7 @@ def _generic_output_rank(
     """Rank of the scaled input-output Jacobian's ``rows`` at a generic configuration: the largest over the
     reference and GENERIC_SAMPLES assembled neighbours (fixed seed), cached per mechanism."""
     key = ("_sing_generic_rank", si, float(L), rows, None if ref_q is None else ref_q.tobytes(), float(rtol))
-    cache = mech.__dict__.setdefault("_sing_generic_rank", {})
+    cache = compile_model(mech).cache.setdefault("_sing_generic_rank", {})
     if key in cache:
         return cache[key]
     tree = mech.tree

@@ -1,0 +1,65 @@
+"""Same samples, same result, whatever the batch they come in (batch 1 included).
+
+Every multibody algorithm has one implementation (the compiled kernels run small batches in one
+block and large ones in parallel blocks of the same per-sample code; influence and site Hessians are
+batched numpy), so a sample's result must not depend on the batch around it: here batches of 1, 150,
+300 and 1000 (below and above the kernels' block size and the former numpy/compiled threshold) of the
+same samples agree to ``BATCH_RTOL`` for FK, site Jacobians, site Hessians, influence coefficients and
+inverse dynamics on the gallery.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from robomech import multibody as mb
+
+# Identical per-sample code gives identical bits; batched BLAS products (influence, Hessians) may
+# reassociate sums by batch size: a few ulps.  1e-12 relative to each quantity's largest entry.
+BATCH_RTOL = 1e-12
+SIZES = (1, 150, 300, 1000)
+GALLERY = ("four_bar", "bennett", "planar_3rrr", "delta", "rps_3", "stewart")
+# Inputs within 0.08 rad / 0.08 L of the reference configuration (inside every gallery workspace).
+SPREAD = 0.08
+
+
+def _close(a: np.ndarray, b: np.ndarray, what: str) -> None:
+    scale = max(1.0, float(np.nanmax(np.abs(b)))) if b.size else 1.0
+    assert np.array_equal(np.isnan(a), np.isnan(b)), what
+    assert np.nanmax(np.abs(a - b), initial=0.0) <= BATCH_RTOL * scale, what
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", GALLERY)
+def test_results_do_not_depend_on_the_batch_size(name):
+    mech = mb.gallery.load(name)
+    tree = mech.tree
+    rng = np.random.default_rng(7)
+    n = max(SIZES)
+    scale = np.where(tree.dof_translational[tree.act_dof], mech.length, 1.0)
+    qa = mech.q0[tree.act_qadr] + SPREAD * scale * rng.uniform(-1, 1, (n, len(mech.actuated)))
+    qd, qdd = rng.normal(size=qa.shape), rng.normal(size=qa.shape)
+    site = mech.sites[0].name
+
+    def run(k: int) -> dict[str, np.ndarray]:
+        fk = mb.forward_kinematics(mech, qa[:k])
+        q = fk.q
+        inf = mb.influence(mech, q)
+        r = mb.inverse_dynamics(mech, q, qd[:k], qdd[:k])
+        return {
+            "fk": q,
+            "site_jacobian": mb.site_jacobian(mech, q, site),
+            "site_hessian": mb.site_hessian(mech, q, site),
+            "G": inf.G,
+            "dG": inf.dG,
+            "tau": r.tau,
+            "M_a": r.M_a,
+        }
+
+    out = {k: run(k) for k in SIZES}
+    ref = out[max(SIZES)]
+    assert mb.forward_kinematics(mech, qa).converged.all()
+    for k in SIZES[:-1]:
+        for key, v in out[k].items():
+            _close(v, ref[key][:k], f"{key} at batch {k}")
