@@ -2,8 +2,8 @@
 
 References: MuJoCo (``mj_rne``, ``mj_fullM``, ``qacc`` of ``mj_forward`` under motor controls) and
 Pinocchio (``rnea``, ``crba``) on the same MJCF, an ODE of the compound pendulum written here, and the
-per-sample result of each batched call (batches of 1, 10 and 300, above the 256-sample threshold at
-which the compiled kernels take over).
+per-sample result of each batched call (batches of 1, 10 and 300: one sample, one block and several
+parallel blocks of the compiled kernels).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from robomech import multibody as mb
-from robomech.multibody import _assembly, _dynamics
+from robomech.multibody import _assembly, _compiled, _dynamics
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -27,9 +27,9 @@ ENGINE_RTOL = 1e-9
 BATCH_RTOL = 1e-12
 # The pendulum's simulation against solve_ivp of its ODE at rtol 1e-12: both integrate to ~1e-10.
 ODE_TOL = 1e-8
-# Batch sizes below and above _assembly.COMPILED_MIN (the numpy -> compiled switch).
+# Batch sizes: one sample, one block and several parallel blocks of the compiled kernels (_compiled.BLOCK)
 BATCHES = (1, 10, 300)
-assert max(BATCHES) > _assembly.COMPILED_MIN
+assert max(BATCHES) > 2 * _compiled.BLOCK
 
 ARM6 = """
 <mujoco model="arm6">
@@ -420,7 +420,7 @@ def test_type_two_singularity_reports_infinite_condition():
     b.connect("C", "coupler", "rocker", anchor1=(1.0, -0.5, 0.0))  # B, C, D collinear at q0
     b.actuate("a")
     mech = b.build()
-    for n in (1, 300):  # numpy and compiled paths
+    for n in (1, 300):  # one block and several parallel blocks
         r = mb.inverse_dynamics(mech, np.tile(mech.q0, (n, 1)), np.zeros((n, 1)), np.zeros((n, 1)))
         assert not r.valid.any() and np.all(r.cond > _dynamics.SINGULAR_COND)
 

@@ -108,6 +108,7 @@ class Model:
     idle_dof: int
     rank_K: int  # generic rank of the full constraint Jacobian
     dyn: DynTables
+    q_ref: np.ndarray  # (nq,) the assembled reference configuration (mech.q0), _reference
     # what other modules derive from the compiled model (their own keys); never the description
     cache: dict[str, Any] = field(default_factory=dict)
 
@@ -245,7 +246,12 @@ def _compile(mech: Mechanism) -> Model:
     cs = compile_constraints(mech, tree)
     act = tree.act_dof.astype(np.int64)
     pas = np.setdiff1d(np.arange(tree.nv), act).astype(np.int64)
-    inst = instantaneous_mobility(tree, cs, tree.q0[None])
+    from ._reference import assembled_reference  # lazily: _reference -> _assembly -> _compile
+
+    # the reference configuration: qpos0, or the assembly nearest to it for a description typed
+    # unassembled (a ValueError with the residual if none); the reference rank is taken there
+    q_ref = assembled_reference(mech, tree, cs)
+    inst = instantaneous_mobility(tree, cs, q_ref[None])
     total = tree.nv - inst.rank
     dof = total - inst.idle
     # the passive block has full column rank but for the idle motions (computed at the reference, not
@@ -284,6 +290,7 @@ def _compile(mech: Mechanism) -> Model:
         idle_dof=int(inst.idle),
         rank_K=int(rank_K),
         dyn=dyn,
+        q_ref=q_ref,
     )
 
 

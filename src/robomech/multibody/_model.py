@@ -497,17 +497,14 @@ class Mechanism:
     def nv(self) -> int:
         return self.tree.nv
 
-    @cached_property
-    def _assembled_q0(self) -> np.ndarray:
-        from ._reference import assembled_reference
-
-        return assembled_reference(self)
-
     @property
     def q0(self) -> np.ndarray:
         """Reference configuration, (nq,): MuJoCo's qpos0 if it satisfies the closures, else the
-        assembly nearest to it (``_reference``; a description that cannot assemble raises ValueError)."""
-        return self._assembled_q0.copy()
+        assembly nearest to it (``_reference``, in the compile step; a description that cannot assemble
+        raises ValueError)."""
+        from ._compile import compile_model
+
+        return compile_model(self).q_ref.copy()
 
     @property
     def length(self) -> float:

@@ -13,6 +13,8 @@ it is loaded (``from_mjcf``, ``Builder.build``) or first used.
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 
 from ._assembly import CONVERGED_RTOL, floating_base_dofs, solve_closure
@@ -31,9 +33,11 @@ START_PERTURBATIONS = 8
 PERTURBATION = 0.2
 
 
-def assembled_reference(mech) -> np.ndarray:
-    """``qpos0`` if it satisfies the closures to ``CONVERGED_RTOL * L``, else the assembly nearest to it."""
-    tree, cs = mech.tree, mech.constraints
+def assembled_reference(mech, tree, cs) -> np.ndarray:
+    """``qpos0`` if it satisfies the closures to ``CONVERGED_RTOL * L``, else the assembly nearest to it.
+
+    Called by the compile step (``_compile``) with the description's just-built tree and closure rows,
+    before the reference rank is taken there (so the rank is that of the assembled reference)."""
     q0 = np.array(tree.q0, dtype=float)
     if cs.m == 0:
         return q0
@@ -41,7 +45,10 @@ def assembled_reference(mech) -> np.ndarray:
     r0 = float(np.max(np.abs(residual(cs, tree, kinematics(tree, q0[None]), q0[None]))))
     if r0 <= tol:
         return q0
-    free = np.setdiff1d(np.arange(tree.nv), floating_base_dofs(mech))
+    # the compiled model is being built: the assembly runs on the tree and rows given here (the numpy
+    # iteration of solve_closure reads only .tree and .constraints; floating_base_dofs .closures)
+    view = SimpleNamespace(tree=tree, constraints=cs, closures=mech.closures)
+    free = np.setdiff1d(np.arange(tree.nv), floating_base_dofs(view))
     # the pose itself and a few fixed perturbations of it: a sketch typed with every link along one axis
     # is a singular start (the closure's gradient vanishes there), as a CAD solver also perturbs it
     rng = np.random.default_rng(0)
@@ -49,7 +56,7 @@ def assembled_reference(mech) -> np.ndarray:
     w = np.where(tree.dof_translational, tree.length, 1.0)[free]
     dv[1:, free] = PERTURBATION * w * rng.uniform(-1.0, 1.0, (START_PERTURBATIONS, len(free)))
     starts = integrate(tree, np.repeat(q0[None], 1 + START_PERTURBATIONS, axis=0), dv)
-    q, rc, _, _ = solve_closure(mech, starts, free, max_iter=ASSEMBLY_MAX_ITER)
+    q, rc, _, _ = solve_closure(view, starts, free, max_iter=ASSEMBLY_MAX_ITER)
     ok = rc <= tol
     if not ok.any():
         best = int(np.argmin(rc))
