@@ -569,3 +569,29 @@ def test_floating_quadruped_simulation_equals_mujoco_rk4():
     for _ in range(1000):
         mujoco.mj_step(m, d)
     assert np.max(np.abs(d.qpos - sim.q[1])) < RK4_TOL and np.max(np.abs(d.qvel - sim.qd[1])) < RK4_TOL
+
+
+@pytest.mark.parametrize("name", ["four_bar", "planar_3rrr", "delta"])
+def test_full_rate_form_equals_actuated_form_on_closed_chains(name):
+    """The virtual-work least-squares form (any kinematic class) against the influence-coefficient form
+    (closed chains actuated in every DOF): the same forces from the same motion."""
+    mech = dataclasses.replace(mb.gallery.load(name), gravity=(0.0, -9.81, -3.0))
+    rng = np.random.default_rng(9)
+    na = len(mech.actuated)
+    fk = mb.forward_kinematics(mech, mech.q0[mech.tree.act_qadr] + 0.1 * rng.uniform(-1, 1, (4, na)), steps=2)
+    assert fk.converged.all()
+    qda, qdda = rng.normal(size=(4, na)), rng.normal(size=(4, na))
+    inf = mb.influence(mech, fk.q)
+    qd = np.einsum("nij,nj->ni", inf.G, qda)
+    qdd = np.einsum("nij,nj->ni", inf.G, qdda) + np.einsum("nijk,nj,nk->ni", inf.dG, qda, qda)
+    a = mb.inverse_dynamics(mech, fk.q, qda, qdda)
+    f = mb.inverse_dynamics(mech, fk.q, qd=qd, qdd=qdd)
+    scale = np.max(np.abs(a.tau))
+    assert a.valid.all() and np.max(np.abs(f.tau - a.tau)) < 1e-9 * scale
+    # what is left does no work on any actuator-driven motion (G^T u = 0) ...
+    assert np.max(np.abs(np.einsum("nij,ni->nj", inf.G, f.unactuated))) < 1e-9 * scale
+    if mb.mobility(mech).idle_dof == 0:
+        assert f.valid.all() and np.max(np.abs(f.unactuated)) < 1e-9 * scale
+    else:  # ... it is the torque that would keep the Delta's idle forearm spins at rest (the G form
+        # prescribes them at rest; the full form says that no actuator can): small, but flagged
+        assert 0 < np.max(np.abs(f.unactuated)) < 1e-3 * scale and not f.valid.any()
