@@ -250,6 +250,19 @@ def test_inverse_dynamics_of_underactuated_systems(name, n):
     assert np.max(np.abs(one.unactuated - ok.unactuated[0])) <= BATCH_RTOL * scale
 
 
+def test_statics_of_a_floating_robot_is_the_base_wrench_of_its_weight():
+    mech = MECH["quadruped"]
+    q, _, _, _ = _states(mech, 3, seed=50)
+    z = np.zeros((3, mech.nv))
+    rne, _, _ = _mujoco("quadruped", q, z, z, np.zeros((3, 12)))
+    st = mb.statics(mech, q)
+    assert not st.valid.any()  # nothing holds the trunk up
+    assert _rel(st.tau, rne[:, _act_order(mech)]) < ENGINE_RTOL
+    assert _rel(st.unactuated[:, :6], rne[:, :6]) < ENGINE_RTOL
+    total = sum(b.inertial.mass for b in mech.bodies)
+    assert abs(st.unactuated[0, 2] - total * 9.81) < 1e-9 * total * 9.81  # the base carries the weight
+
+
 def test_rates_form_is_checked():
     with pytest.raises(ValueError, match="qd="):
         mb.inverse_dynamics(MECH["quadruped"], MECH["quadruped"].q0, np.zeros(12), np.zeros(12))

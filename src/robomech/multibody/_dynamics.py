@@ -1006,14 +1006,20 @@ class StaticsResult:
         Share that balances the site wrenches (N m or N).
     cond : ndarray, shape (...)
         Condition number of the passive constraint block.
+    unactuated : ndarray, shape (..., nv)
+        With fewer actuators than degrees of freedom: the generalized force the unactuated
+        coordinates would need to hold the mechanism at rest (a floating base: the base wrench), as
+        :attr:`InverseDynamicsResult.unactuated`; zero where the actuators determine the motion.
     valid : ndarray of bool, shape (...)
-        False at a singular configuration or a non-finite input.
+        False at a singular configuration, an unassembled ``q``, a non-finite input, or where the
+        actuators cannot hold the mechanism (``unactuated`` not zero).
     """
 
     tau: np.ndarray
     gravity_terms: np.ndarray
     external_terms: np.ndarray
     cond: np.ndarray
+    unactuated: np.ndarray
     valid: np.ndarray
 
 
@@ -1028,12 +1034,13 @@ def statics(
     """Actuator forces balancing ``wrenches`` (applied to the mechanism at sites) and gravity at rest.
 
     The same virtual-work projection as :func:`inverse_dynamics` at ``qd = qdd = 0``:
-    ``tau = -G^T (J_s^T W - g)``.
+    ``tau = -G^T (J_s^T W - g)``; with fewer actuators than degrees of freedom its full-rate form
+    (least-squares forces, ``unactuated`` the rest).
 
     Parameters
     ----------
     mech : Mechanism
-        The described mechanism, actuated in every degree of freedom.
+        The described mechanism.
     q : array_like, shape (..., nq)
         Assembled configurations (MuJoCo ``qpos``).
     wrenches : mapping of str to array_like, shape (..., 6), optional
@@ -1052,7 +1059,7 @@ def statics(
     Raises
     ------
     ValueError
-        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, an array is not
+        If ``mech`` is not a Mechanism, an array is not
         real of the stated shape (non-finite values are allowed and masked), a quaternion in ``q`` is
         zero, the batch shapes do not broadcast, ``wrenches`` is not a mapping of site names,
         ``weights`` is not ``n_act`` non-negative numbers (not all zero), or ``gravity`` is not a bool.
@@ -1069,9 +1076,13 @@ def statics(
     """
     mech = check_mechanism(mech)
     q = as_array(q, "q", (mech.nq,), finite=False)
-    z = np.zeros(len(mech.actuated))
-    r = inverse_dynamics(mech, q, z, z, wrenches=wrenches, weights=weights, gravity=gravity)
-    return StaticsResult(r.tau, r.gravity_terms, r.external_terms, r.cond, r.valid)
+    if _determined(mech):
+        z = np.zeros(len(mech.actuated))
+        r = inverse_dynamics(mech, q, z, z, wrenches=wrenches, weights=weights, gravity=gravity)
+    else:  # the least-squares forces and what the unactuated coordinates would need, at rest
+        z = np.zeros(mech.nv)
+        r = inverse_dynamics(mech, q, qd=z, qdd=z, wrenches=wrenches, weights=weights, gravity=gravity)
+    return StaticsResult(r.tau, r.gravity_terms, r.external_terms, r.cond, r.unactuated, r.valid)
 
 
 @dataclass(frozen=True)
