@@ -65,9 +65,10 @@ class Influence:
         ``max |K G| / L``: zero where every input rate is admissible, > 0 with redundant actuation
         (only admissible ``qd_act`` then have a meaning).
     sigma_min : ndarray, shape (...)
-        Smallest non-zero singular value of ``K_p`` (m).
+        Smallest non-zero singular value of ``K_p`` (m); the characteristic length where ``K_p`` is
+        empty (an open chain or tree: nothing can lose rank).
     cond : ndarray, shape (...)
-        Condition number of ``K_p``.
+        Condition number of ``K_p`` (1 where it is empty).
     """
 
     G: np.ndarray
