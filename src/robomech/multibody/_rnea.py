@@ -13,8 +13,8 @@ and projected ``tau_k = S_k . F_subtree(k)``.  The mass matrix is the composite-
 ``I^c_b`` the inertia of the subtree rooted at b (backward pass), ``M_ij = S_i . I^c_{body(i)} S_j`` for
 ``j`` a coordinate that moves ``body(i)``.  Loops closures are not applied: these are the tree's
 quantities (MuJoCo ``mj_rne`` / ``mj_fullM``, Pinocchio ``rnea`` / ``crba``); the closed-chain
-dynamics project them (``_dynamics``).  Each pass loops over the bodies in Python and is vectorised
-over the batch.
+dynamics project them (``_dynamics``).  The passes run per sample in compiled kernels
+(``_rnea_kernels``), large batches in parallel blocks.
 """
 
 from __future__ import annotations
@@ -23,10 +23,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, broadcast_batch, check_bool
+from robomech._validation import MAX_MAGNITUDE, as_array, broadcast_batch, check_bool
 
 from ._model import Mechanism
-from ._tree import kinematics, normalize_quaternions, quat_to_matrix
+from ._tree import normalize_quaternions, quat_to_matrix
 
 __all__ = ["BodyInertias", "body_inertias", "generalized_forces", "mass_matrix"]
 
@@ -59,112 +59,55 @@ def body_inertias(mech: Mechanism) -> BodyInertias:
     return out
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a x b`` over the last axis (component arithmetic: np.cross is slow on small batches)."""
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
-
-
-def _motion_cross(V: np.ndarray, S: np.ndarray) -> np.ndarray:
-    """``V x S`` for spatial motions ``[ω; v]``: ``[ω x ω_s; ω x v_s + v x ω_s]``."""
-    w, v = V[..., :3], V[..., 3:]
-    ws, vs = S[..., :3], S[..., 3:]
-    return np.concatenate([_cross(w, ws), _cross(w, vs) + _cross(v, ws)], axis=-1)
-
-
-def _world_inertia(bi: BodyInertias, T: np.ndarray):
-    """Per body: mass (nb,), world centre of mass ``c (N, nb, 3)``, world inertia about it (N, nb, 3, 3)."""
-    R = T[..., :3, :3]
-    c = (R @ bi.com[:, :, None])[..., 0] + T[..., :3, 3]
-    Ic = R @ bi.inertia @ R.swapaxes(-1, -2)
-    return bi.mass, c, Ic
-
-
-def _apply_inertia(m: np.ndarray, c: np.ndarray, Ic: np.ndarray, X: np.ndarray) -> np.ndarray:
-    """``I X`` for spatial inertias (mass ``m``, com ``c``, inertia about the com ``Ic``) and motions X
-    ``[ω; v]`` about the world origin: ``f = m (v + ω x c)``, ``n = Ic ω + c x f``."""
-    w, v = X[..., :3], X[..., 3:]
-    f = m[..., None] * (v + _cross(w, c))
-    n = (Ic @ w[..., None])[..., 0] + _cross(c, f)
-    return np.concatenate([n, f], axis=-1)
-
-
 def _rnea_flat(mech: Mechanism, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, g: np.ndarray) -> np.ndarray:
-    """Tree inverse dynamics ``(N, nv)`` at normalised ``q (N, nq)``, ``qd``, ``qdd (N, nv)``, gravity g."""
-    tree = mech.tree
-    N, nb = q.shape[0], len(tree.body_names)
-    st = kinematics(tree, q)
-    S = st.S
-    V = np.zeros((N, nb, 6))
-    A = np.zeros((N, nb, 6))
-    A[:, 0, 3:] = -g  # the base accelerates upwards at g: gravity on every body
-    for b in range(1, nb):
-        p = tree.parent[b]
-        v, a = V[:, p].copy(), A[:, p].copy()
-        for k in tree.body_jnts[b]:
-            typ, da = tree.jnt_type[k], tree.jnt_dadr[k]
-            n = (1, 1, 3, 6)[typ]
-            Sk = S[:, da : da + n]  # (N, n, 6)
-            vj = np.einsum("nkx,nk->nx", Sk, qd[:, da : da + n])
-            aj = np.einsum("nkx,nk->nx", Sk, qdd[:, da : da + n])
-            if typ <= 1:  # hinge / slide: the axis is carried by the frame before the joint
-                aj = aj + _motion_cross(v, Sk[:, 0]) * qd[:, da, None]
-            elif typ == 2:  # ball: axes of the frame after it (local angular velocity)
-                aj = aj + np.einsum("nkx,nk->nx", _motion_cross((v + vj)[:, None], Sk), qd[:, da : da + 3])
-            else:  # free: translation axes fixed in the world, rotation axes the body's own
-                aj = aj + np.einsum(
-                    "nkx,nk->nx", _motion_cross(vj[:, None], Sk[:, 3:]), qd[:, da + 3 : da + 6]
-                )
-            v, a = v + vj, a + aj
-        V[:, b], A[:, b] = v, a
-    m, c, Ic = _world_inertia(body_inertias(mech), st.T)
-    F = _apply_inertia(m, c, Ic, A)
-    h = _apply_inertia(m, c, Ic, V)
-    w, vl = V[..., :3], V[..., 3:]
-    F = F + np.concatenate([_cross(w, h[..., :3]) + _cross(vl, h[..., 3:]), _cross(w, h[..., 3:])], axis=-1)
-    for b in range(nb - 1, 0, -1):  # backward pass: each subtree's wrench into its parent
-        F[:, tree.parent[b]] += F[:, b]
-    return np.einsum("nkx,nkx->nk", S, F[:, tree.dof_body])
+    """Tree inverse dynamics ``(N, nv)`` at normalised ``q (N, nq)``, ``qd``, ``qdd (N, nv)``, gravity g
+    (the compiled kernel, ``_rnea_kernels.rnea_sample``, per sample)."""
+    from ._compile import compile_model
+    from ._rnea_kernels import rnea_batch
+
+    return rnea_batch(compile_model(mech), body_inertias(mech), q, qd, qdd, g)
 
 
 def _crba_flat(mech: Mechanism, q: np.ndarray) -> np.ndarray:
-    """Tree mass matrix ``(N, nv, nv)`` at normalised ``q (N, nq)`` (composite-rigid-body algorithm)."""
-    tree = mech.tree
-    nb = len(tree.body_names)
-    st = kinematics(tree, q)
-    m, c, Ic = _world_inertia(body_inertias(mech), st.T)
-    # composite inertias as 6 x 6 matrices about the world origin (columns: I applied to unit motions)
-    E = np.eye(6)
-    I6 = np.stack([_apply_inertia(m, c, Ic, np.broadcast_to(E[j], (*c.shape[:-1], 6))) for j in range(6)], -1)
-    for b in range(nb - 1, 0, -1):
-        I6[:, tree.parent[b]] += I6[:, b]
-    S = st.S
-    F = (I6[:, tree.dof_body] @ S[..., None])[..., 0]  # (N, nv, 6): I^c_{body(i)} S_i
-    Mf = F @ S.swapaxes(-1, -2)  # Mf[i, j] = S_i . I^c_{body(i)} S_j
-    anc = tree.A[tree.dof_body].astype(bool)  # anc[i, j]: coordinate j moves body(i)
-    return np.where(anc, Mf, np.where(anc.T, Mf.swapaxes(-1, -2), 0.0))
+    """Tree mass matrix ``(N, nv, nv)`` at normalised ``q (N, nq)`` (``_rnea_kernels.crba_block``)."""
+    from ._compile import compile_model
+    from ._rnea_kernels import crba_batch
+
+    return crba_batch(compile_model(mech), body_inertias(mech), q)
 
 
 def _flat_inputs(mech: Mechanism, q: object, others: list[tuple[object, str]]):
-    """Validate ``q (..., nq)`` and ``(..., nv)`` arrays; beyond-finite samples become NaN rows."""
-    qv = as_array(q, "q", (mech.nq,), finite="mask")
-    for a in mech.tree.quat_adr:
+    """Validate ``q (..., nq)`` and ``(..., nv)`` arrays; a sample with a non-finite entry or one beyond
+    ``MAX_MAGNITUDE`` is computed at the reference and returned NaN (``ok`` False)."""
+    tree = mech.tree
+    nq, nv = tree.nq, tree.nv
+    qv = as_array(q, "q", (nq,), finite=False)
+    for a in tree.quat_adr:
         nrm = np.linalg.norm(qv[..., a : a + 4], axis=-1)
         if np.any(np.isfinite(nrm) & (nrm < 1e-9)):
             raise ValueError(
                 f"Expected the quaternion q[..., {a}:{a + 4}] to be non-zero, got norm {nrm.min()}."
             )
-    arrs = [as_array(x, name, (mech.nv,), finite="mask") for x, name in others]
-    batch = broadcast_batch((qv, 1, "q"), *((a, 1, name) for a, (_, name) in zip(arrs, others, strict=True)))
-    flat = [np.broadcast_to(qv, (*batch, mech.nq)).reshape(-1, mech.nq)]
-    flat += [np.broadcast_to(a, (*batch, mech.nv)).reshape(-1, mech.nv) for a in arrs]
-    ok = np.ones(flat[0].shape[0], dtype=bool)
-    for a in flat:
-        ok &= np.all(np.isfinite(a), axis=-1)
-    clean = [np.where(ok[:, None], a, 0.0) for a in flat]
-    clean[0] = normalize_quaternions(mech.tree, np.where(ok[:, None], flat[0], mech.tree.q0))
-    return batch, ok, clean
+    arrs = [as_array(x, name, (nv,), finite=False) for x, name in others]
+    if all(a.shape == (*qv.shape[:-1], nv) for a in arrs):
+        batch = qv.shape[:-1]  # the common case: nothing to broadcast
+    else:
+        batch = broadcast_batch(
+            (qv, 1, "q"), *((a, 1, name) for a, (_, name) in zip(arrs, others, strict=True))
+        )
+    n = int(np.prod(batch))
+    flat = [np.broadcast_to(qv, (*batch, nq)).reshape(n, nq)]
+    flat += [np.broadcast_to(a, (*batch, nv)).reshape(n, nv) for a in arrs]
+    ok = np.ones(n, dtype=bool)
+    with np.errstate(invalid="ignore"):
+        for a in flat:
+            ok &= np.all(np.abs(a) <= MAX_MAGNITUDE, axis=-1)  # False for NaN and inf too
+    if not ok.all():
+        flat = [np.where(ok[:, None], a, 0.0) for a in flat]
+        flat[0] = np.where(ok[:, None], flat[0], tree.q0)
+    if tree.quat_adr:
+        flat[0] = normalize_quaternions(tree, flat[0])
+    return batch, ok, flat
 
 
 def generalized_forces(
@@ -222,8 +165,9 @@ def generalized_forces(
     g = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
     with np.errstate(all="ignore"):
         tau = _rnea_flat(mech, qf, qdf, qddf, g)
-    tau = np.where(ok[:, None], tau, np.nan)
-    return tau.reshape(*batch, mech.nv)
+    if not ok.all():
+        tau = np.where(ok[:, None], tau, np.nan)
+    return tau.reshape(*batch, tau.shape[-1])
 
 
 def mass_matrix(mech: Mechanism, q: object) -> np.ndarray:
@@ -269,5 +213,6 @@ def mass_matrix(mech: Mechanism, q: object) -> np.ndarray:
     batch, ok, (qf,) = _flat_inputs(mech, q, [])
     with np.errstate(all="ignore"):
         M = _crba_flat(mech, qf)
-    M = np.where(ok[:, None, None], M, np.nan)
-    return M.reshape(*batch, mech.nv, mech.nv)
+    if not ok.all():
+        M = np.where(ok[:, None, None], M, np.nan)
+    return M.reshape(*batch, *M.shape[1:])
