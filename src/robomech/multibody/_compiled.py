@@ -656,6 +656,7 @@ def inv_dyn_block(
     smin_o,
     adm_o,
     valid_o,
+    clo_o,
 ):  # pragma: no cover - compiled
     """The closed-chain inverse dynamics of samples ``lo:hi`` (derivation: ``_dynamics``' docstring)."""
     nb = t.parent.shape[0]
@@ -710,6 +711,7 @@ def inv_dyn_block(
         qdda = QDD[n]
         kin(q, t, T, S)
         resjac(q, t, T, S, r, K, True)
+        clo_o[n] = _amax_abs(r)  # the closure of the input q (largest row, m)
         for i in range(m):
             for j in range(npas):
                 Kp[i, j] = K[i, pas[j]]
@@ -1020,6 +1022,7 @@ def inv_dyn_par(
     smin_o,
     adm_o,
     valid_o,
+    clo_o,
 ):  # pragma: no cover - compiled
     """:func:`inv_dyn_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
     N = Q.shape[0]
@@ -1048,6 +1051,7 @@ def inv_dyn_par(
             smin_o,
             adm_o,
             valid_o,
+            clo_o,
         )
 
 

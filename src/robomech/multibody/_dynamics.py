@@ -606,6 +606,7 @@ def _inverse_compiled(mech, q, qd_a, qdd_a, wr, weights, gravity=True) -> dict[s
         sigma_min=np.empty(N),
         admissibility=np.empty(N),
         valid=np.empty(N, dtype=np.bool_),
+        closure=np.empty(N),
     )
     f = np.ascontiguousarray
     inv_dyn(
@@ -810,8 +811,10 @@ def _finish_inverse(mech: Mechanism, q: np.ndarray, d: dict, actuated_mode: bool
 
     tree = mech.tree
     N = q.shape[0]
-    state = kinematics(tree, q)
-    d["closure"] = _closure_error(mech, state, q)
+    state = None
+    if "closure" not in d:  # the compiled kernel reports it (the same max |phi(q)|)
+        state = kinematics(tree, q)
+        d["closure"] = _closure_error(mech, state, q)
     if actuated_mode:
         d["unactuated"] = np.zeros((N, tree.nv))
         pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
@@ -820,6 +823,7 @@ def _finish_inverse(mech: Mechanism, q: np.ndarray, d: dict, actuated_mode: bool
         else:
             bad = np.flatnonzero(~d["valid"])
             if bad.size:
+                state = kinematics(tree, q) if state is None else state
                 sub = TreeState(T=state.T[bad], S=state.S[bad])
                 K = _constraint_matrix(mech, sub, q[bad])
                 d["sigma_min"][bad], d["cond"][bad] = _rank_measures(K[..., pas], _reference(mech)[0], tree.length)
