@@ -1065,6 +1065,52 @@ def inv_dyn(*args) -> None:
         inv_dyn_par(*args)
 
 
+_NO_W = (np.zeros((1, 0, 6)), np.zeros(0, dtype=np.int64), np.zeros((0, 4, 4)))
+_ZERO_G = np.zeros(3)
+_NO_WTS = np.zeros(0)
+
+
+def inv_dyn_one(model, q: np.ndarray, qd_a: np.ndarray, qdd_a: np.ndarray, gravity, on: bool) -> tuple | None:
+    """One sample through :func:`inv_dyn_block` with the least Python around it: the kernel's outputs
+    ``(tau, M_a, vel, grav, ext, qd, qdd, cond, smin, adm, valid, closure)`` with a leading axis of 1,
+    or None where the sample is not valid or not assembled (the caller's general path then flags it)."""
+    tree = model.tree
+    na, nv = len(model.act), tree.nv
+    gv = model.cache.get("gravity_vector")
+    if gv is None:
+        gv = model.cache["gravity_vector"] = np.array(gravity, dtype=float)
+    if not on:
+        gv = _ZERO_G
+    outs = (
+        np.empty((1, na)),
+        np.empty((1, na, na)),
+        np.empty((1, na)),
+        np.empty((1, na)),
+        np.empty((1, na)),
+        np.empty((1, nv)),
+        np.empty((1, nv)),
+        np.empty(1),
+        np.empty(1),
+        np.empty(1),
+        np.empty(1, dtype=np.bool_),
+        np.empty(1),
+    )
+    args = (0, 1, q.reshape(1, -1), qd_a.reshape(1, -1), qdd_a.reshape(1, -1), *_NO_W, gv, _NO_WTS)
+    args = (*args, model.tables, model.dyn, *outs)
+    fn = model.cache.get("inv_dyn_entry")
+    if fn is None:
+        inv_dyn_block(*args)  # compiles or loads the kernel, then its entry point skips the type dispatch
+        sig = tuple(numba.typeof(a) for a in args)
+        fn = model.cache["inv_dyn_entry"] = inv_dyn_block.overloads[sig].entry_point
+    else:
+        fn(*args)
+    if not outs[10][0] or not outs[11][0] <= opt.CLOSURE_RTOL * model.tables.L:
+        return None
+    if model.tables.m == 0 or len(model.pas) == 0:  # the empty passive block's measures
+        outs[7][0], outs[8][0] = 1.0, model.tables.L
+    return outs
+
+
 def compiled_fk(
     mech, q: np.ndarray, free: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
