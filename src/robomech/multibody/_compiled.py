@@ -1169,3 +1169,28 @@ def compiled_site_jacobian(mech, q: np.ndarray, site: int) -> np.ndarray:
     else:
         site_jac_par(Q, *args)
     return J
+
+
+def warm() -> None:
+    """Compile (or load) every kernel of this module on a small mechanism, so that a user's first
+    call finds them in the on-disk cache (``make install`` runs it).  The kernels' argument types do
+    not depend on the mechanism (packed tables of fixed array types), so one specialization per kernel
+    serves every mechanism."""
+    import logging
+
+    from . import _dynamics
+    from .gallery import load
+
+    if not logging.getLogger("robomech").handlers and not logging.getLogger().handlers:
+        logging.basicConfig(level=logging.INFO, format="%(name)s: %(message)s")
+        logging.getLogger("robomech").setLevel(logging.INFO)
+    mech = load("four_bar")
+    model = compile_model(mech)
+    site = mech.tree.site_index(mech.sites[0].name)
+    for n in (1, 2 * BLOCK + 1):  # one block in this thread, then parallel blocks
+        q = np.tile(mech.q0, (n, 1))
+        qf, _, _, _ = compiled_fk(mech, q, model.pas)
+        compiled_site_jacobian(mech, qf, site)
+        z = np.zeros((n, len(model.act)))
+        _dynamics._inverse_compiled(mech, qf, z, z, {}, None, True)
+    inv_dyn_one(model, mech.q0, np.zeros(1), np.zeros(1), mech.gravity, True)
