@@ -10,7 +10,7 @@ REPORTS ?=
 # A second venv with `pip install .` and no extras: what a user without MuJoCo gets.
 MINIMAL := .venv-minimal
 
-.PHONY: install run test bench verify lint typecheck docs check-minimal clean
+.PHONY: install run test test-slow test-all bench verify lint typecheck docs check-minimal clean
 
 install: $(STAMP)
 
@@ -30,9 +30,17 @@ run: install
 	$(BIN)/robomech reproduce --out $(OUT)
 	$(BIN)/robomech verify --out $(OUT)
 
+# The fast tier (the README's second command): lint and every test not marked `slow` (a few minutes).
 test: install
 	$(BIN)/ruff check src tests benchmarks examples docs/conf.py
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -m "not slow"
+
+# The slow tier: engine simulations, whole-study reproductions, clusters, teeth of the heavy checks.
+test-slow: install
+	$(BIN)/python -m pytest -q -m slow
+
+# Everything, both tiers (what CI runs).
+test-all: test test-slow
 
 verify: install
 	$(BIN)/robomech verify

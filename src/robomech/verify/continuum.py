@@ -9,7 +9,7 @@ Two kinds of checks:
   for straight-routed cables, so the library's tensions fed to the Cosserat rod must reproduce the
   library's tip pose (one segment: the virtual-work sign; two segments: the coupling moments of the
   distal cables).  Under a tip load the difference is the modelling error of constant curvature,
-  tabulated by :func:`cc_error_table` (issue 8's table; shown in the ``continuum`` study).
+  tabulated by :func:`cc_error_table` (shown in the ``continuum`` study).
 """
 
 from __future__ import annotations
@@ -532,7 +532,7 @@ CC_TABLE_LOADS = (
 
 
 def cc_error_table(robot: ContinuumRobot | None = None) -> CCErrorTable:
-    """Issue 8's table: library constant-curvature error vs the Cosserat rod (bends in the x-z plane)."""
+    """Library constant-curvature error vs the Cosserat rod (bends in the x-z plane)."""
     robot = ContinuumRobot.paper() if robot is None else robot
     bends = np.array(CC_TABLE_BENDS_DEG)
     forces = np.array([f for _, f in CC_TABLE_LOADS])

@@ -46,8 +46,8 @@ class ContinuumRobot:
         Coulomb friction coefficient per cable (3 n entries, >= 0); paper Table 1 (0.26, 0.31, 0.28).
     pretension : float
         Cable pretension T0 (N, >= 0); not printed, default 10 N (inside Fig. 6's 3-11 N range; with the
-        1.0 mm core a 90 deg bend needs ~13 N of tension difference, so 5 N, the default before issue 16,
-        lets the paid-out cables go slack there).
+        1.0 mm core a 90 deg bend needs ~13 N of tension difference, so 5 N lets the paid-out cables go slack
+        there).
     free_length : float
         Cable length between the actuator and the base plate (m, >= 0); not printed, default 0.1 m.
     cable_offset : float
@@ -67,7 +67,7 @@ class ContinuumRobot:
     hole_radius: float = 0.004
     core_modulus: float = 60e9
     # paper 3 prints no core diameter.  1.0 mm (EI = 2.9e-3 N m²) because the paper's robot runs stably
-    # at pretensions up to 11 N (Fig. 6; issue 16's range goes to 15 N): between two disks (h = 18 mm)
+    # at pretensions up to 11 N (Fig. 6; the verification range goes to 15 N): between two disks (h = 18 mm)
     # the core is a column under the three cables' compression 3 T, so the straight robot buckles at
     # T_cr = pi² EI / (3 h²) per cable (measured on the disk reference: 12.25 N with the 0.8 mm core
     # assumed before, inside that range; 29.9 N with 1.0 mm, twice 15 N), and the chord sagitta's

@@ -325,7 +325,7 @@ def body_velocity(
         resid[sl] = res.residual_norm
         # the condition number stays reported for finite rank-deficient samples (huge or inf)
         cond[sl] = np.where(res.ok, res.cond, np.nan)
-        # A finite but huge sample can overflow the residual (or x) to inf: never valid (issue 14).
+        # A finite but huge sample can overflow the residual (or x) to inf: never valid.
         valid[sl] = (
             res.ok & res.full_rank & np.isfinite(res.residual_norm) & np.all(np.isfinite(res.x), axis=-1)
         )

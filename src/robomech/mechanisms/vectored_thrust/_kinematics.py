@@ -652,8 +652,8 @@ def _ik_unmasked(th: VectoredThruster, s: np.ndarray) -> IKResult:
     # s0 = (sin q2 cos th, sin th, cos q2 cos th).  |q2| < pi/2 (enforced by the parameters) needs
     # cos q2 > 0, so cos(theta) takes the sign of u_z: the branch through q = 0 for a propeller above the
     # horizontal, and theta beyond 90 deg (the propeller past the horizontal, as the FK allows) below it.
-    # Taking cos(theta) > 0 there (as before issue 14) gave |q2| > pi/2 and a wrong root below, i.e. a
-    # "solved" q whose FK was another direction.  paper 5, eq. (13): phi2 = arctan(L*/N*) is right for
+    # Taking cos(theta) > 0 there gives |q2| > pi/2 and a wrong root below, i.e. a
+    # "solved" q whose FK is another direction.  paper 5, eq. (13): phi2 = arctan(L*/N*) is right for
     # u_z > 0 only.
     ct2 = ux * ux
     ct2 += uz * uz
