@@ -656,6 +656,7 @@ def inv_dyn_block(
     smin_o,
     adm_o,
     valid_o,
+    clo_o,
 ):  # pragma: no cover - compiled
     """The closed-chain inverse dynamics of samples ``lo:hi`` (derivation: ``_dynamics``' docstring)."""
     nb = t.parent.shape[0]
@@ -710,6 +711,7 @@ def inv_dyn_block(
         qdda = QDD[n]
         kin(q, t, T, S)
         resjac(q, t, T, S, r, K, True)
+        clo_o[n] = _amax_abs(r)  # the closure of the input q (largest row, m)
         for i in range(m):
             for j in range(npas):
                 Kp[i, j] = K[i, pas[j]]
@@ -1020,6 +1022,7 @@ def inv_dyn_par(
     smin_o,
     adm_o,
     valid_o,
+    clo_o,
 ):  # pragma: no cover - compiled
     """:func:`inv_dyn_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
     N = Q.shape[0]
@@ -1048,6 +1051,7 @@ def inv_dyn_par(
             smin_o,
             adm_o,
             valid_o,
+            clo_o,
         )
 
 
@@ -1059,6 +1063,52 @@ def inv_dyn(*args) -> None:
         inv_dyn_block(0, N, *args)
     else:
         inv_dyn_par(*args)
+
+
+_NO_W = (np.zeros((1, 0, 6)), np.zeros(0, dtype=np.int64), np.zeros((0, 4, 4)))
+_ZERO_G = np.zeros(3)
+_NO_WTS = np.zeros(0)
+
+
+def inv_dyn_one(model, q: np.ndarray, qd_a: np.ndarray, qdd_a: np.ndarray, gravity, on: bool) -> tuple | None:
+    """One sample through :func:`inv_dyn_block` with the least Python around it: the kernel's outputs
+    ``(tau, M_a, vel, grav, ext, qd, qdd, cond, smin, adm, valid, closure)`` with a leading axis of 1,
+    or None where the sample is not valid or not assembled (the caller's general path then flags it)."""
+    tree = model.tree
+    na, nv = len(model.act), tree.nv
+    gv = model.cache.get("gravity_vector")
+    if gv is None:
+        gv = model.cache["gravity_vector"] = np.array(gravity, dtype=float)
+    if not on:
+        gv = _ZERO_G
+    outs = (
+        np.empty((1, na)),
+        np.empty((1, na, na)),
+        np.empty((1, na)),
+        np.empty((1, na)),
+        np.empty((1, na)),
+        np.empty((1, nv)),
+        np.empty((1, nv)),
+        np.empty(1),
+        np.empty(1),
+        np.empty(1),
+        np.empty(1, dtype=np.bool_),
+        np.empty(1),
+    )
+    args = (0, 1, q.reshape(1, -1), qd_a.reshape(1, -1), qdd_a.reshape(1, -1), *_NO_W, gv, _NO_WTS)
+    args = (*args, model.tables, model.dyn, *outs)
+    fn = model.cache.get("inv_dyn_entry")
+    if fn is None:
+        inv_dyn_block(*args)  # compiles or loads the kernel, then its entry point skips the type dispatch
+        sig = tuple(numba.typeof(a) for a in args)
+        fn = model.cache["inv_dyn_entry"] = inv_dyn_block.overloads[sig].entry_point
+    else:
+        fn(*args)
+    if not outs[10][0] or not outs[11][0] <= opt.CLOSURE_RTOL * model.tables.L:
+        return None
+    if model.tables.m == 0 or len(model.pas) == 0:  # the empty passive block's measures
+        outs[7][0], outs[8][0] = 1.0, model.tables.L
+    return outs
 
 
 def compiled_fk(
@@ -1119,3 +1169,28 @@ def compiled_site_jacobian(mech, q: np.ndarray, site: int) -> np.ndarray:
     else:
         site_jac_par(Q, *args)
     return J
+
+
+def warm() -> None:
+    """Compile (or load) every kernel of this module on a small mechanism, so that a user's first
+    call finds them in the on-disk cache (``make install`` runs it).  The kernels' argument types do
+    not depend on the mechanism (packed tables of fixed array types), so one specialization per kernel
+    serves every mechanism."""
+    import logging
+
+    from . import _dynamics
+    from .gallery import load
+
+    if not logging.getLogger("robomech").handlers and not logging.getLogger().handlers:
+        logging.basicConfig(level=logging.INFO, format="%(name)s: %(message)s")
+        logging.getLogger("robomech").setLevel(logging.INFO)
+    mech = load("four_bar")
+    model = compile_model(mech)
+    site = mech.tree.site_index(mech.sites[0].name)
+    for n in (1, 2 * BLOCK + 1):  # one block in this thread, then parallel blocks
+        q = np.tile(mech.q0, (n, 1))
+        qf, _, _, _ = compiled_fk(mech, q, model.pas)
+        compiled_site_jacobian(mech, qf, site)
+        z = np.zeros((n, len(model.act)))
+        _dynamics._inverse_compiled(mech, qf, z, z, {}, None, True)
+    inv_dyn_one(model, mech.q0, np.zeros(1), np.zeros(1), mech.gravity, True)

@@ -612,6 +612,7 @@ def _inverse_compiled(mech, q, qd_a, qdd_a, wr, weights, gravity=True) -> dict[s
         sigma_min=np.empty(N),
         admissibility=np.empty(N),
         valid=np.empty(N, dtype=np.bool_),
+        closure=np.empty(N),
     )
     f = np.ascontiguousarray
     inv_dyn(
@@ -628,6 +629,63 @@ def _inverse_compiled(mech, q, qd_a, qdd_a, wr, weights, gravity=True) -> dict[s
         *out.values(),
     )
     return out
+
+
+def _inverse_one(mech, q, qd_a, qdd_a, gravity) -> InverseDynamicsResult | None:
+    """One sample given as float64 vectors of the exact shapes, no wrench, no weights: validated here,
+    computed by one call of the kernel block (the same per-sample code as every batch).  None — the
+    general path then validates, masks and explains — for any other input and for a sample that is
+    not valid (non-finite, singular, inadmissible or not assembled)."""
+    if not (
+        type(mech) is Mechanism
+        and type(q) is np.ndarray
+        and type(qd_a) is np.ndarray
+        and type(qdd_a) is np.ndarray
+        and (gravity is True or gravity is False)
+    ):
+        return None
+    model = compile_model(mech)
+    tree = model.tree
+    na, nv = len(model.act), tree.nv
+    if (
+        q.shape != (tree.nq,)
+        or qd_a.shape != (na,)
+        or qdd_a.shape != (na,)
+        or q.dtype != np.float64
+        or qd_a.dtype != np.float64
+        or qdd_a.dtype != np.float64
+        or na == 0
+        or na < model.dof
+    ):
+        return None
+    if tree.quat_adr:
+        q = q.copy()
+        for a in tree.quat_adr:
+            w, x, y, z = q[a], q[a + 1], q[a + 2], q[a + 3]
+            nrm = float(np.sqrt(w * w + x * x + y * y + z * z))
+            if not nrm >= 1e-9:  # zero or non-finite: the general path raises or masks
+                return None
+            q[a : a + 4] /= nrm
+    from ._compiled import inv_dyn_one
+
+    o = inv_dyn_one(model, q, qd_a, qdd_a, mech.gravity, gravity)
+    if o is None:
+        return None
+    return InverseDynamicsResult(
+        tau=o[0][0],
+        M_a=o[1][0],
+        velocity_terms=o[2][0],
+        gravity_terms=o[3][0],
+        external_terms=o[4][0],
+        qd=o[5][0],
+        qdd=o[6][0],
+        cond=o[7].reshape(()),
+        sigma_min=o[8].reshape(()),
+        admissibility=o[9].reshape(()),
+        unactuated=np.zeros(nv),
+        closure=o[11].reshape(()),
+        valid=o[10].reshape(()),
+    )
 
 
 def _run_chunked(fn, n: int, arrays: list[np.ndarray], **kw) -> dict[str, np.ndarray]:
@@ -826,8 +884,10 @@ def _finish_inverse(mech: Mechanism, q: np.ndarray, d: dict, actuated_mode: bool
 
     tree = mech.tree
     N = q.shape[0]
-    state = kinematics(tree, q)
-    d["closure"] = _closure_error(mech, state, q)
+    state = None
+    if "closure" not in d:  # the compiled kernel reports it (the same max |phi(q)|)
+        state = kinematics(tree, q)
+        d["closure"] = _closure_error(mech, state, q)
     if actuated_mode:
         d["unactuated"] = np.zeros((N, tree.nv))
         pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
@@ -836,6 +896,7 @@ def _finish_inverse(mech: Mechanism, q: np.ndarray, d: dict, actuated_mode: bool
         else:
             bad = np.flatnonzero(~d["valid"])
             if bad.size:
+                state = kinematics(tree, q) if state is None else state
                 sub = TreeState(T=state.T[bad], S=state.S[bad])
                 K = _constraint_matrix(mech, sub, q[bad])
                 d["sigma_min"][bad], d["cond"][bad] = _rank_measures(
@@ -956,6 +1017,10 @@ def inverse_dynamics(
     >>> r.tau.shape, r.M_a.shape, bool(r.valid)
     ((1,), (1, 1), True)
     """
+    if qd is None and qdd is None and wrenches is None and weights is None:
+        one = _inverse_one(mech, q, qd_act, qdd_act, gravity)
+        if one is not None:  # one valid sample: straight into the kernel (the general path otherwise)
+            return one
     mech = check_mechanism(mech)
     gravity = check_bool(gravity, "gravity")
     act_mode = _rates_mode(mech, "inverse_dynamics", ("qd_act", qd_act), ("qd", qd))
