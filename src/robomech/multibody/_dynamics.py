@@ -350,19 +350,6 @@ def _kdot_qd(mech: Mechanism, state, q: np.ndarray, qd: np.ndarray, Sd: np.ndarr
     return np.concatenate(out, axis=-1) if out else np.zeros((q.shape[0], 0))
 
 
-def _tree_terms(mech: Mechanism, state, qd, Sd, qdd, gravity: bool = True):
-    """Tree dynamics ``M (N, nv, nv)``, velocity terms, gravity terms (N, nv) at ``qdd`` (DynamicsTerms)."""
-    tree = mech.tree
-    bd = _bodies(mech)
-    N = state.T.shape[0]
-    R = state.T[:, bd.idx, :3, :3]
-    Iw = R @ bd.inertia @ R.swapaxes(-1, -2)
-    _, J, a0 = _com_jacobians(tree, state, bd, qd, Sd)
-    g = np.asarray(mech.gravity) if gravity else np.zeros(3)
-    m = np.broadcast_to(bd.mass, (N, len(bd.mass)))
-    return _com_terms(m, Iw, J, a0, qd, qdd, np.broadcast_to(g, (N, 3)))
-
-
 def _energy_flat(mech: Mechanism, q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     tree = mech.tree
     bd = _bodies(mech)
@@ -1286,8 +1273,12 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
     K = _constraint_matrix(mech, state, q)
     Sd = _screw_rates(tree, state, qd)
     kdq = _kdot_qd(mech, state, q, qd, Sd)
-    terms = _tree_terms(mech, state, qd, Sd, np.zeros_like(qd), gravity)
-    f = -terms.velocity_terms - terms.gravity_terms
+    from ._rnea import _crba_flat, _rnea_flat
+
+    # the tree's mass matrix (CRBA) and velocity + gravity forces (RNEA at zero acceleration)
+    g = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
+    M = _crba_flat(mech, q)
+    f = -_rnea_flat(mech, q, qd, np.zeros_like(qd), g)
     if wr:
         f = f - _site_terms(mech, state, wr)
     f[:, tree.act_dof] += tau_a
@@ -1298,7 +1289,6 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
     else:
         qdd_p = np.zeros((N, nv))
         Pn = np.broadcast_to(np.eye(nv), (N, nv, nv))
-    M = terms.M
     Mc = Pn @ M @ Pn + (np.eye(nv) - Pn)
     rhs = _mv(Pn, f - _mv(M, qdd_p))
     if want_cond:
