@@ -14,6 +14,8 @@ import tempfile
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from robomech import multibody as mb
 from robomech.multibody import _assembly, _compiled, _dynamics
@@ -608,3 +610,25 @@ def test_full_rate_form_equals_actuated_form_on_closed_chains(name):
     else:  # ... it is the torque that would keep the Delta's idle forearm spins at rest (the G form
         # prescribes them at rest; the full form says that no actuator can): small, but flagged
         assert 0 < np.max(np.abs(f.unactuated)) < 1e-3 * scale and not f.valid.any()
+
+
+# Central difference of M along qd with step 1e-5: truncation ~h^2 |M'''| ~ 1e-10, rounding ~1e-11.
+FD_MDOT_TOL = 1e-7
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 10**6))
+def test_property_rnea_power_equals_kinetic_energy_rate(seed):
+    """Without the engines: qd . (M qdd + c) = dT/dt = qd . M qdd + qd . Mdot qd / 2 (c's work is half the
+    mass matrix's rate along the motion), with Mdot by central differences of mass_matrix on the arm."""
+    mech = MECH["arm6"]
+    rng = np.random.default_rng(seed)
+    q, qd, qdd = rng.uniform(-2, 2, 6), rng.normal(size=6), rng.normal(size=6)
+    h = 1e-5
+    Md = (mb.mass_matrix(mech, q + h * qd) - mb.mass_matrix(mech, q - h * qd)) / (2 * h)
+    M = mb.mass_matrix(mech, q)
+    f = mb.generalized_forces(mech, q, qd, qdd, gravity=False)
+    lhs = qd @ f
+    rhs = qd @ M @ qdd + 0.5 * qd @ Md @ qd
+    assert abs(lhs - rhs) < FD_MDOT_TOL * max(1.0, abs(rhs))
+    assert np.allclose(M, M.T, rtol=0, atol=1e-15) and np.min(np.linalg.eigvalsh(M)) > 0
