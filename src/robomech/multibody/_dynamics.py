@@ -426,7 +426,8 @@ class InverseDynamicsResult:
     ----------
     tau : ndarray, shape (..., n_act)
         Generalized force at each actuated joint, in actuator order (N m or N; actuator gear not
-        applied).  NaN where not ``valid``.
+        applied).  NaN where not ``valid`` — except, from full rates, where only ``unactuated`` is
+        not zero: the least-squares forces are kept there (the closest the actuators come).
     M_a : ndarray, shape (..., n_act, n_act)
         Mass matrix in actuator space, ``G^T M G`` (kg m^2, kg); with redundant actuation the
         distributed ``Pi G^T M G``, ``Pi`` the stated rule's projector.  From full rates ``qd``,
