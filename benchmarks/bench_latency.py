@@ -7,7 +7,12 @@
 * 10^5 samples: the same call over the batch on all cores (numba ``prange`` over blocks), against
   one thread (``numba.set_num_threads(1)``) and against the lean MuJoCo loop per sample.
 
-``python benchmarks/bench_latency.py`` prints the table recorded in docs/performance.md.
+* a 6-DOF serial arm (a Builder description, exported to MJCF and read by Pinocchio's own MJCF parser):
+  batch-1 ``mb.inverse_dynamics`` and ``mb.generalized_forces`` against ``pinocchio.rnea`` (same
+  answer checked to 1e-10).
+
+``python benchmarks/bench_latency.py`` prints the table recorded in docs/performance.md (per-call
+latencies are not batched workloads: :func:`workloads` gives ``make bench`` none).
 """
 
 from __future__ import annotations
@@ -61,6 +66,62 @@ def lean_mujoco(mech):
     return one
 
 
+def workloads() -> list:
+    """None for ``benchmarks/run.py``: this file prints its own latency table (``main``)."""
+    return []
+
+
+def arm6() -> mb.Mechanism:
+    """A 6-DOF serial arm (alternating axes, offset links, every body massive), all joints actuated."""
+    b = mb.Builder("arm6")
+    axes = [(0, 0, 1), (0, 1, 0), (0, 1, 0), (1, 0, 0), (0, 1, 0), (1, 0, 0)]
+    parent = "world"
+    for i, ax in enumerate(axes):
+        b.body(
+            f"l{i}",
+            parent=parent,
+            pos=(0.2, 0, 0) if i % 2 else (0, 0, 0.1 if i else 0.0),
+            joints=[b.hinge(f"j{i}", axis=ax)],
+            inertial=mb.Inertial(1.0 + 0.1 * i, pos=(0.05, 0.01, 0.02), diaginertia=(0.01, 0.012, 0.008)),
+        )
+        parent = f"l{i}"
+    b.site("tool", parent, pos=(0.1, 0, 0))
+    b.actuate(*[f"j{i}" for i in range(6)])
+    return b.build()
+
+
+def _arm_rows() -> list[str]:
+    import os
+    import tempfile
+
+    import pinocchio as pin
+
+    mech = arm6()
+    rng = np.random.default_rng(0)
+    q, qd, qdd = rng.uniform(-1, 1, 6), rng.normal(size=6), rng.normal(size=6)
+    path = os.path.join(tempfile.mkdtemp(), "arm6.xml")
+    with open(path, "w") as f:
+        f.write(mb.to_mjcf(mech))
+    pm = pin.buildModelFromMJCF(path)
+    pd = pm.createData()
+    ref = pin.rnea(pm, pd, q, qd, qdd)
+    tau = mb.inverse_dynamics(mech, q, qd, qdd).tau
+    assert np.max(np.abs(tau - ref)) <= 1e-10 * np.max(np.abs(ref))  # the same answer
+    assert np.max(np.abs(mb.generalized_forces(mech, q, qd, qdd) - ref)) <= 1e-10 * np.max(np.abs(ref))
+    tp = min(_per(lambda i: pin.rnea(pm, pd, q, qd, qdd), N_BATCH1) for _ in range(REPEATS))
+    rows = []
+    for label, fn in (
+        ("inverse_dynamics", lambda i: mb.inverse_dynamics(mech, q, qd, qdd)),
+        ("generalized_forces", lambda i: mb.generalized_forces(mech, q, qd, qdd)),
+    ):
+        t = min(_per(fn, N_BATCH1) for _ in range(REPEATS))
+        rows.append(
+            f"| 6-DOF arm {label}, batch 1 (per call) | {t * 1e6:.1f} us | "
+            f"pinocchio.rnea {tp * 1e6:.1f} us | {tp / t:.2f}x |"
+        )
+    return rows
+
+
 def _per(fn, n):
     fn(0)
     t0 = time.perf_counter()
@@ -94,7 +155,7 @@ def main() -> None:
         mb.inverse_dynamics(mech, q, qd, qdd)
         ts = min(ts, (time.perf_counter() - t0) / N_LARGE)
     numba.set_num_threads(threads)
-    print("| workload | robomech | lean MuJoCo loop | ratio |")
+    print("| workload | robomech | alternative | alternative / robomech |")
     print("|---|---|---|---|")
     print(
         f"| Delta inverse dynamics, batch 1 (per call) | {t1 * 1e6:.0f} us | {tmj * 1e6:.0f} us | "
@@ -108,6 +169,8 @@ def main() -> None:
         f"| Delta inverse dynamics, 10^5 samples, 1 thread (per sample) | {ts * 1e6:.2f} us | — | "
         f"parallel speed-up {ts / tp:.2f}x |"
     )
+    for row in _arm_rows():
+        print(row)
 
 
 if __name__ == "__main__":

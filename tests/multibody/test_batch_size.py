@@ -86,3 +86,29 @@ def test_one_sample_call_is_the_batch_call(name):
     bad[0] = np.nan
     r = mb.inverse_dynamics(mech, q, qd, bad)
     assert not bool(r.valid) and np.all(np.isnan(r.tau))
+
+
+# The compiled RNEA and the numpy formulation (_rnea._rnea_flat) sum the same terms in another order:
+# rounding of the largest force, ~1e-16 relative measured.
+RNEA_RTOL = 1e-13
+
+
+@pytest.mark.parametrize("name", ("four_bar", "delta", "stewart"))
+def test_generalized_forces_one_kernel_at_every_batch_size(name):
+    from robomech.multibody._rnea import _rnea_flat
+    from robomech.multibody._tree import normalize_quaternions
+
+    mech = mb.gallery.load(name)
+    rng = np.random.default_rng(5)
+    n = 300
+    q = normalize_quaternions(mech.tree, mech.q0 + 0.05 * rng.normal(size=(n, mech.nq)))
+    qd, qdd = rng.normal(size=(n, mech.nv)), rng.normal(size=(n, mech.nv))
+    ref = _rnea_flat(mech, q, qd, qdd, np.asarray(mech.gravity))
+    got = mb.generalized_forces(mech, q, qd, qdd)
+    assert np.max(np.abs(got - ref)) <= RNEA_RTOL * np.max(np.abs(ref))
+    for k in (1, 150):
+        assert np.array_equal(mb.generalized_forces(mech, q[:k], qd[:k], qdd[:k]), got[:k])
+    assert np.array_equal(mb.generalized_forces(mech, q[7], qd[7], qdd[7]), got[7])
+    bad = qdd[7].copy()
+    bad[0] = np.nan
+    assert np.all(np.isnan(mb.generalized_forces(mech, q[7], qd[7], bad)))

@@ -1171,6 +1171,160 @@ def compiled_site_jacobian(mech, q: np.ndarray, site: int) -> np.ndarray:
     return J
 
 
+# ----------------------------------------------------------------------------- tree inverse dynamics (RNEA)
+@_nj
+def _mcross(w0, w1, w2, v0, v1, v2, S, k, out, f):  # pragma: no cover - compiled
+    """``out += f * (V x S_k)`` for the spatial motion ``V = [w; v]``: ``[w x ws; w x vs + v x ws]``."""
+    a0, a1, a2, b0, b1, b2 = S[k, 0], S[k, 1], S[k, 2], S[k, 3], S[k, 4], S[k, 5]
+    out[0] += f * (w1 * a2 - w2 * a1)
+    out[1] += f * (w2 * a0 - w0 * a2)
+    out[2] += f * (w0 * a1 - w1 * a0)
+    out[3] += f * ((w1 * b2 - w2 * b1) + (v1 * a2 - v2 * a1))
+    out[4] += f * ((w2 * b0 - w0 * b2) + (v2 * a0 - v0 * a2))
+    out[5] += f * ((w0 * b1 - w1 * b0) + (v0 * a1 - v1 * a0))
+
+
+@_nj
+def _inertia_apply(mb, c, Ic, X, out):  # pragma: no cover - compiled
+    """``out = I X`` for the spatial inertia (mass ``mb``, world com ``c``, inertia about it ``Ic``) and
+    a motion ``X = [w; v]`` about the world origin: ``f = m (v + w x c)``, ``n = Ic w + c x f``."""
+    w0, w1, w2 = X[0], X[1], X[2]
+    f0 = mb * (X[3] + w1 * c[2] - w2 * c[1])
+    f1 = mb * (X[4] + w2 * c[0] - w0 * c[2])
+    f2 = mb * (X[5] + w0 * c[1] - w1 * c[0])
+    out[3], out[4], out[5] = f0, f1, f2
+    out[0] = Ic[0, 0] * w0 + Ic[0, 1] * w1 + Ic[0, 2] * w2 + (c[1] * f2 - c[2] * f1)
+    out[1] = Ic[1, 0] * w0 + Ic[1, 1] * w1 + Ic[1, 2] * w2 + (c[2] * f0 - c[0] * f2)
+    out[2] = Ic[2, 0] * w0 + Ic[2, 1] * w1 + Ic[2, 2] * w2 + (c[0] * f1 - c[1] * f0)
+
+
+@_nj
+def rnea_block(lo, hi, Q, QD, QDD, gv, t, d, tau_o):  # pragma: no cover - compiled
+    """The spanning tree's recursive Newton-Euler inverse dynamics of samples ``lo:hi`` (world frame,
+    the formulation of ``_rnea``: forward pass of twists and accelerations, the base accelerating at
+    ``[0; -g]``, body wrenches ``I A + V x* I V``, backward pass, ``tau_k = S_k . F_subtree``)."""
+    nb = t.parent.shape[0]
+    nv = t.A.shape[1]
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    V = np.empty((nb, 6))
+    Acc = np.empty((nb, 6))
+    F = np.empty((nb, 6))
+    vj = np.empty(6)
+    c = np.empty(3)
+    Ic = np.empty((3, 3))
+    h = np.empty(6)
+    fa = np.empty(6)
+    for n in range(lo, hi):
+        q, qd, qdd = Q[n], QD[n], QDD[n]
+        kin(q, t, T, S)
+        for i in range(6):
+            V[0, i] = 0.0
+            Acc[0, i] = 0.0
+        for i in range(3):
+            Acc[0, 3 + i] = -gv[i]
+        for b in range(1, nb):
+            p = t.parent[b]
+            for i in range(6):
+                V[b, i] = V[p, i]
+                Acc[b, i] = Acc[p, i]
+            for k in range(t.j0[b], t.j0[b + 1]):
+                typ, da = t.jtype[k], t.jdadr[k]
+                nd = 1 if typ <= 1 else (3 if typ == 2 else 6)
+                for i in range(6):
+                    acc = 0.0
+                    acc2 = 0.0
+                    for j in range(nd):
+                        acc += S[da + j, i] * qd[da + j]
+                        acc2 += S[da + j, i] * qdd[da + j]
+                    vj[i] = acc
+                    Acc[b, i] += acc2
+                w0, w1, w2, v0, v1, v2 = V[b, 0], V[b, 1], V[b, 2], V[b, 3], V[b, 4], V[b, 5]
+                if typ <= 1:  # the axis is carried by the frame before the joint
+                    _mcross(w0, w1, w2, v0, v1, v2, S, da, Acc[b], qd[da])
+                elif typ == 2:  # ball: axes of the frame after it
+                    for j in range(3):
+                        _mcross(
+                            w0 + vj[0],
+                            w1 + vj[1],
+                            w2 + vj[2],
+                            v0 + vj[3],
+                            v1 + vj[4],
+                            v2 + vj[5],
+                            S,
+                            da + j,
+                            Acc[b],
+                            qd[da + j],
+                        )
+                else:  # free: rotation axes the body's own, moved by the joint's own twist
+                    for j in range(3, 6):
+                        _mcross(vj[0], vj[1], vj[2], vj[3], vj[4], vj[5], S, da + j, Acc[b], qd[da + j])
+                for i in range(6):
+                    V[b, i] += vj[i]
+        F[:, :] = 0.0
+        for ib in range(d.bidx.shape[0]):
+            b = d.bidx[ib]
+            cx = d.com[ib]
+            for i in range(3):
+                c[i] = T[b, i, 3] + T[b, i, 0] * cx[0] + T[b, i, 1] * cx[1] + T[b, i, 2] * cx[2]
+            Ib = d.inertia[ib]
+            for i in range(3):
+                for j in range(3):
+                    acc = 0.0
+                    for u in range(3):
+                        ru = Ib[u, 0] * T[b, j, 0] + Ib[u, 1] * T[b, j, 1] + Ib[u, 2] * T[b, j, 2]
+                        acc += T[b, i, u] * ru
+                    Ic[i, j] = acc
+            _inertia_apply(d.mass[ib], c, Ic, Acc[b], fa)
+            _inertia_apply(d.mass[ib], c, Ic, V[b], h)
+            w0, w1, w2, v0, v1, v2 = V[b, 0], V[b, 1], V[b, 2], V[b, 3], V[b, 4], V[b, 5]
+            F[b, 0] = fa[0] + (w1 * h[2] - w2 * h[1]) + (v1 * h[5] - v2 * h[4])
+            F[b, 1] = fa[1] + (w2 * h[0] - w0 * h[2]) + (v2 * h[3] - v0 * h[5])
+            F[b, 2] = fa[2] + (w0 * h[1] - w1 * h[0]) + (v0 * h[4] - v1 * h[3])
+            F[b, 3] = fa[3] + (w1 * h[5] - w2 * h[4])
+            F[b, 4] = fa[4] + (w2 * h[3] - w0 * h[5])
+            F[b, 5] = fa[5] + (w0 * h[4] - w1 * h[3])
+        for b in range(nb - 1, 0, -1):
+            p = t.parent[b]
+            for i in range(6):
+                F[p, i] += F[b, i]
+        for b in range(1, nb):
+            for k in range(t.j0[b], t.j0[b + 1]):
+                typ, da = t.jtype[k], t.jdadr[k]
+                nd = 1 if typ <= 1 else (3 if typ == 2 else 6)
+                for j in range(nd):
+                    acc = 0.0
+                    for i in range(6):
+                        acc += S[da + j, i] * F[b, i]
+                    tau_o[n, da + j] = acc
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def rnea_par(Q, QD, QDD, gv, t, d, tau_o):  # pragma: no cover - compiled
+    """:func:`rnea_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        rnea_block(k * BLOCK, min(N, (k + 1) * BLOCK), Q, QD, QDD, gv, t, d, tau_o)
+
+
+def compiled_rnea(model, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray, gv: np.ndarray) -> np.ndarray:
+    """Tree inverse dynamics ``(N, nv)`` (:func:`rnea_block`) at normalised ``Q (N, nq)``, ``QD``, ``QDD``."""
+    N = Q.shape[0]
+    tau = np.empty((N, model.tree.nv))
+    if N <= BLOCK:
+        fn = model.cache.get("rnea_entry")
+        args = (0, N, Q, QD, QDD, gv, model.tables, model.dyn, tau)
+        if fn is None:
+            rnea_block(*args)
+            sig = tuple(numba.typeof(a) for a in args)
+            model.cache["rnea_entry"] = rnea_block.overloads[sig].entry_point
+        else:
+            fn(*args)
+    else:
+        rnea_par(Q, QD, QDD, gv, model.tables, model.dyn, tau)
+    return tau
+
+
 def warm() -> None:
     """Compile (or load) every kernel of this module on a small mechanism, so that a user's first
     call finds them in the on-disk cache (``make install`` runs it).  The kernels' argument types do
@@ -1194,3 +1348,6 @@ def warm() -> None:
         z = np.zeros((n, len(model.act)))
         _dynamics._inverse_compiled(mech, qf, z, z, {}, None, True)
     inv_dyn_one(model, mech.q0, np.zeros(1), np.zeros(1), mech.gravity, True)
+    for n in (1, 2 * BLOCK + 1):
+        z = np.zeros((n, mech.nv))
+        compiled_rnea(model, np.tile(mech.q0, (n, 1)), z, z, np.zeros(3))

@@ -644,6 +644,7 @@ def _inverse_one(mech, q, qd_a, qdd_a, gravity) -> InverseDynamicsResult | None:
         or qdd_a.dtype != np.float64
         or na == 0
         or na < model.dof
+        or not (q.flags.c_contiguous and qd_a.flags.c_contiguous and qdd_a.flags.c_contiguous)
     ):
         return None
     if tree.quat_adr:

@@ -25,6 +25,7 @@ import numpy as np
 
 from robomech._validation import MAX_MAGNITUDE, as_array, broadcast_batch, check_bool
 
+from ._compile import compile_model
 from ._model import Mechanism
 from ._tree import normalize_quaternions, quat_to_matrix
 
@@ -61,11 +62,13 @@ def body_inertias(mech: Mechanism) -> BodyInertias:
 
 def _rnea_flat(mech: Mechanism, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, g: np.ndarray) -> np.ndarray:
     """Tree inverse dynamics ``(N, nv)`` at normalised ``q (N, nq)``, ``qd``, ``qdd (N, nv)``, gravity g
-    (the compiled kernel, ``_rnea_kernels.rnea_sample``, per sample)."""
-    from ._compile import compile_model
-    from ._rnea_kernels import rnea_batch
+    (the compiled kernel ``_compiled.rnea_block``, per sample)."""
+    from ._compiled import compiled_rnea
 
-    return rnea_batch(compile_model(mech), body_inertias(mech), q, qd, qdd, g)
+    c = np.ascontiguousarray
+    return compiled_rnea(
+        compile_model(mech), c(q, dtype=float), c(qd, dtype=float), c(qdd, dtype=float), c(g, dtype=float)
+    )
 
 
 def _crba_flat(mech: Mechanism, q: np.ndarray) -> np.ndarray:
@@ -108,6 +111,52 @@ def _flat_inputs(mech: Mechanism, q: object, others: list[tuple[object, str]]):
     if tree.quat_adr:
         flat[0] = normalize_quaternions(tree, flat[0])
     return batch, ok, flat
+
+
+def _rnea_one(mech, q, qd, qdd, gravity) -> np.ndarray | None:
+    """One sample given as C-contiguous float64 vectors of the exact shapes, entries within
+    ``MAX_MAGNITUDE`` (robomech._validation's masking rule): the kernel's forces; None (the general
+    path validates and masks) otherwise."""
+    if not (
+        type(mech) is Mechanism
+        and type(q) is np.ndarray
+        and type(qd) is np.ndarray
+        and type(qdd) is np.ndarray
+        and (gravity is True or gravity is False)
+    ):
+        return None
+    model = compile_model(mech)
+    tree = model.tree
+    nq, nv = tree.nq, tree.nv
+    if (
+        q.shape != (nq,)
+        or qd.shape != (nv,)
+        or qdd.shape != (nv,)
+        or q.dtype != np.float64
+        or qd.dtype != np.float64
+        or qdd.dtype != np.float64
+        or not (q.flags.c_contiguous and qd.flags.c_contiguous and qdd.flags.c_contiguous)
+    ):
+        return None
+    big = max(np.abs(q).max(initial=0.0), np.abs(qd).max(initial=0.0), np.abs(qdd).max(initial=0.0))
+    if not big <= MAX_MAGNITUDE:  # NaN, inf or beyond: the general path masks the sample
+        return None
+    if tree.quat_adr:
+        q = q.copy()
+        for a in tree.quat_adr:
+            w, x, y, z = q[a], q[a + 1], q[a + 2], q[a + 3]
+            nrm = float(np.sqrt(w * w + x * x + y * y + z * z))
+            if not nrm >= 1e-9:
+                return None
+            q[a : a + 4] /= nrm
+    gv = model.cache.get("gravity_vector")
+    if gv is None:
+        gv = model.cache["gravity_vector"] = np.array(mech.gravity, dtype=float)
+    from ._compiled import compiled_rnea
+
+    return compiled_rnea(
+        model, q.reshape(1, nq), qd.reshape(1, nv), qdd.reshape(1, nv), gv if gravity else np.zeros(3)
+    )[0]
 
 
 def generalized_forces(
@@ -158,13 +207,20 @@ def generalized_forces(
     0.5
     """
     from ._assembly import check_mechanism
+    from ._compiled import compiled_rnea
 
+    one = _rnea_one(mech, q, qd, qdd, gravity)
+    if one is not None:  # one sample as float64 vectors: straight into the kernel
+        return one
     mech = check_mechanism(mech)
     gravity = check_bool(gravity, "gravity")
     batch, ok, (qf, qdf, qddf) = _flat_inputs(mech, q, [(qd, "qd"), (qdd, "qdd")])
     g = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
-    with np.errstate(all="ignore"):
-        tau = _rnea_flat(mech, qf, qdf, qddf, g)
+    c = np.ascontiguousarray
+    with np.errstate(all="ignore"):  # the one implementation (compiled), any batch size
+        tau = compiled_rnea(
+            compile_model(mech), c(qf, dtype=float), c(qdf, dtype=float), c(qddf, dtype=float), g
+        )
     if not ok.all():
         tau = np.where(ok[:, None], tau, np.nan)
     return tau.reshape(*batch, tau.shape[-1])
