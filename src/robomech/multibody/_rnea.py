@@ -193,9 +193,9 @@ def _rnea_one(mech, q, qd, qdd, gravity) -> np.ndarray | None:
         or not (q.flags.c_contiguous and qd.flags.c_contiguous and qdd.flags.c_contiguous)
     ):
         return None
-    # a sum, not max(): NaN propagates through it (max() of Python floats skips a NaN after the first)
-    big = np.abs(q).max(initial=0.0) + np.abs(qd).max(initial=0.0) + np.abs(qdd).max(initial=0.0)
-    if not big <= MAX_MAGNITUDE:  # NaN, inf or large: the general path masks or computes the sample
+    # sum of squares (three dot products, the cheapest full scan): NaN and inf propagate through it, and
+    # below MAX_MAGNITUDE^2 every entry is within MAX_MAGNITUDE; beyond, the general path masks or computes
+    if not q @ q + qd @ qd + qdd @ qdd <= MAX_MAGNITUDE * MAX_MAGNITUDE:
         return None
     if tree.quat_adr:
         q = q.copy()
