@@ -138,8 +138,9 @@ def _rnea_one(mech, q, qd, qdd, gravity) -> np.ndarray | None:
         or not (q.flags.c_contiguous and qd.flags.c_contiguous and qdd.flags.c_contiguous)
     ):
         return None
-    big = max(np.abs(q).max(initial=0.0), np.abs(qd).max(initial=0.0), np.abs(qdd).max(initial=0.0))
-    if not big <= MAX_MAGNITUDE:  # NaN, inf or beyond: the general path masks the sample
+    # sum of squares (three dot products, the cheapest full scan): NaN and inf propagate through it, and
+    # below MAX_MAGNITUDE^2 every entry is within MAX_MAGNITUDE; beyond, the general path masks or computes
+    if not q @ q + qd @ qd + qdd @ qdd <= MAX_MAGNITUDE * MAX_MAGNITUDE:
         return None
     if tree.quat_adr:
         q = q.copy()
