@@ -632,3 +632,15 @@ def test_property_rnea_power_equals_kinetic_energy_rate(seed):
     rhs = qd @ M @ qdd + 0.5 * qd @ Md @ qd
     assert abs(lhs - rhs) < FD_MDOT_TOL * max(1.0, abs(rhs))
     assert np.allclose(M, M.T, rtol=0, atol=1e-15) and np.min(np.linalg.eigvalsh(M)) > 0
+
+
+@pytest.mark.parametrize("name", list(XML))
+def test_kernels_equal_the_numpy_formulation(name):
+    """The compiled RNEA and CRBA against their numpy formulation (tests/multibody/_reference.py)."""
+    from ._reference import numpy_crba, numpy_rnea
+
+    mech = MECH[name]
+    q, qd, qdd, _ = _states(mech, 70, seed=60)  # more than one parallel block
+    g = np.asarray(mech.gravity)
+    assert _rel(mb.generalized_forces(mech, q, qd, qdd), numpy_rnea(mech, q, qd, qdd, g)) < BATCH_RTOL
+    assert _rel(mb.mass_matrix(mech, q), numpy_crba(mech, q)) < BATCH_RTOL
