@@ -799,7 +799,9 @@ def _inverse_full_flat(mech, q, qd, qdd, wr, weights, gravity=True):
     act = tree.act_dof
     na = len(act)
     L = tree.length
-    state = kinematics(tree, q)
+    closed = mech.constraints.m > 0
+    # a tree without site wrenches needs no kinematics here: the kernels compute their own
+    state = kinematics(tree, q) if closed or wr else None
     z = np.zeros_like(qd)
     gv = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
     M = _crba_flat(mech, q)
@@ -807,10 +809,10 @@ def _inverse_full_flat(mech, q, qd, qdd, wr, weights, gravity=True):
         _mv(M, qdd),
         _rnea_flat(mech, q, qd, z, np.zeros(3)),
         _rnea_flat(mech, q, z, z, gv),
-        _site_terms(mech, state, wr),
+        _site_terms(mech, state, wr) if wr else np.zeros((N, nv)),
     )
     f = parts[0] + parts[1] + parts[2] + parts[3]
-    K = _constraint_matrix(mech, state, q)
+    K = _constraint_matrix(mech, state, q) if closed else np.zeros((N, 0, nv))
     Nb, condK = _null_basis(mech, K)
     NbT = Nb.swapaxes(-1, -2)
     Na = Nb[:, act]  # (N, na, d): the actuated rows of the admissible motions
@@ -833,8 +835,9 @@ def _inverse_full_flat(mech, q, qd, qdd, wr, weights, gravity=True):
     # free motion, whose rounding must not count as a force the actuators cannot give)
     scale = np.max(np.abs(np.stack(parts)), axis=(0, -1)) if nv else np.zeros(N)
     e_force = np.max(np.abs(unact), axis=-1) / np.maximum(scale, 1e-300) if nv else np.zeros(N)
-    Sd = _screw_rates(tree, state, qd)
-    kdq = _kdot_qd(mech, state, q, qd, Sd)
+    if closed:
+        Sd = _screw_rates(tree, state, qd)
+        kdq = _kdot_qd(mech, state, q, qd, Sd)
     sv = np.max(np.abs(qd), axis=-1) if nv else np.zeros(N)
     sa = np.max(np.abs(qdd), axis=-1) + sv * sv if nv else np.zeros(N)
     if K.shape[1]:
@@ -875,7 +878,7 @@ def _finish_inverse(mech: Mechanism, q: np.ndarray, d: dict, actuated_mode: bool
     N = q.shape[0]
     state = None
     if "closure" not in d:  # the compiled kernel reports it (the same max |phi(q)|)
-        state = kinematics(tree, q)
+        state = kinematics(tree, q) if mech.constraints.m else None  # a tree has no closure to check
         d["closure"] = _closure_error(mech, state, q)
     if actuated_mode:
         d["unactuated"] = np.zeros((N, tree.nv))
@@ -1271,10 +1274,13 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
     tree = mech.tree
     N = q.shape[0]
     nv = tree.nv
-    state = kinematics(tree, q)
-    K = _constraint_matrix(mech, state, q)
-    Sd = _screw_rates(tree, state, qd)
-    kdq = _kdot_qd(mech, state, q, qd, Sd)
+    if mech.constraints.m or wr:
+        state = kinematics(tree, q)
+        K = _constraint_matrix(mech, state, q)
+        Sd = _screw_rates(tree, state, qd)
+        kdq = _kdot_qd(mech, state, q, qd, Sd)
+    else:  # a tree without site wrenches: the kernels below are all it needs
+        K, kdq = np.zeros((N, 0, nv)), np.zeros((N, 0))
     from ._rnea import _crba_flat, _rnea_flat
 
     # the tree's mass matrix (CRBA) and velocity + gravity forces (RNEA at zero acceleration)
@@ -1434,9 +1440,12 @@ def forward_dynamics(
     L = tree.length
 
     def fn(qf, rf, tf, *ws):
-        state = kinematics(tree, qf)
-        K = jacobian(mech.constraints, tree, state, qf)
         n = qf.shape[0]
+        if mech.constraints.m:
+            state = kinematics(tree, qf)
+            K = jacobian(mech.constraints, tree, state, qf)
+        else:  # a tree: no closure rows (and _closure_error needs no state)
+            state, K = None, np.zeros((n, 0, tree.nv))
         if act_mode:
             P, rank, _, cK = _pinv(K[..., pas], L)
             qd_f = np.zeros((n, tree.nv))
