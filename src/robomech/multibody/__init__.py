@@ -28,7 +28,11 @@ Beyond kinematics, the same description gives:
   :func:`constraint_jacobian` and its time derivative :func:`constraint_jacobian_rate`;
 * the influence coefficients ``G = ∂qd/∂qd_act (..., nv, n_act)`` and ``∂G/∂q_act``: :func:`influence`;
 * dynamics of the closed chain: :func:`inverse_dynamics`, :func:`statics`, :func:`site_wrench`,
-  :func:`forward_dynamics`, :func:`simulate`, :func:`energy` (the dynamics page of the documentation).
+  :func:`forward_dynamics`, :func:`simulate`, :func:`energy` (the dynamics page of the documentation);
+  for open chains, trees, underactuated and passive mechanisms and floating bases the same functions,
+  with every coordinate's rate ``qd (..., nv)`` where the actuated rates do not give the state;
+* the spanning tree's :func:`generalized_forces` (RNEA, MuJoCo ``mj_rne``) and :func:`mass_matrix`
+  (CRBA, ``mj_fullM``).
 """
 
 from __future__ import annotations
