@@ -17,7 +17,7 @@ from ._reference import numpy_reference
 Q_TOL = 1e-12
 J_TOL = 1e-12
 N = 512  # several parallel blocks of the kernels
-COMPILED_MIN = 256  # samples of the dynamics comparisons
+N_DYN = 256  # samples of the dynamics comparisons
 
 
 def _inputs(mech, seed):
@@ -156,7 +156,7 @@ _GALLERY = ["four_bar", "bennett", "planar_3rrr", "delta", "rps_3", "stewart"]
 @pytest.mark.parametrize("name", [*_GALLERY, "spherical_leg", "spherical_leg_angles"])
 def test_compiled_inverse_dynamics_equals_numpy(name):
     mech = _mechanism(name)
-    q, qd, qdd = _states(mech, 8, COMPILED_MIN, seed=11)
+    q, qd, qdd = _states(mech, 8, N_DYN, seed=11)
     site = mech.sites[0].name
     W = np.random.default_rng(12).normal(size=(q.shape[0], 6))
     fast, slow = _both(mech, q, qd, qdd, wrenches={site: W})

@@ -1199,12 +1199,12 @@ def _inertia_apply(mb, c, Ic, X, out):  # pragma: no cover - compiled
 
 
 @_nj
-def rnea_block(lo, hi, Q, QD, QDD, gv, t, d, tau_o):  # pragma: no cover - compiled
+def rnea_block(lo, hi, Q, QD, QDD, gv, t, tau_o):  # pragma: no cover - compiled
     """The spanning tree's recursive Newton-Euler inverse dynamics of samples ``lo:hi`` (world frame,
     the formulation of ``_rnea``: forward pass of twists and accelerations, the base accelerating at
     ``[0; -g]``, body wrenches ``I A + V x* I V``, backward pass, ``tau_k = S_k . F_subtree``)."""
     nb = t.parent.shape[0]
-    nv = t.A.shape[1]
+    nv = t.nv
     T = np.empty((nb, 4, 4))
     S = np.zeros((nv, 6))
     V = np.empty((nb, 6))
@@ -1262,12 +1262,12 @@ def rnea_block(lo, hi, Q, QD, QDD, gv, t, d, tau_o):  # pragma: no cover - compi
                 for i in range(6):
                     V[b, i] += vj[i]
         F[:, :] = 0.0
-        for ib in range(d.bidx.shape[0]):
-            b = d.bidx[ib]
-            cx = d.com[ib]
+        for ib in range(t.bidx.shape[0]):
+            b = t.bidx[ib]
+            cx = t.com[ib]
             for i in range(3):
                 c[i] = T[b, i, 3] + T[b, i, 0] * cx[0] + T[b, i, 1] * cx[1] + T[b, i, 2] * cx[2]
-            Ib = d.inertia[ib]
+            Ib = t.inertia[ib]
             for i in range(3):
                 for j in range(3):
                     acc = 0.0
@@ -1275,8 +1275,8 @@ def rnea_block(lo, hi, Q, QD, QDD, gv, t, d, tau_o):  # pragma: no cover - compi
                         ru = Ib[u, 0] * T[b, j, 0] + Ib[u, 1] * T[b, j, 1] + Ib[u, 2] * T[b, j, 2]
                         acc += T[b, i, u] * ru
                     Ic[i, j] = acc
-            _inertia_apply(d.mass[ib], c, Ic, Acc[b], fa)
-            _inertia_apply(d.mass[ib], c, Ic, V[b], h)
+            _inertia_apply(t.mass[ib], c, Ic, Acc[b], fa)
+            _inertia_apply(t.mass[ib], c, Ic, V[b], h)
             w0, w1, w2, v0, v1, v2 = V[b, 0], V[b, 1], V[b, 2], V[b, 3], V[b, 4], V[b, 5]
             F[b, 0] = fa[0] + (w1 * h[2] - w2 * h[1]) + (v1 * h[5] - v2 * h[4])
             F[b, 1] = fa[1] + (w2 * h[0] - w0 * h[2]) + (v2 * h[3] - v0 * h[5])
@@ -1300,11 +1300,11 @@ def rnea_block(lo, hi, Q, QD, QDD, gv, t, d, tau_o):  # pragma: no cover - compi
 
 
 @numba.njit(cache=True, error_model="numpy", parallel=True)
-def rnea_par(Q, QD, QDD, gv, t, d, tau_o):  # pragma: no cover - compiled
+def rnea_par(Q, QD, QDD, gv, t, tau_o):  # pragma: no cover - compiled
     """:func:`rnea_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
     N = Q.shape[0]
     for k in numba.prange((N + BLOCK - 1) // BLOCK):
-        rnea_block(k * BLOCK, min(N, (k + 1) * BLOCK), Q, QD, QDD, gv, t, d, tau_o)
+        rnea_block(k * BLOCK, min(N, (k + 1) * BLOCK), Q, QD, QDD, gv, t, tau_o)
 
 
 def compiled_rnea(model, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray, gv: np.ndarray) -> np.ndarray:
@@ -1313,7 +1313,7 @@ def compiled_rnea(model, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray, gv: np.
     tau = np.empty((N, model.tree.nv))
     if N <= BLOCK:
         fn = model.cache.get("rnea_entry")
-        args = (0, N, Q, QD, QDD, gv, model.tables, model.dyn, tau)
+        args = (0, N, Q, QD, QDD, gv, model.rnea, tau)
         if fn is None:
             rnea_block(*args)
             sig = tuple(numba.typeof(a) for a in args)
@@ -1321,7 +1321,7 @@ def compiled_rnea(model, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray, gv: np.
         else:
             fn(*args)
     else:
-        rnea_par(Q, QD, QDD, gv, model.tables, model.dyn, tau)
+        rnea_par(Q, QD, QDD, gv, model.rnea, tau)
     return tau
 
 
