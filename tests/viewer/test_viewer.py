@@ -183,3 +183,33 @@ def test_the_viewer_methods_validate_their_input(delta_viewer):
         v.screenshot("x.png", width=0)
     with pytest.raises(ValueError, match="path to play"):
         v.play()
+
+
+@pytest.mark.parametrize("name", ["delta", "stewart"])
+def test_mjcf_geoms_sit_where_mujoco_puts_them(name):
+    """The geoms hang on the description's body frames: placed at an assembled pose, their centres
+    are MuJoCo's own geom_xpos after mj_kinematics at the same qpos (an independent engine)."""
+    mujoco = pytest.importorskip("mujoco")
+    from robomech.viewer._geoms import mjcf_geoms
+
+    mech = mb.gallery.load(name)
+    path = mb.gallery.path(name)
+    geoms = mjcf_geoms(path)
+    qa0 = mech.q0[[mech.qpos_address(j) for j in mech.actuated]]
+    q = mb.forward_kinematics(mech, qa0 + 0.05, mech.q0).q
+    T = poses(mech, q)
+    index = {n: b for b, n in enumerate(mech.tree.body_names)}
+    ours = np.array([_world(T, index[g.body], g.pos) for g in geoms])
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    data.qpos[:] = q
+    mujoco.mj_kinematics(model, data)
+    drawn = [g for g in range(model.ngeom) if int(model.geom_type[g]) in (2, 3, 4, 5, 6, 7)]
+    np.testing.assert_allclose(ours, data.geom_xpos[drawn], atol=POINT_TOL)
+    v = view(mech, geometry=path)
+    try:
+        assert len(v._geom_nodes) == len(geoms) and all(not n.visible for n in v._links)
+    finally:
+        v.stop()
+    with pytest.raises(ValueError, match="geometry"):
+        view(mech, geometry="no-such-file.xml")

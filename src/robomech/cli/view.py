@@ -49,6 +49,17 @@ def _describe(target: str):
     return describe(target)
 
 
+def _geometry(target: str) -> Path | None:
+    """The MJCF file whose geoms to draw: the file given, or a gallery mechanism's file."""
+    from robomech import multibody as mb
+
+    if target in mb.gallery.NAMES:
+        return mb.gallery.path(target)
+    if target.lower().endswith(".xml") and Path(target).is_file():
+        return Path(target)
+    return None
+
+
 def _description() -> str:
     from robomech import multibody as mb
 
@@ -69,7 +80,10 @@ def _run(args: argparse.Namespace) -> int:
     from robomech import viewer
 
     try:
-        v = viewer.view(mech, site=args.site, port=args.port, open_browser=not args.no_browser)
+        v = viewer.view(
+            mech, site=args.site, port=args.port, open_browser=not args.no_browser,
+            geometry=_geometry(args.mechanism),
+        )  # fmt: skip
     except ValueError as exc:
         raise CliError(str(exc)) from exc
     except OSError as exc:  # the port is taken

@@ -20,6 +20,7 @@ from robomech._validation import as_array, check_int
 from robomech.multibody._assembly import check_mechanism, check_q
 from robomech.multibody._repr import compact_repr
 
+from ._geoms import Geom, mjcf_geoms
 from ._scene import (
     AXIS_LENGTH_FRACTION,
     TRIAD_FRACTION,
@@ -103,6 +104,7 @@ class Viewer:
         site: str | None,
         path: NDArray[np.float64] | None,
         times: NDArray[np.float64] | None,
+        geoms: tuple[Geom, ...] = (),
     ) -> None:
         try:
             import viser
@@ -111,6 +113,7 @@ class Viewer:
         self.mech = mech
         self.site = site
         self._scene: Scene = build_scene(mech)
+        self._geoms = geoms
         self._lock = threading.RLock()
         self._syncing = False
         self._path = path
@@ -166,6 +169,8 @@ class Viewer:
                 position=tuple(centre),
             )
             self._nodes.append((node, colour))
+        self._links = [node for node, _ in self._nodes]
+        self._geom_nodes = self._add_geoms()
         self._axes = []
         for j in sc.joints:
             parent = f"/bodies/{j.body}_{sc.body_names[j.body]}"
@@ -201,6 +206,51 @@ class Viewer:
         self._server.initial_camera.position = tuple(centre + np.array([1.6, -1.6, 1.2]) * L)
         self._server.initial_camera.look_at = tuple(centre)
 
+    def _add_geoms(self) -> list[Any]:
+        """The MJCF geoms, each under its body's frame (a frame per geom carries its pose)."""
+        srv, names = self._server.scene, self._scene.body_names
+        index = {n: b for b, n in enumerate(names)}
+        nodes = []
+        for k, g in enumerate(self._geoms):
+            b = index.get(g.body, 0 if g.body == "world" else None)
+            if b is None:
+                continue  # a body the description does not have (e.g. an auxiliary one)
+            base = f"/bodies/{b}_{names[b]}/geom{k}"
+            frame = srv.add_frame(base, show_axes=False, wxyz=tuple(g.quat), position=tuple(g.pos))
+            nodes.append(frame)
+            colour = tuple(round(255 * float(c)) for c in g.rgba[:3])
+            opacity = float(g.rgba[3]) if g.rgba[3] < 1 else None
+            shapes = []
+            r = float(g.size[0])
+            if g.type == "sphere":
+                shapes.append(srv.add_icosphere(f"{base}/s", radius=r, color=colour, opacity=opacity))
+            elif g.type == "ellipsoid":
+                shapes.append(
+                    srv.add_icosphere(f"{base}/s", radius=1.0, color=colour, opacity=opacity,
+                                      scale=tuple(float(x) for x in g.size[:3]))
+                )  # fmt: skip
+            elif g.type in ("capsule", "cylinder"):
+                h = 2 * float(g.size[1])
+                shapes.append(
+                    srv.add_cylinder(f"{base}/c", radius=r, height=h, color=colour, opacity=opacity)
+                )
+                if g.type == "capsule":
+                    for end, z in (("a", -h / 2), ("b", h / 2)):
+                        shapes.append(
+                            srv.add_icosphere(f"{base}/{end}", radius=r, color=colour, opacity=opacity,
+                                              position=(0.0, 0.0, z))
+                        )  # fmt: skip
+            elif g.type == "box":
+                shapes.append(
+                    srv.add_box(f"{base}/b", color=colour, dimensions=tuple(2 * g.size[:3]), opacity=opacity)
+                )
+            elif g.type == "mesh" and g.vertices is not None and g.faces is not None:
+                shapes.append(
+                    srv.add_mesh_simple(f"{base}/m", g.vertices, g.faces, color=colour, opacity=opacity)
+                )
+            self._nodes += [(shape, colour) for shape in shapes]
+        return nodes
+
     def _place(self, q: NDArray[np.float64]) -> None:
         T = poses(self.mech, q)
         if not np.all(np.isfinite(T)):
@@ -234,8 +284,12 @@ class Viewer:
             reset = gui.add_button("Reset to reference pose")
             reset.on_click(lambda _: self.set_q(np.asarray(self.mech.q0, float)))
         with gui.add_folder("Show"):
+            toggles = [("joint axes", self._axes, True)]
+            if self._geom_nodes:  # the file's shapes; the links (the kinematic skeleton) on request
+                toggles += [("MJCF geoms", self._geom_nodes, True), ("links", self._links, False)]
+                self._set_visible(self._links, False)
             for label, nodes, initial in (
-                ("joint axes", self._axes, True),
+                *toggles,
                 ("sites", self._sites, True),
                 ("body frames", self._body_axes, False),
             ):
@@ -470,6 +524,7 @@ def view(
     times: ArrayLike | None = None,
     port: int | None = None,
     open_browser: bool = False,
+    geometry: str | Path | None = None,
 ) -> Viewer:
     """Show ``mech`` in the browser: a live 3-D view with one slider per actuated joint.
 
@@ -489,6 +544,9 @@ def view(
         TCP port on 127.0.0.1 (default a free one).
     open_browser : bool, optional
         Open the page in the default web browser.
+    geometry : str or Path, optional
+        An MJCF file whose geoms are drawn on the bodies of the same names (e.g. the file ``mech``
+        was read from; needs MuJoCo); the links are then shown on request.
 
     Returns
     -------
@@ -543,7 +601,15 @@ def view(
     port = check_int(port, "port", low=1, high=65535)
     if not isinstance(open_browser, bool):
         raise ValueError(f"Expected open_browser to be True or False, got {open_browser!r}.")
-    viewer = Viewer(mech, np.asarray(q0, float), port=port, site=site, path=qs, times=tt)
+    geoms: tuple[Geom, ...] = ()
+    if geometry is not None:
+        if not isinstance(geometry, (str, Path)) or not Path(geometry).is_file():
+            raise ValueError(f"Expected geometry to be None or an MJCF file, got {geometry!r}.")
+        try:
+            geoms = mjcf_geoms(geometry)
+        except ValueError as exc:  # MuJoCo's compile error
+            raise ValueError(f"Expected geometry to be an MJCF file MuJoCo reads, got {exc}") from exc
+    viewer = Viewer(mech, np.asarray(q0, float), port=port, site=site, path=qs, times=tt, geoms=geoms)
     if open_browser:
         import webbrowser
 
