@@ -167,18 +167,18 @@ def build_scene(mech: Mechanism) -> Scene:
             continue
         (root, root_axis), rest = pts[i][0], pts[i][1:]
         for p, axis in rest:
-            a, b = root, p
-            if np.linalg.norm(b - a) < COINCIDENT_FRACTION * L:
+            end_a, end_b = root, p
+            if np.linalg.norm(end_b - end_a) < COINCIDENT_FRACTION * L:
                 at = T0[i, :3, :3] @ root + T0[i, :3, 3]
                 central = any(np.linalg.norm(at - c) < COINCIDENT_FRACTION * L for c in centres)
                 if not central or (root_axis is None and axis is None):
                     continue
                 r = ARC_RADIUS_FRACTION * L
-                a = root + r * root_axis if root_axis is not None else root
-                b = p + r * axis if axis is not None else p
-                if np.linalg.norm(b - a) < COINCIDENT_FRACTION * L:
+                end_a = root + r * root_axis if root_axis is not None else root
+                end_b = p + r * axis if axis is not None else p
+                if np.linalg.norm(end_b - end_a) < COINCIDENT_FRACTION * L:
                     continue
-            links.append(Link(i, a, b))
+            links.append(Link(i, end_a, end_b))
     return Scene(
         body_names=tuple(tree.body_names),
         links=tuple(links),

@@ -171,14 +171,14 @@ class Viewer:
             self._nodes.append((node, colour))
         self._links = [node for node, _ in self._nodes]
         self._geom_nodes = self._add_geoms()
-        self._axes = []
+        self._axes: list[Any] = []
         for j in sc.joints:
             parent = f"/bodies/{j.body}_{sc.body_names[j.body]}"
             colour = ACTUATED_COLOUR if j.actuated else JOINT_COLOUR
-            node = srv.scene.add_icosphere(
+            joint_node = srv.scene.add_icosphere(
                 f"{parent}/joint_{j.name}", radius=sc.joint_radius, color=colour, position=tuple(j.pos)
             )
-            self._nodes.append((node, colour))
+            self._nodes.append((joint_node, colour))
             if j.axis is not None:
                 half = 0.5 * AXIS_LENGTH_FRACTION * L * j.axis
                 seg = np.array([[j.pos - half, j.pos + half]])
@@ -218,16 +218,20 @@ class Viewer:
             base = f"/bodies/{b}_{names[b]}/geom{k}"
             frame = srv.add_frame(base, show_axes=False, wxyz=tuple(g.quat), position=tuple(g.pos))
             nodes.append(frame)
-            colour = tuple(round(255 * float(c)) for c in g.rgba[:3])
+            colour = (
+                round(255 * float(g.rgba[0])),
+                round(255 * float(g.rgba[1])),
+                round(255 * float(g.rgba[2])),
+            )
             opacity = float(g.rgba[3]) if g.rgba[3] < 1 else None
-            shapes = []
+            shapes: list[Any] = []
             r = float(g.size[0])
             if g.type == "sphere":
                 shapes.append(srv.add_icosphere(f"{base}/s", radius=r, color=colour, opacity=opacity))
             elif g.type == "ellipsoid":
                 shapes.append(
                     srv.add_icosphere(f"{base}/s", radius=1.0, color=colour, opacity=opacity,
-                                      scale=tuple(float(x) for x in g.size[:3]))
+                                      scale=(float(g.size[0]), float(g.size[1]), float(g.size[2])))
                 )  # fmt: skip
             elif g.type in ("capsule", "cylinder"):
                 h = 2 * float(g.size[1])
@@ -242,7 +246,9 @@ class Viewer:
                         )  # fmt: skip
             elif g.type == "box":
                 shapes.append(
-                    srv.add_box(f"{base}/b", color=colour, dimensions=tuple(2 * g.size[:3]), opacity=opacity)
+                    srv.add_box(
+                        f"{base}/b", color=colour, dimensions=2 * np.asarray(g.size[:3]), opacity=opacity
+                    )
                 )
             elif g.type == "mesh" and g.vertices is not None and g.faces is not None:
                 shapes.append(
@@ -282,9 +288,9 @@ class Viewer:
                 s.on_update(self._on_slider)
                 self._sliders.append(s)
             reset = gui.add_button("Reset to reference pose")
-            reset.on_click(lambda _: self.set_q(np.asarray(self.mech.q0, float)))
+            reset.on_click(self._on_reset)
         with gui.add_folder("Show"):
-            toggles = [("joint axes", self._axes, True)]
+            toggles: list[tuple[str, list[Any], bool]] = [("joint axes", self._axes, True)]
             if self._geom_nodes:  # the file's shapes; the links (the kinematic skeleton) on request
                 toggles += [("MJCF geoms", self._geom_nodes, True), ("links", self._links, False)]
                 self._set_visible(self._links, False)
@@ -294,7 +300,7 @@ class Viewer:
                 ("body frames", self._body_axes, False),
             ):
                 box = gui.add_checkbox(label, initial_value=initial)
-                box.on_update(lambda ev, nodes=nodes: self._set_visible(nodes, ev.target.value))
+                box.on_update(self._toggler(nodes))
         self._measures = gui.add_markdown("")
         self._frame_slider = None
         if self._path is not None:
@@ -307,6 +313,15 @@ class Viewer:
                 self._play_button.on_click(lambda _: self._toggle_play())
         shot = gui.add_button("Screenshot (PNG)")
         shot.on_click(self._on_screenshot)
+
+    def _toggler(self, nodes: list[Any]) -> Any:
+        def toggle(event: Any) -> None:
+            self._set_visible(nodes, bool(event.target.value))
+
+        return toggle
+
+    def _on_reset(self, _event: Any) -> None:
+        self.set_q(np.asarray(self.mech.q0, float))
 
     @staticmethod
     def _set_visible(nodes: list[Any], visible: bool) -> None:
@@ -365,7 +380,7 @@ class Viewer:
         try:
             for s, x in zip(self._sliders, q_act, strict=True):
                 if np.isfinite(x):
-                    s.value = float(np.clip(x, s.min, s.max))
+                    s.value = float(np.clip(x, s.min, s.max))  # type: ignore[misc]
         finally:
             self._syncing = False
 
@@ -381,7 +396,7 @@ class Viewer:
         if qa.shape != (len(self.mech.actuated),):
             raise ValueError(f"Expected q_act to have shape ({len(self.mech.actuated)},), got {qa.shape}.")
         with self._lock:
-            start = self.pose.q if self.pose.converged else self._good
+            start = self._good  # the pose shown if it assembled, else the last assembled one
             delta = np.abs(qa - start[self._addr])
             scale = np.array(
                 [STAGE_RAD if self.mech.joint(n).type == "hinge" else STAGE_LENGTH_FRACTION * self.mech.length
@@ -444,7 +459,7 @@ class Viewer:
             if not self._playing.wait(timeout=0.2) or self._frame_slider is None or self._path is None:
                 continue
             k = (int(self._frame_slider.value) + 1) % self._path.shape[0]
-            self._frame_slider.value = k  # runs _show_frame (callbacks are synchronous)
+            self._frame_slider.value = k  # type: ignore[misc]  # runs _show_frame (synchronously)
             time.sleep(1.0 / max(float(self._fps.value), 0.5))
 
     def play(self, playing: bool = True) -> None:
