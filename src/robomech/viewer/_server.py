@@ -49,6 +49,9 @@ SLIDE_SPAN_FRACTION = 1.0
 SLIDER_STEPS = 400
 # Playback: default frame rate (frames per second).
 PLAYBACK_FPS = 20.0
+# Camera distance from the centre of the drawing, in half-diagonals of its bounding box: the whole
+# mechanism in view at viser's default field of view (~50 deg) with a margin.
+CAMERA_DISTANCE = 2.6
 # Bound on the wait for a browser's render of a screenshot (s).
 SCREENSHOT_TIMEOUT = 20.0
 
@@ -202,8 +205,14 @@ class Viewer:
                     position=tuple(s.T[:3, 3]),
                 )
             )
-        centre = poses(self.mech, self.mech.q0)[:, :3, 3].mean(axis=0)
-        self._server.initial_camera.position = tuple(centre + np.array([1.6, -1.6, 1.2]) * L)
+        # the camera frames the whole drawing at q0 (links, joints, sites), from above one corner
+        T0 = poses(self.mech, np.asarray(self.mech.q0, float))
+        pts = [T0[k.body, :3, :3] @ p + T0[k.body, :3, 3] for k in sc.links for p in (k.a, k.b)]
+        pts += [T0[b, :3, 3] for b in range(len(sc.body_names))]
+        lo, hi = np.min(pts, axis=0), np.max(pts, axis=0)
+        centre, radius = (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, L / 2)
+        direction = np.array([1.0, -1.0, 0.75]) / np.linalg.norm([1.0, -1.0, 0.75])
+        self._server.initial_camera.position = tuple(centre + CAMERA_DISTANCE * radius * direction)
         self._server.initial_camera.look_at = tuple(centre)
 
     def _add_geoms(self) -> list[Any]:
@@ -474,7 +483,7 @@ class Viewer:
         if client is None:
             return
         png = self._render_png(client, 720, 960)
-        client.send_file_download(f"{self.mech.name}.png", png)
+        client.send_file_download(f"{self.mech.name}.png", png, save_immediately=True)
 
     @staticmethod
     def _render_png(client: Any, height: int, width: int) -> bytes:
