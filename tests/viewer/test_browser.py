@@ -3,7 +3,8 @@
 The server runs as a subprocess on 127.0.0.1 with a free port; the page must load without console
 errors, and moving the first actuated joint's slider through the page (keyboard on the slider, as a
 user would) must re-assemble the Delta: the status panel's configuration ``q`` changes and still
-reads "assembled"; the screenshot button must download a PNG of the view.  Every wait is bounded and the server is killed at the end.
+reads "assembled"; the screenshot button must download a PNG of the view.  Every wait is bounded
+and the server is killed at the end.
 """
 
 from __future__ import annotations
