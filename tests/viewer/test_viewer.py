@@ -213,3 +213,36 @@ def test_mjcf_geoms_sit_where_mujoco_puts_them(name):
         v.stop()
     with pytest.raises(ValueError, match="geometry"):
         view(mech, geometry="no-such-file.xml")
+
+
+def test_cli_motion_and_simulation_become_the_playback(tmp_path):
+    import argparse
+
+    from robomech.cli.view import _motion
+
+    mech = mb.gallery.load("four_bar")
+    q = mb.forward_kinematics(mech, np.linspace(0.2, 1.0, 4)[:, None]).q
+    np.savez(tmp_path / "m.npz", q=q, t=np.arange(4) * 0.5)
+    np.save(tmp_path / "m.npy", q)
+    none = {"motion": None, "simulate": None}
+    path, times = _motion(argparse.Namespace(**{**none, "motion": str(tmp_path / "m.npz")}), mech)
+    np.testing.assert_array_equal(path, q)
+    np.testing.assert_array_equal(times, np.arange(4) * 0.5)
+    path, times = _motion(argparse.Namespace(**{**none, "motion": str(tmp_path / "m.npy")}), mech)
+    np.testing.assert_array_equal(path, q)
+    assert times is None
+    sim, _ = _motion(argparse.Namespace(**{**none, "simulate": 0.1}), mech)
+    assert isinstance(sim, mb.SimulationResult) and sim.q.shape == (4, mech.nq) and bool(sim.success)
+    v = view(mech, path=sim)
+    try:
+        v._frame_slider.value = 3
+        np.testing.assert_allclose(v.pose.q, sim.q[3])
+    finally:
+        v.stop()
+    src = str(Path(__file__).resolve().parents[2] / "src")
+    env = {"PYTHONPATH": src, "PATH": "/usr/bin:/bin", "HOME": str(Path.home())}
+    r = subprocess.run(
+        [sys.executable, "-m", "robomech", "view", "four_bar", "--no-browser", "--motion", "missing.npy"],
+        capture_output=True, text=True, timeout=CLI_TIMEOUT, env=env, cwd=tmp_path,
+    )  # fmt: skip
+    assert r.returncode == 2 and "--motion" in r.stderr and "Traceback" not in r.stderr
