@@ -29,14 +29,15 @@ $(DOCS_STAMP): $(STAMP)
 CHROMIUM ?= /usr/bin/chromium-headless-shell
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 install-browser:
-	@test -x $(CHROMIUM) || { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium-headless-shell; }
+	@test -x $(CHROMIUM) || { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium-headless-shell; } \
+	  || echo "install-browser: could not install chromium-headless-shell; the browser tests will be skipped"
 
 run: install
 	$(BIN)/robomech reproduce --out $(OUT)
 	$(BIN)/robomech verify --out $(OUT)
 
 # The fast tier (the README's second command): lint and every test not marked `slow` (a few minutes).
-test: install
+test: install install-browser
 	$(BIN)/ruff check src tests benchmarks examples docs/conf.py
 	$(BIN)/python -m pytest -q -m "not slow"
 
@@ -61,8 +62,10 @@ typecheck: install
 	$(BIN)/mypy
 
 # The documentation site; -W: a warning is an error, -n: every cross-reference must resolve.
-# It runs examples/*.py and reproduces the fast studies for their pages (docs/conf.py);
-# `make docs REPORTS=out` shows every report of an earlier `make run` instead.
+# docs/conf.py writes an API page per public name, runs examples/*.py (sphinx-gallery), draws the
+# gallery mechanisms and reproduces the fast studies for their pages; `make docs REPORTS=out` also
+# shows the slow studies' reports of an earlier `make run`.  Math is rendered by MathJax served from
+# the site itself: the first build installs it from npm (Node.js) into docs/_build/npm.
 docs: $(DOCS_STAMP)
 	ROBOMECH_DOCS_REPORTS=$(REPORTS) $(BIN)/sphinx-build -W --keep-going -n -q -b html docs docs/_build/html
 	@echo "docs: open docs/_build/html/index.html"

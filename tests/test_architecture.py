@@ -46,7 +46,13 @@ ALLOWED = {
     "cli": {"studies", "verify", "explore", "viewer"},
     "__main__": {"cli"},  # `python -m robomech`
 }
-INFRASTRUCTURE = {"robomech", "robomech._validation", "robomech._registry", "robomech._numba"}
+INFRASTRUCTURE = {
+    "robomech",
+    "robomech._validation",
+    "robomech._registry",
+    "robomech._numba",
+    "robomech._progress",
+}
 ENGINES = {"mujoco", "exudyn", "pinocchio"}
 # The distributed-computing stack of robomech.explore: imported inside functions only (first use).
 LAZY = {"dask", "distributed", "zarr", "pymoo"}

@@ -123,7 +123,7 @@ def _description() -> str:
 def _run(args: argparse.Namespace) -> int:
     try:
         mech = _describe(args.mechanism)
-    except (ValueError, OSError) as exc:
+    except (ValueError, OSError, ImportError) as exc:  # ImportError: MJCF without MuJoCo
         raise CliError(str(exc)) from exc
     from robomech import viewer
 
@@ -133,7 +133,7 @@ def _run(args: argparse.Namespace) -> int:
             mech, site=args.site, port=args.port, open_browser=not args.no_browser,
             geometry=_geometry(args.mechanism), path=path, times=times,
         )  # fmt: skip
-    except ValueError as exc:
+    except (ValueError, ImportError) as exc:  # ImportError: without the view extra (viser)
         raise CliError(str(exc)) from exc
     except OSError as exc:  # the port is taken
         raise CliError(f"--port {args.port}: cannot serve ({exc.strerror or exc})") from exc

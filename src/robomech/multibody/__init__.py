@@ -22,26 +22,13 @@ every matrix "over all coordinates" has one column per *velocity* coordinate (Mu
 local angular velocity for ball joints).  ``q_act`` are the actuated joints' ``qpos`` entries in
 actuator order.
 
-Internals for the dynamics layer (issue 13).  All take flat batches and return world-frame
-quantities; ``mech.tree`` (``_tree.Tree``) and ``mech.constraints`` (``_constraints.Constraints``)
-are the compiled arrays, cached on the frozen mechanism:
+Beyond kinematics, the same description gives:
 
-* body poses: ``_tree.kinematics(tree, q (N, nq)) -> TreeState`` with ``.T (N, nb, 4, 4)`` every body's
-  world pose (index 0 the world; ``tree.body_names``) and ``.S (N, nv, 6)`` every velocity
-  coordinate's space screw ``[ω; v]``; ``_tree.body_poses`` for poses only;
-* body twists / Jacobians: ``_tree.space_jacobian(tree, state, b) (N, 6, nv)`` (space twist of body b,
-  ``V_b = J qd``), ``_tree.frame_jacobian(tree, state, b, p) (N, 6, nv)`` (``[ω; ṗ]`` of a world point
-  ``p (N, 3)`` fixed in b), ``_tree.body_twists(tree, state, qd)``; their time derivatives along ``qd``:
-  ``Sd = _tree.screw_rates(tree, state, qd)`` (``dS/dt``) and
-  ``_tree.frame_jacobian_rate(tree, state, Sd, b, p, qd)``;  ``tree.A (nb, nv)`` the ancestor mask;
-* constraint Jacobian and its derivative: ``_constraints.residual / jacobian / jacobian_rate``
-  (``K (N, m, nv)``, ``dK/dt`` along ``qd``); public, batched over any shape:
-  :func:`constraint_residual`, :func:`constraint_jacobian`, :func:`constraint_jacobian_rate`;
-* ``G = ∂qd/∂qd_act (…, nv, n_act)`` and ``∂G/∂q_act``: :func:`influence` (``_influence._influence_flat``
-  for flat batches, returning the state, K, G, dG and the screw rates together);
-* dynamics (issue 13, ``_dynamics``): :func:`inverse_dynamics`, :func:`statics`, :func:`site_wrench`,
-  :func:`forward_dynamics`, :func:`simulate`, :func:`energy` (docs/dynamics.md);
-* ``_tree.integrate(tree, q, dv)``: ``q ⊕ dv`` on the configuration manifold (``mj_integratePos``).
+* the loop-closure constraints, batched over any shape: :func:`constraint_residual`,
+  :func:`constraint_jacobian` and its time derivative :func:`constraint_jacobian_rate`;
+* the influence coefficients ``G = ∂qd/∂qd_act (..., nv, n_act)`` and ``∂G/∂q_act``: :func:`influence`;
+* dynamics of the closed chain: :func:`inverse_dynamics`, :func:`statics`, :func:`site_wrench`,
+  :func:`forward_dynamics`, :func:`simulate`, :func:`energy` (the dynamics page of the documentation).
 """
 
 from __future__ import annotations
