@@ -12,9 +12,10 @@ as spheres at their anchors with their axes as short segments; sites and body fr
 triads.
 
 A child's anchor in its parent's frame is ``T_off @ pos`` (the child's frame at zero joint
-coordinate, times the joint's anchor): a hinge or ball turns about that point and a slide starts
-there, so for every joint type the point is fixed in the parent (a slider is drawn from the fixed
-end of its stroke, as ``studies/_animate`` does).
+coordinates, times its first joint's anchor): a hinge or ball turns about that point and a slide
+starts there, so for a body with one joint (or joints about one point) the point is fixed in the
+parent and a slider is drawn from the fixed end of its stroke, as ``studies/_animate`` does; a body
+that stacks a slide on rotations in one body is drawn with its anchor at zero stroke.
 """
 
 from __future__ import annotations
