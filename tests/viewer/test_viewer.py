@@ -163,6 +163,7 @@ def test_cli_rejects_bad_input_with_exit_2(tmp_path):
         (["view", "no-such-mechanism", "--no-browser"], "Expected MECHANISM"),
         (["view", "delta", "--port", "0", "--no-browser"], "--port"),
         (["view", "delta", "--site", "nope", "--no-browser"], "Expected site"),
+        *([(["view", "robot.urdf", "--no-browser"], "URDF")] if not hasattr(mb, "from_urdf") else []),
     ):
         r = subprocess.run(
             [sys.executable, "-m", "robomech", *argv],
