@@ -251,9 +251,9 @@ def _api_pages() -> None:
 # ----------------------------------------------------------------------------- the studies' reports
 # One page per registered study (docs/papers.md).  The fast studies are reproduced from this
 # checkout by `robomech reproduce` during the build and reused by later builds until a source file
-# changes (together about 25 s on this 2-core machine, after the first-use compile); the slow ones (continuum and skid-steer
-# take 10-12 minutes each) get a page that says what the study reproduces and how to get its
-# report.  With ROBOMECH_DOCS_REPORTS=DIR (`make docs REPORTS=out` after `make run`) every study
+# changes (together about 25 s on this 2-core machine, after the first-use compile); the slow ones
+# (continuum and skid-steer, minutes each) get a page that says what the study reproduces and how to
+# get its report.  With ROBOMECH_DOCS_REPORTS=DIR (`make docs REPORTS=out` after `make run`) every study
 # folder of that `robomech reproduce --out DIR` is shown as well.
 FAST_STUDIES = ("demo", "spherical-leg", "vectored-thrust", "omnileg", "sweep-demo")
 REPORTS_DIR = os.environ.get("ROBOMECH_DOCS_REPORTS", "")
@@ -284,8 +284,11 @@ def _study_placeholder(study, why: str) -> str:
     module = inspect.getmodule(study.run)
     doc = inspect.cleandoc(module.__doc__ or "")
     needs = f" It needs `{', '.join(study.requires)}` (an optional extra)." if study.requires else ""
+    from robomech.studies._papers import PAPERS as CITED
+
+    source = next((p.citation() for p in CITED.values() if p.short() == study.source), study.source)
     return (
-        f"# {study.title}\n\n*Source:* {study.source}\n\n```{{note}}\n{why}{needs} To see its report "
+        f"# {study.title}\n\n*Source:* {source}\n\n```{{note}}\n{why}{needs} To see its report "
         f"here: `robomech reproduce {study.name} --out out`, then `make docs REPORTS=out`.\n```\n\n"
         f"## What the study reproduces\n\n{_rst_to_md(doc)}\n"
     )
@@ -335,6 +338,14 @@ def _paper_pages() -> None:
         + "\n",
         encoding="utf-8",
     )
+    # the pages in reading order: the demonstration, the papers by number, then the rest
+    def order(name: str) -> tuple[int, str]:
+        m = re.match(r"Paper (\d+)", studies[name].title)
+        return (int(m.group(1)) if m else (0 if name == "demo" else 99), name)
+
+    pages = [f"papers/{n}/index" for n in sorted(studies, key=order)]
+    toc = ["```{toctree}", ":maxdepth: 1", "", *pages, "```"]
+    (BUILD / "papers-toc.md").write_text("\n".join(toc) + "\n", encoding="utf-8")
     shutil.rmtree(PAPERS, ignore_errors=True)
     for name, study in studies.items():
         dst = PAPERS / name
