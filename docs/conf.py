@@ -50,8 +50,22 @@ numpydoc_xref_param_type = False
 numpydoc_validation_checks: set[str] = set()
 
 # Markdown pages: $...$ and $$...$$ (and ```{math} blocks) are LaTeX math.
-myst_enable_extensions = ["dollarmath", "amsmath"]
+myst_enable_extensions = ["dollarmath", "amsmath", "substitution"]
 myst_heading_anchors = 3
+
+
+def _citation_md(paper) -> str:
+    """A paper's citation as Markdown: title in italics, the DOI as a link."""
+    text = f"{', '.join(paper.authors)}: *{paper.title}*. {paper.venue}, {paper.year}"
+    text += f", pp. {paper.pages}" if paper.pages else ""
+    return text + (f". [doi:{paper.doi}](https://doi.org/{paper.doi})" if paper.doi else "")
+
+
+# {{ paper1 }} ... {{ paper5 }}: each paper's citation, from the one table the reports use too
+# (robomech/studies/_papers.py).
+from robomech.studies._papers import PAPERS as _CITED  # noqa: E402
+
+myst_substitutions = {f"paper{n}": _citation_md(p) for n, p in _CITED.items()}
 
 html_theme = "pydata_sphinx_theme"
 html_title = f"robomech {release}"
@@ -330,13 +344,7 @@ def _paper_pages() -> None:
 
     BUILD.mkdir(parents=True, exist_ok=True)
     (BUILD / "papers-cited.md").write_text(
-        "\n".join(
-            f"{p.number}. {p.citation().rsplit('. doi:', 1)[0]}."
-            + (f" [doi:{p.doi}](https://doi.org/{p.doi})" if p.doi else "")
-            for p in CITED.values()
-        )
-        + "\n",
-        encoding="utf-8",
+        "\n".join(f"{p.number}. {_citation_md(p)}" for p in CITED.values()) + "\n", encoding="utf-8"
     )
     # the pages in reading order: the demonstration, the papers by number, then the rest
     def order(name: str) -> tuple[int, str]:
