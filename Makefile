@@ -10,7 +10,7 @@ REPORTS ?=
 # A second venv with `pip install .` and no extras: what a user without MuJoCo gets.
 MINIMAL := .venv-minimal
 
-.PHONY: install run test test-slow test-all bench verify lint typecheck docs check-minimal clean
+.PHONY: install install-browser run test test-slow test-all bench verify lint typecheck docs check-minimal clean
 
 install: $(STAMP)
 
@@ -24,12 +24,20 @@ $(DOCS_STAMP): $(STAMP)
 	$(BIN)/python -m pip install --quiet -e ".[verify,explore,test,docs]"
 	touch $(DOCS_STAMP)
 
+# Debian's headless Chromium, which the viewer's browser test (tests/viewer) drives with playwright
+# (playwright's own browser download is not used); nothing to do where it is installed.
+CHROMIUM ?= /usr/bin/chromium-headless-shell
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+install-browser:
+	@test -x $(CHROMIUM) || { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium-headless-shell; } \
+	  || echo "install-browser: could not install chromium-headless-shell; the browser tests will be skipped"
+
 run: install
 	$(BIN)/robomech reproduce --out $(OUT)
 	$(BIN)/robomech verify --out $(OUT)
 
 # The fast tier (the README's second command): lint and every test not marked `slow` (a few minutes).
-test: install
+test: install install-browser
 	$(BIN)/ruff check src tests benchmarks examples docs/conf.py
 	$(BIN)/python -m pytest -q -m "not slow"
 

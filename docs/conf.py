@@ -202,6 +202,7 @@ API_MODULES = (
     "robomech.analysis.workspace",
     "robomech.multibody",
     "robomech.multibody.gallery",
+    "robomech.viewer",
     "robomech.mechanisms",
     "robomech.mechanisms.spherical_leg",
     "robomech.mechanisms.omnileg",
@@ -267,8 +268,8 @@ def _api_pages() -> None:
 # checkout by `robomech reproduce` during the build and reused by later builds until a source file
 # changes (together about 25 s on this 2-core machine, after the first-use compile); the slow ones
 # (continuum and skid-steer, minutes each) get a page that says what the study reproduces and how to
-# get its report.  With ROBOMECH_DOCS_REPORTS=DIR (`make docs REPORTS=out` after `make run`) every study
-# folder of that `robomech reproduce --out DIR` is shown as well.
+# get its report.  With ROBOMECH_DOCS_REPORTS=DIR (`make docs REPORTS=out` after `make run`) every
+# study folder of that `robomech reproduce --out DIR` is shown as well.
 FAST_STUDIES = ("demo", "spherical-leg", "vectored-thrust", "omnileg", "sweep-demo")
 REPORTS_DIR = os.environ.get("ROBOMECH_DOCS_REPORTS", "")
 PAPERS = ROOT / "docs" / "papers"

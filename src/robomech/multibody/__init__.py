@@ -14,6 +14,8 @@ exact, batched kinematics with nothing derived by hand::
     m = mb.mobility(mech)                                # .dof, .redundant_constraints, .gruebler_kutzbach
     s = mb.singularities(mech, fk.q, "tip")              # type I / II / constraint, measures in metres
     mb.draw(mech, fk.q[0])                               # matplotlib wireframe
+    mb.animate(mech, fk.q, "motion.gif")                 # a GIF (or .mp4 with ffmpeg) along q (nt, nq)
+    mb.view(mech)                                        # live 3-D in the browser (robomech.viewer)
 
 Coordinates: ``q`` is MuJoCo's ``qpos`` (nq; ``[w, x, y, z]`` quaternions for ball/free joints) and
 every matrix "over all coordinates" has one column per *velocity* coordinate (MuJoCo's ``qvel``, nv:
@@ -32,8 +34,9 @@ Beyond kinematics, the same description gives:
 from __future__ import annotations
 
 from . import gallery
+from ._animate import animate
 from ._assembly import CONVERGED_RTOL, FKResult, IKResult, forward_kinematics, inverse_kinematics
-from ._draw import body_segments, draw
+from ._draw import body_segments, draw, view
 from ._dynamics import (
     ForwardDynamicsResult,
     InverseDynamicsResult,
@@ -60,7 +63,23 @@ from ._influence import (
 from ._mjcf import from_mjcf, to_mjcf
 from ._mobility import MobilityReport, mobility
 from ._model import Body, Builder, Closure, Coupling, Inertial, Joint, Mechanism, Site
+from ._repr import install_compact_repr
 from ._singularity import SingularityMapResult, SingularityResult, singularities, singularity_map
+
+# Results print their fields' shapes, masks as counts and ranges, not their arrays (notebooks).
+install_compact_repr(
+    FKResult,
+    IKResult,
+    Influence,
+    MobilityReport,
+    SingularityResult,
+    SingularityMapResult,
+    InverseDynamicsResult,
+    StaticsResult,
+    SiteWrenchResult,
+    ForwardDynamicsResult,
+    SimulationResult,
+)
 
 __all__ = [
     "CONVERGED_RTOL",
@@ -83,6 +102,7 @@ __all__ = [
     "Site",
     "SiteWrenchResult",
     "StaticsResult",
+    "animate",
     "body_segments",
     "constraint_jacobian",
     "constraint_jacobian_rate",
@@ -106,4 +126,5 @@ __all__ = [
     "site_wrench",
     "statics",
     "to_mjcf",
+    "view",
 ]

@@ -35,7 +35,8 @@ class ContinuumRobot:
         Disks N per segment (chord spans per segment, >= 1); paper: 5 disks.
     hole_radius : float
         Distance r of the cable holes from the core axis (m); not printed, default 4 mm. Must be well
-        below ``segment_length`` (``n_segments * hole_radius < segment_length``).
+        below ``segment_length`` (``n_segments * hole_radius < segment_length``) and clear the core
+        (``hole_radius >= (core_diameter + cable_diameter) / 2``).
     core_modulus, core_diameter : float
         Young's modulus (Pa) and diameter (m) of the NiTi core; not printed (60 GPa, 1.0 mm: EI =
         2.9e-3 N m², chosen for stability, see ``core_diameter`` below and
@@ -57,8 +58,8 @@ class ContinuumRobot:
     ------
     ValueError
         If a count is not an integer >= 1, a length or modulus is not positive, ``pretension`` or
-        ``free_length`` is negative, ``hole_radius`` is too large, or ``friction`` does not have 3 n
-        finite non-negative entries.
+        ``free_length`` is negative, ``hole_radius`` is too large or inside the core, or ``friction``
+        does not have 3 n finite non-negative entries.
     """
 
     n_segments: int = 1
@@ -91,6 +92,14 @@ class ContinuumRobot:
             raise ValueError(
                 f"Expected hole_radius well below segment_length, got {self.hole_radius!r} m vs "
                 f"{self.segment_length!r} m."
+            )
+        # a cable runs in a hole beside the core, not through it: the hole's centre must clear the core
+        # and the cable's own radius
+        clear = 0.5 * (self.core_diameter + self.cable_diameter)
+        if self.hole_radius < clear:
+            raise ValueError(
+                f"Expected hole_radius >= (core_diameter + cable_diameter) / 2 = {clear!r} m (the cable "
+                f"beside the core, not inside it), got {self.hole_radius!r} m."
             )
         mu_a = as_array(self.friction, "friction", (None,))
         if mu_a.ndim != 1:
