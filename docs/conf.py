@@ -76,7 +76,12 @@ html_theme_options = {
     "footer_start": ["copyright"],
     "footer_end": ["sphinx-version"],
 }
-html_sidebars = {"index": []}
+# No left sidebar on pages without sub-pages (it would show an empty "Section Navigation").
+html_sidebars = {
+    name: []
+    for name in ("index", "usage", "conventions", "architecture", "performance", "reports", "multibody",
+                 "dynamics", "explore", "viewer", "mechanisms/*")
+}  # fmt: skip
 html_static_path = ["_static", "_build/vendor"]
 html_css_files = ["robomech.css"]
 html_js_files = ["robomech.js"]
