@@ -79,7 +79,7 @@ def _fmt(x: float) -> str:
 
 
 class Viewer:
-    """A running viewer of one mechanism (returned by :func:`view`; stop it with :meth:`Viewer.stop`).
+    """A running viewer of one mechanism (returned by :func:`view`; stop it with ``stop()``).
 
     Attributes
     ----------
