@@ -18,6 +18,8 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e ".[verify,explore,test]"
+	# compile the multibody kernels into the on-disk cache now, not at the user's first call
+	$(BIN)/python -c "from robomech.multibody._compiled import warm; warm()"
 	touch $(STAMP)
 
 $(DOCS_STAMP): $(STAMP)

@@ -66,6 +66,7 @@ LAZY_ONLY = {
     ("multibody", "_animate.py"): {"matplotlib", "PIL"},
     ("multibody", "_repr.py"): {"matplotlib"},
     ("viewer", "_server.py"): {"viser", "imageio", "webbrowser"},
+    ("viewer", "_geoms.py"): {"mujoco"},  # an MJCF file's geoms, compiled by MuJoCo (the verify extra)
 }
 # The web stack of the viewer: only robomech.viewer imports it, and only inside functions.
 WEB = {"viser"}

@@ -44,6 +44,8 @@ CHAIN: dict[str, Callable[[np.ndarray], Any]] = {
     "site_wrench": lambda q: mb.site_wrench(MECH, q, SITE, np.ones((len(q), 1))),
     "forward_dynamics": lambda q: mb.forward_dynamics(MECH, q, QDA[: len(q)], np.ones((len(q), 1))),
     "energy": lambda q: mb.energy(MECH, q, QD[: len(q)]),
+    "mass_matrix": lambda q: mb.mass_matrix(MECH, q),
+    "generalized_forces": lambda q: mb.generalized_forces(MECH, q, QD[: len(q)], QD[: len(q)]),
     "singularity_map": lambda q: mb.singularity_map(
         MECH, SITE, q_act=np.full((len(q), 1), 0.25), guess=q, steps=1
     ),

@@ -3,7 +3,8 @@
 The server runs as a subprocess on 127.0.0.1 with a free port; the page must load without console
 errors, and moving the first actuated joint's slider through the page (keyboard on the slider, as a
 user would) must re-assemble the Delta: the status panel's configuration ``q`` changes and still
-reads "assembled".  Every wait is bounded and the server is killed at the end.
+reads "assembled"; the screenshot button must download a PNG of the view.  Every wait is bounded
+and the server is killed at the end.
 """
 
 from __future__ import annotations
@@ -127,9 +128,14 @@ def test_page_loads_and_a_slider_reassembles(server):
                 time.sleep(0.2)
                 q_after = _q(panel.inner_text())
             text = panel.inner_text()
+            # the screenshot button: the browser renders the view, the server sends it back as a PNG
+            with page.expect_download(timeout=MOVE_S * 1000) as download:
+                page.get_by_role("button", name="Screenshot (PNG)").click()
+            png = Path(download.value.path()).read_bytes()
         finally:
             browser.close()
     assert not errors, f"console errors: {errors}"
     assert "did not assemble" not in text
     assert q_after.shape == q_before.shape
     assert not np.allclose(q_after, q_before), "the slider move did not change the assembled pose"
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 1000

@@ -163,6 +163,7 @@ def test_cli_rejects_bad_input_with_exit_2(tmp_path):
         (["view", "no-such-mechanism", "--no-browser"], "Expected MECHANISM"),
         (["view", "delta", "--port", "0", "--no-browser"], "--port"),
         (["view", "delta", "--site", "nope", "--no-browser"], "Expected site"),
+        *([(["view", "robot.urdf", "--no-browser"], "URDF")] if not hasattr(mb, "from_urdf") else []),
     ):
         r = subprocess.run(
             [sys.executable, "-m", "robomech", *argv],
@@ -183,3 +184,66 @@ def test_the_viewer_methods_validate_their_input(delta_viewer):
         v.screenshot("x.png", width=0)
     with pytest.raises(ValueError, match="path to play"):
         v.play()
+
+
+@pytest.mark.parametrize("name", ["delta", "stewart"])
+def test_mjcf_geoms_sit_where_mujoco_puts_them(name):
+    """The geoms hang on the description's body frames: placed at an assembled pose, their centres
+    are MuJoCo's own geom_xpos after mj_kinematics at the same qpos (an independent engine)."""
+    mujoco = pytest.importorskip("mujoco")
+    from robomech.viewer._geoms import mjcf_geoms
+
+    mech = mb.gallery.load(name)
+    path = mb.gallery.path(name)
+    geoms = mjcf_geoms(path)
+    qa0 = mech.q0[[mech.qpos_address(j) for j in mech.actuated]]
+    q = mb.forward_kinematics(mech, qa0 + 0.05, mech.q0).q
+    T = poses(mech, q)
+    index = {n: b for b, n in enumerate(mech.tree.body_names)}
+    ours = np.array([_world(T, index[g.body], g.pos) for g in geoms])
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    data.qpos[:] = q
+    mujoco.mj_kinematics(model, data)
+    drawn = [g for g in range(model.ngeom) if int(model.geom_type[g]) in (2, 3, 4, 5, 6, 7)]
+    np.testing.assert_allclose(ours, data.geom_xpos[drawn], atol=POINT_TOL)
+    v = view(mech, geometry=path)
+    try:
+        assert len(v._geom_nodes) == len(geoms) and all(not n.visible for n in v._links)
+    finally:
+        v.stop()
+    with pytest.raises(ValueError, match="geometry"):
+        view(mech, geometry="no-such-file.xml")
+
+
+def test_cli_motion_and_simulation_become_the_playback(tmp_path):
+    import argparse
+
+    from robomech.cli.view import _motion
+
+    mech = mb.gallery.load("four_bar")
+    q = mb.forward_kinematics(mech, np.linspace(0.2, 1.0, 4)[:, None]).q
+    np.savez(tmp_path / "m.npz", q=q, t=np.arange(4) * 0.5)
+    np.save(tmp_path / "m.npy", q)
+    none = {"motion": None, "simulate": None}
+    path, times = _motion(argparse.Namespace(**{**none, "motion": str(tmp_path / "m.npz")}), mech)
+    np.testing.assert_array_equal(path, q)
+    np.testing.assert_array_equal(times, np.arange(4) * 0.5)
+    path, times = _motion(argparse.Namespace(**{**none, "motion": str(tmp_path / "m.npy")}), mech)
+    np.testing.assert_array_equal(path, q)
+    assert times is None
+    sim, _ = _motion(argparse.Namespace(**{**none, "simulate": 0.1}), mech)
+    assert isinstance(sim, mb.SimulationResult) and sim.q.shape == (4, mech.nq) and bool(sim.success)
+    v = view(mech, path=sim)
+    try:
+        v._frame_slider.value = 3
+        np.testing.assert_allclose(v.pose.q, sim.q[3])
+    finally:
+        v.stop()
+    src = str(Path(__file__).resolve().parents[2] / "src")
+    env = {"PYTHONPATH": src, "PATH": "/usr/bin:/bin", "HOME": str(Path.home())}
+    r = subprocess.run(
+        [sys.executable, "-m", "robomech", "view", "four_bar", "--no-browser", "--motion", "missing.npy"],
+        capture_output=True, text=True, timeout=CLI_TIMEOUT, env=env, cwd=tmp_path,
+    )  # fmt: skip
+    assert r.returncode == 2 and "--motion" in r.stderr and "Traceback" not in r.stderr

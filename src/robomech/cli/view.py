@@ -12,6 +12,7 @@ import argparse
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 from ._core import EXIT_INTERRUPTED, EXIT_OK, CliError, Command
 
@@ -35,6 +36,20 @@ def _add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--site", default=None, help="output site of the singularity measures (default: the first)"
     )
+    motion = p.add_mutually_exclusive_group()
+    motion.add_argument(
+        "--motion",
+        metavar="FILE",
+        default=None,
+        help="play back configurations: a .npy of q (nt, nq), or a .npz with q and optionally t (s)",
+    )
+    motion.add_argument(
+        "--simulate",
+        metavar="SECONDS",
+        type=float,
+        default=None,
+        help="simulate the passive motion under gravity from the reference pose and play it back",
+    )
 
 
 def _describe(target: str):
@@ -49,13 +64,58 @@ def _describe(target: str):
     return describe(target)
 
 
+def _geometry(target: str) -> Path | None:
+    """The MJCF file whose geoms to draw: the file given, or a gallery mechanism's file."""
+    from robomech import multibody as mb
+
+    if target in mb.gallery.NAMES:
+        return mb.gallery.path(target)
+    if target.lower().endswith(".xml") and Path(target).is_file():
+        return Path(target)
+    return None
+
+
+# Frames per second of a simulated motion's playback (its output times).
+SIMULATE_FPS = 30.0
+
+
+def _motion(args: argparse.Namespace, mech) -> tuple[Any, Any]:
+    """The path to play back and its times: from --motion FILE, --simulate SECONDS, or none."""
+    import numpy as np
+
+    if args.motion is not None:
+        try:
+            data = np.load(args.motion)
+        except (OSError, ValueError) as exc:
+            raise CliError(f"--motion {args.motion}: cannot read it ({exc})") from exc
+        if isinstance(data, np.ndarray):
+            return data, None
+        if "q" not in data:
+            raise CliError(f"--motion {args.motion}: expected an array q (nt, nq) in the .npz")
+        return data["q"], (data["t"] if "t" in data else None)
+    if args.simulate is not None:
+        from robomech import multibody as mb
+
+        if not (np.isfinite(args.simulate) and args.simulate > 0):
+            raise CliError(f"--simulate: expected a positive duration in seconds, got {args.simulate}")
+        nt = max(2, round(args.simulate * SIMULATE_FPS) + 1)
+        print(
+            f"robomech view: simulating {args.simulate:g} s of {mech.name} ...", file=sys.stderr, flush=True
+        )
+        t0 = time.perf_counter()
+        sim = mb.simulate(mech, mech.q0, np.zeros(len(mech.actuated)), np.linspace(0.0, args.simulate, nt))
+        print(f"robomech view: simulated in {time.perf_counter() - t0:.1f} s", file=sys.stderr, flush=True)
+        return sim, None
+    return None, None
+
+
 def _description() -> str:
     from robomech import multibody as mb
 
     return (
         "Serve a live 3-D view of MECHANISM on http://127.0.0.1:PORT: one slider per actuated joint\n"
         "re-assembles it, the singularity measures of an output site update live, and a button\n"
-        "downloads a screenshot.  Stop with Ctrl-C.\n\n"
+        "downloads a screenshot; --motion FILE or --simulate SECONDS adds a playback.  Stop with Ctrl-C.\n\n"
         "MECHANISM: spherical-leg, omnileg, vectored-thrust (paper descriptions), "
         f"{', '.join(mb.gallery.NAMES)} (gallery), or an MJCF file."
     )
@@ -64,13 +124,17 @@ def _description() -> str:
 def _run(args: argparse.Namespace) -> int:
     try:
         mech = _describe(args.mechanism)
-    except (ValueError, OSError) as exc:
+    except (ValueError, OSError, ImportError) as exc:  # ImportError: MJCF without MuJoCo
         raise CliError(str(exc)) from exc
     from robomech import viewer
 
+    path, times = _motion(args, mech)
     try:
-        v = viewer.view(mech, site=args.site, port=args.port, open_browser=not args.no_browser)
-    except ValueError as exc:
+        v = viewer.view(
+            mech, site=args.site, port=args.port, open_browser=not args.no_browser,
+            geometry=_geometry(args.mechanism), path=path, times=times,
+        )  # fmt: skip
+    except (ValueError, ImportError) as exc:  # ImportError: without the view extra (viser)
         raise CliError(str(exc)) from exc
     except OSError as exc:  # the port is taken
         raise CliError(f"--port {args.port}: cannot serve ({exc.strerror or exc})") from exc

@@ -28,7 +28,11 @@ Beyond kinematics, the same description gives:
   :func:`constraint_jacobian` and its time derivative :func:`constraint_jacobian_rate`;
 * the influence coefficients ``G = ∂qd/∂qd_act (..., nv, n_act)`` and ``∂G/∂q_act``: :func:`influence`;
 * dynamics of the closed chain: :func:`inverse_dynamics`, :func:`statics`, :func:`site_wrench`,
-  :func:`forward_dynamics`, :func:`simulate`, :func:`energy` (the dynamics page of the documentation).
+  :func:`forward_dynamics`, :func:`simulate`, :func:`energy` (the dynamics page of the documentation);
+  for open chains, trees, underactuated and passive mechanisms and floating bases the same functions,
+  with every coordinate's rate ``qd (..., nv)`` where the actuated rates do not give the state;
+* the spanning tree's :func:`generalized_forces` (RNEA, MuJoCo ``mj_rne``) and :func:`mass_matrix`
+  (CRBA, ``mj_fullM``).
 """
 
 from __future__ import annotations
@@ -64,6 +68,7 @@ from ._mjcf import from_mjcf, to_mjcf
 from ._mobility import MobilityReport, mobility
 from ._model import Body, Builder, Closure, Coupling, Inertial, Joint, Mechanism, Site
 from ._repr import install_compact_repr
+from ._rnea import generalized_forces, mass_matrix
 from ._singularity import SingularityMapResult, SingularityResult, singularities, singularity_map
 
 # Results print their fields' shapes, masks as counts and ranges, not their arrays (notebooks).
@@ -113,9 +118,11 @@ __all__ = [
     "forward_kinematics",
     "from_mjcf",
     "gallery",
+    "generalized_forces",
     "influence",
     "inverse_dynamics",
     "inverse_kinematics",
+    "mass_matrix",
     "mobility",
     "simulate",
     "singularities",

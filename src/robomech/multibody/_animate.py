@@ -227,7 +227,7 @@ def animate(
         The file to write: ``.gif`` (matplotlib's ``PillowWriter``) or ``.mp4`` (``FFMpegWriter``,
         needs ``ffmpeg`` on the PATH).
     fps : float, optional
-        Frames per second (a GIF's delay is rounded to GIF's 10 ms, at least 20 ms).
+        Frames per second (a GIF stores its delay in 10 ms steps: rounded, at least 20 ms).
     title : str, optional
         Title above the drawing (default the mechanism's name).
     site : str, optional

@@ -106,9 +106,6 @@ def from_mjcf(path_or_xml: str | os.PathLike) -> Mechanism:
             "Expected path_or_xml to be UTF-8 encoded MJCF (MuJoCo reads names as UTF-8), got a name "
             f"that is not UTF-8 ({exc.reason} at byte {exc.start}): save the file as UTF-8."
         ) from exc
-    from ._assembly import check_assembles
-
-    check_assembles(mech, "path_or_xml")
     return mech
 
 
@@ -239,7 +236,7 @@ def _read(path_or_xml: str | os.PathLike) -> Mechanism:
             )
         actuated.append(jnt_names[m.actuator_trnid[a, 0]])
     name = m.names[: m.names.index(b"\0")].decode() if m.names else "mechanism"
-    return Mechanism(
+    mech = Mechanism(
         tuple(bodies),
         tuple(closures),
         tuple(couplings),
@@ -248,6 +245,8 @@ def _read(path_or_xml: str | os.PathLike) -> Mechanism:
         tuple(m.opt.gravity),
         name or "mechanism",
     )
+    mech.q0  # noqa: B018 - assemble the reference now: a file that can never assemble raises at load
+    return mech
 
 
 def _f(x) -> str:

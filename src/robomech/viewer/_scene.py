@@ -12,9 +12,10 @@ as spheres at their anchors with their axes as short segments; sites and body fr
 triads.
 
 A child's anchor in its parent's frame is ``T_off @ pos`` (the child's frame at zero joint
-coordinate, times the joint's anchor): a hinge or ball turns about that point and a slide starts
-there, so for every joint type the point is fixed in the parent (a slider is drawn from the fixed
-end of its stroke, as ``studies/_animate`` does).
+coordinates, times its first joint's anchor): a hinge or ball turns about that point and a slide
+starts there, so for a body with one joint (or joints about one point) the point is fixed in the
+parent and a slider is drawn from the fixed end of its stroke, as ``studies/_animate`` does; a body
+that stacks a slide on rotations in one body is drawn with its anchor at zero stroke.
 """
 
 from __future__ import annotations
@@ -167,18 +168,18 @@ def build_scene(mech: Mechanism) -> Scene:
             continue
         (root, root_axis), rest = pts[i][0], pts[i][1:]
         for p, axis in rest:
-            a, b = root, p
-            if np.linalg.norm(b - a) < COINCIDENT_FRACTION * L:
+            end_a, end_b = root, p
+            if np.linalg.norm(end_b - end_a) < COINCIDENT_FRACTION * L:
                 at = T0[i, :3, :3] @ root + T0[i, :3, 3]
                 central = any(np.linalg.norm(at - c) < COINCIDENT_FRACTION * L for c in centres)
                 if not central or (root_axis is None and axis is None):
                     continue
                 r = ARC_RADIUS_FRACTION * L
-                a = root + r * root_axis if root_axis is not None else root
-                b = p + r * axis if axis is not None else p
-                if np.linalg.norm(b - a) < COINCIDENT_FRACTION * L:
+                end_a = root + r * root_axis if root_axis is not None else root
+                end_b = p + r * axis if axis is not None else p
+                if np.linalg.norm(end_b - end_a) < COINCIDENT_FRACTION * L:
                     continue
-            links.append(Link(i, a, b))
+            links.append(Link(i, end_a, end_b))
     return Scene(
         body_names=tuple(tree.body_names),
         links=tuple(links),

@@ -20,6 +20,7 @@ from robomech._validation import as_array, check_int
 from robomech.multibody._assembly import check_mechanism, check_q
 from robomech.multibody._repr import compact_repr
 
+from ._geoms import Geom, mjcf_geoms
 from ._scene import (
     AXIS_LENGTH_FRACTION,
     TRIAD_FRACTION,
@@ -48,6 +49,9 @@ SLIDE_SPAN_FRACTION = 1.0
 SLIDER_STEPS = 400
 # Playback: default frame rate (frames per second).
 PLAYBACK_FPS = 20.0
+# Camera distance from the centre of the drawing, in half-diagonals of its bounding box: the whole
+# mechanism in view at viser's default field of view (~50 deg) with a margin.
+CAMERA_DISTANCE = 2.6
 # Bound on the wait for a browser's render of a screenshot (s).
 SCREENSHOT_TIMEOUT = 20.0
 
@@ -103,6 +107,7 @@ class Viewer:
         site: str | None,
         path: NDArray[np.float64] | None,
         times: NDArray[np.float64] | None,
+        geoms: tuple[Geom, ...] = (),
     ) -> None:
         try:
             import viser
@@ -111,6 +116,7 @@ class Viewer:
         self.mech = mech
         self.site = site
         self._scene: Scene = build_scene(mech)
+        self._geoms = geoms
         self._lock = threading.RLock()
         self._syncing = False
         self._path = path
@@ -166,14 +172,16 @@ class Viewer:
                 position=tuple(centre),
             )
             self._nodes.append((node, colour))
-        self._axes = []
+        self._links = [node for node, _ in self._nodes]
+        self._geom_nodes = self._add_geoms()
+        self._axes: list[Any] = []
         for j in sc.joints:
             parent = f"/bodies/{j.body}_{sc.body_names[j.body]}"
             colour = ACTUATED_COLOUR if j.actuated else JOINT_COLOUR
-            node = srv.scene.add_icosphere(
+            joint_node = srv.scene.add_icosphere(
                 f"{parent}/joint_{j.name}", radius=sc.joint_radius, color=colour, position=tuple(j.pos)
             )
-            self._nodes.append((node, colour))
+            self._nodes.append((joint_node, colour))
             if j.axis is not None:
                 half = 0.5 * AXIS_LENGTH_FRACTION * L * j.axis
                 seg = np.array([[j.pos - half, j.pos + half]])
@@ -197,9 +205,66 @@ class Viewer:
                     position=tuple(s.T[:3, 3]),
                 )
             )
-        centre = poses(self.mech, self.mech.q0)[:, :3, 3].mean(axis=0)
-        self._server.initial_camera.position = tuple(centre + np.array([1.6, -1.6, 1.2]) * L)
+        # the camera frames the whole drawing at q0 (links, joints, sites), from above one corner
+        T0 = poses(self.mech, np.asarray(self.mech.q0, float))
+        pts = [T0[k.body, :3, :3] @ p + T0[k.body, :3, 3] for k in sc.links for p in (k.a, k.b)]
+        pts += [T0[b, :3, 3] for b in range(len(sc.body_names))]
+        lo, hi = np.min(pts, axis=0), np.max(pts, axis=0)
+        centre, radius = (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, L / 2)
+        direction = np.array([1.0, -1.0, 0.75]) / np.linalg.norm([1.0, -1.0, 0.75])
+        self._server.initial_camera.position = tuple(centre + CAMERA_DISTANCE * radius * direction)
         self._server.initial_camera.look_at = tuple(centre)
+
+    def _add_geoms(self) -> list[Any]:
+        """The MJCF geoms, each under its body's frame (a frame per geom carries its pose)."""
+        srv, names = self._server.scene, self._scene.body_names
+        index = {n: b for b, n in enumerate(names)}
+        nodes = []
+        for k, g in enumerate(self._geoms):
+            b = index.get(g.body, 0 if g.body == "world" else None)
+            if b is None:
+                continue  # a body the description does not have (e.g. an auxiliary one)
+            base = f"/bodies/{b}_{names[b]}/geom{k}"
+            frame = srv.add_frame(base, show_axes=False, wxyz=tuple(g.quat), position=tuple(g.pos))
+            nodes.append(frame)
+            colour = (
+                round(255 * float(g.rgba[0])),
+                round(255 * float(g.rgba[1])),
+                round(255 * float(g.rgba[2])),
+            )
+            opacity = float(g.rgba[3]) if g.rgba[3] < 1 else None
+            shapes: list[Any] = []
+            r = float(g.size[0])
+            if g.type == "sphere":
+                shapes.append(srv.add_icosphere(f"{base}/s", radius=r, color=colour, opacity=opacity))
+            elif g.type == "ellipsoid":
+                shapes.append(
+                    srv.add_icosphere(f"{base}/s", radius=1.0, color=colour, opacity=opacity,
+                                      scale=(float(g.size[0]), float(g.size[1]), float(g.size[2])))
+                )  # fmt: skip
+            elif g.type in ("capsule", "cylinder"):
+                h = 2 * float(g.size[1])
+                shapes.append(
+                    srv.add_cylinder(f"{base}/c", radius=r, height=h, color=colour, opacity=opacity)
+                )
+                if g.type == "capsule":
+                    for end, z in (("a", -h / 2), ("b", h / 2)):
+                        shapes.append(
+                            srv.add_icosphere(f"{base}/{end}", radius=r, color=colour, opacity=opacity,
+                                              position=(0.0, 0.0, z))
+                        )  # fmt: skip
+            elif g.type == "box":
+                shapes.append(
+                    srv.add_box(
+                        f"{base}/b", color=colour, dimensions=2 * np.asarray(g.size[:3]), opacity=opacity
+                    )
+                )
+            elif g.type == "mesh" and g.vertices is not None and g.faces is not None:
+                shapes.append(
+                    srv.add_mesh_simple(f"{base}/m", g.vertices, g.faces, color=colour, opacity=opacity)
+                )
+            self._nodes += [(shape, colour) for shape in shapes]
+        return nodes
 
     def _place(self, q: NDArray[np.float64]) -> None:
         T = poses(self.mech, q)
@@ -232,15 +297,19 @@ class Viewer:
                 s.on_update(self._on_slider)
                 self._sliders.append(s)
             reset = gui.add_button("Reset to reference pose")
-            reset.on_click(lambda _: self.set_q(np.asarray(self.mech.q0, float)))
+            reset.on_click(self._on_reset)
         with gui.add_folder("Show"):
+            toggles: list[tuple[str, list[Any], bool]] = [("joint axes", self._axes, True)]
+            if self._geom_nodes:  # the file's shapes; the links (the kinematic skeleton) on request
+                toggles += [("MJCF geoms", self._geom_nodes, True), ("links", self._links, False)]
+                self._set_visible(self._links, False)
             for label, nodes, initial in (
-                ("joint axes", self._axes, True),
+                *toggles,
                 ("sites", self._sites, True),
                 ("body frames", self._body_axes, False),
             ):
                 box = gui.add_checkbox(label, initial_value=initial)
-                box.on_update(lambda ev, nodes=nodes: self._set_visible(nodes, ev.target.value))
+                box.on_update(self._toggler(nodes))
         self._measures = gui.add_markdown("")
         self._frame_slider = None
         if self._path is not None:
@@ -253,6 +322,15 @@ class Viewer:
                 self._play_button.on_click(lambda _: self._toggle_play())
         shot = gui.add_button("Screenshot (PNG)")
         shot.on_click(self._on_screenshot)
+
+    def _toggler(self, nodes: list[Any]) -> Any:
+        def toggle(event: Any) -> None:
+            self._set_visible(nodes, bool(event.target.value))
+
+        return toggle
+
+    def _on_reset(self, _event: Any) -> None:
+        self.set_q(np.asarray(self.mech.q0, float))
 
     @staticmethod
     def _set_visible(nodes: list[Any], visible: bool) -> None:
@@ -311,7 +389,7 @@ class Viewer:
         try:
             for s, x in zip(self._sliders, q_act, strict=True):
                 if np.isfinite(x):
-                    s.value = float(np.clip(x, s.min, s.max))
+                    s.value = float(np.clip(x, s.min, s.max))  # type: ignore[misc]
         finally:
             self._syncing = False
 
@@ -327,7 +405,7 @@ class Viewer:
         if qa.shape != (len(self.mech.actuated),):
             raise ValueError(f"Expected q_act to have shape ({len(self.mech.actuated)},), got {qa.shape}.")
         with self._lock:
-            start = self.pose.q if self.pose.converged else self._good
+            start = self._good  # the pose shown if it assembled, else the last assembled one
             delta = np.abs(qa - start[self._addr])
             scale = np.array(
                 [STAGE_RAD if self.mech.joint(n).type == "hinge" else STAGE_LENGTH_FRACTION * self.mech.length
@@ -390,7 +468,7 @@ class Viewer:
             if not self._playing.wait(timeout=0.2) or self._frame_slider is None or self._path is None:
                 continue
             k = (int(self._frame_slider.value) + 1) % self._path.shape[0]
-            self._frame_slider.value = k  # runs _show_frame (callbacks are synchronous)
+            self._frame_slider.value = k  # type: ignore[misc]  # runs _show_frame (synchronously)
             time.sleep(1.0 / max(float(self._fps.value), 0.5))
 
     def play(self, playing: bool = True) -> None:
@@ -405,7 +483,7 @@ class Viewer:
         if client is None:
             return
         png = self._render_png(client, 720, 960)
-        client.send_file_download(f"{self.mech.name}.png", png)
+        client.send_file_download(f"{self.mech.name}.png", png, save_immediately=True)
 
     @staticmethod
     def _render_png(client: Any, height: int, width: int) -> bytes:
@@ -470,6 +548,7 @@ def view(
     times: ArrayLike | None = None,
     port: int | None = None,
     open_browser: bool = False,
+    geometry: str | Path | None = None,
 ) -> Viewer:
     """Show ``mech`` in the browser: a live 3-D view with one slider per actuated joint.
 
@@ -489,6 +568,9 @@ def view(
         TCP port on 127.0.0.1 (default a free one).
     open_browser : bool, optional
         Open the page in the default web browser.
+    geometry : str or Path, optional
+        An MJCF file whose geoms are drawn on the bodies of the same names (e.g. the file ``mech``
+        was read from; needs MuJoCo); the links are then shown on request.
 
     Returns
     -------
@@ -543,7 +625,15 @@ def view(
     port = check_int(port, "port", low=1, high=65535)
     if not isinstance(open_browser, bool):
         raise ValueError(f"Expected open_browser to be True or False, got {open_browser!r}.")
-    viewer = Viewer(mech, np.asarray(q0, float), port=port, site=site, path=qs, times=tt)
+    geoms: tuple[Geom, ...] = ()
+    if geometry is not None:
+        if not isinstance(geometry, (str, Path)) or not Path(geometry).is_file():
+            raise ValueError(f"Expected geometry to be None or an MJCF file, got {geometry!r}.")
+        try:
+            geoms = mjcf_geoms(geometry)
+        except ValueError as exc:  # MuJoCo's compile error
+            raise ValueError(f"Expected geometry to be an MJCF file MuJoCo reads, got {exc}") from exc
+    viewer = Viewer(mech, np.asarray(q0, float), port=port, site=site, path=qs, times=tt, geoms=geoms)
     if open_browser:
         import webbrowser
 

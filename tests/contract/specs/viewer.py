@@ -32,7 +32,7 @@ def _view_spec(view):
     return Spec(
         call=_started_and_stopped(view),
         args={"mech": MECH, "q": Q[0], "site": "coupler_point", "path": Q, "port": None,
-              "open_browser": False},
+              "open_browser": False, "geometry": mb.gallery.path("four_bar")},
         arrays={"q": 1},
         unbatched=("q",),  # one configuration
         params=("mech",),
@@ -41,6 +41,7 @@ def _view_spec(view):
             "path": ("x", np.zeros((3, 4)), np.zeros(3), 1j * Q),
             "port": BAD_PORT,
             "open_browser": BAD_BOOL,
+            "geometry": (1, "no-such-file.xml", ""),
         },
         wrong_shapes={"q": ((2,), (2, 3))},
         finite_result=False,

@@ -111,10 +111,10 @@ def test_empty_trajectories():
 
 
 # Measured lengths: 10 nm of Gaussian noise on Fig. 5(a)'s lengths (2001 samples over 30 s).  Next to
-# the singular curve the closed form amplifies it to ~5e-4 rad (half a sampling step); on the wrong
+# the singular curve the closed form amplifies it to up to 2e-3 rad (measured over 100 seeds); on the wrong
 # branch the error would be the mirror distance 2 |α - α_s|, up to 4 rad.
 NOISE = 10e-9
-NOISY_TOL = 2e-3
+NOISY_TOL = 5e-3
 
 
 def _fig5a(n=2001):
@@ -158,3 +158,18 @@ def test_a_meeting_the_samples_cannot_decide_is_flagged():
         assert not wrong.any()
         hits += tr.ambiguous.any()
     assert hits > 0  # the flag is raised on such data (the rule above is not vacuous)
+
+
+@pytest.mark.parametrize("step", [0.05, 0.1, 0.25, 0.5, 1.0])
+def test_coarse_grids_are_right_or_flagged(step):
+    # Fig. 5(a) dips beyond the curve for 1.2 s per period: on a coarse grid both passages fall
+    # within one window and are decided together; where the samples cannot decide, the samples
+    # after the meeting are flagged -- never a valid sample on the wrong branch
+    t = np.arange(0.0, 30.0 + 1e-9, step)
+    q, _, _ = sl.fig5_motion("a", t)
+    tr = sl.track_branches(LEG, _lengths(q[:, 0], q[:, 1]))
+    np.testing.assert_allclose(tr.alpha[tr.valid], q[tr.valid, 0], atol=NEAR_TOL)
+    if step <= 0.1:  # fine enough: decided, both passages followed
+        assert tr.valid.all() and tr.switched.sum() == 2
+    else:
+        assert tr.ambiguous.any() or tr.valid.all()

@@ -14,17 +14,19 @@ places where the branches meet the branch cannot change (the two solutions are s
 each meeting it asks which of two models explains the samples around it better: the signed distance
 from the curve ``σ = ±separation / 2`` passes through zero (a *crossing*: α moves on through the curve,
 the branch changes) or stays on one side (a *touch*: α turns back, the branch is kept).  Each model is
-a quadratic least-squares fit of σ over ``MEET_WINDOW`` samples on either side, weighted by the
+a cubic least-squares fit of σ over ``MEET_WINDOW`` samples on either side, weighted by the
 distance from the curve (near it, noise in the lengths is amplified: the closed form loses half the
-digits).  A fit over a window, not an extrapolation of the last few samples, keeps the choice right
-on measured lengths: 10 nm of noise moves α by up to 5e-4 rad next to the curve, about half a
-sampling step of Fig. 5(a).  A meeting where neither model fits clearly better (``AMBIGUITY_RATIO``)
-is reported as ``ambiguous``, and every later sample of that trajectory is flagged not valid: its
-branch is not known.
+digits); meetings closer than a window (a dip just beyond the curve on a coarse grid) are decided
+together, every combination of crossing and touch fitted.  A fit over a window, not an
+extrapolation of the last few samples, keeps the choice right on measured lengths: 10 nm of noise
+moves α by up to 2e-3 rad next to the curve, about two sampling steps of Fig. 5(a).  A meeting
+where neither model fits clearly better (``AMBIGUITY_RATIO``) is reported as ``ambiguous``, and
+every later sample of that trajectory is flagged not valid: its branch is not known.
 """
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,20 +47,28 @@ __all__ = ["BranchTrack", "track_branches"]
 # nm on Fig. 5(a)), hence 4.  A local minimum that is no crossing costs only a fit (it is a touch).
 MEET_STEP_FACTOR = 4.0
 # Candidate meetings closer than this many samples are one meeting (noise in the lengths makes the
-# separation wiggle next to the curve and gives several local minima for one passage).
-MEET_MERGE = 4
-# Samples on either side of a meeting that the crossing / touch models are fitted to: enough to
-# average the noise of the samples nearest the curve (16 samples), few enough that a quadratic in the
-# sample index describes σ of any motion sampled finely enough to be tracked (the step near the curve
-# is a small fraction of the motion's amplitude).
-MEET_WINDOW = 8
+# separation wiggle next to the curve and gives several local minima for one passage); two real
+# passages a few samples apart (a dip just beyond the curve on a coarse grid) stay two meetings
+# only if at least one sample separates them, and are then decided together (MEET_CLUSTER_MAX).
+MEET_MERGE = 1
+# Samples on either side of a meeting that the crossing / touch models are fitted to, and the degree
+# of the polynomial in the sample index they are fitted with: 32 samples average the noise of the
+# samples nearest the curve (with 8, 30 nm of noise left most Fig. 5(a) meetings ambiguous), and a
+# cubic describes σ over that window for a motion sampled finely enough to be tracked (a quadratic
+# misfits the asymmetry of a sway passing the curve near its turning point on a 0.5 s grid and then
+# decides wrongly).  Measured on Fig. 5(a) (grids 0.01-1 s, 10-100 nm of noise) and on random sways:
+# docs/mechanisms/spherical_leg.md.
+MEET_WINDOW = 16
+MEET_FIT_DEGREE = 3
 # The crossing model places the passage through the curve within this many samples of the sample
 # nearest it (noise of the order of a step moves that sample to either side).
 MEET_SPLIT = 2
+# At most this many meetings are decided together (every combination of crossing and touch is fitted).
+MEET_CLUSTER_MAX = 3
 # A meeting is decided when the weighted residual of the better model is below this fraction of the
-# other's.  On exact lengths the right model fits to rounding (ratio ~ 1e-6); with 10 nm of noise on
-# Fig. 5(a) the ratio is below 0.1; near 1 the two models explain the samples equally well and the
-# branch after the meeting is not known.
+# best fit that leaves the motion on the other branch.  On exact lengths the right model's residual
+# is only the cubic's misfit of the motion (ratio far below 0.5); near 1 the two explain the samples
+# equally well and the branch after the meeting is not known.
 AMBIGUITY_RATIO = 0.5
 
 
@@ -108,31 +118,60 @@ def _wrap(x: np.ndarray) -> np.ndarray:
 
 def _fit_residual(t: np.ndarray, y: np.ndarray, w: np.ndarray) -> float:
     """Weighted residual norm of the least-squares quadratic through ``(t, y)``."""
-    c = np.polynomial.polynomial.polyfit(t, y, 2, w=w)
+    c = np.polynomial.polynomial.polyfit(t, y, min(MEET_FIT_DEGREE, t.size - 2), w=w)
     return float(np.linalg.norm(w * (np.polynomial.polynomial.polyval(t, c) - y)))
 
 
-def _decide(t: np.ndarray, d: np.ndarray, k: int) -> tuple[bool, bool, int]:
-    """Crossing or touch at one meeting: ``(crossed, ambiguous, first sample on the far side)``.
+def _decide(t: np.ndarray, d: np.ndarray, ks: list[int]) -> tuple[list[int | None], bool]:
+    """Crossing or touch at each meeting of a cluster: ``(splits, ambiguous)``.
 
     ``t`` are the window's sample indices, ``d`` the distances from the curve (half the separation,
-    rad) and ``k`` the position in the window of the sample nearest the curve.  The crossing model
-    puts the passage just before or after one of the samples next to ``k`` (noise moves the sample
-    nearest the curve by about a step) and takes the split that fits best.
+    rad) and ``ks`` the positions in the window of the meetings (the samples nearest the curve).
+    ``splits[j]`` is the first sample on the far side of meeting j if the motion crosses there,
+    ``None`` for a touch.  Every combination is fitted at once (the sign of σ flips at each crossing),
+    so two meetings closer than a window (a motion that dips just beyond the curve and back) are
+    decided together; a crossing is placed just before or after a sample next to the meeting (noise
+    moves the sample nearest the curve by about a step).  The decision is ambiguous when the best
+    fit with the other parity (the other branch after the cluster) fits almost as well.
     """
     n = t.size
-    splits = [p for p in range(k - MEET_SPLIT, k + MEET_SPLIT + 2) if 2 <= p <= n - 2]
-    if n < 5 or not splits:  # too few samples on one side to fit either model
-        return False, True, k
+    bounds = [0, *ks[1:], n]  # meeting j may place its crossing in (ks[j-1], ks[j+1]]
+    options: list[list[int | None]] = []
+    for j, k in enumerate(ks):
+        lo_j = max(bounds[j] + (1 if j else 2), k - MEET_SPLIT)
+        hi_j = min(bounds[j + 1] if j + 1 < len(ks) else n - 2, k + MEET_SPLIT + 1)
+        options.append([None, *range(lo_j, hi_j + 1)])
     w = np.maximum(d, np.finfo(float).tiny)
-    tc = t - t[k]  # centred: a well-conditioned Vandermonde matrix
-    r_touch = _fit_residual(tc, d, w)
-    r_split = [_fit_residual(tc, np.where(np.arange(n) < p, d, -d), w) for p in splits]
-    best = int(np.argmin(r_split))
-    r_cross = r_split[best]
-    crossed = r_cross < r_touch
-    ambiguous = min(r_touch, r_cross) > AMBIGUITY_RATIO * max(r_touch, r_cross)
-    return bool(crossed), bool(ambiguous), splits[best]
+    tc = t - t[ks[0]]  # centred: a well-conditioned Vandermonde matrix
+    idx = np.arange(n)
+    best: dict[int, tuple[float, list[int | None]]] = {}
+    for combo in itertools.product(*options):
+        flips = np.zeros(n, dtype=int)
+        for p in combo:
+            if p is not None:
+                flips += idx >= p
+        r = _fit_residual(tc, np.where(flips % 2 == 0, d, -d), w)
+        parity = sum(p is not None for p in combo) % 2
+        if parity not in best or r < best[parity][0]:
+            best[parity] = (r, list(combo))
+    if n < 5 or len(best) < 2:  # too few samples to fit either model
+        return [None] * len(ks), True
+    (r_win, splits), (r_other, _) = sorted(best.values(), key=lambda x: x[0])
+    # where exactly each crossing lies (before or after the sample nearest the curve) matters only for
+    # that sample, which the window fit weights least: the quadratic through the three samples before
+    # it (signed by the decision so far) extrapolated to it puts it on its side of the curve
+    sign, prev = 1.0, 0
+    for j, (k, p) in enumerate(zip(ks, splits, strict=True)):
+        if p is None:
+            continue
+        past = np.arange(max(prev, k - 3), k)
+        if past.size >= 2 and abs(p - k) <= 1:
+            sig = sign * d[past]
+            pred = np.polyval(np.polyfit(t[past] - t[k], sig, past.size - 1), 0.0)
+            splits[j] = k + 1 if pred * sign > 0 else k
+        here = splits[j]
+        sign, prev = -sign, (p if here is None else here)
+    return splits, bool(r_win > AMBIGUITY_RATIO * r_other)
 
 
 def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> BranchTrack:
@@ -219,20 +258,29 @@ def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> Br
         cur = branch
         start = 0
         tpos = idx.astype(float)
-        for j, k in enumerate(meets):  # positions in idx
-            lo = max(meets[j - 1] + 1 if j else 0, k - MEET_WINDOW)
-            hi = min(meets[j + 1] if j + 1 < len(meets) else M, k + MEET_WINDOW + 1)
-            crossed, amb, split = _decide(tpos[lo:hi], 0.5 * s[lo:hi], k - lo)
-            split = max(split + lo, start)
-            seg[start:split] = cur
-            new = 1 - cur if crossed else cur
-            meeting[i, idx[k]] = True
-            switched[i, idx[k]] = new != cur
+        # meetings closer than a window are decided together (their windows would overlap)
+        clusters: list[list[int]] = []
+        for k in meets:
+            if clusters and k - clusters[-1][-1] <= 2 * MEET_WINDOW and len(clusters[-1]) < MEET_CLUSTER_MAX:
+                clusters[-1].append(k)
+            else:
+                clusters.append([k])
+        for c, ks in enumerate(clusters):
+            lo = max(clusters[c - 1][-1] + 1 if c else 0, ks[0] - MEET_WINDOW)
+            hi = min(clusters[c + 1][0] if c + 1 < len(clusters) else M, ks[-1] + MEET_WINDOW + 1)
+            splits, amb = _decide(tpos[lo:hi], 0.5 * s[lo:hi], [k - lo for k in ks])
+            for k, sp in zip(ks, splits, strict=True):
+                meeting[i, idx[k]] = True
+                if sp is None:
+                    continue
+                split = max(sp + lo, start)
+                seg[start:split] = cur
+                switched[i, idx[k]] = True
+                cur = 1 - cur
+                start = split
             if amb:
-                ambiguous[i, idx[k]] = True
-                known[i, idx[k] :] = False
-            cur = new
-            start = split
+                ambiguous[i, idx[ks[0]]] = True
+                known[i, idx[ks[0]] :] = False
         seg[start:] = cur
         # invalid samples between valid ones carry the branch of the preceding valid sample
         full = np.full(N, branch, dtype=np.int8)
