@@ -207,3 +207,44 @@ def test_to_mjcf_refuses_massless_moving_bodies_naming_them():
 def test_draw_refuses_an_unknown_colour_naming_it():
     with pytest.raises(ValueError, match="Expected color"):
         mb.draw(FOUR_BAR, color="notacolor")
+
+
+# --- mobility of long chains -------------------------------------------------------------------------
+
+
+def _hinge_chain(n: int, close: bool, anchor: tuple[float, float, float] | None = None) -> mb.Mechanism:
+    b = mb.Builder("chain")
+    parent = "world"
+    for i in range(n):
+        b.body(
+            f"b{i}",
+            parent=parent,
+            pos=(0.1, 0, 0) if i else (0, 0, 0),
+            joints=[b.hinge(f"j{i}", (0, 0, 1) if i % 2 else (0, 1, 0))],
+            inertial=mb.Inertial(1.0, diaginertia=(0.1, 0.1, 0.1)),
+        )
+        parent = f"b{i}"
+    if close:
+        b.connect("cl", "world", parent, anchor or (0.1 * (n - 1), 0.0, 0.0))
+    b.actuate("j0")
+    return b.build()
+
+
+@pytest.mark.parametrize(("anchor", "singular"), [(None, True), ((0.8, 0.3, 0.1), False)])
+def test_mobility_with_generic_neighbour_directions_matches_every_direction(monkeypatch, anchor, singular):
+    """The neighbour rank check along 6 generic directions agrees with the check along all of them,
+    at the stretched (singular) pose of a closed 12-hinge chain and at a generic assembly."""
+    from robomech.multibody import _mobility
+
+    mech = _hinge_chain(12, close=True, anchor=anchor)
+    few = mb.mobility(mech)
+    assert few.singular is singular
+    monkeypatch.setattr(_mobility, "NEIGHBOUR_DIRECTIONS", 10**6)  # control: every direction
+    every = mb.mobility(mech)
+    assert (few.dof, few.rank, few.singular) == (every.dof, every.rank, every.singular)
+
+
+def test_mobility_of_a_long_chain_is_linear_work():
+    """1000 hinges: previously one kinematics call per admissible direction (2000 calls)."""
+    m = mb.mobility(_hinge_chain(1000, close=False))
+    assert m.dof == 1000
