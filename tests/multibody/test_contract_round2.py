@@ -248,3 +248,56 @@ def test_mobility_of_a_long_chain_is_linear_work():
     """1000 hinges: previously one kinematics call per admissible direction (2000 calls)."""
     m = mb.mobility(_hinge_chain(1000, close=False))
     assert m.dof == 1000
+
+
+# --- robomech verify: the simulation can be set and a failure says why --------------------------------
+
+
+@pytest.mark.parametrize(
+    ("options", "name"),
+    [
+        ({"duration": 0.0}, "duration"),
+        ({"duration": 100.0}, "duration"),
+        ({"duration": "0.3"}, "duration"),
+        ({"q0": np.zeros(2)}, "q0"),
+        ({"q0": np.array([0.0, 1.0, 1.0])}, "q0"),  # does not assemble
+        ({"q0": FOUR_BAR.q0, "qd_act0": np.zeros(3)}, "qd_act0"),
+        ({"qd_act0": np.zeros(1)}, "q0"),
+    ],
+)
+def test_verify_simulation_options_are_checked(options, name):
+    from robomech.verify._generic import check_mechanism
+
+    with pytest.raises(ValueError, match=rf"Expected {name}\b"):
+        check_mechanism(FOUR_BAR, "fb", **options)
+
+
+def test_verify_simulation_duration_and_start_are_used():
+    from robomech.verify._generic import check_mechanism
+
+    q0 = mb.forward_kinematics(FOUR_BAR, [0.5]).q
+    checks = check_mechanism(FOUR_BAR, "fb", duration=0.05, q0=q0, qd_act0=[1.0])
+    sim = [c for c in checks if c.quantity.startswith("forward simulation")]
+    assert sim and sim[0].quantity.endswith("(0.05 s, passive)") and sim[0].passed
+
+
+def test_a_failing_simulation_check_says_why(monkeypatch):
+    """Control: the same comparison under a tolerance it cannot meet fails, and then names when it left
+    the engine and how close it came to a type II singularity."""
+    from robomech.verify import _generic
+    from robomech.verify._core import Tolerance
+
+    monkeypatch.setattr(_generic, "TOL_SIM", Tolerance(1e-30, "impossible: the control", relative=True))
+    (sim, _) = _generic._simulation_checks(FOUR_BAR, "fb", FOUR_BAR.q0, np.zeros(1), 0.1)
+    assert not sim.passed
+    assert "diverged from the engine after t =" in sim.detail
+    assert "type II singularity" in sim.detail and "sigma_min" in sim.detail
+
+
+def test_verify_cli_takes_duration_and_start(capsys):
+    from robomech.cli import main
+
+    assert main(["verify", "four_bar", "--quiet", "--duration", "0.05", "--q0", "0", "0", "0"]) == 0
+    assert "forward simulation vs engine (0.05 s, passive)" in capsys.readouterr().out
+    assert main(["verify", "four_bar", "--quiet", "--duration", "-1"]) == 2  # control: refused in one line
+    assert "duration" in capsys.readouterr().err

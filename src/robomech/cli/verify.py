@@ -41,6 +41,29 @@ def _add_arguments(p: argparse.ArgumentParser) -> None:
         help="also save the checks to DIR/verification.json (the report index shows them)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+    p.add_argument(
+        "--duration",
+        type=float,
+        default=None,
+        metavar="S",
+        help="passive forward simulation of an MJCF / gallery mechanism: length (s, default 0.3, at most 10)",
+    )
+    p.add_argument(
+        "--q0",
+        type=float,
+        nargs="+",
+        default=None,
+        metavar="Q",
+        help="start configuration of that simulation (MuJoCo qpos, nq numbers; default: the trajectory's)",
+    )
+    p.add_argument(
+        "--qd0",
+        type=float,
+        nargs="+",
+        default=None,
+        metavar="QD",
+        help="start rates of the actuated joints for that simulation (n_act numbers; default 0 with --q0)",
+    )
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -71,8 +94,17 @@ def _run(args: argparse.Namespace) -> int:
     announce_compiles(enabled=not args.quiet)
     show_bars(not args.quiet)  # stage bars on a terminal (robomech._progress)
     report = VerificationReport()
+    sim = {
+        k: v
+        for k, v in (("duration", args.duration), ("q0", args.q0), ("qd_act0", args.qd0))
+        if v is not None
+    }
+    if sim and not generic:
+        raise CliError(
+            f"--{next(iter(sim)).replace('qd_act0', 'qd0')} applies to MJCF files and gallery mechanisms only"
+        )
     try:
-        report.checks.extend(run_generic(generic))
+        report.checks.extend(run_generic(generic, **sim))
     except ValueError as exc:
         raise CliError(str(exc)) from exc
     for n in names or ([] if generic else list(available)):

@@ -66,6 +66,12 @@ SIM_TIMESTEP = 1e-4
 SIM_SOLREF = "0.0005 1"
 SIM_SOLIMP = "0.9999 0.9999 0.001 0.5 2"
 T_SIM = 0.3
+# Longest passive fall a user may ask for: the engine steps at 0.1 ms, 10 s is 1e5 steps (~10 s CPU).
+MAX_SIM_DURATION = 10.0
+# Samples compared along the simulation (and searched for the closest singularity when it fails).
+SIM_SAMPLES = 31
+# A passive block whose smallest singular value is below this fraction of L is at a type II singularity.
+SINGULAR_SIGMA_RTOL = 1e-6
 TOL_SIM = Tolerance(1e-3, "soft engine constraints (0.5 ms, 0.9999) and 0.1 ms RK4 steps", relative=True)
 TOL_DRIFT = Tolerance(
     1e-7,
@@ -208,13 +214,51 @@ _STAGES = ("assembly along the test trajectory", "inverse dynamics", "engine com
            "forward simulation")  # fmt: skip
 
 
-def check_mechanism(mech, name: str | None = None, *, simulate: bool = True) -> list[Check]:
-    """Every check of this module for ``mech`` (the rows of the ``robomech verify`` table)."""
+def check_mechanism(
+    mech,
+    name: str | None = None,
+    *,
+    simulate: bool = True,
+    duration: float = T_SIM,
+    q0: object = None,
+    qd_act0: object = None,
+) -> list[Check]:
+    """Every check of this module for ``mech`` (the rows of the ``robomech verify`` table).
+
+    ``duration`` (s, ``0 < duration <= MAX_SIM_DURATION``) is the length of the passive forward
+    simulation; ``q0`` (nq,) and ``qd_act0`` (n_act,) its start (default: the test trajectory's first
+    state; ``q0`` must be assembled, ``qd_act0`` defaults to zero when ``q0`` is given).
+    """
+    from robomech._validation import as_array, check_bool, check_real
+
+    simulate = check_bool(simulate, "simulate")
+    duration = check_real(duration, "duration", low=0.0, high=MAX_SIM_DURATION, low_open=True)
+    start = None
+    if q0 is not None or qd_act0 is not None:
+        from robomech import multibody as mb
+
+        if q0 is None:
+            raise ValueError("Expected q0 with qd_act0 (the start configuration), got None.")
+        q0 = as_array(q0, "q0", (mech.nq,))
+        if q0.ndim != 1:
+            raise ValueError(f"Expected q0 to have shape ({mech.nq},), got {q0.shape}.")
+        na = len(mech.actuated)
+        qd = np.zeros(na) if qd_act0 is None else as_array(qd_act0, "qd_act0", (na,))
+        if qd.ndim != 1:
+            raise ValueError(f"Expected qd_act0 to have shape ({na},), got {qd.shape}.")
+        r = mb.constraint_residual(mech, q0)
+        miss = float(np.max(np.abs(r))) if r.size else 0.0
+        if not miss <= mb.CONVERGED_RTOL * mech.tree.length:
+            raise ValueError(
+                f"Expected q0 to be an assembled configuration (e.g. forward_kinematics(mech, q_act).q), "
+                f"got closure residual {miss:.3g} m."
+            )
+        start = (q0, qd)
     with stages(f"verify {name or getattr(mech, 'name', 'mechanism')}", _STAGES[: 4 + simulate]) as st:
-        return _checks(mech, name, simulate, st)
+        return _checks(mech, name, simulate, st, duration, start)
 
 
-def _checks(mech, name: str | None, simulate: bool, st) -> list[Check]:
+def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM, start=None) -> list[Check]:
     import mujoco
 
     from robomech import multibody as mb
@@ -314,7 +358,8 @@ def _checks(mech, name: str | None, simulate: bool, st) -> list[Check]:
     checks.append(_power_check(drv, name, m, d, at, t[conv], q, inv.tau, inv.qd[:, tree.act_dof]))
     if simulate:
         st.next()
-        checks += _simulation_checks(mech, name, q[0], qda[0])
+        q_s, qd_s = (q[0], qda[0]) if start is None else start
+        checks += _simulation_checks(mech, name, q_s, qd_s, duration)
     return checks
 
 
@@ -369,12 +414,33 @@ def _power_check(mech, name, m, d, at, t, q, tau, qd_act) -> Check:
     return Check(name, "power balance tau.qd = dE/dt (engine energy)", _rel(err, scale), TOL_POWER, "")
 
 
-def _simulation_checks(mech, name, q0, qd_act0) -> list[Check]:
+def _why(mech, t: np.ndarray, q: np.ndarray, off: np.ndarray) -> str:
+    """Why a simulation disagrees: when it first left the engine, and the closest type II singularity
+    (smallest singular value of the passive block of K, in m, from :func:`multibody.influence`)."""
+    from robomech import multibody as mb
+
+    words = []
+    if off.any():
+        words.append(f"diverged from the engine after t = {t[int(np.argmax(off))]:.3g} s")
+    inf = mb.influence(mech, q, second_order=False)
+    if inf.n_passive:
+        smin = np.where(inf.passive_rank < inf.passive_rank.max(initial=0), 0.0, inf.sigma_min)
+        k = int(np.nanargmin(smin))
+        if smin[k] < SINGULAR_SIGMA_RTOL * mech.tree.length or inf.passive_rank[k] < inf.passive_rank.max():
+            words.append(
+                f"crossed a type II singularity near t = {t[k]:.3g} s (sigma_min {inf.sigma_min[k]:.1e} m)"
+            )
+        else:
+            words.append(f"closest to a type II singularity at t = {t[k]:.3g} s (sigma_min {smin[k]:.1e} m)")
+    return "; ".join(words)
+
+
+def _simulation_checks(mech, name, q0, qd_act0, duration: float = T_SIM) -> list[Check]:
     import mujoco
 
     from robomech import multibody as mb
 
-    t = np.linspace(0.0, T_SIM, 7)
+    t = np.linspace(0.0, duration, SIM_SAMPLES)
     sim = mb.simulate(mech, q0, qd_act0, t)
     m = engine_model(mech, simulation=True)
     d = mujoco.MjData(m)
@@ -388,20 +454,29 @@ def _simulation_checks(mech, name, q0, qd_act0) -> list[Check]:
             mujoco.mj_step(m, d)
         out.append(d.qpos[mech.tree.act_qadr].copy())
     eng = np.array(out)
-    if not bool(sim.success):
-        return [Check(name, "forward simulation vs engine", 1.0, TOL_SIM, "integration failed (error: 1)")]
     tree = mech.tree
+    if not bool(sim.success):
+        ok = np.all(np.isfinite(sim.q), axis=-1)
+        why = _why(mech, t[ok], sim.q[ok], np.zeros(int(ok.sum()), bool)) if ok.any() else ""
+        return [
+            Check(
+                name,
+                "forward simulation vs engine",
+                1.0,
+                TOL_SIM,
+                "integration failed (error: 1)" + (f": {why}" if why else ""),
+            )
+        ]
     scale = np.where(tree.dof_translational[tree.act_dof], 1.0 / tree.length, 1.0)
-    err = float(np.max(np.abs((sim.q_act - eng) * scale)))
+    dev = np.max(np.abs((sim.q_act - eng) * scale), axis=-1)
+    err = float(np.max(dev))
     moved = float(np.max(np.abs((sim.q_act - sim.q_act[0]) * scale)))
+    rel = _rel(err, max(moved, 1e-3))
+    detail = f"max |q_act - engine| {err:.2e} (rad, slides / L) for a motion of {moved:.3g}"
+    if not rel <= TOL_SIM.value:
+        detail += "; " + _why(mech, t, sim.q, dev > TOL_SIM.value * max(moved, 1e-3))
     return [
-        Check(
-            name,
-            f"forward simulation vs engine ({T_SIM} s, passive)",
-            _rel(err, max(moved, 1e-3)),
-            TOL_SIM,
-            f"max |q_act - engine| {err:.2e} (rad, slides / L) for a motion of {moved:.3g}",
-        ),
+        Check(name, f"forward simulation vs engine ({duration:g} s, passive)", rel, TOL_SIM, detail),
         Check(
             name,
             "energy drift of the simulation",
@@ -438,16 +513,18 @@ def split_targets(targets, available) -> tuple[list[str], list[str]]:
     return [a for a in targets if a not in generic], generic
 
 
-def run_generic(targets) -> list[Check]:
+def run_generic(targets, **options) -> list[Check]:
     """The generic checks of each target (MJCF path, gallery or description name); ValueError if one
-    cannot be read."""
+    cannot be read.  ``options`` (``duration``, ``q0``, ``qd_act0``) go to :func:`check_mechanism`."""
     checks: list[Check] = []
     for t in targets:
         try:
             mech = describe(t)
         except OSError as exc:
             raise ValueError(f"cannot read {t!r}: {exc}") from exc
-        checks.extend(check_mechanism(mech, Path(t).stem if t.endswith(".xml") else f"{t} (generic)"))
+        checks.extend(
+            check_mechanism(mech, Path(t).stem if t.endswith(".xml") else f"{t} (generic)", **options)
+        )
     return checks
 
 
