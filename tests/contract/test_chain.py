@@ -178,3 +178,28 @@ def test_control_the_chain_rule_fails_a_failed_sample_given_a_value():
 
 def test_control_the_coverage_rule_sees_a_function_taking_q():
     assert _takes_q("site_pose") and _takes_q("forward_kinematics") and not _takes_q("to_mjcf")
+
+
+def test_control_the_nan_rows_spec_rule_fails_a_function_that_does_not_propagate():
+    """The contract suite's ``nan_rows`` check (test_contract._check_nan_row) rejects a function that
+    fills a failed sample with a value, and passes the real one."""
+    from contract_spec import Spec
+    from test_contract import _check_nan_row
+
+    q = FK.q[GOOD + GOOD[:1]]  # 3 good samples
+    bad = q.copy()
+    bad[1, 0] = np.nan
+
+    def filled(mech, q):
+        return mb.site_pose(mech, np.nan_to_num(q), SITE)
+
+    def real(mech, q):
+        return mb.site_pose(mech, q, SITE)
+
+    for fn, ok in ((filled, False), (real, True)):
+        spec = Spec(args={"mech": MECH, "q": q}, arrays={"q": 1}, nan_rows=("q",), call=fn)
+        if ok:
+            _check_nan_row(f"control-{fn.__name__}", spec, "q", {"mech": MECH, "q": bad}, 3)
+        else:
+            with pytest.raises(AssertionError, match="non-NaN"):
+                _check_nan_row(f"control-{fn.__name__}", spec, "q", {"mech": MECH, "q": bad}, 3)
