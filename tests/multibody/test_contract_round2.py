@@ -244,8 +244,10 @@ def test_mobility_with_generic_neighbour_directions_matches_every_direction(monk
     assert (few.dof, few.rank, few.singular) == (every.dof, every.rank, every.singular)
 
 
+@pytest.mark.slow
 def test_mobility_of_a_long_chain_is_linear_work():
-    """1000 hinges: previously one kinematics call per admissible direction (2000 calls)."""
+    """1000 hinges: previously one kinematics call per admissible direction (2000 calls); building
+    the chain itself takes several seconds, hence slow."""
     m = mb.mobility(_hinge_chain(1000, close=False))
     assert m.dof == 1000
 
@@ -288,7 +290,8 @@ def test_a_failing_simulation_check_says_why(monkeypatch):
     from robomech.verify._core import Tolerance
 
     monkeypatch.setattr(_generic, "TOL_SIM", Tolerance(1e-30, "impossible: the control", relative=True))
-    (sim, _) = _generic._simulation_checks(FOUR_BAR, "fb", FOUR_BAR.q0, np.zeros(1), 0.1)
+    q0 = mb.forward_kinematics(FOUR_BAR, [0.5]).q
+    (sim, _) = _generic._simulation_checks(FOUR_BAR, "fb", q0, np.ones(1), 0.1)
     assert not sim.passed
     assert "diverged from the engine after t =" in sim.detail
     assert "type II singularity" in sim.detail and "sigma_min" in sim.detail
