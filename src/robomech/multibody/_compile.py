@@ -355,7 +355,6 @@ def compile_model(mech: Mechanism) -> Model:
             return hit[1]
         model = _compile(mech)
         key = id(mech)
-
         def _release(_ref: object, key: int = key) -> None:
             _drop(key)
 
