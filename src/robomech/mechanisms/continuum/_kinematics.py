@@ -302,7 +302,6 @@ def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
     psi : array_like, shape (..., 2 n)
         ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
 
@@ -331,7 +330,6 @@ def tip_position(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     psi : array_like, shape (..., 2 n)
         Bend and bending-plane angles of the segments (rad).
 
@@ -419,7 +417,6 @@ def tip_jacobian(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     psi : array_like, shape (..., 2 n)
         Bend and bending-plane angles of the segments (rad).
 
@@ -447,7 +444,6 @@ def disk_transforms(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     psi : array_like, shape (..., 2 n)
         Bend and bending-plane angles of the segments (rad).
 
@@ -535,7 +531,6 @@ def span_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "chord"
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     psi : array_like, shape (..., 2 n)
         Bend and bending-plane angles of the segments (rad).
     model : {"chord", "arc"}, optional
@@ -565,7 +560,6 @@ def span_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "chord
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     psi : array_like, shape (..., 2 n)
         Bend and bending-plane angles of the segments (rad).
     model : {"chord", "arc"}, optional
@@ -602,7 +596,6 @@ def cable_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "arc")
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     psi : array_like, shape (..., 2 n)
         Bend and bending-plane angles of the segments (rad).
     model : {"arc", "chord"}, optional
@@ -633,7 +626,6 @@ def cable_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "arc"
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     psi : array_like, shape (..., 2 n)
         Bend and bending-plane angles of the segments (rad).
     model : {"arc", "chord"}, optional
@@ -858,7 +850,6 @@ def inverse_kinematics(robot: ContinuumRobot, p_tip: object) -> IKResult:
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     p_tip : array_like, shape (..., 3)
         Tip targets in the base frame (m).
 

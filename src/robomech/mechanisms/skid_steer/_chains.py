@@ -119,7 +119,6 @@ def contact_frames(robot: ExplorationRobot, config: ArrayLike) -> np.ndarray:
     Parameters
     ----------
     robot : ExplorationRobot
-        The robot's geometry (m), e.g. ``ExplorationRobot.paper()``.
     config : array_like, shape (..., 8)
         Joint configuration: per side ``SIDE_JOINTS`` (rocker, bogie and slide coordinates; rad, m).
 
@@ -209,7 +208,6 @@ def wheel_jacobians(robot: ExplorationRobot, config: ArrayLike) -> np.ndarray:
     Parameters
     ----------
     robot : ExplorationRobot
-        The robot's geometry (m).
     config : array_like, shape (..., 8)
         Joint configuration (rad, m), ``SIDE_JOINTS`` per side.
 

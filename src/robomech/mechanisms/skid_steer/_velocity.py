@@ -61,7 +61,6 @@ def assemble(robot: ExplorationRobot, config: ArrayLike) -> tuple[np.ndarray, np
     Parameters
     ----------
     robot : ExplorationRobot
-        The robot's geometry (m).
     config : array_like, shape (..., 8)
         Joint configuration (rad, m).
 
@@ -154,7 +153,6 @@ def wheel_measurements(
     Parameters
     ----------
     robot : ExplorationRobot
-        The robot's geometry (m).
     config : array_like, shape (..., 8)
         Joint configuration (rad, m).
     twist : array_like, shape (..., 6)
@@ -257,7 +255,6 @@ def body_velocity(
     Parameters
     ----------
     robot : ExplorationRobot
-        The robot's geometry (m).
     state : array_like, shape (..., 8)
         Joint configuration (rad, m).
     measured : array_like, shape (..., 22)
@@ -272,8 +269,7 @@ def body_velocity(
     Returns
     -------
     BodyVelocity
-        ``twist (..., 6)`` ``[ω_B; v_B]`` (rad/s, m/s, body axes), ``config_rate (..., 8)``,
-        ``unknowns (..., 11)``, ``residual_norm``, ``cond`` and ``valid`` per sample.
+        Body twist, configuration rates, unknowns, conditioning and mask per sample.
 
     Examples
     --------
