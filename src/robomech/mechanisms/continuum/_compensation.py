@@ -119,7 +119,7 @@ def cable_elongation(
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -162,7 +162,7 @@ def theoretical_drive(robot: ContinuumRobot, psi: object, model: CableModel = "a
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -269,7 +269,7 @@ def compensated_drive(
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md); also ``method="disk"`` combined with ``model="arc"`` or a
+        Bad input (see docs/conventions.md); also ``method="disk"`` combined with ``model="arc"`` or a
         ``wrench``.
 
     Examples
@@ -450,7 +450,7 @@ def simulate(
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -663,7 +663,7 @@ def simulate_history(
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md); also ``times`` not strictly increasing, or
+        Bad input (see docs/conventions.md); also ``times`` not strictly increasing, or
         ``memory="elastic"`` combined with ``model="arc"`` or a pulley.
 
     Examples
@@ -895,7 +895,7 @@ def disk_equilibrium(
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md); also both or neither of ``tension`` and ``drive`` given.
+        Bad input (see docs/conventions.md); also both or neither of ``tension`` and ``drive`` given.
 
     Examples
     --------

@@ -76,7 +76,7 @@ def wrap_angles(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -143,7 +143,7 @@ def friction_factors(robot: ContinuumRobot, psi: object, direction: object | Non
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -205,7 +205,7 @@ def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -240,7 +240,7 @@ def classical_capstan_ratio(phi: object, mu: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -332,7 +332,7 @@ def capstan_tension_ratio(
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md); ``rho = inf`` is allowed; also ``rho`` too large for the
+        Bad input (see docs/conventions.md); ``rho = inf`` is allowed; also ``rho`` too large for the
         explicit integration with n < 1 (use ``rho=np.inf``).
 
     Examples
@@ -482,7 +482,7 @@ def identify_friction(
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md); also a batch element with no measurement of nonzero wrap
+        Bad input (see docs/conventions.md); also a batch element with no measurement of nonzero wrap
         and direction.
 
     Examples
@@ -583,7 +583,7 @@ def stick_slip_tensions(
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------

@@ -104,7 +104,7 @@ def identify_friction_from_pose(
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -257,7 +257,7 @@ def identify_friction_from_tip(
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md); also only one of ``sigma_t``, ``sigma_tip`` given.
+        Bad input (see docs/conventions.md); also only one of ``sigma_t``, ``sigma_tip`` given.
     """
     from ._compensation import disk_equilibrium
 

@@ -13,6 +13,7 @@ from typing import Literal
 
 import numpy as np
 
+from robomech._batching import slices
 from robomech._validation import as_array, broadcast_batch, check_params
 from robomech.spatial import SMALL_ANGLE
 
@@ -203,8 +204,7 @@ def _segment_planes(theta: np.ndarray, beta: np.ndarray, length: np.ndarray | fl
     scalar_length = np.ndim(length) == 0
     ln_arr = None if scalar_length else _flat(np.asarray(length, dtype=float), shape)
     ln = float(length) if scalar_length else 0.0
-    for k in range(0, th.size, CHUNK):
-        c = slice(k, k + CHUNK)
+    for c in slices(th.size, CHUNK):
         t = np.ascontiguousarray(th[c])
         st, ct, omc = _half_angle(t)
         sb, cb = _half_angle(be[c], one_minus_cos=False)
@@ -357,8 +357,7 @@ def _local_columns(theta: np.ndarray, beta: np.ndarray, length: float) -> np.nda
     P = np.empty((6, 2, *shape))
     Pf = P.reshape(12, -1)
     th, be = _flat(theta, shape), _flat(beta, shape)
-    for k in range(0, th.size, CHUNK):
-        c = slice(k, k + CHUNK)
+    for c in slices(th.size, CHUNK):
         t = np.ascontiguousarray(th[c])
         st, ct, omc = _half_angle(t)
         sb, cb = _half_angle(be[c], one_minus_cos=False)
@@ -802,8 +801,7 @@ def _single_arc(robot: ContinuumRobot, p: np.ndarray, theta: np.ndarray, beta: n
     from the tip of the arc (the formulas of _segment_T); n >= 2: from the composed forward kinematics."""
     n, L = robot.n_segments, robot.segment_length
     res = np.empty(p.shape[0])
-    for k in range(0, p.shape[0], CHUNK):
-        c = slice(k, k + CHUNK)
+    for c in slices(p.shape[0], CHUNK):
         x, y, z = p[c, 0], p[c, 1], p[c, 2]
         rh = x * x
         rh += y * y

@@ -47,7 +47,7 @@ class Pulley:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------

@@ -43,7 +43,7 @@ def elastic_energy(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -80,7 +80,7 @@ def elastic_gradient(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -115,7 +115,7 @@ def coupling_moments(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -204,7 +204,7 @@ def cable_tensions(
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------

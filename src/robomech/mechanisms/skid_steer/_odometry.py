@@ -64,7 +64,7 @@ class EncoderModel:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
     """
 
     counts_per_rev: int = 2048
@@ -99,7 +99,7 @@ class ImuModel:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
     """
 
     gyro_noise_density: float = math.radians(0.008)  # rad/s/√Hz

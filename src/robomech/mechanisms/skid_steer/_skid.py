@@ -228,7 +228,7 @@ def dead_reckoning(twists: ArrayLike, dt: float, T0: ArrayLike | None = None) ->
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------

@@ -21,6 +21,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from robomech._batching import slices
 from robomech._validation import as_array, broadcast_batch, broadcast_to_batch, check_bool, check_params
 from robomech.analysis import lstsq
 
@@ -85,8 +86,7 @@ def assemble(robot: ExplorationRobot, config: ArrayLike) -> tuple[np.ndarray, np
     qf = q.reshape(n, CONFIG_SIZE)
     A0 = np.empty((n, N_ROWS, UNKNOWN_SIZE))
     J = np.empty((n, N_ROWS, MEASURED_SIZE))
-    for start in range(0, n, ASSEMBLY_CHUNK):
-        sl = slice(start, start + ASSEMBLY_CHUNK)
+    for sl in slices(n, ASSEMBLY_CHUNK):
         A0[sl], J[sl] = _assemble(robot, qf[sl])
     return A0.reshape(*batch, N_ROWS, UNKNOWN_SIZE), J.reshape(*batch, N_ROWS, MEASURED_SIZE)
 
@@ -303,8 +303,7 @@ def body_velocity(
     resid = np.empty(n)
     cond = np.empty(n)
     valid = np.empty(n, dtype=bool)
-    for start in range(0, n, CHUNK):
-        sl = slice(start, start + CHUNK)
+    for sl in slices(n, CHUNK):
         qc, mc = qf[sl], mf[sl]
         finite_q = np.all(np.isfinite(qc), axis=-1)
         A0, J = _assemble(robot, np.where(finite_q[:, None], qc, 0.0))

@@ -139,7 +139,7 @@ def inverse_rates(
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -251,7 +251,7 @@ def static_torques(th: VectoredThruster, q: object, wrench: object) -> StaticsRe
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
+from robomech._batching import chunked
 from robomech._validation import as_array, broadcast_batch, check_params
 from robomech.spatial import lie_bracket
 
@@ -78,34 +79,11 @@ _R = TypeVar("_R", bound="DataclassInstance")  # a frozen result dataclass of ar
 
 
 def _chunked(kernel: Callable[..., _R], th: VectoredThruster, x: np.ndarray) -> _R:
-    """Run ``kernel(th, x_block)`` over blocks of CHUNK samples of ``x (..., k)`` into preallocated outputs.
-
-    ``kernel`` returns a frozen dataclass of arrays whose leading dimension is the sample axis.
-    """
-    batch = x.shape[:-1]
-    flat = x.reshape(-1, x.shape[-1])
-    n = flat.shape[0]
-    if n <= CHUNK:
-        first = kernel(th, flat)
-        return dataclasses.replace(
-            first,
-            **{
-                f.name: getattr(first, f.name).reshape(batch + getattr(first, f.name).shape[1:])
-                for f in dataclasses.fields(first)
-            },
-        )
-    first = kernel(th, flat[:CHUNK])
-    names = [f.name for f in dataclasses.fields(first)]
-    outs = {}
-    for k in names:
-        a = getattr(first, k)
-        outs[k] = np.empty((n, *a.shape[1:]), dtype=a.dtype)
-        outs[k][:CHUNK] = a
-    for i in range(CHUNK, n, CHUNK):  # a fixed number of cache-sized blocks, not a loop over samples
-        r = kernel(th, flat[i : i + CHUNK])
-        for k in names:
-            outs[k][i : i + CHUNK] = getattr(r, k)
-    return dataclasses.replace(first, **{k: v.reshape(batch + v.shape[1:]) for k, v in outs.items()})
+    """``kernel(th, x_block)`` over blocks of CHUNK samples of ``x (..., k)``, reshaped to its batch."""
+    batch, flat = x.shape[:-1], x.reshape(-1, x.shape[-1])
+    r = chunked(lambda s: kernel(th, flat[s]), flat.shape[0], CHUNK)
+    arrays = {f.name: getattr(r, f.name) for f in dataclasses.fields(r)}
+    return dataclasses.replace(r, **{k: a.reshape(batch + a.shape[1:]) for k, a in arrays.items()})
 
 
 _X = np.array([1.0, 0.0, 0.0])
@@ -347,7 +325,7 @@ def joint_axes(th: VectoredThruster, q: object) -> JointAxes:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -449,7 +427,7 @@ def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -537,7 +515,7 @@ def link_clearance(th: VectoredThruster, q: object) -> LinkClearanceResult:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -643,7 +621,7 @@ def platform_rotation(th: VectoredThruster, q: object) -> RotationResult:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -809,7 +787,7 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
     """
     check_params(th, VectoredThruster, "th")
     q = _q(q)
@@ -853,7 +831,7 @@ def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
     """
     check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
@@ -962,7 +940,7 @@ def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityRes
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -1011,7 +989,7 @@ def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: objec
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
     """
     check_params(th, VectoredThruster, "th")
     q, qd, qdd = _q(q), as_array(qd, "qd", (2,)), as_array(qdd, "qdd", (2,))

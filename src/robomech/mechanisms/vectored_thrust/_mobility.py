@@ -55,7 +55,7 @@ def chain_screws(
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md); also a singular ``q``.
+        Bad input (see docs/conventions.md); also a singular ``q``.
 
     Examples
     --------
@@ -107,7 +107,7 @@ def platform_mobility(
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -168,7 +168,7 @@ def mechanism_mobility(
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------

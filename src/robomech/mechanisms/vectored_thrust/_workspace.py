@@ -119,7 +119,7 @@ def dexterity(th: VectoredThruster, q: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -149,7 +149,7 @@ def workspace_map(th: VectoredThruster, q: object) -> WorkspaceMap:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -204,7 +204,7 @@ def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = 
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -233,7 +233,7 @@ def singular_points(th: VectoredThruster) -> np.ndarray:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
     """
     check_params(th, VectoredThruster, "th")
     a = th.arc_angle
@@ -259,7 +259,7 @@ def idle_input_curve(th: VectoredThruster, q1: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        Bad input (see the conventions, docs/conventions.md).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
