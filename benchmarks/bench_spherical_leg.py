@@ -2,7 +2,7 @@
 dynamics along a 10^5-sample trajectory vs a per-sample loop of MuJoCo's inverse dynamics of the same
 mechanism, and a 10^6-sample workspace/singularity map.
 
-Batches of at least ``FK_NUMBA_MIN`` samples run the forward kinematics in compiled (numba) kernels; their
+The forward kinematics runs in compiled (numba) kernels; their
 one-off compile cost (then cached on disk) is measured in a fresh process with an empty cache and printed.
 """
 
@@ -24,7 +24,7 @@ def _fk_compile_seconds() -> float:
     """First large-batch FK call in a fresh process with an empty numba cache, minus a second call."""
     return fresh_process_seconds(
         "import time, numpy as np; from robomech.mechanisms import spherical_leg as sl; "
-        "from robomech.mechanisms.spherical_leg._kinematics import FK_NUMBA_MIN as n; "
+        "n = 4096; "
         "leg = sl.SphericalLeg.paper(); L = sl.inverse_kinematics(leg, np.zeros(n), np.zeros(n)).lengths; "
         "t = time.perf_counter(); sl.forward_kinematics(leg, L); t1 = time.perf_counter(); "
         "sl.forward_kinematics(leg, L); print((t1 - t) - (time.perf_counter() - t1))"

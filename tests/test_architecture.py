@@ -52,6 +52,7 @@ INFRASTRUCTURE = {
     "robomech._registry",
     "robomech._numba",
     "robomech._progress",
+    "robomech._batching",
 }
 ENGINES = {"mujoco", "exudyn", "pinocchio"}
 # The distributed-computing stack of robomech.explore: imported inside functions only (first use).

@@ -234,13 +234,11 @@ def test_chunked_batches_equal_per_sample_across_chunk_boundaries():
         assert abs(sl.workspace_map(LEG, q[k, 0], q[k, 1]).cond - wm.cond[k]) <= 1e-12 * wm.cond[k]
 
 
-def test_compiled_forward_kinematics_matches_the_numpy_path():
-    # batches of at least FK_NUMBA_MIN samples run the compiled kernels; both paths must agree to 1e-12
-    # on noisy, exact, branch-1 and bad samples alike (same flags, NaN in the same places)
-    from robomech.mechanisms.spherical_leg import _kinematics as kin
-
+def test_compiled_forward_kinematics_on_exact_noisy_and_bad_samples():
+    # the compiled kernels on noisy, exact, branch-1 and bad samples: exact lengths give the poses back,
+    # the residual is the inverse kinematics' distance to the measured lengths, bad samples are masked
     rng = np.random.default_rng(11)
-    n = kin.FK_NUMBA_MIN + 5
+    n = 4101
     q = rng.uniform(-1.2, 1.2, (n, 2))
     L = sl.inverse_kinematics(LEG, q[:, 0], q[:, 1]).lengths
     L[: n // 2] += rng.normal(scale=1e-4, size=(n // 2, 3))
@@ -250,12 +248,19 @@ def test_compiled_forward_kinematics_matches_the_numpy_path():
     L[4] = [0.1, 0.1, np.inf]
     L[5] = [0.0, 0.1, 0.1]
     for branch in (0, 1):
-        fast = sl.forward_kinematics(LEG, L, branch=branch)
-        outs = (np.empty(n), np.empty(n), np.empty(n), np.empty(n, bool), np.empty(n, bool))
-        kin._fk_kernel(LEG, branch, L, *outs)
-        alpha, beta, residual, valid, converged = outs
-        assert np.array_equal(fast.valid, valid) and np.array_equal(fast.converged, converged)
-        assert fast.valid[0] and not fast.valid[1:6].any() and fast.valid[6:].mean() > 0.9
-        for got, ref in ((fast.alpha, alpha), (fast.beta, beta), (fast.residual, residual)):
-            assert np.array_equal(np.isnan(got), ~valid) and np.array_equal(np.isnan(ref), ~valid)
-            assert np.max(np.abs(got[valid] - ref[valid])) <= 1e-12
+        fk = sl.forward_kinematics(LEG, L, branch=branch)
+        valid = fk.valid
+        assert valid[0] and not valid[1:6].any() and valid[6:].mean() > 0.9
+        assert not (fk.converged & ~valid).any()
+        for got in (fk.alpha, fk.beta, fk.residual):
+            assert np.array_equal(np.isnan(got), ~valid)
+        back = sl.inverse_kinematics(LEG, fk.alpha[valid], fk.beta[valid]).lengths
+        resid = np.linalg.norm(back - L[valid], axis=-1)
+        assert np.max(np.abs(resid - fk.residual[valid])) <= 1e-12
+        exact = valid.copy()
+        exact[: n // 2] = False
+        if branch == 0:  # the noise-free half: the poses themselves (branch 0 holds alpha = 0)
+            same = exact & (np.abs(fk.alpha - q[:, 0]) < 1e-6)
+            assert same.sum() > 0.5 * exact.sum()
+            assert np.max(np.abs(fk.beta[same] - q[same, 1])) <= 1e-12
+            assert np.max(np.abs(fk.alpha[same] - q[same, 0])) <= 1e-12

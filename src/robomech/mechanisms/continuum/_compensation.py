@@ -100,7 +100,6 @@ def cable_elongation(
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
     psi : array_like, shape (..., 2 n)
         ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
     tension : array_like, shape (..., 3 n)
@@ -120,9 +119,7 @@ def cable_elongation(
     Raises
     ------
     ValueError
-        If ``robot`` is not a :class:`ContinuumRobot`; ``psi`` does not end in an axis of 2 n, or
-        ``tension`` in one of 3 n, or either is not real and finite; ``direction`` has a wrong shape or
-        invalid values.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -152,7 +149,6 @@ def theoretical_drive(robot: ContinuumRobot, psi: object, model: CableModel = "a
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
     psi : array_like, shape (..., 2 n)
         ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
     model : {"chord", "arc"}, optional
@@ -166,8 +162,7 @@ def theoretical_drive(robot: ContinuumRobot, psi: object, model: CableModel = "a
     Raises
     ------
     ValueError
-        If ``robot`` is not a :class:`ContinuumRobot`, or ``psi`` does not end in an axis of 2 n or is
-        not real and finite.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -250,7 +245,6 @@ def compensated_drive(
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
     psi : array_like, shape (..., 2 n)
         ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
     direction : array_like, shape (..., 3 n), optional
@@ -270,15 +264,13 @@ def compensated_drive(
     Returns
     -------
     DriveResult
-        ``q``, ``delta``, ``q_compensated``, ``tension``, ``actuator_tension``, ``delta_pulley``
-        ``(..., 3 n)`` (m, N) and ``taut (...)``.
+        Drive displacements, elongations and tensions per sample.
 
     Raises
     ------
     ValueError
-        If ``robot`` is not a :class:`ContinuumRobot` or ``pulley`` not a :class:`Pulley`; ``psi``,
-        ``direction`` or ``wrench`` has a wrong shape or invalid values; ``method`` or ``model`` is
-        unknown; or ``method="disk"`` is combined with ``model="arc"`` or a ``wrench``.
+        Bad input (see docs/conventions.md); also ``method="disk"`` combined with ``model="arc"`` or a
+        ``wrench``.
 
     Examples
     --------
@@ -436,7 +428,6 @@ def simulate(
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
     q : array_like, shape (..., 3 n)
         Cable pulled in by each actuator since the straight, pretensioned pose (m), e.g.
         ``compensated_drive(...).q_compensated``.
@@ -454,15 +445,12 @@ def simulate(
     Returns
     -------
     SimulationResult
-        ``psi (..., 2 n)`` (rad), ``tension``, ``actuator_tension (..., 3 n)`` (N), ``taut``,
-        ``converged``, ``residual`` (N m) and ``iterations`` per sample ``(...)``.
+        Equilibrium bending, tensions, masks and residual per sample.
 
     Raises
     ------
     ValueError
-        If ``robot`` is not a :class:`ContinuumRobot` or ``pulley`` not a :class:`Pulley`; ``q`` does
-        not end in an axis of 3 n or is not real and finite; ``direction`` or ``initial`` has a wrong
-        shape or invalid values.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -651,7 +639,6 @@ def simulate_history(
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
     q : array_like, shape (n_t, ..., 3 n)
         Drive history: cable pulled in by each actuator since the straight, pretensioned pose (m),
         time axis first (``n_t >= 1``).
@@ -671,17 +658,13 @@ def simulate_history(
     Returns
     -------
     HistoryResult
-        ``psi (n_t, ..., 2 n)``, ``tension``, ``actuator_tension``, ``direction (n_t, ..., 3 n)``,
-        ``span_tension``, ``state``, ``slip (n_t, ..., 3 n, n N)``, ``tip (n_t, ..., 3)``, ``bend
-        (n_t, ..., n N, 2)`` and the flags ``taut``, ``converged``, ``valid`` and ``residual (n_t, ...)``.
+        The quasi-static history along the time axis, with its masks.
 
     Raises
     ------
     ValueError
-        If ``robot`` is not a :class:`ContinuumRobot` or ``pulley`` not a :class:`Pulley`; ``q`` has no
-        leading time axis, does not end in an axis of 3 n or is not real and finite; ``times`` has a
-        shape other than ``(n_t,)`` or is not strictly increasing; ``model`` or ``memory`` is unknown;
-        or ``memory="elastic"`` is combined with ``model="arc"`` or a pulley.
+        Bad input (see docs/conventions.md); also ``times`` not strictly increasing, or
+        ``memory="elastic"`` combined with ``model="arc"`` or a pulley.
 
     Examples
     --------
@@ -895,7 +878,6 @@ def disk_equilibrium(
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
     tension : array_like, shape (..., 3 n), optional
         Actuator-side tensions (N, >= 0).
     drive : array_like, shape (..., 3 n), optional
@@ -913,8 +895,7 @@ def disk_equilibrium(
     Raises
     ------
     ValueError
-        If ``robot`` is not a :class:`ContinuumRobot`; both or neither of ``tension`` and ``drive`` are
-        given; ``tension`` is negative; or an array has a wrong shape or is not real and finite.
+        Bad input (see docs/conventions.md); also both or neither of ``tension`` and ``drive`` given.
 
     Examples
     --------

@@ -65,7 +65,6 @@ def wrap_angles(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
     psi : array_like, shape (..., 2 n)
         ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
 
@@ -77,8 +76,7 @@ def wrap_angles(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``robot`` is not a :class:`ContinuumRobot`, or ``psi`` does not end in an axis of 2 n or is
-        not real and finite.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -131,7 +129,6 @@ def friction_factors(robot: ContinuumRobot, psi: object, direction: object | Non
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
     psi : array_like, shape (..., 2 n)
         ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
     direction : array_like, shape (..., 3 n), optional
@@ -146,9 +143,7 @@ def friction_factors(robot: ContinuumRobot, psi: object, direction: object | Non
     Raises
     ------
     ValueError
-        If ``robot`` is not a :class:`ContinuumRobot`, or ``psi`` does not end in an axis of 2 n or is
-        not real and finite, or ``direction`` has a wrong shape or a value
-        other than +-1 on a cable with friction.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -210,8 +205,7 @@ def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np
     Raises
     ------
     ValueError
-        If an argument is not real and finite, ``rho`` or ``alpha`` is not positive, or ``n`` lies
-        outside (0, 1].
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -246,7 +240,7 @@ def classical_capstan_ratio(phi: object, mu: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``phi`` or ``mu`` is not real and finite.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -338,8 +332,8 @@ def capstan_tension_ratio(
     Raises
     ------
     ValueError
-        If an argument is not real (or, except ``rho = inf``, not finite), out of its range, or if
-        ``rho`` is too large for the explicit integration with n < 1 (use ``rho=np.inf``).
+        Bad input (see docs/conventions.md); ``rho = inf`` is allowed; also ``rho`` too large for the
+        explicit integration with n < 1 (use ``rho=np.inf``).
 
     Examples
     --------
@@ -488,9 +482,8 @@ def identify_friction(
     Raises
     ------
     ValueError
-        If an array is not real and finite or the arrays do not broadcast, a tension is not positive,
-        ``sigma_t`` is not positive, or a batch element has no measurement with nonzero wrap and
-        direction.
+        Bad input (see docs/conventions.md); also a batch element with no measurement of nonzero wrap
+        and direction.
 
     Examples
     --------
@@ -585,15 +578,12 @@ def stick_slip_tensions(
     Returns
     -------
     TensionHistory
-        ``span_tension (n_t, ..., 3 n, n N)`` (N), ``state (n_t, ..., 3 n, n N)`` (+1, -1 or 0) and
-        ``distal (n_t, ..., 3 n)`` (N).
+        Span tensions, stick/slip states and distal tensions along the time axis.
 
     Raises
     ------
     ValueError
-        If ``robot`` is not a :class:`ContinuumRobot`; ``psi`` or ``t_act`` has a wrong shape, no
-        common leading time axis of length >= 1, or is not real and finite; a tension is not positive;
-        or ``initial`` has a wrong shape or a non-positive active span.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------

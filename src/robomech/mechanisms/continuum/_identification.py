@@ -99,15 +99,12 @@ def identify_friction_from_pose(
     Returns
     -------
     PoseFrictionEstimate
-        ``mu``, ``std``, ``ci_low``, ``ci_high``, ``identifiable`` (each ``(3 n,)``), ``residual_rms``
-        (N) and ``success``.
+        Friction estimate with its uncertainty and identifiability.
 
     Raises
     ------
     ValueError
-        If ``robot`` is not a :class:`ContinuumRobot`; the arrays are not real and finite or their
-        shapes do not match; a direction is not +-1; a tension is not positive; ``sigma_t`` is not
-        positive; or ``model`` is unknown.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -255,15 +252,12 @@ def identify_friction_from_tip(
     Returns
     -------
     TipFrictionEstimate
-        ``mu (3 n,)``, ``stiffness_scale``, ``std``, ``ci_low``, ``ci_high`` and ``identifiable`` (each
-        ``(3 n,)``, or ``(3 n + 1,)`` with the stiffness), ``residual_rms`` (m) and ``success``.
+        Friction (and stiffness) estimate with its uncertainty and identifiability.
 
     Raises
     ------
     ValueError
-        If ``robot`` is not a :class:`ContinuumRobot`; an array is not real and finite or the shapes do
-        not match; a direction is not +-1; a tension is not positive; ``fit_stiffness`` is not a bool;
-        or only one of ``sigma_t``, ``sigma_tip`` is given, or one is not positive.
+        Bad input (see docs/conventions.md); also only one of ``sigma_t``, ``sigma_tip`` given.
     """
     from ._compensation import disk_equilibrium
 

@@ -13,6 +13,7 @@ from typing import Literal
 
 import numpy as np
 
+from robomech._batching import slices
 from robomech._validation import as_array, broadcast_batch, check_params
 from robomech.spatial import SMALL_ANGLE
 
@@ -203,8 +204,7 @@ def _segment_planes(theta: np.ndarray, beta: np.ndarray, length: np.ndarray | fl
     scalar_length = np.ndim(length) == 0
     ln_arr = None if scalar_length else _flat(np.asarray(length, dtype=float), shape)
     ln = float(length) if scalar_length else 0.0
-    for k in range(0, th.size, CHUNK):
-        c = slice(k, k + CHUNK)
+    for c in slices(th.size, CHUNK):
         t = np.ascontiguousarray(th[c])
         st, ct, omc = _half_angle(t)
         sb, cb = _half_angle(be[c], one_minus_cos=False)
@@ -302,7 +302,6 @@ def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
     psi : array_like, shape (..., 2 n)
         ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
 
@@ -331,7 +330,6 @@ def tip_position(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     psi : array_like, shape (..., 2 n)
         Bend and bending-plane angles of the segments (rad).
 
@@ -359,8 +357,7 @@ def _local_columns(theta: np.ndarray, beta: np.ndarray, length: float) -> np.nda
     P = np.empty((6, 2, *shape))
     Pf = P.reshape(12, -1)
     th, be = _flat(theta, shape), _flat(beta, shape)
-    for k in range(0, th.size, CHUNK):
-        c = slice(k, k + CHUNK)
+    for c in slices(th.size, CHUNK):
         t = np.ascontiguousarray(th[c])
         st, ct, omc = _half_angle(t)
         sb, cb = _half_angle(be[c], one_minus_cos=False)
@@ -419,7 +416,6 @@ def tip_jacobian(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     psi : array_like, shape (..., 2 n)
         Bend and bending-plane angles of the segments (rad).
 
@@ -447,7 +443,6 @@ def disk_transforms(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     psi : array_like, shape (..., 2 n)
         Bend and bending-plane angles of the segments (rad).
 
@@ -535,7 +530,6 @@ def span_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "chord"
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     psi : array_like, shape (..., 2 n)
         Bend and bending-plane angles of the segments (rad).
     model : {"chord", "arc"}, optional
@@ -565,7 +559,6 @@ def span_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "chord
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     psi : array_like, shape (..., 2 n)
         Bend and bending-plane angles of the segments (rad).
     model : {"chord", "arc"}, optional
@@ -602,7 +595,6 @@ def cable_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "arc")
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     psi : array_like, shape (..., 2 n)
         Bend and bending-plane angles of the segments (rad).
     model : {"arc", "chord"}, optional
@@ -633,7 +625,6 @@ def cable_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "arc"
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     psi : array_like, shape (..., 2 n)
         Bend and bending-plane angles of the segments (rad).
     model : {"arc", "chord"}, optional
@@ -810,8 +801,7 @@ def _single_arc(robot: ContinuumRobot, p: np.ndarray, theta: np.ndarray, beta: n
     from the tip of the arc (the formulas of _segment_T); n >= 2: from the composed forward kinematics."""
     n, L = robot.n_segments, robot.segment_length
     res = np.empty(p.shape[0])
-    for k in range(0, p.shape[0], CHUNK):
-        c = slice(k, k + CHUNK)
+    for c in slices(p.shape[0], CHUNK):
         x, y, z = p[c, 0], p[c, 1], p[c, 2]
         rh = x * x
         rh += y * y
@@ -858,7 +848,6 @@ def inverse_kinematics(robot: ContinuumRobot, p_tip: object) -> IKResult:
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m).
     p_tip : array_like, shape (..., 3)
         Tip targets in the base frame (m).
 

@@ -47,8 +47,7 @@ class Pulley:
     Raises
     ------
     ValueError
-        If ``radius`` is not positive, ``wrap`` or ``alpha`` is negative, ``n`` is not in (0, 1], or a
-        field is not a real finite number.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------

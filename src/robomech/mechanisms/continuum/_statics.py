@@ -32,7 +32,6 @@ def elastic_energy(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
     psi : array_like, shape (..., 2 n)
         ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
 
@@ -44,8 +43,7 @@ def elastic_energy(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``robot`` is not a :class:`ContinuumRobot`, or ``psi`` does not end in an axis of 2 n or is
-        not real and finite.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -71,7 +69,6 @@ def elastic_gradient(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
     psi : array_like, shape (..., 2 n)
         ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
 
@@ -83,8 +80,7 @@ def elastic_gradient(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``robot`` is not a :class:`ContinuumRobot`, or ``psi`` does not end in an axis of 2 n or is
-        not real and finite.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -108,7 +104,6 @@ def coupling_moments(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
     psi : array_like, shape (..., 2 n)
         ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
 
@@ -120,8 +115,7 @@ def coupling_moments(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``robot`` is not a :class:`ContinuumRobot`, or ``psi`` does not end in an axis of 2 n or is
-        not real and finite.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -190,7 +184,6 @@ def cable_tensions(
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m), e.g. ``ContinuumRobot.paper()``.
     psi : array_like, shape (..., 2 n)
         ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
     wrench : array_like, shape (..., 6), optional
@@ -206,15 +199,12 @@ def cable_tensions(
     Returns
     -------
     TensionResult
-        ``tension (..., 3 n)`` (N), ``minimum_norm (..., 3 n)`` (N), ``taut (...)``,
-        ``min_tension (...)`` (N) and ``residual (...)`` (N m).
+        Tensions, tautness mask and residual per sample.
 
     Raises
     ------
     ValueError
-        If ``robot`` is not a :class:`ContinuumRobot`, or ``psi`` does not end in an axis of 2 n or is
-        not real and finite; ``wrench`` or ``direction`` has a wrong shape
-        or invalid values; ``pretension`` is negative; or ``model`` is unknown.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
+from robomech._batching import slices
 from robomech._validation import as_array, check_params
 
 from ._params import ExplorationRobot
@@ -108,8 +109,8 @@ def _blocked(kernel, q: np.ndarray, tail: tuple[int, ...]) -> np.ndarray:
     n = int(np.prod(batch))
     qf = q.reshape(n, CONFIG_SIZE)
     out = np.empty((n, *tail))
-    for start in range(0, n, CHUNK):
-        out[start : start + CHUNK] = kernel(qf[start : start + CHUNK])
+    for s in slices(n, CHUNK):
+        out[s] = kernel(qf[s])
     return out.reshape(*batch, *tail)
 
 
@@ -119,7 +120,6 @@ def contact_frames(robot: ExplorationRobot, config: ArrayLike) -> np.ndarray:
     Parameters
     ----------
     robot : ExplorationRobot
-        The robot's geometry (m), e.g. ``ExplorationRobot.paper()``.
     config : array_like, shape (..., 8)
         Joint configuration: per side ``SIDE_JOINTS`` (rocker, bogie and slide coordinates; rad, m).
 
@@ -209,7 +209,6 @@ def wheel_jacobians(robot: ExplorationRobot, config: ArrayLike) -> np.ndarray:
     Parameters
     ----------
     robot : ExplorationRobot
-        The robot's geometry (m).
     config : array_like, shape (..., 8)
         Joint configuration (rad, m), ``SIDE_JOINTS`` per side.
 

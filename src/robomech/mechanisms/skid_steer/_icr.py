@@ -167,7 +167,6 @@ def wheel_radii(robot: ExplorationRobot) -> np.ndarray:
     Parameters
     ----------
     robot : ExplorationRobot
-        The robot's geometry.
 
     Returns
     -------
@@ -287,8 +286,7 @@ def identify_icr(
     Returns
     -------
     ICRIdentification
-        The identified ``model`` (or ``None``), ``residual_rms (3,)`` (m/s), ``used (N,)``,
-        ``n_used``, ``cond`` and ``identifiable``.
+        The identified model (or ``None``), its fit and identifiability.
 
     Examples
     --------
@@ -344,20 +342,15 @@ def identify_icr(
 class WheelSlip:
     """Per-wheel slip (batch shape ``...``, last axis the six wheels in ``WHEELS`` order).
 
-    ``ratio``: longitudinal slip ``(r φ̇ - v) / max(|r φ̇|, |v|)`` in [-1, 1] (positive: spinning faster
-    than the ground passes, i.e. traction slip; negative: skidding, braking); ``v`` is the ground speed
-    of the contact along the wheel's heading.  ``lateral_velocity``: sideways sliding of the contact (m/s).
-    ``valid``: a finite wheel rate (a drop-out is flagged for that wheel) and not both speeds below
-    ``SLIP_SPEED_FLOOR`` (NaN exactly where it is false).
-
     Attributes
     ----------
     ratio : ndarray, shape (..., 6)
-        Longitudinal slip ratio in [-1, 1] (unit-free); NaN where not ``valid``.
+        Longitudinal slip ``(r φ̇ - v) / max(|r φ̇|, |v|)`` in [-1, 1], ``v`` the contact's ground speed
+        along the wheel's heading (positive: traction slip; negative: skidding); NaN where not ``valid``.
     lateral_velocity : ndarray, shape (..., 6)
         Sideways sliding speed of each contact (m/s); NaN where not ``valid``.
     valid : ndarray of bool, shape (..., 6)
-        A finite wheel rate and not both speeds below ``SLIP_SPEED_FLOOR``.
+        A finite wheel rate (a drop-out flags that wheel) and not both speeds below ``SLIP_SPEED_FLOOR``.
     """
 
     ratio: np.ndarray
@@ -375,7 +368,6 @@ def wheel_slip(
     Parameters
     ----------
     robot : ExplorationRobot
-        The robot's geometry (m).
     wheel_rate : array_like, shape (..., 6)
         Wheel spin rates (rad/s), ``WHEELS`` order.
     body_velocity : array_like, shape (..., 3)

@@ -64,7 +64,7 @@ class EncoderModel:
     Raises
     ------
     ValueError
-        If ``counts_per_rev`` is not an integer >= 1.
+        Bad input (see docs/conventions.md).
     """
 
     counts_per_rev: int = 2048
@@ -99,7 +99,7 @@ class ImuModel:
     Raises
     ------
     ValueError
-        If a noise density is negative or not finite, or a bias is not three finite numbers.
+        Bad input (see docs/conventions.md).
     """
 
     gyro_noise_density: float = math.radians(0.008)  # rad/s/√Hz

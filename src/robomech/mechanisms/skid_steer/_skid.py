@@ -36,18 +36,15 @@ LATERAL_SLIP_RTOL = 1e-9
 class SkidSteerTurn:
     """Turning of a skid-steered body from its right/left track speeds (batch shape ``...``).
 
-    ``yaw_rate = (v1 - v2)/S`` (rad/s, positive counter-clockwise about body z, i.e. turning left);
-    ``forward_speed = (v1 + v2)/2`` of the body centre; ``radius`` of the body centre's path, signed
-    (positive: centre of rotation on the left), ``inf`` where ``turning`` is false (straight or at rest).
-
     Attributes
     ----------
     yaw_rate : ndarray, shape (...)
-        ``(v1 - v2) / S`` (rad/s, about body z).
+        ``(v1 - v2) / S`` (rad/s, about body z; positive: turning left).
     forward_speed : ndarray, shape (...)
         ``(v1 + v2) / 2`` of the body centre (m/s).
     radius : ndarray, shape (...)
-        Signed radius of the body centre's path (m); ``inf`` where not ``turning``.
+        Signed radius of the body centre's path (m, positive: centre of rotation on the left); ``inf``
+        where not ``turning`` (straight or at rest).
     turning : ndarray of bool, shape (...)
         ``|v1 - v2|`` above ``STRAIGHT_RTOL`` times ``|v1| + |v2|``.
     """
@@ -231,8 +228,7 @@ def dead_reckoning(twists: ArrayLike, dt: float, T0: ArrayLike | None = None) ->
     Raises
     ------
     ValueError
-        If ``twists`` is not a finite real array (..., N, 6) with N >= 1, ``dt`` is not positive,
-        ``T0`` is not a batch of rigid transforms, or the batch shapes do not broadcast.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------

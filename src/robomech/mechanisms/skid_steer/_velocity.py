@@ -21,6 +21,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from robomech._batching import slices
 from robomech._validation import as_array, broadcast_batch, broadcast_to_batch, check_bool, check_params
 from robomech.analysis import lstsq
 
@@ -61,7 +62,6 @@ def assemble(robot: ExplorationRobot, config: ArrayLike) -> tuple[np.ndarray, np
     Parameters
     ----------
     robot : ExplorationRobot
-        The robot's geometry (m).
     config : array_like, shape (..., 8)
         Joint configuration (rad, m).
 
@@ -86,8 +86,7 @@ def assemble(robot: ExplorationRobot, config: ArrayLike) -> tuple[np.ndarray, np
     qf = q.reshape(n, CONFIG_SIZE)
     A0 = np.empty((n, N_ROWS, UNKNOWN_SIZE))
     J = np.empty((n, N_ROWS, MEASURED_SIZE))
-    for start in range(0, n, ASSEMBLY_CHUNK):
-        sl = slice(start, start + ASSEMBLY_CHUNK)
+    for sl in slices(n, ASSEMBLY_CHUNK):
         A0[sl], J[sl] = _assemble(robot, qf[sl])
     return A0.reshape(*batch, N_ROWS, UNKNOWN_SIZE), J.reshape(*batch, N_ROWS, MEASURED_SIZE)
 
@@ -154,7 +153,6 @@ def wheel_measurements(
     Parameters
     ----------
     robot : ExplorationRobot
-        The robot's geometry (m).
     config : array_like, shape (..., 8)
         Joint configuration (rad, m).
     twist : array_like, shape (..., 6)
@@ -257,7 +255,6 @@ def body_velocity(
     Parameters
     ----------
     robot : ExplorationRobot
-        The robot's geometry (m).
     state : array_like, shape (..., 8)
         Joint configuration (rad, m).
     measured : array_like, shape (..., 22)
@@ -272,8 +269,7 @@ def body_velocity(
     Returns
     -------
     BodyVelocity
-        ``twist (..., 6)`` ``[ω_B; v_B]`` (rad/s, m/s, body axes), ``config_rate (..., 8)``,
-        ``unknowns (..., 11)``, ``residual_norm``, ``cond`` and ``valid`` per sample.
+        Body twist, configuration rates, unknowns, conditioning and mask per sample.
 
     Examples
     --------
@@ -307,8 +303,7 @@ def body_velocity(
     resid = np.empty(n)
     cond = np.empty(n)
     valid = np.empty(n, dtype=bool)
-    for start in range(0, n, CHUNK):
-        sl = slice(start, start + CHUNK)
+    for sl in slices(n, CHUNK):
         qc, mc = qf[sl], mf[sl]
         finite_q = np.all(np.isfinite(qc), axis=-1)
         A0, J = _assemble(robot, np.where(finite_q[:, None], qc, 0.0))

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech._batching import chunked, slices
 from robomech._validation import as_array, broadcast_to_batch, check_bool, check_int, check_params
 
 # the unvalidated kernel: inputs are validated once at this module's public boundary
@@ -62,21 +63,9 @@ LENGTH_FLOOR = 1e-12
 # memory; on 10^6 poses this roughly halves the time (benchmarks/bench_spherical_leg.py). Every
 # operation is elementwise per sample, so chunking does not change any result bit.
 CHUNK = 16384
-# Forward kinematics of at least this many samples runs its Newton fit and closed forms in compiled
-# kernels (numba, parallel; see _fk_numba_kernels), the rest in numpy: below it the numpy path is
-# as fast and a per-sample caller never pays the one-off compilation (cached on disk afterwards).
-FK_NUMBA_MIN = 4096
 # Samples per block of the compiled Newton fit: a few SIMD widths, so the masked passes vectorise and
 # a block stops as soon as its slowest sample has converged (3 passes for typical noisy lengths).
 FK_BLOCK = 64
-
-
-def _chunked(kernel, inputs: tuple[np.ndarray, ...], outputs: tuple[np.ndarray, ...]) -> None:
-    """Run ``kernel(*inputs[c], *outputs[c])`` over chunks c of the leading (flat) batch axis."""
-    n = inputs[0].shape[0]
-    for start in range(0, n, CHUNK):
-        c = slice(start, start + CHUNK)
-        kernel(*(x[c] for x in inputs), *(o[c] for o in outputs))
 
 
 def _angles(alpha: object, beta: object) -> tuple[np.ndarray, np.ndarray]:
@@ -196,7 +185,8 @@ def inverse_kinematics(leg: SphericalLeg, alpha: object, beta: object) -> Invers
     L = np.empty((n, 3))
     S = np.empty((n, 3, 3))
     B = np.empty((n, 3, 3))
-    _chunked(lambda *x: _ik_kernel(leg, *x), (a.reshape(-1), b.reshape(-1)), (L, S, B))
+    a, b = a.reshape(-1), b.reshape(-1)
+    chunked(lambda c: _ik_kernel(leg, a[c], b[c], L[c], S[c], B[c]), n, CHUNK)
     within = (L >= leg.length_min) & (L <= leg.length_max)
     return InverseKinematicsResult(
         L.reshape(*shape, 3),
@@ -313,85 +303,18 @@ def forward_kinematics(
         a, b, res, ok = (o.reshape(shape) for o in forward_as_printed(leg, L.reshape(n, 3)))
         return ForwardKinematicsResult(alpha=a, beta=b, residual=res, valid=ok, converged=ok.copy())
     outs = (np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=bool), np.empty(n, dtype=bool))
-    if n >= FK_NUMBA_MIN:
-        _fk_kernel_compiled(leg, branch, np.ascontiguousarray(L.reshape(n, 3)), *outs)
-    else:
-        _chunked(lambda *x: _fk_kernel(leg, branch, *x), (L.reshape(n, 3),), outs)
+    _fk_kernel_compiled(leg, branch, np.ascontiguousarray(L.reshape(n, 3)), *outs)
     alpha, beta, residual, valid, converged = (o.reshape(shape) for o in outs)
     return ForwardKinematicsResult(
         alpha=alpha, beta=beta, residual=residual, valid=valid, converged=converged
     )
 
 
-def _fk_kernel(
-    leg: SphericalLeg, branch: int, L, alpha_out, beta_out, resid_out, valid_out, conv_out
-) -> None:
-    """Transcendental-light forward kinematics of one chunk.
-
-    The Newton fit carries (cos b, sin b) instead of b, so an iteration needs only square roots and
-    divisions; the closed forms for alpha are written with sin/cos of phi and asin(s) taken from their
-    defining ratios. Per sample this leaves two atan2 calls (beta, alpha) and one half-angle tangent
-    (sincos of the fitted beta, for a residual bit-consistent with ``inverse_kinematics``).
-    """
-    # per-column work: numpy's reductions over a length-3 last axis cost ~15 ms per 10^6 rows here
-    l1, l2, l3 = L[:, 0], L[:, 1], L[:, 2]
-    # positive and finite (NaN fails every comparison and propagates through maximum)
-    ok_in = (l1 > 0) & (l2 > 0) & (l3 > 0) & (np.maximum(np.maximum(l1, l2), l3) < np.inf)
-    m1, m2, m3 = (np.where(ok_in, li, 1.0) for li in (l1, l2, l3))
-    R, r, h = leg.R, leg.r, leg.h
-    K = R * R + r * r + h * h
-    q = (m1 * m1, m2 * m2, m3 * m3)
-    # paper 1, eq. (6) uses arcsin((l2^2 - l1^2)/(4Rh)); the direction of (cosine from l1^2 + l2^2,
-    # sine from l2^2 - l1^2) is exact for consistent lengths, covers |beta| > pi/2 and never leaves the
-    # domain for noisy ones (it is atan2 of the same pair, normalised without the angle).
-    y = (q[1] - q[0]) * (1.0 / (4 * R * h))
-    x = (2 * K - q[0] - q[1]) * (1.0 / (4 * R * r))
-    n0 = np.sqrt(x * x + y * y)
-    pos = n0 > 0  # atan2(0, 0) = 0: the start (1, 0)
-    inv = 1.0 / np.where(pos, n0, 1.0)
-    cb0 = np.where(pos, x * inv, 1.0)
-    sb0 = y * inv
-    cb0, sb0, converged = _fit_beta_cs(leg, cb0, sb0, m1, m2)
-    beta = np.arctan2(sb0, cb0)
-    sb, cb = sincos(beta)
-    hcb = h * cb
-    rho = np.sqrt(hcb * hcb + r * r)
-    # paper 1, eqs. (7): the printed Ferrari quartic (with a dropped square in k2, 9k2k3k4 for 9k1k2k3
-    # and arctan(2a) for 2 arctan(a)) is replaced by this exact closed form of the l3 equation:
-    # sin(alpha - phi) = s with phi = atan2(r, h cos b), so alpha = phi + asin(s) (branch 0) or
-    # phi + pi - asin(s) (branch 1); sin and cos of alpha follow from those of phi (r/rho, h cos b/rho)
-    # and of asin(s) (s, +-sqrt(1 - s^2)), and alpha itself from one atan2 (in (-pi, pi]).
-    inv_rho = 1.0 / rho
-    s = (q[2] - K) * (0.5 / R) * inv_rho
-    assembles = np.abs(s) <= 1.0 + ASSEMBLY_TOL
-    np.clip(s, -1.0, 1.0, out=s)
-    cw = np.sqrt(np.maximum((1.0 - s) * (1.0 + s), 0.0))
-    if branch == 1:
-        cw = -cw
-    sphi, cphi = r * inv_rho, hcb * inv_rho
-    sa = sphi * cw + cphi * s
-    ca = cphi * cw - sphi * s
-    alpha = np.arctan2(sa, ca)
-    valid = ok_in & assembles
-    # fitted lengths minus measured, squared, written as inverse_kinematics evaluates them
-    rsq = 0.0
-    for qi, mi in zip(_squared_length_columns(leg, sa, ca, sb, cb), (m1, m2, m3), strict=True):
-        ei = np.sqrt(np.maximum(qi, 0.0))
-        ei -= mi
-        rsq = rsq + ei * ei
-    residual = np.sqrt(rsq)
-    alpha_out[:] = np.where(valid, alpha, np.nan)
-    beta_out[:] = np.where(valid, beta, np.nan)
-    resid_out[:] = np.where(valid, residual, np.nan)
-    valid_out[:] = valid
-    conv_out[:] = converged & valid
-
-
 def _fk_kernel_compiled(
     leg: SphericalLeg, branch: int, L, alpha_out, beta_out, resid_out, valid_out, conv_out
 ) -> None:
-    """``_fk_kernel`` with its arithmetic in two compiled per-sample kernels (same operations in the
-    same order, so results agree with the numpy path to rounding); the three transcendental calls
+    """Forward kinematics of a flat batch: the Newton fit of beta and the closed form of alpha in two
+    compiled per-sample kernels (``fit`` and ``close``, below); the three transcendental calls
     stay in numpy, whose SIMD atan2/tan are several times faster than the scalar libm calls numba makes.
     Runs on the whole batch: each compiled kernel is one parallel region (one per cache-sized chunk cost
     ~8 ms each when another process held the second core: the region waits for a scheduler slice).
@@ -403,8 +326,7 @@ def _fk_kernel_compiled(
     tols = (FK_NEWTON_STEP_TOL, FK_STEP_TOL, LENGTH_FLOOR**2)
     M = np.empty((3, n))  # lengths (1.0 for bad samples) by column: contiguous loads vectorise
     fit(L, R, r, h, FK_MAX_ITER, *tols, M, cb, sb, valid_out, conv_out)
-    for start in range(0, n, CHUNK):  # numpy's temporaries stay in cache
-        c = slice(start, start + CHUNK)
+    for c in slices(n, CHUNK):  # numpy's temporaries stay in cache
         np.arctan2(sb[c], cb[c], out=beta_out[c])
         sb[c], cb[c] = sincos(beta_out[c])
     sa, ca = np.empty(n), np.empty(n)
@@ -532,67 +454,6 @@ def _fk_numba_kernels():
     return fit, close
 
 
-def _fit_beta_cs(
-    leg: SphericalLeg, cb: np.ndarray, sb: np.ndarray, m1: np.ndarray, m2: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Newton's method on f(b) = 1/2 sum_{i=1,2} (l_i(b) - m_i)^2 carried on (cos b, sin b), batched.
-
-    Returns (cos b, sin b, converged). The lengths and their beta-derivatives are polynomial in (cos b,
-    sin b), so an iteration needs no transcendental call: the Newton step d is applied as the rotation
-    by 2 atan(d/2) = d - d^3/12 + ..., whose cosine and sine are rational in d/2. This changes a step by
-    O(d^3) only, so the iteration keeps Newton's fixed points and quadratic convergence (and the
-    Gauss-Newton fallback its linear rate); the stopping rule reads the Newton step d itself. Only
-    samples not yet converged are iterated (active set); each sample's iterates are those it would
-    have alone.
-    """
-    R, r, h = leg.R, leg.r, leg.h
-    K = R * R + r * r + h * h
-    cb = np.array(cb, dtype=float, copy=True)
-    sb = np.array(sb, dtype=float, copy=True)
-    done = np.zeros(cb.shape, dtype=bool)
-    idx = None  # None: every sample active (no gather needed)
-    for _ in range(FK_MAX_ITER):
-        if idx is None:
-            c, s, e1, e2 = cb, sb, -m1, -m2
-        else:
-            c, s, e1, e2 = cb[idx], sb[idx], -m1[idx], -m2[idx]
-        rc, hs, rs, hc = r * c, h * s, r * s, h * c
-        # q_i = l_i^2 and its beta-derivatives (closed forms of the module docstring)
-        l1 = np.sqrt(np.maximum(K - 2 * R * (rc + hs), LENGTH_FLOOR**2))
-        l2 = np.sqrt(np.maximum(K - 2 * R * (rc - hs), LENGTH_FLOOR**2))
-        i1, i2 = 1.0 / l1, 1.0 / l2
-        d1 = R * (rs - hc) * i1  # dl/db = (dq/db) / (2 l)
-        d2 = R * (rs + hc) * i2
-        dd1 = (R * (rc + hs) - d1 * d1) * i1  # d2l/db2 = (q''/2 - l'^2) / l
-        dd2 = (R * (rc - hs) - d2 * d2) * i2
-        e1 += l1
-        e2 += l2
-        hgn = d1 * d1 + d2 * d2  # > 0: dl1/db and dl2/db never vanish together (R, r, h > 0)
-        hn = hgn + e1 * dd1 + e2 * dd2
-        newton = hn > 0.5 * hgn  # Gauss-Newton curvature where Newton's is unsafe (large residuals)
-        step = (e1 * d1 + e2 * d2) / np.where(newton, hn, hgn)
-        # b <- b - step as the rotation by -2 atan(step/2): cos/sin = ((1 - t^2), -2t) / (1 + t^2)
-        t = 0.5 * step
-        w = 1.0 / (1.0 + t * t)
-        ct = (1.0 - t * t) * w
-        st = (2.0 * w) * t
-        c_new = c * ct + s * st
-        s_new = s * ct - c * st
-        fin = np.abs(step) <= np.where(newton, FK_NEWTON_STEP_TOL, FK_STEP_TOL)
-        if idx is None:
-            cb, sb = c_new, s_new
-            done = fin
-            idx = np.flatnonzero(~fin)
-        else:
-            cb[idx] = c_new
-            sb[idx] = s_new
-            done[idx[fin]] = True
-            idx = idx[~fin]
-        if idx.size == 0:
-            break
-    return cb, sb, done
-
-
 def jacobian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
     """``J[..., i, j] = d l_i / d (alpha, beta)_j`` -> (..., 3, 2) in m/rad.
 
@@ -618,9 +479,10 @@ def jacobian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
     """
     check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
+    shape, a, b = a.shape, a.reshape(-1), b.reshape(-1)
     J = np.empty((a.size, 3, 2))
-    _chunked(lambda *x: _jacobian_kernel(leg, *x), (a.reshape(-1), b.reshape(-1)), (J,))
-    return J.reshape(*a.shape, 3, 2)
+    chunked(lambda c: _jacobian_kernel(leg, a[c], b[c], J[c]), a.size, CHUNK)
+    return J.reshape(*shape, 3, 2)
 
 
 def _jacobian_kernel(leg: SphericalLeg, a, b, J) -> None:

@@ -12,11 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomech._validation import check_params
+from robomech.analysis.workspace import singularity_map
 
-# the unvalidated kernel: inputs are validated once at this module's public boundary
-from robomech.spatial._so3 import _sincos as sincos
-
-from ._kinematics import LENGTH_FLOOR, _angles, _chunked, _squared_length_columns
+from ._kinematics import _angles, inverse_kinematics, jacobian
 from ._params import SphericalLeg
 
 __all__ = ["WorkspaceMap", "workspace_map"]
@@ -65,7 +63,7 @@ class WorkspaceMap:
 def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMap:
     """Workspace and singularity map at poses ``alpha``, ``beta`` (rad, broadcast) in closed form.
 
-    The singular values of the 3x2 J come from the eigenvalues of the 2x2 Gram matrix J^T J.
+    The singular values of the 3x2 J are :func:`robomech.analysis.workspace.singularity_map`'s.
 
     Parameters
     ----------
@@ -95,51 +93,14 @@ def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMa
     """
     check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
-    n = a.size
-    outs = (np.empty((n, 3)), np.empty(n, dtype=bool), np.empty(n), np.empty(n), np.empty(n), np.empty(n))
-    _chunked(lambda *x: _kernel(leg, *x), (a.reshape(-1), b.reshape(-1)), outs)
-    L, reach, smin, smax, cond, j3a = (o.reshape((*a.shape, *o.shape[1:])) for o in outs)
-    ratio = smin / smax
-    return WorkspaceMap(L, reach, smin, smax, cond, ratio < SINGULAR_RTOL, cond > ILL_CONDITIONED, j3a)
-
-
-def _kernel(leg: SphericalLeg, a, b, L_out, reach_out, smin_out, smax_out, cond_out, j3a_out) -> None:
-    (sa, ca), (sb, cb) = sincos(a), sincos(b)
-    R, r, h = leg.R, leg.r, leg.h
-    # column by column: numpy's reductions over a length-3 last axis cost ~15 ms per 10^6 rows here
-    lengths = []
-    for k, qk in enumerate(_squared_length_columns(leg, sa, ca, sb, cb)):
-        lk = np.sqrt(np.maximum(qk, 0.0, out=qk), out=qk)
-        L_out[:, k] = lk
-        lengths.append(lk)
-    l1, l2, l3 = lengths
-    reach_out[:] = (
-        (l1 >= leg.length_min)
-        & (l1 <= leg.length_max)
-        & (l2 >= leg.length_min)
-        & (l2 <= leg.length_max)
-        & (l3 >= leg.length_min)
-        & (l3 <= leg.length_max)
+    ik = inverse_kinematics(leg, a, b)
+    J = jacobian(leg, a, b)
+    sm = singularity_map(J, rtol=SINGULAR_RTOL)
+    # rank <= 1 where sigma_min = 0: then sigma_max is J's Frobenius norm
+    frob = np.sqrt(np.einsum("...ij,...ij->...", J, J))
+    smax = np.where(sm.dexterity > 0, sm.sigma_min / np.where(sm.dexterity > 0, sm.dexterity, 1.0), frob)
+    L = ik.lengths
+    reach = np.all((L >= leg.length_min) & (L <= leg.length_max), axis=-1)
+    return WorkspaceMap(
+        L, reach, sm.sigma_min, smax, sm.cond, sm.singular, sm.cond > ILL_CONDITIONED, J[..., 2, 0]
     )
-    hcb = h * cb
-    rsb = r * sb
-    j1b = R * (rsb - hcb) / np.maximum(l1, LENGTH_FLOOR)
-    j2b = R * (rsb + hcb) / np.maximum(l2, LENGTH_FLOOR)
-    k3 = R / np.maximum(l3, LENGTH_FLOOR)
-    j3a = (r * sa + hcb * ca) * k3
-    j3b = -(h * sb * sa) * k3
-    g11 = j3a * j3a
-    g22 = j1b * j1b + j2b * j2b + j3b * j3b
-    g12 = j3a * j3b
-    half_tr = 0.5 * (g11 + g22)
-    dg = 0.5 * (g11 - g22)
-    disc = np.sqrt(dg * dg + g12 * g12)
-    lam_max = half_tr + disc
-    # det / lam_max avoids the cancellation of half_tr - disc
-    lam_min = np.maximum(g11 * g22 - g12 * g12, 0.0) / lam_max
-    np.sqrt(lam_max, out=smax_out)
-    np.sqrt(lam_min, out=smin_out)
-    ratio = smin_out / smax_out
-    np.divide(1.0, ratio, out=cond_out, where=ratio > 0)
-    cond_out[~(ratio > 0)] = np.inf
-    j3a_out[:] = j3a

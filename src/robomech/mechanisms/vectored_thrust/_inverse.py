@@ -59,14 +59,6 @@ RATE_RESIDUAL_ATOL = 1e-12
 class InverseRatesResult:
     """Input rates and accelerations per sample for a commanded platform motion.
 
-    ``qd (..., 2)`` rad/s, ``qdd (..., 2)`` rad/s² (NaN if no ω̇ was given, and NaN at the
-    passive-axes-parallel singularity where J does not exist); ``sigma_min (...)`` the smallest
-    singular value of J (0 where J does not exist); ``singular (...)`` where ``sigma_min <
-    1 / INPUT_GAIN_MAX`` or J does not exist (there the weak direction is damped); ``omega_residual``
-    ``|J q̇ - ω|`` (rad/s) and ``omega_dot_residual`` ``|J q̈ + J̇q̇ - ω̇|`` (rad/s²): the part of the
-    command the mechanism cannot realise (ω outside J's range, or damped); ``valid`` is ``~singular``,
-    every value finite and both residuals within ``RATE_RESIDUAL_RTOL`` of the command.
-
     Attributes
     ----------
     qd : ndarray, shape (..., 2)
@@ -76,9 +68,9 @@ class InverseRatesResult:
     sigma_min : ndarray, shape (...)
         Smallest singular value of J (dimensionless; 0 where J does not exist).
     singular : ndarray of bool, shape (...)
-        ``sigma_min < 1 / INPUT_GAIN_MAX`` or J does not exist.
+        ``sigma_min < 1 / INPUT_GAIN_MAX`` or J does not exist (the weak direction is damped there).
     omega_residual : ndarray, shape (...)
-        ``|J q̇ - ω|`` (rad/s).
+        ``|J q̇ - ω|`` (rad/s): the part of ω not realised (outside J's range, or damped).
     omega_dot_residual : ndarray, shape (...)
         ``|J q̈ + J̇ q̇ - ω̇|`` (rad/s²); NaN if no ω̇ was given.
     valid : ndarray of bool, shape (...)
@@ -129,7 +121,6 @@ def inverse_rates(
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     q : array_like, shape (..., 2)
         Input angles ``(q1, q2)`` (rad).
     omega : array_like, shape (..., 3)
@@ -143,14 +134,12 @@ def inverse_rates(
     Returns
     -------
     InverseRatesResult
-        ``qd`` (rad/s) and ``qdd`` (rad/s²), each (..., 2); ``sigma_min``, ``singular``, the residuals
-        and ``valid``, each (...).
+        Input rates and accelerations with their conditioning and masks.
 
     Raises
     ------
     ValueError
-        If ``th`` is not a :class:`VectoredThruster`, an array is not finite and real with the stated
-        last dimension, the batch shapes do not broadcast, or ``damping`` is negative.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -218,10 +207,7 @@ def _inverse_rates(th, q, w, wd, lam_rel, batch) -> InverseRatesResult:
 
 @dataclass(frozen=True)
 class StaticsResult:
-    """Motor torques ``tau (..., 2)`` N·m (inputs q1, q2) holding a wrench on the platform; NaN where
-    not ``valid`` (J does not exist: passive axes parallel); ``moment (..., 3)`` N·m the wrench's moment
-    about O, the only part that loads the motors; ``unloaded (..., 3)`` N·m its component outside J's
-    range, carried by the closure without motor torque.
+    """Motor torques holding a wrench on the platform; only its moment about O loads the motors.
 
     Attributes
     ----------
@@ -232,7 +218,7 @@ class StaticsResult:
     unloaded : ndarray, shape (..., 3)
         Component of ``moment`` outside J's range (N·m), carried without motor torque.
     valid : ndarray of bool, shape (...)
-        J exists and the torques are finite.
+        J exists (passive axes not parallel) and the torques are finite.
     """
 
     tau: np.ndarray
@@ -252,7 +238,6 @@ def static_torques(th: VectoredThruster, q: object, wrench: object) -> StaticsRe
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     q : array_like, shape (..., 2)
         Input angles ``(q1, q2)`` (rad).
     wrench : array_like, shape (..., 6)
@@ -266,8 +251,7 @@ def static_torques(th: VectoredThruster, q: object, wrench: object) -> StaticsRe
     Raises
     ------
     ValueError
-        If ``th`` is not a :class:`VectoredThruster`, an array is not finite and real with the stated
-        last dimension, or the batch shapes do not broadcast.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
+from robomech._batching import chunked
 from robomech._validation import as_array, broadcast_batch, check_params
 from robomech.spatial import lie_bracket
 
@@ -78,34 +79,11 @@ _R = TypeVar("_R", bound="DataclassInstance")  # a frozen result dataclass of ar
 
 
 def _chunked(kernel: Callable[..., _R], th: VectoredThruster, x: np.ndarray) -> _R:
-    """Run ``kernel(th, x_block)`` over blocks of CHUNK samples of ``x (..., k)`` into preallocated outputs.
-
-    ``kernel`` returns a frozen dataclass of arrays whose leading dimension is the sample axis.
-    """
-    batch = x.shape[:-1]
-    flat = x.reshape(-1, x.shape[-1])
-    n = flat.shape[0]
-    if n <= CHUNK:
-        first = kernel(th, flat)
-        return dataclasses.replace(
-            first,
-            **{
-                f.name: getattr(first, f.name).reshape(batch + getattr(first, f.name).shape[1:])
-                for f in dataclasses.fields(first)
-            },
-        )
-    first = kernel(th, flat[:CHUNK])
-    names = [f.name for f in dataclasses.fields(first)]
-    outs = {}
-    for k in names:
-        a = getattr(first, k)
-        outs[k] = np.empty((n, *a.shape[1:]), dtype=a.dtype)
-        outs[k][:CHUNK] = a
-    for i in range(CHUNK, n, CHUNK):  # a fixed number of cache-sized blocks, not a loop over samples
-        r = kernel(th, flat[i : i + CHUNK])
-        for k in names:
-            outs[k][i : i + CHUNK] = getattr(r, k)
-    return dataclasses.replace(first, **{k: v.reshape(batch + v.shape[1:]) for k, v in outs.items()})
+    """``kernel(th, x_block)`` over blocks of CHUNK samples of ``x (..., k)``, reshaped to its batch."""
+    batch, flat = x.shape[:-1], x.reshape(-1, x.shape[-1])
+    r = chunked(lambda s: kernel(th, flat[s]), flat.shape[0], CHUNK)
+    arrays = {f.name: getattr(r, f.name) for f in dataclasses.fields(r)}
+    return dataclasses.replace(r, **{k: a.reshape(batch + a.shape[1:]) for k, a in arrays.items()})
 
 
 _X = np.array([1.0, 0.0, 0.0])
@@ -136,14 +114,14 @@ class JointAxes:
         ``distance > SINGULAR_TOL``.
     """
 
-    s11: np.ndarray  # RRR input axis (X)
-    s12: np.ndarray  # RRR passive axis between the 45 deg and the 90 deg arcs
-    s13: np.ndarray  # RRR passive axis on the platform
-    s21: np.ndarray  # RR input axis (Y)
-    s22: np.ndarray  # RR passive axis on the platform
-    s0: np.ndarray  # propeller shaft (the platform's third axis)
-    distance: np.ndarray  # (...,) |s22 x s12|: distance to the singularity, in [0, 1]
-    valid: np.ndarray  # (...,) distance > SINGULAR_TOL
+    s11: np.ndarray
+    s12: np.ndarray
+    s13: np.ndarray
+    s21: np.ndarray
+    s22: np.ndarray
+    s0: np.ndarray
+    distance: np.ndarray
+    valid: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -185,13 +163,13 @@ class FKResult:
         ``in_range & tilt_ok`` (link interference: see :func:`link_clearance`, ``workspace_map``).
     """
 
-    axis: np.ndarray  # (..., 3) unit propeller axis s0; NaN where not valid
-    tip: np.ndarray  # (..., 3) propeller tip propeller_arm * s0, metres
-    tilt: np.ndarray  # (...,) angle between s0 and Z (universal-joint deflection), rad
-    valid: np.ndarray  # (...,) assembled and not singular
-    in_range: np.ndarray  # (...,) inputs within q1_limits and q2_limits
-    tilt_ok: np.ndarray  # (...,) valid and tilt <= tilt_limit
-    within_limits: np.ndarray  # (...,) valid & in_range & tilt_ok (interference: see workspace_map)
+    axis: np.ndarray
+    tip: np.ndarray
+    tilt: np.ndarray
+    valid: np.ndarray
+    in_range: np.ndarray
+    tilt_ok: np.ndarray
+    within_limits: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -212,11 +190,11 @@ class IKResult:
         ``solved & in_range & tilt_ok``.
     """
 
-    q: np.ndarray  # (..., 2) inputs (q1, q2), rad; NaN where not solved
-    solved: np.ndarray  # (...,) an assembly with this propeller direction exists (ignoring limits)
-    in_range: np.ndarray  # (...,) solved and q within q1_limits, q2_limits
-    tilt_ok: np.ndarray  # (...,) solved and the direction within tilt_limit of Z
-    valid: np.ndarray  # solved & in_range & tilt_ok
+    q: np.ndarray
+    solved: np.ndarray
+    in_range: np.ndarray
+    tilt_ok: np.ndarray
+    valid: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -231,7 +209,7 @@ class RotationResult:
         Not singular.
     """
 
-    R: np.ndarray  # (..., 3, 3) platform rotation R_OP, columns (-s22, -s13, s0); NaN where not valid
+    R: np.ndarray
     valid: np.ndarray
 
 
@@ -265,9 +243,9 @@ class JacobianResult:
         ``|s22 x s12|``, in [0, 1].
     """
 
-    J: np.ndarray  # (..., 3, 2): omega = J qd, omega the platform's angular velocity (base frame)
-    valid: np.ndarray  # (...,) not singular; J is NaN elsewhere
-    distance: np.ndarray  # (...,) |s22 x s12|
+    J: np.ndarray
+    valid: np.ndarray
+    distance: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -288,10 +266,10 @@ class AccelerationResult:
         Not singular.
     """
 
-    omega: np.ndarray  # (..., 3) platform angular velocity, rad/s
-    omega_dot: np.ndarray  # (..., 3) platform angular acceleration, rad/s^2
-    passive_acc: np.ndarray  # (..., 3) passive accelerations (RR s22, RRR s12, RRR s13)
-    velocity_product: np.ndarray  # (..., 3) the Lie-bracket terms of omega_dot (J_dot qd)
+    omega: np.ndarray
+    omega_dot: np.ndarray
+    passive_acc: np.ndarray
+    velocity_product: np.ndarray
     valid: np.ndarray
 
 
@@ -336,7 +314,6 @@ def joint_axes(th: VectoredThruster, q: object) -> JointAxes:
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     q : array_like, shape (..., 2)
         Inputs ``(q1, q2)`` (rad).
 
@@ -348,7 +325,7 @@ def joint_axes(th: VectoredThruster, q: object) -> JointAxes:
     Raises
     ------
     ValueError
-        If ``th`` is not a :class:`VectoredThruster` or ``q`` is not a finite real array of shape (..., 2).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -450,7 +427,7 @@ def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If an argument is not a finite real array of shape (..., 3).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -527,20 +504,18 @@ def link_clearance(th: VectoredThruster, q: object) -> LinkClearanceResult:
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     q : array_like, shape (..., 2)
         Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
     LinkClearanceResult
-        ``clearance`` (rad, on the unit sphere about O; compare with ``th.interference_clearance``) and
-        ``valid``, each of shape (...).
+        Clearance (rad, compare with ``th.interference_clearance``) and its mask.
 
     Raises
     ------
     ValueError
-        If ``th`` is not a :class:`VectoredThruster` or ``q`` is not a finite real array of shape (..., 2).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -609,15 +584,13 @@ def forward_kinematics(th: VectoredThruster, q: object) -> FKResult:
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry (m), e.g. ``VectoredThruster.paper()``.
     q : array_like, shape (..., 2)
         Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
     FKResult
-        ``axis (..., 3)`` unit propeller axis and ``tip (..., 3)`` (m), base frame; ``tilt`` (rad);
-        ``valid``, ``in_range``, ``tilt_ok`` and ``within_limits``.
+        Propeller axis, tip, tilt and the validity and limit masks.
 
     Examples
     --------
@@ -637,7 +610,6 @@ def platform_rotation(th: VectoredThruster, q: object) -> RotationResult:
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     q : array_like, shape (..., 2)
         Inputs ``(q1, q2)`` (rad).
 
@@ -649,7 +621,7 @@ def platform_rotation(th: VectoredThruster, q: object) -> RotationResult:
     Raises
     ------
     ValueError
-        If ``th`` is not a :class:`VectoredThruster` or ``q`` is not a finite real array of shape (..., 2).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -748,7 +720,6 @@ def inverse_kinematics(th: VectoredThruster, s: object) -> IKResult:
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry (m).
     s : array_like, shape (..., 3)
         Desired propeller direction (base frame; any positive multiple).
 
@@ -805,7 +776,6 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     q : array_like, shape (..., 2)
         Inputs ``(q1, q2)`` (rad).
 
@@ -817,7 +787,7 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
     Raises
     ------
     ValueError
-        If ``th`` is not a :class:`VectoredThruster` or ``q`` is not a finite real array of shape (..., 2).
+        Bad input (see docs/conventions.md).
     """
     check_params(th, VectoredThruster, "th")
     q = _q(q)
@@ -848,7 +818,6 @@ def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     q : array_like, shape (..., 2)
         Inputs ``(q1, q2)`` (rad).
     qd : array_like, shape (..., 2)
@@ -862,8 +831,7 @@ def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
     Raises
     ------
     ValueError
-        If ``th`` is not a :class:`VectoredThruster`, an array is not a finite real array of shape
-        (..., 2), or the shapes do not broadcast.
+        Bad input (see docs/conventions.md).
     """
     check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
@@ -916,15 +884,13 @@ def jacobian(th: VectoredThruster, q: object) -> JacobianResult:
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry (m).
     q : array_like, shape (..., 2)
         Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
     JacobianResult
-        ``J (..., 3, 2)`` (rad/s per rad/s, base frame), ``valid`` (not singular) and ``distance``
-        ``|s22 x s12|`` (0 at the singularity).
+        ``J (..., 3, 2)``, its mask and the distance to the singularity.
 
     Examples
     --------
@@ -951,8 +917,8 @@ class VelocityResult:
         Not singular.
     """
 
-    omega: np.ndarray  # (..., 3) platform angular velocity, rad/s; NaN where not valid
-    valid: np.ndarray  # (...,) not singular
+    omega: np.ndarray
+    valid: np.ndarray
 
 
 def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityResult:
@@ -961,7 +927,6 @@ def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityRes
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     q : array_like, shape (..., 2)
         Inputs ``(q1, q2)`` (rad).
     qd : array_like, shape (..., 2)
@@ -975,8 +940,7 @@ def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityRes
     Raises
     ------
     ValueError
-        If ``th`` is not a :class:`VectoredThruster`, an array is not a finite real array of shape
-        (..., 2), or the shapes do not broadcast.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -1010,7 +974,6 @@ def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: objec
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     q : array_like, shape (..., 2)
         Inputs ``(q1, q2)`` (rad).
     qd : array_like, shape (..., 2)
@@ -1021,14 +984,12 @@ def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: objec
     Returns
     -------
     AccelerationResult
-        ``omega`` (rad/s), ``omega_dot`` (rad/s²), ``passive_acc`` and ``velocity_product``, each
-        (..., 3) in the base frame (NaN where singular), and ``valid``.
+        Platform angular velocity and acceleration, passive accelerations, mask.
 
     Raises
     ------
     ValueError
-        If ``th`` is not a :class:`VectoredThruster`, an array is not a finite real array of shape
-        (..., 2), or the shapes do not broadcast.
+        Bad input (see docs/conventions.md).
     """
     check_params(th, VectoredThruster, "th")
     q, qd, qdd = _q(q), as_array(qd, "qd", (2,)), as_array(qdd, "qdd", (2,))

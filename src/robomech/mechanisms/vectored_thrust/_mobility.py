@@ -39,7 +39,6 @@ def chain_screws(
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     q : array_like, shape (2,)
         One input configuration ``(q1, q2)`` (rad), away from the singularity.
     offsets : dict of str to array_like, optional
@@ -56,8 +55,7 @@ def chain_screws(
     Raises
     ------
     ValueError
-        If ``th`` is not a :class:`VectoredThruster`, ``q`` is not a finite (2,) array or is singular,
-        or ``offsets`` is not a dict of known axis names to finite (3,) points.
+        Bad input (see docs/conventions.md); also a singular ``q``.
 
     Examples
     --------
@@ -95,7 +93,6 @@ def platform_mobility(
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     q : array_like, shape (2,), optional
         Input configuration (rad); default ``(0, 0)``.
     offsets : dict of str to array_like, optional
@@ -105,14 +102,12 @@ def platform_mobility(
     Returns
     -------
     MobilityResult
-        ``dof``, the ``platform_twists`` (dof, 6) and ``constraint_wrenches`` (6 - dof, 6), the
-        rotational/translational DOF split, the Grübler-Kutzbach counts and the ``singular`` flag
-        (:mod:`robomech.analysis.mobility`).
+        Mobility analysis (:mod:`robomech.analysis.mobility`).
 
     Raises
     ------
     ValueError
-        As :func:`chain_screws`.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -137,8 +132,8 @@ class MechanismMobility:
         The propeller body: the central RU chain closed with the platform's twists and the shaft s0.
     """
 
-    platform: mobility.MobilityResult  # RRR-RR platform (2R expected)
-    propeller: mobility.MobilityResult  # propeller body: RU central chain + (platform twists, s0)
+    platform: mobility.MobilityResult
+    propeller: mobility.MobilityResult
 
 
 def mechanism_mobility(
@@ -157,7 +152,6 @@ def mechanism_mobility(
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     q : array_like, shape (2,), optional
         Input configuration (rad); default ``(0, 0)``.
     offsets : dict of str to array_like, optional
@@ -174,7 +168,7 @@ def mechanism_mobility(
     Raises
     ------
     ValueError
-        As :func:`chain_screws`, or if ``ujoint_centre`` is not a finite (3,) array.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------

@@ -17,7 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._validation import as_array, check_int, check_params
+from robomech._validation import as_array, check_params
+from robomech.analysis.workspace import grid
 
 from ._kinematics import _chunked, _fk, _interference, _jacobian, _q
 from ._params import VectoredThruster
@@ -67,17 +68,17 @@ class WorkspaceMap:
         ``in_range & tilt_ok & clear`` and not singular.
     """
 
-    q: np.ndarray  # (..., 2) inputs, rad
-    tip: np.ndarray  # (..., 3) propeller tip, m (NaN where singular)
-    tilt: np.ndarray  # (...,) universal-joint deflection, rad
-    clearance: np.ndarray  # (...,) 45 deg arc to fixing device, rad
-    distance: np.ndarray  # (...,) |s22 x s12| (0 at the passive-axes-parallel singularity)
-    dexterity: np.ndarray  # (...,) 1 / cond(J) in [0, 1]; 0 where singular
-    singular: np.ndarray  # (...,) dexterity < DEXTERITY_TOL or passive axes parallel
+    q: np.ndarray
+    tip: np.ndarray
+    tilt: np.ndarray
+    clearance: np.ndarray
+    distance: np.ndarray
+    dexterity: np.ndarray
+    singular: np.ndarray
     in_range: np.ndarray
     tilt_ok: np.ndarray
-    clear: np.ndarray  # (...,) clearance >= interference_clearance
-    reachable: np.ndarray  # in_range & tilt_ok & clear & not singular
+    clear: np.ndarray
+    reachable: np.ndarray
 
 
 def _dexterity(J: np.ndarray, ok: np.ndarray) -> np.ndarray:
@@ -107,7 +108,6 @@ def dexterity(th: VectoredThruster, q: object) -> np.ndarray:
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     q : array_like, shape (..., 2)
         Inputs ``(q1, q2)`` (rad).
 
@@ -119,7 +119,7 @@ def dexterity(th: VectoredThruster, q: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``th`` is not a :class:`VectoredThruster` or ``q`` is not a finite real array of shape (..., 2).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -138,20 +138,18 @@ def workspace_map(th: VectoredThruster, q: object) -> WorkspaceMap:
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     q : array_like, shape (..., 2)
         Inputs ``(q1, q2)`` (rad), e.g. :func:`input_grid`.
 
     Returns
     -------
     WorkspaceMap
-        ``q``, ``tip`` (..., 3) m, ``tilt``, ``clearance`` (rad), ``distance``, ``dexterity`` and the
-        masks ``singular``, ``in_range``, ``tilt_ok``, ``clear``, ``reachable``, each (...).
+        The Section 4 maps and masks per sample.
 
     Raises
     ------
     ValueError
-        If ``th`` is not a :class:`VectoredThruster` or ``q`` is not a finite real array of shape (..., 2).
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -193,7 +191,6 @@ def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = 
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     n : int or tuple of int
         Samples per input (each >= 2): one count for both, or ``(n1, n2)``.
     limits : array_like, shape (2, 2), optional
@@ -207,8 +204,7 @@ def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = 
     Raises
     ------
     ValueError
-        If ``th`` is not a :class:`VectoredThruster`, ``n`` is not an int >= 2 or a pair of them, or
-        ``limits`` is not a finite (2, 2) array with lo < hi.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -219,15 +215,7 @@ def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = 
     lim = np.array([th.q1_limits, th.q2_limits]) if limits is None else as_array(limits, "limits", (2, 2))
     if lim.shape != (2, 2) or np.any(lim[:, 1] <= lim[:, 0]):
         raise ValueError(f"Expected limits of shape (2, 2) with lo < hi per input, got {lim.tolist()}.")
-    if isinstance(n, tuple | list):
-        if len(n) != 2:
-            raise ValueError(f"Expected n to be an int or a pair of ints >= 2, got {n!r}.")
-        n1, n2 = (check_int(k, "n", low=2) for k in n)
-    else:
-        n1 = n2 = check_int(n, "n", low=2)
-    g1 = np.linspace(float(lim[0, 0]), float(lim[0, 1]), n1)
-    g2 = np.linspace(float(lim[1, 0]), float(lim[1, 1]), n2)
-    return np.stack(np.meshgrid(g1, g2, indexing="ij"), axis=-1)
+    return grid(lim, n)
 
 
 def singular_points(th: VectoredThruster) -> np.ndarray:
@@ -236,7 +224,6 @@ def singular_points(th: VectoredThruster) -> np.ndarray:
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
 
     Returns
     -------
@@ -246,7 +233,7 @@ def singular_points(th: VectoredThruster) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``th`` is not a :class:`VectoredThruster`.
+        Bad input (see docs/conventions.md).
     """
     check_params(th, VectoredThruster, "th")
     a = th.arc_angle
@@ -261,7 +248,6 @@ def idle_input_curve(th: VectoredThruster, q1: object) -> np.ndarray:
     Parameters
     ----------
     th : VectoredThruster
-        The mechanism's geometry.
     q1 : array_like, shape (...)
         Input 1 angles (rad).
 
@@ -273,7 +259,7 @@ def idle_input_curve(th: VectoredThruster, q1: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``th`` is not a :class:`VectoredThruster` or ``q1`` is not a finite real array.
+        Bad input (see docs/conventions.md).
 
     Examples
     --------
