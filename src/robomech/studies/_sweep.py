@@ -29,7 +29,7 @@ FRONT_ROWS = 20
 
 def sweep_result(store: Path, out_dir: Path, name: str = "sweep", prefix: str = "") -> StudyResult:
     """A StudyResult (tables, PNGs ``out_dir/<prefix><figure>.png``) from the sweep store ``store``."""
-    r = open_results(store)
+    r = open_results(store, as_dict=True)
     a = r["attrs"]
     study = get_study(a["study"])
     res = StudyResult(
