@@ -543,11 +543,12 @@ def probe_scheduler(address: str, timeout: float) -> None:
 
 
 def _pickle_study(study: DesignStudy) -> bytes:
-    """The study as bytes for the tasks (Dask's pickle, cloudpickle for what plain pickle cannot: a study
-    defined in ``__main__`` travels too)."""
-    from distributed.protocol.pickle import dumps
+    """The study as bytes for the tasks (cloudpickle: a study defined in ``__main__``, or a user model
+    loaded from a file by :func:`load_model` whose module is registered to be pickled by value, travels
+    to workers that cannot import it)."""
+    import cloudpickle
 
-    return bytes(dumps(study))
+    return bytes(cloudpickle.dumps(study))
 
 
 def check_runtime(

@@ -344,6 +344,8 @@ class DesignStudy:
         params = self.designs_to_params(rows)
         out = self.evaluate(self, params, np.asarray(rows, dtype=float), seed)
         ok = np.array([p is not None for p in params], dtype=bool)
+        if "design_ok" in out:  # the study's own verdict (e.g. a description that cannot be built)
+            ok &= np.asarray(out["design_ok"], dtype=bool)
         res = {"design_ok": ok}
         for m in self.metrics:
             a = np.asarray(out[m.name], dtype=m.dtype)
