@@ -382,11 +382,11 @@ def model_study(
         "input_grid": n_in if ibox is not None else None,
         "trajectory_samples": None if traj is None else int(traj[0].size),
         "length": L,
-        "build": f"{getattr(build, '__module__', '?')}:{getattr(build, '__qualname__', '?')}",
+        "build": getattr(build, "__qualname__", type(build).__name__),
     }
     return ModelStudy(
         name=name,
-        title=f"Design study of {parameters['build']}",
+        title=f"Design study {name} ({parameters['build']})",
         mechanism="multibody",
         nominal=_nominal,
         variables=variables,
@@ -456,18 +456,17 @@ def _one_design(study: ModelStudy, params: dict[str, float]) -> dict[str, float]
         "constraint_distance",
     }:
         pts, cell = _task_of(study, mech)
-        ik = mb.inverse_kinematics(mech, study.site, _targets(pts), weights=_weights(study.outputs))
-        ok = np.asarray(ik.converged, bool)
+        q, ok = reach(mech, study.site, pts, study.outputs)
         reached = int(ok.sum())
         out["workspace_measure"] = reached * cell
         out["task_fraction"] = reached / pts.shape[0]
         if gen & {"dexterity_min", "dexterity_mean"}:
-            inv = dexterity(mech, ik.q[ok], study.site, study.outputs, study.length)
+            inv = dexterity(mech, q[ok], study.site, study.outputs, study.length)
             out["dexterity_min"] = float(inv.min()) if inv.size else math.nan
             out["dexterity_mean"] = float(inv.mean()) if inv.size else math.nan
         if gen & {"type2_distance", "constraint_distance"}:
             if reached:
-                s = mb.singularities(mech, ik.q[ok], study.site, length=study.length)
+                s = mb.singularities(mech, q[ok], study.site, length=study.length)
                 out["type2_distance"] = float(np.min(s.sigma_II))
                 out["constraint_distance"] = float(np.min(s.sigma_C))
             else:
@@ -490,6 +489,44 @@ def _one_design(study: ModelStudy, params: dict[str, float]) -> dict[str, float]
         except Exception:  # a user metric failing on one design: NaN for that design only
             out[u.name] = math.nan
     return out
+
+
+# Rounds of re-solving the task points the IK missed from their nearest reached neighbour's configuration.
+IK_RETRIES = 2
+# Continuation stages of such a re-solve (the neighbour's pose is one task cell or more away).
+IK_RETRY_STEPS = 4
+
+
+def reach(mech: Any, site: str, pts: np.ndarray, outputs: str) -> tuple[np.ndarray, np.ndarray]:
+    """Configurations ``q (m, nq)`` placing ``site`` at the task points ``pts (m, 3)`` along ``outputs``,
+    and which converged ``(m,)``.
+
+    One batched :func:`~robomech.multibody.inverse_kinematics` from ``mech.q0``, then up to
+    ``IK_RETRIES`` rounds re-solving each missed point from the configuration of the nearest reached
+    point (continuation in ``IK_RETRY_STEPS`` stages): the IK is a local solver, and a reachable point far
+    from the reference configuration can be missed from ``q0`` alone.
+    """
+    from robomech import multibody as mb
+
+    w = _weights(outputs)
+    T = _targets(pts)
+    ik = mb.inverse_kinematics(mech, site, T, weights=w)
+    q = np.array(ik.q)
+    ok = np.asarray(ik.converged, bool).copy()
+    for _ in range(IK_RETRIES):
+        miss = np.flatnonzero(~ok)
+        if miss.size == 0 or not ok.any():
+            break
+        have = np.flatnonzero(ok)
+        d = np.linalg.norm(pts[miss, None, :] - pts[None, have, :], axis=-1)
+        guess = q[have[np.argmin(d, axis=1)]]
+        again = mb.inverse_kinematics(mech, site, T[miss], guess, weights=w, steps=IK_RETRY_STEPS)
+        got = np.asarray(again.converged, bool)
+        if not got.any():
+            break
+        q[miss[got]] = again.q[got]
+        ok[miss[got]] = True
+    return q, ok
 
 
 def dexterity(mech: Any, q: np.ndarray, site: str, outputs: str, length: float | None = None) -> np.ndarray:
@@ -594,7 +631,10 @@ def load_model(spec: str) -> Callable[..., Any]:
         raise ValueError(f"Expected --model FILE.py:NAME with an existing file, got {spec!r} (no such file).")
     if not attr:
         attr = "build"
-    name = f"robomech_user_model_{abs(hash(str(path.resolve())))}"
+    import hashlib
+
+    # the same module name in every process (str hash() is salted per process)
+    name = "robomech_user_model_" + hashlib.sha256(str(path.resolve()).encode()).hexdigest()[:16]
     try:
         mod_spec = importlib.util.spec_from_file_location(name, path)
         assert mod_spec is not None and mod_spec.loader is not None
