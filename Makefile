@@ -10,7 +10,7 @@ REPORTS ?=
 # A second venv with `pip install .` and no extras: what a user without MuJoCo gets.
 MINIMAL := .venv-minimal
 
-.PHONY: install run test bench verify lint typecheck docs check-minimal clean
+.PHONY: install install-browser run test test-slow test-all bench verify lint typecheck docs check-minimal clean
 
 install: $(STAMP)
 
@@ -18,19 +18,37 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e ".[verify,explore,test]"
+	# compile the multibody kernels into the on-disk cache now, not at the user's first call
+	$(BIN)/python -c "from robomech.multibody._compiled import warm; warm()"
 	touch $(STAMP)
 
 $(DOCS_STAMP): $(STAMP)
 	$(BIN)/python -m pip install --quiet -e ".[verify,explore,test,docs]"
 	touch $(DOCS_STAMP)
 
+# Debian's headless Chromium, which the viewer's browser test (tests/viewer) drives with playwright
+# (playwright's own browser download is not used); nothing to do where it is installed.
+CHROMIUM ?= /usr/bin/chromium-headless-shell
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+install-browser:
+	@test -x $(CHROMIUM) || { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium-headless-shell; } \
+	  || echo "install-browser: could not install chromium-headless-shell; the browser tests will be skipped"
+
 run: install
 	$(BIN)/robomech reproduce --out $(OUT)
 	$(BIN)/robomech verify --out $(OUT)
 
-test: install
+# The fast tier (the README's second command): lint and every test not marked `slow` (a few minutes).
+test: install install-browser
 	$(BIN)/ruff check src tests benchmarks examples docs/conf.py
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -m "not slow"
+
+# The slow tier: engine simulations, whole-study reproductions, clusters, teeth of the heavy checks.
+test-slow: install
+	$(BIN)/python -m pytest -q -m slow
+
+# Everything, both tiers (what CI runs).
+test-all: test test-slow
 
 verify: install
 	$(BIN)/robomech verify
@@ -46,8 +64,10 @@ typecheck: install
 	$(BIN)/mypy
 
 # The documentation site; -W: a warning is an error, -n: every cross-reference must resolve.
-# It runs examples/*.py and reproduces the fast studies for their pages (docs/conf.py);
-# `make docs REPORTS=out` shows every report of an earlier `make run` instead.
+# docs/conf.py writes an API page per public name, runs examples/*.py (sphinx-gallery), draws the
+# gallery mechanisms and reproduces the fast studies for their pages; `make docs REPORTS=out` also
+# shows the slow studies' reports of an earlier `make run`.  Math is rendered by MathJax served from
+# the site itself: the first build installs it from npm (Node.js) into docs/_build/npm.
 docs: $(DOCS_STAMP)
 	ROBOMECH_DOCS_REPORTS=$(REPORTS) $(BIN)/sphinx-build -W --keep-going -n -q -b html docs docs/_build/html
 	@echo "docs: open docs/_build/html/index.html"

@@ -1,4 +1,8 @@
-"""Inverse dynamics of a closed chain: the crank torque that drives an offset slider-crank.
+"""
+Inverse dynamics of a closed chain
+==================================
+
+The crank torque that drives an offset slider-crank.
 
 The crank follows a rest-to-rest quintic (``robomech.trajectory``) through half a turn in 0.5 s,
 with gravity along -y in the mechanism's plane.  ``multibody.inverse_dynamics`` gives the crank

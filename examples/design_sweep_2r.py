@@ -1,4 +1,8 @@
-"""A design sweep: the link-length ratio of a planar 2R arm that gives an isotropic tip Jacobian.
+"""
+A design sweep
+==============
+
+The link-length ratio of a planar 2R arm that gives an isotropic tip Jacobian.
 
 For every ratio l2/l1 on a grid and every elbow angle, the tip Jacobian comes from the product of
 exponentials (``kinematics.jacobian_space``: space twists ``[w; v]``, turned into the tip velocity

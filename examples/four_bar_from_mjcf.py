@@ -1,4 +1,8 @@
-"""Model a mechanism from MJCF: the planar four-bar shipped with robomech.
+"""
+Model a mechanism from MJCF
+===========================
+
+The planar four-bar shipped with robomech.
 
 Loads the MJCF file (compiled by MuJoCo's own ``MjSpec``), assembles the loop for a sweep of crank
 angles, and checks the rocker angle against the closed-form circle intersection (an independent

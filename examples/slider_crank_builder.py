@@ -1,4 +1,8 @@
-"""Model a mechanism with the Python Builder: an offset slider-crank, no XML.
+"""
+Model a mechanism with the Python Builder
+=========================================
+
+An offset slider-crank, no XML.
 
 A crank (0.1 m) on a hinge at the origin, a connecting rod (0.3 m), and a slider on a line parallel
 to x; the loop is cut at the wrist pin by a point closure.  The slider travel from forward

@@ -1,4 +1,6 @@
-"""Verify your own mechanism against an independent engine (MuJoCo).
+"""
+Verify your own mechanism against an independent engine (MuJoCo)
+================================================================
 
 The offset slider-crank of the Builder example, now with masses, is exported to MJCF and handed
 to ``robomech verify``: MuJoCo compiles the file and its own routines (``mj_kinematics``,

@@ -17,6 +17,8 @@ ALLOWED = {
     "dynamics": {"spatial", "kinematics"},
     "analysis": {"spatial", "kinematics"},
     "multibody": {"spatial", "kinematics", "trajectory", "dynamics", "analysis"},
+    # the browser viewer: a consumer of multibody only (viser lazily, inside functions)
+    "viewer": {"spatial", "kinematics", "trajectory", "dynamics", "analysis", "multibody"},
     "mechanisms": {"spatial", "kinematics", "trajectory", "dynamics", "analysis", "multibody"},
     "explore": {"spatial", "kinematics", "trajectory", "dynamics", "analysis", "multibody", "mechanisms"},
     "verify": {
@@ -41,10 +43,16 @@ ALLOWED = {
         "verify",
         "testing",
     },
-    "cli": {"studies", "verify", "explore"},
+    "cli": {"studies", "verify", "explore", "viewer"},
     "__main__": {"cli"},  # `python -m robomech`
 }
-INFRASTRUCTURE = {"robomech", "robomech._validation", "robomech._registry", "robomech._numba"}
+INFRASTRUCTURE = {
+    "robomech",
+    "robomech._validation",
+    "robomech._registry",
+    "robomech._numba",
+    "robomech._progress",
+}
 ENGINES = {"mujoco", "exudyn", "pinocchio"}
 # The distributed-computing stack of robomech.explore: imported inside functions only (first use).
 LAZY = {"dask", "distributed", "zarr", "pymoo"}
@@ -55,7 +63,17 @@ LAZY = {"dask", "distributed", "zarr", "pymoo"}
 LAZY_ONLY = {
     ("multibody", "_mjcf.py"): {"mujoco"},
     ("multibody", "_draw.py"): {"matplotlib"},
+    ("multibody", "_animate.py"): {"matplotlib", "PIL"},
+    ("multibody", "_repr.py"): {"matplotlib"},
+    ("viewer", "_server.py"): {"viser", "imageio", "webbrowser"},
+    ("viewer", "_geoms.py"): {"mujoco"},  # an MJCF file's geoms, compiled by MuJoCo (the verify extra)
 }
+# The web stack of the viewer: only robomech.viewer imports it, and only inside functions.
+WEB = {"viser"}
+# One upward import, inside the one function that needs it: ``multibody.view`` forwards to the viewer
+# (``mb.view(mech)``), so that the viewer's layer stays above multibody and ``import robomech.multibody``
+# never loads it.
+UPWARD_LAZY = {("multibody", "_draw.py"): {"viewer"}}
 
 
 def _imports(path: Path) -> list[str]:
@@ -91,8 +109,11 @@ def test_every_module_respects_the_layering():
         if layer in ("__init__", "_validation", "_registry", "_numba"):
             continue
         lazy = LAZY_ONLY.get((layer, path.name), set())
+        upward = UPWARD_LAZY.get((layer, path.name), set())
         for mod in _module_level_imports(path):
             if mod.split(".")[0] in lazy:
+                problems.append(f"{path.relative_to(SRC)} imports {mod} at module level (lazy only)")
+            if mod.startswith("robomech.") and mod.split(".")[1] in upward:
                 problems.append(f"{path.relative_to(SRC)} imports {mod} at module level (lazy only)")
         for mod in _imports(path):
             top = mod.split(".")[0]
@@ -100,10 +121,12 @@ def test_every_module_respects_the_layering():
                 problems.append(f"{path.relative_to(SRC)} imports engine {mod}")
             if top == "matplotlib" and layer != "studies" and top not in lazy:
                 problems.append(f"{path.relative_to(SRC)} imports matplotlib")
+            if top in WEB and (layer != "viewer" or top not in lazy):
+                problems.append(f"{path.relative_to(SRC)} imports {mod} (only robomech.viewer, lazily)")
             if top != "robomech" or mod in INFRASTRUCTURE:
                 continue
             target = mod.split(".")[1]
-            if target != layer and target not in ALLOWED[layer]:
+            if target != layer and target not in ALLOWED[layer] and target not in upward:
                 problems.append(f"{path.relative_to(SRC)} ({layer}) imports {mod}")
             if layer == "mechanisms" and target == "mechanisms":
                 own = path.relative_to(SRC).parts[1]
@@ -149,7 +172,7 @@ def test_import_robomech_is_light():
     code = (
         "import sys, robomech, robomech.multibody; "
         "heavy = [m for m in ('scipy', 'sympy', 'matplotlib', 'mujoco', 'dask', 'zarr', 'pymoo', "
-        "'robomech.explore') if m in sys.modules];"
+        "'robomech.explore', 'robomech.viewer', 'viser') if m in sys.modules];"
         "print(','.join(heavy))"
     )
     out = subprocess.run(

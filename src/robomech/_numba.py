@@ -1,21 +1,33 @@
 """Deferred numba import with robomech's on-disk kernel cache outside the installed package.
 
 numba's ``cache=True`` writes compiled kernels next to the source (``__pycache__`` of the installed
-package) unless ``NUMBA_CACHE_DIR`` is set: that is read-only or shared in a system-wide install, and
-a cache inside ``site-packages`` outlives the package version.  Before the first numba import this
-points ``NUMBA_CACHE_DIR`` (when the user has not set it) at ``$XDG_CACHE_HOME/robomech/numba``
-(default ``~/.cache/robomech/numba``).  numba reads the variable once, at import: if numba was already
-imported by the application, its own setting stays.
+package) unless a cache directory is configured: that is read-only or shared in a system-wide
+install, and a cache inside ``site-packages`` outlives the package version.  :func:`import_numba`
+points the cache (when the user has not set ``NUMBA_CACHE_DIR``) at ``$XDG_CACHE_HOME/robomech/numba``
+(default ``~/.cache/robomech/numba``): through the environment variable before numba's first import,
+and through ``numba.config.CACHE_DIR`` when the application imported numba first (numba reads the
+variable once, at import, but looks the setting up again whenever a kernel's cache is opened).
+
+Every compilation (a kernel's first use with empty caches) is announced on the ``robomech`` logger
+(``logging.getLogger("robomech")``) at INFO: ``compiling kernel X (first use; cached in DIR)``, then
+the time it took, so that a first call is never minutes of silence.  A kernel loaded from the cache
+is not compiled and says nothing.
 """
 
 from __future__ import annotations
 
+import logging
 import os
 import sys
+import time
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 __all__ = ["cache_dir", "import_numba"]
+
+_LOG = logging.getLogger("robomech")
+_LISTENING = False
 
 
 def cache_dir() -> Path:
@@ -26,10 +38,44 @@ def cache_dir() -> Path:
     return Path(base) / "robomech" / "numba"
 
 
+def _listen(numba: ModuleType) -> None:
+    """Log every numba compilation on the ``robomech`` logger (installed once per process)."""
+    global _LISTENING
+    if _LISTENING:
+        return
+    from numba.core import event
+
+    state = {"depth": 0, "t0": 0.0, "name": ""}
+
+    class _Listener(event.Listener):
+        def on_start(self, ev: Any) -> None:
+            state["depth"] += 1
+            if state["depth"] == 1:  # a kernel's callees compile inside its own first use
+                disp = (ev.data or {}).get("dispatcher")
+                name = getattr(getattr(disp, "py_func", None), "__qualname__", "a kernel")
+                mod = getattr(getattr(disp, "py_func", None), "__module__", "")
+                state["t0"], state["name"] = time.perf_counter(), f"{mod}.{name}" if mod else name
+                _LOG.info(
+                    "compiling kernel %s (first use; cached in %s)", state["name"], numba.config.CACHE_DIR
+                )
+
+        def on_end(self, ev: Any) -> None:
+            state["depth"] -= 1
+            if state["depth"] == 0:
+                _LOG.info("compiled kernel %s in %.1f s", state["name"], time.perf_counter() - state["t0"])
+
+    event.register("numba:compile", _Listener())
+    _LISTENING = True
+
+
 def import_numba() -> ModuleType:
-    """``import numba``, after pointing its cache at :func:`cache_dir` (see the module docstring)."""
-    if "numba" not in sys.modules and not os.environ.get("NUMBA_CACHE_DIR"):
+    """``import numba``, with its cache at :func:`cache_dir` and compilations logged (module docstring)."""
+    user_set = bool(os.environ.get("NUMBA_CACHE_DIR"))
+    if "numba" not in sys.modules and not user_set:
         os.environ["NUMBA_CACHE_DIR"] = str(cache_dir())
     import numba
 
+    if not numba.config.CACHE_DIR:  # imported before robomech could set the variable
+        numba.config.CACHE_DIR = str(cache_dir())
+    _listen(numba)
     return numba

@@ -73,6 +73,7 @@ def as_array(
     *,
     finite: bool | str = True,
     min_ndim: int | None = None,
+    nonempty: bool = False,
 ) -> np.ndarray:
     """Return ``x`` as a float64 array whose trailing dimensions are ``tail``.
 
@@ -82,6 +83,8 @@ def as_array(
     prefers to flag such samples per sample passes ``finite=False`` and masks them itself (see
     ``finite_samples``), or ``finite="mask"``, which also turns every magnitude above
     :data:`MAX_MAGNITUDE` (and inf) into NaN, for models that mask NaN samples.
+    ``nonempty=True`` also requires every free (``None``) trailing dimension to be at least 1: a
+    Jacobian ``(..., m, n)`` with no rows or no columns has no condition, rank or solution to report.
     """
     if x is None or isinstance(x, str | bytes):
         raise ValueError(f"Expected {name} to be an array of real numbers, got {type(x).__name__}.")
@@ -100,6 +103,11 @@ def as_array(
         d is not None and a.shape[a.ndim - len(tail) + i] != d for i, d in enumerate(tail)
     ):
         raise ValueError(f"Expected {name} to have shape {_shape_text(tail)}, got {a.shape}.")
+    if nonempty and any(d is None and a.shape[a.ndim - len(tail) + i] == 0 for i, d in enumerate(tail)):
+        free = ", ".join("n >= 1" if d is None else str(d) for d in tail)
+        raise ValueError(
+            f"Expected {name} to have shape (..., {free}) with no empty dimension, got {a.shape}."
+        )
     if finite == "mask":
         return usable(a)
     if finite:

@@ -55,7 +55,7 @@ def numerical_jacobian(
            [2., 1.]])
     """
     _check_callable(f, "f")
-    x = as_array(x, "x", (None,), min_ndim=1)
+    x = as_array(x, "x", (None,), min_ndim=1, nonempty=True)
     h = check_positive(h, "h")
     n = x.shape[-1]
     cols = []
@@ -131,7 +131,7 @@ def numerical_space_jacobian(
     True
     """
     _check_callable(fk, "fk")
-    q = as_array(q, "q", (None,), min_ndim=1)
+    q = as_array(q, "q", (None,), min_ndim=1, nonempty=True)
     T_inv = inverse_transform(fk(q))
     dT = numerical_jacobian(fk, q, h)  # (..., 4, 4, n)
     return vee_se3(np.einsum("...abk,...bc->...kac", dT, T_inv)).swapaxes(-1, -2)

@@ -171,6 +171,7 @@ def test_strict_json_of_list(capsys):
     assert {s["name"] for s in data["studies"]} == set(available_studies())
 
 
+@pytest.mark.slow  # ~8 s: builds and runs the three engine verifications
 def test_verify_json_is_strict_for_the_engine_mechanisms(capsys):
     # continuum: strict JSON checked in test_optional_engine (it runs there without the engine)
     names = ["omnileg", "skid-steer", "spherical-leg", "vectored-thrust"]

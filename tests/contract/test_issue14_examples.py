@@ -68,18 +68,23 @@ def test_actuator_forces_with_one_inf_sample_returns_and_masks_it():
 
     J = np.tile(np.array([[1.0, 0.0], [0.0, 2.0], [1.0, 1.0]]), (3, 1, 1))
     J[1, 0, 0] = np.inf
-    f, resid = dynamics.actuator_forces(J, np.ones((3, 2)))
-    assert np.all(np.isnan(f[1])) and np.isnan(resid[1])
-    assert np.all(np.isfinite(f[[0, 2]])) and np.all(resid[[0, 2]] < 1e-12)
+    r = dynamics.actuator_forces(J, np.ones((3, 2)))
+    assert np.all(np.isnan(r.forces[1])) and np.isnan(r.residual[1])
+    assert r.valid.tolist() == [True, False, True]
+    assert np.all(np.isfinite(r.forces[[0, 2]])) and np.all(r.residual[[0, 2]] < 1e-12)
 
 
-def test_condition_number_with_one_nan_sample_keeps_the_batch():
+def test_a_batch_with_one_nan_jacobian_is_masked_by_singularity_map():
+    # condition_number returns a bare number per sample, with no mask: it refuses a non-finite J;
+    # singularity_map keeps the batch and masks the sample
     from robomech.analysis import workspace
 
     J = np.tile(np.eye(3), (3, 1, 1))
     J[2, 1, 1] = np.nan
-    c = workspace.condition_number(J)
-    assert np.isnan(c[2]) and np.allclose(c[:2], 1.0)
+    with pytest.raises(ValueError, match="J"):
+        workspace.condition_number(J)
+    m = workspace.singularity_map(J)
+    assert m.singular.tolist() == [False, False, True] and np.allclose(m.cond[:2], 1.0)
 
 
 def test_normal_equations_with_one_huge_finite_sample_keeps_the_batch():

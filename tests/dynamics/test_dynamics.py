@@ -102,7 +102,9 @@ def test_static_torques_and_redundant_actuator_forces():
     tau = dynamics.static_torques(J, w)
     assert np.allclose(tau, np.einsum("kij,ki->kj", J, w))
     J_act = rng.normal(size=(10, 3, 2))  # 3 actuators, 2 DOF: redundant
-    f, resid = dynamics.actuator_forces(J_act, tau[:, :2])
+    r = dynamics.actuator_forces(J_act, tau[:, :2])
+    f, resid = r.forces, r.residual
+    assert r.valid.all()
     assert np.allclose(np.einsum("kij,ki->kj", J_act, f), tau[:, :2])
     assert resid.max() < 1e-12
     # minimum norm: f is in the range of J_act (orthogonal to its left null space)

@@ -286,7 +286,12 @@ def test_list_names_the_design_studies_in_text_and_json(capsys, monkeypatch):
     assert main(["list"]) == 0
     text = capsys.readouterr().out
     section = text.split("design studies (robomech sweep NAME --out DIR):\n", 1)[1]
-    lines = {ln.split()[0]: ln for ln in section.splitlines() if ln.startswith("  ")}
+    section_lines = []
+    for ln in section.splitlines():  # up to the next heading (the gallery and descriptions follow)
+        if not ln.startswith("  "):
+            break
+        section_lines.append(ln)
+    lines = {ln.split()[0]: ln for ln in section_lines}
     assert set(lines) == set(available_studies())
     for name, st in available_studies().items():
         assert st.title in lines[name] and "skipped" not in lines[name]

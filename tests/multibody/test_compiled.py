@@ -1,4 +1,4 @@
-"""The compiled per-sample kernels (large batches) agree with the numpy path, sample by sample."""
+"""The compiled per-sample kernels agree with the numpy formulation (tests/multibody/_reference.py)."""
 
 from __future__ import annotations
 
@@ -9,14 +9,15 @@ from hypothesis import strategies as st
 
 from robomech import multibody as mb
 from robomech.mechanisms import spherical_leg as sl
-from robomech.multibody import _assembly
 
-# Same algorithm, different operation order: configurations agree to rounding (~1e-15 measured),
-# site Jacobians to ~1e-12 (the compiled path solves the passive rates by refined normal equations
-# instead of an SVD; with redundant actuation the least-squares solutions agree to ~3e-12).
+from ._reference import numpy_reference
+
+# Same algorithm, different operation order: configurations agree to rounding (~1e-15 measured), site
+# Jacobians too (both take the passive rates from the SVD pseudo-inverse of K_p).
 Q_TOL = 1e-12
-J_TOL = 1e-10
-N = 2 * _assembly.COMPILED_MIN  # large enough for the compiled path
+J_TOL = 1e-12
+N = 512  # several parallel blocks of the kernels
+N_DYN = 256  # samples of the dynamics comparisons
 
 
 def _inputs(mech, seed):
@@ -35,7 +36,7 @@ def _leg():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["delta", "stewart", "bennett", "spherical_leg"])
-def test_compiled_equals_numpy(name, monkeypatch):
+def test_compiled_equals_numpy(name):
     if name == "spherical_leg":
         mech, qa = _leg()
     else:
@@ -44,12 +45,12 @@ def test_compiled_equals_numpy(name, monkeypatch):
     site = mech.sites[0].name
     fast = mb.forward_kinematics(mech, qa)
     J_fast = mb.site_jacobian(mech, fast.q, site)
-    monkeypatch.setattr(_assembly, "COMPILED_MIN", 10**9)
-    slow = mb.forward_kinematics(mech, qa)
-    J_slow = mb.site_jacobian(mech, slow.q, site)
+    with numpy_reference():
+        slow = mb.forward_kinematics(mech, qa)
+        J_slow = mb.site_jacobian(mech, slow.q, site)
     assert fast.converged.all() and slow.converged.all()
     assert np.max(np.abs(fast.q - slow.q)) < Q_TOL
-    assert np.max(np.abs(J_fast - J_slow)) < J_TOL
+    assert np.max(np.abs(J_fast - J_slow)) < J_TOL * max(1.0, float(np.max(np.abs(J_slow))))
 
 
 @pytest.mark.slow
@@ -80,26 +81,7 @@ ADM_ATOL = 1e-12
 _ID_KEYS = ("tau", "M_a", "velocity_terms", "gravity_terms", "external_terms", "qd", "qdd")
 
 
-class _numpy_path:
-    """Context: every multibody batch runs the numpy path (the reference)."""
-
-    def __enter__(self):
-        self.old = _assembly.COMPILED_MIN
-        _assembly.COMPILED_MIN = 10**9
-
-    def __exit__(self, *exc):
-        _assembly.COMPILED_MIN = self.old
-
-
-class _compiled_path:
-    """Context: every inverse-dynamics batch, however small, runs the compiled kernel."""
-
-    def __enter__(self):
-        self.old = _assembly.COMPILED_MIN
-        _assembly.COMPILED_MIN = 1
-
-    def __exit__(self, *exc):
-        _assembly.COMPILED_MIN = self.old
+_numpy_path = numpy_reference  # every multibody kernel replaced by the numpy formulation
 
 
 def _assert_same(fast, slow):
@@ -161,8 +143,7 @@ def _states(mech, n_conf, n, seed, amp=0.08):
 
 
 def _both(mech, q, qd, qdd, **kw):
-    with _compiled_path():
-        fast = mb.inverse_dynamics(mech, q, qd, qdd, **kw)
+    fast = mb.inverse_dynamics(mech, q, qd, qdd, **kw)
     with _numpy_path():
         slow = mb.inverse_dynamics(mech, q, qd, qdd, **kw)
     return fast, slow
@@ -175,15 +156,15 @@ _GALLERY = ["four_bar", "bennett", "planar_3rrr", "delta", "rps_3", "stewart"]
 @pytest.mark.parametrize("name", [*_GALLERY, "spherical_leg", "spherical_leg_angles"])
 def test_compiled_inverse_dynamics_equals_numpy(name):
     mech = _mechanism(name)
-    q, qd, qdd = _states(mech, 8, _assembly.COMPILED_MIN, seed=11)
+    q, qd, qdd = _states(mech, 8, N_DYN, seed=11)
     site = mech.sites[0].name
     W = np.random.default_rng(12).normal(size=(q.shape[0], 6))
     fast, slow = _both(mech, q, qd, qdd, wrenches={site: W})
     assert slow.valid.mean() > 0.9  # the comparison is about valid forces
     _assert_same(fast, slow)
-    # the default dispatch (>= COMPILED_MIN samples) is the compiled kernel
-    default = mb.inverse_dynamics(mech, q, qd, qdd, wrenches={site: W})
-    assert np.array_equal(default.tau, fast.tau, equal_nan=True)
+    # batch 1 runs the same kernel: the same forces, sample by sample
+    one = mb.inverse_dynamics(mech, q[:1], qd[:1], qdd[:1], wrenches={site: W[:1]})
+    assert np.array_equal(one.tau, fast.tau[:1], equal_nan=True)
 
 
 @pytest.mark.slow

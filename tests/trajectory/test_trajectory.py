@@ -58,3 +58,15 @@ def test_bad_input():
         tr.quintic(np.zeros(3), 0.0)
     with pytest.raises(ValueError, match="t"):
         tr.sinusoid([0.0, np.nan], 1.0, 1.0)
+
+
+def test_stack_refuses_what_is_not_a_profile_of_the_same_times():
+    t5, t6 = np.linspace(0.0, 1.0, 5), np.linspace(0.0, 1.0, 6)
+    a, b = tr.quintic(t5, 1.0), tr.quintic(t6, 1.0)
+    with pytest.raises(ValueError, match="self"):
+        tr.Profile.stack(None)
+    with pytest.raises(ValueError, match=r"others\[0\]"):
+        a.stack(None)
+    with pytest.raises(ValueError, match=r"others\[0\].*shape"):
+        a.stack(b)
+    assert a.stack(tr.quintic(t5, 2.0)).q.shape == (5, 2)  # control: same times stack

@@ -3,6 +3,7 @@
 import dataclasses
 
 import numpy as np
+import pytest
 
 from robomech.mechanisms.continuum import ContinuumRobot
 from robomech.verify import run_verifications
@@ -15,6 +16,7 @@ from robomech.verify.continuum import (
 )
 
 
+@pytest.mark.slow  # ~10 s: every continuum check, reference solves included
 def test_continuum_verification_passes():
     report = run_verifications(["continuum"])
     assert report.passed, report.table()

@@ -65,7 +65,7 @@ class LstsqResult:
 
 
 def _validate(A: ArrayLike, b: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-    A = as_array(A, "A", (None, None), finite=False)
+    A = as_array(A, "A", (None, None), finite=False, nonempty=True)
     m, n = A.shape[-2:]
     if m < n:
         raise ValueError(f"Expected A to have at least as many rows as columns (m >= n), got {A.shape}.")

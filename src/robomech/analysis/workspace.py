@@ -63,8 +63,9 @@ def grid(ranges: ArrayLike, n: int | Sequence[int]) -> NDArray[np.float64]:
 def condition_number(J: ArrayLike) -> NDArray[np.float64]:
     """2-norm condition number ``sigma_max / sigma_min`` of each Jacobian (inf where singular).
 
-    A Jacobian with a non-finite entry gets NaN and is kept away from LAPACK (whose SVD raises for
-    the whole batch on one NaN).
+    ``J`` must be finite: a bare number per sample has no mask to flag a non-finite Jacobian with.
+    For a batch that may hold failed samples (NaN Jacobians of unreachable poses) use
+    :func:`singularity_map`, whose ``singular`` mask is True there and whose ``cond`` is inf.
 
     Parameters
     ----------
@@ -75,18 +76,24 @@ def condition_number(J: ArrayLike) -> NDArray[np.float64]:
     Returns
     -------
     ndarray, shape (...)
-        ``sigma_max / sigma_min`` (>= 1), ``inf`` where ``sigma_min = 0``, NaN for a non-finite ``J``.
-        An exactly singular matrix usually gives a large finite value (~1e16) from rounding: use
-        :func:`singularity_map` for a singular mask.
+        ``sigma_max / sigma_min`` (>= 1), ``inf`` where ``sigma_min = 0``.  An exactly singular
+        matrix usually gives a large finite value (~1e16) from rounding: use :func:`singularity_map`
+        for a singular mask.
+
+    Raises
+    ------
+    ValueError
+        If ``J`` is not a real array of shape (..., m, n) with m, n >= 1, or has a non-finite entry or
+        one beyond ``MAX_MAGNITUDE``.
 
     Examples
     --------
     >>> import numpy as np
-    >>> J = np.array([[[2.0, 0.0], [0.0, 1.0]], [[1.0, 0.0], [0.0, np.nan]]])
+    >>> J = np.array([[[2.0, 0.0], [0.0, 1.0]], [[1.0, 0.0], [0.0, 1e-3]]])
     >>> condition_number(J)
-    array([ 2., nan])
+    array([   2., 1000.])
     """
-    J = as_array(J, "J", (None, None), finite=False)
+    J = as_array(J, "J", (None, None), nonempty=True)
     s, finite = _singular_values(J)
     smin = s[..., -1]
     cond = np.where(smin > 0, s[..., 0] / np.where(smin > 0, smin, 1.0), np.inf)
@@ -150,7 +157,7 @@ def singularity_map(J: ArrayLike, *, rtol: float = SINGULAR_RTOL) -> Singularity
     >>> m.dexterity[0], m.singular
     (np.float64(0.5), array([False,  True]))
     """
-    J = as_array(J, "J", (None, None), finite=False)
+    J = as_array(J, "J", (None, None), finite=False, nonempty=True)
     rtol = check_real(rtol, "rtol", low=0.0, high=1.0, low_open=True)
     s, finite = _singular_values(J)
     smax, smin = s[..., 0], s[..., -1]

@@ -10,7 +10,9 @@ Exit codes
 1
     A verification check ran and failed.
 2
-    Usage or input error (unknown name, bad ``--out``, bad arguments).
+    Usage or input error (unknown name, bad ``--out``, bad arguments, a missing or malformed input
+    file, an output path that cannot be written, an optional engine that is not installed): one line
+    on stderr saying why.
 3
     Internal error (a bug in robomech: please report it; ``--traceback`` shows where).
 130
@@ -20,13 +22,14 @@ Exit codes
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import traceback
 from collections.abc import Callable, Sequence
 
 from robomech._registry import discover
 
-from ._core import EXIT_INTERNAL, EXIT_INTERRUPTED, EXIT_USAGE, CliError, Command
+from ._core import EXIT_INTERNAL, EXIT_INTERRUPTED, EXIT_USAGE, CliError, Command, missing_extra
 
 __all__ = ["Command", "available_commands", "build_parser", "main"]
 
@@ -95,6 +98,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     >>> main(["verify", "no-such-mechanism"])  # the message goes to stderr
     2
     """
+    if "matplotlib" not in sys.modules:
+        # the command writes figures to files and shows none: matplotlib's Agg backend, chosen for
+        # this process (and the workers it starts) here, never by a library import
+        os.environ["MPLBACKEND"] = "agg"
     try:
         parser = build_parser()
         args = parser.parse_args(argv)  # exits 2 on a usage error, 0 after --help/--version
@@ -113,6 +120,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         sys.stderr.close()
         return 0
     except Exception as e:  # the last line of defence: an exit code, not a traceback
+        hint = missing_extra(e)
+        if hint is not None:  # an optional engine is not installed: the user's setup, not a bug
+            print(f"robomech {args.command}: this needs an optional engine: {hint}", file=sys.stderr)
+            return EXIT_USAGE
         if args.traceback:
             traceback.print_exc()
         print(

@@ -8,6 +8,7 @@ Keep command modules cheap to import: import the library inside ``run``.
 from __future__ import annotations
 
 import argparse
+import difflib
 import os
 import sys
 import tempfile
@@ -26,6 +27,10 @@ __all__ = [
     "CliError",
     "Command",
     "announce_compiles",
+    "did_you_mean",
+    "input_file",
+    "missing_extra",
+    "output_file",
     "output_folder",
 ]
 
@@ -110,6 +115,95 @@ def output_folder(value: str) -> Path:
     except OSError as e:
         raise CliError(f"--out: folder {str(path)!r} is not writable: {e.strerror or e}") from e
     return path
+
+
+def output_file(value: str) -> Path:
+    """An output file path whose folder exists and is writable, or a ``CliError`` with the reason.
+
+    Rejects an empty path, an existing folder, a path whose folder is missing or not a folder, and a
+    folder where a file cannot be created (``/proc``, a read-only mount).
+    """
+    if not value or not value.strip():
+        raise CliError("expected an output file path, got an empty string")
+    path = Path(value).expanduser()
+    if path.is_dir():
+        raise CliError(f"cannot write {str(path)!r}: it is a folder, expected a file path")
+    parent = path.parent
+    if not parent.exists():
+        raise CliError(f"cannot write {str(path)!r}: no such folder {str(parent)!r}")
+    if not parent.is_dir():
+        raise CliError(f"cannot write {str(path)!r}: {str(parent)!r} is not a folder")
+    try:  # the real test, as for --out: create (and remove) a file beside it
+        fd, probe = tempfile.mkstemp(dir=parent, prefix=".robomech-probe-")
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as e:
+        raise CliError(
+            f"cannot write {str(path)!r}: no file can be created in {str(parent)!r} ({e.strerror or e})"
+        ) from e
+    return path
+
+
+# Arguments that name a file rather than a registered or gallery name.
+FILE_SUFFIXES = (".xml", ".mjcf", ".urdf")
+
+
+def looks_like_file(arg: str) -> bool:
+    """An argument meant as a file path: a known suffix, a path separator, or an existing file."""
+    return arg.lower().endswith(FILE_SUFFIXES) or os.sep in arg or Path(arg).is_file()
+
+
+def input_file(arg: str) -> Path:
+    """An input file that exists and, for XML, parses; else a one-line ``CliError`` (``file:line``).
+
+    The XML is parsed here (by the standard library) before a model compiler sees it, so a
+    malformed file is reported as ``FILE:LINE:COLUMN: malformed XML (...)``, not in the compiler's words.
+    """
+    path = Path(arg).expanduser()
+    if not path.exists():
+        raise CliError(f"no such file: {arg}")
+    if path.is_dir():
+        raise CliError(f"expected a file, got the folder {arg}")
+    if path.suffix.lower() in FILE_SUFFIXES:
+        import xml.etree.ElementTree as ET
+
+        try:
+            ET.parse(path)
+        except ET.ParseError as e:
+            line, col = e.position
+            reason = str(e).split(":")[0]
+            raise CliError(f"{arg}:{line}:{col + 1}: malformed XML ({reason})") from e
+        except UnicodeDecodeError as e:
+            raise CliError(f"{arg}: not readable as text ({e.reason})") from e
+        except OSError as e:
+            raise CliError(f"cannot read {arg}: {e.strerror or e}") from e
+    return path
+
+
+def did_you_mean(name: str, choices: list[str] | tuple[str, ...]) -> str:
+    """``" (did you mean 'omnileg'?)"`` for the closest of ``choices`` (difflib), or ``""``."""
+    close = difflib.get_close_matches(name, list(choices), n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def missing_extra(exc: BaseException) -> str | None:
+    """The install hint for an optional dependency that is not installed (``import mujoco`` failed).
+
+    ``"install robomech[verify] (needs mujoco)"`` when ``exc``, or an exception it was raised from, is
+    a ``ModuleNotFoundError`` of one of the optional packages of ``robomech._registry.EXTRAS``;
+    ``None`` for anything else (a missing module of robomech itself is a bug).
+    """
+    from robomech._registry import EXTRAS
+
+    seen: set[int] = set()
+    e: BaseException | None = exc
+    while e is not None and id(e) not in seen:  # also an ImportError re-raised "from" the missing module
+        seen.add(id(e))
+        if isinstance(e, ModuleNotFoundError) and e.name and e.name.split(".")[0] in EXTRAS:
+            root = e.name.split(".")[0]
+            return f"install robomech[{EXTRAS[root]}] (needs {root})"
+        e = e.__cause__ or e.__context__
+    return None
 
 
 class _CompileNotice:

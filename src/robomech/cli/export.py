@@ -10,9 +10,8 @@ one get MuJoCo's inertia from the visual geoms).
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-from ._core import EXIT_OK, CliError, Command
+from ._core import EXIT_OK, CliError, Command, did_you_mean, input_file, looks_like_file, output_file
 
 
 def _add_arguments(p: argparse.ArgumentParser) -> None:
@@ -22,17 +21,30 @@ def _add_arguments(p: argparse.ArgumentParser) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     from robomech import multibody as mb
-    from robomech.verify._generic import describe  # verify may import the mechanisms; cli may not
+    from robomech.verify._generic import _paper, describe  # verify may import the mechanisms; cli may not
 
+    # every user mistake is found before any work: the output path, then the input
+    out = None if args.mjcf in (None, "-") else output_file(args.mjcf)
+    names = [*sorted(_paper()), *mb.gallery.NAMES]
+    if args.mechanism not in names:
+        if not looks_like_file(args.mechanism):
+            raise CliError(
+                f"unknown mechanism {args.mechanism!r}{did_you_mean(args.mechanism, names)}; valid ones are: "
+                f"{', '.join(names)}, or an MJCF file"
+            )
+        input_file(args.mechanism)
     try:
         mech = describe(args.mechanism)
     except (ValueError, OSError) as exc:
         raise CliError(str(exc)) from exc
     xml = mb.to_mjcf(mech)
-    if args.mjcf in (None, "-"):
+    if out is None:
         print(xml)
     else:
-        Path(args.mjcf).write_text(xml)
+        try:
+            out.write_text(xml)
+        except OSError as exc:
+            raise CliError(f"cannot write {args.mjcf!r}: {exc.strerror or exc}") from exc
         print(f"wrote {args.mjcf} ({mech.name}: {len(mech.bodies)} bodies, {len(mech.closures)} closures)")
     return EXIT_OK
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ._core import EXIT_OK, CliError, Command, announce_compiles, output_folder
+from ._core import EXIT_OK, CliError, Command, announce_compiles, did_you_mean, output_folder
 
 
 def _description() -> str:
@@ -41,7 +41,8 @@ def _run(args: argparse.Namespace) -> int:
     unknown = [n for n in args.studies if n not in studies]
     if unknown:
         raise CliError(
-            f"unknown study {', '.join(map(repr, unknown))}; valid studies are: {', '.join(studies)}"
+            f"unknown study {', '.join(map(repr, unknown))}{did_you_mean(unknown[0], list(studies))}; "
+            f"valid studies are: {', '.join(studies)}"
         )
     for n in args.studies:  # asked for by name: not running it is an error, not a skip
         why = skip_reason(studies[n].requires)

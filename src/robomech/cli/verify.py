@@ -5,7 +5,19 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ._core import EXIT_CHECK_FAILED, EXIT_OK, CliError, Command, announce_compiles, output_folder
+from robomech._progress import show_bars
+
+from ._core import (
+    EXIT_CHECK_FAILED,
+    EXIT_OK,
+    CliError,
+    Command,
+    announce_compiles,
+    did_you_mean,
+    input_file,
+    looks_like_file,
+    output_folder,
+)
 
 
 def _description() -> str:
@@ -40,10 +52,16 @@ def _run(args: argparse.Namespace) -> int:
     available = available_verifications()
     # MJCF paths and gallery / description names get the generic engine checks (issue 13)
     names, generic = split_targets(args.mechanisms, available)
+    for n in [*names, *generic]:  # a file that is missing or malformed: say so in one line
+        if n not in available and looks_like_file(n):
+            input_file(n)
     unknown = [n for n in names if n not in available]
     if unknown:
+        from robomech import multibody as mb
+
+        hint = did_you_mean(unknown[0], [*available, *mb.gallery.NAMES])
         raise CliError(
-            f"unknown mechanism {', '.join(map(repr, unknown))}; valid ones are: {', '.join(available)}"
+            f"unknown mechanism {', '.join(map(repr, unknown))}{hint}; valid ones are: {', '.join(available)}"
             ", a gallery mechanism or an MJCF file"
         )
     for n in names:  # asked for by name: not running it is an error, not a skip
@@ -51,6 +69,7 @@ def _run(args: argparse.Namespace) -> int:
         if why:
             raise CliError(f"{n} cannot run here: {why}")
     announce_compiles(enabled=not args.quiet)
+    show_bars(not args.quiet)  # stage bars on a terminal (robomech._progress)
     report = VerificationReport()
     try:
         report.checks.extend(run_generic(generic))

@@ -34,6 +34,9 @@ from robomech.spatial._se3 import ad
 from robomech.spatial._so3 import _hat as hat
 
 __all__ = [
+    "ACTUATION_RESIDUAL_RTOL",
+    "INERTIA_RTOL",
+    "ActuatorForces",
     "DynamicsTerms",
     "actuator_forces",
     "com_inverse_dynamics",
@@ -45,6 +48,33 @@ __all__ = [
     "static_torques",
     "world_inertia",
 ]
+
+
+# A rotational inertia is symmetric positive semidefinite (I = Σ m (|r|² 1 - r rᵀ)); both are tested
+# relative to the largest entry: 1e-9 admits inertias assembled from rounded CAD values (and the zero
+# moment of a thin rod about its axis) and refuses any with a negative principal moment, which no
+# mass has (its kinetic energy would be negative).
+INERTIA_RTOL = 1e-9
+
+
+def _check_inertia(Ic: np.ndarray, name: str) -> None:
+    """ValueError naming ``name`` unless every ``(3, 3)`` matrix is symmetric positive semidefinite."""
+    if Ic.size == 0:
+        return
+    scale = np.max(np.abs(Ic), axis=(-2, -1), keepdims=True)
+    scale = np.where(scale > 0, scale, 1.0)
+    asym = np.max(np.abs(Ic - np.swapaxes(Ic, -1, -2)) / scale)
+    if asym > INERTIA_RTOL:
+        raise ValueError(f"Expected {name} to be symmetric, got an asymmetry of {asym:.3g} (relative).")
+    ev = np.linalg.eigvalsh(0.5 * (Ic + np.swapaxes(Ic, -1, -2))) / scale[..., 0]  # (..., 3) ascending
+    worst = ev[..., 0].reshape(-1)
+    if worst.min() < -INERTIA_RTOL:
+        k = int(np.argmin(worst))
+        moments = (ev.reshape(-1, 3)[k] * scale.reshape(-1)[k]).tolist()
+        raise ValueError(
+            f"Expected {name} to be a rotational inertia (symmetric, principal moments >= 0), got "
+            f"principal moments {[float(f'{x:.6g}') for x in moments]}."
+        )
 
 
 def spatial_inertia(mass: ArrayLike, com: ArrayLike, inertia_com: ArrayLike) -> np.ndarray:
@@ -60,11 +90,18 @@ def spatial_inertia(mass: ArrayLike, com: ArrayLike, inertia_com: ArrayLike) -> 
     com : array_like, shape (..., 3)
         Centre of mass in the body frame (m).
     inertia_com : array_like, shape (..., 3, 3)
-        Rotational inertia about the centre of mass, body axes (kg m^2).
+        Rotational inertia about the centre of mass, body axes (kg m^2): symmetric with principal
+        moments >= 0 (within ``INERTIA_RTOL``).
 
     Returns
     -------
     ndarray, shape (..., 6, 6)
+
+    Raises
+    ------
+    ValueError
+        If an array is not finite and real with the stated shape, ``mass`` is negative,
+        ``inertia_com`` is not a rotational inertia, or the batch shapes do not broadcast.
 
     Examples
     --------
@@ -78,6 +115,7 @@ def spatial_inertia(mass: ArrayLike, com: ArrayLike, inertia_com: ArrayLike) -> 
     Ic = as_array(inertia_com, "inertia_com", (3, 3))
     if np.any(m < 0):
         raise ValueError(f"Expected mass >= 0, got {mass!r}.")
+    _check_inertia(Ic, "inertia_com")
     broadcast_batch((m, 0, "mass"), (c, 1, "com"), (Ic, 2, "inertia_com"))
     C = hat(c)
     mm = m[..., None, None]
@@ -290,21 +328,47 @@ def static_torques(J: ArrayLike, wrench: ArrayLike) -> np.ndarray:
     return np.einsum("...ij,...i->...j", J, w)
 
 
-def actuator_forces(
-    J_act: ArrayLike, tau_q: ArrayLike, *, rcond: float | None = None
-) -> tuple[np.ndarray, np.ndarray]:
-    """Actuator forces ``f`` with ``J_act^T f = tau_q`` of minimum norm, and the residual per sample.
+# The actuators balance tau_q when |J_act^T f - tau_q| is at most this fraction of |tau_q| (a zero
+# tau_q has the zero solution, residual 0): the minimum-norm solution of a consistent system has
+# a residual of rounding (~1e-16 relative, amplified by the conditioning up to 1/rcond = 1e12 only at
+# the cut-off); a configuration where tau_q has a component outside the range of J_act^T (an
+# actuation singularity) leaves a residual of that component's size.
+ACTUATION_RESIDUAL_RTOL = 1e-9
+
+
+@dataclass(frozen=True)
+class ActuatorForces:
+    """Actuator forces per sample (the result of :func:`actuator_forces`).
+
+    Attributes
+    ----------
+    forces : ndarray, shape (..., k)
+        Minimum-norm actuator forces (N or N m); NaN for a sample with a non-finite entry.
+    residual : ndarray, shape (...)
+        ``|J_act^T f - tau_q|`` (the units of ``tau_q``); NaN for a sample with a non-finite entry.
+    valid : ndarray of bool, shape (...)
+        The sample is finite and the actuators balance ``tau_q``: ``residual`` at most
+        ``ACTUATION_RESIDUAL_RTOL`` times ``|tau_q|``.
+    """
+
+    forces: np.ndarray
+    residual: np.ndarray
+    valid: np.ndarray
+
+
+def actuator_forces(J_act: ArrayLike, tau_q: ArrayLike, *, rcond: float | None = None) -> ActuatorForces:
+    """Actuator forces ``f`` with ``J_act^T f = tau_q`` of minimum norm, the residual and a mask per sample.
 
     ``J_act`` maps generalized rates to the k actuator rates (k >= n; k > n is redundant actuation,
-    resolved here by the minimum-norm rule).  A residual well above rounding flags a configuration
-    where the actuators cannot balance ``tau_q`` (an actuation singularity).  A sample with a
-    non-finite entry gets NaN forces and a NaN residual and never reaches LAPACK (an SVD of an inf
-    matrix does not return).
+    resolved here by the minimum-norm rule).  A residual above ``ACTUATION_RESIDUAL_RTOL`` flags a
+    configuration where the actuators cannot balance ``tau_q`` (an actuation singularity): ``valid``
+    False.  A sample with a non-finite entry (or one beyond ``MAX_MAGNITUDE``) gets NaN forces, a NaN
+    residual and ``valid`` False, and never reaches LAPACK (an SVD of an inf matrix does not return).
 
     Parameters
     ----------
     J_act : array_like, shape (..., k, n)
-        Actuator Jacobian (actuator rates per generalized rate).
+        Actuator Jacobian (actuator rates per generalized rate), k >= n >= 1.
     tau_q : array_like, shape (..., n)
         Generalized forces to balance (N m or N).
     rcond : float, optional
@@ -312,20 +376,24 @@ def actuator_forces(
 
     Returns
     -------
-    f : ndarray, shape (..., k)
-        Actuator forces (N or N m).
-    residual : ndarray, shape (...)
-        ``|J_act^T f - tau_q|``.
+    ActuatorForces
+        ``forces`` (..., k), ``residual`` (...) and ``valid`` (...).
+
+    Raises
+    ------
+    ValueError
+        If ``J_act`` is not a real array (..., k, n) with k >= n >= 1, ``tau_q`` not a real array
+        (..., n), their batch shapes do not broadcast, or ``rcond`` is not a positive real number.
 
     Examples
     --------
     >>> import numpy as np
     >>> J_act = np.array([[1.0], [1.0]])             # two actuators driving one coordinate
-    >>> f, res = actuator_forces(J_act, np.array([4.0]))
-    >>> f.round(12), float(res.round(12))          # shared equally (minimum norm)
-    (array([2., 2.]), 0.0)
+    >>> r = actuator_forces(J_act, np.array([4.0]))
+    >>> r.forces.round(12), float(r.residual.round(12)), bool(r.valid)   # shared equally (minimum norm)
+    (array([2., 2.]), 0.0, True)
     """
-    J_act = as_array(J_act, "J_act", (None, None), finite=False)
+    J_act = as_array(J_act, "J_act", (None, None), finite=False, nonempty=True)
     if J_act.shape[-2] < J_act.shape[-1]:
         raise ValueError(f"Expected J_act (..., k, n) with k >= n actuators, got {J_act.shape}.")
     tau_q = as_array(tau_q, "tau_q", (J_act.shape[-1],), finite=False)
@@ -341,13 +409,16 @@ def actuator_forces(
     scale = np.where(scale > 0, scale, 1.0)
     f = np.full((*batch, k), np.nan)
     resid = np.full(batch, np.nan)
+    valid = np.zeros(batch, dtype=bool)
     if np.any(good):
         JTg = JT[good] / scale[good][:, None, None]
         tg = tq[good] / scale[good][:, None]
         fg = np.einsum("...ij,...j->...i", np.linalg.pinv(JTg, rcond=rc), tg)
-        resid[good] = np.linalg.norm(np.einsum("...ij,...j->...i", JTg, fg) - tg, axis=-1) * scale[good]
+        rg = np.linalg.norm(np.einsum("...ij,...j->...i", JTg, fg) - tg, axis=-1)
+        resid[good] = rg * scale[good]
+        valid[good] = np.isfinite(rg) & (rg <= ACTUATION_RESIDUAL_RTOL * np.linalg.norm(tg, axis=-1))
         f[good] = fg
-    return f, resid
+    return ActuatorForces(forces=f, residual=resid, valid=valid)
 
 
 def world_inertia(R: ArrayLike, inertia: ArrayLike) -> np.ndarray:

@@ -14,8 +14,8 @@ gamma = 0 (the shank stretched straight) is singular for every design (J[2, 2] =
 the minimum of |det J| over Table 2's full range [0, 85 deg] is 0 for every design; the study's usable
 workspace starts at GAMMA_USABLE_MIN.  L5 translates the workspace along Z0 and changes neither metric.
 
-``dataclasses.replace`` of an OmniLeg derives the default inertias from the new dimensions (issue 14,
-defect 1, fixed in the parameter object): the torques use each design's own link inertias
+``dataclasses.replace`` of an OmniLeg derives the default inertias from the new dimensions (in the
+parameter object): the torques use each design's own link inertias
 (docs/explore.md).
 """
 

@@ -14,39 +14,33 @@ exact, batched kinematics with nothing derived by hand::
     m = mb.mobility(mech)                                # .dof, .redundant_constraints, .gruebler_kutzbach
     s = mb.singularities(mech, fk.q, "tip")              # type I / II / constraint, measures in metres
     mb.draw(mech, fk.q[0])                               # matplotlib wireframe
+    mb.animate(mech, fk.q, "motion.gif")                 # a GIF (or .mp4 with ffmpeg) along q (nt, nq)
+    mb.view(mech)                                        # live 3-D in the browser (robomech.viewer)
 
 Coordinates: ``q`` is MuJoCo's ``qpos`` (nq; ``[w, x, y, z]`` quaternions for ball/free joints) and
 every matrix "over all coordinates" has one column per *velocity* coordinate (MuJoCo's ``qvel``, nv:
 local angular velocity for ball joints).  ``q_act`` are the actuated joints' ``qpos`` entries in
 actuator order.
 
-Internals for the dynamics layer (issue 13).  All take flat batches and return world-frame
-quantities; ``mech.tree`` (``_tree.Tree``) and ``mech.constraints`` (``_constraints.Constraints``)
-are the compiled arrays, cached on the frozen mechanism:
+Beyond kinematics, the same description gives:
 
-* body poses: ``_tree.kinematics(tree, q (N, nq)) -> TreeState`` with ``.T (N, nb, 4, 4)`` every body's
-  world pose (index 0 the world; ``tree.body_names``) and ``.S (N, nv, 6)`` every velocity
-  coordinate's space screw ``[ω; v]``; ``_tree.body_poses`` for poses only;
-* body twists / Jacobians: ``_tree.space_jacobian(tree, state, b) (N, 6, nv)`` (space twist of body b,
-  ``V_b = J qd``), ``_tree.frame_jacobian(tree, state, b, p) (N, 6, nv)`` (``[ω; ṗ]`` of a world point
-  ``p (N, 3)`` fixed in b), ``_tree.body_twists(tree, state, qd)``; their time derivatives along ``qd``:
-  ``Sd = _tree.screw_rates(tree, state, qd)`` (``dS/dt``) and
-  ``_tree.frame_jacobian_rate(tree, state, Sd, b, p, qd)``;  ``tree.A (nb, nv)`` the ancestor mask;
-* constraint Jacobian and its derivative: ``_constraints.residual / jacobian / jacobian_rate``
-  (``K (N, m, nv)``, ``dK/dt`` along ``qd``); public, batched over any shape:
-  :func:`constraint_residual`, :func:`constraint_jacobian`, :func:`constraint_jacobian_rate`;
-* ``G = ∂qd/∂qd_act (…, nv, n_act)`` and ``∂G/∂q_act``: :func:`influence` (``_influence._influence_flat``
-  for flat batches, returning the state, K, G, dG and the screw rates together);
-* dynamics (issue 13, ``_dynamics``): :func:`inverse_dynamics`, :func:`statics`, :func:`site_wrench`,
-  :func:`forward_dynamics`, :func:`simulate`, :func:`energy` (docs/dynamics.md);
-* ``_tree.integrate(tree, q, dv)``: ``q ⊕ dv`` on the configuration manifold (``mj_integratePos``).
+* the loop-closure constraints, batched over any shape: :func:`constraint_residual`,
+  :func:`constraint_jacobian` and its time derivative :func:`constraint_jacobian_rate`;
+* the influence coefficients ``G = ∂qd/∂qd_act (..., nv, n_act)`` and ``∂G/∂q_act``: :func:`influence`;
+* dynamics of the closed chain: :func:`inverse_dynamics`, :func:`statics`, :func:`site_wrench`,
+  :func:`forward_dynamics`, :func:`simulate`, :func:`energy` (the dynamics page of the documentation);
+  for open chains, trees, underactuated and passive mechanisms and floating bases the same functions,
+  with every coordinate's rate ``qd (..., nv)`` where the actuated rates do not give the state;
+* the spanning tree's :func:`generalized_forces` (RNEA, MuJoCo ``mj_rne``) and :func:`mass_matrix`
+  (CRBA, ``mj_fullM``).
 """
 
 from __future__ import annotations
 
 from . import gallery
+from ._animate import animate
 from ._assembly import CONVERGED_RTOL, FKResult, IKResult, forward_kinematics, inverse_kinematics
-from ._draw import body_segments, draw
+from ._draw import body_segments, draw, view
 from ._dynamics import (
     ForwardDynamicsResult,
     InverseDynamicsResult,
@@ -73,7 +67,24 @@ from ._influence import (
 from ._mjcf import from_mjcf, to_mjcf
 from ._mobility import MobilityReport, mobility
 from ._model import Body, Builder, Closure, Coupling, Inertial, Joint, Mechanism, Site
+from ._repr import install_compact_repr
+from ._rnea import generalized_forces, mass_matrix
 from ._singularity import SingularityMapResult, SingularityResult, singularities, singularity_map
+
+# Results print their fields' shapes, masks as counts and ranges, not their arrays (notebooks).
+install_compact_repr(
+    FKResult,
+    IKResult,
+    Influence,
+    MobilityReport,
+    SingularityResult,
+    SingularityMapResult,
+    InverseDynamicsResult,
+    StaticsResult,
+    SiteWrenchResult,
+    ForwardDynamicsResult,
+    SimulationResult,
+)
 
 __all__ = [
     "CONVERGED_RTOL",
@@ -96,6 +107,7 @@ __all__ = [
     "Site",
     "SiteWrenchResult",
     "StaticsResult",
+    "animate",
     "body_segments",
     "constraint_jacobian",
     "constraint_jacobian_rate",
@@ -106,9 +118,11 @@ __all__ = [
     "forward_kinematics",
     "from_mjcf",
     "gallery",
+    "generalized_forces",
     "influence",
     "inverse_dynamics",
     "inverse_kinematics",
+    "mass_matrix",
     "mobility",
     "simulate",
     "singularities",
@@ -119,4 +133,5 @@ __all__ = [
     "site_wrench",
     "statics",
     "to_mjcf",
+    "view",
 ]

@@ -19,6 +19,7 @@ from robomech._validation import as_array, broadcast_batch, check_int
 
 from ._constraints import jacobian, residual
 from ._model import Mechanism
+from ._options import CONVERGED_RTOL, MAX_ITER, MAX_STEP, MU_MAX, MU_MIN, MU_START, STOP_RTOL
 from ._tree import TreeState, frame_jacobian, integrate, kinematics, normalize_quaternions
 
 __all__ = [
@@ -32,30 +33,7 @@ __all__ = [
     "solve_closure",
 ]
 
-# A configuration is assembled when every closure row is below CONVERGED_RTOL * L (L the
-# characteristic length): 1e-10 m for a 1 m mechanism, far below any manufacturing tolerance and
-# well above the ~1e-15 L where Newton's quadratic convergence stops (rounding).
-CONVERGED_RTOL = 1e-10
-# A sample stops iterating once its residual is below STOP_RTOL * L: a few ulps of the coordinates.
-STOP_RTOL = 1e-14
-# Levenberg–Marquardt damping, relative to the mean diagonal of K^T K.  Start nearly at Gauss–Newton
-# (quadratic convergence near a solution); x10 on a rejected step, /10 on an accepted one; a sample
-# whose damping exceeds MU_MAX takes steps of relative size < 1e-10: it has stalled and stops.
-MU_START = 1e-8
-MU_MIN = 1e-14
-MU_MAX = 1e10
-# Largest step per iteration, in radians (translations divided by L): Gauss–Newton far from a
-# solution can take steps of many radians and land on another assembly branch; capping the step keeps
-# the iteration on the branch connected to the guess (0.5 rad: the closure equations are nearly
-# linear over such a step) at the cost of a few more iterations for large moves.  Only coordinates
-# that move a closure point or the IK site are capped.
-MAX_STEP = 0.5
-# Batches of at least this many samples run the assembly in the compiled kernels of _compiled.py
-# (the same algorithm per sample); smaller ones in numpy, with no compilation.
-COMPILED_MIN = 256
-# Iterations per continuation stage: from the reference configuration Newton takes 4-8 iterations on
-# the gallery; 60 leaves room for the damped steps far from a solution before a sample is given up.
-MAX_ITER = 60
+# (tolerances and iteration limits: _options)
 
 
 def check_mechanism(mech: object) -> Mechanism:
@@ -86,8 +64,15 @@ def solve_closure(
     """LM on the closure rows (plus ``extra(state, q, idx) -> (r, J)`` rows) over the coordinates ``free``.
 
     ``q (N, nq)`` start (normalised); ``free`` indices of velocity coordinates that may move.
-    Returns ``q, closure residual (N,) max-abs, total residual (N,), iterations (N,)``.
+    Returns ``q, closure residual (N,) max-abs, total residual (N,), iterations (N,)``.  Without extra
+    rows (assembly) this is the compiled kernel (``_compiled.fk_block``), the same iteration per sample;
+    the numpy iteration here serves the rows that only inverse kinematics adds.
     """
+    if extra is None and max_iter == MAX_ITER:
+        from ._compiled import compiled_fk  # numba loads on the first kernel call, not at import
+
+        q, rc, it, res = compiled_fk(mech, q, np.asarray(free))
+        return q, rc, res, it
     tree, cs = mech.tree, mech.constraints
     N = q.shape[0]
     nf = len(free)
@@ -209,12 +194,28 @@ class IKResult:
 
 def _guess(mech: Mechanism, guess: ArrayLike | None, batch: tuple[int, ...]) -> np.ndarray:
     if guess is None:
-        return np.broadcast_to(mech.tree.q0, (*batch, mech.nq))
+        return np.broadcast_to(mech.q0, (*batch, mech.nq))  # the assembled reference
     g = as_array(guess, "guess", (mech.nq,))
     for a in mech.tree.quat_adr:
         if np.any(np.linalg.norm(g[..., a : a + 4], axis=-1) < 1e-9):
             raise ValueError(f"Expected the quaternion guess[..., {a}:{a + 4}] to be non-zero.")
     return normalize_quaternions(mech.tree, g)
+
+
+def floating_base_dofs(mech: Mechanism) -> np.ndarray:
+    """Velocity coordinates of the free joints that float a whole sub-mechanism (no closure ties their
+    body's subtree to anything outside it): moving them moves the closures rigidly, so assembly holds
+    them at the guess (a free joint closed by connects, a Delta's platform, is a passive coordinate)."""
+    tree = mech.tree
+    out: list[int] = []
+    for k in range(len(tree.jnt_names)):
+        if tree.jnt_type[k] != 3:
+            continue
+        d0 = int(tree.jnt_dadr[k])
+        sub = {tree.body_names[b] for b in range(len(tree.body_names)) if tree.A[b, d0]}
+        if all((c.body1 in sub) == (c.body2 in sub) for c in mech.closures):
+            out.extend(range(d0, d0 + 6))
+    return np.array(out, dtype=int)
 
 
 def forward_kinematics(
@@ -226,7 +227,10 @@ def forward_kinematics(
     ``mech.q0``) and the solution is the assembly branch connected to it.  ``steps > 1`` moves the
     inputs from the guess's values to ``q_act`` in that many equal stages (continuation), which
     keeps the branch over large moves; along a trajectory pass the previous solution as the guess.
-    Non-finite inputs give ``converged = False`` and NaN for that sample only.
+    Non-finite inputs give ``converged = False`` and NaN for that sample only.  A free joint that
+    floats a whole sub-mechanism (a floating-base robot) is a coordinate like the actuated ones: held
+    at the guess, never moved by the assembly.  Without actuators, ``q_act`` has shape ``(..., 0)`` and
+    the passive chain is assembled from the guess.
 
     Parameters
     ----------
@@ -260,22 +264,20 @@ def forward_kinematics(
     steps = check_int(steps, "steps", low=1)
     g0 = _guess(mech, guess, qa.shape[:-1])
     batch = broadcast_batch((qa, 1, "q_act"), (g0, 1, "guess"))
-    qa_f = np.broadcast_to(qa, (*batch, na)).reshape(-1, na)
-    q = np.array(np.broadcast_to(g0, (*batch, mech.nq)).reshape(-1, mech.nq))
+    n = int(np.prod(batch))  # explicit: reshape(-1, 0) is ambiguous for a mechanism without actuators
+    qa_f = np.broadcast_to(qa, (*batch, na)).reshape(n, na)
+    q = np.array(np.broadcast_to(g0, (*batch, mech.nq)).reshape(n, mech.nq))
     ok = np.all(np.isfinite(qa_f), axis=-1)
     q[~ok] = tree.q0
     start = q[:, tree.act_qadr].copy()
     target = np.where(ok[:, None], qa_f, start)
-    free = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
+    free = np.setdiff1d(np.arange(tree.nv), np.concatenate([tree.act_dof, floating_base_dofs(mech)]))
     iters = np.zeros(q.shape[0], dtype=int)
+    from ._compiled import compiled_fk  # numba loads on the first kernel call, not at import
+
     for s in range(1, steps + 1):
         q[:, tree.act_qadr] = start + (target - start) * (s / steps)
-        if q.shape[0] >= COMPILED_MIN:  # same algorithm, compiled per sample (see _compiled.py)
-            from ._compiled import compiled_fk
-
-            q, rc, it = compiled_fk(mech, q, free)
-        else:
-            q, rc, _, it = solve_closure(mech, q, free)
+        q, rc, it, _ = compiled_fk(mech, q, free)  # the one implementation, any batch size
         iters += it
     conv = ok & (rc <= CONVERGED_RTOL * tree.length)
     q = np.where(ok[:, None], q, np.nan)

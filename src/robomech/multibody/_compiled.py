@@ -1,128 +1,34 @@
-"""Compiled (numba) per-sample kernels for large batches: FK, site Jacobians, inverse dynamics.
+"""The compiled (numba) per-sample kernels: assembly (FK), site Jacobians, inverse dynamics.
 
-The same algorithms as the numpy path (``_tree``, ``_constraints``, ``_assembly``, ``_influence``,
-``_dynamics``), written per sample in one loop over the batch: tree kinematics, closure residual and
-velocity constraint matrix, the Levenberg–Marquardt assembly with the same damping, step cap and
-stopping rules, ``G = [I; -K_p^+ K_a]`` with the site's ``[ω; ṗ]`` Jacobian, and the closed-chain
-inverse dynamics of ``_dynamics._inverse_flat`` (:func:`inv_dyn`: passive pseudo-inverse, screw rates,
-``K̇ q̇``, the bodies' Newton–Euler terms through ``G``, site wrenches, the redundant-actuation rule and
-the same validity flags).  A numpy batch pays one Python-level operation per body and per closure on
-arrays of the whole batch; here every sample stays in cache.  The mechanism is passed packed, as the
-named tuples :class:`Tables` and :class:`DynTables`.  The tests check that both paths agree to
-rounding.  This module (and numba) loads on the first large call.
+The one implementation of each of these algorithms, for every batch size (batch 1 included): tree
+kinematics, closure residual and velocity constraint matrix (the formulas of ``_tree`` and
+``_constraints``, written per sample), the Levenberg–Marquardt assembly (damping, step cap and
+stopping rules of ``_options``), ``G = [I; -K_p^+ K_a]`` by the SVD pseudo-inverse with the site's
+``[ω; ṗ]`` Jacobian, and the closed-chain inverse dynamics (:func:`inv_dyn`: passive pseudo-inverse,
+screw rates, ``K̇ q̇``, the bodies' Newton–Euler terms through ``G``, site wrenches, the
+redundant-actuation rule and the validity flags).  Every sample stays in cache; large batches run in
+parallel over the cores (``numba.prange``).  The mechanism is passed packed, as the named tuples
+``_compile.Tables`` and ``_compile.DynTables`` of its compiled model.  The numpy formulation stays in
+the tests as the reference (tests/multibody/_reference.py).
 """
 
 from __future__ import annotations
 
-from typing import NamedTuple
-
 import numpy as np
-from numpy.typing import NDArray
 
 from robomech._numba import import_numba
 
-from ._assembly import COMPILED_MIN, MAX_ITER, MAX_STEP, MU_MAX, MU_MIN, MU_START, STOP_RTOL
-from ._influence import PASSIVE_RANK_RTOL
-from ._model import Mechanism
+from . import _options as opt
+from ._compile import compile_model
 
-__all__ = [
-    "COMPILED_MIN",
-    "DynTables",
-    "Tables",
-    "compiled_fk",
-    "compiled_site_jacobian",
-    "inv_dyn",
-    "tables",
-]
+__all__ = ["compiled_fk", "compiled_site_jacobian", "inv_dyn"]
 
-# this module is imported on the first large batch only; the kernel cache lives in robomech's cache dir
 numba = import_numba()
 
-
-class Tables(NamedTuple):
-    """The mechanism packed for the kernels (one argument instead of ~20 arrays; numba types it as a
-    named tuple, so the kernels read ``t.parent``, ``t.A``, ...).  Built once per mechanism
-    (``Mechanism.compiled_tables``)."""
-
-    parent: NDArray[np.int64]
-    T_off: NDArray[np.float64]
-    j0: NDArray[np.int64]  # (nb + 1,) joints of body b are j0[b]:j0[b + 1]
-    jtype: NDArray[np.int64]
-    jqadr: NDArray[np.int64]
-    jdadr: NDArray[np.int64]
-    jpos: NDArray[np.float64]
-    jaxis: NDArray[np.float64]
-    jref: NDArray[np.float64]
-    A: NDArray[np.float64]  # (nb, nv) coordinate k moves body b
-    C: NDArray[np.float64]  # (nv, nv) coordinate j moves the carrier frame of coordinate k
-    dof_tr: NDArray[np.bool_]
-    # closure rows
-    pp: NDArray[np.int64]  # (np, 3) int: b1, b2, first row
-    px: NDArray[np.float64]  # (np, 2, 3) local points
-    rr: NDArray[np.int64]  # (nr, 3) int: b1, b2, first row
-    rR: NDArray[np.float64]  # (nr, 3, 3)
-    cc: NDArray[np.int64]  # (nc, 5) int: d1, q1, d2, q2, row
-    cf: NDArray[np.float64]  # (nc, 8) float: ref1, ref2, c0..c4, scale
-    geom_row: NDArray[np.bool_]  # (m,) bool
-    m: int
-    L: float
-
-
-def tables(mech: Mechanism) -> Tables:
-    tree, cs = mech.tree, mech.constraints
-    nb = len(tree.body_names)
-    j0 = np.zeros(nb + 1, dtype=np.int64)
-    for b in range(nb):
-        j0[b + 1] = j0[b] + len(tree.body_jnts[b])
-    pp, px, rr, rR, cc, cf = [], [], [], [], [], []
-    row = 0
-    for k, d in cs.blocks:
-        if k == "point":
-            b1, x1, b2, x2 = d
-            pp.append((b1, b2, row))
-            px.append((x1[:3], x2[:3]))
-            row += 3
-        elif k == "rot":
-            b1, R, b2 = d
-            rr.append((b1, b2, row))
-            rR.append(R)
-            row += 3
-        else:
-            d1, q1, ref1, d2, q2, ref2, c, s = d
-            cc.append((d1, q1, d2, q2, row))
-            cf.append((ref1, ref2, *c, s))
-            row += 1
-    return Tables(
-        parent=tree.parent.astype(np.int64),
-        T_off=np.ascontiguousarray(tree.T_off),
-        j0=j0,
-        jtype=tree.jnt_type.astype(np.int64),
-        jqadr=tree.jnt_qadr.astype(np.int64),
-        jdadr=tree.jnt_dadr.astype(np.int64),
-        jpos=np.ascontiguousarray(tree.jnt_pos),
-        jaxis=np.ascontiguousarray(tree.jnt_axis),
-        jref=tree.jnt_ref.astype(float),
-        A=np.ascontiguousarray(tree.A),
-        C=np.ascontiguousarray(tree.C),
-        dof_tr=tree.dof_translational.astype(np.bool_),
-        pp=np.array(pp, dtype=np.int64).reshape(-1, 3),
-        px=np.array(px, dtype=float).reshape(-1, 2, 3),
-        rr=np.array(rr, dtype=np.int64).reshape(-1, 3),
-        rR=np.array(rR, dtype=float).reshape(-1, 3, 3),
-        cc=np.array(cc, dtype=np.int64).reshape(-1, 5),
-        cf=np.array(cf, dtype=float).reshape(-1, 8),
-        geom_row=np.array([k != "coupling" for k in cs.row_kind], dtype=np.bool_),
-        m=cs.m,
-        L=float(tree.length),
-    )
-
-
 _nj = numba.njit(cache=True, error_model="numpy")
-# Site Jacobian: Tikhonov weight of the passive normal equations relative to their mean diagonal,
-# and the refinement steps that remove its bias (each multiplies it by eps / sigma^2 <= 1e-8 / 1e-4
-# for sigma_min / sigma_max >= 1e-2; three solves leave ~1e-18 relative).
-REG = 1e-8
-REFINE = 2
+# Samples per parallel task: large enough that a task's scratch arrays are allocated rarely, small
+# enough that two cores share a batch of a few thousand evenly.
+BLOCK = 64
 
 
 @_nj
@@ -357,15 +263,18 @@ def integrate(q, dv, jtype, jqadr, jdadr, out):  # pragma: no cover
         out[o], out[o + 1], out[o + 2], out[o + 3] = nw / n, nx / n, ny / n, nz / n
 
 
-@numba.njit(cache=True, error_model="numpy")
-def fk(Q, free, wstep, t, max_iter, stop2, mu0, mu_min, mu_max, max_step, rc_out, it_out):  # pragma: no cover
-    N, nq = Q.shape
+@_nj
+def fk_block(
+    Q, lo, hi, free, wstep, t, max_iter, stop2, mu0, mu_min, mu_max, max_step, rc_out, it_out, cost_out
+):  # pragma: no cover
+    """The Levenberg–Marquardt closure solve of samples ``lo:hi`` of ``Q (N, nq)``, in place."""
+    nq = Q.shape[1]
     nb = t.parent.shape[0]
     nv = t.A.shape[1]
     nf = free.shape[0]
     m, geom_row = t.m, t.geom_row
     jtype, jqadr, jdadr = t.jtype, t.jqadr, t.jdadr
-    for n in numba.prange(N):
+    for n in range(lo, hi):
         q = Q[n].copy()
         T = np.empty((nb, 4, 4))
         S = np.zeros((nv, 6))
@@ -446,73 +355,74 @@ def fk(Q, free, wstep, t, max_iter, stop2, mu0, mu_min, mu_max, max_step, rc_out
             rc = max(rc, abs(r[i]))
         rc_out[n] = rc if finite else np.inf
         it_out[n] = it
+        cost_out[n] = cost if finite else np.inf
 
 
-@numba.njit(cache=True, error_model="numpy")
-def site_jac(Q, act, pas, sb, Tsite, t, rtol, J_out):  # pragma: no cover
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def fk_par(
+    Q, free, wstep, t, max_iter, stop2, mu0, mu_min, mu_max, max_step, rc_out, it_out, cost_out
+):  # pragma: no cover
+    """:func:`fk_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
     N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        fk_block(
+            Q,
+            k * BLOCK,
+            min(N, (k + 1) * BLOCK),
+            free,
+            wstep,
+            t,
+            max_iter,
+            stop2,
+            mu0,
+            mu_min,
+            mu_max,
+            max_step,
+            rc_out,
+            it_out,
+            cost_out,
+        )
+
+
+@_nj
+def site_jac_block(Q, lo, hi, act, pas, sb, Tsite, t, rtol, J_out):  # pragma: no cover
+    """``J = J_f G`` of the site (body ``sb``, pose ``Tsite`` in it) for samples ``lo:hi`` of ``Q``.
+
+    ``G = [I; -K_p^+ K_a]`` with the SVD pseudo-inverse of ``K_p`` (:func:`svd_pinv`, singular values
+    below ``rtol`` times the largest dropped): the minimum-norm passive rates, as :func:`influence`."""
     nb = t.parent.shape[0]
     A, m = t.A, t.m
     nv = A.shape[1]
     na, npas = act.shape[0], pas.shape[0]
-    for n in numba.prange(N):
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    r = np.empty(m)
+    K = np.empty((m, nv))
+    G = np.zeros((nv, na))
+    Kp = np.empty((m, npas))
+    P = np.empty((npas, m))
+    for n in range(lo, hi):
         q = Q[n]
-        T = np.empty((nb, 4, 4))
-        S = np.zeros((nv, 6))
-        r = np.empty(m)
-        K = np.empty((m, nv))
         kin(q, t, T, S)
         resjac(q, t, T, S, r, K, True)
-        G = np.zeros((nv, na))
+        G[:, :] = 0.0
         for j in range(na):
             G[act[j], j] = 1.0
         if m > 0 and npas > 0:
-            Kp = np.empty((m, npas))
-            Ka = np.empty((m, na))
             for i in range(m):
                 for j in range(npas):
                     Kp[i, j] = K[i, pas[j]]
-                for j in range(na):
-                    Ka[i, j] = K[i, act[j]]
-            # least-squares passive rates: K_p^T K_p + eps I factored once, then refined twice
-            # (x += M^-1 K_p^T (b - K_p x)), which converges to the least-squares solution at the rate
-            # eps / (sigma^2 + eps) per step; idle directions (sigma = 0) keep a component of order
-            # rounding / eps that moves no site, so the site Jacobian is the numpy path's (SVD) one.
-            M = Kp.T @ Kp
-            tr = 0.0
-            for i in range(npas):
-                tr += M[i, i]
-            eps = REG * tr / npas + 1e-300
-            for i in range(npas):
-                M[i, i] += eps
-            chol_factor(M)
-            b = np.empty(m)
-            b_tmp = np.empty(m)
-            rhs = np.empty(npas)
-            x = np.empty(npas)
-            dxr = np.empty(npas)
+            svd_pinv(Kp, rtol, P)
             for j in range(na):
-                for i in range(m):
-                    b[i] = -Ka[i, j]
-                x[:] = 0.0
-                for _ in range(REFINE + 1):
-                    for i in range(m):
-                        acc = b[i]
-                        for c in range(npas):
-                            acc -= Kp[i, c] * x[c]
-                        b_tmp[i] = acc  # residual b - K_p x
-                    for c in range(npas):
-                        acc = 0.0
-                        for i in range(m):
-                            acc += Kp[i, c] * b_tmp[i]
-                        rhs[c] = acc
-                    chol_subst(M, rhs, dxr)
-                    for c in range(npas):
-                        x[c] += dxr[c]
+                aj = act[j]
                 for i in range(npas):
-                    G[pas[i], j] = x[i]
-        Ts = T[sb] @ Tsite
-        p0, p1, p2 = Ts[0, 3], Ts[1, 3], Ts[2, 3]
+                    acc = 0.0
+                    for c in range(m):
+                        acc += P[i, c] * K[c, aj]
+                    G[pas[i], j] = -acc
+        p0 = T[sb, 0, 3] + T[sb, 0, 0] * Tsite[0, 3] + T[sb, 0, 1] * Tsite[1, 3] + T[sb, 0, 2] * Tsite[2, 3]
+        p1 = T[sb, 1, 3] + T[sb, 1, 0] * Tsite[0, 3] + T[sb, 1, 1] * Tsite[1, 3] + T[sb, 1, 2] * Tsite[2, 3]
+        p2 = T[sb, 2, 3] + T[sb, 2, 0] * Tsite[0, 3] + T[sb, 2, 1] * Tsite[1, 3] + T[sb, 2, 2] * Tsite[2, 3]
         for j in range(na):
             for i in range(6):
                 J_out[n, i, j] = 0.0
@@ -520,43 +430,29 @@ def site_jac(Q, act, pas, sb, Tsite, t, rtol, J_out):  # pragma: no cover
             if A[sb, k] == 0.0:
                 continue
             w0, w1, w2 = S[k, 0], S[k, 1], S[k, 2]
-            col = (
-                w0,
-                w1,
-                w2,
-                S[k, 3] + w1 * p2 - w2 * p1,
-                S[k, 4] + w2 * p0 - w0 * p2,
-                S[k, 5] + w0 * p1 - w1 * p0,
-            )
+            c3 = S[k, 3] + w1 * p2 - w2 * p1
+            c4 = S[k, 4] + w2 * p0 - w0 * p2
+            c5 = S[k, 5] + w0 * p1 - w1 * p0
             for j in range(na):
                 g = G[k, j]
                 if g != 0.0:
-                    for i in range(6):
-                        J_out[n, i, j] += col[i] * g
+                    J_out[n, 0, j] += w0 * g
+                    J_out[n, 1, j] += w1 * g
+                    J_out[n, 2, j] += w2 * g
+                    J_out[n, 3, j] += c3 * g
+                    J_out[n, 4, j] += c4 * g
+                    J_out[n, 5, j] += c5 * g
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def site_jac_par(Q, act, pas, sb, Tsite, t, rtol, J_out):  # pragma: no cover
+    """:func:`site_jac_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        site_jac_block(Q, k * BLOCK, min(N, (k + 1) * BLOCK), act, pas, sb, Tsite, t, rtol, J_out)
 
 
 # ----------------------------------------------------------------------------- inverse dynamics
-class DynTables(NamedTuple):
-    """What the inverse-dynamics kernel needs beyond :class:`Tables` (built once per mechanism)."""
-
-    bidx: NDArray[np.int64]  # (B,) bodies with mass or inertia
-    mass: NDArray[np.float64]  # (B,)
-    com: NDArray[np.float64]  # (B, 3) body frame
-    inertia: NDArray[np.float64]  # (B, 3, 3) about the com, body axes
-    act: NDArray[np.int64]  # (na,) actuated velocity coordinates
-    pas: NDArray[np.int64]  # (npas,) the others
-    rank0: int  # generic rank of K_p
-    dof: int  # mobility
-    gram_cond_max: float  # _dynamics.GRAM_COND_MAX
-    gram_refine_cond: float  # _dynamics.GRAM_REFINE_COND
-    gram_refine2_cond: float  # _dynamics.GRAM_REFINE2_COND
-    pinv_rtol: float  # _influence.PASSIVE_RANK_RTOL
-    rank_rtol: float  # _dynamics.RANK_RTOL
-    singular_cond: float  # _dynamics.SINGULAR_COND
-    admissible_rtol: float  # _dynamics.ADMISSIBLE_RTOL
-    rate_floor: float  # _dynamics.RATE_FLOOR
-
-
 @_nj
 def _cross_into(a0, a1, a2, b0, b1, b2, out, o):  # pragma: no cover - compiled
     out[o] = a1 * b2 - a2 * b1
@@ -735,8 +631,10 @@ def passive_solve(Kp, Gi, P, mode, nref, b, x, res, dx, tmp):  # pragma: no cove
             x[i] += dx[i]
 
 
-@numba.njit(cache=True, error_model="numpy")
-def inv_dyn(
+@_nj
+def inv_dyn_block(
+    lo,
+    hi,
     Q,
     QD,
     QDD,
@@ -758,9 +656,9 @@ def inv_dyn(
     smin_o,
     adm_o,
     valid_o,
+    clo_o,
 ):  # pragma: no cover - compiled
-    """``_dynamics._inverse_flat`` per sample (same formulas; see there for the derivation)."""
-    N = Q.shape[0]
+    """The closed-chain inverse dynamics of samples ``lo:hi`` (derivation: ``_dynamics``' docstring)."""
     nb = t.parent.shape[0]
     A, C, m, L = t.A, t.C, t.m, t.L
     nv = A.shape[1]
@@ -807,12 +705,13 @@ def inv_dyn(
     ext = np.empty(nv)
     KG = np.empty((m, na))
     tmpm = np.empty(m)
-    for n in range(N):
+    for n in range(lo, hi):
         q = Q[n]
         qa = QD[n]
         qdda = QDD[n]
         kin(q, t, T, S)
         resjac(q, t, T, S, r, K, True)
+        clo_o[n] = _amax_abs(r)  # the closure of the input q (largest row, m)
         for i in range(m):
             for j in range(npas):
                 Kp[i, j] = K[i, pas[j]]
@@ -1100,53 +999,355 @@ def inv_dyn(
         valid_o[n] = ok and fin and rank >= d.rank0 and cond <= d.singular_cond and adm <= d.admissible_rtol
 
 
-def _kernels():
-    return fk, site_jac
-
-
-def compiled_fk(mech, q: np.ndarray, free: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The LM closure solve of ``solve_closure`` (no extra rows) on ``q (N, nq)`` in place: (q, rc, iters)."""
-    t = mech.compiled_tables
-    fk, _ = _kernels()
-    tree = mech.tree
-    Q = np.ascontiguousarray(q, dtype=float).copy()
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def inv_dyn_par(
+    Q,
+    QD,
+    QDD,
+    W,
+    wsb,
+    wT,
+    gv,
+    wts,
+    t,
+    d,
+    tau_o,
+    Ma_o,
+    vel_o,
+    grav_o,
+    ex_o,
+    qd_o,
+    qdd_o,
+    cond_o,
+    smin_o,
+    adm_o,
+    valid_o,
+    clo_o,
+):  # pragma: no cover - compiled
+    """:func:`inv_dyn_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
     N = Q.shape[0]
-    rc, it = np.empty(N), np.zeros(N, dtype=np.int64)
-    wstep = np.where(tree.dof_translational, 1.0 / tree.length, 1.0)[free].astype(float)
-    fk(
-        Q,
-        free.astype(np.int64),
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        inv_dyn_block(
+            k * BLOCK,
+            min(N, (k + 1) * BLOCK),
+            Q,
+            QD,
+            QDD,
+            W,
+            wsb,
+            wT,
+            gv,
+            wts,
+            t,
+            d,
+            tau_o,
+            Ma_o,
+            vel_o,
+            grav_o,
+            ex_o,
+            qd_o,
+            qdd_o,
+            cond_o,
+            smin_o,
+            adm_o,
+            valid_o,
+            clo_o,
+        )
+
+
+def inv_dyn(*args) -> None:
+    """:func:`inv_dyn_block` on every sample: one block in this thread for a small batch, in parallel
+    blocks for a large one (the same per-sample code either way: results do not depend on the batch)."""
+    N = args[0].shape[0]
+    if N <= BLOCK:
+        inv_dyn_block(0, N, *args)
+    else:
+        inv_dyn_par(*args)
+
+
+_NO_W = (np.zeros((1, 0, 6)), np.zeros(0, dtype=np.int64), np.zeros((0, 4, 4)))
+_ZERO_G = np.zeros(3)
+_NO_WTS = np.zeros(0)
+
+
+def inv_dyn_one(model, q: np.ndarray, qd_a: np.ndarray, qdd_a: np.ndarray, gravity, on: bool) -> tuple | None:
+    """One sample through :func:`inv_dyn_block` with the least Python around it: the kernel's outputs
+    ``(tau, M_a, vel, grav, ext, qd, qdd, cond, smin, adm, valid, closure)`` with a leading axis of 1,
+    or None where the sample is not valid or not assembled (the caller's general path then flags it)."""
+    tree = model.tree
+    na, nv = len(model.act), tree.nv
+    gv = model.cache.get("gravity_vector")
+    if gv is None:
+        gv = model.cache["gravity_vector"] = np.array(gravity, dtype=float)
+    if not on:
+        gv = _ZERO_G
+    outs = (
+        np.empty((1, na)),
+        np.empty((1, na, na)),
+        np.empty((1, na)),
+        np.empty((1, na)),
+        np.empty((1, na)),
+        np.empty((1, nv)),
+        np.empty((1, nv)),
+        np.empty(1),
+        np.empty(1),
+        np.empty(1),
+        np.empty(1, dtype=np.bool_),
+        np.empty(1),
+    )
+    args = (0, 1, q.reshape(1, -1), qd_a.reshape(1, -1), qdd_a.reshape(1, -1), *_NO_W, gv, _NO_WTS)
+    args = (*args, model.tables, model.dyn, *outs)
+    fn = model.cache.get("inv_dyn_entry")
+    if fn is None:
+        inv_dyn_block(*args)  # compiles or loads the kernel, then its entry point skips the type dispatch
+        sig = tuple(numba.typeof(a) for a in args)
+        fn = model.cache["inv_dyn_entry"] = inv_dyn_block.overloads[sig].entry_point
+    else:
+        fn(*args)
+    if not outs[10][0] or not outs[11][0] <= opt.CLOSURE_RTOL * model.tables.L:
+        return None
+    if model.tables.m == 0 or len(model.pas) == 0:  # the empty passive block's measures
+        outs[7][0], outs[8][0] = 1.0, model.tables.L
+    return outs
+
+
+def compiled_fk(
+    mech, q: np.ndarray, free: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The closure solve on ``q (N, nq)`` over the velocity coordinates ``free``: (q, rc, iterations,
+    total residual ``sqrt(sum r^2)``), ``rc`` the largest closure row (m)."""
+    model = compile_model(mech)
+    t = model.tables
+    tree = model.tree
+    Q = np.array(q, dtype=np.float64, order="C")
+    N = Q.shape[0]
+    rc, it, cost = np.empty(N), np.zeros(N, dtype=np.int64), np.empty(N)
+    key = ("fk_wstep", free.tobytes())
+    wstep = model.cache.get(key)
+    if wstep is None:
+        wstep = model.cache[key] = np.where(tree.dof_translational, 1.0 / tree.length, 1.0)[free].astype(
+            float
+        )
+    args = (
+        np.ascontiguousarray(free, dtype=np.int64),
         wstep,
         t,
-        MAX_ITER,
-        (STOP_RTOL * t.L) ** 2,
-        MU_START,
-        MU_MIN,
-        MU_MAX,
-        MAX_STEP,
+        opt.MAX_ITER,
+        (opt.STOP_RTOL * t.L) ** 2,
+        opt.MU_START,
+        opt.MU_MIN,
+        opt.MU_MAX,
+        opt.MAX_STEP,
         rc,
         it,
+        cost,
     )
-    return Q, rc, it
+    if N <= BLOCK:
+        fk_block(Q, 0, N, *args)
+    else:
+        fk_par(Q, *args)
+    return Q, rc, it, np.sqrt(cost)
 
 
 def compiled_site_jacobian(mech, q: np.ndarray, site: int) -> np.ndarray:
-    """``J (N, 6, n_act)`` of site index ``site`` at ``q (N, nq)`` (the numpy path's ``site_jacobian``)."""
-    t = mech.compiled_tables
-    _, sj = _kernels()
-    tree = mech.tree
-    act = tree.act_dof.astype(np.int64)
-    pas = np.setdiff1d(np.arange(tree.nv), act).astype(np.int64)
-    Q = np.ascontiguousarray(q, dtype=float)
-    J = np.empty((Q.shape[0], 6, len(act)))
-    sj(
-        Q,
-        act,
-        pas,
+    """``J (N, 6, n_act)`` of site index ``site`` at ``q (N, nq)`` (:func:`site_jac_block`)."""
+    model = compile_model(mech)
+    tree = model.tree
+    Q = np.ascontiguousarray(q, dtype=np.float64)
+    J = np.empty((Q.shape[0], 6, len(model.act)))
+    args = (
+        model.act,
+        model.pas,
         int(tree.site_body[site]),
         np.ascontiguousarray(tree.T_site[site]),
-        t,
-        PASSIVE_RANK_RTOL,
+        model.tables,
+        opt.PASSIVE_RANK_RTOL,
         J,
     )
+    if Q.shape[0] <= BLOCK:
+        site_jac_block(Q, 0, Q.shape[0], *args)
+    else:
+        site_jac_par(Q, *args)
     return J
+
+
+# ----------------------------------------------------------------------------- tree inverse dynamics (RNEA)
+@_nj
+def _mcross(w0, w1, w2, v0, v1, v2, S, k, out, f):  # pragma: no cover - compiled
+    """``out += f * (V x S_k)`` for the spatial motion ``V = [w; v]``: ``[w x ws; w x vs + v x ws]``."""
+    a0, a1, a2, b0, b1, b2 = S[k, 0], S[k, 1], S[k, 2], S[k, 3], S[k, 4], S[k, 5]
+    out[0] += f * (w1 * a2 - w2 * a1)
+    out[1] += f * (w2 * a0 - w0 * a2)
+    out[2] += f * (w0 * a1 - w1 * a0)
+    out[3] += f * ((w1 * b2 - w2 * b1) + (v1 * a2 - v2 * a1))
+    out[4] += f * ((w2 * b0 - w0 * b2) + (v2 * a0 - v0 * a2))
+    out[5] += f * ((w0 * b1 - w1 * b0) + (v0 * a1 - v1 * a0))
+
+
+@_nj
+def _inertia_apply(mb, c, Ic, X, out):  # pragma: no cover - compiled
+    """``out = I X`` for the spatial inertia (mass ``mb``, world com ``c``, inertia about it ``Ic``) and
+    a motion ``X = [w; v]`` about the world origin: ``f = m (v + w x c)``, ``n = Ic w + c x f``."""
+    w0, w1, w2 = X[0], X[1], X[2]
+    f0 = mb * (X[3] + w1 * c[2] - w2 * c[1])
+    f1 = mb * (X[4] + w2 * c[0] - w0 * c[2])
+    f2 = mb * (X[5] + w0 * c[1] - w1 * c[0])
+    out[3], out[4], out[5] = f0, f1, f2
+    out[0] = Ic[0, 0] * w0 + Ic[0, 1] * w1 + Ic[0, 2] * w2 + (c[1] * f2 - c[2] * f1)
+    out[1] = Ic[1, 0] * w0 + Ic[1, 1] * w1 + Ic[1, 2] * w2 + (c[2] * f0 - c[0] * f2)
+    out[2] = Ic[2, 0] * w0 + Ic[2, 1] * w1 + Ic[2, 2] * w2 + (c[0] * f1 - c[1] * f0)
+
+
+@_nj
+def rnea_block(lo, hi, Q, QD, QDD, gv, t, tau_o):  # pragma: no cover - compiled
+    """The spanning tree's recursive Newton-Euler inverse dynamics of samples ``lo:hi`` (world frame,
+    the formulation of ``_rnea``: forward pass of twists and accelerations, the base accelerating at
+    ``[0; -g]``, body wrenches ``I A + V x* I V``, backward pass, ``tau_k = S_k . F_subtree``)."""
+    nb = t.parent.shape[0]
+    nv = t.nv
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    V = np.empty((nb, 6))
+    Acc = np.empty((nb, 6))
+    F = np.empty((nb, 6))
+    vj = np.empty(6)
+    c = np.empty(3)
+    Ic = np.empty((3, 3))
+    h = np.empty(6)
+    fa = np.empty(6)
+    for n in range(lo, hi):
+        q, qd, qdd = Q[n], QD[n], QDD[n]
+        kin(q, t, T, S)
+        for i in range(6):
+            V[0, i] = 0.0
+            Acc[0, i] = 0.0
+        for i in range(3):
+            Acc[0, 3 + i] = -gv[i]
+        for b in range(1, nb):
+            p = t.parent[b]
+            for i in range(6):
+                V[b, i] = V[p, i]
+                Acc[b, i] = Acc[p, i]
+            for k in range(t.j0[b], t.j0[b + 1]):
+                typ, da = t.jtype[k], t.jdadr[k]
+                nd = 1 if typ <= 1 else (3 if typ == 2 else 6)
+                for i in range(6):
+                    acc = 0.0
+                    acc2 = 0.0
+                    for j in range(nd):
+                        acc += S[da + j, i] * qd[da + j]
+                        acc2 += S[da + j, i] * qdd[da + j]
+                    vj[i] = acc
+                    Acc[b, i] += acc2
+                w0, w1, w2, v0, v1, v2 = V[b, 0], V[b, 1], V[b, 2], V[b, 3], V[b, 4], V[b, 5]
+                if typ <= 1:  # the axis is carried by the frame before the joint
+                    _mcross(w0, w1, w2, v0, v1, v2, S, da, Acc[b], qd[da])
+                elif typ == 2:  # ball: axes of the frame after it
+                    for j in range(3):
+                        _mcross(
+                            w0 + vj[0],
+                            w1 + vj[1],
+                            w2 + vj[2],
+                            v0 + vj[3],
+                            v1 + vj[4],
+                            v2 + vj[5],
+                            S,
+                            da + j,
+                            Acc[b],
+                            qd[da + j],
+                        )
+                else:  # free: rotation axes the body's own, moved by the joint's own twist
+                    for j in range(3, 6):
+                        _mcross(vj[0], vj[1], vj[2], vj[3], vj[4], vj[5], S, da + j, Acc[b], qd[da + j])
+                for i in range(6):
+                    V[b, i] += vj[i]
+        F[:, :] = 0.0
+        for ib in range(t.bidx.shape[0]):
+            b = t.bidx[ib]
+            cx = t.com[ib]
+            for i in range(3):
+                c[i] = T[b, i, 3] + T[b, i, 0] * cx[0] + T[b, i, 1] * cx[1] + T[b, i, 2] * cx[2]
+            Ib = t.inertia[ib]
+            for i in range(3):
+                for j in range(3):
+                    acc = 0.0
+                    for u in range(3):
+                        ru = Ib[u, 0] * T[b, j, 0] + Ib[u, 1] * T[b, j, 1] + Ib[u, 2] * T[b, j, 2]
+                        acc += T[b, i, u] * ru
+                    Ic[i, j] = acc
+            _inertia_apply(t.mass[ib], c, Ic, Acc[b], fa)
+            _inertia_apply(t.mass[ib], c, Ic, V[b], h)
+            w0, w1, w2, v0, v1, v2 = V[b, 0], V[b, 1], V[b, 2], V[b, 3], V[b, 4], V[b, 5]
+            F[b, 0] = fa[0] + (w1 * h[2] - w2 * h[1]) + (v1 * h[5] - v2 * h[4])
+            F[b, 1] = fa[1] + (w2 * h[0] - w0 * h[2]) + (v2 * h[3] - v0 * h[5])
+            F[b, 2] = fa[2] + (w0 * h[1] - w1 * h[0]) + (v0 * h[4] - v1 * h[3])
+            F[b, 3] = fa[3] + (w1 * h[5] - w2 * h[4])
+            F[b, 4] = fa[4] + (w2 * h[3] - w0 * h[5])
+            F[b, 5] = fa[5] + (w0 * h[4] - w1 * h[3])
+        for b in range(nb - 1, 0, -1):
+            p = t.parent[b]
+            for i in range(6):
+                F[p, i] += F[b, i]
+        for b in range(1, nb):
+            for k in range(t.j0[b], t.j0[b + 1]):
+                typ, da = t.jtype[k], t.jdadr[k]
+                nd = 1 if typ <= 1 else (3 if typ == 2 else 6)
+                for j in range(nd):
+                    acc = 0.0
+                    for i in range(6):
+                        acc += S[da + j, i] * F[b, i]
+                    tau_o[n, da + j] = acc
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def rnea_par(Q, QD, QDD, gv, t, tau_o):  # pragma: no cover - compiled
+    """:func:`rnea_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        rnea_block(k * BLOCK, min(N, (k + 1) * BLOCK), Q, QD, QDD, gv, t, tau_o)
+
+
+def compiled_rnea(model, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray, gv: np.ndarray) -> np.ndarray:
+    """Tree inverse dynamics ``(N, nv)`` (:func:`rnea_block`) at normalised ``Q (N, nq)``, ``QD``, ``QDD``."""
+    N = Q.shape[0]
+    tau = np.empty((N, model.tree.nv))
+    if N <= BLOCK:
+        fn = model.cache.get("rnea_entry")
+        args = (0, N, Q, QD, QDD, gv, model.rnea, tau)
+        if fn is None:
+            rnea_block(*args)
+            sig = tuple(numba.typeof(a) for a in args)
+            model.cache["rnea_entry"] = rnea_block.overloads[sig].entry_point
+        else:
+            fn(*args)
+    else:
+        rnea_par(Q, QD, QDD, gv, model.rnea, tau)
+    return tau
+
+
+def warm() -> None:
+    """Compile (or load) every kernel of this module on a small mechanism, so that a user's first
+    call finds them in the on-disk cache (``make install`` runs it).  The kernels' argument types do
+    not depend on the mechanism (packed tables of fixed array types), so one specialization per kernel
+    serves every mechanism."""
+    import logging
+
+    from . import _dynamics
+    from .gallery import load
+
+    if not logging.getLogger("robomech").handlers and not logging.getLogger().handlers:
+        logging.basicConfig(level=logging.INFO, format="%(name)s: %(message)s")
+        logging.getLogger("robomech").setLevel(logging.INFO)
+    mech = load("four_bar")
+    model = compile_model(mech)
+    site = mech.tree.site_index(mech.sites[0].name)
+    for n in (1, 2 * BLOCK + 1):  # one block in this thread, then parallel blocks
+        q = np.tile(mech.q0, (n, 1))
+        qf, _, _, _ = compiled_fk(mech, q, model.pas)
+        compiled_site_jacobian(mech, qf, site)
+        z = np.zeros((n, len(model.act)))
+        _dynamics._inverse_compiled(mech, qf, z, z, {}, None, True)
+    inv_dyn_one(model, mech.q0, np.zeros(1), np.zeros(1), mech.gravity, True)
+    for n in (1, 2 * BLOCK + 1):
+        z = np.zeros((n, mech.nv))
+        compiled_rnea(model, np.tile(mech.q0, (n, 1)), z, z, np.zeros(3))

@@ -15,7 +15,7 @@ from ._assembly import check_mechanism, check_q
 from ._model import Mechanism
 from ._tree import body_poses
 
-__all__ = ["body_segments", "draw"]
+__all__ = ["body_segments", "draw", "view"]
 
 
 def body_segments(mech: Mechanism, q: ArrayLike) -> dict[str, np.ndarray]:
@@ -142,3 +142,25 @@ def draw(
     ax.set_zlabel("z (m)")
     ax.set_title(title if title is not None else mech.name)
     return ax
+
+
+def view(mech: Mechanism, q: ArrayLike | None = None, **options):
+    """Show ``mech`` live in the browser: :func:`robomech.viewer.view` (the ``view`` extra, viser).
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The described mechanism.
+    q : array_like, shape (nq,), optional
+        Configuration shown first (default ``mech.q0``).
+    **options
+        ``site``, ``path``, ``times``, ``port``, ``open_browser``: see :func:`robomech.viewer.view`.
+
+    Returns
+    -------
+    robomech.viewer.Viewer
+        The running viewer (``.url``, ``.stop()``); displayed inline in Jupyter.
+    """
+    from robomech.viewer import view as _view  # the viewer layer sits above multibody (architecture.md)
+
+    return _view(mech, q, **options)

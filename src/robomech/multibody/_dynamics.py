@@ -1,4 +1,4 @@
-"""Closed-chain dynamics in actuator space for any described mechanism (issue 13).
+"""Dynamics of any described mechanism: closed chains in actuator space, and every other kinematic class.
 
 The spanning tree's rigid-body dynamics (Newton-Euler of every body about its centre of mass,
 :func:`robomech.dynamics.com_inverse_dynamics`) over the tree's velocity coordinates ``qd (nv)``,
@@ -29,7 +29,13 @@ Forward dynamics works on the tree coordinates with the closure as a constraint 
 included, as the engine has them): ``qdd = qdd_p + u``, ``K qdd_p = -Kdot qd`` (minimum norm), ``u`` in
 ``null(K)`` from ``P (M u - f) = 0`` with ``P = I - K^+ K``.  :func:`simulate` integrates ``(q, qd)`` with
 ``scipy.integrate.solve_ivp`` and projects back onto the constraint manifold (positions by the
-closure Newton iteration, velocities onto ``null(K)``) at every output time.
+closure Newton iteration, velocities onto ``null(K)``) at every output time, every sample on its own.
+
+Where the actuated rates do not determine the state (fewer actuators than degrees of freedom, none, a
+floating base) the functions take every coordinate's rate ``qd (nv)`` instead of ``qd_act``;
+inverse dynamics then solves virtual work over an orthonormal basis ``Nb`` of ``null(K)`` in least
+squares, ``Nb^T E tau = Nb^T f`` with ``f`` the tree's generalized forces (:mod:`._rnea`), and reports
+``Nb (Nb^T f - Nb^T E tau)``, what the unactuated coordinates would need (``_inverse_full_flat``).
 """
 
 from __future__ import annotations
@@ -40,19 +46,29 @@ from typing import TypeVar
 
 import numpy as np
 
-from robomech._validation import as_array, broadcast_batch, check_bool
+from robomech._validation import MAX_MAGNITUDE, as_array, broadcast_batch, check_bool
 from robomech.dynamics import _com_terms
 
 from ._assembly import check_mechanism, check_q, solve_closure
+from ._compile import Bodies, compile_model
 from ._constraints import jacobian
-from ._influence import PASSIVE_RANK_RTOL, _pinv
+from ._influence import _pinv
 from ._model import Mechanism
+from ._options import (
+    ADMISSIBLE_RTOL,
+    CLOSURE_RTOL,
+    GRAM_COND_MAX,
+    GRAM_REFINE2_COND,
+    GRAM_REFINE_COND,
+    RANK_RTOL,
+    RATE_FLOOR,
+    SINGULAR_COND,
+)
 from ._tree import (
     frame_jacobian,
     kinematics,
     normalize_quaternions,
     quat_mul,
-    quat_to_matrix,
 )
 
 __all__ = [
@@ -71,22 +87,6 @@ __all__ = [
     "statics",
 ]
 
-# A configuration is flagged singular when the passive block K_p of the constraint Jacobian has a
-# condition number above SINGULAR_COND (or lost rank against the reference configuration): actuator
-# forces grow like cond, and the closure is only solved to CONVERGED_RTOL = 1e-10 relative, so beyond
-# 1e6 the forces would carry relative errors of order 1e-4 from the geometry alone — and they are
-# physically unbounded as cond -> inf.  Such samples get valid = False and NaN forces.
-SINGULAR_COND = 1e6
-# The prescribed motion must be admissible: |K qd| and |K qdd + Kdot qd| below ADMISSIBLE_RTOL times
-# their scale (L |qd|, L (|qdd| + |qd|^2)).  Rounding leaves ~1e-15; an inconsistent rate of a
-# redundantly actuated mechanism (or a rank drop) gives O(1).
-ADMISSIBLE_RTOL = 1e-8
-# ... and below RATE_FLOOR (1/s, 1/s^2) of motion the scale is RATE_FLOOR: at rest the test is absolute
-# (1e-8 L per s^2), not relative to zero.
-RATE_FLOOR = 1.0
-# Rank decisions on K G (redundant actuation) and on the forward-dynamics matrices: singular values
-# below this fraction of the largest are zero (the same reasoning as PASSIVE_RANK_RTOL).
-RANK_RTOL = PASSIVE_RANK_RTOL
 # Samples per block in the batched kernels: bounds the (N, bodies, 6, nv) temporaries to ~100 MB.
 CHUNK = 2048
 
@@ -101,43 +101,16 @@ def _mv(A: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 def _cache(mech: Mechanism, key: str, make: Callable[[], _T]) -> _T:
-    d = mech.__dict__  # frozen dataclass: cached_property writes here too
+    d = compile_model(mech).cache  # the compiled model's, never the frozen description
     if key not in d:
         d[key] = make()
     out: _T = d[key]
     return out
 
 
-@dataclass(frozen=True)
-class _Bodies:
-    idx: np.ndarray  # (B,) tree body indices with mass or inertia
-    mass: np.ndarray  # (B,)
-    com: np.ndarray  # (B, 3) body frame
-    inertia: np.ndarray  # (B, 3, 3) about the com, body axes
-
-
-def _bodies(mech: Mechanism) -> _Bodies:
-    def make() -> _Bodies:
-        idx, m, c, inn = [], [], [], []
-        for i, b in enumerate(mech.bodies, start=1):
-            if b.inertial is None:
-                continue
-            it = b.inertial
-            if it.mass == 0 and max(it.diaginertia) == 0:
-                continue
-            Ri = quat_to_matrix(np.asarray(it.quat))
-            idx.append(i)
-            m.append(it.mass)
-            c.append(it.pos)
-            inn.append(Ri @ np.diag(it.diaginertia) @ Ri.T)
-        return _Bodies(
-            np.array(idx, dtype=int),
-            np.array(m, float),
-            np.array(c, float).reshape(-1, 3),
-            np.array(inn, float).reshape(-1, 3, 3),
-        )
-
-    return _cache(mech, "_dyn_bodies", make)
+def _bodies(mech: Mechanism) -> Bodies:
+    """The bodies with mass or inertia, from the compiled model."""
+    return compile_model(mech).bodies
 
 
 def _reference(mech: Mechanism) -> tuple[int, int]:
@@ -167,20 +140,7 @@ def _pinv_rank(K: np.ndarray, r: int) -> tuple[np.ndarray, np.ndarray]:
     return P, np.where(ok, s[:, 0] / np.where(ok, sr, 1.0), np.inf)
 
 
-# Below this 1-norm condition estimate of K_p the Gram-matrix inverse (with refinement) is used; above it
-# the sample is recomputed with the SVD pseudo-inverse (exact rank decision).  The Gram matrix squares
-# the condition number: its inverse carries ~cond^2 eps relative error, and each refinement step
-# (x += P0 (b - K_p x)) multiplies the error by ~cond^2 eps again.  SINGULAR_COND: beyond it the sample
-# is invalid anyway, and the estimate bounds the 2-norm condition number from above (within sqrt(rank)),
-# so a sample judged by the estimate is never wrongly valid.
-GRAM_COND_MAX = SINGULAR_COND
-# Refinement steps: one above GRAM_REFINE_COND (below it cond^2 eps < 1e-12), two above
-# GRAM_REFINE2_COND (at cond 1e6: 1e-4 -> 1e-8 -> 1e-12, below the inherent cond eps ~ 1e-10).
-GRAM_REFINE_COND = 1e2
-GRAM_REFINE2_COND = 1e4
-
-
-def _passive_inverse(Kp: np.ndarray, rank0: int):
+def _passive_inverse(Kp: np.ndarray, rank0: int, length: float = 1.0):
     """Pseudo-inverse of the passive block ``Kp (N, m, n)`` with (rank, sigma_min, cond) per sample.
 
     Fast path where the generic rank is ``min(m, n)`` (no idle motion *and* redundant rows at once):
@@ -193,7 +153,7 @@ def _passive_inverse(Kp: np.ndarray, rank0: int):
     """
     N, m, n = Kp.shape
     if m == 0 or n == 0 or rank0 != min(m, n):
-        return _pinv(Kp)
+        return _pinv(Kp, length)
     wide = m <= n
     KT = Kp.swapaxes(-1, -2)
     Gm = Kp @ KT if wide else KT @ Kp
@@ -201,7 +161,7 @@ def _passive_inverse(Kp: np.ndarray, rank0: int):
         try:
             Gi = np.linalg.inv(Gm)
         except np.linalg.LinAlgError:
-            return _pinv(Kp)
+            return _pinv(Kp, length)
         P = KT @ Gi if wide else Gi @ KT
         ni = np.linalg.norm(Gi, 1, axis=(-2, -1))
         cond = np.sqrt(np.linalg.norm(Gm, 1, axis=(-2, -1)) * ni)
@@ -215,27 +175,43 @@ def _passive_inverse(Kp: np.ndarray, rank0: int):
     rank = np.full(N, rank0)
     bad = ~(np.isfinite(cond) & (cond <= GRAM_COND_MAX) & np.all(np.isfinite(P), axis=(-1, -2)))
     if np.any(bad):
-        Pb, rb, sb, cb = _pinv(Kp[bad])
+        Pb, rb, sb, cb = _pinv(Kp[bad], length)
         P[bad], rank[bad], smin[bad], cond[bad] = Pb, rb, sb, cb
     return P, rank, smin, cond
 
 
+def _rank_measures(Kp: np.ndarray, rank0: int, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(sigma_min, cond)`` of ``Kp (N, m, n)`` against the mechanism's generic passive rank ``rank0``:
+    the ``rank0``-th singular value and ``s_1`` over it (inf where it is zero).  A truncated
+    pseudo-inverse keeps only the non-zero values, so its own ratio is 1 at a rank drop (a type II
+    singularity); this is the measure reported wherever a sample is not valid.  An empty block or a
+    generic rank 0: ``(length, 1)`` as in ``_influence._pinv``."""
+    N, m, n = Kp.shape
+    if m == 0 or n == 0 or rank0 == 0:
+        return np.full(N, float(length)), np.ones(N)
+    s = np.linalg.svd(np.where(np.isfinite(Kp), Kp, 0.0), compute_uv=False)
+    sr = s[:, rank0 - 1] if s.shape[1] >= rank0 else np.zeros(N)
+    cond = np.where(sr > 0, s[:, 0] / np.where(sr > 0, sr, 1.0), np.inf)
+    return sr, cond
+
+
+def _closure_error(mech: Mechanism, state, q: np.ndarray) -> np.ndarray:
+    """Largest closure row ``max |phi(q)|`` (m) per sample; 0 for a tree."""
+    from ._constraints import residual
+
+    if mech.constraints.m == 0:
+        return np.zeros(q.shape[0])
+    return np.max(np.abs(residual(mech.constraints, mech.tree, state, q)), axis=-1)
+
+
 def _reference3(mech: Mechanism) -> tuple[int, int, int]:
-    def make() -> tuple[int, int, int]:
-        from ._mobility import mobility
-
-        tree = mech.tree
-        pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
-        mob = mobility(mech)
-        # the passive block has full column rank but for the idle motions (computed, not taken from q0,
-        # which may itself be singular); K's generic rank leaves the DOF and the idle motions free
-        return len(pas) - int(mob.idle_dof), int(mob.dof), int(tree.nv - mob.dof - mob.idle_dof)
-
-    return _cache(mech, "_dyn_reference", make)
+    """(generic passive rank, mobility DOF, generic rank of K): the compiled model's reference rank."""
+    m = compile_model(mech)
+    return m.rank0, m.dof, m.rank_K
 
 
 # ----------------------------------------------------------------------------- tree kernels
-def _com_jacobians(tree, state, bd: _Bodies, qd: np.ndarray | None, Sd: np.ndarray | None):
+def _com_jacobians(tree, state, bd: Bodies, qd: np.ndarray | None, Sd: np.ndarray | None):
     """Centre-of-mass points (N, B, 3), Jacobians (N, B, 6, nv) and ``Jdot qd`` (N, B, 6)."""
     T = state.T[:, bd.idx]
     p = (T[..., :3, :3] @ bd.com[:, :, None])[..., 0] + T[..., :3, 3]
@@ -263,7 +239,7 @@ def _cross_rows(a: np.ndarray, p: np.ndarray) -> np.ndarray:
     return np.stack([a1 * z - a2 * y, a2 * x - a0 * z, a0 * y - a1 * x], axis=-2)
 
 
-def _com_projected(tree, state, bd: _Bodies, qd, Sd, G, extra_qdd):
+def _com_projected(tree, state, bd: Bodies, qd, Sd, G, extra_qdd):
     """Centre-of-mass Jacobians through G, ``J_b G (N, B, 6, na)``, and the accelerations
     ``Jdot_b qd + J_b extra_qdd (N, B, 6)`` — without the (N, B, 6, nv) Jacobians' cross products."""
     T = state.T[:, bd.idx]
@@ -295,11 +271,8 @@ def _screw_rates(tree, state, qd: np.ndarray) -> np.ndarray:
 
 
 def _path(tree, b: int) -> np.ndarray:
-    """Indices of the velocity coordinates that move body ``b`` (cached on the compiled tree)."""
-    cache = tree.__dict__.setdefault("_dyn_paths", {})
-    if b not in cache:
-        cache[b] = np.flatnonzero(tree.A[b])
-    return cache[b]
+    """Indices of the velocity coordinates that move body ``b`` (``Tree.dof_paths``, compiled once)."""
+    return tree.dof_paths[b]
 
 
 def _constraint_matrix(mech: Mechanism, state, q: np.ndarray) -> np.ndarray:
@@ -375,19 +348,6 @@ def _kdot_qd(mech: Mechanism, state, q: np.ndarray, qd: np.ndarray, Sd: np.ndarr
                 row[:, 0] = -sc * _poly(c, q[:, q2] - ref2)[2] * qd[:, d2] ** 2
             out.append(row)
     return np.concatenate(out, axis=-1) if out else np.zeros((q.shape[0], 0))
-
-
-def _tree_terms(mech: Mechanism, state, qd, Sd, qdd, gravity: bool = True):
-    """Tree dynamics ``M (N, nv, nv)``, velocity terms, gravity terms (N, nv) at ``qdd`` (DynamicsTerms)."""
-    tree = mech.tree
-    bd = _bodies(mech)
-    N = state.T.shape[0]
-    R = state.T[:, bd.idx, :3, :3]
-    Iw = R @ bd.inertia @ R.swapaxes(-1, -2)
-    _, J, a0 = _com_jacobians(tree, state, bd, qd, Sd)
-    g = np.asarray(mech.gravity) if gravity else np.zeros(3)
-    m = np.broadcast_to(bd.mass, (N, len(bd.mass)))
-    return _com_terms(m, Iw, J, a0, qd, qdd, np.broadcast_to(g, (N, 3)))
 
 
 def _energy_flat(mech: Mechanism, q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -466,10 +426,12 @@ class InverseDynamicsResult:
     ----------
     tau : ndarray, shape (..., n_act)
         Generalized force at each actuated joint, in actuator order (N m or N; actuator gear not
-        applied).  NaN where not ``valid``.
+        applied).  NaN where not ``valid`` — except, from full rates, where only ``unactuated`` is
+        not zero: the least-squares forces are kept there (the closest the actuators come).
     M_a : ndarray, shape (..., n_act, n_act)
         Mass matrix in actuator space, ``G^T M G`` (kg m^2, kg); with redundant actuation the
-        distributed ``Pi G^T M G``, ``Pi`` the stated rule's projector.
+        distributed ``Pi G^T M G``, ``Pi`` the stated rule's projector.  From full rates ``qd``,
+        ``B M B^T`` with ``tau = B f`` the rule applied to the generalized forces ``f``.
     velocity_terms : ndarray, shape (..., n_act)
         Coriolis and centrifugal share of ``tau`` (N m or N).
     gravity_terms : ndarray, shape (..., n_act)
@@ -486,10 +448,20 @@ class InverseDynamicsResult:
     sigma_min : ndarray, shape (...)
         Smallest kept singular value of the passive constraint block (m).
     admissibility : ndarray, shape (...)
-        Closure error of the prescribed motion, relative (above ``ADMISSIBLE_RTOL``: not valid).
+        How far the motion is from one the actuators can produce, relative: the closure error of the
+        prescribed rates and accelerations and, with fewer actuators than degrees of freedom, the
+        size of ``unactuated`` over that of the generalized forces (above ``ADMISSIBLE_RTOL``: not
+        valid).
+    unactuated : ndarray, shape (..., nv)
+        The generalized force (``qvel`` order) the unactuated coordinates would need for the motion
+        (a floating base: the base wrench, force in world axes then torque in body axes): the
+        minimum-norm force doing the virtual work the actuators cannot, over every admissible motion.
+        Zero where the actuators determine the motion.
+    closure : ndarray, shape (...)
+        Largest closure row of the input ``q`` (m); above ``CLOSURE_RTOL * L`` the sample is not valid.
     valid : ndarray of bool, shape (...)
-        False at a singular configuration, an inadmissible motion or a non-finite input; the forces
-        are NaN there.
+        False at a singular configuration, an inadmissible motion, an unassembled ``q`` or a
+        non-finite input; the forces are NaN there.
     """
 
     tau: np.ndarray
@@ -502,6 +474,8 @@ class InverseDynamicsResult:
     cond: np.ndarray
     sigma_min: np.ndarray
     admissibility: np.ndarray
+    unactuated: np.ndarray
+    closure: np.ndarray
     valid: np.ndarray
 
 
@@ -542,7 +516,7 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
     N = q.shape[0]
     state = kinematics(tree, q)
     K = _constraint_matrix(mech, state, q)
-    P, rank, smin, cond = _passive_inverse(K[..., pas], rank0)
+    P, rank, smin, cond = _passive_inverse(K[..., pas], rank0, tree.length)
     G = np.zeros((N, tree.nv, na))
     G[:, act, np.arange(na)] = 1.0
     G[:, pas] = -P @ K[..., act]
@@ -598,46 +572,13 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
     )
 
 
-def _dyn_tables(mech: Mechanism):
-    """The compiled kernel's per-mechanism tables (``_compiled.DynTables``), built once."""
-
-    def make():
-        from ._compiled import DynTables
-
-        tree = mech.tree
-        bd = _bodies(mech)
-        rank0, dof = _reference(mech)
-        act = tree.act_dof.astype(np.int64)
-        return DynTables(
-            bidx=bd.idx.astype(np.int64),
-            mass=np.ascontiguousarray(bd.mass, dtype=float),
-            com=np.ascontiguousarray(bd.com, dtype=float),
-            inertia=np.ascontiguousarray(bd.inertia, dtype=float),
-            act=act,
-            pas=np.setdiff1d(np.arange(tree.nv), act).astype(np.int64),
-            rank0=int(rank0),
-            dof=int(dof),
-            gram_cond_max=float(GRAM_COND_MAX),
-            gram_refine_cond=float(GRAM_REFINE_COND),
-            gram_refine2_cond=float(GRAM_REFINE2_COND),
-            pinv_rtol=float(PASSIVE_RANK_RTOL),
-            rank_rtol=float(RANK_RTOL),
-            singular_cond=float(SINGULAR_COND),
-            admissible_rtol=float(ADMISSIBLE_RTOL),
-            rate_floor=float(RATE_FLOOR),
-        )
-
-    return _cache(mech, "_dyn_compiled_tables", make)
-
-
 def _inverse_compiled(mech, q, qd_a, qdd_a, wr, weights, gravity=True) -> dict[str, np.ndarray]:
     """:func:`_inverse_flat` by the compiled per-sample kernel (``_compiled.inv_dyn``): same formulas,
     same flags; the tests check both paths agree to rounding."""
     from ._compiled import inv_dyn
 
-    tree = mech.tree
-    t = mech.compiled_tables
-    d = _dyn_tables(mech)
+    model = compile_model(mech)
+    tree, t, d = model.tree, model.tables, model.dyn
     N, nv, na = q.shape[0], tree.nv, len(tree.act_dof)
     sites = list(wr)
     W = np.zeros((N, len(sites), 6))
@@ -659,6 +600,7 @@ def _inverse_compiled(mech, q, qd_a, qdd_a, wr, weights, gravity=True) -> dict[s
         sigma_min=np.empty(N),
         admissibility=np.empty(N),
         valid=np.empty(N, dtype=np.bool_),
+        closure=np.empty(N),
     )
     f = np.ascontiguousarray
     inv_dyn(
@@ -675,6 +617,64 @@ def _inverse_compiled(mech, q, qd_a, qdd_a, wr, weights, gravity=True) -> dict[s
         *out.values(),
     )
     return out
+
+
+def _inverse_one(mech, q, qd_a, qdd_a, gravity) -> InverseDynamicsResult | None:
+    """One sample given as float64 vectors of the exact shapes, no wrench, no weights: validated here,
+    computed by one call of the kernel block (the same per-sample code as every batch).  None — the
+    general path then validates, masks and explains — for any other input and for a sample that is
+    not valid (non-finite, singular, inadmissible or not assembled)."""
+    if not (
+        type(mech) is Mechanism
+        and type(q) is np.ndarray
+        and type(qd_a) is np.ndarray
+        and type(qdd_a) is np.ndarray
+        and (gravity is True or gravity is False)
+    ):
+        return None
+    model = compile_model(mech)
+    tree = model.tree
+    na, nv = len(model.act), tree.nv
+    if (
+        q.shape != (tree.nq,)
+        or qd_a.shape != (na,)
+        or qdd_a.shape != (na,)
+        or q.dtype != np.float64
+        or qd_a.dtype != np.float64
+        or qdd_a.dtype != np.float64
+        or na == 0
+        or na < model.dof
+        or not (q.flags.c_contiguous and qd_a.flags.c_contiguous and qdd_a.flags.c_contiguous)
+    ):
+        return None
+    if tree.quat_adr:
+        q = q.copy()
+        for a in tree.quat_adr:
+            w, x, y, z = q[a], q[a + 1], q[a + 2], q[a + 3]
+            nrm = float(np.sqrt(w * w + x * x + y * y + z * z))
+            if not nrm >= 1e-9:  # zero or non-finite: the general path raises or masks
+                return None
+            q[a : a + 4] /= nrm
+    from ._compiled import inv_dyn_one
+
+    o = inv_dyn_one(model, q, qd_a, qdd_a, mech.gravity, gravity)
+    if o is None:
+        return None
+    return InverseDynamicsResult(
+        tau=o[0][0],
+        M_a=o[1][0],
+        velocity_terms=o[2][0],
+        gravity_terms=o[3][0],
+        external_terms=o[4][0],
+        qd=o[5][0],
+        qdd=o[6][0],
+        cond=o[7].reshape(()),
+        sigma_min=o[8].reshape(()),
+        admissibility=o[9].reshape(()),
+        unactuated=np.zeros(nv),
+        closure=o[11].reshape(()),
+        valid=o[10].reshape(()),
+    )
 
 
 def _run_chunked(fn, n: int, arrays: list[np.ndarray], **kw) -> dict[str, np.ndarray]:
@@ -705,8 +705,9 @@ def _broadcast(mech, q, others: list[tuple[object, str, int]], qname: str = "q")
     batch = broadcast_batch(
         (qv, 1, qname), *((a, 1, name) for a, (_, name, _) in zip(arrs, others, strict=True))
     )
-    flat = [np.broadcast_to(qv, (*batch, mech.nq)).reshape(-1, mech.nq)]
-    flat += [np.broadcast_to(a, (*batch, a.shape[-1])).reshape(-1, a.shape[-1]) for a in arrs]
+    n = int(np.prod(batch))  # explicit: reshape(-1, 0) of an empty trailing axis is ambiguous
+    flat = [np.broadcast_to(qv, (*batch, mech.nq)).reshape(n, mech.nq)]
+    flat += [np.broadcast_to(a, (*batch, a.shape[-1])).reshape(n, a.shape[-1]) for a in arrs]
     return batch, flat
 
 
@@ -723,7 +724,10 @@ def _site_inputs(mech, q, arrays, wrenches):
 
 
 def _sanitize(mech, flat: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray]]:
+    # a sample with an entry beyond MAX_MAGNITUDE (1e300, say) would overflow in products: masked like NaN
     ok = _finite_rows(*flat)
+    for a in flat:
+        ok &= np.all(np.abs(np.where(np.isfinite(a), a, 0.0)) <= MAX_MAGNITUDE, axis=-1)
     out = []
     for i, a in enumerate(flat):
         a = np.array(a, dtype=float)
@@ -734,19 +738,29 @@ def _sanitize(mech, flat: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray
 
 
 def _shape(d: dict, batch, ok: np.ndarray, nan_keys) -> dict:
-    # a sample whose results overflowed (inputs of 1e300, say) is not valid
-    for v in d.values():
+    """Reshape the flat results to ``batch``.  ``ok``: the input rows were finite.  A sample with any
+    non-finite result (inputs of 1e300 overflowing, say; a massless motion's acceleration) is not valid;
+    ``nan_keys`` (the forces or accelerations) are NaN where not valid, the other fields (measures such
+    as an infinite condition number) keep their values but for non-finite input rows (NaN)."""
+    # "_computed" (optional): where the forces are the right answer to a question that has one even if
+    # the sample is not valid (an underactuated motion: the least-squares forces); elsewhere "valid"
+    computed = d.pop("_computed", d["valid"])
+    fin = ok.copy()
+    for k, v in d.items():
         v = np.asarray(v)
-        if v.dtype.kind == "f" and v.shape[:1] == ok.shape:
-            ok = ok & np.all(np.isfinite(v.reshape(v.shape[0], int(np.prod(v.shape[1:])))), axis=-1)
+        if k != "valid" and v.dtype.kind == "f" and v.shape[:1] == ok.shape:
+            fin &= np.all(np.isfinite(v.reshape(v.shape[0], int(np.prod(v.shape[1:])))), axis=-1)
+    keep = np.asarray(computed) & ok
+    for k in nan_keys:  # a computed, finite force stays even where a measure is not finite
+        v = np.asarray(d[k])
+        keep &= np.all(np.isfinite(v.reshape(v.shape[0], int(np.prod(v.shape[1:])))), axis=-1)
     res = {}
     for k, v in d.items():
         v = np.array(v)
         if k == "valid":
-            v = v & ok
+            v = v & fin
         elif k in nan_keys:
-            bad = ~(d["valid"] & ok)
-            v = np.where(bad.reshape(-1, *(1,) * (v.ndim - 1)), np.nan, v)
+            v = np.where(keep.reshape(-1, *(1,) * (v.ndim - 1)), v, np.nan)
         elif v.dtype.kind == "f":
             v = np.where(ok.reshape(-1, *(1,) * (v.ndim - 1)), v, np.nan)
         res[k] = np.reshape(v, (*batch, *v.shape[1:]))
@@ -756,38 +770,209 @@ def _shape(d: dict, batch, ok: np.ndarray, nan_keys) -> dict:
 _FORCE_KEYS = ("tau", "M_a", "velocity_terms", "gravity_terms", "external_terms")
 
 
+def _null_basis(mech: Mechanism, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Orthonormal basis ``(N, nv, d)`` of the admissible velocities ``null(K)`` at the mechanism's
+    generic rank of ``K``, and ``s_1 / s_r`` of ``K`` (N,): 1 for a tree (the identity basis)."""
+    N, m, nv = K.shape
+    r = _rank_K(mech) if m else 0
+    if r == 0:
+        return np.broadcast_to(np.eye(nv), (N, nv, nv)), np.ones(N)
+    _, s, Vt = np.linalg.svd(K, full_matrices=True)
+    sr = s[:, r - 1]
+    cond = np.where(sr > 0, s[:, 0] / np.where(sr > 0, sr, 1.0), np.inf)
+    return Vt[:, r:].swapaxes(-1, -2), cond
+
+
+def _inverse_full_flat(mech, q, qd, qdd, wr, weights, gravity=True):
+    """Inverse dynamics from every coordinate's rates and accelerations (any kinematic class).
+
+    With ``Nb`` an orthonormal basis of the admissible velocities and ``f = M qdd + c + g - J_s^T W`` the
+    tree's generalized forces (:mod:`._rnea`), virtual work over every admissible motion asks
+    ``Nb^T E tau = Nb^T f``; ``tau = B f`` is its least-squares solution (minimum norm, or minimum
+    ``sum tau_i^2 / w_i``), and what no actuator force can do, ``Nb (Nb^T f - Nb^T E tau)``, is the
+    force the unactuated coordinates would need.  Where the actuators determine the motion this is
+    ``G^T f`` of :func:`_inverse_flat`."""
+    from ._rnea import _crba_flat, _rnea_flat
+
+    tree = mech.tree
+    N, nv = q.shape[0], tree.nv
+    act = tree.act_dof
+    na = len(act)
+    L = tree.length
+    closed = mech.constraints.m > 0
+    # a tree without site wrenches needs no kinematics here: the kernels compute their own
+    state = kinematics(tree, q) if closed or wr else None
+    z = np.zeros_like(qd)
+    gv = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
+    M = _crba_flat(mech, q)
+    parts = (
+        _mv(M, qdd),
+        _rnea_flat(mech, q, qd, z, np.zeros(3)),
+        _rnea_flat(mech, q, z, z, gv),
+        _site_terms(mech, state, wr) if wr else np.zeros((N, nv)),
+    )
+    f = parts[0] + parts[1] + parts[2] + parts[3]
+    K = _constraint_matrix(mech, state, q) if closed else np.zeros((N, 0, nv))
+    Nb, condK = _null_basis(mech, K)
+    NbT = Nb.swapaxes(-1, -2)
+    Na = Nb[:, act]  # (N, na, d): the actuated rows of the admissible motions
+    ws = np.ones(na) if weights is None else np.sqrt(weights)
+    A = NbT[:, :, act] * ws  # (N, d, na)
+    d = Nb.shape[-1]
+    if na and d:
+        sA = np.linalg.svd(A, compute_uv=False)
+        smin = sA[:, -1]
+        cond_a = np.where(smin > RANK_RTOL * sA[:, 0], sA[:, 0] / np.where(smin > 0, smin, 1.0), np.inf)
+        B = ws[:, None] * (np.linalg.pinv(A, rcond=RANK_RTOL) @ NbT)  # (N, na, nv)
+    else:
+        smin, cond_a = np.ones(N), np.ones(N)
+        B = np.zeros((N, na, nv))
+    tau_parts = [_mv(B, x) for x in parts]
+    tau = tau_parts[0] + tau_parts[1] + tau_parts[2] + tau_parts[3]
+    b = _mv(NbT, f)
+    unact = _mv(Nb, b - _mv(Na.swapaxes(-1, -2), tau))
+    # relative to the largest of the inertial, velocity, gravity and external terms (their sum is ~0 on a
+    # free motion, whose rounding must not count as a force the actuators cannot give)
+    scale = np.max(np.abs(np.stack(parts)), axis=(0, -1)) if nv else np.zeros(N)
+    e_force = np.max(np.abs(unact), axis=-1) / np.maximum(scale, 1e-300) if nv else np.zeros(N)
+    if closed:
+        Sd = _screw_rates(tree, state, qd)
+        kdq = _kdot_qd(mech, state, q, qd, Sd)
+    sv = np.max(np.abs(qd), axis=-1) if nv else np.zeros(N)
+    sa = np.max(np.abs(qdd), axis=-1) + sv * sv if nv else np.zeros(N)
+    if K.shape[1]:
+        e1 = np.max(np.abs(_mv(K, qd)), axis=-1) / (L * np.maximum(sv, RATE_FLOOR))
+        e2 = np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
+        adm = np.maximum(np.maximum(e1, e2), e_force)
+    else:
+        adm = e_force
+    M_a = B @ M @ B.swapaxes(-1, -2)
+    cond = np.maximum(condK, cond_a)
+    fin = np.all(np.isfinite(tau), axis=-1) & np.all(np.isfinite(M_a), axis=(-1, -2))
+    computed = fin & (cond <= SINGULAR_COND)
+    return dict(
+        _computed=computed,
+        tau=tau,
+        M_a=M_a,
+        velocity_terms=tau_parts[1],
+        gravity_terms=tau_parts[2],
+        external_terms=tau_parts[3],
+        qd=np.array(qd),
+        qdd=np.array(qdd),
+        cond=cond,
+        sigma_min=L * smin,
+        admissibility=adm,
+        unactuated=unact,
+        valid=computed & (adm <= ADMISSIBLE_RTOL),
+    )
+
+
+def _finish_inverse(mech: Mechanism, q: np.ndarray, d: dict, actuated_mode: bool) -> dict:
+    """The checks common to both inverse-dynamics paths (numpy and compiled, so that a sample's flags do
+    not depend on the batch size): the closure of the input ``q``; in actuator mode a zero
+    ``unactuated`` force, the empty passive block's measures and, where a sample is not valid, the
+    rank measures against the generic rank (``_rank_measures``: a type II singularity has cond inf)."""
+    from ._tree import TreeState
+
+    tree = mech.tree
+    N = q.shape[0]
+    state = None
+    if "closure" not in d:  # the compiled kernel reports it (the same max |phi(q)|)
+        state = kinematics(tree, q) if mech.constraints.m else None  # a tree has no closure to check
+        d["closure"] = _closure_error(mech, state, q)
+    if actuated_mode:
+        d["unactuated"] = np.zeros((N, tree.nv))
+        pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
+        if mech.constraints.m == 0 or len(pas) == 0:
+            d["sigma_min"], d["cond"] = np.full(N, tree.length), np.ones(N)
+        else:
+            bad = np.flatnonzero(~d["valid"])
+            if bad.size:
+                state = kinematics(tree, q) if state is None else state
+                sub = TreeState(T=state.T[bad], S=state.S[bad])
+                K = _constraint_matrix(mech, sub, q[bad])
+                d["sigma_min"][bad], d["cond"][bad] = _rank_measures(
+                    K[..., pas], _reference(mech)[0], tree.length
+                )
+    assembled = d["closure"] <= CLOSURE_RTOL * tree.length
+    d["valid"] = d["valid"] & assembled
+    if "_computed" in d:
+        d["_computed"] = d["_computed"] & assembled
+    return d
+
+
+def _determined(mech: Mechanism) -> bool:
+    """The actuated rates determine every coordinate's rate (at least one actuator per degree of freedom)."""
+    _, dof = _reference(mech)
+    na = len(mech.actuated)
+    return na > 0 and na >= dof
+
+
+def _rates_mode(mech: Mechanism, fn: str, act: tuple[str, object], full: tuple[str, object]) -> bool:
+    """True: the actuated-rates form (``act``), False: the full-velocity form (``full``); checks that
+    exactly one is given and that the actuated form is only used where the actuators determine the motion."""
+    (an, av), (fname, fv) = act, full
+    if (av is None) == (fv is None):
+        raise ValueError(
+            f"Expected exactly one of {an} (..., n_act) and {fname}= (..., nv) in {fn}, got "
+            f"{'both' if av is not None else 'neither'}."
+        )
+    if av is not None and not _determined(mech):
+        _, dof = _reference(mech)
+        raise ValueError(
+            f"Expected {fname}= (every coordinate's rate, (..., {mech.nv})) for this mechanism: its "
+            f"{len(mech.actuated)} actuated joint(s) do not determine its {dof} degree(s) of freedom, "
+            f"so {an} cannot give the state."
+        )
+    return av is not None
+
+
 def inverse_dynamics(
     mech: Mechanism,
     q: object,
-    qd_act: object,
-    qdd_act: object,
+    qd_act: object = None,
+    qdd_act: object = None,
     *,
+    qd: object = None,
+    qdd: object = None,
     wrenches: Mapping[str, object] | None = None,
     weights: object = None,
     gravity: bool = True,
 ) -> InverseDynamicsResult:
-    """Actuator forces for the motion ``(q, qd_act, qdd_act)`` of any described closed chain.
+    """Actuator forces for the motion ``(q, qd_act, qdd_act)`` or ``(q, qd, qdd)`` of any described mechanism.
 
     ``q (..., nq)`` an assembled configuration (from :func:`forward_kinematics` /
     :func:`inverse_kinematics`), ``qd_act``, ``qdd_act (..., n_act)`` the actuated joints' rates and
-    accelerations in actuator order; ``wrenches`` maps site names to wrenches ``[m; f] (..., 6)``
-    applied *to* the mechanism at the site (world axes, moment about the site point); gravity from
-    ``mech.gravity`` (MJCF ``<option gravity>``) unless ``gravity=False``.  ``weights (n_act,)``: the
-    redundant-actuation rule (module docstring; default minimum norm).  Actuator ``gear`` is not
-    applied: ``tau`` is the generalized force at each actuated joint.  Batched over any leading shape;
-    non-finite samples and singular configurations give ``valid = False`` and NaN forces.
+    accelerations in actuator order — where the actuators determine the motion (closed chains actuated
+    in every degree of freedom, open chains and trees actuated at every joint); for any mechanism,
+    every coordinate's rates and accelerations ``qd=``, ``qdd= (..., nv)`` instead (fewer actuators
+    than degrees of freedom, none, a floating base).  ``wrenches`` maps site names to wrenches
+    ``[m; f] (..., 6)`` applied *to* the mechanism at the site (world axes, moment about the site
+    point); gravity from ``mech.gravity`` (MJCF ``<option gravity>``) unless ``gravity=False``.
+    ``weights (n_act,)``: the redundant-actuation rule (module docstring; default minimum norm).
+    Actuator ``gear`` is not applied: ``tau`` is the generalized force at each actuated joint.  With
+    fewer actuators than degrees of freedom ``tau`` is the least-squares best and ``unactuated`` what
+    the unactuated coordinates would need (a floating base: the base wrench); the sample is valid only
+    where that is zero.  Batched over any leading shape; non-finite samples, unassembled ``q`` and
+    singular configurations give ``valid = False`` and NaN forces.
 
     Parameters
     ----------
     mech : Mechanism
-        The described mechanism, actuated in every degree of freedom.
+        The described mechanism.
     q : array_like, shape (..., nq)
-        Assembled configurations (MuJoCo ``qpos``).
-    qd_act : array_like, shape (..., n_act)
+        Assembled configurations (MuJoCo ``qpos``): the closure residual must be below
+        ``CLOSURE_RTOL * L``.
+    qd_act : array_like, shape (..., n_act), optional
         Actuated joints' rates in actuator order (rad/s or m/s); must be admissible (with redundant
-        actuation, in the consistent subspace), else ``valid`` is False.
-    qdd_act : array_like, shape (..., n_act)
+        actuation, in the consistent subspace), else ``valid`` is False.  Exactly one of ``qd_act``
+        (with ``qdd_act``) and ``qd`` (with ``qdd``).
+    qdd_act : array_like, shape (..., n_act), optional
         Actuated joints' accelerations (rad/s^2 or m/s^2).
+    qd : array_like, shape (..., nv), optional
+        Every coordinate's rate (MuJoCo ``qvel``; rad/s, m/s), admissible (``K qd = 0``).
+    qdd : array_like, shape (..., nv), optional
+        Every coordinate's acceleration (``qacc``; rad/s^2, m/s^2), admissible.
     wrenches : mapping of str to array_like, shape (..., 6), optional
         Site name -> wrench ``[m; f]`` applied *to* the mechanism at that site (world axes, moment
         about the site point; N m, N).  Default None: no external wrench.
@@ -801,15 +986,18 @@ def inverse_dynamics(
     -------
     InverseDynamicsResult
         ``tau``, ``M_a``, ``velocity_terms``, ``gravity_terms``, ``external_terms``, every coordinate's
-        ``qd`` and ``qdd``, the per-sample ``cond``, ``sigma_min``, ``admissibility`` and ``valid``.
+        ``qd`` and ``qdd``, the per-sample ``cond``, ``sigma_min``, ``admissibility``, ``unactuated``,
+        ``closure`` and ``valid``.
 
     Raises
     ------
     ValueError
-        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, an array is not
-        real of the stated shape (non-finite values are allowed and masked), a quaternion in ``q`` is
-        zero, the batch shapes do not broadcast, ``wrenches`` is not a mapping of site names,
-        ``weights`` is not ``n_act`` non-negative numbers (not all zero), or ``gravity`` is not a bool.
+        If ``mech`` is not a Mechanism, not exactly one of ``qd_act`` / ``qd`` is given (with its
+        acceleration), ``qd_act`` is given for a mechanism whose actuators do not determine its
+        motion, an array is not real of the stated shape (non-finite values are allowed and masked),
+        a quaternion in ``q`` is zero, the batch shapes do not broadcast, ``wrenches`` is not a mapping
+        of site names, ``weights`` is not ``n_act`` non-negative numbers (not all zero), or ``gravity``
+        is not a bool.
 
     Examples
     --------
@@ -821,26 +1009,40 @@ def inverse_dynamics(
     >>> r.tau.shape, r.M_a.shape, bool(r.valid)
     ((1,), (1, 1), True)
     """
+    if qd is None and qdd is None and wrenches is None and weights is None:
+        one = _inverse_one(mech, q, qd_act, qdd_act, gravity)
+        if one is not None:  # one valid sample: straight into the kernel (the general path otherwise)
+            return one
     mech = check_mechanism(mech)
-    _fully_actuated(mech)
     gravity = check_bool(gravity, "gravity")
+    act_mode = _rates_mode(mech, "inverse_dynamics", ("qd_act", qd_act), ("qd", qd))
+    if act_mode and qdd_act is None:
+        raise ValueError("Expected qdd_act (..., n_act) with qd_act, got None.")
+    if not act_mode and qdd is None:
+        raise ValueError("Expected qdd= (..., nv) with qd=, got None.")
+    if (act_mode and qdd is not None) or (not act_mode and qdd_act is not None):
+        raise ValueError("Expected qdd_act with qd_act, or qdd= with qd=, not a mix of the two forms.")
     w = _check_weights(mech, weights)
-    na = len(mech.actuated)
-    arrays = [(qd_act, "qd_act", na), (qdd_act, "qdd_act", na)]
+    na, nv = len(mech.actuated), mech.nv
+    if act_mode:
+        arrays = [(qd_act, "qd_act", na), (qdd_act, "qdd_act", na)]
+    else:
+        arrays = [(qd, "qd", nv), (qdd, "qdd", nv)]
     names, batch, ok, flat = _site_inputs(mech, q, arrays, wrenches)
     n = flat[0].shape[0]
+    if not act_mode:
 
-    def fn(qf, qdf, qddf, *ws, **kw):
-        return _inverse_flat(mech, qf, qdf, qddf, dict(zip(names, ws, strict=True)), w, gravity)
+        def fn_full(qf, qdf, qddf, *ws):
+            d = _inverse_full_flat(mech, qf, qdf, qddf, dict(zip(names, ws, strict=True)), w, gravity)
+            return _finish_inverse(mech, qf, d, False)
 
-    from . import _assembly
-
-    if n >= _assembly.COMPILED_MIN:  # same formulas, compiled per sample (_compiled.inv_dyn)
-        d = _inverse_compiled(
-            mech, flat[0], flat[1], flat[2], dict(zip(names, flat[3:], strict=True)), w, gravity
-        )
-    else:
-        d = _run_chunked(fn, n, flat)
+        d = _run_chunked(fn_full, n, flat)
+    else:  # the one implementation, compiled per sample (_compiled.inv_dyn), any batch size
+        with np.errstate(all="ignore"):
+            d = _inverse_compiled(
+                mech, flat[0], flat[1], flat[2], dict(zip(names, flat[3:], strict=True)), w, gravity
+            )
+            d = _finish_inverse(mech, flat[0], d, True)
     return InverseDynamicsResult(**_shape(d, batch, ok, _FORCE_KEYS))
 
 
@@ -861,14 +1063,20 @@ class StaticsResult:
         Share that balances the site wrenches (N m or N).
     cond : ndarray, shape (...)
         Condition number of the passive constraint block.
+    unactuated : ndarray, shape (..., nv)
+        With fewer actuators than degrees of freedom: the generalized force the unactuated
+        coordinates would need to hold the mechanism at rest (a floating base: the base wrench), as
+        :attr:`InverseDynamicsResult.unactuated`; zero where the actuators determine the motion.
     valid : ndarray of bool, shape (...)
-        False at a singular configuration or a non-finite input.
+        False at a singular configuration, an unassembled ``q``, a non-finite input, or where the
+        actuators cannot hold the mechanism (``unactuated`` not zero).
     """
 
     tau: np.ndarray
     gravity_terms: np.ndarray
     external_terms: np.ndarray
     cond: np.ndarray
+    unactuated: np.ndarray
     valid: np.ndarray
 
 
@@ -883,12 +1091,13 @@ def statics(
     """Actuator forces balancing ``wrenches`` (applied to the mechanism at sites) and gravity at rest.
 
     The same virtual-work projection as :func:`inverse_dynamics` at ``qd = qdd = 0``:
-    ``tau = -G^T (J_s^T W - g)``.
+    ``tau = -G^T (J_s^T W - g)``; with fewer actuators than degrees of freedom its full-rate form
+    (least-squares forces, ``unactuated`` the rest).
 
     Parameters
     ----------
     mech : Mechanism
-        The described mechanism, actuated in every degree of freedom.
+        The described mechanism.
     q : array_like, shape (..., nq)
         Assembled configurations (MuJoCo ``qpos``).
     wrenches : mapping of str to array_like, shape (..., 6), optional
@@ -907,7 +1116,7 @@ def statics(
     Raises
     ------
     ValueError
-        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, an array is not
+        If ``mech`` is not a Mechanism, an array is not
         real of the stated shape (non-finite values are allowed and masked), a quaternion in ``q`` is
         zero, the batch shapes do not broadcast, ``wrenches`` is not a mapping of site names,
         ``weights`` is not ``n_act`` non-negative numbers (not all zero), or ``gravity`` is not a bool.
@@ -924,9 +1133,13 @@ def statics(
     """
     mech = check_mechanism(mech)
     q = as_array(q, "q", (mech.nq,), finite=False)
-    z = np.zeros(len(mech.actuated))
-    r = inverse_dynamics(mech, q, z, z, wrenches=wrenches, weights=weights, gravity=gravity)
-    return StaticsResult(r.tau, r.gravity_terms, r.external_terms, r.cond, r.valid)
+    if _determined(mech):
+        z = np.zeros(len(mech.actuated))
+        r = inverse_dynamics(mech, q, z, z, wrenches=wrenches, weights=weights, gravity=gravity)
+    else:  # the least-squares forces and what the unactuated coordinates would need, at rest
+        z = np.zeros(mech.nv)
+        r = inverse_dynamics(mech, q, qd=z, qdd=z, wrenches=wrenches, weights=weights, gravity=gravity)
+    return StaticsResult(r.tau, r.gravity_terms, r.external_terms, r.cond, r.unactuated, r.valid)
 
 
 @dataclass(frozen=True)
@@ -1029,7 +1242,7 @@ def site_wrench(
             qc, tc = qf[i : i + CHUNK], tf[i : i + CHUNK]
             n = qc.shape[0]
             z = np.zeros((n, na))
-            st = _inverse_flat(mech, qc, z, z, {}, None, gravity)
+            st = _inverse_compiled(mech, qc, z, z, {}, None, gravity)
             state, _, G, _, _, _ = _influence_flat(mech, qc, False)
             b = tree.site_body[si]
             p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
@@ -1045,7 +1258,8 @@ def site_wrench(
             res = np.linalg.norm(np.einsum("nik,ni->nk", J, W) - rhs, axis=-1)
             smin = s[:, -1] if na <= 6 else s[:, 5]
             cond = smax[:, 0] / np.maximum(smin, 1e-300)
-            valid = st["valid"] & (cond <= SINGULAR_COND) & np.all(np.isfinite(W), axis=-1)
+            assembled = _closure_error(mech, state, qc) <= CLOSURE_RTOL * L
+            valid = st["valid"] & assembled & (cond <= SINGULAR_COND) & np.all(np.isfinite(W), axis=-1)
             for k, v in zip(out, (W, res, smin, cond, valid), strict=True):
                 out[k].append(v)
     d = {k: np.concatenate(v)[: 0 if empty else None] for k, v in out.items()}
@@ -1060,12 +1274,19 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
     tree = mech.tree
     N = q.shape[0]
     nv = tree.nv
-    state = kinematics(tree, q)
-    K = _constraint_matrix(mech, state, q)
-    Sd = _screw_rates(tree, state, qd)
-    kdq = _kdot_qd(mech, state, q, qd, Sd)
-    terms = _tree_terms(mech, state, qd, Sd, np.zeros_like(qd), gravity)
-    f = -terms.velocity_terms - terms.gravity_terms
+    if mech.constraints.m or wr:
+        state = kinematics(tree, q)
+        K = _constraint_matrix(mech, state, q)
+        Sd = _screw_rates(tree, state, qd)
+        kdq = _kdot_qd(mech, state, q, qd, Sd)
+    else:  # a tree without site wrenches: the kernels below are all it needs
+        K, kdq = np.zeros((N, 0, nv)), np.zeros((N, 0))
+    from ._rnea import _crba_flat, _rnea_flat
+
+    # the tree's mass matrix (CRBA) and velocity + gravity forces (RNEA at zero acceleration)
+    g = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
+    M = _crba_flat(mech, q)
+    f = -_rnea_flat(mech, q, qd, np.zeros_like(qd), g)
     if wr:
         f = f - _site_terms(mech, state, wr)
     f[:, tree.act_dof] += tau_a
@@ -1076,19 +1297,35 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
     else:
         qdd_p = np.zeros((N, nv))
         Pn = np.broadcast_to(np.eye(nv), (N, nv, nv))
-    M = terms.M
     Mc = Pn @ M @ Pn + (np.eye(nv) - Pn)
     rhs = _mv(Pn, f - _mv(M, qdd_p))
     if want_cond:
-        s = np.linalg.svd(Mc, compute_uv=False)
-        cond = s[:, 0] / np.maximum(s[:, -1], 1e-300)
+        s = np.linalg.svd(np.where(np.isfinite(Mc), Mc, 0.0), compute_uv=False)
+        # a zero matrix (every body massless) has no condition number: inf, never "0"
+        cond = (
+            np.where(s[:, -1] > 0, s[:, 0] / np.where(s[:, -1] > 0, s[:, -1], 1.0), np.inf)
+            if nv
+            else np.ones(N)
+        )
     else:
         cond = np.ones(N)
+    return qdd_p + _solve_each(Mc, rhs), cond, K, kdq
+
+
+def _solve_each(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``A x = b`` per sample (N, n, n), LAPACK ``gesv`` on each matrix: a sample's result never depends on
+    the others.  An exactly singular matrix (a massless motion) makes numpy's batched solve raise for the
+    whole batch; the samples are then solved one by one and the singular ones get NaN."""
     try:
-        u = np.linalg.solve(Mc, rhs[..., None])[..., 0]
-    except np.linalg.LinAlgError:  # a massless motion somewhere in the batch: minimum-norm there
-        u = _mv(np.linalg.pinv(Mc, rcond=RANK_RTOL), rhs)
-    return qdd_p + u, cond, K, kdq
+        return np.linalg.solve(A, b[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        out = np.full(b.shape, np.nan)
+        for i in range(A.shape[0]):
+            try:
+                out[i] = np.linalg.solve(A[i], b[i])
+            except np.linalg.LinAlgError:
+                pass
+        return out
 
 
 @dataclass(frozen=True)
@@ -1102,14 +1339,18 @@ class ForwardDynamicsResult:
     qdd : ndarray, shape (..., nv)
         Every tree coordinate's acceleration (MuJoCo ``qvel`` order); NaN where not ``valid``.
     qd : ndarray, shape (..., nv)
-        Every tree coordinate's rate, ``G qd_act`` (rad/s, m/s).
+        Every tree coordinate's rate, ``G qd_act`` or the given ``qd`` (rad/s, m/s).
     cond : ndarray, shape (...)
-        Condition number of the constrained mass matrix (large: a nearly massless motion).
+        Condition number of the constrained mass matrix (large: a nearly massless motion; inf: a
+        massless one), or of the passive constraint block if larger (``qd_act`` form).
     admissibility : ndarray, shape (...)
-        Closure error ``|K qdd + Kdot qd|`` of the resulting acceleration, relative.
+        Closure error of the given rates ``|K qd|`` and of the resulting acceleration
+        ``|K qdd + Kdot qd|``, relative.
+    closure : ndarray, shape (...)
+        Largest closure row of the input ``q`` (m); above ``CLOSURE_RTOL * L`` the sample is not valid.
     valid : ndarray of bool, shape (...)
-        False at a singular configuration, a rank-deficient mass matrix, an inadmissible result or a
-        non-finite input.
+        False at a singular configuration, a singular (e.g. massless) mass matrix, an inadmissible
+        result, an unassembled ``q`` or a non-finite input.
     """
 
     qdd_act: np.ndarray
@@ -1117,35 +1358,43 @@ class ForwardDynamicsResult:
     qd: np.ndarray
     cond: np.ndarray
     admissibility: np.ndarray
+    closure: np.ndarray
     valid: np.ndarray
 
 
 def forward_dynamics(
     mech: Mechanism,
     q: object,
-    qd_act: object,
-    tau: object,
+    qd_act: object = None,
+    tau: object = None,
     *,
+    qd: object = None,
     wrenches: Mapping[str, object] | None = None,
     gravity: bool = True,
 ) -> ForwardDynamicsResult:
-    """Accelerations under actuator forces ``tau (..., n_act)`` at ``(q, qd_act)`` (idle motions at rest).
+    """Accelerations under actuator forces ``tau (..., n_act)`` at ``(q, qd_act)`` or ``(q, qd)``.
 
     The inverse of :func:`inverse_dynamics`: ``forward_dynamics(mech, q, qd, inverse_dynamics(mech, q,
-    qd, qdd).tau).qdd_act == qdd`` wherever both are valid (idle motions decoupled).  The rates of the
-    passive coordinates are ``qd = G qd_act``; the closure is a constraint on the tree accelerations
-    (``K qdd = -Kdot qd``, module docstring).
+    qd, qdd).tau).qdd_act == qdd`` wherever both are valid (idle motions decoupled).  Where the
+    actuators determine the motion, the state is ``(q, qd_act)`` and the passive coordinates' rates are
+    ``qd = G qd_act`` (idle motions at rest); for any mechanism — and necessarily where the actuators
+    do not determine it (fewer actuators than degrees of freedom, none, a floating base) — every
+    coordinate's rate ``qd= (..., nv)`` instead.  The closure is a constraint on the tree
+    accelerations (``K qdd = -Kdot qd``, module docstring).
 
     Parameters
     ----------
     mech : Mechanism
-        The described mechanism, actuated in every degree of freedom.
+        The described mechanism.
     q : array_like, shape (..., nq)
-        Assembled configurations (MuJoCo ``qpos``).
-    qd_act : array_like, shape (..., n_act)
-        Actuated joints' rates in actuator order (rad/s or m/s).
-    tau : array_like, shape (..., n_act)
-        Generalized forces at the actuated joints (N m or N; actuator ``gear`` not applied).
+        Assembled configurations (MuJoCo ``qpos``; closure residual below ``CLOSURE_RTOL * L``).
+    qd_act : array_like, shape (..., n_act), optional
+        Actuated joints' rates in actuator order (rad/s or m/s).  Exactly one of ``qd_act`` and ``qd``.
+    tau : array_like, shape (..., n_act), optional
+        Generalized forces at the actuated joints (N m or N; actuator ``gear`` not applied); default
+        None: no actuator force.
+    qd : array_like, shape (..., nv), optional
+        Every coordinate's rate (MuJoCo ``qvel``; rad/s, m/s), admissible (``K qd = 0``).
     wrenches : mapping of str to array_like, shape (..., 6), optional
         Site name -> wrench ``[m; f]`` applied *to* the mechanism at that site (world axes, moment
         about the site point; N m, N).  Default None: no external wrench.
@@ -1156,13 +1405,14 @@ def forward_dynamics(
     -------
     ForwardDynamicsResult
         ``qdd_act (..., n_act)``, every coordinate's ``qdd`` and ``qd (..., nv)``, and per sample
-        ``cond``, ``admissibility`` and ``valid`` (accelerations NaN where not valid).
+        ``cond``, ``admissibility``, ``closure`` and ``valid`` (accelerations NaN where not valid).
 
     Raises
     ------
     ValueError
-        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, an array is not
-        real of the stated shape (non-finite values are masked), a quaternion in ``q`` is zero, the
+        If ``mech`` is not a Mechanism, not exactly one of ``qd_act`` and ``qd`` is given,
+        ``qd_act`` is given for a mechanism whose actuators do not determine its motion, an array is
+        not real of the stated shape (non-finite values are masked), a quaternion in ``q`` is zero, the
         batch shapes do not broadcast, ``wrenches`` is not a mapping of site names, or ``gravity`` is
         not a bool.
 
@@ -1178,39 +1428,71 @@ def forward_dynamics(
     (True, True)
     """
     mech = check_mechanism(mech)
-    _fully_actuated(mech)
     gravity = check_bool(gravity, "gravity")
-    na = len(mech.actuated)
-    names, batch, ok, flat = _site_inputs(mech, q, [(qd_act, "qd_act", na), (tau, "tau", na)], wrenches)
+    act_mode = _rates_mode(mech, "forward_dynamics", ("qd_act", qd_act), ("qd", qd))
+    na, nv = len(mech.actuated), mech.nv
+    rates = (qd_act, "qd_act", na) if act_mode else (qd, "qd", nv)
+    tau_in = np.zeros(na) if tau is None else tau
+    names, batch, ok, flat = _site_inputs(mech, q, [rates, (tau_in, "tau", na)], wrenches)
     rank0, _ = _reference(mech)
     tree = mech.tree
     pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
+    L = tree.length
 
-    def fn(qf, qdf, tf, *ws):
-        state = kinematics(tree, qf)
-        K = jacobian(mech.constraints, tree, state, qf)
-        P, rank, _, cK = _pinv(K[..., pas])
-        qd = np.zeros((qf.shape[0], tree.nv))
-        qd[:, tree.act_dof] = qdf
-        qd[:, pas] = -np.einsum("nij,njk,nk->ni", P, K[..., tree.act_dof], qdf)
+    def fn(qf, rf, tf, *ws):
+        n = qf.shape[0]
+        if mech.constraints.m:
+            state = kinematics(tree, qf)
+            K = jacobian(mech.constraints, tree, state, qf)
+        else:  # a tree: no closure rows (and _closure_error needs no state)
+            state, K = None, np.zeros((n, 0, tree.nv))
+        if act_mode:
+            P, rank, _, cK = _pinv(K[..., pas], L)
+            qd_f = np.zeros((n, tree.nv))
+            qd_f[:, tree.act_dof] = rf
+            qd_f[:, pas] = -np.einsum("nij,njk,nk->ni", P, K[..., tree.act_dof], rf)
+            reg = (rank >= rank0) & (cK <= SINGULAR_COND)
+            e1 = np.zeros(n)
+        else:
+            qd_f = rf
+            reg = np.ones(n, dtype=bool)
+            cK = np.ones(n)
+            sv = np.max(np.abs(qd_f), axis=-1) if tree.nv else np.zeros(n)
+            e1 = (
+                np.max(np.abs(_mv(K, qd_f)), axis=-1) / (L * np.maximum(sv, RATE_FLOOR))
+                if K.shape[1]
+                else np.zeros(n)
+            )
         qdd, cond, K, kdq = _forward_full(
-            mech, qf, qd, tf, dict(zip(names, ws, strict=True)), gravity, want_cond=True
+            mech, qf, qd_f, tf, dict(zip(names, ws, strict=True)), gravity, want_cond=True
         )
-        L = tree.length
-        sa = np.max(np.abs(qdd), axis=-1) + np.max(np.abs(qd), axis=-1) ** 2 if tree.nv else 0.0
-        adm = (
+        sa = np.max(np.abs(qdd), axis=-1) + np.max(np.abs(qd_f), axis=-1) ** 2 if tree.nv else 0.0
+        e2 = (
             np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
             if K.shape[1]
-            else np.zeros(qf.shape[0])
+            else np.zeros(n)
         )
+        adm = np.maximum(e1, np.where(np.isfinite(e2), e2, np.inf))
+        closure = _closure_error(mech, state, qf)
         valid = (
-            (rank >= rank0)
-            & (cK <= SINGULAR_COND)
+            reg
             & (cond < 1.0 / RANK_RTOL)
             & (adm <= ADMISSIBLE_RTOL)
+            & (closure <= CLOSURE_RTOL * L)
             & np.all(np.isfinite(qdd), axis=-1)
         )
-        return dict(qdd_act=qdd[:, tree.act_dof], qdd=qdd, qd=qd, cond=cond, admissibility=adm, valid=valid)
+        if act_mode and np.any(~reg):  # a singular passive block: its measure against the generic rank
+            bad = np.flatnonzero(~reg)
+            cond[bad] = np.maximum(cond[bad], _rank_measures(K[bad][..., pas], rank0, L)[1])
+        return dict(
+            qdd_act=qdd[:, tree.act_dof],
+            qdd=qdd,
+            qd=np.array(qd_f),
+            cond=cond,
+            admissibility=adm,
+            closure=closure,
+            valid=valid,
+        )
 
     d = _run_chunked(fn, flat[0].shape[0], flat)
     return ForwardDynamicsResult(**_shape(d, batch, ok, ("qdd_act", "qdd")))
@@ -1354,82 +1636,116 @@ def _project(mech, q, qd):
     return q, qd, rc
 
 
-def _simulate_flat(mech, q0, qd0, t, tau_fn, gravity):
+class _SampleFailed(Exception):
+    """A sample's integration cannot go on (non-finite state, force or acceleration)."""
+
+
+def _callback_forces(tau_fn, tt, q, qd, na: int) -> np.ndarray:
+    """Call ``tau_fn(t, q (1, nq), qd (1, nv))``; check its return: ``(n_act,)`` or ``(1, n_act)`` reals."""
+    out = tau_fn(tt, q, qd)
+    try:
+        a = np.asarray(out, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(
+            f"Expected the tau callback to return {na} real force(s) per sample, shape (1, {na}), "
+            f"got {type(out).__name__}."
+        ) from exc
+    if a.shape not in ((na,), (1, na)) and not (na == 0 and a.size == 0):
+        raise ValueError(
+            f"Expected the tau callback to return shape (1, {na}) (or ({na},)) for the one sample it "
+            f"is given, got shape {a.shape}."
+        )
+    return a.reshape(1, na)
+
+
+def _simulate_one(mech, q0, qd0, t, tau_fn, gravity):
+    """One sample's trajectory (its own ``solve_ivp`` run: step sizes and error control are its own, so
+    no other sample can change it).  Returns ``Q (nt, nq), QD (nt, nv), W (nt,), RC (nt,), ok``."""
     from scipy.integrate import solve_ivp
 
     tree = mech.tree
-    N, nq, nv = q0.shape[0], tree.nq, tree.nv
+    nq, nv = tree.nq, tree.nv
     na = len(tree.act_dof)
 
-    def unpack(y):
-        Y = y.reshape(N, nq + nv + 1)
-        return Y[:, :nq], Y[:, nq : nq + nv], Y[:, -1]
-
-    def forces(tt, q, qd):
-        if tau_fn is None:
-            return np.zeros((N, na))
-        return np.broadcast_to(np.asarray(tau_fn(tt, q, qd), float), (N, na))
-
     def rhs(tt, y):
-        q, qd, _ = unpack(y)
+        q, qd = y[None, :nq], y[None, nq : nq + nv]
         qn = normalize_quaternions(tree, q) if tree.quat_adr else q
-        tau = forces(tt, qn, qd)
-        qdd, _, _, _ = _forward_full(mech, qn, qd, tau, None, gravity)
+        tau = np.zeros((1, na)) if tau_fn is None else tau_fn(tt, qn, qd)
+        if not np.all(np.isfinite(tau)):
+            raise _SampleFailed
+        try:
+            qdd, _, _, _ = _forward_full(mech, qn, qd, tau, None, gravity)
+        except np.linalg.LinAlgError as exc:  # a non-finite state reached the SVD
+            raise _SampleFailed from exc
+        if not np.all(np.isfinite(qdd)):  # a singular (massless) motion: no acceleration exists
+            raise _SampleFailed
         power = np.sum(tau * qd[:, tree.act_dof], axis=-1)
-        return np.concatenate([_qpos_rate(tree, qn, qd), qdd, power[:, None]], axis=-1).ravel()
+        return np.concatenate([_qpos_rate(tree, qn, qd)[0], qdd[0], power])
 
     nt = len(t)
-    Q = np.empty((N, nt, nq))
-    QD = np.empty((N, nt, nv))
-    W = np.zeros((N, nt))
-    RC = np.zeros((N, nt))
-    q, qd, rc = _project(mech, q0, qd0)
-    Q[:, 0], QD[:, 0], RC[:, 0] = q, qd, rc
-    ok = True
-    for i in range(1, nt):
-        y0 = np.concatenate([q, qd, W[:, i - 1 : i]], axis=-1).ravel()
-        sol = solve_ivp(rhs, (t[i - 1], t[i]), y0, method="DOP853", rtol=SIM_RTOL, atol=SIM_ATOL)
-        if not sol.success or not np.all(np.isfinite(sol.y[:, -1])):
-            ok = False
-            Q[:, i:], QD[:, i:], W[:, i:], RC[:, i:] = np.nan, np.nan, np.nan, np.inf
-            break
-        q, qd, w = unpack(sol.y[:, -1])
-        q, qd, rc = _project(mech, normalize_quaternions(tree, q), qd)
-        Q[:, i], QD[:, i], W[:, i], RC[:, i] = q, qd, w, rc
-    return Q, QD, W, RC, ok
+    Q = np.full((nt, nq), np.nan)
+    QD = np.full((nt, nv), np.nan)
+    W = np.full(nt, np.nan)
+    RC = np.full(nt, np.inf)
+    q, qd, rc = _project(mech, q0[None], qd0[None])
+    Q[0], QD[0], W[0], RC[0] = q[0], qd[0], 0.0, rc[0]
+    with np.errstate(all="ignore"):
+        for i in range(1, nt):
+            y0 = np.concatenate([Q[i - 1], QD[i - 1], W[i - 1 : i]])
+            try:
+                sol = solve_ivp(rhs, (t[i - 1], t[i]), y0, method="DOP853", rtol=SIM_RTOL, atol=SIM_ATOL)
+            except _SampleFailed:
+                return Q, QD, W, RC, False
+            if not sol.success or not np.all(np.isfinite(sol.y[:, -1])):
+                return Q, QD, W, RC, False
+            y = sol.y[:, -1]
+            try:
+                q, qd, rc = _project(mech, normalize_quaternions(tree, y[None, :nq]), y[None, nq : nq + nv])
+            except np.linalg.LinAlgError:
+                return Q, QD, W, RC, False
+            Q[i], QD[i], W[i], RC[i] = q[0], qd[0], y[-1], rc[0]
+    return Q, QD, W, RC, True
 
 
 def simulate(
     mech: Mechanism,
     q0: object,
-    qd_act0: object,
-    t: object,
+    qd_act0: object = None,
+    t: object = None,
     *,
+    qd0: object = None,
     tau: object = None,
     gravity: bool = True,
 ) -> SimulationResult:
-    """Integrate the closed chain from ``(q0 (..., nq), qd_act0 (..., n_act))`` to the output times ``t``.
+    """Integrate the mechanism from ``(q0, qd_act0)`` (or ``(q0, qd0)``) to the output times ``t``.
 
-    ``tau`` the actuator forces: None (passive motion), an array ``(..., n_act)`` held constant, or a
-    callable ``tau(t, q (N, nq), qd (N, nv)) -> (N, n_act)`` over the flattened batch.  The state is
-    every tree coordinate (idle motions included) integrated by ``scipy.integrate.solve_ivp`` (DOP853,
-    ``SIM_RTOL = 1e-10``, ``SIM_ATOL = 1e-12``) between consecutive output times, projected back onto the
-    constraint manifold at each of them.  Batched over initial conditions (one ODE system; a batch
-    whose integration fails is retried sample by sample so that one bad sample does not spoil the rest).
+    The initial rates: ``qd_act0 (..., n_act)`` where the actuators determine the motion (the other
+    coordinates start at ``qd = G qd_act0``), or every coordinate's rate ``qd0= (..., nv)`` for any
+    mechanism (necessarily where the actuators do not determine the motion: fewer actuators than
+    degrees of freedom, none, a floating base).  ``tau`` the actuator forces: None (passive motion),
+    an array ``(..., n_act)`` held constant, or a callable ``tau(t, q (1, nq), qd (1, nv)) -> (1, n_act)``
+    called for one sample at a time.  The state is every tree coordinate (idle motions included),
+    integrated by ``scipy.integrate.solve_ivp`` (DOP853, ``SIM_RTOL = 1e-10``, ``SIM_ATOL = 1e-12``)
+    between consecutive output times and projected back onto the constraint manifold at each of them.
+    Every sample is integrated on its own (its own steps and error control): one sample's state
+    never changes another's, and a sample that fails (a massless motion without acceleration, a
+    non-finite force from the callback) stops alone with ``success = False``.
 
     Parameters
     ----------
     mech : Mechanism
-        The described mechanism, actuated in every degree of freedom.
+        The described mechanism.
     q0 : array_like, shape (..., nq)
         Initial configurations (MuJoCo ``qpos``); projected onto the closure before the start.
-    qd_act0 : array_like, shape (..., n_act)
-        Initial actuated rates (rad/s or m/s); the other coordinates start at ``qd = G qd_act0``.
+    qd_act0 : array_like, shape (..., n_act), optional
+        Initial actuated rates (rad/s or m/s).  Exactly one of ``qd_act0`` and ``qd0``.
     t : array_like, shape (nt,)
-        Strictly increasing output times (s), at least two; the first is the start time.
+        Strictly increasing output times (s), at least two; the first is the start time.  Required.
+    qd0 : array_like, shape (..., nv), optional
+        Every coordinate's initial rate (``qvel``; rad/s, m/s), projected onto the admissible ones.
     tau : None, array_like of shape (..., n_act), or callable, optional
         Actuator forces (N m or N): None (default, no actuator force), constant forces, or
-        ``tau(t, q (N, nq), qd (N, nv)) -> (N, n_act)`` over the flattened batch.
+        ``tau(t, q (1, nq), qd (1, nv)) -> (1, n_act)`` (or ``(n_act,)``) for the sample it is given.
     gravity : bool, optional
         Apply ``mech.gravity`` (MJCF ``<option gravity>``, m/s^2); default True.
 
@@ -1443,9 +1759,11 @@ def simulate(
     Raises
     ------
     ValueError
-        If ``mech`` is not a Mechanism or has fewer actuators than degrees of freedom, ``t`` is not at
-        least two increasing times, an array is not real of the stated shape, ``q0`` or ``qd_act0`` is
-        not finite or exceeds ``MAX_STATE``, or ``gravity`` is not a bool.
+        If ``mech`` is not a Mechanism, not exactly one of ``qd_act0`` and ``qd0`` is given,
+        ``qd_act0`` is given for a mechanism whose actuators do not determine its motion, ``t`` is not
+        at least two increasing times, an array is not real of the stated shape, ``q0`` or the initial
+        rates are not finite or exceed ``MAX_STATE``, ``gravity`` is not a bool, or the ``tau``
+        callback returns something other than ``(1, n_act)`` real forces.
 
     Examples
     --------
@@ -1458,68 +1776,68 @@ def simulate(
     ((3, 3), (3, 1), True)
     """
     mech = check_mechanism(mech)
-    _fully_actuated(mech)
     gravity = check_bool(gravity, "gravity")
+    act_mode = _rates_mode(mech, "simulate", ("qd_act0", qd_act0), ("qd0", qd0))
     tree = mech.tree
     na = len(mech.actuated)
+    if t is None:
+        raise ValueError("Expected t to be increasing output times (at least 2), got None.")
     t = as_array(t, "t", (None,))
     if t.ndim != 1 or t.shape[0] < 2 or np.any(np.diff(t) <= 0):
         raise ValueError(f"Expected t to be increasing output times (at least 2), got shape {t.shape}.")
     tau_arr = None
     if tau is not None and not callable(tau):
         tau_arr = as_array(tau, "tau", (na,))
+    rates = (qd_act0, "qd_act0", na) if act_mode else (qd0, "qd0", tree.nv)
     batch, flat = _broadcast(
         mech,
         q0,
-        [(qd_act0, "qd_act0", na)] + ([(tau_arr, "tau", na)] if tau_arr is not None else []),
+        [rates] + ([(tau_arr, "tau", na)] if tau_arr is not None else []),
         qname="q0",
     )
-    q0f, qa0 = flat[0], flat[1]
-    for x, nm in ((q0f, "q0"), (qa0, "qd_act0")):
+    q0f, r0 = flat[0], flat[1]
+    for x, nm in ((q0f, "q0"), (r0, rates[1])):
         # an initial state is simulated, not masked: it must be finite and of physical size
         if not np.all(np.isfinite(x)) or np.any(np.abs(x) > MAX_STATE):
             raise ValueError(f"Expected {nm} finite with |value| <= {MAX_STATE:g}, got NaN, inf or more.")
     q0f = normalize_quaternions(tree, q0f)
     N = q0f.shape[0]
-    # the initial rates of every coordinate: qd = G qd_act0 (idle motions at rest)
-    from ._influence import _influence_flat
+    if act_mode:  # the initial rates of every coordinate: qd = G qd_act0 (idle motions at rest)
+        from ._influence import _influence_flat
 
-    _, _, G, _, _, _ = _influence_flat(mech, q0f, False)
-    qd0 = _mv(G, qa0)
-    tau_fn: Callable[..., object] | None
-    if tau_arr is not None:
-        tv = flat[2]
-
-        def _held(tt, q, qd, tv=tv):
-            return tv if q.shape[0] == tv.shape[0] else tv[: q.shape[0]]
-
-        tau_fn = _held
+        _, _, G, _, _, _ = _influence_flat(mech, q0f, False)
+        qd0f = _mv(G, r0)
     else:
-        tau_fn = tau if callable(tau) else None
-    Q, QD, W, RC, ok = _simulate_flat(mech, q0f, qd0, t, tau_fn, gravity)
-    success = np.full(N, ok)
-    if not ok and N > 1:
-        for i in range(N):
-            fn_i = None
-            if tau_arr is not None:
-                fn_i = lambda tt, q, qd, v=flat[2][i : i + 1]: v  # noqa: E731
-            elif callable(tau):
-                fn_i = lambda tt, q, qd, i=i: np.asarray(tau(tt, q, qd), dtype=float).reshape(-1, na)[:1]  # noqa: E731
-            Qi, QDi, Wi, RCi, oki = _simulate_flat(mech, q0f[i : i + 1], qd0[i : i + 1], t, fn_i, gravity)
-            Q[i], QD[i], W[i], RC[i], success[i] = Qi[0], QDi[0], Wi[0], RCi[0], oki
+        qd0f = np.array(r0)
+    nt = len(t)
+    Q = np.empty((N, nt, tree.nq))
+    QD = np.empty((N, nt, tree.nv))
+    W = np.empty((N, nt))
+    RC = np.empty((N, nt))
+    success = np.zeros(N, dtype=bool)
+    for i in range(N):
+        fn_i: Callable[..., np.ndarray] | None = None
+        if tau_arr is not None:
+            held = flat[2][i : i + 1]
+            fn_i = lambda tt, q, qd, v=held: v  # noqa: E731
+        elif callable(tau):
+            fn_i = lambda tt, q, qd: _callback_forces(tau, tt, q, qd, na)  # noqa: E731
+        Q[i], QD[i], W[i], RC[i], success[i] = _simulate_one(mech, q0f[i], qd0f[i], t, fn_i, gravity)
     from ._assembly import CONVERGED_RTOL
 
-    nt = len(t)
     Tk, U = _energy_flat(mech, np.nan_to_num(Q.reshape(-1, tree.nq)), np.nan_to_num(QD.reshape(-1, tree.nv)))
     Tk, U = Tk.reshape(N, nt), U.reshape(N, nt)
     E = Tk + U - W
-    drift = np.max(np.abs(E - E[:, :1]), axis=-1)
-    scale = np.maximum.reduce([np.max(Tk, -1), np.max(np.abs(U - U[:, :1]), -1), np.max(np.abs(W), -1)])
-    rel = drift / np.maximum(scale, 1e-300)
+    with np.errstate(all="ignore"):
+        drift = np.max(np.abs(E - E[:, :1]), axis=-1)
+        scale = np.maximum.reduce([np.max(Tk, -1), np.max(np.abs(U - U[:, :1]), -1), np.max(np.abs(W), -1)])
+        rel = drift / np.maximum(scale, 1e-300)
     success &= np.all(np.isfinite(Q), axis=(-1, -2)) & np.all(RC <= CONVERGED_RTOL * tree.length, axis=-1)
     bad = ~success
     drift = np.where(bad, np.nan, drift)
     rel = np.where(bad, np.nan, rel)
+    Tk = np.where(np.isfinite(Q).all(-1), Tk, np.nan)
+    U = np.where(np.isfinite(Q).all(-1), U, np.nan)
 
     def rs(x, *tail):
         return np.reshape(x, (*batch, *tail))

@@ -26,6 +26,7 @@ from robomech._validation import as_array, broadcast_batch, check_bool
 from ._assembly import check_mechanism, check_q
 from ._constraints import jacobian, jacobian_rate
 from ._model import Mechanism
+from ._options import PASSIVE_RANK_RTOL
 from ._tree import frame_jacobian, frame_jacobian_rate, kinematics, screw_rates
 
 __all__ = [
@@ -40,10 +41,6 @@ __all__ = [
     "site_pose",
 ]
 
-# Singular values of K_p below PASSIVE_RANK_RTOL * sigma_max are zero in the pseudo-inverse: K_p is
-# built from unit screws times lengths of order L, so rounding leaves ~1e-15 relative; a genuine
-# (non-singular) passive direction of a well-posed mechanism is far above 1e-10.
-PASSIVE_RANK_RTOL = 1e-10
 
 
 @dataclass(frozen=True)
@@ -68,9 +65,10 @@ class Influence:
         ``max |K G| / L``: zero where every input rate is admissible, > 0 with redundant actuation
         (only admissible ``qd_act`` then have a meaning).
     sigma_min : ndarray, shape (...)
-        Smallest non-zero singular value of ``K_p`` (m).
+        Smallest non-zero singular value of ``K_p`` (m); the characteristic length where ``K_p`` is
+        empty (an open chain or tree: nothing can lose rank).
     cond : ndarray, shape (...)
-        Condition number of ``K_p``.
+        Condition number of ``K_p`` (1 where it is empty).
     """
 
     G: np.ndarray
@@ -82,11 +80,14 @@ class Influence:
     cond: np.ndarray
 
 
-def _pinv(Kp: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+# An empty passive block (an open chain or tree: no closure rows, or no passive coordinate) cannot lose
+# rank: its measures are those of the best-conditioned block, cond 1 and sigma_min = the characteristic
+# length (the singular value of a unit passive column at distance L), finite like every other sample's.
+def _pinv(Kp: np.ndarray, length: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Batched pseudo-inverse of ``Kp (N, m, n)`` with its rank, smallest kept singular value, cond."""
     N, m, n = Kp.shape
     if m == 0 or n == 0:
-        return np.zeros((N, n, m)), np.zeros(N, dtype=int), np.full(N, np.inf), np.ones(N)
+        return np.zeros((N, n, m)), np.zeros(N, dtype=int), np.full(N, float(length)), np.ones(N)
     U, s, Vt = np.linalg.svd(Kp, full_matrices=False)
     cut = PASSIVE_RANK_RTOL * s[:, :1]
     keep = s > cut
@@ -106,7 +107,7 @@ def _influence_flat(mech: Mechanism, q: np.ndarray, second: bool):
     na = len(tree.act_dof)
     act = tree.act_dof
     pas = np.setdiff1d(np.arange(tree.nv), act)
-    P, rank, smin, cond = _pinv(K[..., pas])
+    P, rank, smin, cond = _pinv(K[..., pas], tree.length)
     G = np.zeros((N, tree.nv, na))
     G[:, act, np.arange(na)] = 1.0
     G[:, pas] = -P @ K[..., act]
@@ -269,19 +270,10 @@ def site_jacobian(mech: Mechanism, q: object, site: str) -> np.ndarray:
     mech = check_mechanism(mech)
     si = _site_index(mech, site)
     qf, batch = _flat(mech, q)
-    tree = mech.tree
-    from ._assembly import COMPILED_MIN
+    from ._compiled import compiled_site_jacobian  # numba loads on the first kernel call
 
-    if qf.shape[0] >= COMPILED_MIN:  # same formulas, compiled per sample (see _compiled.py)
-        from ._compiled import compiled_site_jacobian
-
-        J = compiled_site_jacobian(mech, qf, si)
-        return J.reshape(*batch, 6, J.shape[-1])
-    state, _, G, _, _, _ = _influence_flat(mech, qf, False)
-    b = tree.site_body[si]
-    p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
-    J = frame_jacobian(tree, state, b, p) @ G
-    return J.reshape(*batch, 6, G.shape[-1])
+    J = compiled_site_jacobian(mech, qf, si)
+    return J.reshape(*batch, 6, J.shape[-1])
 
 
 def site_hessian(mech: Mechanism, q: object, site: str) -> np.ndarray:

@@ -219,7 +219,7 @@ def from_mjcf(path_or_xml: str | os.PathLike) -> Mechanism:
             )
         actuated.append(jnt_names[m.actuator_trnid[a, 0]])
     name = m.names[: m.names.index(b"\0")].decode() if m.names else "mechanism"
-    return Mechanism(
+    mech = Mechanism(
         tuple(bodies),
         tuple(closures),
         tuple(couplings),
@@ -228,6 +228,8 @@ def from_mjcf(path_or_xml: str | os.PathLike) -> Mechanism:
         tuple(m.opt.gravity),
         name or "mechanism",
     )
+    mech.q0  # noqa: B018 - assemble the reference now: a file that can never assemble raises at load
+    return mech
 
 
 def _f(x) -> str:

@@ -32,19 +32,14 @@ from numpy.typing import ArrayLike
 from robomech.analysis import mobility as screw_mobility
 
 from ._assembly import check_mechanism, check_q, solve_closure
+from ._compile import _rank, instantaneous_mobility
 from ._constraints import jacobian
 from ._model import Mechanism
+from ._options import MOBILITY_RTOL, NEIGHBOUR_STEP
 from ._tree import TreeState, kinematics, space_jacobian
 
 __all__ = ["MOBILITY_RTOL", "NEIGHBOUR_STEP", "MobilityReport", "mobility"]
 
-# Singular values of the unit-scaled K below MOBILITY_RTOL * sigma_max count as zero: entries are
-# unit screws times lengths of order L, rounding leaves ~1e-15 relative, and a configuration
-# 1e-4 rad from a singularity (NEIGHBOUR_STEP) still has the vanishing value ~1e-4 >> 1e-9.
-MOBILITY_RTOL = 1e-9
-# The "locally constant rank" test re-assembles the mechanism this far (rad, or L for translations)
-# along each admissible direction and compares the ranks there.
-NEIGHBOUR_STEP = 1e-4
 _C = {"point": 3, "revolute": 5, "rigid": 6}
 
 
@@ -133,30 +128,6 @@ def _scaled_K(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, TreeState]:
     return K * col, st
 
 
-def _rank(X: np.ndarray, scale: float | None = None) -> int:
-    """Numerical rank; ``scale`` the size of a non-zero entry (default the largest singular value)."""
-    if X.size == 0:
-        return 0
-    s = np.linalg.svd(X, compute_uv=False)
-    ref = s[0] if scale is None else scale
-    return int(np.sum(s > MOBILITY_RTOL * max(ref, 1e-300))) if s.size else 0
-
-
-def _null(X: np.ndarray, n: int) -> np.ndarray:
-    if X.shape[0] == 0:
-        return np.eye(n)
-    _, s, Vt = np.linalg.svd(X)
-    r = int(np.sum(s > MOBILITY_RTOL * max(s[0] if s.size else 0.0, 1e-300)))
-    return Vt[r:].T
-
-
-def _output_bodies(mech: Mechanism) -> list[int]:
-    tree = mech.tree
-    if len(tree.site_names):
-        return sorted(set(int(b) for b in tree.site_body))
-    return list(range(1, len(tree.body_names)))
-
-
 def _serial_legs(mech: Mechanism, st, platform: int) -> list[np.ndarray] | None:
     """Joint screws (world, at q) of each serial leg to ``platform``; None if not of that form."""
     tree = mech.tree
@@ -242,28 +213,17 @@ def mobility(mech: Mechanism, q: ArrayLike | None = None, *, platform: str | Non
             f"Expected platform to be None or a body name among {list(tree.body_names[1:])}, "
             f"got {platform!r}."
         )
-    q = tree.q0 if q is None else check_q(mech, q)
+    q = mech.q0 if q is None else check_q(mech, q)  # the assembled reference
     if q.ndim != 1:
         raise ValueError(f"Expected q to have shape ({mech.nq},) (one configuration), got {q.shape}.")
     q = q[None]
-    K, st = _scaled_K(mech, q)
-    K = K[0]
-    _m, nv = K.shape
-    kmax = float(np.max(np.linalg.svd(K, compute_uv=False))) if K.size else 1.0
-    rank = _rank(K, kmax)
+    inst = instantaneous_mobility(tree, mech.constraints, q)
+    K, st, kmax, rank, N = inst.K, inst.state, inst.kmax, inst.rank, inst.N
+    locked, idle = inst.locked, inst.idle
+    nv = K.shape[1]
     total = nv - rank
-    N = _null(K, nv)  # admissible motions (scaled coordinates)
     col = np.where(tree.dof_translational, tree.length, 1.0)
     na = len(tree.act_dof)
-    locked = N @ _null(N[tree.act_dof], N.shape[1]) if na else N
-    outs = []
-    for b in _output_bodies(mech):
-        Jb = space_jacobian(tree, st, b)[0] / col  # twist per scaled coordinate
-        Jb = Jb * np.array([tree.length] * 3 + [1.0] * 3)[:, None]
-        outs.append(Jb)
-    Jout = np.concatenate(outs) if outs else np.zeros((0, nv))
-    # Jout has unit screws times L: rows of order L, so a motion that moves an output has |Jout v| ~ L|v|
-    idle = locked.shape[1] - _rank(Jout @ locked, tree.length) if locked.shape[1] else 0
     dof = total - idle
     n_c = _cut_constraints(mech)
     gk = nv - n_c

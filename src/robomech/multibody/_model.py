@@ -10,12 +10,13 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
 
 from robomech._validation import as_array, check_real
+
+from ._options import ASSEMBLED_RTOL, MIN_NORM, ROTATION_TOL  # noqa: F401 (ASSEMBLED_RTOL re-exported)
 
 __all__ = [
     "JOINT_TYPES",
@@ -31,12 +32,8 @@ __all__ = [
 
 JOINT_TYPES = ("hinge", "slide", "ball", "free")
 CLOSURE_KINDS = ("point", "rigid", "revolute")
-# Quaternions and axes given by the user are normalised; a norm below this is not a direction.
-_MIN_NORM = 1e-12
-# A reference configuration "is assembled" (MuJoCo's qpos0 semantics hold for an exported closure)
-# when the two anchors of a closure coincide to this distance relative to the mechanism size:
-# a few hundred ulps of the coordinates.
-ASSEMBLED_RTOL = 1e-10
+# tolerances: _options (MIN_NORM for a direction; ASSEMBLED_RTOL and ROTATION_TOL re-exported here)
+_MIN_NORM = MIN_NORM
 
 # A point, axis or quaternion given to the Builder: a sequence of floats or a float64 array.
 Vector = Sequence[float] | NDArray[np.float64]
@@ -473,24 +470,20 @@ class Mechanism:
             L = check_positive(self.characteristic_length, "characteristic_length")
             object.__setattr__(self, "characteristic_length", L)
 
-    # -- derived, cached (the dataclass stays frozen: cached_property writes the instance dict) --
-    @cached_property
+    # -- derived: the compiled model (``_compile.compile_model``, built once, kept outside the description)
+    @property
     def tree(self):
-        from ._tree import compile_tree
+        """The compiled spanning tree (``_tree.Tree``) of :func:`_compile.compile_model`."""
+        from ._compile import compile_model
 
-        return compile_tree(self)
+        return compile_model(self).tree
 
-    @cached_property
-    def compiled_tables(self):
-        from ._compiled import tables
-
-        return tables(self)
-
-    @cached_property
+    @property
     def constraints(self):
-        from ._constraints import compile_constraints
+        """The compiled closure rows (``_constraints.Constraints``) of :func:`_compile.compile_model`."""
+        from ._compile import compile_model
 
-        return compile_constraints(self, self.tree)
+        return compile_model(self).constraints
 
     @property
     def joints(self) -> tuple[Joint, ...]:
@@ -506,13 +499,23 @@ class Mechanism:
 
     @property
     def q0(self) -> np.ndarray:
-        """Reference configuration (MuJoCo's qpos0), (nq,)."""
-        return self.tree.q0.copy()
+        """Reference configuration, (nq,): MuJoCo's qpos0 if it satisfies the closures, else the
+        assembly nearest to it (``_reference``, in the compile step; a description that cannot assemble
+        raises ValueError)."""
+        from ._compile import compile_model
+
+        return compile_model(self).q_ref.copy()
 
     @property
     def length(self) -> float:
         """The characteristic length (m) that makes rotations and translations commensurate."""
         return self.tree.length
+
+    def _repr_png_(self) -> bytes:
+        """Jupyter's picture of the mechanism: its wireframe at ``q0`` (Agg canvas, no pyplot)."""
+        from ._repr import mechanism_png
+
+        return mechanism_png(self)
 
     def site(self, name: str) -> Site:
         for s in self.sites:
@@ -754,7 +757,7 @@ class Builder:
                         name, "rigid", b1, b2, anchor2=tuple(a), relpos=tuple(relpos), relquat=tuple(relquat)
                     )
                 )
-        return Mechanism(
+        mech = Mechanism(
             tuple(self._bodies),
             tuple(closures),
             tuple(self._couplings),
@@ -763,12 +766,8 @@ class Builder:
             self.gravity,
             self.name,
         )
-
-
-# A rotation matrix must satisfy R^T R = I and det R = +1 to this tolerance: composed transforms are
-# orthonormal to ~1e-15, a matrix typed with 7 significant digits to ~1e-7; a wrong frame (a
-# non-orthogonal or reflected matrix, e.g. a swapped axis) is off by O(1).
-ROTATION_TOL = 1e-6
+        mech.q0  # noqa: B018 - assemble the reference now: a description that cannot assemble raises here
+        return mech
 
 
 def _quat_from_matrix(R: np.ndarray) -> np.ndarray:

@@ -33,6 +33,7 @@ from robomech._validation import as_array, check_int, check_positive, check_real
 from robomech.analysis import workspace
 
 from ._assembly import FKResult, IKResult, check_mechanism, check_q, forward_kinematics, inverse_kinematics
+from ._compile import compile_model
 from ._influence import _influence_flat
 from ._mobility import mobility
 from ._model import Mechanism
@@ -66,6 +67,11 @@ class SingularityResult:
         ``cond_I``, ``cond_II``, ``cond_C`` above ``1 / rtol``.
     singular : ndarray of bool, shape (...)
         Any of the three.
+    closure : ndarray, shape (...)
+        Largest closure row of the input ``q`` (m).
+    assembled : ndarray of bool, shape (...)
+        ``closure <= CLOSURE_RTOL * L``: where False, ``q`` is off the closure manifold and the
+        classification has no meaning.
     length : float
         The characteristic length used (m).
     """
@@ -80,14 +86,84 @@ class SingularityResult:
     type_II: np.ndarray
     constraint: np.ndarray
     singular: np.ndarray  # any of the three
+    closure: np.ndarray
+    assembled: np.ndarray
     length: float  # the characteristic length used (m)
 
 
-def _kth(s: np.ndarray, k: int) -> np.ndarray:
-    """k-th largest singular value (1-based) per sample, 0 where there are fewer than k."""
+def _kth(s: np.ndarray, k: int) -> np.ndarray | None:
+    """k-th largest singular value (1-based) per sample, 0 where there are fewer than k; None for k <= 0
+    (no direction that could be lost: the measure of the best-conditioned matrix, see ``cond``)."""
     if k <= 0:
-        return np.full(s.shape[0], np.inf)
+        return None
     return s[:, k - 1] if s.shape[1] >= k else np.zeros(s.shape[0])
+
+
+# Rows of the site Jacobian [ω; ṗ] selected by ``output``.
+OUTPUTS = {"pose": (0, 1, 2, 3, 4, 5), "orientation": (0, 1, 2), "position": (3, 4, 5)}
+# Configurations near the reference at which the output's generic rank is taken (the largest rank
+# found): the reference itself may be singular (a straight arm), a random neighbour is not.
+GENERIC_SAMPLES = 4
+# Amplitude (rad for hinges, L for slides) of the random input offsets of those neighbours.
+GENERIC_AMPLITUDE = 0.3
+
+
+def _rows(output: object) -> tuple[int, ...]:
+    if isinstance(output, str):
+        if output not in OUTPUTS:
+            raise ValueError(f"Expected output in {sorted(OUTPUTS)} or row indices 0..5, got {output!r}.")
+        return OUTPUTS[output]
+    try:
+        rows = tuple(int(r) for r in output)  # type: ignore[union-attr]
+        exact = all(float(r) == int(r) and not isinstance(r, bool) for r in output)  # type: ignore[union-attr]
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"Expected output to be a name or a sequence of row indices 0..5, got {output!r}."
+        ) from None
+    if not rows or not exact or len(set(rows)) != len(rows) or min(rows) < 0 or max(rows) > 5:
+        raise ValueError(f"Expected output to be distinct row indices 0..5 of [ω; ṗ], got {output!r}.")
+    return rows
+
+
+def _scaled_output_jacobian(mech: Mechanism, qf: np.ndarray, si: int, L: float, rows: tuple[int, ...]):
+    tree = mech.tree
+    state, K, G, _, _, _ = _influence_flat(mech, qf, False)
+    col = np.where(tree.dof_translational, 1.0, L)
+    scale = np.array([L, L, L, 1.0, 1.0, 1.0])
+    b = tree.site_body[si]
+    p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
+    Jf = frame_jacobian(tree, state, b, p)
+    J = (scale[:, None] * (Jf @ G) / col[tree.act_dof])[:, list(rows)]
+    return state, K, G, col, J
+
+
+def _generic_output_rank(
+    mech: Mechanism, si: int, L: float, rows: tuple[int, ...], ref_q, rtol: float
+) -> int:
+    """Rank of the scaled input-output Jacobian's ``rows`` at a generic configuration: the largest over the
+    reference and GENERIC_SAMPLES assembled neighbours (fixed seed), cached per mechanism."""
+    key = ("_sing_generic_rank", si, float(L), rows, None if ref_q is None else ref_q.tobytes(), float(rtol))
+    cache = compile_model(mech).cache.setdefault("_sing_generic_rank", {})
+    if key in cache:
+        return cache[key]
+    tree = mech.tree
+    q_ref = mech.q0 if ref_q is None else ref_q
+    na = len(tree.act_dof)
+    qs = [q_ref[None]]
+    if na:
+        rng = np.random.default_rng(0)
+        amp = np.where(tree.dof_translational[tree.act_dof], L, 1.0) * GENERIC_AMPLITUDE
+        qa = q_ref[tree.act_qadr] + amp * rng.uniform(-1.0, 1.0, (GENERIC_SAMPLES, na))
+        fk = forward_kinematics(mech, qa, q_ref)
+        if np.any(fk.converged):
+            qs.append(fk.q[fk.converged])
+    J = _scaled_output_jacobian(mech, np.concatenate(qs), si, L, rows)[4]
+    r = 0
+    if J.shape[-1] and J.shape[-2]:
+        s = np.linalg.svd(J, compute_uv=False)
+        r = int(np.max(np.sum(s > rtol * np.maximum(s[:, :1], L), axis=-1)))
+    cache[key] = r
+    return r
 
 
 def singularities(
@@ -95,6 +171,7 @@ def singularities(
     q: ArrayLike,
     site: str,
     *,
+    output: str | tuple[int, ...] = "pose",
     reference: ArrayLike | None = None,
     length: float | None = None,
     rtol: float = workspace.SINGULAR_RTOL,
@@ -109,8 +186,13 @@ def singularities(
         Assembled configurations.
     site : str
         The output site.
+    output : str or sequence of int, optional
+        Which of the site's motions is the output of the type I test: ``"pose"`` (default, all six
+        rows ``[ω; ṗ]``), ``"position"`` (the point's velocity, rows 3-5), ``"orientation"`` (rows
+        0-2), or distinct row indices 0..5.  Type I is a drop of the selected rows' rank below their
+        generic rank (taken at the reference and a few assembled neighbours).
     reference : array_like, shape (nq,), optional
-        Configuration for the characteristic length (default ``mech.q0``).
+        A generic configuration for the reference counts (default ``mech.q0``).
     length : float, optional
         Characteristic length L (m) that scales rotations and hinge columns (default ``mech.length``).
     rtol : float, optional
@@ -143,37 +225,41 @@ def singularities(
         reference = check_q(mech, reference, "reference")
         if reference.ndim != 1:
             raise ValueError(f"Expected reference to have shape ({mech.nq},), got {reference.shape}.")
+    out_rows = _rows(output)
     ref = mobility(mech, reference)
     batch = q.shape[:-1]
     qf = q.reshape(-1, mech.nq)
-    state, K, G, _, _, _ = _influence_flat(mech, qf, False)
-    col = np.where(tree.dof_translational, 1.0, L)  # hinge columns times L -> metres
-    rows = np.array([L, L, L, 1.0, 1.0, 1.0])
+    # input-output Jacobian per scaled input rate: G maps unscaled rates; hinge inputs are per rad
+    state, K, _, col, J = _scaled_output_jacobian(mech, qf, si, L, out_rows)
     act = tree.act_dof
     pas = np.setdiff1d(np.arange(tree.nv), act)
     Ks = K * col  # K rows are already lengths
     sK = np.linalg.svd(Ks, compute_uv=False) if Ks.shape[1] and Ks.shape[2] else np.zeros((len(qf), 0))
     sP = np.linalg.svd(Ks[..., pas], compute_uv=False) if Ks.shape[1] and len(pas) else np.zeros((len(qf), 0))
-    b = tree.site_body[si]
-    p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
-    Jf = frame_jacobian(tree, state, b, p)
-    # input-output Jacobian per scaled input rate: G maps unscaled rates; hinge inputs are per rad
-    J = rows[:, None] * (Jf @ G) / col[act]
     sJ = np.linalg.svd(J, compute_uv=False) if len(act) else np.zeros((len(qf), 0))
     idle_locked = ref.locked_dof  # motions of a generic configuration with every input locked
-    sigma_I = _kth(sJ, ref.dof)
+    # the output can lose no more directions than it has at a generic configuration (a floating robot's
+    # trunk site does not move with the legs; a point output has at most 3)
+    k_out = min(ref.dof, _generic_output_rank(mech, si, L, out_rows, reference, rtol))
+    sigma_I = _kth(sJ, k_out)
     sigma_II = _kth(sP, len(pas) - idle_locked)
     sigma_C = _kth(sK, ref.rank)
 
-    def cond(sig: np.ndarray, smax: np.ndarray) -> np.ndarray:
-        # reference: the largest singular value, or L if larger (a one-input J has a single value)
+    def cond(sig: np.ndarray | None, smax: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        # reference: the largest singular value, or L if larger (a one-input J has a single value);
+        # nothing to lose (k <= 0: an open chain's empty passive block): sigma L, cond 1
+        if sig is None:
+            return np.full(len(qf), L), np.ones(len(qf))
         ok = sig > 0
-        return np.where(ok, np.maximum(smax, L) / np.where(ok, sig, 1.0), np.inf)
+        return sig, np.where(ok, np.maximum(smax, L) / np.where(ok, sig, 1.0), np.inf)
 
-    cI = cond(sigma_I, sJ[:, 0] if sJ.shape[1] else np.ones(len(qf)))
-    cII = cond(sigma_II, sP[:, 0] if sP.shape[1] else np.ones(len(qf)))
-    cC = cond(sigma_C, sK[:, 0] if sK.shape[1] else np.ones(len(qf)))
+    sigma_I, cI = cond(sigma_I, sJ[:, 0] if sJ.shape[1] else np.ones(len(qf)))
+    sigma_II, cII = cond(sigma_II, sP[:, 0] if sP.shape[1] else np.ones(len(qf)))
+    sigma_C, cC = cond(sigma_C, sK[:, 0] if sK.shape[1] else np.ones(len(qf)))
     tI, tII, tC = cI > 1 / rtol, cII > 1 / rtol, cC > 1 / rtol
+    from ._dynamics import CLOSURE_RTOL, _closure_error
+
+    closure = _closure_error(mech, state, qf)
 
     def sh(x: np.ndarray) -> np.ndarray:
         return x.reshape(batch)
@@ -189,6 +275,8 @@ def singularities(
         type_II=sh(tII),
         constraint=sh(tC),
         singular=sh(tI | tII | tC),
+        closure=sh(closure),
+        assembled=sh(closure <= CLOSURE_RTOL * L),
         length=L,
     )
 
@@ -236,6 +324,7 @@ def singularity_map(
     steps: int = 4,
     ik_weights: ArrayLike | None = None,
     length: float | None = None,
+    output: str | tuple[int, ...] = "pose",
 ) -> SingularityMapResult:
     """Workspace / dexterity / singularity maps over a grid of inputs ``q_act (..., n_act)`` (FK) or
     of site targets ``T (..., 4, 4)`` (IK), e.g. from :func:`robomech.analysis.workspace.grid`.
@@ -258,6 +347,8 @@ def singularity_map(
         Error-row weights of the IK solves (:func:`inverse_kinematics`).
     length : float, optional
         Characteristic length (m).
+    output : str or sequence of int, optional
+        The output of the type I test, as in :func:`singularities` (default ``"pose"``).
 
     Returns
     -------
@@ -279,6 +370,7 @@ def singularity_map(
         raise ValueError(f"Expected site to be a site name (str), got {type(site).__name__}.")
     mech.tree.site_index(site)
     steps = check_int(steps, "steps", low=1)
+    _rows(output)  # checked before any solve
     if length is not None:
         check_positive(length, "length")
     if (q_act is None) == (T is None):
@@ -292,7 +384,7 @@ def singularity_map(
         r = inverse_kinematics(mech, site, T, guess, weights=ik_weights, steps=steps)
     ok = r.converged
     q = np.where(ok[..., None], r.q, mech.tree.q0)
-    s = singularities(mech, q, site, length=length)
+    s = singularities(mech, q, site, output=output, length=length)
     tree = mech.tree
     L = s.length
     qf = q.reshape(-1, mech.nq)
@@ -314,7 +406,11 @@ def singularity_map(
 
     sing = SingularityResult(
         **{
-            f: (mask(getattr(s, f), nan) if f.startswith(("sigma", "cond")) else mask(getattr(s, f), False))
+            f: (
+                mask(getattr(s, f), nan)
+                if f.startswith(("sigma", "cond", "closure"))
+                else mask(getattr(s, f), False)
+            )
             for f in (
                 "sigma_I",
                 "sigma_II",
@@ -326,6 +422,8 @@ def singularity_map(
                 "type_II",
                 "constraint",
                 "singular",
+                "closure",
+                "assembled",
             )
         },
         length=L,

@@ -20,6 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._options import QUAT_MIN_NORM as _QUAT_MIN_NORM
+
 __all__ = [
     "Tree",
     "TreeState",
@@ -37,9 +39,6 @@ __all__ = [
 ]
 
 _TYPES = {"hinge": 0, "slide": 1, "ball": 2, "free": 3}
-# Ball and free quaternions below this norm cannot be normalised; the kinematics uses identity there
-# (only reachable from user input, which the public boundary rejects as non-finite or zero).
-_QUAT_MIN_NORM = 1e-300
 
 
 # ------------------------------------------------------------------ small batched SO(3)/quaternion tools
@@ -135,6 +134,7 @@ class Tree:
     act_dof: np.ndarray  # (na,) velocity coordinate of each actuator
     act_qadr: np.ndarray  # (na,) qpos address of each actuator
     length: float  # characteristic length (m)
+    dof_paths: tuple[np.ndarray, ...] = ()  # (nb,) the velocity coordinates that move body b
 
     def body_index(self, name: str) -> int:
         try:
@@ -263,6 +263,7 @@ def compile_tree(mech) -> Tree:
         act_dof=jd_arr[act_jnt] if len(act_jnt) else np.zeros(0, dtype=int),
         act_qadr=jq_arr[act_jnt] if len(act_jnt) else np.zeros(0, dtype=int),
         length=1.0,
+        dof_paths=tuple(np.flatnonzero(A[b]) for b in range(nb)),
     )
     L = mech.characteristic_length
     if L is None:

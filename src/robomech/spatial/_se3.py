@@ -442,7 +442,7 @@ def screw_to_axis(S: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return direction, point, pitch
 
 
-def wrench_at(force: np.ndarray, point: np.ndarray, moment: np.ndarray | float = 0.0) -> np.ndarray:
+def wrench_at(force: np.ndarray, point: np.ndarray, moment: np.ndarray | None = None) -> np.ndarray:
     """Wrench ``[m; f]`` about the origin of a force applied at ``point`` plus a free ``moment``.
 
     Parameters
@@ -451,25 +451,33 @@ def wrench_at(force: np.ndarray, point: np.ndarray, moment: np.ndarray | float =
         Force (N).
     point : array_like, shape (..., 3)
         Point of application (m), in the same frame.
-    moment : float or array_like, shape (..., 3), optional
-        Free moment added (N m).  Default 0.
+    moment : array_like, shape (..., 3), optional
+        Free moment added (N m), a vector like the force.  Default: none.
 
     Returns
     -------
     ndarray, shape (..., 6)
         ``[point x force + moment; force]``.
 
+    Raises
+    ------
+    ValueError
+        If an argument is not a finite real array of shape (..., 3) (a scalar moment is not a
+        moment), or the batch shapes do not broadcast.
+
     Examples
     --------
-    >>> wrench_at([0.0, 0.0, -10.0], [1.0, 0.0, 0.0])  # 10 N down at x = 1 m
+    >>> wrench_at([0.0, 0.0, -10.0], [1.0, 0.0, 0.0]) + 0.0  # 10 N down at x = 1 m
     array([  0.,  10.,   0.,   0.,   0., -10.])
     """
     force = as_array(force, "force", (3,))
     point = as_array(point, "point", (3,))
-    moment = as_array(moment, "moment")
-    if moment.ndim and moment.shape[-1] != 3 and moment.size != 1:
-        raise ValueError(f"Expected moment to have shape (..., 3) or be a scalar, got {moment.shape}.")
-    moment_batch = [(moment, 1, "moment")] if moment.ndim and moment.shape[-1] == 3 else []
-    broadcast_batch((force, 1, "force"), (point, 1, "point"), *moment_batch)
-    m = np.cross(point, force) + moment
+    items = [(force, 1, "force"), (point, 1, "point")]
+    if moment is not None:
+        moment = as_array(moment, "moment", (3,))
+        items.append((moment, 1, "moment"))
+    broadcast_batch(*items)
+    m = np.cross(point, force)
+    if moment is not None:
+        m = m + moment
     return np.concatenate(np.broadcast_arrays(m, force), axis=-1)

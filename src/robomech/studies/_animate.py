@@ -1,21 +1,15 @@
-"""Pictures that move: a described mechanism following a trajectory, written as a GIF (issue 13).
+"""Pictures that move: a described mechanism following a trajectory, written as a GIF.
 
-Draws the multibody layer's wireframe (the stars of ``mb.body_segments``, with sliders drawn from
-their fixed end) on matplotlib's Agg canvas and saves the frames with Pillow (a dependency of
-matplotlib), so any mechanism with a description animates the same way.
+The pictures are :func:`robomech.multibody.animate`'s (the multibody layer's wireframe, written
+with matplotlib's movie writers), so any mechanism with a description animates the same way; this
+module adds what a report needs:
 
 * :func:`assemble_path` assembles a described mechanism along a sequence of actuated coordinates
   as following it frame by frame does (one assembly branch), in two batched solves;
-* :func:`animate` writes the GIF: every body drawn as its wireframe star (one colour per chain from
-  the base), ground attachments as triangles, loop closures as circles, and optionally the whole
-  path of one site (dotted) with the site's current position marked;
+* :func:`animate` is :func:`robomech.multibody.animate` (a GIF: every body drawn as its wireframe
+  star, one colour per chain from the base; ground attachments, loop closures, one site's path);
 * :func:`animation_figure` does both for a study and returns the report's :class:`Figure` with the
   data a test needs to check that the picture is the model's motion (:class:`Animation`).
-
-The axes, panes and title are drawn once and each frame draws only the moving lines over that
-background (blitting), and every frame is mapped to one shared palette (no flicker between frames,
-a smaller file); a 60-frame GIF at 80 dpi (320 x 320 px, ~0.1 MB) renders in about a second.  The
-axes limits are fixed over the motion and to scale.
 """
 
 from __future__ import annotations
@@ -28,31 +22,18 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from robomech import multibody as mb
-from robomech._validation import as_array, check_int, check_positive, check_real
-from robomech.multibody._assembly import check_q
-from robomech.multibody._tree import body_poses
+from robomech._validation import as_array
+from robomech.multibody._animate import animate, frame_ms
 
 from ._core import Figure
-from ._plot import plt
 
 __all__ = ["Animation", "animate", "animation_figure", "assemble_path", "frame_ms"]
 
-# Smallest drawn extent of an axis, as a fraction of the largest one: a planar motion keeps a
-# visible (not collapsed) third axis.
-MIN_AXIS_FRACTION = 0.25
 # Stages of the continuation from the reference configuration to each frame (assemble_path).
 CONTINUATION_STEPS = 4
 # Two assemblies of one frame on the same branch agree to the solver's tolerance (~1e-12 in every
 # coordinate); distinct branches differ by O(0.1-1) rad or m.  1e-6 separates the two with margin.
 BRANCH_TOL = 1e-6
-# Palette of each GIF frame: a wireframe on a white background needs few colours (smaller file).
-GIF_COLOURS = 64
-# Ticks per axis (at most): the labels of a narrow axis must not overlap at 6 pt.
-TICKS = 3
-# Frames sampled (evenly over the motion) to build the GIF's one palette.
-PALETTE_FRAMES = 6
-# Margin around the motion's bounding box, as a fraction of its largest extent.
-MARGIN = 0.08
 
 
 @dataclass(frozen=True)
@@ -87,12 +68,6 @@ class Animation:
         }
 
 
-def frame_ms(fps: float) -> int:
-    """The GIF frame delay (ms) for ``fps``: GIF stores delays in 1/100 s, and browsers replace a delay
-    below 0.02 s by 0.1 s, so the delay is ``fps``'s rounded to 10 ms, at least 20 ms."""
-    return 10 * max(2, round(100.0 / check_positive(fps, "fps")))
-
-
 def _check_mech(mech: object) -> mb.Mechanism:
     if not isinstance(mech, mb.Mechanism):
         raise ValueError(f"Expected mech to be a robomech.multibody.Mechanism, got {type(mech).__name__}.")
@@ -125,265 +100,6 @@ def assemble_path(mech: mb.Mechanism, q_act: ArrayLike) -> mb.FKResult:
                 r = mb.forward_kinematics(mech, qa[k], q[k - 1])
                 q[k], res[k], conv[k], it[k] = r.q, r.residual, r.converged, r.iterations
     return mb.FKResult(q=q, residual=res, converged=conv, iterations=it)
-
-
-def _chain_colours(mech: mb.Mechanism) -> dict[str, str]:
-    """One matplotlib colour per chain from the base: a body gets the colour of its root ancestor."""
-    parent = {b.name: b.parent for b in mech.bodies}
-    roots: list[str] = []
-    colours = {}
-    for b in mech.bodies:
-        root = b.name
-        while parent[root] != "world":
-            root = parent[root]
-        if root not in roots:
-            roots.append(root)
-        colours[b.name] = f"C{roots.index(root) % 10}"
-    return colours
-
-
-@dataclass(frozen=True)
-class _Drawing:
-    """What a frame shows, for all frames at once (world coordinates, m)."""
-
-    T: NDArray[np.float64]  # (nt, nb, 4, 4) body poses
-    segments: NDArray[np.float64]  # (nt, ns, 2, 3) each body's star
-    colours: list[str]  # (ns,) the colour of each segment (its chain)
-    polygons: NDArray[np.float64]  # (nt, np, 2, 3) edges joining a body's >= 3 closure anchors
-    ground: NDArray[np.float64]  # (nt, ng, 3) where top-level bodies are jointed to the ground
-    closures: NDArray[np.float64]  # (nt, nc, 3) loop-closure points
-
-
-def _drawing(mech: mb.Mechanism, q: NDArray[np.float64]) -> _Drawing:
-    """The wireframe of ``mb.body_segments`` for a batch ``q (nt, nq)``, with one change for sliders.
-
-    Each body is a star from its root to every point it carries (children's roots, closure anchors,
-    sites).  The root is the first joint's anchor where the parent holds it: for a hinge or ball the
-    same point as ``body_segments`` uses, for a slide the fixed end of the stroke, so a prismatic leg
-    is drawn at its actual length from its base (not as a rod of constant length sliding past it).
-    """
-    tree = mech.tree
-    T = body_poses(tree, q)  # (nt, nb, 4, 4)
-    nt = q.shape[0]
-
-    def world(b: int, x: ArrayLike) -> NDArray[np.float64]:
-        return np.asarray(T[:, b, :3, :3] @ np.asarray(x, float) + T[:, b, :3, 3])
-
-    pts: dict[int, list[NDArray[np.float64]]] = {i: [] for i in range(len(tree.body_names))}
-    ground = []
-    for i, b in enumerate(mech.bodies, start=1):
-        if not b.joints:
-            root = T[:, i, :3, 3]
-        elif b.joints[0].type == "slide":
-            held = T[:, int(tree.parent[i])] @ tree.T_off[i]  # the body's frame at zero stroke
-            root = held[:, :3, :3] @ np.asarray(b.joints[0].pos) + held[:, :3, 3]
-        else:
-            root = world(i, b.joints[0].pos)
-        pts[i].insert(0, root)
-        pts[int(tree.parent[i])].append(root)
-        if b.parent == "world" and b.joints:
-            ground.append(root)
-    closure_pts = []
-    on_body: dict[int, list[NDArray[np.float64]]] = {}
-    for c in mech.closures:
-        b1, b2 = tree.body_index(c.body1), tree.body_index(c.body2)
-        pts[b1].append(world(b1, c.anchor1 if c.kind != "rigid" else c.relpos))
-        p2 = world(b2, c.anchor2)
-        pts[b2].append(p2)
-        closure_pts.append(p2)
-        on_body.setdefault(b2, []).append(p2)
-    for si in range(len(tree.site_names)):
-        sb = int(tree.site_body[si])
-        pts[sb].append((T[:, sb] @ tree.T_site[si])[:, :3, 3])
-    colour_of = _chain_colours(mech)
-    segs, colours = [], []
-    for i, name in enumerate(tree.body_names):
-        if i == 0 or len(pts[i]) < 2:
-            continue
-        for p in pts[i][1:]:
-            segs.append(np.stack([pts[i][0], p], axis=1))  # (nt, 2, 3)
-            colours.append(colour_of[name])
-    polys = []
-    for anchors in on_body.values():
-        if len(anchors) >= 3:
-            polys += [
-                np.stack([anchors[k], anchors[(k + 1) % len(anchors)]], axis=1) for k in range(len(anchors))
-            ]
-
-    def stack(items: list[NDArray[np.float64]], tail: tuple[int, ...]) -> NDArray[np.float64]:
-        return np.stack(items, axis=1) if items else np.zeros((nt, 0, *tail))
-
-    return _Drawing(
-        T=T,
-        segments=stack(segs, (2, 3)),
-        colours=colours,
-        polygons=stack(polys, (2, 3)),
-        ground=stack(ground, (3,)),
-        closures=stack(closure_pts, (3,)),
-    )
-
-
-def _polyline(segments: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Segments ``(nt, ns, 2, 3)`` as one path per frame ``(nt, 3 ns, 3)``: a, b, NaN for each."""
-    nt, ns = segments.shape[:2]
-    gap = np.full((nt, ns, 1, 3), np.nan)
-    return np.concatenate([segments, gap], axis=2).reshape(nt, 3 * ns, 3)
-
-
-def _limits(pts: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    lo, hi = np.nanmin(pts, axis=0), np.nanmax(pts, axis=0)
-    span = max(float(np.max(hi - lo)), 1e-3)
-    half = np.maximum((hi - lo) / 2, MIN_AXIS_FRACTION * span / 2) + MARGIN * span
-    c = (lo + hi) / 2
-    return c - half, c + half
-
-
-def animate(
-    mech: mb.Mechanism,
-    q: ArrayLike,
-    path: str | Path,
-    *,
-    fps: float = 20.0,
-    title: str = "",
-    site: str | None = None,
-    times: ArrayLike | None = None,
-    dpi: int = 80,
-    size: float = 4.0,
-    view: tuple[float, float] | None = None,
-    invert_z: bool = False,
-) -> Path:
-    """Write a GIF of ``mech`` through the configurations ``q (nt, nq)`` (e.g. ``simulate(...).q``).
-
-    Parameters
-    ----------
-    mech : robomech.multibody.Mechanism
-        The described mechanism.
-    q : array (nt, nq)
-        One assembled configuration per frame (MuJoCo qpos).
-    path : path
-        The GIF to write.
-    fps : float
-        Frames per second of the GIF (the delay is rounded to GIF's 10 ms, at least 20 ms: ``frame_ms``).
-    title : str
-        Title above the drawing (default the mechanism's name); the frame (or time) is appended.
-    site : str, optional
-        A site whose whole path is drawn dotted, with its position in the current frame marked.
-    times : array (nt,), optional
-        Time of each frame (s), shown in the title instead of the frame number.
-    dpi, size : int, float
-        Resolution and side of the square picture (inches): ``size * dpi`` pixels.
-    view : (elev, azim), optional
-        Camera angles (deg) of the 3-D axes.
-    invert_z : bool
-        Draw z pointing down (a mechanism described in a frame whose z points down, e.g. a leg).
-    """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.ticker import MaxNLocator
-    from PIL import Image
-
-    mech = _check_mech(mech)
-    qa = as_array(q, "q", (mech.nq,))
-    if qa.ndim != 2 or qa.shape[0] < 1:
-        raise ValueError(f"Expected q to have shape (nt, {mech.nq}), got {qa.shape}.")
-    nt = qa.shape[0]
-    fps = check_positive(fps, "fps")
-    dpi = check_int(dpi, "dpi", low=10, high=600)
-    size = check_positive(size, "size")
-    if not isinstance(title, str):
-        raise ValueError(f"Expected title to be a str, got {type(title).__name__}.")
-    if site is not None and (not isinstance(site, str) or site not in mech.tree.site_names):
-        raise ValueError(f"Expected site to be None or one of {list(mech.tree.site_names)}, got {site!r}.")
-    tt = None
-    if times is not None:
-        tt = as_array(times, "times")
-        if tt.shape != (nt,):
-            raise ValueError(f"Expected times to have shape ({nt},) (one per frame), got {tt.shape}.")
-    if view is not None:
-        if not (isinstance(view, tuple) and len(view) == 2):
-            raise ValueError(f"Expected view to be None or (elev, azim) in degrees, got {view!r}.")
-        view = (check_real(view[0], "view (elev)"), check_real(view[1], "view (azim)"))
-    if not isinstance(invert_z, bool):
-        raise ValueError(f"Expected invert_z to be True or False, got {invert_z!r}.")
-
-    qa = check_q(mech, qa)
-    drawing = _drawing(mech, qa)
-    site_path = None
-    if site is not None:
-        si = mech.tree.site_index(site)
-        site_path = (drawing.T[:, mech.tree.site_body[si]] @ mech.tree.T_site[si])[:, :3, 3]
-    allpts = [drawing.segments.reshape(nt, -1, 3), drawing.ground]
-    if site_path is not None:
-        allpts.append(site_path[:, None])
-    lo, hi = _limits(np.concatenate(allpts, axis=1).reshape(-1, 3))
-
-    fig = plt.figure(figsize=(size, size), dpi=dpi)
-    ax = fig.add_subplot(projection="3d")
-    ax.set_xlim(lo[0], hi[0])
-    ax.set_ylim(lo[1], hi[1])
-    ax.set_zlim(lo[2], hi[2])
-    ax.set_box_aspect(tuple(hi - lo))  # to scale
-    if invert_z:
-        ax.invert_zaxis()
-    if view is not None:
-        ax.view_init(elev=view[0], azim=view[1])
-    ax.set_xlabel("x (m)", fontsize=7, labelpad=-4)
-    ax.set_ylabel("y (m)", fontsize=7, labelpad=-4)
-    ax.set_zlabel("z (m)", fontsize=7, labelpad=-4)
-    ax.tick_params(labelsize=6, pad=-2)
-    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
-        axis.set_major_locator(MaxNLocator(TICKS))
-    # one line per colour, its segments separated by NaN (a break in the drawn path)
-    strokes = [
-        (
-            ax.plot([], [], [], color=c, lw=2)[0],
-            _polyline(drawing.segments[:, np.array(drawing.colours) == c]),
-        )
-        for c in dict.fromkeys(drawing.colours)
-    ]
-    if drawing.polygons.shape[1]:
-        strokes.append((ax.plot([], [], [], color="0.3", lw=1)[0], _polyline(drawing.polygons)))
-    (ground,) = ax.plot([], [], [], "k^", ms=6, ls="none")
-    (closures,) = ax.plot([], [], [], "o", ms=5, mfc="none", mec="C3", ls="none")
-    marker = None
-    if site_path is not None:
-        ax.plot(*site_path.T, color="0.4", lw=1, ls=":")
-        (marker,) = ax.plot([], [], [], "o", ms=4, color="k", ls="none")
-    label = title or mech.name
-    ax.set_title(label, fontsize=9)  # static: part of the background
-    clock = fig.text(0.02, 0.02, "", fontsize=8)  # the frame's time (few glyphs: text is the costly part)
-    fig.subplots_adjust(left=0.0, right=0.9, bottom=0.03, top=0.95)
-
-    dynamic = [line for line, _ in strokes]
-    dynamic += [a for a in (ground, closures, clock, marker) if a is not None]
-    for a in dynamic:
-        a.set_animated(True)  # drawn per frame over the static background (blitting)
-    canvas = FigureCanvasAgg(fig)  # the raster canvas whose buffer the frames are read from
-    canvas.draw()
-    background = canvas.copy_from_bbox(fig.bbox)
-    rgb = []
-    for k in range(nt):
-        canvas.restore_region(background)
-        for line, xyz in strokes:
-            line.set_data_3d(*xyz[k].T)
-        ground.set_data_3d(*drawing.ground[k].T)
-        closures.set_data_3d(*drawing.closures[k].T)
-        if marker is not None and site_path is not None:
-            marker.set_data_3d(site_path[k : k + 1, 0], site_path[k : k + 1, 1], site_path[k : k + 1, 2])
-        when = f"t = {tt[k]:.2f} s" if tt is not None else f"frame {k + 1}/{nt}"
-        clock.set_text(when)
-        for a in dynamic:
-            fig.draw_artist(a)
-        rgba = np.asarray(canvas.buffer_rgba())
-        rgb.append(np.array(rgba[..., :3]))
-    # one palette for every frame (from a few frames side by side): a per-frame palette would map the
-    # same background grey to different entries from frame to frame (flicker, and a larger file)
-    sample = np.concatenate([rgb[k] for k in np.linspace(0, nt - 1, min(nt, PALETTE_FRAMES)).astype(int)], 1)
-    palette = Image.fromarray(sample).quantize(GIF_COLOURS, method=Image.Quantize.FASTOCTREE)
-    images = [Image.fromarray(f).quantize(palette=palette, dither=Image.Dither.NONE) for f in rgb]
-    path = Path(path)
-    images[0].save(path, save_all=True, append_images=images[1:], duration=frame_ms(fps), loop=0, disposal=1)
-    plt.close(fig)
-    return path
 
 
 def animation_figure(

@@ -20,6 +20,8 @@ from typing import Any, TypeVar
 
 import numpy as np
 
+from robomech._progress import LOGGER
+
 __all__ = [
     "Figure",
     "Printed",
@@ -299,6 +301,7 @@ class Progress:
 
     def step(self, message: str) -> None:
         """Print ``message`` with the elapsed time (s) and the prefix."""
+        LOGGER.info("%s%s", self.prefix, message)  # the Python API's progress (logger "robomech")
         if self.enabled:
             elapsed = time.perf_counter() - self._t0
             print(f"[{elapsed:7.1f} s] {self.prefix}{message}", file=self.stream, flush=True)

@@ -17,6 +17,7 @@ from robomech.mechanisms import continuum as C
 from robomech.verify import continuum as V
 
 from ._core import Progress, Study, StudyResult, Table, comparison_table
+from ._papers import PAPERS, cite
 from ._plot import plt, save_figure
 
 # Simulated sensors (paper 3, Section 5): JLBS-MD 10 kg load cells, 0.05 % of full scale ~ 0.05 N;
@@ -44,7 +45,7 @@ def _fig9(out_dir: Path, res: StudyResult) -> None:
                 ax.plot(np.degrees(phi), k, ls=ls, color=color, label=f"improved ρ={rho:g}, n={n:g}")
                 rows.append([alpha, rho, n, float(k[-1]), float(np.exp(alpha * np.pi))])
         ax.set_xlabel("wrap angle φ (deg)")
-        ax.set_title(f"Fig. 9: tension ratio, friction α = {alpha}")
+        ax.set_title(f"tension ratio, friction α = {alpha}")
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
     axes[0].set_ylabel("T_in / T_out (output tension 1 N)")
@@ -75,12 +76,12 @@ def _fig6(out_dir: Path, res: StudyResult) -> None:
         axes[0].plot(pre, loss[:, j], "o-", label=f"wrap {w:g}°")
     axes[0].set_xlabel("pretension (output tension) T_out (N)")
     axes[0].set_ylabel("tension loss T_in − T_out (N)")
-    axes[0].set_title("Fig. 6c trend: loss vs pretension")
+    axes[0].set_title("trend: loss vs pretension")
     for i, t in enumerate(pre):
         axes[1].plot(wrap_deg, loss[i, :], "s-", label=f"T_out {t:g} N")
     axes[1].set_xlabel("wrap angle (deg)")
     axes[1].set_ylabel("tension loss T_in − T_out (N)")
-    axes[1].set_title("Fig. 6d trend: loss vs wrap angle")
+    axes[1].set_title("trend: loss vs wrap angle")
     for ax in axes:
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
@@ -165,8 +166,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     res = StudyResult(
         name="continuum",
         title="Paper 3: cable-driven continuum robot — capstan friction, statics and drive compensation",
-        source="Qi, Zhang, Pei, Chen, Wu: Drive error compensation of continuum manipulator based on force "
-        "transfer model, Trans. CSAM 54(1), 2023 (doi:10.6041/j.issn.1000-1298.2023.01.041)",
+        source=cite(3),
         summary=(
             "Exact: the constant-curvature kinematics (eqs. (1)-(6), with eq. (1)'s misprinted element "
             "corrected), cable lengths (arc model of eq. (4) and straight chords between disks), "
@@ -258,7 +258,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     ax.plot(np.degrees(th), errs_p[1] * mm, "b-.", label="after compensation (paper's method)")
     ax.set_xlabel("commanded bend angle θ (deg)")
     ax.set_ylabel("tip position error (mm)")
-    ax.set_title("Fig. 12c analogue: tip error (SIMULATED robot)")
+    ax.set_title("planar bending: tip error before and after compensation (SIMULATED robot)")
     ax.legend()
     ax.grid(True, alpha=0.3)
     res.figures.append(
@@ -287,7 +287,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     ax.plot(np.degrees(be), errs_c[1] * mm, "b-.", label="after compensation (paper's method)")
     ax.set_xlabel("bending-plane angle β (deg)")
     ax.set_ylabel("tip position error (mm)")
-    ax.set_title("Fig. 13c analogue: tip error (SIMULATED robot)")
+    ax.set_title("spatial circle: tip error before and after compensation (SIMULATED robot)")
     ax.legend(fontsize=8)
     ax.grid(True, alpha=0.3)
     res.figures.append(
@@ -610,6 +610,6 @@ def _cosserat_section(res: StudyResult, out_dir: Path, progress: Progress) -> No
 STUDY = Study(
     name="continuum",
     title="Paper 3: cable-driven continuum robot (capstan friction, statics, compensation)",
-    source="Qi et al., Trans. CSAM 54(1), 2023",
+    source=PAPERS[3].short(),
     run=run,
 )

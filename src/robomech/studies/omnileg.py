@@ -22,6 +22,7 @@ from robomech.verify import omnileg as engine_check
 
 from ._animate import Animation, animation_figure
 from ._core import Progress, Study, StudyResult, Table, comparison_table
+from ._papers import PAPERS, cite
 from ._plot import plt, save_figure
 
 # Fig. 11: external force on the foot during 0-1 s of eq. (52), N (paper 2, Section 4).
@@ -123,7 +124,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     res = StudyResult(
         name="omnileg",
         title="Paper 2: the OmniLeg serial-parallel leg — kinematics and dynamics",
-        source="Xu, Lu, Zhu, Luo, China Mechanical Engineering 36(4), 2025 (paper 2)",
+        source=cite(2),
     )
     tables: list[Table] = []
 
@@ -270,7 +271,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         axs[j].grid(True, alpha=0.3)
         axs[j].legend(fontsize=8)
     axs[-1].set_xlabel("time t (s)")
-    axs[0].set_title("Fig. 11 — motor torques along eq. (52), 0–2 s")
+    axs[0].set_title("motor torques along eq. (52), 0–2 s")
     res.figures.append(
         save_figure(
             fig,
@@ -299,7 +300,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         axs[2].plot(sim["t"], np.degrees(drift), color=col,
                     ls=("-", "--", "-")[j], label=("α", "β (= α in eq. (52))", "γ")[j])  # fmt: skip
     axs[0].set_ylabel("torque (N·m)")
-    axs[0].set_title("Fig. 11 vs engine: analytic torques and MuJoCo inverse dynamics (force in 0–1 s)")
+    axs[0].set_title("analytic torques and MuJoCo inverse dynamics (force in 0–1 s)")
     axs[1].set_ylabel("|analytic − engine| (N·m)")
     axs[2].set_ylabel("drift (deg)")
     axs[2].set_xlabel("time t (s)")
@@ -364,7 +365,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         axs[j].grid(True, alpha=0.3)
     axs[0].legend(["motor torque (shaded: stance, 30 N ground reaction)"], fontsize=8)
     axs[-1].set_xlabel("time t (s)")
-    axs[0].set_title("Fig. 19 — motor torques of the gait eq. (53): swing, stance, swing, ...")
+    axs[0].set_title("motor torques of the gait eq. (53): swing, stance, swing, ...")
     res.figures.append(
         save_figure(
             fig,
@@ -687,7 +688,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
 STUDY = Study(
     name="omnileg",
     title="Paper 2: OmniLeg serial-parallel leg",
-    source="Xu et al., China Mechanical Engineering 36(4), 2025",
+    source=PAPERS[2].short(),
     run=run,
     requires=("mujoco",),  # the engine overlays (robomech.verify); skipped without robomech[verify]
 )

@@ -34,6 +34,7 @@ from robomech.verify.skid_steer import simulate
 
 from . import _skid_steer_comparison as engine_cmp
 from ._core import Progress, Study, StudyResult, Table, comparison_table
+from ._papers import PAPERS, cite
 from ._plot import plt, save_figure
 
 DURATION = 50.0  # s, paper 4 Sec. 2.2
@@ -101,8 +102,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     res = StudyResult(
         name="skid-steer",
         title="Paper 4: skid-steer exploration robot — body velocity from six wheel chains by batched QR",
-        source="Shang, Qiu, Yang, China Mechanical Engineering 23(2), 2012, "
-        "DOI 10.3969/j.issn.1004-132X.2012.02.010",
+        source=cite(4),
     )
     progress.step(f"ground truth: {DURATION:.0f} s at {RATE:.0f} Hz on uneven ground (independent model)")
     gt = simulate(robot, DURATION, RATE)
@@ -499,7 +499,7 @@ def _figures(
         ax.legend(loc="upper right", fontsize=7)
     for ax in axes[-1]:
         ax.set_xlabel("time (s)")
-    fig.suptitle("Body twist in body axes: estimated vs true (cf. paper Fig. 7)")
+    fig.suptitle("Body twist in body axes: estimated vs true")
     res.figures.append(
         save_figure(fig, out_dir, "body_velocity", "Body velocity estimated vs true (cf. Fig. 7)")
     )
@@ -561,7 +561,7 @@ def _figures(
 STUDY = Study(
     name="skid-steer",
     title="Paper 4: skid-steer exploration robot velocity kinematics",
-    source="Shang, Qiu, Yang (2012), China Mechanical Engineering 23(2)",
+    source=PAPERS[4].short(),
     run=run,
     requires=("mujoco",),  # the contact-physics comparison; skipped without robomech[verify]
 )

@@ -17,6 +17,7 @@ from robomech.mechanisms import spherical_leg as sl
 
 from ._animate import Animation, animation_figure
 from ._core import Progress, Study, StudyResult, Table, comparison_table
+from ._papers import PAPERS, cite
 from ._plot import plt, save_figure
 
 PI = np.pi
@@ -172,9 +173,7 @@ def _kinematics_figures(leg: sl.SphericalLeg, out_dir: Path, res: StudyResult, e
         ax.grid(True, alpha=0.3)
         ax.legend()
     axes[0].set_ylabel("leg rate l̇ (mm/s)")
-    fig.suptitle(
-        "Fig. 3 reproduced: leg input velocities, amplitude π/3 at 0.05 Hz (dots: 0.1 s grid, every 5th)"
-    )
+    fig.suptitle("leg input velocities, amplitude π/3 at 0.05 Hz (dots: 0.1 s grid, every 5th)")
     res.figures.append(
         save_figure(
             fig,
@@ -207,7 +206,7 @@ def _kinematics_figures(leg: sl.SphericalLeg, out_dir: Path, res: StudyResult, e
         lo, hi = ax.get_ylim()
         ax.set_ylim(lo, hi + 0.6 * (hi - lo))  # headroom for the legend
         ax.legend(fontsize=8, loc="upper center", ncol=2)
-    fig.suptitle("Fig. 4 reproduced: leg input accelerations (l̈ = J q̈ + q̇ᵀ H q̇)")
+    fig.suptitle("leg input accelerations (l̈ = J q̈ + q̇ᵀ H q̇)")
     res.figures.append(
         save_figure(
             fig,
@@ -249,7 +248,7 @@ def _force_figures(leg: sl.SphericalLeg, out_dir: Path, res: StudyResult, engine
             ax.set_yscale("symlog", linthresh=100.0)
         ax.set_xlabel("time t (s)")
         ax.set_ylabel("leg force f (N), + extends")
-        ax.set_title(f"Fig. 5{label}")
+        ax.set_title(label)
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7)
         if (~pd.valid).any():
@@ -275,12 +274,10 @@ def _force_figures(leg: sl.SphericalLeg, out_dir: Path, res: StudyResult, engine
     ax.plot(t, mn.leg_forces[:, 2] * s3[:, 2], "C2--", label="leg 3, minimum-norm")
     ax.set_xlabel("time t (s)")
     ax.set_ylabel("Z component of leg-3 force f₃ s₃·Z (N)")
-    ax.set_title("Fig. 5(c): Z component, sway about X at β = 0")
+    ax.set_title("(c) Z component, sway about X at β = 0")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
-    fig.suptitle(
-        "Fig. 5 reproduced: actuator forces (Kane inverse dynamics, g = 10 m/s², screw spin included)"
-    )
+    fig.suptitle("actuator forces (Kane inverse dynamics, g = 10 m/s², screw spin included)")
     res.figures.append(
         save_figure(
             fig,
@@ -324,7 +321,7 @@ def _branch_figure(leg: sl.SphericalLeg, out_dir: Path, res: StudyResult) -> Non
     fixed = sl.forward_kinematics(leg, L, branch=0)
     tr = sl.track_branches(leg, L)
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
-    a1.plot(t, np.degrees(q[:, 0]), "k-", lw=3, alpha=0.3, label="α of the motion (Fig. 5(a))")
+    a1.plot(t, np.degrees(q[:, 0]), "k-", lw=3, alpha=0.3, label="α of force case (a)")
     a1.plot(t, np.degrees(fixed.alpha), "C3--", label="forward kinematics, branch 0 throughout")
     a1.plot(t, np.degrees(tr.alpha), "C0-", lw=1, label="track_branches (continuation)")
     a_s = np.degrees(-np.arctan2(leg.h * np.cos(PI / 3), leg.r))
@@ -334,7 +331,7 @@ def _branch_figure(leg: sl.SphericalLeg, out_dir: Path, res: StudyResult) -> Non
     a1.set_ylabel("α (deg)")
     a1.set_ylim(-62, -50)
     a1.legend(fontsize=7, loc="upper right")
-    a1.set_title("Fig. 5(a) lengths: a fixed branch returns the mirror pose beyond the curve (residual 0)")
+    a1.set_title("motion (a) lengths: a fixed branch returns the mirror pose beyond the curve (residual 0)")
     a2.semilogy(t, np.abs(fixed.alpha - q[:, 0]) + 1e-17, "C3--", label="|α error|, branch 0 throughout")
     a2.semilogy(t, np.abs(tr.alpha - q[:, 0]) + 1e-17, "C0-", label="|α error|, tracked")
     a2.semilogy(t, fixed.residual + 1e-17, "C7:", label="length residual of the fixed branch (m)")
@@ -447,17 +444,18 @@ def _workspace_figure(leg: sl.SphericalLeg, out_dir: Path, res: StudyResult) -> 
         [], [], "w-", label=f"stroke limits {leg.length_min * 1e3:.0f}–{leg.length_max * 1e3:.0f} mm"
     )
     axes[0].plot([], [], "r-", label="singular: ∂l3/∂α = 0")
-    axes[0].legend(fontsize=8, loc="lower right")
+    # below the map: inside, the legend would hide the singular curve and the stroke limits
+    axes[0].legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
     axes[0].set_xlabel("α (deg)")
     axes[0].set_ylabel("β (deg)")
     axes[0].set_title("Condition number of J and the singular curve")
     cs = axes[1].contourf(deg, deg, (wm.sigma_min * 1e3).T, levels=20, cmap="magma")
     fig.colorbar(cs, ax=axes[1], label="σ_min(J) (mm/rad)")
-    axes[1].plot([-60.0, 60.0], [60.0, 60.0], "c-", lw=2, label="Fig. 5(a) path (β = 60°, α ±60°)")
+    axes[1].plot([-60.0, 60.0], [60.0, 60.0], "c-", lw=2, label="path of force case (a) (β = 60°, α ±60°)")
     axes[1].set_xlabel("α (deg)")
     axes[1].set_ylabel("β (deg)")
     axes[1].set_title("Smallest singular value of J (leg-rate sensitivity)")
-    axes[1].legend(fontsize=8)
+    axes[1].legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13))
     res.figures.append(
         save_figure(
             fig,
@@ -526,7 +524,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     res = StudyResult(
         name="spherical-leg",
         title="Paper 1: the 2RUHU-RUPR-RUR spherical parallel leg",
-        source="Chen et al., Optics and Precision Engineering 27(8), 2019 (1-spherical-parallel-leg.txt)",
+        source=cite(1),
     )
     progress.step("Table 1 and forward-solution accuracy")
     _table1(leg, res)
@@ -586,6 +584,6 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
 STUDY = Study(
     name="spherical-leg",
     title="Paper 1: spherical parallel leg — exact kinematics, dynamics, singularity",
-    source="Optics and Precision Engineering 27(8), 2019",
+    source=PAPERS[1].short(),
     run=run,
 )

@@ -12,16 +12,24 @@ import math
 from pathlib import Path
 
 import numpy as np
+from matplotlib.lines import Line2D
 
 from robomech.mechanisms import vectored_thrust as vt
 
 from ._animate import Animation, animation_figure
 from ._core import Figure, Progress, Study, StudyResult, Table, comparison_table
+from ._papers import PAPERS, cite
 from ._plot import plt, save_figure
 
 MAP_SAMPLES = 401  # per input axis for the workspace and singularity maps (~160k samples each)
 TRAJ_SAMPLES = 629  # Table 1 trajectory over one period (0.01 s spacing)
 ENGINE_SAMPLES = 63  # engine overlay points (every 10th trajectory sample)
+# Time step (s) of the central differences of the platform rotation that give the (ω, ω̇) fed to
+# inverse_rates: truncation ~ h² |d³ω/dt³|, measured 5e-6 rad/s on ω and 4e-5 rad/s² on ω̇ along the
+# Table 1 trajectory (q̇, q̈ recovered to 2e-6 / 3e-5); rounding of the nested difference ~ eps / h²
+# ~ 2e-10.  The check never evaluates the Lie-bracket velocity products, which are up to 3 rad/s² here:
+# a model without them would be off by that much.
+FD_STEP = 1e-3
 
 
 def _mechanism_picture(th: vt.VectoredThruster, out_dir: Path) -> Figure:
@@ -107,13 +115,42 @@ def table1_animation(th: vt.VectoredThruster, out_dir: Path) -> tuple[Animation,
     return anim, {"max_tip_error_m": float(np.max(np.abs(anim.site - tip)))}
 
 
+def _platform_motion_by_differences(th: vt.VectoredThruster, t: np.ndarray, q_of_t) -> tuple:
+    """ω and ω̇ (base frame) of the platform along ``q_of_t(t)`` by central differences of its rotation.
+
+    ``ω^ = Ṙ Rᵀ`` with ``Ṙ ≈ (R(t + h) - R(t - h)) / 2h`` and ``ω̇ ≈ (ω(t + h) - ω(t - h)) / 2h``
+    (h = ``FD_STEP``): an independent formulation of the forward rate and acceleration models.
+    """
+
+    def omega(tt):
+        rp, rm, r0 = (vt.platform_rotation(th, q_of_t(tt + d)).R for d in (FD_STEP, -FD_STEP, 0.0))
+        W = np.einsum("...ij,...kj->...ik", (rp - rm) / (2.0 * FD_STEP), r0)
+        return 0.5 * np.stack(
+            [W[..., 2, 1] - W[..., 1, 2], W[..., 0, 2] - W[..., 2, 0], W[..., 1, 0] - W[..., 0, 1]], -1
+        )
+
+    return omega(t), (omega(t + FD_STEP) - omega(t - FD_STEP)) / (2.0 * FD_STEP)
+
+
+def _legend_with_styles(ax, styles, fontsize) -> None:
+    """One legend entry per coloured line (its label) and one per line style, in black: a source
+    (analytic, MuJoCo, ...) is named once, not once per component."""
+    handles, labels = ax.get_legend_handles_labels()
+    for style, label in styles:
+        if style in ("-", ":", "--", "-."):
+            handles.append(Line2D([], [], color="k", ls=style, lw=1.5))
+        else:
+            handles.append(Line2D([], [], color="k", ls="", marker=style, ms=4, mfc="none"))
+        labels.append(label)
+    ax.legend(handles, labels, ncol=4, fontsize=fontsize, loc="upper center", bbox_to_anchor=(0.5, -0.15))
+
+
 def run(out_dir: Path, progress: Progress) -> StudyResult:
     th = vt.VectoredThruster.paper()
     res = StudyResult(
         name="vectored-thrust",
         title="Paper 5: RRR-RR vectored-thrust spherical mechanism",
-        source="Xu, Li, Chen, Zhang, Gao, Robot 38(6), 2016 "
-        "(shared/papers/5-vectored-thrust-spherical-mechanism.txt)",
+        source=cite(5),
     )
 
     # -- mobility ---------------------------------------------------------------------------------------
@@ -199,14 +236,20 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         s=2,
         c=np.degrees(wm.tilt[::4, ::4][rch]),
         cmap="viridis",
-        label="reachable",
     )
-    fig.colorbar(sc, ax=a1, shrink=0.6, label="tilt from Z (deg)")
+    fig.colorbar(sc, ax=a1, shrink=0.6, pad=0.12, label="tilt from Z (deg)")
     a1.set_xlabel("x (mm)")
     a1.set_ylabel("y (mm)")
-    a1.set_zlabel("z (mm)")
-    a1.set_title("Fig. 5: propeller tip workspace (inputs over Table 1 ranges)")
-    a1.legend(loc="upper left", fontsize=8)
+    a1.set_zlabel("z (mm)", labelpad=4)
+    a1.set_box_aspect(None, zoom=0.9)  # room for the z label beside the colour bar
+    a1.set_title("propeller tip workspace (Table 1 input ranges)")
+    # the reachable points are coloured by tilt: their legend marker says so instead of one colour
+    reach_marker = Line2D([], [], ls="", marker="o", ms=4, mfc=plt.get_cmap("viridis")(0.6), mec="none")
+    gray_marker = Line2D([], [], ls="", marker="o", ms=4, mfc="lightgray", mec="none")
+    a1.legend(
+        [gray_marker, reach_marker], ["beyond U-joint limit", "reachable (colour: tilt)"],
+        loc="upper left", fontsize=8,
+    )  # fmt: skip
     a2 = fig.add_subplot(1, 2, 2)
     for mask, c, lab in (
         (~wm.reachable, "lightgray", "beyond U-joint limit"),
@@ -245,7 +288,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     b2.set_aspect("equal")
     b2.set_xlabel("x (mm)")
     b2.set_ylabel("y (mm)")
-    b2.set_title("Fig. 6: reachable tip points on the 80 mm sphere (top view)")
+    b2.set_title("reachable tip points on the 80 mm sphere (top view)")
     b2.legend(fontsize=8)
     res.figures.append(
         save_figure(
@@ -273,17 +316,15 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     colors = ("tab:blue", "tab:orange", "tab:green")
     fig, ax = plt.subplots(figsize=(10, 5.5))
     for k in range(3):
-        ax.plot(t, acc.omega[:, k], color=colors[k], label=f"{labels[k]} analytic")
-        ax.plot(
-            t[idx], tr.omega_engine[:, k], "o", color=colors[k], ms=4, mfc="none", label=f"{labels[k]} MuJoCo"
-        )
+        ax.plot(t, acc.omega[:, k], color=colors[k], label=labels[k])
+        ax.plot(t[idx], tr.omega_engine[:, k], "o", color=colors[k], ms=4, mfc="none")
     ax.fill_between(
         t, 0, 1, where=over, transform=ax.get_xaxis_transform(), color="red", alpha=0.08, label="tilt > 45°"
     )
     ax.set_xlabel("time t (s)")
     ax.set_ylabel("platform angular velocity (rad/s)")
-    ax.set_title("Fig. 7: angular velocity along q1 = (π/4) sin t, q2 = −(π/4) sin t")
-    ax.legend(ncol=4, fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.15))
+    ax.set_title("angular velocity along q1 = (π/4) sin t, q2 = −(π/4) sin t")
+    _legend_with_styles(ax, [("-", "analytic"), ("o", "MuJoCo")], fontsize=8)
     ax.grid(True, alpha=0.3)
     res.figures.append(
         save_figure(
@@ -295,20 +336,17 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     )
     fig, ax = plt.subplots(figsize=(10, 5.5))
     for k in range(3):
-        ax.plot(
-            t, acc.omega_dot[:, k], color=colors[k], label=f"{labels[k].replace('ω', 'ω̇')} Lie-bracket model"
-        )
-        ax.plot(t[idx], tr.omega_dot_engine[:, k], "o", color=colors[k], ms=4, mfc="none", label="MuJoCo")
-        ax.plot(
-            t, printed_style[:, k], ":", color=colors[k], lw=1, label="eq. (32) style (no velocity products)"
-        )
+        ax.plot(t, acc.omega_dot[:, k], color=colors[k], label=labels[k].replace("ω", "ω̇"))
+        ax.plot(t[idx], tr.omega_dot_engine[:, k], "o", color=colors[k], ms=4, mfc="none")
+        ax.plot(t, printed_style[:, k], ":", color=colors[k], lw=1)
     ax.fill_between(
         t, 0, 1, where=over, transform=ax.get_xaxis_transform(), color="red", alpha=0.08, label="tilt > 45°"
     )
     ax.set_xlabel("time t (s)")
     ax.set_ylabel("platform angular acceleration (rad/s²)")
-    ax.set_title("Fig. 8: angular acceleration along the Table 1 trajectory")
-    ax.legend(ncol=4, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.15))
+    ax.set_title("angular acceleration along the Table 1 trajectory")
+    styles = [("-", "Lie-bracket model"), ("o", "MuJoCo"), (":", "eq. (32) style (no velocity products)")]
+    _legend_with_styles(ax, styles, fontsize=7)
     ax.grid(True, alpha=0.3)
     res.figures.append(
         save_figure(
@@ -336,7 +374,12 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     progress.step(
         "Section 3.3: inverse accelerations along the trajectory; motor torques of a propeller load"
     )
-    inv = vt.inverse_rates(th, q, acc.omega, acc.omega_dot)
+    # (ω, ω̇) by finite differences of the forward rotation, not by angular_acceleration: inverting the
+    # latter's output would subtract the very velocity-product term it added (a round trip that holds
+    # by construction); these come from the rotation alone, so the recovered (q̇, q̈) test the model
+    w_fd, wd_fd = _platform_motion_by_differences(th, t, lambda tt: vv.table1_trajectory(tt)[0])
+    inv = vt.inverse_rates(th, q, w_fd, wd_fd)
+    regular = ~inv.singular
     s0 = fk.axis
     # an assumed propeller load: 10 N thrust along the shaft and a 0.05 N·m reaction torque about it (the
     # paper gives no propeller data); plus a 1 N side force at the tip (e.g. a current) along the
@@ -353,9 +396,9 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     for k, name in enumerate(("q̈1", "q̈2")):
         a1.plot(t, qdd[:, k], color=colors[k], label=f"{name} of the trajectory")
         a1.plot(t[::12], inv.qdd[::12, k], "o", color=colors[k], ms=3, mfc="none",
-                label=f"{name} from (ω, ω̇) by inverse_rates")  # fmt: skip
+                label=f"{name} by inverse_rates from finite differences of R(t)")  # fmt: skip
     a1.set_ylabel("input acceleration (rad/s²)")
-    a1.set_title("Section 3.3: input accelerations recovered from the platform's (ω, ω̇)")
+    a1.set_title("Section 3.3: input accelerations recovered from the platform's motion (ω, ω̇ of R(t))")
     a1.legend(fontsize=7, ncol=2)
     a2.semilogy(t, inv.sigma_min, "k-", label="σ_min(J)")
     a2.axhline(1.0 / vt.INPUT_GAIN_MAX, color="r", ls=":", label=f"singular flag (1/{vt.INPUT_GAIN_MAX:.0f})")
@@ -382,8 +425,9 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         )
     )
     res.data["inverse"] = {
-        "max_qdd_round_trip": float(np.abs(inv.qdd - qdd).max()),
-        "max_qd_round_trip": float(np.abs(inv.qd - qd).max()),
+        "max_qdd_vs_differences": float(np.abs(inv.qdd - qdd)[regular].max()),
+        "max_qd_vs_differences": float(np.abs(inv.qd - qd)[regular].max()),
+        "fd_step_s": FD_STEP,
         "min_sigma_min": float(inv.sigma_min.min()),
         "samples_flagged": int(inv.singular.sum()),
         "max_thrust_torque_Nm": float(
@@ -435,7 +479,9 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         if lim:
             axp.set_xlim(-lim, lim)
             axp.set_ylim(-lim, lim)
-        axp.legend(fontsize=7, loc="lower left")
+        if lim is None:  # one legend, below the first map (inside, it would hide a singular curve);
+            # grey so that the white outline shows
+            axp.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, facecolor="0.8")
     res.figures.append(
         save_figure(
             fig,
@@ -538,9 +584,10 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
             f"{100 * over.mean():.0f} % of the period; it stays {d_min:.2f} (sine of the passive-axis angle)",
             "away from the singular point. The link-interference constraint (assumed 0.3 rad clearance) is",
             f"inactive: the 45° arc stays ≥ {clear_min:.0f}° from the fixing device.",
-            "Section 3.3's inverse acceleration model (inverse_rates, with the Lie-bracket terms) returns",
-            "the",
-            f"trajectory's input accelerations to {res.data['inverse']['max_qdd_round_trip']:.0e} rad/s²; by",
+            "Section 3.3's inverse acceleration model (inverse_rates, with the Lie-bracket terms), fed the",
+            f"platform's (ω, ω̇) from central differences of its rotation (h = {FD_STEP:g} s), returns the",
+            f"trajectory's input accelerations to {res.data['inverse']['max_qdd_vs_differences']:.0e} rad/s²",
+            "(the differences' truncation) at the samples not flagged singular; by",
             "virtual work the motors hold only the moment about O (τ = −Jᵀ m_O): the thrust along the shaft",
             "passes through O and needs no torque.",
         ]
@@ -554,7 +601,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
 STUDY = Study(
     name="vectored-thrust",
     title="Paper 5: vectored-thrust spherical mechanism",
-    source="Robot 38(6), 2016",
+    source=PAPERS[5].short(),
     run=run,
     requires=("mujoco",),  # the engine overlays (robomech.verify); skipped without robomech[verify]
 )

@@ -49,6 +49,11 @@ class Profile:
         Profile
             ``q``, ``qd``, ``qdd`` of shape ``(..., 1 + len(others))``.
 
+        Raises
+        ------
+        ValueError
+            If one of ``others`` is not a :class:`Profile` or has another shape.
+
         Examples
         --------
         >>> import numpy as np
@@ -58,6 +63,15 @@ class Profile:
         (5, 2)
         """
         ps = (self, *others)
+        names = ["self", *(f"others[{i}]" for i in range(len(others)))]
+        for name, p in zip(names, ps, strict=True):  # also Profile.stack(a, b) called on the class
+            if not isinstance(p, Profile):
+                raise ValueError(f"Expected {name} to be a Profile, got {type(p).__name__}.")
+            if p.q.shape != self.q.shape:
+                raise ValueError(
+                    f"Expected {name} to have the shape {self.q.shape} of the first profile (the same "
+                    f"times), got {p.q.shape}."
+                )
         return Profile(*(np.stack([getattr(p, k) for p in ps], axis=-1) for k in ("q", "qd", "qdd")))
 
 

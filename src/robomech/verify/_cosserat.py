@@ -244,7 +244,7 @@ class TendonRod:
         The one "paper robot" of robomech: the same unprinted values as
         ``robomech.mechanisms.continuum.ContinuumRobot.paper()`` (a test checks it): core diameter
         1.0 mm, NiTi austenite E = 60 GPa (EI = 2.9e-3 N m²), ν = 0.33, cable-hole radius 4 mm.
-        (Issue 16: the 0.8 mm core assumed before buckles between the disks at 12 N pretension, inside
+        (A 0.8 mm core buckles between the disks at 12 N pretension, inside
         the paper's operating range; see ``ContinuumRobot.core_diameter``.)
         """
         return cls.from_round_rod(
@@ -845,7 +845,7 @@ def constant_curvature_statics(
 
 
 # ----------------------------------------------------------------------------------------------------
-# Error table (issue 8, paper 3)
+# Error table (paper 3)
 # ----------------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class ErrorTable:

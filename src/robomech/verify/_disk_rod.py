@@ -411,7 +411,7 @@ def _newton(fun, jac, x: np.ndarray) -> tuple[np.ndarray, float]:
     Jacobian, halved (up to ``DISK_NEWTON_BACKTRACKS`` times) while they do not lower |F|².  Returns
     the last iterate and its max |residual| (inf if a trial became non-finite or singular).
 
-    Replaces MINPACK ``hybr`` (issue 16): with its xtol at round-off, hybr spent its 100 evaluations per
+    Newton rather than MINPACK ``hybr``: with its xtol at round-off, hybr spent its 100 evaluations per
     continuation step on rank-one updates and failed half the steps; Newton with the exact-structure
     Jacobian converges quadratically in 3-6 iterations per step (9x fewer integrations, measured)."""
     with np.errstate(all="ignore"):
@@ -491,7 +491,7 @@ def straight_stability(robot: DiskRobot, tension: object, *, steps: int = DISK_R
 
     The straight rod under equal tensions is an exact equilibrium at every tension; where this value
     falls to 0 that equilibrium bifurcates (the robot buckles: a double zero, one per bending plane, so
-    the determinant touches 0 without changing sign).  Issue 16: with the 0.8 mm core assumed before,
+    the determinant touches 0 without changing sign).  With a 0.8 mm core
     the zero sits at 12.25 N per cable, = the Euler load pi² EI / h² of one disk interval under the
     three cables' compression 3 T, inside the paper's 3-11 N range plus margin; see
     ``docs/mechanisms/continuum_cosserat.md``."""

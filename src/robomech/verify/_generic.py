@@ -32,6 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
+from robomech._progress import stages
+
 from ._core import Check, Tolerance, VerificationReport
 
 __all__ = [
@@ -201,8 +203,18 @@ def _rel(err: float, scale: float) -> float:
     return float(err / scale) if scale > 0 else float(err)
 
 
+# The stages of check_mechanism, reported as progress (robomech._progress).
+_STAGES = ("assembly along the test trajectory", "inverse dynamics", "engine comparison", "power balance",
+           "forward simulation")  # fmt: skip
+
+
 def check_mechanism(mech, name: str | None = None, *, simulate: bool = True) -> list[Check]:
     """Every check of this module for ``mech`` (the rows of the ``robomech verify`` table)."""
+    with stages(f"verify {name or getattr(mech, 'name', 'mechanism')}", _STAGES[: 4 + simulate]) as st:
+        return _checks(mech, name, simulate, st)
+
+
+def _checks(mech, name: str | None, simulate: bool, st) -> list[Check]:
     import mujoco
 
     from robomech import multibody as mb
@@ -216,6 +228,7 @@ def check_mechanism(mech, name: str | None = None, *, simulate: bool = True) -> 
     tree = mech.tree
     L = tree.length
     checks: list[Check] = []
+    st.next()
     drv = _driver(mech)  # redundant actuation: a consistent motion is driven through `dof` actuators
     t, at = trajectory(drv)
     qa, qda, qdda = at(t)
@@ -233,10 +246,12 @@ def check_mechanism(mech, name: str | None = None, *, simulate: bool = True) -> 
     q, qa, qda, qdda = q[conv], qa[conv], qda[conv], qdda[conv]
     if not len(q):
         return checks
+    st.next()
     if drv is not mech:  # every actuator's rates along the driven (consistent) motion
         rd = mb.inverse_dynamics(drv, q, qda, qdda)
         qa, qda, qdda = q[:, tree.act_qadr], rd.qd[:, tree.act_dof], rd.qdd[:, tree.act_dof]
     inv = mb.inverse_dynamics(mech, q, qda, qdda)
+    st.next()
     m = engine_model(mech)
     d = mujoco.MjData(m)
     closure = vel = acc = 0.0
@@ -295,8 +310,10 @@ def check_mechanism(mech, name: str | None = None, *, simulate: bool = True) -> 
             f"max |tau| {tscale:.3g}; {int(inv.valid.sum())}/{len(inv.valid)} valid",
         )
     )
+    st.next()
     checks.append(_power_check(drv, name, m, d, at, t[conv], q, inv.tau, inv.qd[:, tree.act_dof]))
     if simulate:
+        st.next()
         checks += _simulation_checks(mech, name, q[0], qda[0])
     return checks
 

@@ -9,7 +9,7 @@ Two kinds of checks:
   for straight-routed cables, so the library's tensions fed to the Cosserat rod must reproduce the
   library's tip pose (one segment: the virtual-work sign; two segments: the coupling moments of the
   distal cables).  Under a tip load the difference is the modelling error of constant curvature,
-  tabulated by :func:`cc_error_table` (issue 8's table; shown in the ``continuum`` study).
+  tabulated by :func:`cc_error_table` (shown in the ``continuum`` study).
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ import math
 
 import numpy as np
 
+from robomech._progress import stages
 from robomech.mechanisms.continuum import (
     ContinuumRobot,
     cable_elongation,
@@ -477,23 +478,38 @@ def _segment_checks() -> list[Check]:
 def _run() -> list[Check]:
     rod = TendonRod.paper()
     rigid = TendonRod.paper(rigid_axial_shear=True)
-    return [
-        _arc_check(rigid),
-        _elastica_check(rigid),
-        _balance_check(rod),
-        _convergence_check(rod),
-        _library_check(ContinuumRobot.paper(), _ONE_SEGMENT_PSI, "1 segment (sign of virtual work)"),
+    robot = ContinuumRobot.paper()
+    steps = [
+        ("circular arc (rigid rod)", lambda: [_arc_check(rigid)]),
+        ("elastica (rigid rod)", lambda: [_elastica_check(rigid)]),
+        ("tendon balance", lambda: [_balance_check(rod)]),
+        ("mesh convergence", lambda: [_convergence_check(rod)]),
+        (
+            "library, 1 segment",
+            lambda: [_library_check(robot, _ONE_SEGMENT_PSI, "1 segment (sign of virtual work)")],
+        ),
         # the default pretension (10 N; 5 N on the old 0.8 mm core was already beyond the fixed point the
         # reference used before its Newton strain solve)
-        _library_check(
-            ContinuumRobot(n_segments=2, friction=(0.0,) * 6),
-            _TWO_SEGMENT_PSI,
-            "2 segments (coupling moments)",
+        (
+            "library, 2 segments",
+            lambda: [
+                _library_check(
+                    ContinuumRobot(n_segments=2, friction=(0.0,) * 6),
+                    _TWO_SEGMENT_PSI,
+                    "2 segments (coupling moments)",
+                )
+            ],
         ),
-        *_disk_checks(ContinuumRobot.paper()),
-        *_diskwise_checks(ContinuumRobot.paper()),
-        *_segment_checks(),
+        ("disk-resolved reference", lambda: _disk_checks(robot)),
+        ("disk-wise friction", lambda: _diskwise_checks(robot)),
+        ("segment cases", _segment_checks),
     ]
+    checks: list[Check] = []
+    with stages("verify continuum", [name for name, _ in steps]) as st:
+        for name, run in steps:
+            st.next(name)
+            checks.extend(run())
+    return checks
 
 
 def _grid_markdown(n_segments, pretension, bend_deg, cell) -> str:
@@ -532,7 +548,7 @@ CC_TABLE_LOADS = (
 
 
 def cc_error_table(robot: ContinuumRobot | None = None) -> CCErrorTable:
-    """Issue 8's table: library constant-curvature error vs the Cosserat rod (bends in the x-z plane)."""
+    """Library constant-curvature error vs the Cosserat rod (bends in the x-z plane)."""
     robot = ContinuumRobot.paper() if robot is None else robot
     bends = np.array(CC_TABLE_BENDS_DEG)
     forces = np.array([f for _, f in CC_TABLE_LOADS])

@@ -62,7 +62,7 @@ TOL_VELOCITY = Tolerance(
 # Energy: the same bodies summed by two codes (MuJoCo from its compiled principal inertias).
 TOL_ENERGY = Tolerance(1e-10, "the same 22 rigid bodies; rounding of principal-axis inertias", relative=True)
 # Inverse dynamics: both sides are exact rigid-body models of the same bodies; only rounding differs
-# (measured 6e-15; issue 13's bar 1e-8 relative, was 1e-6 with the hand-written model).
+# (measured 6e-15; the bar is 1e-8 relative).
 TOL_TORQUE = Tolerance(
     1e-8, "exact tree inverse dynamics + least-squares projection; rounding only", relative=True
 )

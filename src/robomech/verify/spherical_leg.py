@@ -74,8 +74,8 @@ FORCE_TOL = Tolerance(1e-8, "exact rigid-body dynamics both sides; projection co
 MASS_TOL = Tolerance(1e-10, "exact mass matrices both sides (engine M through exact G)", relative=True)
 ENERGY_TOL = Tolerance(1e-10, "exact energies both sides; rounding", relative=True)
 # Forward simulation with stiff soft equality constraints (solref 2 ms) and a 0.2 ms Euler step: the
-# tracking error is the integrator's first-order error (measured 1.6e-4 rad before issue 13 with the
-# ball-jointed hand-written model, halving with the step); the PD (30 rad/s) keeps it from accumulating.
+# tracking error is the integrator's first-order error (measured 1.6e-4 rad with a ball-jointed
+# hand-written model, halving with the step); the PD (30 rad/s) keeps it from accumulating.
 SIM_TRACKING_TOL = Tolerance(3e-4, "Euler O(dt) error at 0.2 ms, measured ~1.6e-4 rad (halves with dt)")
 SIM_FEEDBACK_TOL = Tolerance(
     1e-2, "feedback share of the leg forces: the analytic feed-forward must do the work", relative=True
@@ -451,7 +451,7 @@ def run_checks(analytic: sl.SphericalLeg | None = None, *, paper_as_printed: boo
     """All checks of the paper-1 verification; ``analytic`` (default: the engine's own parameters) is the
     model being verified: pass a deliberately wrong one to see the checks fail.  ``paper_as_printed``
     verifies the analytic dynamics without the legs' spin that the base universal joints impose (paper
-    1, eq. (23)): the dynamic checks then fail, which is the finding of issue 13."""
+    1, eq. (23)): the dynamic checks then fail: the paper's energy misses that spin."""
     if analytic is not None:
         check_params(analytic, sl.SphericalLeg, "analytic")
     printed = check_bool(paper_as_printed, "paper_as_printed")

@@ -1,7 +1,7 @@
 """Bad-input specs of robomech.dynamics."""
 
 import numpy as np
-from contract_spec import RESULT_TYPE, Spec
+from contract_spec import CONSTANT, RESULT_TYPE, Spec
 
 from robomech import dynamics
 
@@ -16,6 +16,9 @@ JA = rng.normal(size=(3, 4, 3))  # actuator Jacobians (k = 4 actuators, n = 3)
 
 SPECS = {
     P + "DynamicsTerms": RESULT_TYPE,
+    P + "ActuatorForces": RESULT_TYPE,
+    P + "ACTUATION_RESIDUAL_RTOL": CONSTANT,
+    P + "INERTIA_RTOL": CONSTANT,
     P + "spatial_inertia": Spec(
         args={
             "mass": np.array([1.0, 2.0]),
@@ -24,7 +27,11 @@ SPECS = {
         },
         arrays={"mass": 0, "com": 1, "inertia_com": 2},
         wrong_shapes={"mass": ((3,),)},
-        options={"mass": (-1.0,)},
+        # an indefinite and an asymmetric inertia: no mass has them
+        options={
+            "mass": (-1.0,),
+            "inertia_com": (np.diag([1.0, 1.0, -1.0]), np.array([[1.0, 0.5, 0], [0, 1, 0], [0, 0, 1]])),
+        },
     ),
     P + "mass_matrix": Spec(
         args={"G": G2, "J": J},
@@ -59,7 +66,7 @@ SPECS = {
         arrays={"J_act": 2, "tau_q": 1},
         wrong_shapes={"J_act": ((3, 2, 3),)},
         masked=("J_act", "tau_q"),
-        mask=lambda r: np.isfinite(r[1]),
+        mask="valid",
         options={"rcond": (np.nan, -1.0, "1e-12", True)},
     ),
 }

@@ -70,11 +70,18 @@ SPECS = {
         P,
     ),
     P + "ContinuumRobot": Spec(
-        args={"n_segments": 1, "segment_length": 0.09, "friction": (0.2, 0.3, 0.25), "pretension": 5.0},
+        args={
+            "n_segments": 1,
+            "segment_length": 0.09,
+            "friction": (0.2, 0.3, 0.25),
+            "pretension": 5.0,
+            "hole_radius": 0.004,
+        },
         options={
             "n_segments": (*BAD_INT, 0, True),
             "segment_length": BAD_POSITIVE,
             "pretension": BAD_NONNEGATIVE,
+            "hole_radius": (1e-6, 4e-4),  # inside the 1 mm core: the cable cannot run there
             "friction": (
                 None,
                 "abc",

@@ -48,7 +48,8 @@ SPECS = {
     ),
     P + "default_bodies": Spec(
         args={**L, "knee_to_crank": 0.03},
-        options={"L1": BAD_POSITIVE, "L5": BAD_POSITIVE, "knee_to_crank": BAD_REAL},
+        # a negative depth, and one that leaves the foot rod no length (>= L5), are refused by name
+        options={"L1": BAD_POSITIVE, "L5": BAD_POSITIVE, "knee_to_crank": (*BAD_REAL, -0.01, 1.0)},
     ),
     P + "forward_kinematics": _leg(q=Q),
     P + "jacobian": _leg(q=Q),

@@ -62,8 +62,16 @@ SPECS = {
         # twists (..., N, 6): a batch of 2 histories of N = 3 twists, each from its own start pose
         args={"twists": np.stack([TWIST, -TWIST]), "dt": 0.01, "T0": np.stack([np.eye(4), np.eye(4)])},
         arrays={"twists": 2, "T0": 2},
-        wrong_shapes={"T0": ((3, 4),)},
-        options={"dt": BAD_POSITIVE},
+        wrong_shapes={"T0": ((3, 4),), "twists": ((2, 0, 6),)},
+        # a start pose that is no rigid transform: scaled, sheared, or with a projective last row
+        options={
+            "dt": BAD_POSITIVE,
+            "T0": (
+                2.0 * np.eye(4),
+                np.eye(4) + np.triu(np.ones((4, 4)), 1) * 0.1,
+                np.diag([1.0, 1.0, -1.0, 1.0]),
+            ),
+        },
     ),
     P + "skid_steer_turn": Spec(
         args={"v_right": np.array([1.0, 2.0]), "v_left": np.array([0.5, 1.5]), "track_width": 0.5},

@@ -26,8 +26,8 @@ SPECS = {
     P + "DEXTERITY_TOL": CONSTANT,
     P + "SINGULAR_TOL": CONSTANT,
     **exempt(
-        "AccelerationResult FKResult IKResult JacobianResult JointAxes MechanismMobility PassiveResult"
-        " RotationResult VelocityResult WorkspaceMap",
+        "AccelerationResult FKResult IKResult JacobianResult JointAxes LinkClearanceResult MechanismMobility"
+        " PassiveResult RotationResult VelocityResult WorkspaceMap",
         RESULT_TYPE,
         P,
     ),
@@ -51,7 +51,7 @@ SPECS = {
     P + "passive_angles": _q("valid"),
     P + "jacobian": _q("valid"),
     P + "workspace_map": _q("reachable"),
-    P + "link_clearance": _q(None),
+    P + "link_clearance": _q("valid"),
     P + "dexterity": _q(None),
     P + "passive_rates": _q("valid", qd=QD),
     P + "angular_velocity": _q("valid", qd=QD),

@@ -16,6 +16,8 @@ W = np.array([[0.1, 0.2, 0.0], [0.0, -0.3, 0.1], [0.2, 0.0, 0.1]])
 
 SPECS = {
     P + "INPUT_GAIN_MAX": CONSTANT,
+    P + "RATE_RESIDUAL_ATOL": CONSTANT,
+    P + "RATE_RESIDUAL_RTOL": CONSTANT,
     **exempt("InverseRatesResult StaticsResult", RESULT_TYPE, P),
     P + "inverse_rates": Spec(
         args={"th": TH, "q": Q, "omega": W, "omega_dot": W[::-1].copy(), "damping": 0.01},

@@ -31,6 +31,9 @@ BAD_STEPS = (*BAD_INT, 0)
 # the gallery's write() writes its files here, not into the package
 WRITE_DIR = tempfile.mkdtemp(prefix="robomech-gallery-")
 
+# the output of the type I test: a name among pose/position/orientation or distinct rows 0..5
+BAD_OUTPUT = (None, "speed", 3, (), (3, 3), (0, 6), (-1,), (1.5,), ("a",))
+
 SPECS = {
     # ---- description -------------------------------------------------------------------------------
     P + "Joint": Spec(
@@ -203,19 +206,25 @@ SPECS = {
             "reference": MECH.q0,
             "length": 0.5,
             "rtol": 1e-8,
+            "output": "position",
         },
         arrays={"q": 1, "reference": 1},
         unbatched=("reference",),  # one reference configuration (the branch) for the whole batch
         params=("mech",),
-        options={"site": (*BAD_STR, "nope"), "length": BAD_LENGTH, "rtol": (*BAD_REAL, 0.0, 1.0, -1.0)},
+        options={
+            "site": (*BAD_STR, "nope"),
+            "length": BAD_LENGTH,
+            "rtol": (*BAD_REAL, 0.0, 1.0, -1.0),
+            "output": BAD_OUTPUT,
+        },
     ),
     P + "singularity_map": Spec(
-        args={"mech": MECH, "site": "coupler_point", "q_act": QA, "guess": Q, "steps": 2},
+        args={"mech": MECH, "site": "coupler_point", "q_act": QA, "guess": Q, "steps": 2, "output": (3, 4)},
         arrays={"q_act": 1, "guess": 1},
         masked=("q_act",),
         mask="reachable",
         params=("mech",),
-        options={"site": (*BAD_STR, "nope"), "steps": BAD_STEPS},
+        options={"site": (*BAD_STR, "nope"), "steps": BAD_STEPS, "output": BAD_OUTPUT},
     ),
     # ---- drawing -----------------------------------------------------------------------------------
     P + "body_segments": Spec(

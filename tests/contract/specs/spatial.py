@@ -1,7 +1,7 @@
 """Bad-input specs of robomech.spatial (pure math: every bad input raises, nothing is masked)."""
 
 import numpy as np
-from contract_spec import BAD_REAL, CONSTANT, Spec
+from contract_spec import CONSTANT, Spec
 
 P = "robomech.spatial."
 W2 = np.array([[0.1, -0.2, 0.3], [0.4, 0.5, -0.6]])  # (2, 3) rotation vectors
@@ -43,8 +43,8 @@ SPECS = {
     ),
     P + "screw_to_axis": Spec(args={"S": V2}, arrays={"S": 1}),
     P + "wrench_at": Spec(
-        args={"force": W2, "point": W2[::-1], "moment": 0.0},
-        arrays={"force": 1, "point": 1},
-        options={"moment": BAD_REAL[:5]},
+        args={"force": W2, "point": W2[::-1], "moment": W2 * 0.5},
+        arrays={"force": 1, "point": 1, "moment": 1},
+        options={"moment": (0.0, 1.0, [1.0, 2.0])},  # a moment is a vector: no scalar
     ),
 }

@@ -67,8 +67,21 @@ def test_gamma_zero_is_flagged_and_damped_not_blown_up():
     u = ol.thigh_direction(0.3, -0.2)
     P = np.eye(3) - np.outer(u, u)
     np.testing.assert_allclose(P @ ol.foot_velocity(LEG, q[0], r.qd[0]), P @ v, atol=1e-12)
-    # damping 0: truncated pseudo-inverse, γ̇ = 0 exactly at γ = 0
+    # damping 0: at γ = 0 exactly (σ = 0) the null direction gets 0, γ̇ = 0 ...
     assert ol.joint_rates(LEG, q[0], v, damping=0.0).qd[2] == 0.0
+
+
+def test_damping_zero_inverts_the_weak_direction_fully():
+    # ... but next to it the weak direction is inverted fully (1/σ, the exact inverse), not dropped:
+    # what the docstring says, and what a truncated pseudo-inverse would not do (γ̇ would stay 0)
+    q = np.array([0.3, -0.2, 1e-5])
+    v = np.array([0.0, 0.0, 1e-4])
+    r = ol.joint_rates(LEG, q, v, damping=0.0)
+    exact = np.linalg.solve(ol.jacobian(LEG, q), v)
+    np.testing.assert_allclose(r.qd, exact, rtol=1e-9, atol=1e-9 * np.abs(exact).max())  # rounding of the SVD
+    assert abs(r.qd[2]) > 1.0 and r.velocity_residual < 1e-12 and r.singular and not r.valid
+    damped = ol.joint_rates(LEG, q, v)  # the default damping bounds it
+    assert abs(damped.qd[2]) < abs(r.qd[2]) / 10
 
 
 def test_batch_equals_per_sample_and_no_acceleration():

@@ -48,13 +48,81 @@ def test_every_reachable_sample_lies_inside_the_extents():
     assert np.all(np.linalg.norm(p[:, :2], axis=-1) <= fw.radius_max + 1e-12)
 
 
+# The joint maps behind paper 2's symmetry claim (measured once, then asserted): the foot mirrored
+# in x is the foot at (α, -β, γ), mirrored in y at (-α, β, γ), swapped (x, y) -> (-y, -x) at (β, α, γ).
+# With the box |α|, |β| <= 65° they make workspace_symmetry hold by construction (an identity of the
+# box), so the claim is tested on the kinematics instead: the forward and inverse kinematics must
+# carry these maps (a sign or axis error in either breaks them), and the reachable set must follow
+# the box on both sides of its boundary.
+_IMAGES = (
+    (lambda p: p * [-1.0, 1.0, 1.0], lambda q: q * [1.0, -1.0, 1.0]),
+    (lambda p: p * [1.0, -1.0, 1.0], lambda q: q * [-1.0, 1.0, 1.0]),
+    (lambda p: np.stack([-p[..., 1], -p[..., 0], p[..., 2]], -1), lambda q: q[..., [1, 0, 2]]),
+)
+# FK of mirrored joint angles vs the mirrored FK: the same floating-point operations up to signs and
+# one rounding of a sum's order.
+EQUIVARIANCE_TOL = 1e-15
+# IK of a mirrored foot vs the mirrored joint angles: the closed form's rounding, amplified near the
+# joint-limit corners (measured 9.5e-15 over 2000 samples of the box).
+IK_IMAGE_TOL = 1e-12
+
+
+def _equivariance_error(fk, q):
+    p = fk(q)
+    return max(float(np.abs(fk(jmap(q)) - pmap(p)).max()) for pmap, jmap in _IMAGES)
+
+
+def _inside(n, seed):
+    rng = np.random.default_rng(seed)
+    return rng.uniform([-1, -1, 0.05], [1, 1, 1], (n, 3)) * [LEG.alpha_max, LEG.beta_max, LEG.gamma_max]
+
+
+def test_the_kinematics_carry_the_symmetry_maps():
+    q = _inside(2000, seed=1)
+    assert _equivariance_error(lambda x: ol.forward_kinematics(LEG, x), q) <= EQUIVARIANCE_TOL
+    p = ol.forward_kinematics(LEG, q)
+    for pmap, jmap in _IMAGES:
+        ik = ol.inverse_kinematics(LEG, pmap(p))
+        assert ik.reachable.all()
+        np.testing.assert_allclose(ik.q, jmap(q), atol=IK_IMAGE_TOL)
+
+
+def test_the_equivariance_check_catches_a_sign_error():
+    # control: a forward kinematics with one sign wrong (β entering as -β in the y coordinate only)
+    def wrong(q):
+        p = ol.forward_kinematics(LEG, q)
+        return p + np.stack([0 * p[..., 0], 0.01 * np.sin(q[..., 1]) * np.cos(q[..., 0]), 0 * p[..., 2]], -1)
+
+    assert _equivariance_error(wrong, _inside(200, seed=2)) > 1e-3
+
+
+def test_reachability_follows_the_box_on_both_sides_of_its_boundary():
+    # feet just inside and just outside |α| = α_max (and |β| = β_max): reachable exactly inside, for
+    # the sample and for each image -- the classification of the inverse kinematics, not of the box
+    eps = 1e-6
+    rng = np.random.default_rng(3)
+    n = 200
+    other = rng.uniform(-0.9, 0.9, n) * LEG.beta_max
+    gamma = rng.uniform(0.1, 1.0, n) * LEG.gamma_max
+    sign = rng.choice([-1.0, 1.0], n)
+    for k in (0, 1):  # the α limit, then the β limit
+        lim = (LEG.alpha_max, LEG.beta_max)[k]
+        for scale, expected in ((1 - eps, True), (1 + eps, False)):
+            q = np.zeros((n, 3))
+            q[:, k], q[:, 1 - k], q[:, 2] = sign * lim * scale, other, gamma
+            p = ol.forward_kinematics(LEG, q)
+            assert np.all(ol.inverse_kinematics(LEG, p).reachable == expected)
+            for pmap, _ in _IMAGES:
+                assert np.all(ol.inverse_kinematics(LEG, pmap(p)).reachable == expected)
+
+
 def test_paper_symmetry_claim_holds_for_table_2():
     fw = ol.foot_workspace(LEG)
     p, _ = _box_samples(fw, 100_000, seed=1)
     s = ol.workspace_symmetry(LEG, p)
     assert 0.3 < s.reachable.mean() < 0.7  # the samples probe the boundary, not only the inside
     assert s.holds.all()
-    # and exactly: the boundary maps onto itself under the four-fold symmetry
+    # and the boundary of the projected workspace (foot_workspace's quadrature) maps onto itself
     b = fw.boundary
     for img in (b * [-1, 1], b * [1, -1], np.stack([-b[:, 1], -b[:, 0]], -1)):
         d = np.min(np.linalg.norm(img[:, None] - b[None], axis=-1), axis=1)

@@ -153,3 +153,25 @@ def test_identification_round_trip_on_random_models(yl, yr, xi, seed):
     assert ident.identifiable
     for k in ("y_left", "y_right", "x_icr"):
         assert getattr(ident.model, k) == pytest.approx(getattr(true, k), abs=1e-9)
+
+
+def test_zero_weights_are_unused_samples():
+    import warnings
+
+    rng = np.random.default_rng(7)
+    true = ICRModel(y_left=0.3, y_right=-0.32, x_icr=0.02)
+    r = rng.uniform(0.1, 0.5, 8) * rng.choice([-1, 1], 8)
+    vx = rng.uniform(0.1, 0.5, 8)
+    V = np.stack([vx, -r * true.x_icr, r], axis=-1)
+    vr, vl = vx - r * true.y_right, vx - r * true.y_left
+    w = np.array([1, 1, 1, 1, 1, 0, 0, 0], dtype=float)
+    vr_bad = vr.copy()
+    vr_bad[5:] += 10.0  # garbage where the weight is 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ident = identify_icr(vr_bad, vl, V, weights=w)
+        none = identify_icr(vr, vl, V, weights=np.zeros(8))  # no warning from inside lstsq either
+    assert ident.n_used == 5 and ident.used.tolist() == [True] * 5 + [False] * 3
+    assert ident.identifiable and abs(ident.model.y_right - true.y_right) < 1e-12
+    np.testing.assert_allclose(ident.residual_rms, 0.0, atol=1e-12)  # the garbage is not in the rms
+    assert none.n_used == 0 and not none.identifiable and none.model is None

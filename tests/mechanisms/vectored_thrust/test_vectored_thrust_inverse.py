@@ -43,6 +43,38 @@ def test_unrealisable_angular_velocity_leaves_a_residual():
     r = vt.inverse_rates(TH, q, n)  # normal to J's range: no input motion produces it
     np.testing.assert_allclose(r.qd, 0.0, atol=1e-12)
     np.testing.assert_allclose(r.omega_residual, 1.0, atol=1e-12)
+    assert not r.valid.any()  # a command the mechanism cannot produce is not a valid solution
+
+
+def test_valid_means_the_command_is_realised():
+    th = vt.VectoredThruster.paper()
+    r = vt.inverse_rates(th, [0.0, 0.0], [0.0, 0.0, 1.0])
+    assert float(r.omega_residual) == pytest.approx(1.0) and not r.valid
+    # control: a realisable command at the same configuration is valid, and a component outside J's
+    # range just above the tolerance is not
+    q = _box(50, seed=4)
+    J = vt.jacobian(th, q).J
+    w = np.einsum("...ij,...j->...i", J, np.random.default_rng(5).normal(size=(50, 2)))
+    assert vt.inverse_rates(th, q, w).valid.all()
+    n = np.cross(J[:, :, 0], J[:, :, 1])
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    scale = 10.0 * vt.RATE_RESIDUAL_RTOL * np.linalg.norm(w, axis=-1, keepdims=True)
+    assert not vt.inverse_rates(th, q, w + scale * n).valid.any()
+    # the same for ω̇: a realisable ω with an unrealisable ω̇
+    wd = np.einsum("...ij,...j->...i", J, np.ones((50, 2)))
+    ok = vt.inverse_rates(
+        th, q, w, vt.angular_acceleration(th, q, vt.inverse_rates(th, q, w).qd, 0 * w[:, :2]).omega_dot
+    )
+    assert ok.valid.all()
+    assert not vt.inverse_rates(th, q, w, wd + n).valid.any()
+
+
+def test_link_clearance_is_flagged_where_singular():
+    th = vt.VectoredThruster.paper()
+    r = vt.link_clearance(th, [[0.0, np.pi / 4], [0.1, 0.2]])
+    assert r.valid.tolist() == [False, True]
+    assert np.isnan(r.clearance[0]) and np.isfinite(r.clearance[1])
+    assert np.array_equal(r.valid, vt.joint_axes(th, [[0.0, np.pi / 4], [0.1, 0.2]]).valid)
 
 
 def test_idle_input_curve_and_singular_points_are_flagged():

@@ -79,7 +79,9 @@ def test_link_clearance_matches_the_reference_over_the_input_box(arc: float) -> 
     ax = vt.joint_axes(th, q)
     ok = ax.valid
     ref = _reference_clearance(ax.s11[ok], ax.s12[ok], ax.s22[ok], ax.s13[ok])
-    got = vt.link_clearance(th, q)
+    res = vt.link_clearance(th, q)
+    got = res.clearance
+    assert np.array_equal(res.valid, ok)  # NaN exactly where flagged
     # the kernel specialises the geometry (closed-form normals and side vectors): the same to rounding,
     # which arcsin amplifies by 1 / cos(clearance) where a perpendicular distance approaches pi/2
     tol = ROUNDING_TOL / np.maximum(np.cos(ref), 1e-6)

@@ -234,7 +234,7 @@ def compensated_drive(
     disks in the sliding ``direction``, pretension in the null space), the elongation from
     :func:`cable_elongation`, q~ = q + delta.
 
-    ``method="disk"`` (issue 16; not in the paper): the drive that puts the segment ends of the
+    ``method="disk"`` (not in the paper): the drive that puts the segment ends of the
     disk-wise constant-curvature model (:func:`disk_equilibrium`: one arc per disk interval, so the
     curvature can fall from disk to disk under friction) on the commanded ones.  A pose psi' is sought
     (Gauss-Newton, least squares over the 3 n end coordinates) whose library tensions
@@ -242,7 +242,7 @@ def compensated_drive(
     at those of psi; q~ is the drive of that equilibrium (chord lengths and cable stretch included), and
     ``delta = q~ - q``.  Chord cables only (``model="chord"``), no ``wrench``.
 
-    ``pulley`` (issue 16, eqs. (29)-(35)): the guide pulley at every actuator.  The tension entering the
+    ``pulley`` (paper 3, eqs. (29)-(35)): the guide pulley at every actuator.  The tension entering the
     robot is the model tension above; the actuator side differs by the improved-capstan ratio kappa
     (eq. (32), in the cable's sliding ``direction``), and the cable wrapped over the pulley stretches by
     delta_c (eq. (34)), which is added to delta.  None (default): no pulley, today's drive exactly.
@@ -263,7 +263,7 @@ def compensated_drive(
         unloaded.
     method : {"paper", "disk"}, optional
         ``"paper"`` (default): segment-wise constant curvature as printed; ``"disk"``: the disk-wise
-        model (issue 16), see above.
+        model, see above.
     pulley : Pulley, optional
         Guide pulley at every actuator (eqs. (29)-(35)); ``None``: no pulley.
 
@@ -625,7 +625,7 @@ def simulate_history(
 ) -> HistoryResult:
     """The simulated robot driven through a history ``q (n_t, ..., 3 n)`` (m, leading time axis).
 
-    Path-dependent (issue 16 item 3, paper 3 eq. (19) with memory), from the straight pretensioned pose
+    Path-dependent (paper 3 eq. (19) with memory), from the straight pretensioned pose
     (q = 0, every span at the pretension).
 
     ``memory="elastic"`` (default): stick-slip with memory that the pose feels, on the disk-wise robot
@@ -833,7 +833,7 @@ def _slip_history(
     )
 
 
-# ---- disk-wise constant curvature (issue 16) ----------------------------------------------------
+# ---- disk-wise constant curvature ---------------------------------------------------------------
 def _ends_of(robot: ContinuumRobot, eq: DiskEquilibrium) -> np.ndarray:
     N = robot.disks_per_segment
     return eq.disk_T[..., N::N, :3, 3].reshape(*eq.tip.shape[:-1], 3 * robot.n_segments)
@@ -886,7 +886,7 @@ def disk_equilibrium(
     direction: object | None = None,
     initial: object | None = None,
 ) -> DiskEquilibrium:
-    """Equilibrium of the disk-wise constant-curvature robot: one arc per disk interval (issue 16).
+    """Equilibrium of the disk-wise constant-curvature robot: one arc per disk interval.
 
     Exactly one of ``tension`` and ``drive`` loads the robot.  Chord spans, wrap angles, capstan
     friction and cable stretch as in the segment model; the curvature may differ from interval to

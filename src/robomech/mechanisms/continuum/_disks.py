@@ -1,4 +1,4 @@
-"""Disk-wise constant curvature: every disk interval its own arc (issue 16).
+"""Disk-wise constant curvature: every disk interval its own arc.
 
 Paper 3 models each segment as one arc (eqs. (1)-(4)) and multiplies the tensions by one friction
 factor per segment (eq. (24)).  With friction at the holes the span tensions fall (pulled cable) or
@@ -215,7 +215,7 @@ def _state(
     # compression depends on the tensions that depend on the paths: a fixed point (the shortening is
     # ~1e-5 m, and 1e-5 m of path is ~0.1 N of tension); measured: after 5 passes the drive-mode round
     # trip is off by 2e-7 N at 80 deg, after COLUMN_PASSES = 8 by 1e-9 N (paper robot, 1.0 mm core at
-    # 10 N; 2e-5 / 6e-8 N with the 0.8 mm core at 5 N before issue 16).
+    # 10 N; 2e-5 / 6e-8 N with a 0.8 mm core at 5 N).
     ell_path, t_raw = ell, load
     for _ in range(1 if mode == "tension" else COLUMN_PASSES):
         t_u = load if mode == "tension" else _tension_estimate(robot, ell_path, P, load)
@@ -293,7 +293,7 @@ def _uniform_k(robot: ContinuumRobot, theta: Array, beta: Array) -> Array:
     return np.stack([th * np.cos(be), th * np.sin(be)], -1).reshape(*th.shape[:-1], 2 * th.shape[-1])
 
 
-# ---- stick-slip with memory fed back into the pose (issue 16 item 3) ------------------------------
+# ---- stick-slip with memory fed back into the pose -------------------------------------------------
 @dataclass(frozen=True)
 class MemoryStep:
     """One step of the stick-slip history of the disk-wise robot (internal; see simulate_history).

@@ -100,7 +100,7 @@ def _as_direction(robot: ContinuumRobot, direction: object | None, batch: tuple[
     d = as_array(direction, "direction", (robot.n_cables,))
     # paper 3, eq. (19): the stuck branch (q_dot = 0) keeps the previous tension, which needs a stick-slip
     # model with memory; it is not implemented, so a sticking cable with friction is refused instead of
-    # silently getting the frictionless tension (issue 14, defect 6).  0 is accepted where mu = 0.
+    # silently getting the frictionless tension.  0 is accepted where mu = 0.
     sliding = (d == 1.0) | (d == -1.0)
     if np.any(~sliding & (robot.friction_array > 0.0)):
         raise ValueError(
@@ -669,7 +669,7 @@ def stick_slip_tensions(
     return TensionHistory(span_tension=out, state=state, distal=distal)
 
 
-# ---- stick-slip of an elastic cable through the holes (issue 16 item 3) ---------------------------
+# ---- stick-slip of an elastic cable through the holes ---------------------------------------------
 # A cable is a chain of pieces: piece 0 the free length between the actuator and the base plate, piece
 # p >= 1 the span that starts at hole p - 1 (hole 0 the base plate, hole k >= 1 disk k).  The state is
 # the unstretched material m_p of every piece; its tension follows Hooke's law on the current length g_p,

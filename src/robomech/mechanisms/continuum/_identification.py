@@ -166,7 +166,7 @@ core diameter is not printed: a factor 4 either way covers any plausible core)."
 
 @dataclass(frozen=True)
 class TipFrictionEstimate:
-    """Output-error fit of the disk-wise model to tracked tips (:func:`identify_friction_from_tip`, issue 16).
+    """Output-error fit of the disk-wise model to tracked tips (:func:`identify_friction_from_tip`).
 
     Uncertainties are linearised: covariance s² (JᵀJ)⁻¹ with s² the residual variance of the tip fit
     (model error included, not only the tracker noise), or 1 in the errors-in-variables fit.
@@ -209,7 +209,7 @@ def identify_friction_from_tip(
     sigma_t: float | None = None,
     sigma_tip: float | None = None,
 ) -> TipFrictionEstimate:
-    """Friction coefficients (and optionally the core stiffness) from tracked tips (issue 16).
+    """Friction coefficients (and optionally the core stiffness) from tracked tips.
 
     Measurements: ``tip (m, 3)`` tracked tip positions (m), ``t_act (m, 3 n)`` actuator-side tensions
     (load cells, N), ``direction (m, 3 n)`` the sliding direction (±1).  Model: the disk-wise

@@ -35,7 +35,8 @@ class ContinuumRobot:
         Disks N per segment (chord spans per segment, >= 1); paper: 5 disks.
     hole_radius : float
         Distance r of the cable holes from the core axis (m); not printed, default 4 mm. Must be well
-        below ``segment_length`` (``n_segments * hole_radius < segment_length``).
+        below ``segment_length`` (``n_segments * hole_radius < segment_length``) and clear the core
+        (``hole_radius >= (core_diameter + cable_diameter) / 2``).
     core_modulus, core_diameter : float
         Young's modulus (Pa) and diameter (m) of the NiTi core; not printed (60 GPa, 1.0 mm: EI =
         2.9e-3 N m², chosen for stability, see ``core_diameter`` below and
@@ -46,8 +47,8 @@ class ContinuumRobot:
         Coulomb friction coefficient per cable (3 n entries, >= 0); paper Table 1 (0.26, 0.31, 0.28).
     pretension : float
         Cable pretension T0 (N, >= 0); not printed, default 10 N (inside Fig. 6's 3-11 N range; with the
-        1.0 mm core a 90 deg bend needs ~13 N of tension difference, so 5 N, the default before issue 16,
-        lets the paid-out cables go slack there).
+        1.0 mm core a 90 deg bend needs ~13 N of tension difference, so 5 N lets the paid-out cables go slack
+        there).
     free_length : float
         Cable length between the actuator and the base plate (m, >= 0); not printed, default 0.1 m.
     cable_offset : float
@@ -57,8 +58,8 @@ class ContinuumRobot:
     ------
     ValueError
         If a count is not an integer >= 1, a length or modulus is not positive, ``pretension`` or
-        ``free_length`` is negative, ``hole_radius`` is too large, or ``friction`` does not have 3 n
-        finite non-negative entries.
+        ``free_length`` is negative, ``hole_radius`` is too large or inside the core, or ``friction``
+        does not have 3 n finite non-negative entries.
     """
 
     n_segments: int = 1
@@ -67,7 +68,7 @@ class ContinuumRobot:
     hole_radius: float = 0.004
     core_modulus: float = 60e9
     # paper 3 prints no core diameter.  1.0 mm (EI = 2.9e-3 N m²) because the paper's robot runs stably
-    # at pretensions up to 11 N (Fig. 6; issue 16's range goes to 15 N): between two disks (h = 18 mm)
+    # at pretensions up to 11 N (Fig. 6; the verification range goes to 15 N): between two disks (h = 18 mm)
     # the core is a column under the three cables' compression 3 T, so the straight robot buckles at
     # T_cr = pi² EI / (3 h²) per cable (measured on the disk reference: 12.25 N with the 0.8 mm core
     # assumed before, inside that range; 29.9 N with 1.0 mm, twice 15 N), and the chord sagitta's
@@ -91,6 +92,14 @@ class ContinuumRobot:
             raise ValueError(
                 f"Expected hole_radius well below segment_length, got {self.hole_radius!r} m vs "
                 f"{self.segment_length!r} m."
+            )
+        # a cable runs in a hole beside the core, not through it: the hole's centre must clear the core
+        # and the cable's own radius
+        clear = 0.5 * (self.core_diameter + self.cable_diameter)
+        if self.hole_radius < clear:
+            raise ValueError(
+                f"Expected hole_radius >= (core_diameter + cable_diameter) / 2 = {clear!r} m (the cable "
+                f"beside the core, not inside it), got {self.hole_radius!r} m."
             )
         mu_a = as_array(self.friction, "friction", (None,))
         if mu_a.ndim != 1:

@@ -637,7 +637,7 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     tau = as_array(tau, "tau", (3,))
-    broadcast_batch((q, 1, "q"), (tau, 1, "tau"))
+    batch = broadcast_batch((q, 1, "q"), (tau, 1, "tau"))
     J = jacobian(leg, q)
     U, s, Vt = np.linalg.svd(J)
     rcond = s[..., -1] / s[..., 0]
@@ -649,4 +649,10 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     # paper 2, eq. (47): F_f = (Jᵀ)⁻¹ τ for the force the foot delivers; the force applied to it is -F_f
     F = -np.einsum("...ij,...j->...i", U, coef * np.einsum("...ij,...j->...i", Vt, tau))
     resid = np.linalg.norm(-np.einsum("...ij,...i->...j", J, F) - tau, axis=-1)
-    return FootForceResult(force=F, singular=singular, rcond=rcond, residual=resid)
+    # the per-sample fields have the batch of every argument (q may be one configuration for many tau)
+    return FootForceResult(
+        force=F,
+        singular=np.broadcast_to(singular, batch),
+        rcond=np.broadcast_to(rcond, batch),
+        residual=resid,
+    )

@@ -157,7 +157,7 @@ def default_bodies(L1: float, L3: float, L4: float, L5: float, knee_to_crank: fl
         Thigh rod length, U-joint radius, shank link length and knee height (m), each > 0 (see
         :class:`OmniLeg`).
     knee_to_crank : float
-        Depth of the crank joints C_i below the knee point O0' (m).
+        Depth of the crank joints C_i below the knee point O0' (m), ``0 <= knee_to_crank < L5``.
 
     Returns
     -------
@@ -169,7 +169,8 @@ def default_bodies(L1: float, L3: float, L4: float, L5: float, knee_to_crank: fl
     Raises
     ------
     ValueError
-        If a length is not a positive finite real number or ``knee_to_crank`` is not a finite real.
+        If a length is not a positive finite real number, or ``knee_to_crank`` is negative or not
+        below ``L5``.
 
     Examples
     --------
@@ -178,7 +179,13 @@ def default_bodies(L1: float, L3: float, L4: float, L5: float, knee_to_crank: fl
     (11, True)
     """
     L1, L3, L4, L5 = (check_positive(v, n) for v, n in ((L1, "L1"), (L3, "L3"), (L4, "L4"), (L5, "L5")))
-    knee_to_crank = check_real(knee_to_crank, "knee_to_crank")
+    knee_to_crank = check_positive(knee_to_crank, "knee_to_crank", allow_zero=True)
+    if knee_to_crank >= L5:
+        # the foot rod runs from the crank plane down to the foot point: it needs a positive length
+        raise ValueError(
+            f"Expected knee_to_crank < L5 (the cranks above the foot), got knee_to_crank={knee_to_crank!r}, "
+            f"L5={L5!r}."
+        )
     cross = _cross(0.0025, 0.024)
     # Thigh rod: tube plus fittings (2 x 20 g) at its ends; com at mid-length by symmetry.
     r_o, r_i = 0.008, 0.006
@@ -346,7 +353,7 @@ class OmniLeg:
     gamma_min, gamma_max : float, optional
         Range of the crank angle γ (rad), ``-π/2 < gamma_min < gamma_max < π/2``; default 0 and 85°.
     knee_to_crank : float, optional
-        Depth of the C_i joints below O0' (m), in [0, L5]; default 0.03 m.
+        Depth of the C_i joints below O0' (m), in [0, L5) (the foot point lies below); default 0.03 m.
     shank_radius : float, optional
         Radius of the C_i and E_i circles (m), > 0; default 0.025 m.
     shank_azimuth : float, optional
@@ -398,9 +405,9 @@ class OmniLeg:
                 raise ValueError(f"Expected OmniLeg.{name} > 0 and finite, got {getattr(self, name)!r}.")
             object.__setattr__(self, name, v)
         h = _real(self.knee_to_crank, "OmniLeg.knee_to_crank")
-        if not (math.isfinite(h) and 0 <= h <= self.L5):
+        if not (math.isfinite(h) and 0 <= h < self.L5):  # the foot rod below the cranks needs a length
             raise ValueError(
-                f"Expected OmniLeg.knee_to_crank in [0, L5 = {self.L5}], got {self.knee_to_crank!r}."
+                f"Expected OmniLeg.knee_to_crank in [0, L5 = {self.L5}), got {self.knee_to_crank!r}."
             )
         object.__setattr__(self, "knee_to_crank", h)
         for name in ("alpha_max", "beta_max"):

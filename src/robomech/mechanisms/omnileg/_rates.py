@@ -84,7 +84,9 @@ def joint_rates(
     ``foot_acceleration (..., 3)`` m/s² or None; all broadcast.  ``damping`` (>= 0, relative to
     sigma_max) damps the directions with ``sigma < SINGULAR_RCOND sigma_max``: ``c = σ / (σ² + λ²)``,
     ``λ = damping sigma_max`` (selectively damped least squares: the well-determined components stay
-    exact).  ``damping = 0`` drops the weak directions (truncated pseudo-inverse).
+    exact).  ``damping = 0`` inverts the weak directions fully (``c = 1/σ``: the exact inverse,
+    unbounded as σ -> 0; only a direction with σ = 0 exactly gets ``c = 0``), so near γ = 0 the
+    rates grow like 1/σ and ``valid`` is False there as for any damping.
 
     Paper 2, eq. (47)'s inverse of the foot Jacobian (eq. (14)), regularised at the singularity γ = 0.
 

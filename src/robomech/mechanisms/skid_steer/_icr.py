@@ -271,9 +271,9 @@ def identify_icr(
     Equations per sample: ``-r y_right = v_right - v_x``, ``-r y_left = v_left - v_x``, ``-r x_icr = v_y``.
     ``weights (N,)`` (``>= 0``) weight each sample's three equations (e.g. ``1/σ²`` of that sample).
     Samples with any non-finite value (drop-outs; also magnitudes beyond ``_validation.MAX_MAGNITUDE``,
-    which would overflow the products) are not used and are reported in ``used`` (nothing is
-    dropped silently).  Straight driving carries no information (its rows are zero); a data set without
-    turning is reported ``identifiable = False``.
+    which would overflow the products) and samples of weight 0 are not used and are reported in
+    ``used`` (nothing is dropped silently).  Straight driving carries no information (its rows are
+    zero); a data set without turning is reported ``identifiable = False``.
 
     Parameters
     ----------
@@ -282,7 +282,7 @@ def identify_icr(
     body_velocity : array_like, shape (N, 3)
         Measured planar body velocities ``(v_x, v_y, r)`` (m/s, m/s, rad/s).
     weights : array_like, shape (N,), optional
-        Per-sample weights (``>= 0``).
+        Per-sample weights (``>= 0``; a sample of weight 0 is not used).
 
     Returns
     -------
@@ -320,7 +320,8 @@ def identify_icr(
         raise ValueError(f"Expected weights to have shape {vr.shape} like v_right, got {w.shape}.")
     if np.any(w < 0):
         raise ValueError(f"Expected weights >= 0, got {int(np.sum(w < 0))} negative value(s).")
-    used = np.isfinite(vr) & np.isfinite(vl) & np.all(np.isfinite(V), axis=-1)
+    # a zero weight removes a sample from the fit: it is not used (nor counted in n_used, nor in the rms)
+    used = np.isfinite(vr) & np.isfinite(vl) & np.all(np.isfinite(V), axis=-1) & (w > 0.0)
     n = int(used.sum())
     # The three groups decouple (each unknown has its own column): three (N, 1) systems, one batched call.
     r = V[used, 2]

@@ -9,6 +9,7 @@ from numpy.typing import ArrayLike
 
 from robomech._validation import as_array, broadcast_batch, check_positive
 from robomech.spatial import exp_se3
+from robomech.spatial._so3 import ROTATION_ATOL
 
 __all__ = [
     "LATERAL_SLIP_RTOL",
@@ -190,6 +191,21 @@ def paper_lateral_slip(
     return LateralSlip(lateral_speed=np.where(valid, out, np.nan), valid=valid)
 
 
+def _check_rigid(T: np.ndarray, name: str) -> np.ndarray:
+    """``T`` if every matrix is a rigid transform within ``ROTATION_ATOL``, else a ValueError naming it."""
+    R = T[..., :3, :3]
+    err = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-2, -1), initial=0.0)
+    det_err = np.abs(np.linalg.det(R) - 1.0) if R.size else np.zeros(R.shape[:-2])
+    row_err = np.abs(T[..., 3, :] - [0.0, 0.0, 0.0, 1.0]).max(axis=-1, initial=0.0)
+    worst = float(max(np.max(err, initial=0.0), np.max(det_err, initial=0.0), np.max(row_err, initial=0.0)))
+    if worst > ROTATION_ATOL:
+        raise ValueError(
+            f"Expected {name} to be rigid transforms (rotation part R^T R = I, det R = 1, last row "
+            f"(0, 0, 0, 1), within {ROTATION_ATOL}), got a deviation of {worst:.3g}."
+        )
+    return T
+
+
 def dead_reckoning(twists: ArrayLike, dt: float, T0: ArrayLike | None = None) -> np.ndarray:
     """Body poses ``T_GB (..., N, 4, 4)`` from body twists ``[ω; v]`` ``(..., N, 6)`` sampled every ``dt`` s.
 
@@ -204,12 +220,19 @@ def dead_reckoning(twists: ArrayLike, dt: float, T0: ArrayLike | None = None) ->
     dt : float
         Sample period (s), ``> 0``.
     T0 : array_like, shape (..., 4, 4), optional
-        Initial pose ``T_GB`` (default the identity).
+        Initial pose ``T_GB`` (default the identity): a rigid transform (rotation part orthonormal
+        with determinant 1 and last row ``(0, 0, 0, 1)``, within ``ROTATION_ATOL``).
 
     Returns
     -------
     ndarray, shape (..., N, 4, 4)
         Poses ``T_GB`` at the sample times (the first is ``T0``).
+
+    Raises
+    ------
+    ValueError
+        If ``twists`` is not a finite real array (..., N, 6) with N >= 1, ``dt`` is not positive,
+        ``T0`` is not a batch of rigid transforms, or the batch shapes do not broadcast.
 
     Examples
     --------
@@ -219,10 +242,10 @@ def dead_reckoning(twists: ArrayLike, dt: float, T0: ArrayLike | None = None) ->
     >>> T.shape, T[-1, :2, 3].round(4)                          # on the arc of radius 2 m after 0.2 s
     ((3, 4, 4), array([0.1997, 0.01  ]))
     """
-    V = as_array(twists, "twists", (None, 6), min_ndim=2)
+    V = as_array(twists, "twists", (None, 6), min_ndim=2, nonempty=True)
     h = check_positive(dt, "dt")
     n = V.shape[-2]
-    T0a = np.eye(4) if T0 is None else as_array(T0, "T0", (4, 4))
+    T0a = np.eye(4) if T0 is None else _check_rigid(as_array(T0, "T0", (4, 4)), "T0")
     out = np.empty((*broadcast_batch((V, 2, "twists"), (T0a, 2, "T0")), n, 4, 4))
     out[..., 0, :, :] = T0a
     if n == 1:

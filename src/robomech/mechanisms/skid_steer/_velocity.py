@@ -21,7 +21,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from robomech._validation import as_array, broadcast_batch, check_bool, check_params
+from robomech._validation import as_array, broadcast_batch, broadcast_to_batch, check_bool, check_params
 from robomech.analysis import lstsq
 
 from ._chains import CONFIG_SIZE, N_WHEELS, _linear_columns
@@ -180,7 +180,8 @@ def wheel_measurements(
     q = as_array(config, "config", (CONFIG_SIZE,))
     V = as_array(twist, "twist", (6,))
     qd = as_array(config_rate, "config_rate", (CONFIG_SIZE,))
-    broadcast_batch((q, 1, "config"), (V, 1, "twist"), (qd, 1, "config_rate"))
+    # every argument to the common batch: the kernel stacks per-wheel slices of each
+    q, V, qd = broadcast_to_batch((q, 1, "config"), (V, 1, "twist"), (qd, 1, "config_rate"))
     p, alpha, G = _linear_columns(robot, q)
     w_B, v_B = V[..., None, :3], V[..., None, 3:]
     v = v_B + np.cross(w_B, p)  # (..., 6, 3)
@@ -325,7 +326,7 @@ def body_velocity(
         resid[sl] = res.residual_norm
         # the condition number stays reported for finite rank-deficient samples (huge or inf)
         cond[sl] = np.where(res.ok, res.cond, np.nan)
-        # A finite but huge sample can overflow the residual (or x) to inf: never valid (issue 14).
+        # A finite but huge sample can overflow the residual (or x) to inf: never valid.
         valid[sl] = (
             res.ok & res.full_rank & np.isfinite(res.residual_norm) & np.all(np.isfinite(res.x), axis=-1)
         )

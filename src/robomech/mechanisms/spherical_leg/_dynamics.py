@@ -22,7 +22,7 @@ both bodies of the leg to spin about the leg axis s at
 (u_a about a, u_b about the turned second axis; ``_cardan_spin``), and the lead screws of legs 1
 and 3 spin at ``2 pi ldot / lead`` more (helical joint) when ``leg.screw_spin`` is set.  Paper 1's
 leg energy, eq. (23), has no spin about the leg axis at all; ``paper_as_printed=True`` drops the
-Cardan spin (the model before issue 13), for comparison only.  Leg forces f (positive = extending
+Cardan spin (paper 1 as printed), for comparison only.  Leg forces f (positive = extending
 the leg) satisfy ``J^T f = tau`` (virtual work, power f . ldot): three legs drive two coordinates,
 so a rule picks f.
 """
@@ -599,7 +599,7 @@ def inverse_dynamics(
     about O); ``driven_legs`` selects the force distribution (see :func:`distribute_forces`).
     ``valid`` is also False where a base universal joint is at or near gimbal lock
     (``CARDAN_LOCK_TOL``).  ``paper_as_printed=True``: without the spin of the legs about their own
-    axes that the base universal joints impose (paper 1, eq. (23), and this module before issue 13),
+    axes that the base universal joints impose (paper 1, eq. (23)),
     for comparison only; the lead-screw spin still follows ``leg.screw_spin``. Replaces paper 1,
     eqs. (19)-(28) (see the module docstring).
 

@@ -182,8 +182,13 @@ class SphericalLeg:
             )
         for name in ("lower", "upper"):
             bodies = getattr(self, name)
-            if len(bodies) != 3 or not all(isinstance(b, LegBody) for b in bodies):
+            if (
+                not isinstance(bodies, tuple | list)
+                or len(bodies) != 3
+                or not all(isinstance(b, LegBody) for b in bodies)
+            ):
                 raise ValueError(f"Expected {name} to be a tuple of 3 LegBody, got {bodies!r}.")
+            object.__setattr__(self, name, tuple(bodies))
         g = as_array(self.gravity, "gravity", (3,))
         flags = any(isinstance(x, bool | np.bool_) for x in np.asarray(self.gravity, dtype=object).ravel())
         if g.ndim != 1 or flags:

@@ -7,16 +7,26 @@ curve (paper 1's Fig. 5(a) does, twice per period) passes from one branch to the
 forward kinematics that keeps branch 0 then returns the mirror image of the pose about the curve with a
 residual of 0, indistinguishable from the right pose by the lengths alone.
 
+Both solutions give the same length residual (they are exact mirror images), so the residual cannot tell
+the branches apart; what tells them apart is the motion around the place where they meet.
 :func:`track_branches` solves both branches for every sample and follows the motion: between the
-samples where the branches meet the branch cannot change (the two solutions are separated), and at
-each meeting it keeps the continuation that best continues the motion so far (quadratic extrapolation
-of the three samples before the meeting to the two after it), which separates a crossing of the curve
-(α moves on through it) from a touch (α turns back).  The separation of the two solutions is returned
-per sample, and the meetings are reported.
+places where the branches meet the branch cannot change (the two solutions are separated), and at
+each meeting it asks which of two models explains the samples around it better: the signed distance
+from the curve ``σ = ±separation / 2`` passes through zero (a *crossing*: α moves on through the curve,
+the branch changes) or stays on one side (a *touch*: α turns back, the branch is kept).  Each model is
+a cubic least-squares fit of σ over ``MEET_WINDOW`` samples on either side, weighted by the
+distance from the curve (near it, noise in the lengths is amplified: the closed form loses half the
+digits); meetings closer than a window (a dip just beyond the curve on a coarse grid) are decided
+together, every combination of crossing and touch fitted.  A fit over a window, not an
+extrapolation of the last few samples, keeps the choice right on measured lengths: 10 nm of noise
+moves α by up to 2e-3 rad next to the curve, about two sampling steps of Fig. 5(a).  A meeting
+where neither model fits clearly better (``AMBIGUITY_RATIO``) is reported as ``ambiguous``, and
+every later sample of that trajectory is flagged not valid: its branch is not known.
 """
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,11 +39,37 @@ from ._params import SphericalLeg
 __all__ = ["BranchTrack", "track_branches"]
 
 # A local minimum of the branch separation counts as a meeting of the branches (a place where the
-# motion may change branch) when the separation there is at most this many times the largest step of
-# α between neighbouring samples: near the singular curve the separation is 2 |α - α_s| (the two
-# solutions are mirror images about α_s), so a crossing between two samples leaves a separation of at
-# most 2 steps at the nearer one; 2.5 allows for the curvature of the motion within the step.
-MEET_STEP_FACTOR = 2.5
+# motion may change branch) when the separation there is at most this many times the motion's step
+# (the largest step per sample within MEET_WINDOW samples, times the gap to the neighbouring valid
+# samples): near the singular curve the separation is 2 |α - α_s| (the two solutions are mirror
+# images about α_s), so a crossing between two samples leaves a separation of at most 2 steps at the
+# nearer one; noise in the lengths moves the samples next to the curve by up to about a step (10-30
+# nm on Fig. 5(a)), hence 4.  A local minimum that is no crossing costs only a fit (it is a touch).
+MEET_STEP_FACTOR = 4.0
+# Candidate meetings closer than this many samples are one meeting (noise in the lengths makes the
+# separation wiggle next to the curve and gives several local minima for one passage); two real
+# passages a few samples apart (a dip just beyond the curve on a coarse grid) stay two meetings
+# only if at least one sample separates them, and are then decided together (MEET_CLUSTER_MAX).
+MEET_MERGE = 1
+# Samples on either side of a meeting that the crossing / touch models are fitted to, and the degree
+# of the polynomial in the sample index they are fitted with: 32 samples average the noise of the
+# samples nearest the curve (with 8, 30 nm of noise left most Fig. 5(a) meetings ambiguous), and a
+# cubic describes σ over that window for a motion sampled finely enough to be tracked (a quadratic
+# misfits the asymmetry of a sway passing the curve near its turning point on a 0.5 s grid and then
+# decides wrongly).  Measured on Fig. 5(a) (grids 0.01-1 s, 10-100 nm of noise) and on random sways:
+# docs/mechanisms/spherical_leg.md.
+MEET_WINDOW = 16
+MEET_FIT_DEGREE = 3
+# The crossing model places the passage through the curve within this many samples of the sample
+# nearest it (noise of the order of a step moves that sample to either side).
+MEET_SPLIT = 2
+# At most this many meetings are decided together (every combination of crossing and touch is fitted).
+MEET_CLUSTER_MAX = 3
+# A meeting is decided when the weighted residual of the better model is below this fraction of the
+# best fit that leaves the motion on the other branch.  On exact lengths the right model's residual
+# is only the cubic's misfit of the motion (ratio far below 0.5); near 1 the two explain the samples
+# equally well and the branch after the meeting is not known.
+AMBIGUITY_RATIO = 0.5
 
 
 @dataclass(frozen=True)
@@ -47,9 +83,11 @@ class BranchTrack:
     alpha, beta : ndarray, shape (..., N)
         Platform angles (rad); NaN where not ``valid``.
     residual : ndarray, shape (..., N)
-        Length residual (m), as in :func:`forward_kinematics`.
+        Length residual (m), as in :func:`forward_kinematics`; the same on both branches, so it does
+        not show which branch a sample is on.
     valid : ndarray of bool, shape (..., N)
-        Both closed-form solutions exist (finite positive lengths that assemble).
+        Both closed-form solutions exist (finite positive lengths that assemble) and the branch is
+        known: False from the first ``ambiguous`` meeting on.
     branch : ndarray of int8, shape (..., N)
         Which closed-form solution the motion is on (0 or 1); -1 where not valid.
     separation : ndarray, shape (..., N)
@@ -59,6 +97,8 @@ class BranchTrack:
         tracker had to choose.
     switched : ndarray of bool, shape (..., N)
         The meetings where the motion changed branch.
+    ambiguous : ndarray of bool, shape (..., N)
+        The meetings where the samples do not tell a crossing from a touch (see ``AMBIGUITY_RATIO``).
     """
 
     alpha: np.ndarray
@@ -69,22 +109,68 @@ class BranchTrack:
     separation: np.ndarray
     meeting: np.ndarray
     switched: np.ndarray
+    ambiguous: np.ndarray
 
 
 def _wrap(x: np.ndarray) -> np.ndarray:
     return (x + np.pi) % (2.0 * np.pi) - np.pi
 
 
-def _extrapolate(past_t: np.ndarray, past_a: np.ndarray, at: np.ndarray) -> np.ndarray:
-    """The interpolating polynomial of (at most 3) past samples evaluated at ``at`` (sample indices).
+def _fit_residual(t: np.ndarray, y: np.ndarray, w: np.ndarray) -> float:
+    """Weighted residual norm of the least-squares quadratic through ``(t, y)``."""
+    c = np.polynomial.polynomial.polyfit(t, y, min(MEET_FIT_DEGREE, t.size - 2), w=w)
+    return float(np.linalg.norm(w * (np.polynomial.polynomial.polyval(t, c) - y)))
 
-    Quadratic: exact for a motion that touches the curve and turns back, where a second difference
-    cannot tell the two continuations apart.
+
+def _decide(t: np.ndarray, d: np.ndarray, ks: list[int]) -> tuple[list[int | None], bool]:
+    """Crossing or touch at each meeting of a cluster: ``(splits, ambiguous)``.
+
+    ``t`` are the window's sample indices, ``d`` the distances from the curve (half the separation,
+    rad) and ``ks`` the positions in the window of the meetings (the samples nearest the curve).
+    ``splits[j]`` is the first sample on the far side of meeting j if the motion crosses there,
+    ``None`` for a touch.  Every combination is fitted at once (the sign of σ flips at each crossing),
+    so two meetings closer than a window (a motion that dips just beyond the curve and back) are
+    decided together; a crossing is placed just before or after a sample next to the meeting (noise
+    moves the sample nearest the curve by about a step).  The decision is ambiguous when the best
+    fit with the other parity (the other branch after the cluster) fits almost as well.
     """
-    if past_t.size == 1:
-        return np.full(at.shape, past_a[0])
-    c = np.polyfit(past_t - past_t[-1], past_a, past_t.size - 1)
-    return np.polyval(c, at - past_t[-1])
+    n = t.size
+    bounds = [0, *ks[1:], n]  # meeting j may place its crossing in (ks[j-1], ks[j+1]]
+    options: list[list[int | None]] = []
+    for j, k in enumerate(ks):
+        lo_j = max(bounds[j] + (1 if j else 2), k - MEET_SPLIT)
+        hi_j = min(bounds[j + 1] if j + 1 < len(ks) else n - 2, k + MEET_SPLIT + 1)
+        options.append([None, *range(lo_j, hi_j + 1)])
+    w = np.maximum(d, np.finfo(float).tiny)
+    tc = t - t[ks[0]]  # centred: a well-conditioned Vandermonde matrix
+    idx = np.arange(n)
+    best: dict[int, tuple[float, list[int | None]]] = {}
+    for combo in itertools.product(*options):
+        flips = np.zeros(n, dtype=int)
+        for p in combo:
+            if p is not None:
+                flips += idx >= p
+        r = _fit_residual(tc, np.where(flips % 2 == 0, d, -d), w)
+        parity = sum(p is not None for p in combo) % 2
+        if parity not in best or r < best[parity][0]:
+            best[parity] = (r, list(combo))
+    if n < 5 or len(best) < 2:  # too few samples to fit either model
+        return [None] * len(ks), True
+    (r_win, splits), (r_other, _) = sorted(best.values(), key=lambda x: x[0])
+    # where exactly each crossing lies (before or after the sample nearest the curve) matters only for
+    # that sample, which the window fit weights least: the quadratic through the three samples before
+    # it (signed by the decision so far) extrapolated to it puts it on its side of the curve
+    sign, prev = 1.0, 0
+    for j, (k, p) in enumerate(zip(ks, splits, strict=True)):
+        if p is None:
+            continue
+        past = np.arange(max(prev, k - 3), k)
+        if past.size >= 2 and abs(p - k) <= 1:
+            sig = sign * d[past]
+            pred = np.polyval(np.polyfit(t[past] - t[k], sig, past.size - 1), 0.0)
+            splits[j] = k + 1 if pred * sign > 0 else k
+        sign, prev = -sign, splits[j]
+    return splits, bool(r_win > AMBIGUITY_RATIO * r_other)
 
 
 def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> BranchTrack:
@@ -93,8 +179,9 @@ def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> Br
     The time axis is the second-to-last axis of ``lengths`` (N >= 1 samples in order); leading axes are
     independent trajectories.  Samples that do not assemble are flagged (``valid`` False) and bridged:
     the branch carries across them.  Where the two closed-form solutions of :func:`forward_kinematics`
-    meet, the tracker keeps the one that continues the motion (a quadratic extrapolation of the
-    preceding samples).
+    meet, the tracker fits the samples around the meeting with a crossing and with a touch of the
+    singular curve and keeps the branch the better fit implies; a meeting neither fit explains clearly
+    better is flagged ``ambiguous`` and the samples after it not ``valid``.
 
     Parameters
     ----------
@@ -110,7 +197,7 @@ def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> Br
     -------
     BranchTrack
         ``alpha``, ``beta`` (rad), ``residual`` (m), ``valid``, ``branch``, ``separation`` (rad),
-        ``meeting`` and ``switched``, each of shape ``(..., N)``.
+        ``meeting``, ``switched`` and ``ambiguous``, each of shape ``(..., N)``.
 
     Raises
     ------
@@ -143,37 +230,56 @@ def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> Br
     br = np.full((B, N), branch, dtype=np.int8)
     meeting = np.zeros((B, N), dtype=bool)
     switched = np.zeros((B, N), dtype=bool)
+    ambiguous = np.zeros((B, N), dtype=bool)
+    known = np.ones((B, N), dtype=bool)
     for i in range(B):  # independent trajectories; within one, a loop over its meetings only
         idx = np.flatnonzero(valid[i])
         if idx.size < 3:
             continue
         s = sep[i, idx]
         ai = a[i, idx]  # (M, 2)
+        gap = np.diff(idx).astype(float)  # samples between neighbouring valid samples (> 1 across a gap)
         step = np.max(np.abs(_wrap(np.diff(ai, axis=0))), axis=-1)  # (M-1,) largest step of either branch
+        # the motion's step per sample around each sample: either branch folds back at the curve, so
+        # its own step there is small, while the separation keeps changing at twice the motion's rate;
+        # the largest over the neighbouring MEET_WINDOW steps is the motion's
+        rate = np.maximum(step, 0.5 * np.abs(np.diff(s))) / gap
+        padded = np.pad(rate, MEET_WINDOW, mode="edge")
+        rate = np.lib.stride_tricks.sliding_window_view(padded, 2 * MEET_WINDOW + 1).max(-1)
         local_min = (s[1:-1] <= s[:-2]) & (s[1:-1] <= s[2:])
-        scale = np.maximum(step[:-1], step[1:])
+        scale = np.maximum(rate[:-1], rate[1:]) * np.maximum(gap[:-1], gap[1:])
         cand = np.flatnonzero(local_min & (s[1:-1] <= MEET_STEP_FACTOR * scale)) + 1
-        cur = branch
-        seg = np.zeros(idx.size, dtype=np.int8)
-        start = 0
+        # one meeting per cluster of candidates: the one nearest the curve
+        groups = np.split(cand, np.flatnonzero(np.diff(cand) > MEET_MERGE) + 1) if cand.size else []
+        meets = [int(g[np.argmin(s[g])]) for g in groups]
         M = idx.size
-        cand_list: list[int] = [int(x) for x in cand]
-        for k in cand_list:  # positions in idx
-            seg[start:k] = cur
-            # the motion before the meeting (samples k-3 .. k-1; the meeting sample itself may already
-            # lie on the other side) extrapolated to k, k+1, k+2; keep the continuation that fits it
-            past = np.arange(max(0, k - 3), k)
-            pa = np.unwrap(ai[past, seg[past]])
-            ahead = np.arange(k + 1, min(M, k + 3))
-            pred = _extrapolate(past.astype(float), pa, np.concatenate([[k], ahead]).astype(float))
-            err = [float(np.sum(np.abs(_wrap(ai[ahead, b] - pred[1:])))) for b in (0, 1)]
-            new = cur if err[cur] <= err[1 - cur] else 1 - cur
-            # the meeting sample itself: the solution nearer the extrapolation
-            seg[k] = 0 if abs(_wrap(ai[k, 0] - pred[0])) <= abs(_wrap(ai[k, 1] - pred[0])) else 1
-            meeting[i, idx[k]] = True
-            switched[i, idx[k]] = new != cur
-            cur = new
-            start = k + 1
+        seg = np.zeros(M, dtype=np.int8)
+        cur = branch
+        start = 0
+        tpos = idx.astype(float)
+        # meetings closer than a window are decided together (their windows would overlap)
+        clusters: list[list[int]] = []
+        for k in meets:
+            if clusters and k - clusters[-1][-1] <= 2 * MEET_WINDOW and len(clusters[-1]) < MEET_CLUSTER_MAX:
+                clusters[-1].append(k)
+            else:
+                clusters.append([k])
+        for c, ks in enumerate(clusters):
+            lo = max(clusters[c - 1][-1] + 1 if c else 0, ks[0] - MEET_WINDOW)
+            hi = min(clusters[c + 1][0] if c + 1 < len(clusters) else M, ks[-1] + MEET_WINDOW + 1)
+            splits, amb = _decide(tpos[lo:hi], 0.5 * s[lo:hi], [k - lo for k in ks])
+            for k, sp in zip(ks, splits, strict=True):
+                meeting[i, idx[k]] = True
+                if sp is None:
+                    continue
+                split = max(sp + lo, start)
+                seg[start:split] = cur
+                switched[i, idx[k]] = True
+                cur = 1 - cur
+                start = split
+            if amb:
+                ambiguous[i, idx[ks[0]]] = True
+                known[i, idx[ks[0]] :] = False
         seg[start:] = cur
         # invalid samples between valid ones carry the branch of the preceding valid sample
         full = np.full(N, branch, dtype=np.int8)
@@ -183,14 +289,16 @@ def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> Br
         br[i] = full
     alpha = np.where(br == 0, a[..., 0], a[..., 1])
     resid = np.where(br == 0, f0.residual, f1.residual)
+    ok = valid & known
     out = dict(
-        alpha=np.where(valid, alpha, np.nan),
-        beta=np.where(valid, f0.beta, np.nan),
-        residual=np.where(valid, resid, np.nan),
-        valid=valid,
-        branch=np.where(valid, br, -1).astype(np.int8),
+        alpha=np.where(ok, alpha, np.nan),
+        beta=np.where(ok, f0.beta, np.nan),
+        residual=np.where(ok, resid, np.nan),
+        valid=ok,
+        branch=np.where(ok, br, -1).astype(np.int8),
         separation=np.where(valid, sep, np.nan),
         meeting=meeting,
         switched=switched,
+        ambiguous=ambiguous,
     )
     return BranchTrack(**{k: v.reshape(shape) for k, v in out.items()})

@@ -1,6 +1,14 @@
 """Paper 5: the RRR-RR vectored-thrust spherical mechanism (kinematics, mobility, workspace, singularity)."""
 
-from ._inverse import INPUT_GAIN_MAX, InverseRatesResult, StaticsResult, inverse_rates, static_torques
+from ._inverse import (
+    INPUT_GAIN_MAX,
+    RATE_RESIDUAL_ATOL,
+    RATE_RESIDUAL_RTOL,
+    InverseRatesResult,
+    StaticsResult,
+    inverse_rates,
+    static_torques,
+)
 from ._kinematics import (
     SINGULAR_TOL,
     AccelerationResult,
@@ -8,6 +16,7 @@ from ._kinematics import (
     IKResult,
     JacobianResult,
     JointAxes,
+    LinkClearanceResult,
     PassiveResult,
     RotationResult,
     VelocityResult,
@@ -38,6 +47,8 @@ from ._workspace import (
 __all__ = [
     "DEXTERITY_TOL",
     "INPUT_GAIN_MAX",
+    "RATE_RESIDUAL_ATOL",
+    "RATE_RESIDUAL_RTOL",
     "SINGULAR_TOL",
     "AccelerationResult",
     "FKResult",
@@ -45,6 +56,7 @@ __all__ = [
     "InverseRatesResult",
     "JacobianResult",
     "JointAxes",
+    "LinkClearanceResult",
     "MechanismMobility",
     "PassiveResult",
     "RotationResult",

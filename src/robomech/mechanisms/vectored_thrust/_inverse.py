@@ -27,6 +27,8 @@ from ._params import VectoredThruster
 
 __all__ = [
     "INPUT_GAIN_MAX",
+    "RATE_RESIDUAL_ATOL",
+    "RATE_RESIDUAL_RTOL",
     "InverseRatesResult",
     "StaticsResult",
     "inverse_rates",
@@ -42,6 +44,15 @@ INPUT_GAIN_MAX = 100.0
 # Default damping of the weak direction at flagged samples, relative to sigma_max: with
 # lambda = sigma_min_bound = 1 / INPUT_GAIN_MAX no direction is amplified by more than INPUT_GAIN_MAX / 2.
 DEFAULT_DAMPING = 1.0 / INPUT_GAIN_MAX
+# A commanded ω (ω̇) is realised when the residual |J q̇ - ω| (|J q̈ + J̇q̇ - ω̇|) is at most this
+# fraction of the command's size (plus RATE_RESIDUAL_ATOL): at a regular sample q̇ is the exact
+# least-squares solution, whose residual for a command in J's range is rounding (~1e-16 |ω| times
+# 1/sigma_min <= INPUT_GAIN_MAX); 1e-9 leaves six orders for commands built from rounded data, while a
+# command with a component outside the platform's two rotational freedoms leaves a residual of that
+# component's size and is not valid.
+RATE_RESIDUAL_RTOL = 1e-9
+# Absolute floor of that test (rad/s, rad/s²): a zero command has a zero residual to rounding.
+RATE_RESIDUAL_ATOL = 1e-12
 
 
 @dataclass(frozen=True)
@@ -53,7 +64,8 @@ class InverseRatesResult:
     singular value of J (0 where J does not exist); ``singular (...)`` where ``sigma_min <
     1 / INPUT_GAIN_MAX`` or J does not exist (there the weak direction is damped); ``omega_residual``
     ``|J q̇ - ω|`` (rad/s) and ``omega_dot_residual`` ``|J q̈ + J̇q̇ - ω̇|`` (rad/s²): the part of the
-    command the mechanism cannot realise (ω outside J's range, or damped); ``valid = ~singular``.
+    command the mechanism cannot realise (ω outside J's range, or damped); ``valid`` is ``~singular``,
+    every value finite and both residuals within ``RATE_RESIDUAL_RTOL`` of the command.
 
     Attributes
     ----------
@@ -70,7 +82,9 @@ class InverseRatesResult:
     omega_dot_residual : ndarray, shape (...)
         ``|J q̈ + J̇ q̇ - ω̇|`` (rad/s²); NaN if no ω̇ was given.
     valid : ndarray of bool, shape (...)
-        Not singular and every value finite.
+        Not singular, every value finite and the command realised: ``omega_residual`` (and
+        ``omega_dot_residual`` if given) at most ``RATE_RESIDUAL_RTOL`` times the command's norm plus
+        ``RATE_RESIDUAL_ATOL`` (a command outside the platform's two rotational freedoms is not valid).
     """
 
     qd: np.ndarray
@@ -187,6 +201,9 @@ def _inverse_rates(th, q, w, wd, lam_rel, batch) -> InverseRatesResult:
         qdd = np.where(exists[..., None], qdd, np.nan)
         wd_res = np.where(exists, wd_res, np.nan)
     finite = np.all(np.isfinite(qd), -1) & (wd is None or np.all(np.isfinite(qdd), -1))
+    realised = w_res <= RATE_RESIDUAL_RTOL * np.linalg.norm(w, axis=-1) + RATE_RESIDUAL_ATOL
+    if wd is not None:
+        realised &= wd_res <= RATE_RESIDUAL_RTOL * np.linalg.norm(wd, axis=-1) + RATE_RESIDUAL_ATOL
     return InverseRatesResult(
         qd=np.where(exists[..., None], qd, np.nan),
         qdd=qdd,
@@ -194,7 +211,8 @@ def _inverse_rates(th, q, w, wd, lam_rel, batch) -> InverseRatesResult:
         singular=singular,
         omega_residual=np.where(exists, w_res, np.nan),
         omega_dot_residual=wd_res,
-        valid=~singular & finite,  # a flag never says valid where a value overflowed (e.g. |ω| ~ 1e300)
+        # a flag never says valid where a value overflowed (e.g. |ω| ~ 1e300) or ω is not realised
+        valid=~singular & finite & realised,
     )
 
 

@@ -38,6 +38,7 @@ __all__ = [
     "IKResult",
     "JacobianResult",
     "JointAxes",
+    "LinkClearanceResult",
     "PassiveResult",
     "RotationResult",
     "VelocityResult",
@@ -143,6 +144,23 @@ class JointAxes:
     s0: np.ndarray  # propeller shaft (the platform's third axis)
     distance: np.ndarray  # (...,) |s22 x s12|: distance to the singularity, in [0, 1]
     valid: np.ndarray  # (...,) distance > SINGULAR_TOL
+
+
+@dataclass(frozen=True)
+class LinkClearanceResult:
+    """The interference clearance of :func:`link_clearance` per sample.
+
+    Attributes
+    ----------
+    clearance : ndarray, shape (...)
+        Angular clearance (rad) between the 45 deg arc and the fixing device; NaN where not ``valid``.
+    valid : ndarray of bool, shape (...)
+        The configuration is not singular (``|s12 x s22| > SINGULAR_TOL``: the fixing device's arc
+        exists), so the clearance is defined.
+    """
+
+    clearance: np.ndarray
+    valid: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -499,10 +517,12 @@ def _interference_unmasked(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
     return np.where(valid, np.where(crosses, 0.0, ends), np.nan)
 
 
-def link_clearance(th: VectoredThruster, q: object) -> np.ndarray:
+def link_clearance(th: VectoredThruster, q: object) -> LinkClearanceResult:
     """Angular clearance (rad) between the RRR chain's 45 deg arc and the fixing device at ``q (..., 2)``.
 
-    Section 4.1 (2).  NaN where the configuration is singular (covered by ``joint_axes(...).valid``).
+    Section 4.1 (2).  Where the configuration is singular (``|s12 x s22| <= SINGULAR_TOL``, the same
+    samples as ``joint_axes(...).valid`` False) the fixing device's arc does not exist: ``clearance`` is
+    NaN there and ``valid`` False.
 
     Parameters
     ----------
@@ -513,16 +533,26 @@ def link_clearance(th: VectoredThruster, q: object) -> np.ndarray:
 
     Returns
     -------
-    ndarray, shape (...)
-        Clearance (rad) on the unit sphere about O; compare with ``th.interference_clearance``.
+    LinkClearanceResult
+        ``clearance`` (rad, on the unit sphere about O; compare with ``th.interference_clearance``) and
+        ``valid``, each of shape (...).
 
     Raises
     ------
     ValueError
         If ``th`` is not a :class:`VectoredThruster` or ``q`` is not a finite real array of shape (..., 2).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robomech.mechanisms import vectored_thrust as vt
+    >>> r = vt.link_clearance(vt.VectoredThruster.paper(), [[0.0, 0.2], [0.0, np.pi / 4]])
+    >>> r.valid
+    array([ True, False])
     """
     check_params(th, VectoredThruster, "th")
-    return _interference(th, _q(q))
+    c = _interference(th, _q(q))
+    return LinkClearanceResult(clearance=c, valid=np.isfinite(c))
 
 
 def _theta_cs(th: VectoredThruster, q: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -652,8 +682,8 @@ def _ik_unmasked(th: VectoredThruster, s: np.ndarray) -> IKResult:
     # s0 = (sin q2 cos th, sin th, cos q2 cos th).  |q2| < pi/2 (enforced by the parameters) needs
     # cos q2 > 0, so cos(theta) takes the sign of u_z: the branch through q = 0 for a propeller above the
     # horizontal, and theta beyond 90 deg (the propeller past the horizontal, as the FK allows) below it.
-    # Taking cos(theta) > 0 there (as before issue 14) gave |q2| > pi/2 and a wrong root below, i.e. a
-    # "solved" q whose FK was another direction.  paper 5, eq. (13): phi2 = arctan(L*/N*) is right for
+    # Taking cos(theta) > 0 there gives |q2| > pi/2 and a wrong root below, i.e. a
+    # "solved" q whose FK is another direction.  paper 5, eq. (13): phi2 = arctan(L*/N*) is right for
     # u_z > 0 only.
     ct2 = ux * ux
     ct2 += uz * uz
@@ -837,10 +867,11 @@ def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
     """
     check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
-    broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
+    batch = broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     ax = _axes(th, q)
     x = _rates(ax, qd)
-    return PassiveResult(values=np.where(ax.valid[..., None], x, np.nan), valid=ax.valid)
+    valid = np.broadcast_to(ax.valid, batch)  # the mask has the batch of every argument
+    return PassiveResult(values=np.where(valid[..., None], x, np.nan), valid=valid)
 
 
 def _jacobian(th: VectoredThruster, q: np.ndarray) -> JacobianResult:
@@ -955,9 +986,10 @@ def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityRes
     """
     check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
-    broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
+    batch = broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     jr = _jacobian(th, q)
-    return VelocityResult(omega=np.einsum("...ij,...j->...i", jr.J, qd), valid=jr.valid)
+    valid = np.broadcast_to(jr.valid, batch)  # the mask has the batch of every argument
+    return VelocityResult(omega=np.einsum("...ij,...j->...i", jr.J, qd), valid=valid)
 
 
 def _screw(s: np.ndarray) -> np.ndarray:
@@ -1000,7 +1032,7 @@ def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: objec
     """
     check_params(th, VectoredThruster, "th")
     q, qd, qdd = _q(q), as_array(qd, "qd", (2,)), as_array(qdd, "qdd", (2,))
-    broadcast_batch((q, 1, "q"), (qd, 1, "qd"), (qdd, 1, "qdd"))
+    batch = broadcast_batch((q, 1, "q"), (qd, 1, "qd"), (qdd, 1, "qdd"))
     ax = _axes(th, q)
     s13 = np.where(ax.valid[..., None], ax.s13, 0.0)
     axv = JointAxes(ax.s11, ax.s12, s13, ax.s21, ax.s22, ax.s0, ax.distance, ax.valid)
@@ -1020,12 +1052,13 @@ def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: objec
     b0 = lie_rrr[..., :3] - lie_rr[..., :3]
     acc0, _ = _solve3(ax.s22, -ax.s12, -s13, b0)
     vp = acc0[..., 0:1] * ax.s22 + lie_rr[..., :3]
-    m = ax.valid[..., None]
+    valid = np.broadcast_to(ax.valid, batch)  # the mask has the batch of every argument
+    m = valid[..., None]
     nan = np.nan
     return AccelerationResult(
         omega=np.where(m, omega, nan),
         omega_dot=np.where(m, omega_dot, nan),
         passive_acc=np.where(m, acc, nan),
         velocity_product=np.where(m, vp, nan),
-        valid=ax.valid,
+        valid=valid,
     )

@@ -1,0 +1,120 @@
+"""Compiled (numba) per-sample kernel of the tree's composite-rigid-body algorithm (``_rnea``).
+
+Per sample: the tree kinematics of ``_compiled.kin`` (body poses and space screws), then the CRBA in
+world coordinates as the module docstring of :mod:`._rnea` states it; large batches in parallel
+blocks of ``_compiled.BLOCK`` samples (``numba.prange``).  The RNEA kernel is ``_compiled.rnea_block``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robomech._numba import import_numba
+
+from ._compiled import BLOCK, kin
+
+__all__ = ["crba_batch"]
+
+numba = import_numba()
+_nj = numba.njit(cache=True, error_model="numpy")
+
+
+@_nj
+def _inertia_world(T, mass, com, inertia, b, c, Ic):  # pragma: no cover - compiled
+    """World centre of mass ``c (3,)`` and inertia about it ``Ic (3, 3)`` of body ``b``."""
+    for i in range(3):
+        c[i] = T[b, i, 3] + T[b, i, 0] * com[b, 0] + T[b, i, 1] * com[b, 1] + T[b, i, 2] * com[b, 2]
+    for i in range(3):
+        for j in range(3):
+            s = 0.0
+            for k in range(3):
+                for m in range(3):
+                    s += T[b, i, k] * inertia[b, k, m] * T[b, j, m]
+            Ic[i, j] = s
+
+
+@_nj
+def _apply(m, c, Ic, X, out):  # pragma: no cover - compiled
+    """``out = I X``: ``f = m (v + w x c)``, ``n = Ic w + c x f`` (motions about the world origin)."""
+    w0, w1, w2 = X[0], X[1], X[2]
+    f0 = m * (X[3] + w1 * c[2] - w2 * c[1])
+    f1 = m * (X[4] + w2 * c[0] - w0 * c[2])
+    f2 = m * (X[5] + w0 * c[1] - w1 * c[0])
+    out[0] = Ic[0, 0] * w0 + Ic[0, 1] * w1 + Ic[0, 2] * w2 + c[1] * f2 - c[2] * f1
+    out[1] = Ic[1, 0] * w0 + Ic[1, 1] * w1 + Ic[1, 2] * w2 + c[2] * f0 - c[0] * f2
+    out[2] = Ic[2, 0] * w0 + Ic[2, 1] * w1 + Ic[2, 2] * w2 + c[0] * f1 - c[1] * f0
+    out[3], out[4], out[5] = f0, f1, f2
+
+
+@_nj
+def crba_block(Q, lo, hi, t, mass, com, inertia, dof_body, Aanc, out):  # pragma: no cover
+    nb, nv = t.parent.shape[0], out.shape[1]
+    parent = t.parent
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    I6 = np.empty((nb, 6, 6))
+    X = np.empty(6)
+    col = np.empty(6)
+    c = np.empty(3)
+    Ic = np.empty((3, 3))
+    Fi = np.empty(6)
+    for n in range(lo, hi):
+        kin(Q[n], t, T, S)
+        for b in range(nb):
+            _inertia_world(T, mass, com, inertia, b, c, Ic)
+            for j in range(6):
+                for i in range(6):
+                    X[i] = 1.0 if i == j else 0.0
+                _apply(mass[b], c, Ic, X, col)
+                for i in range(6):
+                    I6[b, i, j] = col[i]
+        for b in range(nb - 1, 0, -1):  # composite inertias
+            for i in range(6):
+                for j in range(6):
+                    I6[parent[b], i, j] += I6[b, i, j]
+        M = out[n]
+        for i in range(nv):
+            bi = dof_body[i]
+            for r in range(6):
+                s = 0.0
+                for m in range(6):
+                    s += I6[bi, r, m] * S[i, m]
+                Fi[r] = s
+            for j in range(nv):
+                if Aanc[bi, j] != 0.0:
+                    s = 0.0
+                    for r in range(6):
+                        s += Fi[r] * S[j, r]
+                    M[i, j] = s
+                    M[j, i] = s
+                elif Aanc[dof_body[j], i] == 0.0:
+                    M[i, j] = 0.0
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def crba_par(Q, t, mass, com, inertia, dof_body, Aanc, out):  # pragma: no cover
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        crba_block(Q, k * BLOCK, min(N, (k + 1) * BLOCK), t, mass, com, inertia, dof_body, Aanc, out)
+
+
+def crba_batch(model, bi, q: np.ndarray) -> np.ndarray:
+    """``(N, nv, nv)`` tree mass matrix of the compiled ``model`` with inertias ``bi`` (``_rnea``)."""
+    tree = model.tree
+    f = np.ascontiguousarray
+    Q = f(q, dtype=np.float64)
+    out = np.empty((Q.shape[0], tree.nv, tree.nv))
+    args = (
+        model.tables,
+        f(bi.mass),
+        f(bi.com),
+        f(bi.inertia),
+        tree.dof_body.astype(np.int64),
+        f(tree.A),
+        out,
+    )
+    if Q.shape[0] <= BLOCK:
+        crba_block(Q, 0, Q.shape[0], *args)
+    else:
+        crba_par(Q, *args)
+    return out

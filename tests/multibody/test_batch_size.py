@@ -1,0 +1,115 @@
+"""Same samples, same result, whatever the batch they come in (batch 1 included).
+
+Every multibody algorithm has one implementation (the compiled kernels run small batches in one
+block and large ones in parallel blocks of the same per-sample code; influence and site Hessians are
+batched numpy), so a sample's result must not depend on the batch around it: here batches of 1, 150,
+300 and 1000 (below and above the kernels' block size and the former numpy/compiled threshold) of the
+same samples agree to ``BATCH_RTOL`` for FK, site Jacobians, site Hessians, influence coefficients and
+inverse dynamics on the gallery.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from robomech import multibody as mb
+
+# Identical per-sample code gives identical bits; batched BLAS products (influence, Hessians) may
+# reassociate sums by batch size: a few ulps.  1e-12 relative to each quantity's largest entry.
+BATCH_RTOL = 1e-12
+SIZES = (1, 150, 300, 1000)
+GALLERY = ("four_bar", "bennett", "planar_3rrr", "delta", "rps_3", "stewart")
+# Inputs within 0.08 rad / 0.08 L of the reference configuration (inside every gallery workspace).
+SPREAD = 0.08
+
+
+def _close(a: np.ndarray, b: np.ndarray, what: str) -> None:
+    scale = max(1.0, float(np.nanmax(np.abs(b)))) if b.size else 1.0
+    assert np.array_equal(np.isnan(a), np.isnan(b)), what
+    assert np.nanmax(np.abs(a - b), initial=0.0) <= BATCH_RTOL * scale, what
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", GALLERY)
+def test_results_do_not_depend_on_the_batch_size(name):
+    mech = mb.gallery.load(name)
+    tree = mech.tree
+    rng = np.random.default_rng(7)
+    n = max(SIZES)
+    scale = np.where(tree.dof_translational[tree.act_dof], mech.length, 1.0)
+    qa = mech.q0[tree.act_qadr] + SPREAD * scale * rng.uniform(-1, 1, (n, len(mech.actuated)))
+    qd, qdd = rng.normal(size=qa.shape), rng.normal(size=qa.shape)
+    site = mech.sites[0].name
+
+    def run(k: int) -> dict[str, np.ndarray]:
+        fk = mb.forward_kinematics(mech, qa[:k])
+        q = fk.q
+        inf = mb.influence(mech, q)
+        r = mb.inverse_dynamics(mech, q, qd[:k], qdd[:k])
+        return {
+            "fk": q,
+            "site_jacobian": mb.site_jacobian(mech, q, site),
+            "site_hessian": mb.site_hessian(mech, q, site),
+            "G": inf.G,
+            "dG": inf.dG,
+            "tau": r.tau,
+            "M_a": r.M_a,
+        }
+
+    out = {k: run(k) for k in SIZES}
+    ref = out[max(SIZES)]
+    assert mb.forward_kinematics(mech, qa).converged.all()
+    for k in SIZES[:-1]:
+        for key, v in out[k].items():
+            _close(v, ref[key][:k], f"{key} at batch {k}")
+
+
+@pytest.mark.parametrize("name", ("four_bar", "delta", "stewart"))
+def test_one_sample_call_is_the_batch_call(name):
+    """A single sample given as vectors takes the shortest way into the kernel: every field equal to
+    the same sample in a batch (bit for bit), with and without gravity; a bad sample still falls back
+    to the general path's flags."""
+    mech = mb.gallery.load(name)
+    tree = mech.tree
+    fk = mb.forward_kinematics(mech, mech.q0[tree.act_qadr][None] + 0.01)
+    na = len(mech.actuated)
+    q, qd, qdd = fk.q[0], np.linspace(0.3, 1.0, na), np.linspace(-1.0, 1.0, na)
+    for gravity in (True, False):
+        one = mb.inverse_dynamics(mech, q, qd, qdd, gravity=gravity)
+        batch = mb.inverse_dynamics(mech, q[None], qd[None], qdd[None], gravity=gravity)
+        assert bool(one.valid)
+        for k in one.__dataclass_fields__:
+            a, b = np.asarray(getattr(one, k)), np.asarray(getattr(batch, k))[0]
+            assert a.shape == b.shape and np.array_equal(a, b, equal_nan=True), k
+    bad = qdd.copy()
+    bad[0] = np.nan
+    r = mb.inverse_dynamics(mech, q, qd, bad)
+    assert not bool(r.valid) and np.all(np.isnan(r.tau))
+
+
+# The compiled RNEA and the numpy formulation (_rnea._rnea_flat) sum the same terms in another order:
+# rounding of the largest force, ~1e-16 relative measured.
+RNEA_RTOL = 1e-13
+
+
+@pytest.mark.parametrize("name", ("four_bar", "delta", "stewart"))
+def test_generalized_forces_one_kernel_at_every_batch_size(name):
+    from robomech.multibody._tree import normalize_quaternions
+
+    from ._reference import numpy_rnea
+
+    mech = mb.gallery.load(name)
+    rng = np.random.default_rng(5)
+    n = 300
+    q = normalize_quaternions(mech.tree, mech.q0 + 0.05 * rng.normal(size=(n, mech.nq)))
+    qd, qdd = rng.normal(size=(n, mech.nv)), rng.normal(size=(n, mech.nv))
+    ref = numpy_rnea(mech, q, qd, qdd, np.asarray(mech.gravity))
+    got = mb.generalized_forces(mech, q, qd, qdd)
+    assert np.max(np.abs(got - ref)) <= RNEA_RTOL * np.max(np.abs(ref))
+    for k in (1, 150):
+        assert np.array_equal(mb.generalized_forces(mech, q[:k], qd[:k], qdd[:k]), got[:k])
+    assert np.array_equal(mb.generalized_forces(mech, q[7], qd[7], qdd[7]), got[7])
+    bad = qdd[7].copy()
+    bad[0] = np.nan
+    assert np.all(np.isnan(mb.generalized_forces(mech, q[7], qd[7], bad)))
