@@ -456,7 +456,12 @@ def _one_design(study: ModelStudy, params: dict[str, float]) -> dict[str, float]
         "constraint_distance",
     }:
         pts, cell = _task_of(study, mech)
-        q, ok = reach(mech, study.site, pts, study.outputs)
+        radius = (
+            None
+            if study.box is None
+            else RETRY_CELLS * float(np.max(np.diff(study.box, axis=1))) / study.grid
+        )
+        q, ok = reach(mech, study.site, pts, study.outputs, radius)
         reached = int(ok.sum())
         out["workspace_measure"] = reached * cell
         out["task_fraction"] = reached / pts.shape[0]
@@ -493,18 +498,25 @@ def _one_design(study: ModelStudy, params: dict[str, float]) -> dict[str, float]
 
 # Rounds of re-solving the task points the IK missed from their nearest reached neighbour's configuration.
 IK_RETRIES = 2
+# On a task grid, re-solve only the missed points within this many cells of a reached one (1.5: the
+# eight neighbours of a cell).
+RETRY_CELLS = 1.5
 # Continuation stages of such a re-solve (the neighbour's pose is one task cell or more away).
 IK_RETRY_STEPS = 4
 
 
-def reach(mech: Any, site: str, pts: np.ndarray, outputs: str) -> tuple[np.ndarray, np.ndarray]:
+def reach(
+    mech: Any, site: str, pts: np.ndarray, outputs: str, radius: float | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Configurations ``q (m, nq)`` placing ``site`` at the task points ``pts (m, 3)`` along ``outputs``,
     and which converged ``(m,)``.
 
     One batched :func:`~robomech.multibody.inverse_kinematics` from ``mech.q0``, then up to
     ``IK_RETRIES`` rounds re-solving each missed point from the configuration of the nearest reached
     point (continuation in ``IK_RETRY_STEPS`` stages): the IK is a local solver, and a reachable point far
-    from the reference configuration can be missed from ``q0`` alone.
+    from the reference configuration can be missed from ``q0`` alone.  With ``radius`` (m) only the
+    missed points within ``radius`` of a reached one are re-solved (on a task grid, the cells next to
+    the reached region: each round grows it by one cell).
     """
     from robomech import multibody as mb
 
@@ -519,7 +531,13 @@ def reach(mech: Any, site: str, pts: np.ndarray, outputs: str) -> tuple[np.ndarr
             break
         have = np.flatnonzero(ok)
         d = np.linalg.norm(pts[miss, None, :] - pts[None, have, :], axis=-1)
-        guess = q[have[np.argmin(d, axis=1)]]
+        near = np.argmin(d, axis=1)
+        if radius is not None:
+            keep = d[np.arange(miss.size), near] <= radius
+            miss, near = miss[keep], near[keep]
+            if miss.size == 0:
+                break
+        guess = q[have[near]]
         again = mb.inverse_kinematics(mech, site, T[miss], guess, weights=w, steps=IK_RETRY_STEPS)
         got = np.asarray(again.converged, bool)
         if not got.any():
