@@ -222,3 +222,32 @@ def test_bit_identical_locally_and_on_a_two_worker_loopback_cluster(small, clien
     a, b = open_results(tmp_path / "a"), open_results(tmp_path / "b")
     for name in ("design_ok", *METRICS):
         assert a[name].values.tobytes() == b[name].values.tobytes(), name
+
+
+PENDULUM = (
+    '<mujoco><worldbody><body name="b"><joint name="j" type="hinge" axis="0 0 1"/>'
+    '<geom type="capsule" fromto="0 0 0 {L} 0 0" size="0.01"/><site name="tip" pos="{L} 0 0"/>'
+    "</body></worldbody><actuator><motor joint='j'/></actuator></mujoco>"
+)
+
+
+def test_an_mjcf_template_study_reaches_the_circle_of_its_radius(tmp_path):
+    from robomech.explore import template_builder
+
+    path = tmp_path / "pendulum.xml"
+    path.write_text(PENDULUM)
+    build = template_builder(path)
+    assert build.names == ("L",)
+    st = model_study(
+        build,
+        [Variable("L", 0.1, 0.3, "m")],
+        site="tip",
+        metrics=["task_fraction"],
+        task_points=[[0.0, 0.2, 0.0], [0.2, 0.0, 0.0], [0.5, 0.0, 0.0]],
+    )
+    res = st.evaluate_rows(np.array([[0.2], [0.25]]), None)
+    # the tip reaches exactly the points at distance L from the hinge
+    assert res["task_fraction"].tolist() == [2 / 3, 0.0]
+    path2 = tmp_path / "dollar.xml"
+    path2.write_text(PENDULUM.replace("{L}", "$L"))
+    assert template_builder(path2)(L=0.2).nq == 1

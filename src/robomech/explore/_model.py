@@ -309,7 +309,7 @@ def model_study(
     if not all(isinstance(u, UserMetric) for u in user_metrics):
         raise ValueError("Expected user_metrics to be a sequence of UserMetric.")
     if not metrics and not user_metrics:
-        raise ValueError("Expected at least one metric, got none.")
+        raise ValueError("Expected metrics or user_metrics to hold at least one metric, got none.")
     k = len(outputs)
     n_grid = check_int(task_grid_size, "task_grid_size", low=2, high=4096)
     box = None
@@ -639,16 +639,14 @@ def load_model(spec: str) -> Callable[..., Any]:
     """
     if not isinstance(spec, str) or not spec:
         raise ValueError(f"Expected spec to be 'FILE.py:NAME' or a template file, got {spec!r}.")
-    path_s, sep, attr = spec.rpartition(":") if spec.endswith((".xml", ".urdf")) is False else (spec, "", "")
-    if not sep:
-        path_s, attr = spec, ""
+    path_s, sep, attr = spec.rpartition(":")
+    if not sep or not attr.isidentifier():
+        path_s, attr = spec, "build"
     path = Path(path_s)
     if path.suffix in (".xml", ".urdf", ".mjcf"):
         return template_builder(path)
     if not path.is_file():
-        raise ValueError(f"Expected --model FILE.py:NAME with an existing file, got {spec!r} (no such file).")
-    if not attr:
-        attr = "build"
+        raise ValueError(f"Expected spec (--model FILE.py:NAME) to name an existing file, got {spec!r}.")
     import hashlib
 
     # the same module name in every process (str hash() is salted per process)
@@ -660,10 +658,14 @@ def load_model(spec: str) -> Callable[..., Any]:
         sys.modules[name] = module
         mod_spec.loader.exec_module(module)
     except Exception as exc:
-        raise ValueError(f"Expected --model {spec!r} to import, got {type(exc).__name__}: {exc}") from exc
+        raise ValueError(
+            f"Expected spec (--model) {spec!r} to import, got {type(exc).__name__}: {exc}"
+        ) from exc
     fn = getattr(module, attr, None)
     if not callable(fn):
-        raise ValueError(f"Expected {path} to define a function {attr!r}, got {type(fn).__name__}.")
+        raise ValueError(
+            f"Expected spec (--model) {spec!r} to name a function of the file, got {type(fn).__name__}."
+        )
     import cloudpickle
 
     cloudpickle.register_pickle_by_value(module)
@@ -733,6 +735,7 @@ def template_builder(path: Path | str) -> Callable[..., Any]:
         kind = "format"
     if not names:
         raise ValueError(
-            f"Expected the template {str(path)!r} to hold named parameters ({{L1}} or $L1), got none."
+            f"Expected path {str(path)!r} to be a template holding named parameters "
+            "({L1} or $L1), got none."
         )
     return _Template(text, kind, names)
