@@ -5,11 +5,15 @@ user's Delta along a 21-sample pick-and-place path (peak and RMS actuator torque
 ``build`` call and one batched engine call per metric family (IK with neighbour retries, Jacobians,
 singularities; or IK along the path and inverse dynamics).  Warm (numba compiled) timings.
 
-    PYTHONPATH=src python benchmarks/bench_model_study.py [--designs N]
+    PYTHONPATH=src python benchmarks/bench_model_study.py [--designs N] [--workers K]
+
+``--workers K``: the same studies through ``run_sweep`` on a K-worker loopback LocalCluster (chunks of
+4 designs, a warm-up sweep first so that every worker has compiled the kernels).
 """
 
 import argparse
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -49,7 +53,27 @@ def studies():
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--designs", type=int, default=8)
-    n = ap.parse_args().designs
+    ap.add_argument("--workers", type=int, default=0)
+    args = ap.parse_args()
+    n = args.designs
+    if args.workers:
+        from distributed import Client
+
+        from robomech.explore import local_cluster, run_sweep
+
+        with local_cluster(args.workers) as cl, Client(cl) as c:
+            for name, st in studies().items():
+                with tempfile.TemporaryDirectory() as d:
+                    run_sweep(
+                        st, d + "/warm", designs=2 * args.workers, chunk_size=1, client=c, progress=False
+                    )
+                    r = run_sweep(st, d + "/s", designs=n, chunk_size=4, client=c, progress=False)
+                poses = st.poses_per_design
+                print(
+                    f"{name}: {args.workers} workers, {n} designs x {poses} poses in {r.seconds:.2f} s -> "
+                    f"{n / r.seconds:.2f} designs/s, {n * poses / r.seconds:.0f} design-poses/s"
+                )
+        return
     for name, st in studies().items():
         X = design_matrix(st.variables, n, "sobol", 0, n)
         st.evaluate_rows(X[:1], None)  # compile
