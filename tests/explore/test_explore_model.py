@@ -107,6 +107,7 @@ def test_workspace_area_equals_the_annuli_intersection_to_the_grid_resolution(st
         assert cut * h * h < 0.5 * true_area  # the bound is not vacuous
 
 
+@pytest.mark.slow
 def test_dexterity_equals_an_svd_of_the_five_bar_velocity_equations(study, build):
     res = study.evaluate_rows(ROWS, None)
     for (L1, L2, B), dmin, dmean in zip(ROWS, res["dexterity_min"], res["dexterity_mean"], strict=True):
@@ -155,6 +156,7 @@ def test_user_metric_and_bad_input(build):
         model_study(None, VARS, site="tip")
 
 
+@pytest.mark.slow
 def test_sweep_store_resume_and_labelled_results(small, client, tmp_path):
     study = small
     out = tmp_path / "s"
@@ -251,3 +253,53 @@ def test_an_mjcf_template_study_reaches_the_circle_of_its_radius(tmp_path):
     path2 = tmp_path / "dollar.xml"
     path2.write_text(PENDULUM.replace("{L}", "$L"))
     assert template_builder(path2)(L=0.2).nq == 1
+
+
+DELTA = Path(__file__).resolve().parents[2] / "examples" / "models" / "delta.py"
+# Central-difference step of the actuated angles (rad) for the virtual-work reference, and the
+# tolerance on the torque: truncation O(h^2) times dU''' ~ 1 J plus the FK's closure tolerance
+# over h (1e-10 m / 1e-5 rad of a ~1 kg mechanism: ~1e-4 N m).
+FD_STEP = 1e-5
+VIRTUAL_WORK_ATOL = 1e-4
+
+
+@pytest.mark.slow
+def test_delta_peak_torque_at_rest_equals_virtual_work_of_gravity():
+    """Held at rest (a 'trajectory' that does not move), the actuator torques are the gravity load,
+    tau_i = dU/dtheta_i: the potential energy differentiated through the forward kinematics
+    (multibody.energy of the assembled configurations), independent of the inverse dynamics."""
+    build = load_model(f"{DELTA}:build")
+    params = {"arm": 0.22, "forearm": 0.55, "R": 0.18, "r": 0.05}
+    mech = build(**params)
+    z = mb.site_pose(mech, mech.q0, "tcp")[2, 3]
+    still = (np.linspace(0.0, 1.0, 5), np.tile([0.03, -0.02, z + 0.02], (5, 1)))
+    st = model_study(
+        build,
+        [Variable(k, v * 0.9, v * 1.1, "m") for k, v in params.items()],
+        site="tcp",
+        outputs="xyz",
+        metrics=("peak_force", "rms_force"),
+        trajectory=still,
+    )
+    res = st.evaluate_rows(np.array([list(params.values())]), None)
+    ik = mb.inverse_kinematics(
+        mech,
+        "tcp",
+        np.eye(4) + np.pad([[0.03], [-0.02], [z + 0.02]], ((0, 1), (3, 0))),
+        weights=(0, 0, 0, 1, 1, 1),
+        steps=4,
+    )
+    assert bool(ik.converged)
+    th = ik.q_act
+    grad = np.zeros(3)
+    for i in range(3):
+        e = np.eye(3)[i] * FD_STEP
+        U = []
+        for sgn in (1.0, -1.0):
+            fk = mb.forward_kinematics(mech, th + sgn * e, ik.q)
+            assert bool(fk.converged)
+            U.append(mb.energy(mech, fk.q, np.zeros(mech.nv))[1])
+        grad[i] = (U[0] - U[1]) / (2 * FD_STEP)
+    assert res["peak_force"][0] == pytest.approx(np.max(np.abs(grad)), abs=VIRTUAL_WORK_ATOL)
+    assert res["rms_force"][0] == pytest.approx(np.sqrt(np.mean(grad**2)), abs=VIRTUAL_WORK_ATOL)
+    assert np.max(np.abs(grad)) > 0.1  # a real load (N m), not a vacuous comparison

@@ -173,6 +173,7 @@ def _serve(server):
     return t
 
 
+@pytest.mark.slow
 def test_scheduler_at_an_http_port_or_a_silent_port_is_unreachable_within_the_timeout(tmp_path):
     http = HTTPServer(("127.0.0.1", 0), _Http)
     silent = socket.socket()
