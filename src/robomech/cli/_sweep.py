@@ -49,7 +49,7 @@ def _model_study(args: argparse.Namespace):
     if not args.site:
         raise ValueError("Expected --site NAME (the output site of the model) with --model, got none.")
     variables = [_variable(v) for v in args.var]
-    kwargs = {}
+    kwargs: dict[str, list[list[float]]] = {}
     if args.task_box:
         kwargs["task_box"] = _box(args.task_box, "--task-box")
     if args.input_box:
@@ -71,7 +71,8 @@ def _model_study(args: argparse.Namespace):
         input_grid=args.input_grid,
         objectives=objectives,
         name=f"model:{args.model}",
-        **kwargs,
+        task_box=kwargs.get("task_box"),
+        input_box=kwargs.get("input_box"),
     )
 
 

@@ -368,7 +368,7 @@ def model_study(
         for m in metrics
     ]
     metric_objs += [Metric(u.name, u.unit, u.description) for u in user_metrics]
-    n_task = 0 if box is None and pts is None else (n_grid**k if box is not None else pts.shape[0])
+    n_task = n_grid**k if box is not None else (pts.shape[0] if pts is not None else 0)
     poses = max(
         1, n_task + (n_in ** ibox.shape[0] if ibox is not None else 0) + (traj[0].size if traj else 0)
     )
@@ -486,7 +486,7 @@ def _one_design(study: ModelStudy, params: dict[str, float]) -> dict[str, float]
         qa = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, box.shape[0])
         fk = mb.forward_kinematics(mech, qa)
         out["assembly_failure"] = float(1.0 - np.mean(np.asarray(fk.converged, bool)))
-    if gen & {"peak_force", "rms_force"}:
+    if gen & {"peak_force", "rms_force"} and study.trajectory is not None:
         out["peak_force"], out["rms_force"] = task_forces(mech, study.site, study.outputs, study.trajectory)
     for u in study.user_metrics:
         try:

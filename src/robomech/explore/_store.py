@@ -131,49 +131,48 @@ def verify_store(g: zarr.Group, path: Path | str) -> dict[int, str]:
             f"{', '.join(missing)} missing (its metadata deleted, or its creation cut short); "
             "use another --out or remove this one."
         )
-    for n in names:
-        if not isinstance(g[n], zarr.Array):
+    arrays: dict[str, zarr.Array] = {}
+    for name in names:
+        node = g[name]
+        if not isinstance(node, zarr.Array):
             raise StoreDamaged(
-                f"Expected {n!r} in the sweep store {str(path)!r} to be an array, got a group."
+                f"Expected {name!r} in the sweep store {str(path)!r} to be an array, got a group."
             )
+        arrays[name] = node
     try:
-        done = np.asarray(g["chunk_done"][...], dtype=bool)
+        done = np.asarray(arrays["chunk_done"][...], dtype=bool)
     except Exception as exc:
         raise StoreDamaged(
             f"Expected the sweep store {str(path)!r} to have a readable chunk_done array, got "
             f"{type(exc).__name__}: {exc}; use another --out or remove this one."
         ) from exc
-    chunk = int(g["design_ok"].chunks[0])
-    n = int(g["design_ok"].shape[0])
+    chunk = int(arrays["design_ok"].chunks[0])
+    n = int(arrays["design_ok"].shape[0])
     metric_names = names[len(FIXED) + (1 if "chunk_checksum" in names else 0) :]
     rows_of = ["design_ok", *metric_names]
-    sums = None
-    if "chunk_checksum" in names:
+    sums: NDArray[np.uint64] | None = None
+    sums_unreadable = False
+    if "chunk_checksum" in arrays:
         try:
-            sums = np.asarray(g["chunk_checksum"][...], dtype=np.uint64)
-        except Exception:
-            sums = None  # unreadable: every finished chunk is re-read chunk by chunk below
-            damaged_all = True
-        else:
-            damaged_all = False
-    else:
-        damaged_all = False
+            sums = np.asarray(arrays["chunk_checksum"][...], dtype=np.uint64)
+        except Exception:  # unreadable: every finished chunk is reported
+            sums_unreadable = True
     whole: dict[str, NDArray[Any] | None] = {}
     for name in rows_of:
         try:
-            whole[name] = np.asarray(g[name][...])
+            whole[name] = np.asarray(arrays[name][...])
         except Exception:  # a chunk that cannot be decoded: found chunk by chunk below
             whole[name] = None
     damaged: dict[int, str] = {}
-    for k in np.flatnonzero(done):
-        k = int(k)
+    for kk in np.flatnonzero(done):
+        k = int(kk)
         rows = slice(k * chunk, min((k + 1) * chunk, n))
         res: dict[str, NDArray[Any]] = {}
         for name in rows_of:
             a = whole[name]
             if a is None:
                 try:
-                    res[name] = np.asarray(g[name][rows])
+                    res[name] = np.asarray(arrays[name][rows])
                 except Exception as exc:
                     damaged[k] = f"{name} unreadable ({type(exc).__name__})"
                     break
@@ -181,7 +180,7 @@ def verify_store(g: zarr.Group, path: Path | str) -> dict[int, str]:
                 res[name] = a[rows]
         if k in damaged:
             continue
-        if damaged_all:
+        if sums_unreadable:
             damaged[k] = "chunk_checksum unreadable"
         elif sums is not None and int(sums[k]) != chunk_checksum(res, rows_of):
             bad = [x for x in rows_of[1:] if res[x].dtype.kind == "f" and np.isnan(res[x]).all()]
@@ -366,7 +365,7 @@ def open_results(out: Path | str, *, as_dict: bool = False) -> Any:
     damaged = verify_store(g, out)
     if damaged:
         raise StoreDamaged(damage_message(out, damaged))
-    arrays = {name: np.asarray(g[name][...]) for name in expected_arrays(meta)}
+    arrays = {name: np.asarray(store_array(g, name)[...]) for name in expected_arrays(meta)}
     if as_dict:
         return {"attrs": meta, **arrays}
     return to_dataset(meta, arrays)
