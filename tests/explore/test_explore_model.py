@@ -303,3 +303,78 @@ def test_delta_peak_torque_at_rest_equals_virtual_work_of_gravity():
     assert res["peak_force"][0] == pytest.approx(np.max(np.abs(grad)), abs=VIRTUAL_WORK_ATOL)
     assert res["rms_force"][0] == pytest.approx(np.sqrt(np.mean(grad**2)), abs=VIRTUAL_WORK_ATOL)
     assert np.max(np.abs(grad)) > 0.1  # a real load (N m), not a vacuous comparison
+
+
+# Seconds the killed run may take to store its first chunks (a LocalCluster start and numba compiles).
+KILL_DEADLINE = 120.0
+
+
+@pytest.mark.slow
+def test_a_sweep_killed_with_sigkill_resumes_exactly_the_missing_chunks(small, client, tmp_path):
+    """``robomech sweep --model`` in its own process group, SIGKILLed (client, cluster and all) once two
+    chunks are stored; the rerun computes exactly the chunks not flagged done, and the store equals an
+    uninterrupted sweep bit for bit."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    import zarr
+
+    out = tmp_path / "k"
+    cmd = [sys.executable, "-m", "robomech", "sweep", "--model", f"{MODEL}:build", "--site", "tip"]
+    cmd += ["--var", "L1=0.15:0.25", "--var", "L2=0.15:0.25", "--var", "B=0.05:0.15"]
+    cmd += [
+        "--task-box=-0.5:0.5,-0.5:0.5",
+        "--task-grid",
+        "8",
+        *[x for m in METRICS for x in ("--metric", m)],
+    ]
+    cmd += [
+        "--designs",
+        "24",
+        "--chunk-size",
+        "2",
+        "--seed",
+        "4",
+        "--workers",
+        "1",
+        "--quiet",
+        "--out",
+        str(out),
+    ]
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(MODEL.parents[2] / "src"), os.environ.get("PYTHONPATH", "")]),
+    }
+    proc = subprocess.Popen(
+        cmd, env=env, start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
+    try:
+        t0 = time.monotonic()
+        done = 0
+        while time.monotonic() - t0 < KILL_DEADLINE and proc.poll() is None:
+            try:
+                done = int(np.sum(zarr.open_group(str(out), mode="r")["chunk_done"][...]))
+            except Exception:
+                done = 0  # not created yet
+            if done >= 2:
+                break
+            time.sleep(0.05)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait(10)
+    assert 2 <= done < 12, done
+    before = np.asarray(zarr.open_group(str(out), mode="r")["chunk_done"][...], bool)
+    st = model_study(load_model(f"{MODEL}:build"), [Variable("L1", 0.15, 0.25), Variable("L2", 0.15, 0.25),
+                     Variable("B", 0.05, 0.15)], site="tip", metrics=METRICS, task_box=BOX, task_grid_size=8,
+                     name=f"model:{MODEL}:build")  # fmt: skip
+    s = run_sweep(st, out, designs=24, chunk_size=2, seed=4, client=client, progress=False)
+    assert s.computed_chunks == tuple(int(k) for k in np.flatnonzero(~before))
+    ref = tmp_path / "ref"
+    run_sweep(st, ref, designs=24, chunk_size=2, seed=4, client=client, progress=False)
+    a, b = open_results(out), open_results(ref)
+    for name in ("design_ok", *METRICS):
+        assert a[name].values.tobytes() == b[name].values.tobytes(), name
