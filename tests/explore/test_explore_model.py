@@ -207,6 +207,9 @@ def test_cli_sweep_of_a_model_file(tmp_path, capsys):
     assert main([*args[:-2], "--out", str(tmp_path / "d"), "--var", "Q=0:1"]) == 2
     assert "parameters of build" in capsys.readouterr().err
     assert main(["sweep", "--model", str(tmp_path / "missing.py:build"), "--site", "t", "--out", "x"]) == 2
+    assert main(["sweep", "--out", str(tmp_path / "e")]) == 2  # neither STUDY nor --model
+    assert "neither" in capsys.readouterr().err
+    assert main(["sweep", "--model", f"{MODEL}:build", "--out", str(tmp_path / "f")]) == 2  # no --site
 
 
 @pytest.mark.slow
