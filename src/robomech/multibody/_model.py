@@ -607,12 +607,16 @@ class Builder:
 
     # joints
     @staticmethod
-    def hinge(name: str, axis: Vector = (0, 0, 1), pos: Vector = (0, 0, 0), ref: float = 0.0) -> Joint:
+    def hinge(
+        name: str, axis: Vector = (0, 0, 1), pos: Vector = (0, 0, 0), ref: float = 0.0
+    ) -> Joint:
         """A hinge ``Joint`` about ``axis`` (body frame) through ``pos`` (m), zero at ``ref`` (rad)."""
         return Joint(name, "hinge", tuple(axis), tuple(pos), ref)
 
     @staticmethod
-    def slide(name: str, axis: Vector = (0, 0, 1), pos: Vector = (0, 0, 0), ref: float = 0.0) -> Joint:
+    def slide(
+        name: str, axis: Vector = (0, 0, 1), pos: Vector = (0, 0, 0), ref: float = 0.0
+    ) -> Joint:
         """A slide ``Joint`` along ``axis`` (body frame), zero at ``ref`` (m)."""
         return Joint(name, "slide", tuple(axis), tuple(pos), ref)
 
@@ -627,14 +631,18 @@ class Builder:
         return Joint(name, "free")
 
     @staticmethod
-    def universal(name: str, axis1: Vector, axis2: Vector, pos: Vector = (0, 0, 0)) -> tuple[Joint, Joint]:
+    def universal(
+        name: str, axis1: Vector, axis2: Vector, pos: Vector = (0, 0, 0)
+    ) -> tuple[Joint, Joint]:
         """A universal joint as two hinges through one point (``name_1`` then ``name_2``)."""
         return (
             Joint(f"{name}_1", "hinge", tuple(axis1), tuple(pos)),
             Joint(f"{name}_2", "hinge", tuple(axis2), tuple(pos)),
         )
 
-    def helical(self, name: str, axis: Vector, pitch: float, pos: Vector = (0, 0, 0)) -> tuple[Joint, Joint]:
+    def helical(
+        self, name: str, axis: Vector, pitch: float, pos: Vector = (0, 0, 0)
+    ) -> tuple[Joint, Joint]:
         """A helical joint: hinge ``name_r`` and slide ``name_p`` coupled by ``p = pitch * theta`` (m/rad)."""
         r = Joint(f"{name}_r", "hinge", tuple(axis), tuple(pos))
         p = Joint(f"{name}_p", "slide", tuple(axis), tuple(pos))
@@ -658,7 +666,9 @@ class Builder:
         self._bodies.append(Body(name, parent, tuple(pos), tuple(quat), tuple(flat), inertial))
         return name
 
-    def site(self, name: str, body: str, pos: Vector = (0, 0, 0), quat: Vector = (1, 0, 0, 0)) -> str:
+    def site(
+        self, name: str, body: str, pos: Vector = (0, 0, 0), quat: Vector = (1, 0, 0, 0)
+    ) -> str:
         """Add a site on ``body`` at ``pos`` (m), ``quat`` ``[w, x, y, z]`` (body frame); returns the name."""
         self._sites.append(Site(name, body, tuple(pos), tuple(quat)))
         return name
