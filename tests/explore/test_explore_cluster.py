@@ -126,7 +126,7 @@ def local_run(tmp_path_factory):
     """The same sweep on the default LocalCluster (one worker process here)."""
     out = tmp_path_factory.mktemp("local") / "s"
     assert main(["sweep", STUDY, "--out", str(out), "--workers", "1", *ARGS]) == 0
-    return open_results(out)
+    return open_results(out, as_dict=True)
 
 
 def _assert_identical(a: dict, b: dict) -> None:
@@ -140,7 +140,7 @@ def test_cluster_run_is_bit_identical_to_the_local_run(cluster, local_run, tmp_p
     assert main(["sweep", STUDY, "--out", str(out), "--scheduler", cluster.address, "--json", *ARGS]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["workers"] == 2 and summary["computed_chunks"] == 8
-    r = open_results(out)
+    r = open_results(out, as_dict=True)
     _assert_identical(r, local_run)
     assert r["attrs"]["fingerprint"] == local_run["attrs"]["fingerprint"]
 
@@ -157,12 +157,12 @@ def test_interrupted_cluster_run_resumes_only_the_missing_chunks(cluster, local_
     with pytest.raises(KeyboardInterrupt):
         run_sweep(get_study(STUDY), out, designs=48, chunk_size=6, seed=11, scheduler=cluster.address,
                   progress=False, on_chunk=interrupt)  # fmt: skip
-    done = open_results(out)["chunk_done"]
+    done = open_results(out, as_dict=True)["chunk_done"]
     assert done.sum() == 3
     assert main(["sweep", STUDY, "--out", str(out), "--scheduler", cluster.address, "--json", *ARGS]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["computed_chunks"] == 5 and summary["skipped_chunks"] == 3
-    _assert_identical(open_results(out), local_run)
+    _assert_identical(open_results(out, as_dict=True), local_run)
 
 
 def test_a_worker_killed_mid_run_costs_only_its_chunks(cluster, tmp_path):
@@ -190,7 +190,7 @@ def test_a_worker_killed_mid_run_costs_only_its_chunks(cluster, tmp_path):
     assert killed, "the victim never held a task after a chunk was stored: the test proved nothing"
     assert cluster.procs["victim"].wait(timeout=30) != 0
     assert s.computed_chunks == tuple(range(12))
-    r = open_results(tmp_path / "s")
+    r = open_results(tmp_path / "s", as_dict=True)
     X = design_matrix(study.variables, n, study.default_sampler, seed, chunk)
     for k in range(12):
         _, ref, _, _ = evaluate_chunk(study, X[k * chunk : (k + 1) * chunk], seed, k)

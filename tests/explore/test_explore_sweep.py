@@ -50,7 +50,7 @@ def _tree_digest(path: Path) -> str:
 def test_store_layout_and_attributes(tmp_path, client):
     s = run_sweep(get_study(STUDY), tmp_path / "s", client=client, progress=False, **SMALL)
     assert s.n_chunks == 4 and s.computed_chunks == (0, 1, 2, 3) and s.skipped_chunks == 0
-    r = open_results(tmp_path / "s")
+    r = open_results(tmp_path / "s", as_dict=True)
     st = get_study(STUDY)
     assert r["designs"].shape == (24, 3)
     np.testing.assert_array_equal(r["designs"], design_matrix(st.variables, 24, "sobol", 3, 6))
@@ -76,7 +76,7 @@ def test_rerun_computes_nothing_and_interrupted_run_resumes_missing_chunks(tmp_p
 
     with pytest.raises(KeyboardInterrupt):
         run_sweep(get_study(STUDY), out, client=client, progress=False, on_chunk=stop_after_two, **SMALL)
-    done = open_results(out)["chunk_done"]
+    done = open_results(out, as_dict=True)["chunk_done"]
     assert done.sum() == 2
     s = run_sweep(get_study(STUDY), out, client=client, progress=False, **SMALL)
     assert set(s.computed_chunks) == set(np.flatnonzero(~done)) and s.skipped_chunks == 2
@@ -84,7 +84,7 @@ def test_rerun_computes_nothing_and_interrupted_run_resumes_missing_chunks(tmp_p
     assert again.computed_chunks == () and again.skipped_chunks == 4
     ref = run_sweep(get_study(STUDY), tmp_path / "ref", client=client, progress=False, **SMALL)
     assert ref.computed_chunks == (0, 1, 2, 3)
-    a, b = open_results(out), open_results(tmp_path / "ref")
+    a, b = open_results(out, as_dict=True), open_results(tmp_path / "ref", as_dict=True)
     for m in get_study(STUDY).metrics:
         assert a[m.name].tobytes() == b[m.name].tobytes()
 
@@ -190,7 +190,7 @@ def test_nsga2_evaluates_through_the_store_and_reuses_it(tmp_path, client):
     st = get_study(STUDY)
     s = optimize_nsga2(st, tmp_path / "o", population=8, generations=2, seed=1, client=client, progress=False)
     assert s.computed_chunks == (0, 1) and s.n_designs == 16
-    r = open_results(tmp_path / "o")
+    r = open_results(tmp_path / "o", as_dict=True)
     assert r["chunk_done"].all() and np.isfinite(r["designs"]).all()
     direct = st.evaluate_rows(r["designs"], None)
     np.testing.assert_array_equal(r["workspace_fraction"], direct["workspace_fraction"])
@@ -320,10 +320,10 @@ def test_chunk_writer_writes_rows_then_the_flag_and_refuses_unknown_arrays(tmp_p
     k, res, secs, cpu = evaluate_chunk(st, X[4:], 1, 1)
     names = ["design_ok", *(m.name for m in st.metrics)]
     with ChunkWriter(out, names) as w:
-        with pytest.raises(RuntimeError, match="does not hold"):
+        with pytest.raises(RuntimeError, match="other than the store"):
             w.write(0, slice(0, 4), {**res, "not_a_metric": res["rms_error"]}, secs, cpu)
         w.write(k, slice(4, 8), res, secs, cpu)
-    r = open_results(out)
+    r = open_results(out, as_dict=True)
     assert r["chunk_done"].tolist() == [False, True]  # the refused chunk wrote nothing
     assert r["chunk_seconds"][1] == secs and r["chunk_cpu_seconds"][1] == cpu
     assert np.isnan(r["rms_error"][:4]).all()

@@ -28,12 +28,66 @@ def _variable(text: str):
         raise ValueError(f"Expected numbers in --var {text!r} (NAME=LO:HI or NAME=SIGMA).") from exc
 
 
+def _box(text: str, what: str) -> list[list[float]]:
+    """``LO:HI,LO:HI,...`` as ``[[lo, hi], ...]``."""
+    try:
+        out = []
+        for part in text.split(","):
+            lo, hi = part.split(":")
+            out.append([float(lo), float(hi)])
+        return out
+    except ValueError as exc:
+        raise ValueError(f"Expected {what} LO:HI[,LO:HI...] (numbers, SI units), got {text!r}.") from exc
+
+
+def _model_study(args: argparse.Namespace):
+    """The study of ``--model FILE.py:NAME`` (or a template file) with the command line's task and metrics."""
+    from robomech.explore import load_model, model_study
+
+    if args.study is not None:
+        raise ValueError(f"Expected either STUDY or --model, got both ({args.study!r} and {args.model!r}).")
+    if not args.site:
+        raise ValueError("Expected --site NAME (the output site of the model) with --model, got none.")
+    variables = [_variable(v) for v in args.var]
+    kwargs: dict[str, list[list[float]]] = {}
+    if args.task_box:
+        kwargs["task_box"] = _box(args.task_box, "--task-box")
+    if args.input_box:
+        kwargs["input_box"] = _box(args.input_box, "--input-box")
+    metrics = args.metric or ["workspace_measure", "task_fraction", "dexterity_min", "dexterity_mean"]
+    objectives = []
+    for o in args.objective:
+        from robomech.explore import Objective
+
+        name, _, sense = o.partition(":")
+        objectives.append(Objective(name, sense or "max"))
+    return model_study(
+        load_model(args.model),
+        variables,
+        site=args.site,
+        metrics=metrics,
+        outputs=args.outputs,
+        task_grid_size=args.task_grid,
+        input_grid=args.input_grid,
+        objectives=objectives,
+        name=f"model:{args.model}",
+        task_box=kwargs.get("task_box"),
+        input_box=kwargs.get("input_box"),
+    )
+
+
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from robomech.explore import get_study, run_sweep
 
     try:
-        study = get_study(args.study)
-        variables = [_variable(v) for v in args.var]
+        if args.model:
+            study = _model_study(args)
+            variables = []
+        elif args.study is None:
+            raise ValueError("Expected a STUDY name or --model FILE.py:NAME, got neither.")
+        else:
+            study = get_study(args.study)
+            variables = [_variable(v) for v in args.var]
         if args.method == "nsga2":
             from robomech.explore import optimize_nsga2
 
@@ -98,7 +152,23 @@ def register(subparsers) -> None:
         description="Run or resume a design study; results are a Zarr group under --out (docs/explore.md). "
         "Studies: spherical-leg-synthesis, vectored-thrust-tolerance, omnileg-synthesis.",
     )
-    sp.add_argument("study", metavar="STUDY", help="design study name")
+    sp.add_argument("study", metavar="STUDY", nargs="?", default=None, help="built-in design study name")
+    sp.add_argument(
+        "--model",
+        default=None,
+        metavar="FILE.py:NAME|FILE.xml",
+        help="a study of your own mechanism: build(**params) -> Mechanism, or an MJCF/URDF template",
+    )
+    sp.add_argument("--site", default=None, help="--model: the output site")
+    sp.add_argument("--outputs", default="xy", help="--model: output axes of the task (default xy)")
+    sp.add_argument("--task-box", default=None, metavar="LO:HI,LO:HI", help="--model: task box (m)")
+    sp.add_argument("--task-grid", type=int, default=32, help="--model: task cells per axis (default 32)")
+    sp.add_argument("--input-box", default=None, metavar="LO:HI,LO:HI", help="--model: actuator box")
+    sp.add_argument("--input-grid", type=int, default=8, help="--model: actuator grid per axis (default 8)")
+    sp.add_argument("--metric", action="append", default=[], help="--model: a generic metric (repeatable)")
+    sp.add_argument(
+        "--objective", action="append", default=[], metavar="METRIC:max|min", help="--model: objective"
+    )
     sp.add_argument(
         "--out", required=True, help="Zarr store directory (created, or resumed if it is this sweep's)"
     )

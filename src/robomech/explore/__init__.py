@@ -5,36 +5,47 @@ A :class:`DesignStudy` maps design variables onto a mechanism's frozen parameter
 mechanism's batched kernels.  :func:`run_sweep` evaluates chunks of designs as Dask tasks (a LocalCluster
 by default, or an existing cluster) and writes a resumable Zarr store; :func:`optimize_nsga2` runs pymoo's
 NSGA-II with its populations evaluated by the same machinery.  ``robomech sweep`` is the command line.
-See ``docs/explore.md``.  dask, distributed, zarr and pymoo are imported on first use only.
+:func:`model_study` makes a study of any parametrized description (``build(**params) -> Mechanism`` or
+an MJCF/URDF template) with generic, engine-computed metrics.  :func:`open_results` returns an
+``xarray.Dataset``.  See ``docs/explore.md``.  dask, distributed, zarr, pymoo and xarray are imported
+on first use only.
 """
 
 from __future__ import annotations
 
+from ._model import GENERIC_METRICS, ModelStudy, UserMetric, load_model, model_study, template_builder
 from ._optimize import optimize_nsga2
 from ._pareto import pareto_front
 from ._runner import SchedulerUnreachable, SweepSummary, local_cluster, run_sweep
 from ._sampling import SAMPLERS, chunk_seed, design_matrix
-from ._store import StoreMismatch, open_results
+from ._store import StoreDamaged, StoreMismatch, open_results
 from ._study import DesignStudy, Metric, Objective, Variable, with_variables
 
 __all__ = [
+    "GENERIC_METRICS",
     "SAMPLERS",
     "DesignStudy",
     "Metric",
+    "ModelStudy",
     "Objective",
     "SchedulerUnreachable",
+    "StoreDamaged",
     "StoreMismatch",
     "SweepSummary",
+    "UserMetric",
     "Variable",
     "available_studies",
     "chunk_seed",
     "design_matrix",
     "get_study",
+    "load_model",
     "local_cluster",
+    "model_study",
     "open_results",
     "optimize_nsga2",
     "pareto_front",
     "run_sweep",
+    "template_builder",
     "with_variables",
 ]
 

@@ -24,13 +24,16 @@ from ._runner import (
     SweepSummary,
     _Bar,
     _existing,
+    check_client,
     check_runtime,
+    check_writable,
     dask_client,
     evaluate_chunk,
+    resume_flags,
     robomech_version,
     sweep_fingerprint,
 )
-from ._store import open_store, prepare_store, store_array
+from ._store import chunk_checksum, open_store, prepare_store, store_array
 from ._study import DesignStudy, Variable, check_variables, with_variables
 
 __all__ = ["optimize_nsga2"]
@@ -127,7 +130,13 @@ def optimize_nsga2(
     fp = {**sweep_fingerprint(study, P * G, "nsga2", int(seed), P), "population": P, "generations": G}
     info = {**study.describe(), "robomech_version": robomech_version(), "method": "nsga2"}
     prepare = (Path(out), study, None, P, fp, info, P * G)
+    client = check_client(client)
     g = open_store(Path(out), fp, None)  # raises StoreMismatch before anything is written
+    if g is None:
+        check_writable(Path(out))  # before a cluster is started
+    else:
+        flags = resume_flags(g, Path(out), progress)  # damaged generations are recomputed
+        store_array(g, "chunk_done")[...] = flags
     xl = np.array([v.low for v in study.variables])
     xu = np.array([v.high for v in study.variables])
     bar = _Bar(f"{study.name} (NSGA-II)", P * G, progress)
@@ -158,8 +167,13 @@ def optimize_nsga2(
             parts = [f.result()[1] for f in futures]  # in order: deterministic regardless of workers
             res = {name: np.concatenate([p[name] for p in parts]) for name in parts[0]}
             store_array(g, "designs")[rows] = X
-            for name, arr in res.items():
-                store_array(g, name)[rows] = arr
+            names = ["design_ok", *(m.name for m in study.metrics)]
+            for name in names:
+                store_array(g, name)[rows] = res[name]
+            if "chunk_checksum" in g:
+                full = slice(k * P, (k + 1) * P)  # the stored chunk, as verify_store reads it
+                back = {name: np.asarray(store_array(g, name)[full]) for name in names}
+                store_array(g, "chunk_checksum")[k] = chunk_checksum(back, names)
             store_array(g, "chunk_done")[k] = True
             computed.append(k)
         bar.update(X.shape[0])

@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 from robomech._validation import check_bool, check_choice, check_int, check_positive
 
 from ._sampling import SAMPLERS, chunk_seed, design_matrix
-from ._store import ChunkWriter, open_store, prepare_store, store_array
+from ._store import ChunkWriter, damage_message, open_store, prepare_store, store_array, verify_store
 from ._study import DesignStudy, Variable, check_variables, with_variables
 
 if TYPE_CHECKING:
@@ -185,9 +185,10 @@ def dask_client(
             raise SchedulerUnreachable(
                 f"Expected a scheduler address like tcp://HOST:PORT, got {scheduler!r}."
             )
+        probe_scheduler(scheduler, timeout)
         try:
             client = Client(scheduler, timeout=timeout)
-        except (OSError, TimeoutError) as exc:
+        except (OSError, TimeoutError, MemoryError, ValueError, TypeError) as exc:
             raise SchedulerUnreachable(
                 f"Expected a Dask scheduler at {scheduler!r}, got no answer within {timeout:g} s "
                 f"({type(exc).__name__}: {exc})."
@@ -398,10 +399,11 @@ def run_sweep(
         "units": {**{v.name: v.unit for v in study.variables}, **{m.name: m.unit for m in study.metrics}},
     }
     n_chunks = -(-n // chunk)
+    client = check_client(client)
     g = open_store(Path(out), fp, X)  # raises StoreMismatch before anything is written
-    done = (
-        np.zeros(n_chunks, bool) if g is None else np.asarray(store_array(g, "chunk_done")[...], dtype=bool)
-    )
+    if g is None:
+        check_writable(out)  # before a cluster is started
+    done = np.zeros(n_chunks, bool) if g is None else resume_flags(g, out, progress)
     missing = [k for k in range(done.size) if not done[k]]
     t0 = time.perf_counter()
     computed: list[int] = []
@@ -457,12 +459,96 @@ def run_sweep(
     )
 
 
-def _pickle_study(study: DesignStudy) -> bytes:
-    """The study as bytes for the tasks (Dask's pickle, cloudpickle for what plain pickle cannot: a study
-    defined in ``__main__`` travels too)."""
-    from distributed.protocol.pickle import dumps
+def resume_flags(g: Any, out: Path, progress: bool) -> np.ndarray:
+    """``chunk_done`` of a store being resumed, false for every chunk :func:`verify_store` finds damaged
+    (those are recomputed; a warning names them on stderr)."""
+    damaged = verify_store(g, out)  # StoreDamaged if an array is missing: nothing to resume into
+    done = np.asarray(store_array(g, "chunk_done")[...], dtype=bool)
+    if damaged:
+        done[list(damaged)] = False
+        print(f"robomech sweep: {damage_message(out, damaged)}", file=sys.stderr)
+    return done
 
-    return bytes(dumps(study))
+
+def check_client(client: object) -> Any:
+    """``client`` if it is None or a ``distributed.Client``; ValueError otherwise (before any work)."""
+    if client is None:
+        return None
+    from distributed import Client
+
+    if not isinstance(client, Client):
+        raise ValueError(f"Expected client to be a distributed.Client or None, got {type(client).__name__}.")
+    return client
+
+
+def check_writable(out: Path) -> None:
+    """Create the directory ``out`` (and its parents) or raise ValueError saying why it cannot be."""
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / ".robomech-write-test"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as exc:
+        raise ValueError(
+            f"Expected out to be a directory robomech can create and write, got {str(out)!r} "
+            f"({exc.strerror or type(exc).__name__})."
+        ) from exc
+
+
+def probe_scheduler(address: str, timeout: float) -> None:
+    """Raise SchedulerUnreachable unless a Dask scheduler answers at ``tcp://HOST:PORT`` within
+    ``timeout`` seconds.
+
+    A Dask server writes its handshake as soon as it accepts a connection: a port that refuses, accepts
+    and stays silent (a stalled server), or answers with anything other than a Dask frame (an HTTP
+    server answers nothing until it gets a request) is not a scheduler.  Bounds the whole connection
+    attempt by ``timeout``, which the Client's own handshake does not.
+    """
+    import socket
+    from urllib.parse import urlsplit
+
+    parts = urlsplit(address)
+    if parts.scheme != "tcp":
+        return  # tls:// and other comms: left to distributed's own connection
+    try:
+        host, port = parts.hostname, parts.port
+    except ValueError as exc:
+        raise SchedulerUnreachable(
+            f"Expected a scheduler address like tcp://HOST:PORT, got {address!r}."
+        ) from exc
+    if not host or port is None:
+        raise SchedulerUnreachable(f"Expected a scheduler address like tcp://HOST:PORT, got {address!r}.")
+    deadline = time.monotonic() + timeout
+    try:
+        with socket.create_connection((host, port), timeout=timeout) as sock:
+            sock.settimeout(max(1e-3, deadline - time.monotonic()))
+            head = sock.recv(8)
+    except TimeoutError as exc:
+        raise SchedulerUnreachable(
+            f"Expected a Dask scheduler at {address!r}, got a port that accepted but sent no Dask "
+            f"handshake within {timeout:g} s (not a scheduler, or a stalled one)."
+        ) from exc
+    except OSError as exc:
+        raise SchedulerUnreachable(
+            f"Expected a Dask scheduler at {address!r}, got no answer within {timeout:g} s "
+            f"({exc.strerror or type(exc).__name__})."
+        ) from exc
+    # distributed's TCP messages start with their length (little-endian uint64): its handshake is
+    # tens of bytes, an HTTP or other text reply reads as a length of exabytes
+    if len(head) < 8 or int.from_bytes(head, "little") > 1 << 16:
+        raise SchedulerUnreachable(
+            f"Expected a Dask scheduler at {address!r}, got a server speaking another protocol "
+            f"(first bytes {head[:8]!r})."
+        )
+
+
+def _pickle_study(study: DesignStudy) -> bytes:
+    """The study as bytes for the tasks (cloudpickle: a study defined in ``__main__``, or a user model
+    loaded from a file by :func:`load_model` whose module is registered to be pickled by value, travels
+    to workers that cannot import it)."""
+    import cloudpickle
+
+    return bytes(cloudpickle.dumps(study))
 
 
 def check_runtime(

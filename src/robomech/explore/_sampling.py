@@ -24,6 +24,9 @@ SAMPLERS = ("sobol", "lhs", "grid", "random")
 # Unit-cube samples are kept this far inside (0, 1): a normal variable maps 0 and 1 to -inf and +inf
 # (a scrambled Sobol point can be exactly 0).  1e-12 caps a normal draw at 7 sigma.
 UNIT_MARGIN = 1e-12
+# Largest design matrix built (rows): 10^7 rows of 8 variables are 640 MB of float64, beyond any sweep
+# this machine finishes in a day; more is a typo, refused before memory is allocated.
+MAX_DESIGNS = 10**7
 
 
 def chunk_seed(seed: int, chunk: int) -> np.random.SeedSequence:
@@ -86,8 +89,9 @@ def design_matrix(variables: Sequence[Variable], n: int, sampler: str, seed: int
     Raises
     ------
     ValueError
-        If ``variables`` is not a non-empty sequence of Variable, ``sampler`` is unknown, or ``n``,
-        ``seed``, ``chunk`` are not ints in range.
+        If ``variables`` is not a non-empty sequence of Variable (or names a variable twice),
+        ``sampler`` is unknown, or ``n`` (1 to ``MAX_DESIGNS``), ``seed``, ``chunk`` are not ints in
+        range.
 
     Examples
     --------
@@ -97,10 +101,14 @@ def design_matrix(variables: Sequence[Variable], n: int, sampler: str, seed: int
     """
     variables = check_variables(variables)
     check_choice(sampler, "sampler", SAMPLERS)
-    n = check_int(n, "n", low=1)
+    n = check_int(n, "n", low=1, high=MAX_DESIGNS)
     seed = check_int(seed, "seed", low=0)
     chunk = check_int(chunk, "chunk", low=1)
     d = len(variables)
+    names = [v.name for v in variables]
+    if len(set(names)) != d:
+        dup = sorted({x for x in names if names.count(x) > 1})
+        raise ValueError(f"Expected variables with distinct names, got {', '.join(dup)} more than once.")
     if d == 0:
         raise ValueError("Expected variables to hold at least one design variable, got none.")
     if sampler == "sobol":

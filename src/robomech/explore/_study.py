@@ -288,6 +288,7 @@ class DesignStudy:
             "chunk_done",
             "chunk_seconds",
             "chunk_cpu_seconds",
+            "chunk_checksum",
             "report",
         } & set(names)
         if reserved or len(set(names)) != len(names):
@@ -343,6 +344,8 @@ class DesignStudy:
         params = self.designs_to_params(rows)
         out = self.evaluate(self, params, np.asarray(rows, dtype=float), seed)
         ok = np.array([p is not None for p in params], dtype=bool)
+        if "design_ok" in out:  # the study's own verdict (e.g. a description that cannot be built)
+            ok &= np.asarray(out["design_ok"], dtype=bool)
         res = {"design_ok": ok}
         for m in self.metrics:
             a = np.asarray(out[m.name], dtype=m.dtype)
@@ -405,7 +408,8 @@ def with_variables(study: DesignStudy, variables: Sequence[Variable]) -> DesignS
     Raises
     ------
     ValueError
-        If ``study`` is not a DesignStudy, ``variables`` is not a sequence of Variable, a range
+        If ``study`` is not a DesignStudy, ``variables`` is not a sequence of Variable (or names a
+        variable twice), a range
         variable names no parameter field (or names an error), a normal variable names no error, or an
         override changes a variable's kind.
 
@@ -419,6 +423,12 @@ def with_variables(study: DesignStudy, variables: Sequence[Variable]) -> DesignS
     if not isinstance(study, DesignStudy):
         raise ValueError(f"Expected study to be a DesignStudy, got {type(study).__name__}.")
     overrides = check_variables(variables, "variables")
+    names = [v.name for v in overrides]
+    if len(set(names)) != len(names):
+        dup = sorted({x for x in names if names.count(x) > 1})
+        raise ValueError(
+            f"Expected variables to name each variable once, got {', '.join(dup)} more than once."
+        )
     fields = study.parameter_fields()
     current = {v.name: v for v in study.variables}
     for ov in overrides:

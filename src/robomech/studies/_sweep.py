@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import itertools
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
-from robomech.explore import get_study, open_results, pareto_front
+from robomech.explore import Metric, Objective, Variable, available_studies, open_results, pareto_front
 
 from ._core import StudyResult, Table
 from ._plot import plt, save_figure
@@ -29,9 +30,9 @@ FRONT_ROWS = 20
 
 def sweep_result(store: Path, out_dir: Path, name: str = "sweep", prefix: str = "") -> StudyResult:
     """A StudyResult (tables, PNGs ``out_dir/<prefix><figure>.png``) from the sweep store ``store``."""
-    r = open_results(store)
+    r = open_results(store, as_dict=True)
     a = r["attrs"]
-    study = get_study(a["study"])
+    study = _study_of(a, r)
     res = StudyResult(
         name=name,
         title=f"Sweep: {a['title']}",
@@ -72,6 +73,8 @@ def sweep_result(store: Path, out_dir: Path, name: str = "sweep", prefix: str = 
     )
     if study.objectives:
         _pareto(res, r, study, out_dir, prefix)
+    if any(v["kind"] == "range" for v in a["variables"]) and scalar:
+        _sensitivity(res, r, study, scalar, out_dir, prefix)
     if any(v["kind"] == "normal" for v in a["variables"]):
         _tolerance(res, r, scalar, out_dir, prefix)
     if study.summarize is not None:
@@ -79,6 +82,82 @@ def sweep_result(store: Path, out_dir: Path, name: str = "sweep", prefix: str = 
             res.tables.append(Table(t["title"], t["columns"], t["rows"], note=t.get("note", "")))
     res.data = {"attrs": a, "n_designs": int(r["designs"].shape[0])}
     return res
+
+
+def _study_of(a: dict, r: dict):
+    """The registered study of the store, or one rebuilt from its attributes (a model study, whose
+    description lives in the user's file): name, variables, metrics and objectives."""
+    studies = available_studies()
+    if a["study"] in studies:
+        return studies[a["study"]]
+    variables = tuple(
+        Variable(v["name"], v["low"], v["high"], unit=v["unit"], description=v["description"])
+        if v["kind"] == "range"
+        else Variable(v["name"], kind="normal", sigma=v["sigma"], unit=v["unit"])
+        for v in a["variables"]
+    )
+    metrics = tuple(
+        Metric(
+            m["name"],
+            m["unit"],
+            m["description"],
+            shape=tuple(np.asarray(r[m["name"]]).shape[1:]),
+            dtype="bool" if np.asarray(r[m["name"]]).dtype == bool else "float64",
+        )
+        for m in a["metrics"]
+    )
+    objectives = tuple(Objective(o["metric"], o["sense"]) for o in a.get("objectives", []))
+    return SimpleNamespace(
+        name=a["study"], variables=variables, metrics=metrics, objectives=objectives, summarize=None
+    )
+
+
+# Designs needed for a rank correlation to be reported (fewer: the sensitivity table is left out).
+MIN_SENSITIVITY_DESIGNS = 8
+
+
+def _sensitivity(res: StudyResult, r: dict, study, metrics, out_dir: Path, prefix: str) -> None:
+    """Spearman rank correlation of each scalar metric with each range variable over the designs where
+    the metric is finite (scipy.stats.spearmanr): +1 the metric grows monotonically with the variable."""
+    from scipy.stats import spearmanr
+
+    X = np.asarray(r["designs"], float)
+    cols = [i for i, v in enumerate(study.variables) if v.kind == "range"]
+    names = [study.variables[i].name for i in cols]
+    rho = np.full((len(metrics), len(cols)), np.nan)
+    for a, m in enumerate(metrics):
+        y = np.asarray(r[m.name], float)
+        ok = np.isfinite(y) & np.asarray(r["design_ok"], bool)
+        if ok.sum() < MIN_SENSITIVITY_DESIGNS or np.ptp(y[ok]) == 0:
+            continue
+        for b, i in enumerate(cols):
+            rho[a, b] = spearmanr(X[ok, i], y[ok]).statistic
+    if not np.isfinite(rho).any():
+        return
+    fig, ax = plt.subplots(figsize=(1.2 * len(cols) + 3, 0.5 * len(metrics) + 1.8))
+    im = ax.imshow(rho, cmap="RdBu_r", vmin=-1, vmax=1, aspect="auto")
+    ax.set_xticks(range(len(cols)), names)
+    ax.set_yticks(range(len(metrics)), [m.name for m in metrics])
+    for (a, b), v in np.ndenumerate(rho):
+        if np.isfinite(v):
+            ax.text(b, a, f"{v:+.2f}", ha="center", va="center", fontsize=8)
+    fig.colorbar(im, ax=ax, label="Spearman rank correlation")
+    ax.set_title(f"{study.name}: sensitivity of each metric to each variable")
+    res.figures.append(
+        save_figure(
+            fig,
+            out_dir,
+            prefix + "sensitivity",
+            "Spearman rank correlation of each metric with each design variable over the sampled designs.",
+        )
+    )
+    res.tables.append(
+        Table(
+            "Sensitivity: Spearman rank correlation of each metric with each variable",
+            ["metric", *names],
+            [[m.name, *(float(x) if np.isfinite(x) else "—" for x in rho[a])] for a, m in enumerate(metrics)],
+        )
+    )
 
 
 def _pareto(res: StudyResult, r: dict, study, out_dir: Path, prefix: str) -> None:

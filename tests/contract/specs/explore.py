@@ -21,11 +21,20 @@ from contract_spec import (
     Spec,
 )
 
-from robomech.explore import Objective, Variable, design_matrix, get_study
+from robomech.explore import Objective, Variable, design_matrix, get_study, load_model
 from robomech.explore._runner import sweep_fingerprint
 from robomech.explore._store import prepare_store
 
 P = "robomech.explore."
+_FIVE_BAR = Path(__file__).resolve().parents[3] / "examples" / "models" / "five_bar.py"
+
+
+def _metric_fn(mech, params):
+    return 0.0
+
+
+_five_bar = load_model(f"{_FIVE_BAR}:build")
+
 STUDY = get_study("spherical-leg-synthesis")
 VARS = STUDY.variables
 TMP = Path(tempfile.mkdtemp(prefix="robomech-contract-explore-"))
@@ -35,6 +44,12 @@ atexit.register(shutil.rmtree, TMP, True)
 _X = design_matrix(VARS, 4, "sobol", 0, 2)
 prepare_store(TMP / "store", STUDY, _X, 2, sweep_fingerprint(STUDY, 4, "sobol", 0, 2), STUDY.describe())
 (TMP / "file.txt").write_text("not a store")
+_TEMPLATE = TMP / "pendulum.xml"
+_TEMPLATE.write_text(
+    '<mujoco><worldbody><body name="b"><joint name="j" type="hinge" axis="0 1 0"/>'
+    '<geom type="capsule" fromto="0 0 0 {L} 0 0" size="0.01"/><site name="tip" pos="{L} 0 0"/>'
+    '</body></worldbody><actuator><motor joint="j"/></actuator></mujoco>'
+)
 
 # integer options whose default is None (None is valid there)
 BAD_COUNT = ("1", True, 1.5, float("nan"), 1j, 0, -1)
@@ -67,6 +82,41 @@ SPECS = {
     P + "SweepSummary": RESULT_TYPE,
     P + "StoreMismatch": Exempt("exception type: raised by the library, takes no input to validate"),
     P + "SchedulerUnreachable": Exempt("exception type: raised by the library, takes no input to validate"),
+    P + "StoreDamaged": Exempt("exception type: raised by the library, takes no input to validate"),
+    P + "GENERIC_METRICS": Exempt("constant: the generic metrics' units, definitions and requirements"),
+    P + "ModelStudy": Exempt("made by model_study, which validates every field; a DesignStudy subclass"),
+    P + "UserMetric": Spec(
+        args={"name": "m", "fn": _metric_fn, "unit": "m", "description": "d"},
+        options={"name": (None, 1, "not an id", "task_fraction"), "fn": (None, 1), "unit": (None, 1)},
+    ),
+    P + "load_model": Spec(
+        args={"spec": f"{_FIVE_BAR}:build"},
+        options={"spec": (None, 1, "", str(TMP / "missing.py:build"), f"{_FIVE_BAR}:nope")},
+    ),
+    P + "template_builder": Spec(
+        args={"path": str(_TEMPLATE)},
+        options={"path": (None, 1, "", str(TMP / "missing.xml"), str(TMP / "file.txt"))},
+    ),
+    P + "model_study": Spec(
+        args={
+            "build": _five_bar,
+            "variables": (Variable("L1", 0.15, 0.25),),
+            "site": "tip",
+            "metrics": ("workspace_measure",),
+            "outputs": "xy",
+            "task_box": [[-0.5, 0.5], [-0.5, 0.5]],
+            "task_grid_size": 4,
+        },
+        options={
+            "build": (None, 1),
+            "variables": (None, (), (Variable("nope", 0, 1),), (Variable("e", kind="normal", sigma=1.0),)),
+            "site": (None, "", 1),
+            "metrics": (None, "workspace_measure", ("nope",), ()),
+            "outputs": (None, "yx", "q", "xx", ""),
+            "task_box": ([[0, 1]], [[1, 0], [0, 1]], "a", [[np.nan, 1], [0, 1]]),
+            "task_grid_size": (None, 1, 1.5, 10**5),
+        },
+    ),
     P + "available_studies": Exempt("registry: takes no input"),
     P + "Variable": Spec(
         args={"name": "R", "low": 0.05, "high": 0.1, "unit": "m", "kind": "range", "description": ""},
