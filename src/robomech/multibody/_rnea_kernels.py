@@ -11,7 +11,7 @@ import numpy as np
 
 from robomech._numba import import_numba
 
-from ._compiled import BLOCK, kin
+from ._compiled import BLOCK, entry, kin, prepare_one
 
 __all__ = ["crba_batch"]
 
@@ -20,16 +20,17 @@ _nj = numba.njit(cache=True, error_model="numpy")
 
 
 @_nj
-def _inertia_world(T, mass, com, inertia, b, c, Ic):  # pragma: no cover - compiled
-    """World centre of mass ``c (3,)`` and inertia about it ``Ic (3, 3)`` of body ``b``."""
+def _inertia_world(T, com, inertia, b, ib, c, Ic):  # pragma: no cover - compiled
+    """World centre of mass ``c (3,)`` and inertia about it ``Ic (3, 3)`` of body ``b`` (its mass
+    properties ``com[ib]``, ``inertia[ib]``)."""
     for i in range(3):
-        c[i] = T[b, i, 3] + T[b, i, 0] * com[b, 0] + T[b, i, 1] * com[b, 1] + T[b, i, 2] * com[b, 2]
+        c[i] = T[b, i, 3] + T[b, i, 0] * com[ib, 0] + T[b, i, 1] * com[ib, 1] + T[b, i, 2] * com[ib, 2]
     for i in range(3):
         for j in range(3):
             s = 0.0
             for k in range(3):
                 for m in range(3):
-                    s += T[b, i, k] * inertia[b, k, m] * T[b, j, m]
+                    s += T[b, i, k] * inertia[ib, k, m] * T[b, j, m]
             Ic[i, j] = s
 
 
@@ -47,9 +48,11 @@ def _apply(m, c, Ic, X, out):  # pragma: no cover - compiled
 
 
 @_nj
-def crba_block(Q, lo, hi, t, mass, com, inertia, dof_body, Aanc, out):  # pragma: no cover
+def crba_block(Q, lo, hi, t, out):  # pragma: no cover
+    """The composite-rigid-body mass matrix of samples ``lo:hi`` into ``out (N, nv, nv)`` (``t`` the
+    compiled model's ``RneaTables``: the tree, its massive bodies, ``dof_body`` and the sparsity ``A``)."""
     nb, nv = t.parent.shape[0], out.shape[1]
-    parent = t.parent
+    parent, dof_body, Aanc = t.parent, t.dof_body, t.A
     T = np.empty((nb, 4, 4))
     S = np.zeros((nv, 6))
     I6 = np.empty((nb, 6, 6))
@@ -60,12 +63,14 @@ def crba_block(Q, lo, hi, t, mass, com, inertia, dof_body, Aanc, out):  # pragma
     Fi = np.empty(6)
     for n in range(lo, hi):
         kin(Q[n], t, T, S)
-        for b in range(nb):
-            _inertia_world(T, mass, com, inertia, b, c, Ic)
+        I6[:, :, :] = 0.0
+        for ib in range(t.bidx.shape[0]):  # bodies without mass or inertia stay zero
+            b = t.bidx[ib]
+            _inertia_world(T, t.com, t.inertia, b, ib, c, Ic)
             for j in range(6):
                 for i in range(6):
                     X[i] = 1.0 if i == j else 0.0
-                _apply(mass[b], c, Ic, X, col)
+                _apply(t.mass[ib], c, Ic, X, col)
                 for i in range(6):
                     I6[b, i, j] = col[i]
         for b in range(nb - 1, 0, -1):  # composite inertias
@@ -92,29 +97,29 @@ def crba_block(Q, lo, hi, t, mass, com, inertia, dof_body, Aanc, out):  # pragma
 
 
 @numba.njit(cache=True, error_model="numpy", parallel=True)
-def crba_par(Q, t, mass, com, inertia, dof_body, Aanc, out):  # pragma: no cover
+def crba_par(Q, t, out):  # pragma: no cover
     N = Q.shape[0]
     for k in numba.prange((N + BLOCK - 1) // BLOCK):
-        crba_block(Q, k * BLOCK, min(N, (k + 1) * BLOCK), t, mass, com, inertia, dof_body, Aanc, out)
+        crba_block(Q, k * BLOCK, min(N, (k + 1) * BLOCK), t, out)
 
 
-def crba_batch(model, bi, q: np.ndarray) -> np.ndarray:
-    """``(N, nv, nv)`` tree mass matrix of the compiled ``model`` with inertias ``bi`` (``_rnea``)."""
-    tree = model.tree
-    f = np.ascontiguousarray
-    Q = f(q, dtype=np.float64)
-    out = np.empty((Q.shape[0], tree.nv, tree.nv))
-    args = (
-        model.tables,
-        f(bi.mass),
-        f(bi.com),
-        f(bi.inertia),
-        tree.dof_body.astype(np.int64),
-        f(tree.A),
-        out,
-    )
+@_nj
+def crba_one(q, t, qs, out):  # pragma: no cover - compiled
+    """One sample, checked (``_compiled.prepare_one``), then :func:`crba_block` into ``out (nv, nv)``."""
+    if prepare_one(q, (q,), t.jtype, t.jqadr, qs) != 0:
+        return 1
+    nv = out.shape[0]
+    crba_block(qs.reshape(1, qs.shape[0]), 0, 1, t, out.reshape(1, nv, nv))
+    return 0
+
+
+def crba_batch(model, q: np.ndarray) -> np.ndarray:
+    """``(N, nv, nv)`` tree mass matrix of the compiled ``model`` at normalised ``q (N, nq)``."""
+    Q = np.ascontiguousarray(q, dtype=np.float64)
+    nv = model.tree.nv
+    out = np.empty((Q.shape[0], nv, nv))
     if Q.shape[0] <= BLOCK:
-        crba_block(Q, 0, Q.shape[0], *args)
+        entry(model, crba_block, "crba_block", (Q, 0, Q.shape[0], model.rnea, out))
     else:
-        crba_par(Q, *args)
+        crba_par(Q, model.rnea, out)
     return out
