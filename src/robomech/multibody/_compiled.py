@@ -1358,8 +1358,16 @@ def entry(model, kernel, key: str, args: tuple):
     return fn(*args)
 
 
+def writable(x: np.ndarray) -> np.ndarray:
+    """``x`` as a C-contiguous, writable float64 array: numba types a read-only array (a broadcast
+    view, say) as another argument type, i.e. another specialization to compile at first use."""
+    a = np.ascontiguousarray(x, dtype=np.float64)
+    return a if a.flags.writeable else a.copy()
+
+
 def compiled_rnea(model, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray, gv: np.ndarray) -> np.ndarray:
     """Tree inverse dynamics ``(N, nv)`` (:func:`rnea_block`) at normalised ``Q (N, nq)``, ``QD``, ``QDD``."""
+    Q, QD, QDD, gv = writable(Q), writable(QD), writable(QDD), writable(gv)
     N = Q.shape[0]
     tau = np.empty((N, model.tree.nv))
     if N <= BLOCK:
@@ -1399,13 +1407,35 @@ def warm() -> None:
         z = np.zeros((n, len(model.act)))
         _dynamics._inverse_compiled(mech, qf, z, z, {}, None, True)
     inv_dyn_one(model, mech.q0, np.zeros(1), np.zeros(1), mech.gravity, True)
-    from ._rnea import _crba_one, _rnea_one
-    from ._rnea_kernels import crba_batch
+    from ._rnea import generalized_forces, mass_matrix
 
+    tree_mech = _open_chain()  # the tree dynamics through the public calls (forward dynamics too)
     for n in (1, 2 * BLOCK + 1):
+        q = np.tile(mech.q0, (n, 1))
         z = np.zeros((n, mech.nv))
-        compiled_rnea(model, np.tile(mech.q0, (n, 1)), z, z, np.zeros(3))
-        crba_batch(model, np.tile(mech.q0, (n, 1)))
+        generalized_forces(mech, q, z, z)
+        mass_matrix(mech, q)
+        z = np.zeros((n, tree_mech.nv))
+        _dynamics.forward_dynamics(tree_mech, z, tau=z, qd=z)
     z = np.zeros(mech.nv)
-    _rnea_one(mech, np.array(mech.q0, dtype=float), z, z, True)
-    _crba_one(mech, np.array(mech.q0, dtype=float))
+    generalized_forces(mech, np.array(mech.q0, dtype=float), z, z)
+    mass_matrix(mech, np.array(mech.q0, dtype=float))
+    z = np.zeros(tree_mech.nv)
+    _dynamics.forward_dynamics(tree_mech, z, tau=z, qd=z)
+
+
+def _open_chain():
+    """A two-link open chain (both joints actuated), for :func:`warm`."""
+    from ._model import Builder, Inertial
+
+    b = Builder("warm_2r")
+    b.body("l1", joints=[b.hinge("j1", axis=(0, 0, 1))], inertial=Inertial(1.0, pos=(0.1, 0, 0)))
+    b.body(
+        "l2",
+        parent="l1",
+        pos=(0.2, 0, 0),
+        joints=[b.hinge("j2", axis=(0, 1, 0))],
+        inertial=Inertial(1.0, pos=(0.1, 0, 0)),
+    )
+    b.actuate("j1", "j2")
+    return b.build()

@@ -11,9 +11,9 @@ import numpy as np
 
 from robomech._numba import import_numba
 
-from ._compiled import BLOCK, entry, kin, prepare_one
+from ._compiled import BLOCK, chol_solve, entry, kin, prepare_one, rnea_block, writable
 
-__all__ = ["crba_batch"]
+__all__ = ["crba_batch", "fd_tree"]
 
 numba = import_numba()
 _nj = numba.njit(cache=True, error_model="numpy")
@@ -115,7 +115,7 @@ def crba_one(q, t, qs, out):  # pragma: no cover - compiled
 
 def crba_batch(model, q: np.ndarray) -> np.ndarray:
     """``(N, nv, nv)`` tree mass matrix of the compiled ``model`` at normalised ``q (N, nq)``."""
-    Q = np.ascontiguousarray(q, dtype=np.float64)
+    Q = writable(q)
     nv = model.tree.nv
     out = np.empty((Q.shape[0], nv, nv))
     if Q.shape[0] <= BLOCK:
@@ -123,3 +123,68 @@ def crba_batch(model, q: np.ndarray) -> np.ndarray:
     else:
         crba_par(Q, model.rnea, out)
     return out
+
+
+# ----------------------------------------------------------------------------- tree forward dynamics
+@_nj
+def fd_tree_block(lo, hi, Q, QD, F, gv, t, qdd_o, cond_o):  # pragma: no cover - compiled
+    """Forward dynamics of an open tree (no closure rows), samples ``lo:hi``: ``M qdd = F - b`` with
+    ``M`` the CRBA mass matrix, ``b`` the RNEA forces at zero acceleration (velocity and gravity terms)
+    and ``F (N, nv)`` the applied generalized forces, solved by Cholesky; ``cond_o`` the 2-norm
+    condition number of ``M`` (singular values, LAPACK; inf where the smallest is 0)."""
+    nv = QD.shape[1]
+    M = np.empty((1, nv, nv))
+    b = np.empty((1, nv))
+    zero = np.zeros((1, nv))
+    f = np.empty(nv)
+    x = np.empty(nv)
+    H = np.empty((nv, nv))
+    for n in range(lo, hi):
+        q1 = Q[n : n + 1]
+        crba_block(q1, 0, 1, t, M)
+        rnea_block(0, 1, q1, QD[n : n + 1], zero, gv, t, b)
+        for i in range(nv):
+            f[i] = -b[0, i] + F[n, i]
+        for i in range(nv):
+            for j in range(nv):
+                v = M[0, i, j]
+                H[i, j] = v if np.isfinite(v) else 0.0
+        s = np.linalg.svd(H)[1]
+        cond_o[n] = s[0] / s[nv - 1] if s[nv - 1] > 0 else np.inf
+        for i in range(nv):
+            for j in range(nv):
+                H[i, j] = M[0, i, j]
+        chol_solve(H, f, x)
+        for i in range(nv):
+            qdd_o[n, i] = x[i]
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def fd_tree_par(Q, QD, F, gv, t, qdd_o, cond_o):  # pragma: no cover - compiled
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        fd_tree_block(k * BLOCK, min(N, (k + 1) * BLOCK), Q, QD, F, gv, t, qdd_o, cond_o)
+
+
+@_nj
+def fd_tree_one(q, qd, F, gv, t, qs, qdd, cond):  # pragma: no cover - compiled
+    """One sample, checked (``_compiled.prepare_one``), then :func:`fd_tree_block`."""
+    if prepare_one(q, (qd, F), t.jtype, t.jqadr, qs) != 0:
+        return 1
+    nq, nv = qs.shape[0], qd.shape[0]
+    fd_tree_block(
+        0, 1, qs.reshape(1, nq), qd.reshape(1, nv), F.reshape(1, nv), gv, t, qdd.reshape(1, nv), cond
+    )
+    return 0
+
+
+def fd_tree(model, q: np.ndarray, qd: np.ndarray, F: np.ndarray, gv: np.ndarray) -> tuple:
+    """``(qdd (N, nv), cond (N,))`` of an open tree at normalised ``q (N, nq)`` (:func:`fd_tree_block`)."""
+    Q, QD, FF, G = writable(q), writable(qd), writable(F), writable(gv)
+    N = Q.shape[0]
+    qdd, cond = np.empty((N, model.tree.nv)), np.empty(N)
+    if N <= BLOCK:
+        entry(model, fd_tree_block, "fd_tree_block", (0, N, Q, QD, FF, G, model.rnea, qdd, cond))
+    else:
+        fd_tree_par(Q, QD, FF, G, model.rnea, qdd, cond)
+    return qdd, cond
