@@ -8,8 +8,13 @@
   one thread (``numba.set_num_threads(1)``) and against the lean MuJoCo loop per sample.
 
 * a 6-DOF serial arm (a Builder description, exported to MJCF and read by Pinocchio's own MJCF parser):
-  batch-1 ``mb.inverse_dynamics`` and ``mb.generalized_forces`` against ``pinocchio.rnea`` (same
-  answer checked to 1e-10).
+  batch-1 ``mb.inverse_dynamics``, ``mb.generalized_forces``, ``mb.mass_matrix`` and the full-rate
+  ``mb.forward_dynamics`` against ``pinocchio.rnea`` / ``pinocchio.crba`` (same answer checked to
+  1e-10); at 10^5 samples ``mb.generalized_forces`` against ``pinocchio.rneaInParallel`` with the same
+  thread counts (1 and all), and against a Python loop of ``pinocchio.rnea``;
+* the Delta at batch 1 also against a Pinocchio-written closed-loop inverse dynamics
+  (:func:`pinocchio_closed_loop`: the Pinocchio model built from the description's tree, ``pin.rnea``,
+  the closure rows from ``getFrameJacobian``, the lean MuJoCo loop's projection; same answer to 1e-8).
 
 ``python benchmarks/bench_latency.py`` prints the table recorded in docs/performance.md (per-call
 latencies are not batched workloads: :func:`workloads` gives ``make bench`` none).
@@ -66,6 +71,110 @@ def lean_mujoco(mech):
     return one
 
 
+def pinocchio_closed_loop(mech):
+    """A Pinocchio-written closed-loop inverse dynamics of ``mech`` (one joint per body: hinges, balls,
+    free joints; closures ``point`` rows): the Pinocchio model built from the description's tree, then
+    per sample ``pin.rnea``, the closure rows from ``getFrameJacobian`` at the closure points, and the
+    same projection as :func:`lean_mujoco`.  Returns (one(q, v, a) in Pinocchio's coordinates, to_pin)."""
+    import pinocchio as pin
+
+    t = mech.tree
+    model = pin.Model()
+    model.gravity = pin.Motion(np.array(mech.gravity, float), np.zeros(3))
+    jid = {0: 0}  # tree body -> Pinocchio joint
+    shift = {0: np.zeros(3)}  # body frame origin in its Pinocchio joint frame
+    for b in range(1, len(t.body_names)):
+        (k,) = t.body_jnts[b]
+        typ = int(t.jnt_type[k])
+        p = np.asarray(t.jnt_pos[k], float)
+        Toff = np.array(t.T_off[b], float)
+        if typ == 3:
+            assert t.parent[b] == 0
+            place, jm, p = pin.SE3.Identity(), pin.JointModelFreeFlyer(), np.zeros(3)
+        else:
+            R, x = Toff[:3, :3], Toff[:3, 3] - shift[int(t.parent[b])] + Toff[:3, :3] @ p
+            place = pin.SE3(R, x)
+            jm = (
+                pin.JointModelRevoluteUnaligned(np.asarray(t.jnt_axis[k], float))
+                if typ == 0
+                else pin.JointModelSpherical()
+            )
+            assert typ in (0, 2)
+        jid[b] = model.addJoint(jid[int(t.parent[b])], jm, place, t.jnt_names[k])
+        shift[b] = p
+        body = mech.bodies[b - 1]
+        if body.inertial is not None:
+            it = body.inertial
+            Rq = pin.Quaternion(*it.quat).toRotationMatrix()  # (w, x, y, z)
+            I = Rq @ np.diag(it.diaginertia) @ Rq.T
+            model.appendBodyToJoint(
+                jid[b], pin.Inertia(it.mass, np.asarray(it.pos) - p, I), pin.SE3.Identity()
+            )
+    frames = []
+    for kind, d in mech.constraints.blocks:
+        assert kind == "point"
+        b1, x1, b2, x2 = d
+        pair = []
+        for bb, xx in ((b1, x1), (b2, x2)):
+            f = pin.Frame(
+                f"c{len(frames)}_{len(pair)}",
+                jid[bb],
+                pin.SE3(np.eye(3), xx[:3] - shift[bb]),
+                pin.FrameType.OP_FRAME,
+            )
+            pair.append(model.addFrame(f))
+        frames.append(pair)
+    data = model.createData()
+    act = []
+    for name in mech.actuated:
+        act.append(model.joints[model.getJointId(name)].idx_v)
+    E = np.zeros((model.nv, len(act)))
+    E[act, np.arange(len(act))] = 1.0
+    K = np.zeros((3 * len(frames), model.nv))
+    LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+    def one(q, v, a):
+        f = pin.rnea(model, data, q, v, a)
+        pin.computeJointJacobians(model, data, q)
+        for i, (f1, f2) in enumerate(frames):
+            K[3 * i : 3 * i + 3] = (
+                pin.getFrameJacobian(model, data, f1, LWA)[:3]
+                - pin.getFrameJacobian(model, data, f2, LWA)[:3]
+            )
+        _, s, Vt = np.linalg.svd(K)
+        Nn = Vt[int(np.sum(s > 1e-9 * s[0])) :].T
+        return np.linalg.lstsq(Nn.T @ E, Nn.T @ f, rcond=None)[0]
+
+    def to_pin(q, qd, qdd):
+        """MuJoCo (qpos, qvel, qacc) -> Pinocchio (q, v, a): quaternions (w, x, y, z) -> (x, y, z, w);
+        a free joint's world linear velocity and acceleration -> body axes (a = d/dt of v)."""
+        qp, vp, ap = np.zeros(model.nq), np.zeros(model.nv), np.zeros(model.nv)
+        for b in range(1, len(t.body_names)):
+            (k,) = t.body_jnts[b]
+            typ, qa, da = int(t.jnt_type[k]), int(t.jnt_qadr[k]), int(t.jnt_dadr[k])
+            jm = model.joints[jid[b]]
+            iq, iv = jm.idx_q, jm.idx_v
+            if typ == 0:
+                qp[iq], vp[iv], ap[iv] = q[qa] - t.jnt_ref[k], qd[da], qdd[da]  # angle from the reference
+            elif typ == 2:
+                w, x, y, z = q[qa : qa + 4]
+                qp[iq : iq + 4] = (x, y, z, w)
+                vp[iv : iv + 3], ap[iv : iv + 3] = qd[da : da + 3], qdd[da : da + 3]
+            else:
+                w, x, y, z = q[qa + 3 : qa + 7]
+                qp[iq : iq + 3] = q[qa : qa + 3]
+                qp[iq + 3 : iq + 7] = (x, y, z, w)
+                R = pin.Quaternion(w, x, y, z).toRotationMatrix()
+                om = qd[da + 3 : da + 6]
+                vl = R.T @ qd[da : da + 3]
+                vp[iv : iv + 3], vp[iv + 3 : iv + 6] = vl, om
+                ap[iv : iv + 3] = R.T @ qdd[da : da + 3] - np.cross(om, vl)
+                ap[iv + 3 : iv + 6] = qdd[da + 3 : da + 6]
+        return qp, vp, ap
+
+    return one, to_pin
+
+
 def workloads() -> list:
     """None for ``benchmarks/run.py``: this file prints its own latency table (``main``)."""
     return []
@@ -94,6 +203,7 @@ def _arm_rows() -> list[str]:
     import os
     import tempfile
 
+    import numba
     import pinocchio as pin
 
     mech = arm6()
@@ -108,17 +218,60 @@ def _arm_rows() -> list[str]:
     tau = mb.inverse_dynamics(mech, q, qd, qdd).tau
     assert np.max(np.abs(tau - ref)) <= 1e-10 * np.max(np.abs(ref))  # the same answer
     assert np.max(np.abs(mb.generalized_forces(mech, q, qd, qdd) - ref)) <= 1e-10 * np.max(np.abs(ref))
+    assert np.max(np.abs(mb.mass_matrix(mech, q) - pin.crba(pm, pd, q))) <= 1e-10  # (pin fills both halves)
     tp = min(_per(lambda i: pin.rnea(pm, pd, q, qd, qdd), N_BATCH1) for _ in range(REPEATS))
+    tpm = min(_per(lambda i: pin.crba(pm, pd, q), N_BATCH1) for _ in range(REPEATS))
     rows = []
-    for label, fn in (
-        ("inverse_dynamics", lambda i: mb.inverse_dynamics(mech, q, qd, qdd)),
-        ("generalized_forces", lambda i: mb.generalized_forces(mech, q, qd, qdd)),
+    for label, fn, alt, ta in (
+        ("inverse_dynamics", lambda i: mb.inverse_dynamics(mech, q, qd, qdd), "pinocchio.rnea", tp),
+        ("generalized_forces", lambda i: mb.generalized_forces(mech, q, qd, qdd), "pinocchio.rnea", tp),
+        ("mass_matrix", lambda i: mb.mass_matrix(mech, q), "pinocchio.crba", tpm),
+        ("forward_dynamics (full qd)", lambda i: mb.forward_dynamics(mech, q, tau=ref, qd=qd), "—", np.nan),
     ):
         t = min(_per(fn, N_BATCH1) for _ in range(REPEATS))
         rows.append(
             f"| 6-DOF arm {label}, batch 1 (per call) | {t * 1e6:.1f} us | "
-            f"pinocchio.rnea {tp * 1e6:.1f} us | {tp / t:.2f}x |"
+            + (f"{alt} {ta * 1e6:.1f} us | {ta / t:.2f}x |" if np.isfinite(ta) else "— | — |")
         )
+    # 10^5 samples: generalized_forces on all cores and on one, against pinocchio.rneaInParallel
+    # (its own thread pool over a ModelPool, column-major (nv, N) arrays) with the same thread counts
+    Q = rng.uniform(-np.pi, np.pi, (N_LARGE, 6))
+    QD, QDD = rng.normal(size=(N_LARGE, 6)), rng.normal(size=(N_LARGE, 6))
+    threads = numba.get_num_threads()
+    pool = pin.ModelPool(pm, threads)
+    QF, QDF, QDDF = (np.asfortranarray(x.T) for x in (Q, QD, QDD))
+    TF = np.zeros((6, N_LARGE), order="F")
+    pin.rneaInParallel(threads, pool, QF, QDF, QDDF, TF)
+    ours = mb.generalized_forces(mech, Q, QD, QDD)
+    assert np.max(np.abs(ours - TF.T)) <= 1e-10 * np.max(np.abs(TF))  # the same answer
+    best = {}
+    for _ in range(REPEATS):  # alternated, best of each: the machine is shared
+        for nt in (threads, 1):
+            numba.set_num_threads(nt)
+            t0 = time.perf_counter()
+            mb.generalized_forces(mech, Q, QD, QDD)
+            t1 = time.perf_counter()
+            pin.rneaInParallel(nt, pool, QF, QDF, QDDF, TF)
+            t2 = time.perf_counter()
+            best[("rm", nt)] = min(best.get(("rm", nt), np.inf), (t1 - t0) / N_LARGE)
+            best[("pin", nt)] = min(best.get(("pin", nt), np.inf), (t2 - t1) / N_LARGE)
+    numba.set_num_threads(threads)
+    tl = min(_per(lambda i: pin.rnea(pm, pd, Q[i], QD[i], QDD[i]), N_MJ) for _ in range(REPEATS))
+    for nt in (1, threads):
+        a, b = best[("rm", nt)], best[("pin", nt)]
+        rows.append(
+            f"| 6-DOF arm generalized_forces, 10^5 samples, {nt} thread(s) (per sample) | {a * 1e6:.2f} us | "
+            f"pinocchio.rneaInParallel({nt}) {b * 1e6:.2f} us | {b / a:.2f}x |"
+        )
+    rows.append(
+        f"| 6-DOF arm generalized_forces, 10^5 samples: parallel speed-up | "
+        f"{best[('rm', 1)] / best[('rm', threads)]:.2f}x | "
+        f"rneaInParallel {best[('pin', 1)] / best[('pin', threads)]:.2f}x | — |"
+    )
+    rows.append(
+        f"| 6-DOF arm, 10^5 samples, {threads} threads (per sample) | {best[('rm', threads)] * 1e6:.2f} us | "
+        f"Python loop of pinocchio.rnea {tl * 1e6:.2f} us | {tl / best[('rm', threads)]:.1f}x |"
+    )
     return rows
 
 
@@ -142,6 +295,11 @@ def main() -> None:
     assert np.max(np.abs(tau_mj - r.tau)) <= 1e-8 * np.max(np.abs(tau_mj))  # the same answer
     t1 = min(_per(lambda i: mb.inverse_dynamics(mech, q[i], qd[i], qdd[i]), N_BATCH1) for _ in range(REPEATS))
     tmj = min(_per(lambda i: one(q[i], r.qd[i % 200], r.qdd[i % 200]), N_MJ) for _ in range(REPEATS))
+    pone, to_pin = pinocchio_closed_loop(mech)
+    pin_args = [to_pin(q[i], r.qd[i], r.qdd[i]) for i in range(200)]  # converted outside the timing
+    tau_pin = np.array([pone(*a) for a in pin_args])
+    assert np.max(np.abs(tau_pin - r.tau)) <= 1e-8 * np.max(np.abs(r.tau))  # the same answer
+    tpin = min(_per(lambda i: pone(*pin_args[i % 200]), N_MJ) for _ in range(REPEATS))
     mb.inverse_dynamics(mech, q[:1000], qd[:1000], qdd[:1000])
     threads = numba.get_num_threads()
     tp = ts = np.inf
@@ -158,8 +316,13 @@ def main() -> None:
     print("| workload | robomech | alternative | alternative / robomech |")
     print("|---|---|---|---|")
     print(
-        f"| Delta inverse dynamics, batch 1 (per call) | {t1 * 1e6:.0f} us | {tmj * 1e6:.0f} us | "
+        f"| Delta inverse dynamics, batch 1 (per call) | {t1 * 1e6:.0f} us | "
+        f"lean MuJoCo loop {tmj * 1e6:.0f} us | "
         f"{tmj / t1:.2f}x |"
+    )
+    print(
+        f"| Delta inverse dynamics, batch 1 (per call) | {t1 * 1e6:.0f} us | Pinocchio-written loop "
+        f"{tpin * 1e6:.0f} us | {tpin / t1:.2f}x |"
     )
     print(
         f"| Delta inverse dynamics, 10^5 samples, {threads} threads (per sample) | {tp * 1e6:.2f} us | "

@@ -113,3 +113,39 @@ def test_generalized_forces_one_kernel_at_every_batch_size(name):
     bad = qdd[7].copy()
     bad[0] = np.nan
     assert np.all(np.isnan(mb.generalized_forces(mech, q[7], qd[7], bad)))
+
+
+# The open tree's forward dynamics (one kernel: CRBA, RNEA, Cholesky) against the numpy formulation it
+# replaced (numpy CRBA and RNEA, LAPACK gesv, singular values by numpy): Cholesky and LU of the same
+# mass matrix round differently, cond(M) eps ~1e-14 for these trees.
+FD_RTOL = 1e-12
+
+
+@pytest.mark.parametrize("name", ("arm6", "quadruped", "cart"))
+def test_tree_forward_dynamics_one_kernel_at_every_batch_size(name):
+    from ._reference import numpy_crba, numpy_rnea
+    from .test_kinematic_classes import MECH, _states
+
+    mech = MECH[name]
+    n = 300
+    q, qd, _, tau = _states(mech, n, seed=11)
+    g = np.asarray(mech.gravity, float)
+    M = numpy_crba(mech, q)
+    f = -numpy_rnea(mech, q, qd, np.zeros_like(qd), g)
+    f[:, mech.tree.act_dof] += tau
+    ref = np.linalg.solve(M, f[..., None])[..., 0]
+    s = np.linalg.svd(M, compute_uv=False)
+    cond = s[:, 0] / s[:, -1]
+    got = mb.forward_dynamics(mech, q, tau=tau, qd=qd)
+    assert got.valid.all()
+    assert np.max(np.abs(got.qdd - ref)) <= FD_RTOL * np.max(np.abs(ref))
+    assert np.max(np.abs(got.cond - cond) / cond) <= FD_RTOL
+    for k in (1, 150):
+        part = mb.forward_dynamics(mech, q[:k], tau=tau[:k], qd=qd[:k])
+        assert np.array_equal(part.qdd, got.qdd[:k]) and np.array_equal(part.cond, got.cond[:k])
+    one = mb.forward_dynamics(mech, q[7], tau=tau[7], qd=qd[7])
+    assert np.array_equal(one.qdd, got.qdd[7]) and one.cond == got.cond[7] and bool(one.valid)
+    bad = tau[7].copy()
+    bad[0] = np.nan
+    nan = mb.forward_dynamics(mech, q[7], tau=bad, qd=qd[7])
+    assert np.all(np.isnan(nan.qdd)) and not nan.valid

@@ -101,6 +101,8 @@ class RneaTables(NamedTuple):
     mass: NDArray[np.float64]
     com: NDArray[np.float64]
     inertia: NDArray[np.float64]
+    dof_body: NDArray[np.int64]  # (nv,) the body each coordinate moves directly
+    A: NDArray[np.float64]  # (nb, nv) coordinate k moves body b (the mass matrix's sparsity)
 
 
 @dataclass(frozen=True, eq=False)
@@ -315,6 +317,8 @@ def _compile(mech: Mechanism) -> Model:
         mass=dyn.mass,
         com=dyn.com,
         inertia=dyn.inertia,
+        dof_body=tree.dof_body.astype(np.int64),
+        A=tables.A,
     )
     return Model(
         tree=tree,

@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from robomech._numba import import_numba
+from robomech._validation import MAX_MAGNITUDE
 
 from . import _options as opt
 from ._compile import compile_model
@@ -26,6 +27,7 @@ __all__ = ["compiled_fk", "compiled_site_jacobian", "inv_dyn"]
 numba = import_numba()
 
 _nj = numba.njit(cache=True, error_model="numpy")
+opt_max_magnitude = MAX_MAGNITUDE  # a global: numba freezes it into the kernels
 # Samples per parallel task: large enough that a task's scratch arrays are allocated rarely, small
 # enough that two cores share a batch of a few thousand evenly.
 BLOCK = 64
@@ -1307,8 +1309,65 @@ def rnea_par(Q, QD, QDD, gv, t, tau_o):  # pragma: no cover - compiled
         rnea_block(k * BLOCK, min(N, (k + 1) * BLOCK), Q, QD, QDD, gv, t, tau_o)
 
 
+@_nj
+def prepare_one(q, vs, jtype, jqadr, qs):  # pragma: no cover - compiled
+    """The boundary check of one sample, in the kernel: 0 where every entry of ``q`` and of the
+    vectors ``vs`` is within ``MAX_MAGNITUDE`` (False for NaN and inf) and every quaternion is
+    non-zero, with ``qs`` = ``q``, its quaternions normalised (``sqrt`` of the sum of squares, as
+    ``_rnea._rnea_one``); 1 otherwise (the caller's general path then validates and masks)."""
+    big = opt_max_magnitude
+    for i in range(q.shape[0]):
+        if not abs(q[i]) <= big:
+            return 1
+        qs[i] = q[i]
+    for v in vs:
+        for i in range(v.shape[0]):
+            if not abs(v[i]) <= big:
+                return 1
+    for k in range(jtype.shape[0]):
+        if jtype[k] >= 2:
+            a = jqadr[k] + (3 if jtype[k] == 3 else 0)
+            w, x, y, z = qs[a], qs[a + 1], qs[a + 2], qs[a + 3]
+            nrm = np.sqrt(w * w + x * x + y * y + z * z)
+            if not nrm >= 1e-9:
+                return 1
+            for i in range(4):
+                qs[a + i] /= nrm
+    return 0
+
+
+@_nj
+def rnea_one(q, qd, qdd, gv, t, qs, tau):  # pragma: no cover - compiled
+    """One sample, checked (:func:`prepare_one`), then :func:`rnea_block` into ``tau (nv,)``."""
+    if prepare_one(q, (qd, qdd), t.jtype, t.jqadr, qs) != 0:
+        return 1
+    nq, nv = qs.shape[0], qd.shape[0]
+    rnea_block(0, 1, qs.reshape(1, nq), qd.reshape(1, nv), qdd.reshape(1, nv), gv, t, tau.reshape(1, nv))
+    return 0
+
+
+def entry(model, kernel, key: str, args: tuple):
+    """Run ``kernel(*args)`` through its compiled entry point (cached on the model after the first
+    call): a direct call skips numba's type dispatch, a few microseconds per call."""
+    fn = model.cache.get(key)
+    if fn is None:
+        out = kernel(*args)  # compiles or loads the kernel
+        sig = tuple(numba.typeof(a) for a in args)
+        model.cache[key] = kernel.overloads[sig].entry_point
+        return out
+    return fn(*args)
+
+
+def writable(x: np.ndarray) -> np.ndarray:
+    """``x`` as a C-contiguous, writable float64 array: numba types a read-only array (a broadcast
+    view, say) as another argument type, i.e. another specialization to compile at first use."""
+    a = np.ascontiguousarray(x, dtype=np.float64)
+    return a if a.flags.writeable else a.copy()
+
+
 def compiled_rnea(model, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray, gv: np.ndarray) -> np.ndarray:
     """Tree inverse dynamics ``(N, nv)`` (:func:`rnea_block`) at normalised ``Q (N, nq)``, ``QD``, ``QDD``."""
+    Q, QD, QDD, gv = writable(Q), writable(QD), writable(QDD), writable(gv)
     N = Q.shape[0]
     tau = np.empty((N, model.tree.nv))
     if N <= BLOCK:
@@ -1348,6 +1407,35 @@ def warm() -> None:
         z = np.zeros((n, len(model.act)))
         _dynamics._inverse_compiled(mech, qf, z, z, {}, None, True)
     inv_dyn_one(model, mech.q0, np.zeros(1), np.zeros(1), mech.gravity, True)
+    from ._rnea import generalized_forces, mass_matrix
+
+    tree_mech = _open_chain()  # the tree dynamics through the public calls (forward dynamics too)
     for n in (1, 2 * BLOCK + 1):
+        q = np.tile(mech.q0, (n, 1))
         z = np.zeros((n, mech.nv))
-        compiled_rnea(model, np.tile(mech.q0, (n, 1)), z, z, np.zeros(3))
+        generalized_forces(mech, q, z, z)
+        mass_matrix(mech, q)
+        z = np.zeros((n, tree_mech.nv))
+        _dynamics.forward_dynamics(tree_mech, z, tau=z, qd=z)
+    z = np.zeros(mech.nv)
+    generalized_forces(mech, np.array(mech.q0, dtype=float), z, z)
+    mass_matrix(mech, np.array(mech.q0, dtype=float))
+    z = np.zeros(tree_mech.nv)
+    _dynamics.forward_dynamics(tree_mech, z, tau=z, qd=z)
+
+
+def _open_chain():
+    """A two-link open chain (both joints actuated), for :func:`warm`."""
+    from ._model import Builder, Inertial
+
+    b = Builder("warm_2r")
+    b.body("l1", joints=[b.hinge("j1", axis=(0, 0, 1))], inertial=Inertial(1.0, pos=(0.1, 0, 0)))
+    b.body(
+        "l2",
+        parent="l1",
+        pos=(0.2, 0, 0),
+        joints=[b.hinge("j2", axis=(0, 1, 0))],
+        inertial=Inertial(1.0, pos=(0.1, 0, 0)),
+    )
+    b.actuate("j1", "j2")
+    return b.build()

@@ -1285,6 +1285,13 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
 
     # the tree's mass matrix (CRBA) and velocity + gravity forces (RNEA at zero acceleration)
     g = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
+    if not K.shape[1] and not wr and nv:  # an open tree: CRBA, RNEA and Cholesky in one kernel
+        from ._rnea_kernels import fd_tree
+
+        F = np.zeros((N, nv))
+        F[:, tree.act_dof] = tau_a
+        qdd, cond = fd_tree(compile_model(mech), q, qd, F, g)
+        return qdd, (cond if want_cond else np.ones(N)), K, kdq
     M = _crba_flat(mech, q)
     f = -_rnea_flat(mech, q, qd, np.zeros_like(qd), g)
     if wr:
@@ -1310,6 +1317,68 @@ def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
     else:
         cond = np.ones(N)
     return qdd_p + _solve_each(Mc, rhs), cond, K, kdq
+
+
+_F64 = np.dtype(np.float64)
+
+
+def _forward_tree_one(mech, q, tau, qd, gravity) -> ForwardDynamicsResult | None:
+    """One sample of an open tree (no closure rows) in the full-rate form, given as C-contiguous float64
+    vectors of the exact shapes: the kernel checks the entries (within ``MAX_MAGNITUDE``; quaternions
+    non-zero) and computes ``qdd`` and ``cond`` in one call, with the general path's flags (no closure:
+    admissibility and closure 0, valid where ``cond < 1 / RANK_RTOL`` and every value is finite);
+    None (the general path validates and masks) otherwise."""
+    if not (
+        type(mech) is Mechanism
+        and type(q) is np.ndarray
+        and type(qd) is np.ndarray
+        and (tau is None or type(tau) is np.ndarray)
+        and (gravity is True or gravity is False)
+    ):
+        return None
+    model = compile_model(mech)
+    tree = model.tree
+    nv = tree.nv
+    if model.tables.m or not nv:
+        return None
+    na = len(model.act)
+    for x, shape in ((q, (tree.nq,)), (qd, (nv,)), (tau, (na,))):
+        if x is not None and (x.shape != shape or x.dtype is not _F64 or not x.flags.c_contiguous):
+            return None
+    from ._compiled import entry
+    from ._rnea_kernels import fd_tree_one
+
+    F = np.zeros(nv)
+    if tau is not None:
+        F[tree.act_dof] = tau
+    gv = model.cache.get("gravity_vector")
+    if gv is None:
+        gv = model.cache["gravity_vector"] = np.array(mech.gravity, dtype=float)
+    qdd, cond = np.empty(nv), np.empty(1)
+    if entry(
+        model,
+        fd_tree_one,
+        "fd_tree_one",
+        (q, qd, F, gv if gravity else _ZERO3, model.rnea, np.empty(tree.nq), qdd, cond),
+    ):
+        return None
+    c = cond[0]
+    fin = bool(np.isfinite(c)) and bool(np.all(np.isfinite(qdd)))
+    valid = fin and c < 1.0 / RANK_RTOL
+    if not valid:
+        qdd = np.full(nv, np.nan)
+    return ForwardDynamicsResult(
+        qdd_act=qdd[tree.act_dof],
+        qdd=qdd,
+        qd=qd.copy(),
+        cond=np.array(c),
+        admissibility=np.array(0.0),
+        closure=np.array(0.0),
+        valid=np.array(valid),
+    )
+
+
+_ZERO3 = np.zeros(3)
 
 
 def _solve_each(A: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -1427,6 +1496,10 @@ def forward_dynamics(
     >>> bool(np.allclose(fd.qdd_act, 0.5)), bool(fd.valid)
     (True, True)
     """
+    if qd_act is None and wrenches is None:
+        one = _forward_tree_one(mech, q, tau, qd, gravity)
+        if one is not None:  # one sample of an open tree as float64 vectors: one kernel call
+            return one
     mech = check_mechanism(mech)
     gravity = check_bool(gravity, "gravity")
     act_mode = _rates_mode(mech, "forward_dynamics", ("qd_act", qd_act), ("qd", qd))

@@ -76,7 +76,7 @@ def _crba_flat(mech: Mechanism, q: np.ndarray) -> np.ndarray:
     from ._compile import compile_model
     from ._rnea_kernels import crba_batch
 
-    return crba_batch(compile_model(mech), body_inertias(mech), q)
+    return crba_batch(compile_model(mech), q)
 
 
 def _flat_inputs(mech: Mechanism, q: object, others: list[tuple[object, str]]):
@@ -114,9 +114,9 @@ def _flat_inputs(mech: Mechanism, q: object, others: list[tuple[object, str]]):
 
 
 def _rnea_one(mech, q, qd, qdd, gravity) -> np.ndarray | None:
-    """One sample given as C-contiguous float64 vectors of the exact shapes, entries within
-    ``MAX_MAGNITUDE`` (robomech._validation's masking rule): the kernel's forces; None (the general
-    path validates and masks) otherwise."""
+    """One sample given as C-contiguous float64 vectors of the exact shapes: the kernel checks the
+    entries (within ``MAX_MAGNITUDE``, robomech._validation's masking rule; quaternions non-zero) and
+    returns the forces in the same call; None (the general path validates and masks) otherwise."""
     if not (
         type(mech) is Mechanism
         and type(q) is np.ndarray
@@ -126,38 +126,66 @@ def _rnea_one(mech, q, qd, qdd, gravity) -> np.ndarray | None:
     ):
         return None
     model = compile_model(mech)
-    tree = model.tree
-    nq, nv = tree.nq, tree.nv
+    one = model.cache.get("rnea_one_call")
+    if one is None:
+        one = model.cache["rnea_one_call"] = _one_call(model, mech)
+    fn, sq, sv, gv, tables = one
     if (
-        q.shape != (nq,)
-        or qd.shape != (nv,)
-        or qdd.shape != (nv,)
-        or q.dtype != np.float64
-        or qd.dtype != np.float64
-        or qdd.dtype != np.float64
+        q.shape != sq
+        or qd.shape != sv
+        or qdd.shape != sv
+        or q.dtype is not _F64
+        or qd.dtype is not _F64
+        or qdd.dtype is not _F64
         or not (q.flags.c_contiguous and qd.flags.c_contiguous and qdd.flags.c_contiguous)
     ):
         return None
-    # sum of squares (three dot products, the cheapest full scan): NaN and inf propagate through it, and
-    # below MAX_MAGNITUDE^2 every entry is within MAX_MAGNITUDE; beyond, the general path masks or computes
-    if not q @ q + qd @ qd + qdd @ qdd <= MAX_MAGNITUDE * MAX_MAGNITUDE:
-        return None
-    if tree.quat_adr:
-        q = q.copy()
-        for a in tree.quat_adr:
-            w, x, y, z = q[a], q[a + 1], q[a + 2], q[a + 3]
-            nrm = float(np.sqrt(w * w + x * x + y * y + z * z))
-            if not nrm >= 1e-9:
-                return None
-            q[a : a + 4] /= nrm
-    gv = model.cache.get("gravity_vector")
-    if gv is None:
-        gv = model.cache["gravity_vector"] = np.array(mech.gravity, dtype=float)
-    from ._compiled import compiled_rnea
+    tau = np.empty(sv)
+    if fn is None:
+        from ._compiled import entry, rnea_one
 
-    return compiled_rnea(
-        model, q.reshape(1, nq), qd.reshape(1, nv), qdd.reshape(1, nv), gv if gravity else np.zeros(3)
-    )[0]
+        args = (q, qd, qdd, gv if gravity else _ZERO3, tables, np.empty(sq), tau)
+        if entry(model, rnea_one, "rnea_one", args):
+            return None
+        model.cache["rnea_one_call"] = (model.cache["rnea_one"], *one[1:])
+        return tau
+    if fn(q, qd, qdd, gv if gravity else _ZERO3, tables, np.empty(sq), tau):
+        return None
+    return tau
+
+
+def _one_call(model, mech) -> tuple:
+    """What a single-sample call reads, in one tuple: (kernel entry point or None before the first
+    call, the shapes of ``q`` and of the rates, the gravity vector, the kernel tables)."""
+    return (
+        model.cache.get("rnea_one"),
+        (model.tree.nq,),
+        (model.tree.nv,),
+        np.array(mech.gravity, dtype=float),
+        model.rnea,
+    )
+
+
+_ZERO3 = np.zeros(3)
+_F64 = np.dtype(np.float64)
+
+
+def _crba_one(mech, q) -> np.ndarray | None:
+    """One sample as a C-contiguous float64 vector of shape ``(nq,)``: checked and computed in one
+    kernel call (as :func:`_rnea_one`); None (the general path) otherwise."""
+    if not (type(mech) is Mechanism and type(q) is np.ndarray):
+        return None
+    model = compile_model(mech)
+    if q.shape != (model.tree.nq,) or q.dtype is not _F64 or not q.flags.c_contiguous:
+        return None
+    from ._compiled import entry as entry_call
+    from ._rnea_kernels import crba_one
+
+    nv = model.rnea.nv
+    M = np.empty((nv, nv))
+    if entry_call(model, crba_one, "crba_one", (q, model.rnea, np.empty(q.shape[0]), M)):
+        return None
+    return M
 
 
 def generalized_forces(
@@ -207,12 +235,12 @@ def generalized_forces(
     >>> float(mb.generalized_forces(mech, [0.0], [0.0], [1.0], gravity=False)[0])   # m l^2 qdd
     0.5
     """
-    from ._assembly import check_mechanism
-    from ._compiled import compiled_rnea
-
     one = _rnea_one(mech, q, qd, qdd, gravity)
     if one is not None:  # one sample as float64 vectors: straight into the kernel
         return one
+    from ._assembly import check_mechanism
+    from ._compiled import compiled_rnea
+
     mech = check_mechanism(mech)
     gravity = check_bool(gravity, "gravity")
     batch, ok, (qf, qdf, qddf) = _flat_inputs(mech, q, [(qd, "qd"), (qdd, "qdd")])
@@ -266,6 +294,9 @@ def mass_matrix(mech: Mechanism, q: object) -> np.ndarray:
     """
     from ._assembly import check_mechanism
 
+    one = _crba_one(mech, q)
+    if one is not None:  # one sample as a float64 vector: straight into the kernel
+        return one
     mech = check_mechanism(mech)
     batch, ok, (qf,) = _flat_inputs(mech, q, [])
     with np.errstate(all="ignore"):

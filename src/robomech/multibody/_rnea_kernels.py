@@ -11,25 +11,26 @@ import numpy as np
 
 from robomech._numba import import_numba
 
-from ._compiled import BLOCK, kin
+from ._compiled import BLOCK, chol_solve, entry, kin, prepare_one, rnea_block, writable
 
-__all__ = ["crba_batch"]
+__all__ = ["crba_batch", "fd_tree"]
 
 numba = import_numba()
 _nj = numba.njit(cache=True, error_model="numpy")
 
 
 @_nj
-def _inertia_world(T, mass, com, inertia, b, c, Ic):  # pragma: no cover - compiled
-    """World centre of mass ``c (3,)`` and inertia about it ``Ic (3, 3)`` of body ``b``."""
+def _inertia_world(T, com, inertia, b, ib, c, Ic):  # pragma: no cover - compiled
+    """World centre of mass ``c (3,)`` and inertia about it ``Ic (3, 3)`` of body ``b`` (its mass
+    properties ``com[ib]``, ``inertia[ib]``)."""
     for i in range(3):
-        c[i] = T[b, i, 3] + T[b, i, 0] * com[b, 0] + T[b, i, 1] * com[b, 1] + T[b, i, 2] * com[b, 2]
+        c[i] = T[b, i, 3] + T[b, i, 0] * com[ib, 0] + T[b, i, 1] * com[ib, 1] + T[b, i, 2] * com[ib, 2]
     for i in range(3):
         for j in range(3):
             s = 0.0
             for k in range(3):
                 for m in range(3):
-                    s += T[b, i, k] * inertia[b, k, m] * T[b, j, m]
+                    s += T[b, i, k] * inertia[ib, k, m] * T[b, j, m]
             Ic[i, j] = s
 
 
@@ -47,9 +48,11 @@ def _apply(m, c, Ic, X, out):  # pragma: no cover - compiled
 
 
 @_nj
-def crba_block(Q, lo, hi, t, mass, com, inertia, dof_body, Aanc, out):  # pragma: no cover
+def crba_block(Q, lo, hi, t, out):  # pragma: no cover
+    """The composite-rigid-body mass matrix of samples ``lo:hi`` into ``out (N, nv, nv)`` (``t`` the
+    compiled model's ``RneaTables``: the tree, its massive bodies, ``dof_body`` and the sparsity ``A``)."""
     nb, nv = t.parent.shape[0], out.shape[1]
-    parent = t.parent
+    parent, dof_body, Aanc = t.parent, t.dof_body, t.A
     T = np.empty((nb, 4, 4))
     S = np.zeros((nv, 6))
     I6 = np.empty((nb, 6, 6))
@@ -60,12 +63,14 @@ def crba_block(Q, lo, hi, t, mass, com, inertia, dof_body, Aanc, out):  # pragma
     Fi = np.empty(6)
     for n in range(lo, hi):
         kin(Q[n], t, T, S)
-        for b in range(nb):
-            _inertia_world(T, mass, com, inertia, b, c, Ic)
+        I6[:, :, :] = 0.0
+        for ib in range(t.bidx.shape[0]):  # bodies without mass or inertia stay zero
+            b = t.bidx[ib]
+            _inertia_world(T, t.com, t.inertia, b, ib, c, Ic)
             for j in range(6):
                 for i in range(6):
                     X[i] = 1.0 if i == j else 0.0
-                _apply(mass[b], c, Ic, X, col)
+                _apply(t.mass[ib], c, Ic, X, col)
                 for i in range(6):
                     I6[b, i, j] = col[i]
         for b in range(nb - 1, 0, -1):  # composite inertias
@@ -92,29 +97,94 @@ def crba_block(Q, lo, hi, t, mass, com, inertia, dof_body, Aanc, out):  # pragma
 
 
 @numba.njit(cache=True, error_model="numpy", parallel=True)
-def crba_par(Q, t, mass, com, inertia, dof_body, Aanc, out):  # pragma: no cover
+def crba_par(Q, t, out):  # pragma: no cover
     N = Q.shape[0]
     for k in numba.prange((N + BLOCK - 1) // BLOCK):
-        crba_block(Q, k * BLOCK, min(N, (k + 1) * BLOCK), t, mass, com, inertia, dof_body, Aanc, out)
+        crba_block(Q, k * BLOCK, min(N, (k + 1) * BLOCK), t, out)
 
 
-def crba_batch(model, bi, q: np.ndarray) -> np.ndarray:
-    """``(N, nv, nv)`` tree mass matrix of the compiled ``model`` with inertias ``bi`` (``_rnea``)."""
-    tree = model.tree
-    f = np.ascontiguousarray
-    Q = f(q, dtype=np.float64)
-    out = np.empty((Q.shape[0], tree.nv, tree.nv))
-    args = (
-        model.tables,
-        f(bi.mass),
-        f(bi.com),
-        f(bi.inertia),
-        tree.dof_body.astype(np.int64),
-        f(tree.A),
-        out,
-    )
+@_nj
+def crba_one(q, t, qs, out):  # pragma: no cover - compiled
+    """One sample, checked (``_compiled.prepare_one``), then :func:`crba_block` into ``out (nv, nv)``."""
+    if prepare_one(q, (q,), t.jtype, t.jqadr, qs) != 0:
+        return 1
+    nv = out.shape[0]
+    crba_block(qs.reshape(1, qs.shape[0]), 0, 1, t, out.reshape(1, nv, nv))
+    return 0
+
+
+def crba_batch(model, q: np.ndarray) -> np.ndarray:
+    """``(N, nv, nv)`` tree mass matrix of the compiled ``model`` at normalised ``q (N, nq)``."""
+    Q = writable(q)
+    nv = model.tree.nv
+    out = np.empty((Q.shape[0], nv, nv))
     if Q.shape[0] <= BLOCK:
-        crba_block(Q, 0, Q.shape[0], *args)
+        entry(model, crba_block, "crba_block", (Q, 0, Q.shape[0], model.rnea, out))
     else:
-        crba_par(Q, *args)
+        crba_par(Q, model.rnea, out)
     return out
+
+
+# ----------------------------------------------------------------------------- tree forward dynamics
+@_nj
+def fd_tree_block(lo, hi, Q, QD, F, gv, t, qdd_o, cond_o):  # pragma: no cover - compiled
+    """Forward dynamics of an open tree (no closure rows), samples ``lo:hi``: ``M qdd = F - b`` with
+    ``M`` the CRBA mass matrix, ``b`` the RNEA forces at zero acceleration (velocity and gravity terms)
+    and ``F (N, nv)`` the applied generalized forces, solved by Cholesky; ``cond_o`` the 2-norm
+    condition number of ``M`` (singular values, LAPACK; inf where the smallest is 0)."""
+    nv = QD.shape[1]
+    M = np.empty((1, nv, nv))
+    b = np.empty((1, nv))
+    zero = np.zeros((1, nv))
+    f = np.empty(nv)
+    x = np.empty(nv)
+    H = np.empty((nv, nv))
+    for n in range(lo, hi):
+        q1 = Q[n : n + 1]
+        crba_block(q1, 0, 1, t, M)
+        rnea_block(0, 1, q1, QD[n : n + 1], zero, gv, t, b)
+        for i in range(nv):
+            f[i] = -b[0, i] + F[n, i]
+        for i in range(nv):
+            for j in range(nv):
+                v = M[0, i, j]
+                H[i, j] = v if np.isfinite(v) else 0.0
+        s = np.linalg.svd(H)[1]
+        cond_o[n] = s[0] / s[nv - 1] if s[nv - 1] > 0 else np.inf
+        for i in range(nv):
+            for j in range(nv):
+                H[i, j] = M[0, i, j]
+        chol_solve(H, f, x)
+        for i in range(nv):
+            qdd_o[n, i] = x[i]
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def fd_tree_par(Q, QD, F, gv, t, qdd_o, cond_o):  # pragma: no cover - compiled
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        fd_tree_block(k * BLOCK, min(N, (k + 1) * BLOCK), Q, QD, F, gv, t, qdd_o, cond_o)
+
+
+@_nj
+def fd_tree_one(q, qd, F, gv, t, qs, qdd, cond):  # pragma: no cover - compiled
+    """One sample, checked (``_compiled.prepare_one``), then :func:`fd_tree_block`."""
+    if prepare_one(q, (qd, F), t.jtype, t.jqadr, qs) != 0:
+        return 1
+    nq, nv = qs.shape[0], qd.shape[0]
+    fd_tree_block(
+        0, 1, qs.reshape(1, nq), qd.reshape(1, nv), F.reshape(1, nv), gv, t, qdd.reshape(1, nv), cond
+    )
+    return 0
+
+
+def fd_tree(model, q: np.ndarray, qd: np.ndarray, F: np.ndarray, gv: np.ndarray) -> tuple:
+    """``(qdd (N, nv), cond (N,))`` of an open tree at normalised ``q (N, nq)`` (:func:`fd_tree_block`)."""
+    Q, QD, FF, G = writable(q), writable(qd), writable(F), writable(gv)
+    N = Q.shape[0]
+    qdd, cond = np.empty((N, model.tree.nv)), np.empty(N)
+    if N <= BLOCK:
+        entry(model, fd_tree_block, "fd_tree_block", (0, N, Q, QD, FF, G, model.rnea, qdd, cond))
+    else:
+        fd_tree_par(Q, QD, FF, G, model.rnea, qdd, cond)
+    return qdd, cond
