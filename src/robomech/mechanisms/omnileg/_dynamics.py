@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech._batching import chunked
 from robomech._validation import as_array, broadcast_batch, check_bool, check_params
 
 from . import _jet as jt
@@ -285,14 +286,7 @@ def _terms_chunked(
     paper_drive: bool = False,
 ) -> _Terms:
     """:func:`_terms` over cache-sized chunks of samples (identical results, far fewer cache misses)."""
-    N = q.shape[0]
-    if N <= DYN_CHUNK:
-        return _terms(leg, q, qd, qdd, poses, paper_drive)
-    parts = [
-        _terms(leg, q[s : s + DYN_CHUNK], qd[s : s + DYN_CHUNK], qdd[s : s + DYN_CHUNK], poses, paper_drive)
-        for s in range(0, N, DYN_CHUNK)
-    ]  # loop over chunks of DYN_CHUNK samples, not over samples
-    return _Terms(*(np.concatenate([getattr(t, f) for t in parts]) for f in _Terms.__dataclass_fields__))
+    return chunked(lambda s: _terms(leg, q[s], qd[s], qdd[s], poses, paper_drive), q.shape[0], DYN_CHUNK)
 
 
 def _flat(*arrays: np.ndarray) -> tuple[tuple[int, ...], list[np.ndarray]]:

@@ -16,6 +16,7 @@ from functools import cached_property
 
 import numpy as np
 
+from robomech._batching import slices
 from robomech._validation import as_array, broadcast_batch, check_params
 
 from ._params import OmniLeg
@@ -56,11 +57,6 @@ def _cos_sin(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     t2 = t * t
     d = 1.0 / (1.0 + t2)
     return (1.0 - t2) * d, 2.0 * t * d
-
-
-def _chunks(n: int):
-    """Slices of at most KIN_CHUNK samples (a loop over chunks, not over samples)."""
-    return (slice(s, min(s + KIN_CHUNK, n)) for s in range(0, n, KIN_CHUNK))
 
 
 def _q(q: object) -> np.ndarray:
@@ -129,7 +125,7 @@ def forward_kinematics(leg: OmniLeg, q: object) -> np.ndarray:
     qf = q.reshape(-1, 3)
     out = np.empty_like(qf)
     L1, L4, L5 = leg.L1, leg.L4, leg.L5
-    for s in _chunks(qf.shape[0]):
+    for s in slices(qf.shape[0], KIN_CHUNK):
         alpha, beta, gamma = qf[s, 0], qf[s, 1], qf[s, 2]
         ca, sa = _cos_sin(alpha)
         cb, sb = _cos_sin(beta)
@@ -229,7 +225,7 @@ def jacobian(leg: OmniLeg, q: object) -> np.ndarray:
     q = _q(q)
     qf = q.reshape(-1, 3)
     J = np.zeros((qf.shape[0], 3, 3))
-    for s in _chunks(qf.shape[0]):
+    for s in slices(qf.shape[0], KIN_CHUNK):
         ca, sa = _cos_sin(qf[s, 0])
         cb, sb = _cos_sin(qf[s, 1])
         inv = 1.0 / np.sqrt(ca * ca + (cb * sa) ** 2)
@@ -475,7 +471,7 @@ def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
     exists = np.empty(n, dtype=bool)
     lim = np.empty(n, dtype=bool)
     L1, L4, L5 = leg.L1, leg.L4, leg.L5
-    for s in _chunks(n):
+    for s in slices(n, KIN_CHUNK):
         finite = np.isfinite(pf[s]).all(axis=-1)
         ps = pf[s] if finite.all() else np.where(finite[:, None], pf[s], 0.0)  # non-finite: flagged below
         px, py, pz = ps[:, 0], ps[:, 1], ps[:, 2]
