@@ -73,7 +73,7 @@ def chain_screws(leg: OmniLeg) -> tuple[np.ndarray, np.ndarray]:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`.
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     w1 = np.array([[0.0, 1, 0], [1, 0, 0], [1, 0, 0], [0, 1, 0]])  # paper 2, eq. (1)
@@ -149,15 +149,13 @@ def thigh_closure(leg: OmniLeg, alpha: object, beta: object) -> ThighClosure:
 
     Returns
     -------
-    ThighClosure
-        All twelve joint angles ``theta`` (..., 3, 4), the knee pose ``T_knee`` (..., 4, 4), the
-        ``residual``, ``converged``, ``rotation_error`` and ``translation_only`` per sample.
+    :class:`ThighClosure`
+        The thigh's joint angles and knee pose per sample, with convergence flags.
 
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`, ``alpha``/``beta`` is not a finite real array, or their
-        shapes do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -272,7 +270,7 @@ def shank_frames(leg: OmniLeg) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`.
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     psi = leg.shank_azimuth + 2.0 * np.pi * np.arange(3) / 3.0
@@ -299,13 +297,13 @@ def shank_crank_slider(leg: OmniLeg, gamma: object) -> ShankResult:
 
     Returns
     -------
-    ShankResult
-        Joint points ``C, D, E`` (..., 3, 3) m, ``slider``, ``coupler_angle``, ``delta_L2`` and ``valid``.
+    :class:`ShankResult`
+        The shank's joint points and slider per sample, with a ``valid`` mask.
 
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``gamma`` is not a finite real array.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------

@@ -314,7 +314,7 @@ def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``q`` is not a finite real array of shape (..., 3).
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -383,9 +383,8 @@ def inverse_dynamics(
 
     Returns
     -------
-    DynamicsResult
-        ``tau`` (..., 3) N·m, the inertia matrix ``M`` (..., 3, 3) kg m², and the ``velocity_terms``,
-        ``gravity_terms`` and ``foot_terms`` (each (..., 3), N·m) that sum with ``M q̈`` to ``tau``.
+    :class:`DynamicsResult`
+        Actuator torques per sample and the terms that sum to them.
 
     Raises
     ------
@@ -450,7 +449,7 @@ def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``q`` is not a finite real array of shape (..., 3).
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -485,7 +484,7 @@ def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``q`` is not a finite real array of shape (..., 3).
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -517,8 +516,7 @@ def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3), or
-        the shapes do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -553,8 +551,7 @@ def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3), or
-        the shapes do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -619,14 +616,13 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
 
     Returns
     -------
-    FootForceResult
-        ``force`` (..., 3) N, the ``singular`` mask, ``rcond`` and ``residual`` (N·m), each (...).
+    :class:`FootForceResult`
+        Foot force per sample, with a singular mask and residual.
 
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3), or
-        the shapes do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))

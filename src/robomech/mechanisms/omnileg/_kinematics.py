@@ -82,7 +82,7 @@ def thigh_direction(alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``alpha`` or ``beta`` is not a finite real array, or they do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -165,7 +165,7 @@ def passive_angles(leg: OmniLeg, alpha: object, beta: object) -> tuple[np.ndarra
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`, or ``alpha``/``beta`` is not a finite real array.
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     a = as_array(alpha, "alpha")
@@ -259,8 +259,7 @@ def hessian(leg: OmniLeg, q: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or an array is not a finite real array of shape (..., 3)
-        (or the shapes do not broadcast).
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = _q(q)
@@ -304,8 +303,7 @@ def foot_velocity(leg: OmniLeg, q: object, qd: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or an array is not a finite real array of shape (..., 3)
-        (or the shapes do not broadcast).
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -342,8 +340,7 @@ def foot_acceleration(leg: OmniLeg, q: object, qd: object, qdd: object) -> np.nd
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or an array is not a finite real array of shape (..., 3)
-        (or the shapes do not broadcast).
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     qd = as_array(qd, "qd", (3,))
@@ -372,7 +369,7 @@ def within_limits(leg: OmniLeg, q: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``q`` is not a real array of shape (..., 3).
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -450,8 +447,8 @@ def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
 
     Returns
     -------
-    IKResult
-        ``q (..., 3)`` joint angles (rad), ``exists``, ``within_limits`` and ``reachable`` per sample.
+    :class:`IKResult`
+        Joint angles per sample, with existence and joint-limit masks.
 
     Examples
     --------

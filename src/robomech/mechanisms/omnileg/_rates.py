@@ -105,9 +105,8 @@ def joint_rates(
 
     Returns
     -------
-    JointRatesResult
-        ``qd`` (rad/s) and ``qdd`` (rad/s²), each (..., 3); ``rcond``, ``singular``, the velocity and
-        acceleration residuals and ``valid``, each (...).
+    :class:`JointRatesResult`
+        Joint rates and accelerations per sample, with singular mask and residuals.
 
     Raises
     ------

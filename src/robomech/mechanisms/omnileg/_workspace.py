@@ -139,14 +139,13 @@ def workspace_map(leg: OmniLeg, q: object) -> WorkspaceMap:
 
     Returns
     -------
-    WorkspaceMap
-        The samples ``q`` and per sample the ``foot`` position (..., 3) m, ``within_limits``, ``det``,
-        ``cond``, ``dexterity``, ``sigma_min`` and ``singular``.
+    :class:`WorkspaceMap`
+        Per-sample workspace and singularity measures.
 
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``q`` is not a finite real array of shape (..., 3).
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -189,8 +188,7 @@ def singular_surface(leg: OmniLeg, alpha: object, beta: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`, ``alpha``/``beta`` is not a finite real array, or they do
-        not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     _leg(leg)
     a = as_array(alpha, "alpha")
@@ -255,9 +253,8 @@ def foot_workspace(leg: OmniLeg, *, nodes: int = AREA_NODES) -> FootWorkspace:
 
     Returns
     -------
-    FootWorkspace
-        ``volume`` (m³), ``projected_area`` (m²), ``stroke``, ``boundary`` (M, 2), ``depth_min``,
-        ``depth_max`` and ``radius_max`` (m).
+    :class:`FootWorkspace`
+        Volume, area and extent of the foot workspace.
 
     Raises
     ------
@@ -342,13 +339,13 @@ def workspace_symmetry(leg: OmniLeg, p_foot: object) -> SymmetryResult:
 
     Returns
     -------
-    SymmetryResult
-        ``reachable``, ``mirror_x``, ``mirror_y``, ``swap`` and ``holds`` masks, each (...).
+    :class:`SymmetryResult`
+        Per-sample masks of the workspace's symmetries.
 
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``p_foot`` is not a real array of shape (..., 3).
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------

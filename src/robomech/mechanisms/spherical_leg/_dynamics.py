@@ -279,8 +279,7 @@ def generalized_forces(
     Raises
     ------
     ValueError
-        If ``leg`` is not a :class:`SphericalLeg`, or an input has a wrong shape, is not real and
-        finite, or the inputs do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -319,7 +318,7 @@ def mass_matrix(leg: SphericalLeg, q: object, *, paper_as_printed: bool = False)
     Raises
     ------
     ValueError
-        If ``leg`` is not a :class:`SphericalLeg`, or ``q`` has a wrong shape or is not real and finite.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -372,8 +371,7 @@ def mechanical_energy(
     Raises
     ------
     ValueError
-        If ``leg`` is not a :class:`SphericalLeg`, or an input has a wrong shape, is not real and
-        finite, or the inputs do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -468,9 +466,8 @@ def distribute_forces(
 
     Returns
     -------
-    ForceDistribution
-        ``forces (..., 3)`` (N), ``residual (...)`` (N m), ``valid (...)``, ``sigma_min (...)`` (m/rad)
-        and ``rcond (...)``.
+    :class:`ForceDistribution`
+        Leg forces per sample, with residual and conditioning.
 
     Raises
     ------
@@ -624,9 +621,8 @@ def inverse_dynamics(
 
     Returns
     -------
-    InverseDynamicsResult
-        ``generalized_forces (..., 2)`` (N m), ``leg_forces (..., 3)`` (N), ``residual (...)`` (N m),
-        ``valid (...)``, ``sigma_min (...)`` (m/rad) and ``rcond (...)``.
+    :class:`InverseDynamicsResult`
+        Generalized and leg forces per sample, with residual and conditioning.
 
     Raises
     ------
