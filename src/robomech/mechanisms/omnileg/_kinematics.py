@@ -390,19 +390,15 @@ def within_limits(leg: OmniLeg, q: object) -> np.ndarray:
 
 @dataclass(frozen=True)
 class IKResult:
-    """Inverse kinematics per sample.
-
-    ``q (..., 3)`` is NaN exactly where ``exists`` is false (no real solution: the foot is farther than
-    L1 from Z0 horizontally, or deeper/shallower than the shank can reach).  ``within_limits`` checks the
-    joint ranges; ``reachable = exists & within_limits``.  ``residual`` is ``|FK(q) - p|`` (m, NaN where
-    no solution exists), a diagnostic computed on first access (it costs a forward kinematics).
+    """Inverse kinematics per sample (the result of :func:`inverse_kinematics`).
 
     Attributes
     ----------
     q : ndarray, shape (..., 3)
         Joint angles ``(α, β, γ)`` (rad), branch γ ≥ 0; NaN where no solution exists.
     exists : ndarray of bool, shape (...)
-        A real solution exists.
+        A real solution exists (the foot is not farther than L1 from Z0 horizontally, nor deeper or
+        shallower than the shank can reach).
     within_limits : ndarray of bool, shape (...)
         The solution is within the joint ranges.
     reachable : ndarray of bool, shape (...)
@@ -412,7 +408,8 @@ class IKResult:
     p_foot : ndarray, shape (..., 3)
         The requested foot positions (m, hip frame).
     residual : ndarray, shape (...)
-        ``|FK(q) - p_foot|`` (m), NaN where no solution exists (computed on first access).
+        ``|FK(q) - p_foot|`` (m), NaN where no solution exists (computed on first access: it costs
+        a forward kinematics).
     """
 
     q: np.ndarray

@@ -73,8 +73,8 @@ ACTUATION_SINGULAR_RTOL = 1e-8
 # generalized force needs more than 1 kN of leg force, 10x the largest force of any well-conditioned
 # sample of paper 1's Fig. 5 (max 345 N, typical 100 N), and (ii) 10 um of leg-length error (lead-screw
 # backlash) leaves more than 10 mrad (0.6 deg) of platform play: the legs no longer hold the pose.
-# Samples below it are flagged (valid False) with their finite forces kept for inspection; before issue
-# 14 only the 1e-8 ratio flagged, which let ~1e8 N through as valid 1e-6 rad from the singular curve.
+# Samples below it are flagged (valid False) with their finite forces kept for inspection; the 1e-8
+# ratio alone would let ~1e8 N through as valid 1e-6 rad from the singular curve.
 ACTUATION_SIGMA_MIN = 1e-3
 # Gimbal lock of a base universal joint: the leg along the joint's fixed axis, 1 - (a . s)^2 = 0, where
 # the spin sigma = (a . s)(a . (s x sdot)) / (1 - (a . s)^2) is unbounded (the joint cannot follow).
