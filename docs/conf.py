@@ -41,7 +41,6 @@ autodoc_typehints = "none"
 autodoc_mock_imports: list[str] = []
 # autosummary: one page per public function and class (docs/api/generated/, from the pages that
 # _api_pages writes from each module's __all__; templates in docs/_templates/autosummary/).
-autosummary_generate = True
 autosummary_ignore_module_all = False
 # numpydoc: no per-class member tables (autodoc lists members) and no type cross-references (no
 # intersphinx: the docs build offline).
@@ -50,8 +49,22 @@ numpydoc_xref_param_type = False
 numpydoc_validation_checks: set[str] = set()
 
 # Markdown pages: $...$ and $$...$$ (and ```{math} blocks) are LaTeX math.
-myst_enable_extensions = ["dollarmath", "amsmath"]
+myst_enable_extensions = ["dollarmath", "amsmath", "substitution"]
 myst_heading_anchors = 3
+
+
+def _citation_md(paper) -> str:
+    """A paper's citation as Markdown: title in italics, the DOI as a link."""
+    text = f"{', '.join(paper.authors)}: *{paper.title}*. {paper.venue}, {paper.year}"
+    text += f", pp. {paper.pages}" if paper.pages else ""
+    return text + (f". [doi:{paper.doi}](https://doi.org/{paper.doi})" if paper.doi else "")
+
+
+# {{ paper1 }} ... {{ paper5 }}: each paper's citation, from the one table the reports use too
+# (robomech/studies/_papers.py).
+from robomech.studies._papers import PAPERS as _CITED  # noqa: E402
+
+myst_substitutions = {f"paper{n}": _citation_md(p) for n, p in _CITED.items()}
 
 html_theme = "pydata_sphinx_theme"
 html_title = f"robomech {release}"
@@ -62,7 +75,12 @@ html_theme_options = {
     "footer_start": ["copyright"],
     "footer_end": ["sphinx-version"],
 }
-html_sidebars = {"index": []}
+# No left sidebar on pages without sub-pages (it would show an empty "Section Navigation").
+html_sidebars = {
+    name: []
+    for name in ("index", "usage", "conventions", "architecture", "performance", "reports", "multibody",
+                 "dynamics", "explore", "viewer", "mechanisms/*")
+}  # fmt: skip
 html_static_path = ["_static", "_build/vendor"]
 html_css_files = ["robomech.css"]
 html_js_files = ["robomech.js"]
@@ -202,6 +220,9 @@ API_MODULES = (
     "robomech.cli",
 )
 API = ROOT / "docs" / "api"
+# The pages autosummary writes stubs for, named (not "every source file": in an incremental build
+# that is the previous build's list, which lacks a module page added since).
+autosummary_generate = [f"api/{name}.rst" for name in API_MODULES]
 
 
 def _public_names(module_name: str) -> dict[str, list[str]]:
@@ -252,11 +273,10 @@ def _api_pages() -> None:
 # ----------------------------------------------------------------------------- the studies' reports
 # One page per registered study (docs/papers.md).  The fast studies are reproduced from this
 # checkout by `robomech reproduce` during the build and reused by later builds until a source file
-# changes (together about 25 s on this 2-core machine, after the first-use compile); the slow
-# ones (continuum and skid-steer take 10-12 minutes each) get a page that says what the study
-# reproduces and how to get its
-# report.  With ROBOMECH_DOCS_REPORTS=DIR (`make docs REPORTS=out` after `make run`) every study
-# folder of that `robomech reproduce --out DIR` is shown as well.
+# changes (together about 25 s on this 2-core machine, after the first-use compile); the slow ones
+# (continuum and skid-steer, minutes each) get a page that says what the study reproduces and how to
+# get its report.  With ROBOMECH_DOCS_REPORTS=DIR (`make docs REPORTS=out` after `make run`) every
+# study folder of that `robomech reproduce --out DIR` is shown as well.
 FAST_STUDIES = ("demo", "spherical-leg", "vectored-thrust", "omnileg", "sweep-demo")
 REPORTS_DIR = os.environ.get("ROBOMECH_DOCS_REPORTS", "")
 PAPERS = ROOT / "docs" / "papers"
@@ -286,8 +306,11 @@ def _study_placeholder(study, why: str) -> str:
     module = inspect.getmodule(study.run)
     doc = inspect.cleandoc(module.__doc__ or "")
     needs = f" It needs `{', '.join(study.requires)}` (an optional extra)." if study.requires else ""
+    from robomech.studies._papers import PAPERS as CITED
+
+    source = next((p.citation() for p in CITED.values() if p.short() == study.source), study.source)
     return (
-        f"# {study.title}\n\n*Source:* {study.source}\n\n```{{note}}\n{why}{needs} To see its report "
+        f"# {study.title}\n\n*Source:* {source}\n\n```{{note}}\n{why}{needs} To see its report "
         f"here: `robomech reproduce {study.name} --out out`, then `make docs REPORTS=out`.\n```\n\n"
         f"## What the study reproduces\n\n{_rst_to_md(doc)}\n"
     )
@@ -329,14 +352,16 @@ def _paper_pages() -> None:
 
     BUILD.mkdir(parents=True, exist_ok=True)
     (BUILD / "papers-cited.md").write_text(
-        "\n".join(
-            f"{p.number}. {p.citation().rsplit('. doi:', 1)[0]}."
-            + (f" [doi:{p.doi}](https://doi.org/{p.doi})" if p.doi else "")
-            for p in CITED.values()
-        )
-        + "\n",
-        encoding="utf-8",
+        "\n".join(f"{p.number}. {_citation_md(p)}" for p in CITED.values()) + "\n", encoding="utf-8"
     )
+    # the pages in reading order: the demonstration, the papers by number, then the rest
+    def order(name: str) -> tuple[int, str]:
+        m = re.match(r"Paper (\d+)", studies[name].title)
+        return (int(m.group(1)) if m else (0 if name == "demo" else 99), name)
+
+    pages = [f"papers/{n}/index" for n in sorted(studies, key=order)]
+    toc = ["```{toctree}", ":maxdepth: 1", "", *pages, "```"]
+    (BUILD / "papers-toc.md").write_text("\n".join(toc) + "\n", encoding="utf-8")
     shutil.rmtree(PAPERS, ignore_errors=True)
     for name, study in studies.items():
         dst = PAPERS / name

@@ -68,4 +68,16 @@ for ti, ta, pw in zip(t, tau, power, strict=True):
     print(f"  t = {ti:.2f} s   tau = {ta:+.4f} N m   power = {pw:+.4f} W")
 print(f"power balance tau * dphi/dt vs dE/dt: max relative error {rel:.1e}")
 assert rel < POWER_RTOL
+
+# The crank torque along the motion, and the power balance it satisfies.
+import matplotlib.pyplot as plt  # noqa: E402
+
+fig, (a1, a2) = plt.subplots(2, 1, figsize=(6, 5), sharex=True)
+a1.plot(t, tau, "o-")
+a1.set_ylabel("crank torque (N m)")
+a2.plot(t, power, "o-", label="tau * dphi/dt")
+a2.plot(t, dEdt, "k+", ms=10, label="dE/dt (central difference)")
+a2.set_xlabel("time (s)")
+a2.set_ylabel("power (W)")
+a2.legend()
 print("OK")

@@ -49,4 +49,15 @@ for k in range(0, len(ratios), 40):
     print(f"  l2/l1 = {ratios[k]:.2f}: best condition number {cond[k].min():.3f}")
 assert abs(best_ratio - 1 / np.sqrt(2)) <= RATIO_ATOL
 assert abs(best_elbow - np.deg2rad(135.0)) <= ELBOW_ATOL
+
+# The sweep as a map: log10 of the condition number over ratio and elbow angle, the optimum marked.
+import matplotlib.pyplot as plt  # noqa: E402
+
+fig, ax = plt.subplots(figsize=(6, 4))
+im = ax.pcolormesh(np.rad2deg(elbow), ratios, np.log10(cond), shading="auto", cmap="viridis", vmax=2)
+fig.colorbar(im, ax=ax, label="log10 condition number of the tip Jacobian")
+ax.plot(np.rad2deg(best_elbow), best_ratio, "r+", ms=14, mew=2, label="isotropic optimum")
+ax.set_xlabel("elbow angle (deg)")
+ax.set_ylabel("link ratio l2/l1")
+ax.legend(loc="upper left")
 print("OK")

@@ -58,4 +58,13 @@ assert np.max(np.abs(G - G_fd)) < RATIO_ATOL
 for t2, g in zip(theta2, G, strict=True):
     print(f"  theta2 = {t2:+.2f} rad   d(theta4)/d(theta2) = {g:+.4f}")
 print(f"transmission ratio vs closed form: max error {np.max(np.abs(G - G_fd)):.1e}")
+
+# The linkage at the extreme crank angles, drawn by robomech (matplotlib; the docs gallery shows it).
+import matplotlib.pyplot as plt  # noqa: E402
+
+fig = plt.figure(figsize=(5, 4))
+ax = fig.add_subplot(projection="3d")
+for k, color in ((0, "C0"), (len(theta2) - 1, "C1")):
+    mb.draw(mech, fk.q[k], ax=ax, color=color, title="four-bar at crank angles -0.6 and +0.6 rad")
+ax.view_init(elev=90, azim=-90)  # the linkage moves in the x-y plane
 print("OK")

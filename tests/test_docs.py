@@ -175,7 +175,7 @@ def test_the_docs_show_every_example_the_studies_and_the_gallery():
         head = script.read_text().split('"""')[1].strip().splitlines()
         # sphinx-gallery's page title: the docstring's first line underlined with "="
         assert len(head) > 1 and set(head[1]) == {"="} and len(head[1]) == len(head[0]), script.name
-    assert "papers/*/index" in (DOCS / "papers.md").read_text()
+    assert "_build/papers-toc.md" in (DOCS / "papers.md").read_text()  # written by _paper_pages
     assert "mechanisms/gallery/*" in (DOCS / "mechanism-gallery.md").read_text()
     index = (DOCS / "index.md").read_text()
     for entry in ("papers", "examples/index", "mechanism-gallery"):
@@ -190,6 +190,14 @@ def test_the_reports_cite_the_papers_not_a_file():
     assert not any("shared/papers" in s or ".txt" in s for s in sources)
     for paper in PAPERS.values():
         assert paper.doi and paper.title and paper.authors and paper.venue, paper.number
+    # the docs cite them from the same table ({{ paperN }}, docs/conf.py myst_substitutions)
+    for page in DOCS.rglob("*.md"):
+        if not page.relative_to(DOCS).as_posix().startswith(GENERATED):
+            assert "shared/papers" not in page.read_text(), page
+    for n in PAPERS:
+        page = {1: "spherical_leg", 2: "omnileg", 3: "continuum", 4: "skid_steer", 5: "vectored_thrust"}[n]
+        assert f"{{{{ paper{n} }}}}" in (DOCS / "mechanisms" / f"{page}.md").read_text(), page
+    assert set(_conf().myst_substitutions) == {f"paper{n}" for n in PAPERS}
 
 
 def inspect_source(func) -> str:

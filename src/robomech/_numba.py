@@ -45,7 +45,7 @@ def _listen(numba: ModuleType) -> None:
         return
     from numba.core import event
 
-    state = {"depth": 0, "t0": 0.0, "name": ""}
+    state: dict[str, Any] = {"depth": 0, "t0": 0.0, "name": ""}
 
     class _Listener(event.Listener):
         def on_start(self, ev: Any) -> None:
@@ -55,9 +55,8 @@ def _listen(numba: ModuleType) -> None:
                 name = getattr(getattr(disp, "py_func", None), "__qualname__", "a kernel")
                 mod = getattr(getattr(disp, "py_func", None), "__module__", "")
                 state["t0"], state["name"] = time.perf_counter(), f"{mod}.{name}" if mod else name
-                _LOG.info(
-                    "compiling kernel %s (first use; cached in %s)", state["name"], numba.config.CACHE_DIR
-                )
+                where = getattr(numba.config, "CACHE_DIR", "")
+                _LOG.info("compiling kernel %s (first use; cached in %s)", state["name"], where)
 
         def on_end(self, ev: Any) -> None:
             state["depth"] -= 1
@@ -75,7 +74,7 @@ def import_numba() -> ModuleType:
         os.environ["NUMBA_CACHE_DIR"] = str(cache_dir())
     import numba
 
-    if not numba.config.CACHE_DIR:  # imported before robomech could set the variable
-        numba.config.CACHE_DIR = str(cache_dir())
+    if not getattr(numba.config, "CACHE_DIR", ""):  # imported before robomech could set the variable
+        setattr(numba.config, "CACHE_DIR", str(cache_dir()))  # noqa: B010 (numba.config is untyped)
     _listen(numba)
     return numba

@@ -256,7 +256,16 @@ def _mask_from_values(spec: Spec) -> bool:
     return False
 
 
-@pytest.mark.parametrize("name", sorted(n for n, s in ACTIVE.items() if s.masked))
+# Functions that return a bare array, as their peers do (MuJoCo mj_rne / mj_fullM, Pinocchio rnea / crba),
+# and have no physical failure (the tree's inverse dynamics and mass matrix exist at every configuration):
+# a failed sample from an earlier call (a NaN row) gives a NaN row there and nowhere else, which the
+# generic mask check of test_contract.py verifies; there is no flag to compute.
+BARE_ARRAY_RESULTS = {"robomech.multibody.generalized_forces", "robomech.multibody.mass_matrix"}
+
+
+@pytest.mark.parametrize(
+    "name", sorted(n for n, s in ACTIVE.items() if s.masked and n not in BARE_ARRAY_RESULTS)
+)
 def test_a_masked_argument_is_flagged_by_a_result_field(name):
     assert not _mask_from_values(ACTIVE[name]), (
         f"{name}: its mask is the finiteness of its values; a non-finite input sample must be flagged by "

@@ -12,6 +12,7 @@ import argparse
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 from ._core import EXIT_INTERRUPTED, EXIT_OK, CliError, Command
 
@@ -78,7 +79,7 @@ def _geometry(target: str) -> Path | None:
 SIMULATE_FPS = 30.0
 
 
-def _motion(args: argparse.Namespace, mech) -> tuple[object, object]:
+def _motion(args: argparse.Namespace, mech) -> tuple[Any, Any]:
     """The path to play back and its times: from --motion FILE, --simulate SECONDS, or none."""
     import numpy as np
 

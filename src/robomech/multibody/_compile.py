@@ -131,7 +131,7 @@ class Model:
     q_ref: np.ndarray  # (nq,) the assembled reference configuration (mech.q0), _reference
     rnea: RneaTables
     # what other modules derive from the compiled model (their own keys); never the description
-    cache: dict[str, Any] = field(default_factory=dict)
+    cache: dict[Any, Any] = field(default_factory=dict)
 
 
 # ----------------------------------------------------------------------------- the reference rank
@@ -355,5 +355,8 @@ def compile_model(mech: Mechanism) -> Model:
             return hit[1]
         model = _compile(mech)
         key = id(mech)
-        _MODELS[key] = (weakref.ref(mech, lambda _r, key=key: _drop(key)), model)
+        def _release(_ref: object, key: int = key) -> None:
+            _drop(key)
+
+        _MODELS[key] = (weakref.ref(mech, _release), model)
         return model

@@ -1096,14 +1096,14 @@ def inv_dyn_one(model, q: np.ndarray, qd_a: np.ndarray, qdd_a: np.ndarray, gravi
         np.empty(1),
     )
     args = (0, 1, q.reshape(1, -1), qd_a.reshape(1, -1), qdd_a.reshape(1, -1), *_NO_W, gv, _NO_WTS)
-    args = (*args, model.tables, model.dyn, *outs)
+    call = (*args, model.tables, model.dyn, *outs)
     fn = model.cache.get("inv_dyn_entry")
     if fn is None:
-        inv_dyn_block(*args)  # compiles or loads the kernel, then its entry point skips the type dispatch
-        sig = tuple(numba.typeof(a) for a in args)
+        inv_dyn_block(*call)  # compiles or loads the kernel, then its entry point skips the type dispatch
+        sig = tuple(numba.typeof(a) for a in call)
         fn = model.cache["inv_dyn_entry"] = inv_dyn_block.overloads[sig].entry_point
     else:
-        fn(*args)
+        fn(*call)
     if not outs[10][0] or not outs[11][0] <= opt.CLOSURE_RTOL * model.tables.L:
         return None
     if model.tables.m == 0 or len(model.pas) == 0:  # the empty passive block's measures

@@ -14,6 +14,7 @@ it is loaded (``from_mjcf``, ``Builder.build``) or first used.
 from __future__ import annotations
 
 from types import SimpleNamespace
+from typing import Any
 
 import numpy as np
 
@@ -47,7 +48,7 @@ def assembled_reference(mech, tree, cs) -> np.ndarray:
         return q0
     # the compiled model is being built: the assembly runs on the tree and rows given here (the numpy
     # iteration of solve_closure reads only .tree and .constraints; floating_base_dofs .closures)
-    view = SimpleNamespace(tree=tree, constraints=cs, closures=mech.closures)
+    view: Any = SimpleNamespace(tree=tree, constraints=cs, closures=mech.closures)
     free = np.setdiff1d(np.arange(tree.nv), floating_base_dofs(view))
     # the pose itself and a few fixed perturbations of it: a sketch typed with every link along one axis
     # is a singular start (the closure's gradient vanishes there), as a CAD solver also perturbs it

@@ -114,8 +114,8 @@ def _rows(output: object) -> tuple[int, ...]:
             raise ValueError(f"Expected output in {sorted(OUTPUTS)} or row indices 0..5, got {output!r}.")
         return OUTPUTS[output]
     try:
-        rows = tuple(int(r) for r in output)  # type: ignore[union-attr]
-        exact = all(float(r) == int(r) and not isinstance(r, bool) for r in output)  # type: ignore[union-attr]
+        rows = tuple(int(r) for r in output)  # type: ignore[attr-defined]
+        exact = all(float(r) == int(r) and not isinstance(r, bool) for r in output)  # type: ignore[attr-defined]
     except (TypeError, ValueError):
         raise ValueError(
             f"Expected output to be a name or a sequence of row indices 0..5, got {output!r}."

@@ -14,6 +14,7 @@ import dataclasses
 from pathlib import Path
 
 import numpy as np
+from matplotlib.lines import Line2D
 
 import robomech.mechanisms.omnileg as ol
 from robomech.mechanisms.omnileg._dynamics import BODY_NAMES
@@ -292,9 +293,9 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     fig, axs = plt.subplots(3, 1, figsize=(8, 7.5), sharex=True)
     for j in range(3):
         col = f"C{j}"
-        axs[0].plot(t_eng, tau_an_eng[:, j], color=col, label=f"{MOTORS[j]} robomech")
+        axs[0].plot(t_eng, tau_an_eng[:, j], color=col, label=MOTORS[j])
         axs[0].plot(t_eng, tau_en[:, j], color=col, ls="none", marker="o", mfc="none", ms=3,
-                    markevery=4, label=f"{MOTORS[j]} MuJoCo")  # fmt: skip
+                    markevery=4)  # fmt: skip
         axs[1].semilogy(t_eng, np.abs(tau_an_eng[:, j] - tau_en[:, j]) + 1e-18, color=col, label=MOTORS[j])
         drift = np.asarray(sim["q_sim"])[:, j] - np.asarray(sim["q_ref"])[:, j]  # dict of arrays and floats
         axs[2].plot(sim["t"], np.degrees(drift), color=col,
@@ -308,6 +309,10 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
     for ax in axs:
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7, ncol=3)
+    # one entry per motor (colour) and one per source (style), not "MuJoCo" once per motor
+    handles, labels = axs[0].get_legend_handles_labels()
+    handles += [Line2D([], [], color="k"), Line2D([], [], color="k", ls="", marker="o", mfc="none", ms=3)]
+    axs[0].legend(handles, [*labels, "robomech", "MuJoCo"], fontsize=7, ncol=5)
     res.figures.append(
         save_figure(
             fig,

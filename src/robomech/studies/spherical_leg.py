@@ -237,8 +237,8 @@ def _force_figures(leg: sl.SphericalLeg, out_dir: Path, res: StudyResult, engine
         ax.plot(t, fmn[:, 1], "C1--", label="leg 2, minimum-norm (0 under the paper's rule)")
         if engine is not None and label.startswith("(b)"):
             te, fe = engine["force_b"]
-            ax.plot(te, fe[:, 2], "k.", ms=4, label="leg 3, MuJoCo (paper's rule)")
-            ax.plot(te, fe[:, 0], "ks", ms=2.5, mfc="none", label="leg 1, MuJoCo (paper's rule)")
+            ax.plot(te, fe[:, 2], "k.", ms=4, label="MuJoCo, paper's rule (• leg 3, □ leg 1)")
+            ax.plot(te, fe[:, 0], "ks", ms=2.5, mfc="none")
         wm = sl.workspace_map(leg, case[0][:, 0], case[0][:, 1])
         flips = np.nonzero(np.diff(np.sign(wm.dl3_dalpha)) != 0)[0]
         for k in flips:

@@ -169,7 +169,8 @@ def _decide(t: np.ndarray, d: np.ndarray, ks: list[int]) -> tuple[list[int | Non
             sig = sign * d[past]
             pred = np.polyval(np.polyfit(t[past] - t[k], sig, past.size - 1), 0.0)
             splits[j] = k + 1 if pred * sign > 0 else k
-        sign, prev = -sign, splits[j]
+        here = splits[j]
+        sign, prev = -sign, (p if here is None else here)
     return splits, bool(r_win > AMBIGUITY_RATIO * r_other)
 
 
