@@ -73,7 +73,7 @@ def chain_screws(leg: OmniLeg) -> tuple[np.ndarray, np.ndarray]:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`.
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     w1 = np.array([[0.0, 1, 0], [1, 0, 0], [1, 0, 0], [0, 1, 0]])  # paper 2, eq. (1)
@@ -86,19 +86,14 @@ def chain_screws(leg: OmniLeg) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass(frozen=True)
 class ThighClosure:
-    """Closure of the thigh per sample.
-
-    ``theta (..., 3, 4)`` all joint angles (chain k, joint i as θ_{k+1, i+1}); ``T_knee (..., 4, 4)`` the
-    knee-plate pose O0' in O0 (chain 1's PoE); ``residual`` the largest closure twist |log(T_k T_1^-1)|;
-    ``converged`` the Gauss-Newton flag; ``rotation_error`` the angle of the knee plate's rotation (rad);
-    ``translation_only`` = converged and rotation_error <= TRANSLATION_ONLY_TOL.
+    """Closure of the thigh per sample (the result of :func:`thigh_closure`).
 
     Attributes
     ----------
     theta : ndarray, shape (..., 3, 4)
         Joint angles of the three chains (rad), ``theta[..., k, i] = θ_{k+1, i+1}``.
     T_knee : ndarray, shape (..., 4, 4)
-        Knee-plate pose ``T_O0 O0'`` (m).
+        Knee-plate pose ``T_O0 O0'`` (m), chain 1's product of exponentials.
     residual : ndarray, shape (...)
         Largest component of the closure twists ``log(T_k T_1^-1)`` (rad or m).
     converged : ndarray of bool, shape (...)
@@ -149,15 +144,13 @@ def thigh_closure(leg: OmniLeg, alpha: object, beta: object) -> ThighClosure:
 
     Returns
     -------
-    ThighClosure
-        All twelve joint angles ``theta`` (..., 3, 4), the knee pose ``T_knee`` (..., 4, 4), the
-        ``residual``, ``converged``, ``rotation_error`` and ``translation_only`` per sample.
+    :class:`ThighClosure`
+        The thigh's joint angles and knee pose per sample, with convergence flags.
 
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`, ``alpha``/``beta`` is not a finite real array, or their
-        shapes do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -226,11 +219,6 @@ def _newton(
 class ShankResult:
     """Shank chains in the knee-plate frame O0' (axes parallel to O0), per sample.
 
-    ``C, D, E (..., 3, 3)`` joint points of chains i = 1..3 (m); ``slider (...)`` the depth of the E
-    plane below the C plane (m); ``coupler_angle (...)`` the coupler's angle from Z0' (rad, sign opposite
-    to the crank); ``delta_L2 (...)`` the shank shortening 2 L4 - slider (eq. (10)); ``valid (...)``
-    false (and D, E, slider NaN) where |γ| >= π/2, where the chain folds flat.
-
     Attributes
     ----------
     C, D, E : ndarray, shape (..., 3, 3)
@@ -238,11 +226,11 @@ class ShankResult:
     slider : ndarray, shape (...)
         Depth of the E plane below the C plane (m).
     coupler_angle : ndarray, shape (...)
-        Coupler angle from Z0' (rad).
+        Coupler angle from Z0' (rad, sign opposite to the crank).
     delta_L2 : ndarray, shape (...)
-        Shank shortening ``2 L4 - slider`` (m).
+        Shank shortening ``2 L4 - slider`` (m, eq. (10)).
     valid : ndarray of bool, shape (...)
-        ``|γ| < π/2``.
+        ``|γ| < π/2``; beyond it the chain folds flat and D, E, slider are NaN.
     """
 
     C: np.ndarray
@@ -272,7 +260,7 @@ def shank_frames(leg: OmniLeg) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`.
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     psi = leg.shank_azimuth + 2.0 * np.pi * np.arange(3) / 3.0
@@ -299,13 +287,13 @@ def shank_crank_slider(leg: OmniLeg, gamma: object) -> ShankResult:
 
     Returns
     -------
-    ShankResult
-        Joint points ``C, D, E`` (..., 3, 3) m, ``slider``, ``coupler_angle``, ``delta_L2`` and ``valid``.
+    :class:`ShankResult`
+        The shank's joint points and slider per sample, with a ``valid`` mask.
 
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``gamma`` is not a finite real array.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------

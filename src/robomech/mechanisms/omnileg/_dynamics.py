@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech._batching import chunked
 from robomech._validation import as_array, broadcast_batch, check_bool, check_params
 
 from . import _jet as jt
@@ -285,14 +286,7 @@ def _terms_chunked(
     paper_drive: bool = False,
 ) -> _Terms:
     """:func:`_terms` over cache-sized chunks of samples (identical results, far fewer cache misses)."""
-    N = q.shape[0]
-    if N <= DYN_CHUNK:
-        return _terms(leg, q, qd, qdd, poses, paper_drive)
-    parts = [
-        _terms(leg, q[s : s + DYN_CHUNK], qd[s : s + DYN_CHUNK], qdd[s : s + DYN_CHUNK], poses, paper_drive)
-        for s in range(0, N, DYN_CHUNK)
-    ]  # loop over chunks of DYN_CHUNK samples, not over samples
-    return _Terms(*(np.concatenate([getattr(t, f) for t in parts]) for f in _Terms.__dataclass_fields__))
+    return chunked(lambda s: _terms(leg, q[s], qd[s], qdd[s], poses, paper_drive), q.shape[0], DYN_CHUNK)
 
 
 def _flat(*arrays: np.ndarray) -> tuple[tuple[int, ...], list[np.ndarray]]:
@@ -320,7 +314,7 @@ def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``q`` is not a finite real array of shape (..., 3).
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -389,9 +383,8 @@ def inverse_dynamics(
 
     Returns
     -------
-    DynamicsResult
-        ``tau`` (..., 3) N·m, the inertia matrix ``M`` (..., 3, 3) kg m², and the ``velocity_terms``,
-        ``gravity_terms`` and ``foot_terms`` (each (..., 3), N·m) that sum with ``M q̈`` to ``tau``.
+    :class:`DynamicsResult`
+        Actuator torques per sample and the terms that sum to them.
 
     Raises
     ------
@@ -456,7 +449,7 @@ def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``q`` is not a finite real array of shape (..., 3).
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -491,7 +484,7 @@ def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``q`` is not a finite real array of shape (..., 3).
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -523,8 +516,7 @@ def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3), or
-        the shapes do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -559,8 +551,7 @@ def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3), or
-        the shapes do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -625,14 +616,13 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
 
     Returns
     -------
-    FootForceResult
-        ``force`` (..., 3) N, the ``singular`` mask, ``rcond`` and ``residual`` (N·m), each (...).
+    :class:`FootForceResult`
+        Foot force per sample, with a singular mask and residual.
 
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3), or
-        the shapes do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))

@@ -68,14 +68,13 @@ def joint_motion(leg: OmniLeg, q: object, qd: object, qdd: object) -> JointMotio
 
     Returns
     -------
-    JointMotion
-        ``q``, ``qd``, ``qdd`` of the 22 tree joints, each (..., 22).
+    :class:`JointMotion`
+        Angles, rates and accelerations of the 22 tree joints.
 
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3), or
-        the shapes do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------

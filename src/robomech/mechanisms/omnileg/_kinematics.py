@@ -16,6 +16,7 @@ from functools import cached_property
 
 import numpy as np
 
+from robomech._batching import slices
 from robomech._validation import as_array, broadcast_batch, check_params
 
 from ._params import OmniLeg
@@ -58,11 +59,6 @@ def _cos_sin(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return (1.0 - t2) * d, 2.0 * t * d
 
 
-def _chunks(n: int):
-    """Slices of at most KIN_CHUNK samples (a loop over chunks, not over samples)."""
-    return (slice(s, min(s + KIN_CHUNK, n)) for s in range(0, n, KIN_CHUNK))
-
-
 def _q(q: object) -> np.ndarray:
     return as_array(q, "q", (3,))
 
@@ -86,7 +82,7 @@ def thigh_direction(alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``alpha`` or ``beta`` is not a finite real array, or they do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -129,7 +125,7 @@ def forward_kinematics(leg: OmniLeg, q: object) -> np.ndarray:
     qf = q.reshape(-1, 3)
     out = np.empty_like(qf)
     L1, L4, L5 = leg.L1, leg.L4, leg.L5
-    for s in _chunks(qf.shape[0]):
+    for s in slices(qf.shape[0], KIN_CHUNK):
         alpha, beta, gamma = qf[s, 0], qf[s, 1], qf[s, 2]
         ca, sa = _cos_sin(alpha)
         cb, sb = _cos_sin(beta)
@@ -169,7 +165,7 @@ def passive_angles(leg: OmniLeg, alpha: object, beta: object) -> tuple[np.ndarra
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`, or ``alpha``/``beta`` is not a finite real array.
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     a = as_array(alpha, "alpha")
@@ -229,7 +225,7 @@ def jacobian(leg: OmniLeg, q: object) -> np.ndarray:
     q = _q(q)
     qf = q.reshape(-1, 3)
     J = np.zeros((qf.shape[0], 3, 3))
-    for s in _chunks(qf.shape[0]):
+    for s in slices(qf.shape[0], KIN_CHUNK):
         ca, sa = _cos_sin(qf[s, 0])
         cb, sb = _cos_sin(qf[s, 1])
         inv = 1.0 / np.sqrt(ca * ca + (cb * sa) ** 2)
@@ -263,8 +259,7 @@ def hessian(leg: OmniLeg, q: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or an array is not a finite real array of shape (..., 3)
-        (or the shapes do not broadcast).
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = _q(q)
@@ -308,8 +303,7 @@ def foot_velocity(leg: OmniLeg, q: object, qd: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or an array is not a finite real array of shape (..., 3)
-        (or the shapes do not broadcast).
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -346,8 +340,7 @@ def foot_acceleration(leg: OmniLeg, q: object, qd: object, qdd: object) -> np.nd
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or an array is not a finite real array of shape (..., 3)
-        (or the shapes do not broadcast).
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     qd = as_array(qd, "qd", (3,))
@@ -376,7 +369,7 @@ def within_limits(leg: OmniLeg, q: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``q`` is not a real array of shape (..., 3).
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -397,19 +390,15 @@ def within_limits(leg: OmniLeg, q: object) -> np.ndarray:
 
 @dataclass(frozen=True)
 class IKResult:
-    """Inverse kinematics per sample.
-
-    ``q (..., 3)`` is NaN exactly where ``exists`` is false (no real solution: the foot is farther than
-    L1 from Z0 horizontally, or deeper/shallower than the shank can reach).  ``within_limits`` checks the
-    joint ranges; ``reachable = exists & within_limits``.  ``residual`` is ``|FK(q) - p|`` (m, NaN where
-    no solution exists), a diagnostic computed on first access (it costs a forward kinematics).
+    """Inverse kinematics per sample (the result of :func:`inverse_kinematics`).
 
     Attributes
     ----------
     q : ndarray, shape (..., 3)
         Joint angles ``(α, β, γ)`` (rad), branch γ ≥ 0; NaN where no solution exists.
     exists : ndarray of bool, shape (...)
-        A real solution exists.
+        A real solution exists (the foot is not farther than L1 from Z0 horizontally, nor deeper or
+        shallower than the shank can reach).
     within_limits : ndarray of bool, shape (...)
         The solution is within the joint ranges.
     reachable : ndarray of bool, shape (...)
@@ -419,7 +408,8 @@ class IKResult:
     p_foot : ndarray, shape (..., 3)
         The requested foot positions (m, hip frame).
     residual : ndarray, shape (...)
-        ``|FK(q) - p_foot|`` (m), NaN where no solution exists (computed on first access).
+        ``|FK(q) - p_foot|`` (m), NaN where no solution exists (computed on first access: it costs
+        a forward kinematics).
     """
 
     q: np.ndarray
@@ -454,8 +444,8 @@ def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
 
     Returns
     -------
-    IKResult
-        ``q (..., 3)`` joint angles (rad), ``exists``, ``within_limits`` and ``reachable`` per sample.
+    :class:`IKResult`
+        Joint angles per sample, with existence and joint-limit masks.
 
     Examples
     --------
@@ -475,7 +465,7 @@ def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
     exists = np.empty(n, dtype=bool)
     lim = np.empty(n, dtype=bool)
     L1, L4, L5 = leg.L1, leg.L4, leg.L5
-    for s in _chunks(n):
+    for s in slices(n, KIN_CHUNK):
         finite = np.isfinite(pf[s]).all(axis=-1)
         ps = pf[s] if finite.all() else np.where(finite[:, None], pf[s], 0.0)  # non-finite: flagged below
         px, py, pz = ps[:, 0], ps[:, 1], ps[:, 2]

@@ -121,7 +121,7 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`.
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     L1, L3, L4 = leg.L1, leg.L3, leg.L4

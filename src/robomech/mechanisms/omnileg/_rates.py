@@ -28,13 +28,7 @@ DEFAULT_DAMPING = SINGULAR_RCOND
 
 @dataclass(frozen=True)
 class JointRatesResult:
-    """Joint rates and accelerations per sample for a foot motion.
-
-    ``qd (..., 3)`` rad/s and ``qdd (..., 3)`` rad/s² (NaN if no foot acceleration was given);
-    ``rcond (...)`` = sigma_min / sigma_max of J; ``singular (...)`` where ``rcond < SINGULAR_RCOND``
-    (γ ≈ 0): there the weak direction is damped, so the solution is the damped least-squares one and
-    ``velocity_residual = |J q̇ - ṗ|`` (m/s) and ``acceleration_residual = |J q̈ + q̇ᵀHq̇ - p̈|`` (m/s²)
-    are no longer zero; ``valid = ~singular`` and every value finite.
+    """Joint rates and accelerations per sample for a foot motion (the result of :func:`joint_rates`).
 
     Attributes
     ----------
@@ -45,7 +39,8 @@ class JointRatesResult:
     rcond : ndarray, shape (...)
         ``sigma_min / sigma_max`` of the foot Jacobian (dimensionless).
     singular : ndarray of bool, shape (...)
-        ``rcond < SINGULAR_RCOND``: the solution is the damped least-squares one.
+        ``rcond < SINGULAR_RCOND`` (γ ≈ 0): the weak direction is damped, so the solution is the damped
+        least-squares one and the residuals are no longer zero.
     velocity_residual : ndarray, shape (...)
         ``|J q̇ - ṗ|`` (m/s).
     acceleration_residual : ndarray, shape (...)
@@ -105,9 +100,8 @@ def joint_rates(
 
     Returns
     -------
-    JointRatesResult
-        ``qd`` (rad/s) and ``qdd`` (rad/s²), each (..., 3); ``rcond``, ``singular``, the velocity and
-        acceleration residuals and ``valid``, each (...).
+    :class:`JointRatesResult`
+        Joint rates and accelerations per sample, with singular mask and residuals.
 
     Raises
     ------

@@ -63,7 +63,7 @@ def start_point(leg: OmniLeg) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`.
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     return forward_kinematics(leg, np.array([0.0, 0.0, START_GAMMA]))
@@ -97,7 +97,7 @@ def foot_trajectory_eq51(leg: OmniLeg, t: object) -> Profile:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``t`` is not a finite real array.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -138,7 +138,7 @@ def joint_trajectory_eq52(t: object) -> Profile:
     Raises
     ------
     ValueError
-        If ``t`` is not a finite real array.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -187,8 +187,8 @@ def gait_eq53(leg: OmniLeg, t: object, periods: int = 6) -> GaitProfile:
 
     Returns
     -------
-    GaitProfile
-        The foot profile (..., 3) (m, m/s, m/s²) and the ``stance`` mask (...).
+    :class:`GaitProfile`
+        The foot profile and its ``stance`` mask.
 
     Raises
     ------

@@ -48,10 +48,7 @@ BOUNDARY_POINTS = 200
 
 @dataclass(frozen=True)
 class WorkspaceMap:
-    """Per joint sample (...): foot position (..., 3) m; within_limits (Table 2); det (...) of J (m³/rad³);
-    cond (...) 2-norm condition number (inf where singular); dexterity 1/cond in [0, 1]; sigma_min (...)
-    m/rad; singular (...) where sigma_min / sigma_max < SINGULAR_RCOND (the threshold of the damped
-    solves, γ ≈ 0).
+    """Foot position and singularity measures per joint sample (the result of :func:`workspace_map`).
 
     Attributes
     ----------
@@ -70,7 +67,7 @@ class WorkspaceMap:
     sigma_min : ndarray, shape (...)
         Smallest singular value of the Jacobian (m/rad).
     singular : ndarray of bool, shape (...)
-        ``sigma_min / sigma_max < SINGULAR_RCOND``.
+        ``sigma_min / sigma_max < SINGULAR_RCOND`` (the damped solves' threshold; γ ≈ 0).
     """
 
     q: np.ndarray
@@ -139,14 +136,13 @@ def workspace_map(leg: OmniLeg, q: object) -> WorkspaceMap:
 
     Returns
     -------
-    WorkspaceMap
-        The samples ``q`` and per sample the ``foot`` position (..., 3) m, ``within_limits``, ``det``,
-        ``cond``, ``dexterity``, ``sigma_min`` and ``singular``.
+    :class:`WorkspaceMap`
+        Per-sample workspace and singularity measures.
 
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``q`` is not a finite real array of shape (..., 3).
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -189,8 +185,7 @@ def singular_surface(leg: OmniLeg, alpha: object, beta: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg`, ``alpha``/``beta`` is not a finite real array, or they do
-        not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
     """
     _leg(leg)
     a = as_array(alpha, "alpha")
@@ -201,24 +196,19 @@ def singular_surface(leg: OmniLeg, alpha: object, beta: object) -> np.ndarray:
 
 @dataclass(frozen=True)
 class FootWorkspace:
-    """The foot workspace over the joint ranges.
-
-    volume (m³) = projected_area (m², the knee patch seen from above, = the workspace's horizontal
-    section) x stroke (m, the shank's vertical travel 2 L4 (max cos γ - min cos γ)); boundary (M, 2) m:
-    the closed horizontal boundary (x, y), images of the edges |α| = α_max, |β| = β_max; depth_min,
-    depth_max (m): the shallowest and deepest foot positions along Z0; radius_max (m): the largest
-    horizontal distance of the foot from Z0.
+    """The foot workspace over the joint ranges (the result of :func:`foot_workspace`).
 
     Attributes
     ----------
     volume : float
         Workspace volume (m³), ``projected_area * stroke``.
     projected_area : float
-        Area of the workspace's horizontal section (m²).
+        Area of the workspace's horizontal section (m²): the knee patch seen from above.
     stroke : float
-        Vertical travel of the shank (m).
+        Vertical travel of the shank (m), ``2 L4 (max cos γ - min cos γ)``.
     boundary : ndarray, shape (M, 2)
-        Closed horizontal boundary ``(x, y)`` (m, hip frame), ``M = 4 BOUNDARY_POINTS``.
+        Closed horizontal boundary ``(x, y)`` (m, hip frame), ``M = 4 BOUNDARY_POINTS``: the images
+        of the edges ``|α| = α_max``, ``|β| = β_max``.
     depth_min, depth_max : float
         Shallowest and deepest foot positions along Z0 (m).
     radius_max : float
@@ -255,9 +245,8 @@ def foot_workspace(leg: OmniLeg, *, nodes: int = AREA_NODES) -> FootWorkspace:
 
     Returns
     -------
-    FootWorkspace
-        ``volume`` (m³), ``projected_area`` (m²), ``stroke``, ``boundary`` (M, 2), ``depth_min``,
-        ``depth_max`` and ``radius_max`` (m).
+    :class:`FootWorkspace`
+        Volume, area and extent of the foot workspace.
 
     Raises
     ------
@@ -307,16 +296,14 @@ def foot_workspace(leg: OmniLeg, *, nodes: int = AREA_NODES) -> FootWorkspace:
 
 @dataclass(frozen=True)
 class SymmetryResult:
-    """Per foot sample (...): reachable (within Table 2's ranges) and, for each symmetry of the claim,
-    whether the image's reachability agrees: mirror_x (x -> -x), mirror_y (y -> -y), swap
-    ((x, y) -> (-y, -x), the α <-> β exchange); holds = all three agree.
+    """Per foot sample: is it reachable, and does each symmetry's image agree (:func:`workspace_symmetry`).
 
     Attributes
     ----------
     reachable : ndarray of bool, shape (...)
         The foot sample is reachable within Table 2's ranges.
     mirror_x, mirror_y, swap : ndarray of bool, shape (...)
-        The image under x -> -x, y -> -y, (x, y) -> (-y, -x) has the same reachability.
+        The image under x -> -x, y -> -y, (x, y) -> (-y, -x) (the α <-> β exchange) has the same reachability.
     holds : ndarray of bool, shape (...)
         ``mirror_x & mirror_y & swap``.
     """
@@ -342,13 +329,13 @@ def workspace_symmetry(leg: OmniLeg, p_foot: object) -> SymmetryResult:
 
     Returns
     -------
-    SymmetryResult
-        ``reachable``, ``mirror_x``, ``mirror_y``, ``swap`` and ``holds`` masks, each (...).
+    :class:`SymmetryResult`
+        Per-sample masks of the workspace's symmetries.
 
     Raises
     ------
     ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``p_foot`` is not a real array of shape (..., 3).
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------

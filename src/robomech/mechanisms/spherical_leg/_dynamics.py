@@ -73,8 +73,8 @@ ACTUATION_SINGULAR_RTOL = 1e-8
 # generalized force needs more than 1 kN of leg force, 10x the largest force of any well-conditioned
 # sample of paper 1's Fig. 5 (max 345 N, typical 100 N), and (ii) 10 um of leg-length error (lead-screw
 # backlash) leaves more than 10 mrad (0.6 deg) of platform play: the legs no longer hold the pose.
-# Samples below it are flagged (valid False) with their finite forces kept for inspection; before issue
-# 14 only the 1e-8 ratio flagged, which let ~1e8 N through as valid 1e-6 rad from the singular curve.
+# Samples below it are flagged (valid False) with their finite forces kept for inspection; the 1e-8
+# ratio alone would let ~1e8 N through as valid 1e-6 rad from the singular curve.
 ACTUATION_SIGMA_MIN = 1e-3
 # Gimbal lock of a base universal joint: the leg along the joint's fixed axis, 1 - (a . s)^2 = 0, where
 # the spin sigma = (a . s)(a . (s x sdot)) / (1 - (a . s)^2) is unbounded (the joint cannot follow).
@@ -279,8 +279,7 @@ def generalized_forces(
     Raises
     ------
     ValueError
-        If ``leg`` is not a :class:`SphericalLeg`, or an input has a wrong shape, is not real and
-        finite, or the inputs do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -319,7 +318,7 @@ def mass_matrix(leg: SphericalLeg, q: object, *, paper_as_printed: bool = False)
     Raises
     ------
     ValueError
-        If ``leg`` is not a :class:`SphericalLeg`, or ``q`` has a wrong shape or is not real and finite.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -372,8 +371,7 @@ def mechanical_energy(
     Raises
     ------
     ValueError
-        If ``leg`` is not a :class:`SphericalLeg`, or an input has a wrong shape, is not real and
-        finite, or the inputs do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -468,9 +466,8 @@ def distribute_forces(
 
     Returns
     -------
-    ForceDistribution
-        ``forces (..., 3)`` (N), ``residual (...)`` (N m), ``valid (...)``, ``sigma_min (...)`` (m/rad)
-        and ``rcond (...)``.
+    :class:`ForceDistribution`
+        Leg forces per sample, with residual and conditioning.
 
     Raises
     ------
@@ -624,9 +621,8 @@ def inverse_dynamics(
 
     Returns
     -------
-    InverseDynamicsResult
-        ``generalized_forces (..., 2)`` (N m), ``leg_forces (..., 3)`` (N), ``residual (...)`` (N m),
-        ``valid (...)``, ``sigma_min (...)`` (m/rad) and ``rcond (...)``.
+    :class:`InverseDynamicsResult`
+        Generalized and leg forces per sample, with residual and conditioning.
 
     Raises
     ------

@@ -91,7 +91,7 @@ def platform_rotation(alpha: object, beta: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If an angle is not real and finite, or the two do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -167,10 +167,8 @@ def inverse_kinematics(leg: SphericalLeg, alpha: object, beta: object) -> Invers
 
     Returns
     -------
-    InverseKinematicsResult
-        ``lengths (..., 3)`` (m), ``unit_vectors (..., 3, 3)`` (leg directions, base frame),
-        ``platform_points (..., 3, 3)`` (m, base frame), ``base_points (3, 3)`` and
-        ``within_limits (..., 3)`` (the actuator stroke).
+    :class:`InverseKinematicsResult`
+        Leg lengths, directions and platform points per pose, with stroke masks.
 
     Examples
     --------
@@ -277,9 +275,8 @@ def forward_kinematics(
 
     Returns
     -------
-    ForwardKinematicsResult
-        ``alpha``, ``beta`` (rad, about the platform's rotation axes), ``residual`` (m), ``valid``
-        and ``converged``, each of shape ``(...)``.
+    :class:`ForwardKinematicsResult`
+        Platform angles per sample, with residual and ``valid``/``converged`` masks.
 
     Examples
     --------
@@ -548,8 +545,7 @@ def hessian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``leg`` is not a :class:`SphericalLeg`, or an angle is not real and finite, or the angles do
-        not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -584,7 +580,7 @@ def angular_velocity_jacobian(alpha: object) -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``alpha`` is not real and finite.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -626,8 +622,7 @@ def influence_coefficients(leg: SphericalLeg, alpha: object, beta: object) -> np
     Raises
     ------
     ValueError
-        If ``leg`` is not a :class:`SphericalLeg`, or an angle is not real and finite, or the angles do
-        not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -674,8 +669,7 @@ def leg_rates(
     Raises
     ------
     ValueError
-        If ``leg`` is not a :class:`SphericalLeg`, or an input has a wrong shape, is not real and
-        finite, or the three do not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------

@@ -196,9 +196,8 @@ def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> Br
 
     Returns
     -------
-    BranchTrack
-        ``alpha``, ``beta`` (rad), ``residual`` (m), ``valid``, ``branch``, ``separation`` (rad),
-        ``meeting``, ``switched`` and ``ambiguous``, each of shape ``(..., N)``.
+    :class:`BranchTrack`
+        The assembly followed along each path, with branch diagnostics.
 
     Raises
     ------

@@ -74,15 +74,13 @@ def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMa
 
     Returns
     -------
-    WorkspaceMap
-        ``lengths (..., 3)`` (m), ``reachable``, ``sigma_min``, ``sigma_max`` (m/rad), ``cond``,
-        ``singular``, ``ill_conditioned`` and ``dl3_dalpha`` (m/rad), each of shape ``(...)``.
+    :class:`WorkspaceMap`
+        Per-sample workspace and singularity measures.
 
     Raises
     ------
     ValueError
-        If ``leg`` is not a :class:`SphericalLeg`, or an angle is not real and finite, or the angles do
-        not broadcast.
+        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
