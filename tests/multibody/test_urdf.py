@@ -19,6 +19,8 @@ GRIPPER = DATA / "gripper_mimic.urdf"
 # Double-precision agreement between independently formulated chains/engines on a ~1 m arm with
 # ~10 kg links: products of a handful of 4x4 matrices and O(10) RNEA terms lose a few ulps.
 TOL_FK = 1e-12
+# Batched vs per-sample calls run the same kernel code: they agree to rounding.
+TOL_BATCH = 1e-13
 TOL_ENGINE = 1e-9  # relative, the issue's acceptance bound for dynamics against Pinocchio/MuJoCo
 
 
@@ -191,3 +193,44 @@ def test_cli_verify_and_export(tmp_path, capsys):
     assert main(["export", str(GRIPPER), "--mjcf", str(out)]) == 0
     back = mb.from_mjcf(out)
     assert back.actuated == ("wrist", "left_joint")
+    assert main(["verify", str(ARM)]) == 0
+    capsys.readouterr()
+
+
+@pytest.mark.parametrize("n", [1, 300])
+def test_batched_equals_per_sample_and_engines(arm, n):
+    """Batches of 1 and 300: each sample equals its own call and Pinocchio (from the URDF text) and
+    MuJoCo's mj_rne / mj_fullM."""
+    pin = pytest.importorskip("pinocchio")
+    mujoco = pytest.importorskip("mujoco")
+    model = pin.buildModelFromXML(ARM.read_text())
+    data = model.createData()
+    m = mujoco.MjModel.from_xml_string(mb.to_mjcf(arm))
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(n)
+    q, qd, qdd = (rng.uniform(-np.pi, np.pi, (n, 6)) for _ in range(3))
+    tau = mb.generalized_forces(arm, q, qd, qdd)
+    M = mb.mass_matrix(arm, q)
+    T = mb.site_pose(arm, q, "tool0")
+    fid = model.getFrameId("tool0")
+    for k in range(0, n, max(1, n // 30)):
+        tk = mb.generalized_forces(arm, q[k], qd[k], qdd[k])
+        np.testing.assert_allclose(tk, tau[k], rtol=TOL_BATCH, atol=TOL_BATCH * np.abs(tau[k]).max())
+        np.testing.assert_allclose(
+            mb.mass_matrix(arm, q[k]), M[k], rtol=TOL_BATCH, atol=TOL_BATCH * np.abs(M[k]).max()
+        )
+        pin.framesForwardKinematics(model, data, q[k])
+        np.testing.assert_allclose(T[k], data.oMf[fid].homogeneous, atol=TOL_FK)
+        ref = pin.rnea(model, data, q[k], qd[k], qdd[k])
+        np.testing.assert_allclose(tau[k], ref, rtol=TOL_ENGINE, atol=TOL_ENGINE * np.abs(ref).max())
+        Mp = pin.crba(model, data, q[k])
+        Mp = np.triu(Mp) + np.triu(Mp, 1).T
+        np.testing.assert_allclose(M[k], Mp, rtol=TOL_ENGINE, atol=TOL_ENGINE * np.abs(Mp).max())
+        d.qpos[:], d.qvel[:], d.qacc[:] = q[k], qd[k], np.zeros(6)
+        mujoco.mj_forward(m, d)
+        Mm = np.zeros((6, 6))
+        mujoco.mj_fullM(m, d, Mm)
+        np.testing.assert_allclose(M[k], Mm, rtol=TOL_ENGINE, atol=TOL_ENGINE * np.abs(Mm).max())
+        d.qacc[:] = qdd[k]
+        mujoco.mj_rne(m, d, 1, rne := np.zeros(6))
+        np.testing.assert_allclose(tau[k], rne, rtol=TOL_ENGINE, atol=TOL_ENGINE * np.abs(rne).max())

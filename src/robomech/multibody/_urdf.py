@@ -29,6 +29,7 @@ from ._model import Closure, Coupling, Mechanism, Site
 __all__ = ["from_urdf"]
 
 _MOVING = ("revolute", "continuous", "prismatic", "floating")
+_TYPES = (*_MOVING, "fixed", "planar")
 
 
 def _read(path_or_text: str | os.PathLike) -> tuple[ET.Element, Path | None]:
@@ -177,6 +178,12 @@ def from_urdf(
                 f"got {closures!r}."
             )
     joints = root.findall("joint")
+    for j in joints:
+        if j.get("type") not in _TYPES:
+            raise ValueError(
+                f"Expected path_or_text to be URDF with joint types among {_TYPES}, "
+                f"got {j.get('type')!r} (joint {j.get('name')!r})."
+            )
     moving = [j.get("name", "") for j in joints if j.get("type") in _MOVING]
     fixed = {j.get("name", "") for j in joints if j.get("type") not in _MOVING}
     couplings = []
