@@ -2,7 +2,7 @@
 
 ``MECHANISM`` is a paper mechanism with a multibody description (its ``to_multibody`` at the paper's
 parameters: ``spherical-leg``, ``omnileg``, ``vectored-thrust``), a gallery mechanism (``four_bar``,
-``delta``, ...) or a path to an MJCF file (read and written back through the description).  The file
+``delta``, ...) or a path to an MJCF or URDF file (read and written back through the description).  The file
 loads in MuJoCo with visible geometry (``mb.to_mjcf``) and the description's inertias (bodies without
 one get MuJoCo's inertia from the visual geoms).
 """
@@ -15,7 +15,7 @@ from ._core import EXIT_OK, CliError, Command, did_you_mean, input_file, looks_l
 
 
 def _add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("mechanism", metavar="MECHANISM", help="paper mechanism, gallery name or MJCF file")
+    p.add_argument("mechanism", metavar="MECHANISM", help="paper mechanism, gallery name, MJCF or URDF file")
     p.add_argument("--mjcf", default=None, metavar="FILE", help="output file (default: stdout)")
 
 
@@ -30,7 +30,7 @@ def _run(args: argparse.Namespace) -> int:
         if not looks_like_file(args.mechanism):
             raise CliError(
                 f"unknown mechanism {args.mechanism!r}{did_you_mean(args.mechanism, names)}; valid ones are: "
-                f"{', '.join(names)}, or an MJCF file"
+                f"{', '.join(names)}, or an MJCF or URDF file"
             )
         input_file(args.mechanism)
     try:
@@ -51,7 +51,7 @@ def _run(args: argparse.Namespace) -> int:
 
 COMMAND = Command(
     name="export",
-    help="write the MJCF of a described mechanism (paper description, gallery, MJCF file)",
+    help="write the MJCF of a described mechanism (paper description, gallery, MJCF or URDF file)",
     add_arguments=_add_arguments,
     run=_run,
 )

@@ -32,7 +32,9 @@ def _description() -> str:
 
 
 def _add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("mechanisms", nargs="*", metavar="MECHANISM", help="mechanisms, MJCF files (default: all)")
+    p.add_argument(
+        "mechanisms", nargs="*", metavar="MECHANISM", help="mechanisms, MJCF or URDF files (default: all)"
+    )
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument(
         "--out",
@@ -85,7 +87,7 @@ def _run(args: argparse.Namespace) -> int:
         hint = did_you_mean(unknown[0], [*available, *mb.gallery.NAMES])
         raise CliError(
             f"unknown mechanism {', '.join(map(repr, unknown))}{hint}; valid ones are: {', '.join(available)}"
-            ", a gallery mechanism or an MJCF file"
+            ", a gallery mechanism or an MJCF or URDF file"
         )
     for n in names:  # asked for by name: not running it is an error, not a skip
         why = skip_reason(available[n].requires)

@@ -70,6 +70,7 @@ from ._model import Body, Builder, Closure, Coupling, Inertial, Joint, Mechanism
 from ._repr import install_compact_repr
 from ._rnea import generalized_forces, mass_matrix
 from ._singularity import SingularityMapResult, SingularityResult, singularities, singularity_map
+from ._urdf import from_urdf
 
 # Results print their fields' shapes, masks as counts and ranges, not their arrays (notebooks).
 install_compact_repr(
@@ -117,6 +118,7 @@ __all__ = [
     "forward_dynamics",
     "forward_kinematics",
     "from_mjcf",
+    "from_urdf",
     "gallery",
     "generalized_forces",
     "influence",

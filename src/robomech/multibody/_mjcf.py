@@ -112,8 +112,34 @@ def from_mjcf(path_or_xml: str | os.PathLike) -> Mechanism:
 def _read(path_or_xml: str | os.PathLike) -> Mechanism:
     if not isinstance(path_or_xml, str | os.PathLike):
         raise ValueError(f"Expected path_or_xml to be a path or MJCF text, got {type(path_or_xml).__name__}.")
+    _refuse_urdf(path_or_xml)
     mujoco = _import_mujoco()
-    m = _compile(mujoco, path_or_xml)
+    return mechanism_from_model(mujoco, _compile(mujoco, path_or_xml))
+
+
+def _refuse_urdf(source: str | os.PathLike) -> None:
+    """ValueError if ``source`` is URDF (root ``<robot>``): MuJoCo would read it without actuators."""
+    try:
+        if isinstance(source, str) and _is_xml(source):
+            root = ET.fromstring(source)
+        elif Path(source).is_file():
+            root = ET.parse(Path(source)).getroot()
+        else:
+            return
+    except ET.ParseError:
+        return  # MuJoCo reports malformed XML in its own words
+    if root.tag == "robot":
+        raise ValueError(
+            "Expected path_or_xml to be MJCF (root <mujoco>), got URDF (root <robot>): "
+            "this is URDF; use robomech.multibody.from_urdf."
+        )
+
+
+def mechanism_from_model(mujoco, m, *, actuated: tuple[str, ...] | None = None) -> Mechanism:
+    """The :class:`Mechanism` of a compiled ``MjModel`` ``m`` (shared by the MJCF and URDF readers).
+
+    ``actuated`` (joint names) replaces the model's actuators when given.
+    """
     unsupported = [
         ("tendon", m.ntendon),
         ("flex", m.nflex),
@@ -226,7 +252,7 @@ def _read(path_or_xml: str | os.PathLike) -> Mechanism:
                 "Expected path_or_xml with connect, weld and joint equalities only (robomech.multibody "
                 f"supports those), got equality {name!r} of type {kind}."
             )
-    actuated = []
+    actuated_given, actuated = actuated, []
     for a in range(m.nu):
         if int(m.actuator_trntype[a]) != int(mujoco.mjtTrn.mjTRN_JOINT):
             raise ValueError(
@@ -235,6 +261,8 @@ def _read(path_or_xml: str | os.PathLike) -> Mechanism:
                 f"{mujoco.mjtTrn(int(m.actuator_trntype[a])).name} transmission."
             )
         actuated.append(jnt_names[m.actuator_trnid[a, 0]])
+    if actuated_given is not None:
+        actuated = list(actuated_given)
     name = m.names[: m.names.index(b"\0")].decode() if m.names else "mechanism"
     mech = Mechanism(
         tuple(bodies),

@@ -261,7 +261,7 @@ def mobility(mech: Mechanism, q: ArrayLike | None = None, *, platform: str | Non
         p_tw = U[:, :p_dof].T
         p_rot = _rank(p_tw[:, :3], 1.0) if p_dof else 0
         legs = _serial_legs(mech, st, pb)
-        if legs is not None:
+        if legs is not None and all(len(c) for c in legs):  # a platform welded to the world has no legs
             # analysis.mobility divides moments by length_scale and wants unit screws after that:
             # prismatic screws [0; d] are passed as [0; L d]
             legs = [

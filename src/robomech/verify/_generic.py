@@ -488,10 +488,9 @@ def _simulation_checks(mech, name, q0, qd_act0, duration: float = T_SIM) -> list
 
 
 def verify_file(path: str | Path) -> VerificationReport:
-    """``robomech verify path/to/model.xml``: every check of :func:`check_mechanism` on a user's MJCF."""
-    from robomech import multibody as mb
-
-    mech = mb.from_mjcf(Path(path))
+    """``robomech verify path/to/model.xml`` (or ``.urdf``): every check of :func:`check_mechanism` on a
+    user's MJCF or URDF."""
+    mech = _load_file(Path(path))
     report = VerificationReport()
     report.checks.extend(check_mechanism(mech, Path(path).stem))
     return report
@@ -507,7 +506,7 @@ def split_targets(targets, available) -> tuple[list[str], list[str]]:
     described = set(_paper()) | set(mb.gallery.NAMES)
 
     def is_generic(a: str) -> bool:
-        return a not in available and (a in described or a.endswith(".xml") or Path(a).is_file())
+        return a not in available and (a in described or a.endswith((".xml", ".urdf")) or Path(a).is_file())
 
     generic = [a for a in targets if is_generic(a)]
     return [a for a in targets if a not in generic], generic
@@ -522,9 +521,8 @@ def run_generic(targets, **options) -> list[Check]:
             mech = describe(t)
         except OSError as exc:
             raise ValueError(f"cannot read {t!r}: {exc}") from exc
-        checks.extend(
-            check_mechanism(mech, Path(t).stem if t.endswith(".xml") else f"{t} (generic)", **options)
-        )
+        label = Path(t).stem if t.endswith((".xml", ".urdf")) else f"{t} (generic)"
+        checks.extend(check_mechanism(mech, label, **options))
     return checks
 
 
@@ -550,9 +548,16 @@ def describe(target: str):
         return paper[target]()
     if target in mb.gallery.NAMES:
         return mb.gallery.load(target)
-    if target.endswith(".xml") or Path(target).is_file():
-        return mb.from_mjcf(Path(target))
+    if target.endswith((".xml", ".urdf")) or Path(target).is_file():
+        return _load_file(Path(target))
     raise ValueError(
         f"Expected MECHANISM among {sorted(paper)} or the gallery {list(mb.gallery.NAMES)}, "
-        f"or an MJCF file, got {target!r}."
+        f"or an MJCF or URDF file, got {target!r}."
     )
+
+
+def _load_file(path: Path):
+    """An MJCF file through ``from_mjcf``, a ``.urdf`` file through ``from_urdf``."""
+    from robomech import multibody as mb
+
+    return mb.from_urdf(path) if path.suffix.lower() == ".urdf" else mb.from_mjcf(path)

@@ -26,6 +26,12 @@ QD = np.array([[1.0, 0.5, -0.3], [0.2, -0.1, 0.4], [0.0, 1.0, 1.0]])
 V3 = np.array([0.1, -0.2, 0.3])
 QUAT = np.array([1.0, 0.0, 0.0, 0.0])
 BAD_NAME = (*BAD_STR, "")
+URDF = (  # a one-joint URDF (text) for from_urdf
+    "<robot name='r'><link name='a'/><link name='b'><inertial><mass value='1'/>"
+    "<inertia ixx='1' iyy='1' izz='1' ixy='0' ixz='0' iyz='0'/></inertial></link>"
+    "<joint name='j' type='revolute'><parent link='a'/><child link='b'/><axis xyz='0 0 1'/>"
+    "<limit lower='-1' upper='1' effort='1' velocity='1'/></joint></robot>"
+)
 BAD_LENGTH = (np.nan, np.inf, -1.0, 0.0, "1", True, 1j)
 BAD_STEPS = (*BAD_INT, 0)
 # the gallery's write() writes its files here, not into the package
@@ -120,6 +126,22 @@ SPECS = {
         options={"name": BAD_NAME},
     ),
     # ---- MJCF --------------------------------------------------------------------------------------
+    P + "from_urdf": Spec(
+        args={"path_or_text": URDF, "actuated": ["j"], "closures": None},
+        options={
+            "path_or_text": (
+                None,
+                1,
+                1.5,
+                "/no/such/file.urdf",
+                "<robot name='r'><link name='a'/><joint name='j' type='bogus'/></robot>",
+                mb.to_mjcf(MECH),
+            ),
+            "actuated": ("j", [1], ["nope"]),
+            "closures": ([1], "<notequality/>", "<equality"),
+        },
+        slow=False,
+    ),
     P + "from_mjcf": Spec(
         args={"path_or_xml": mb.to_mjcf(MECH)},
         options={
