@@ -129,6 +129,28 @@ class ModelStudy(DesignStudy):
     Each design row is passed to ``build`` as keyword arguments; ``evaluate`` computes the generic
     metrics of :data:`GENERIC_METRICS` it was given and the user metrics.  Runs through
     :func:`run_sweep` and :func:`optimize_nsga2` like the built-in studies.
+
+    Attributes
+    ----------
+    build : callable
+        ``build(**params) -> Mechanism``, the parametrized description.
+    site : str
+        The output site of the task and workspace metrics.
+    outputs : str
+        The site's position axes the task is stated in (``"xy"``, ``"xyz"``, ...).
+    task, box, grid
+        Task points ``(m, 3)`` (m), or a task box ``(k, 2)`` over the output axes (m) sampled on
+        ``grid`` cells per axis.
+    input_box, input_grid
+        The actuator box ``(n_act, 2)`` and its cells per axis, for the assembly-failure metric.
+    trajectory : tuple of ndarray, optional
+        Times ``(T,)`` (s) and site points ``(T, 3)`` (m) of the task the actuator forces are taken along.
+    length : float, optional
+        Characteristic length (m) dividing hinge columns in the dexterity (default the mechanism's).
+    user_metrics : tuple of UserMetric
+        Metrics given as Python callables.
+    generic : tuple of str
+        The generic metrics computed (names in :data:`GENERIC_METRICS`).
     """
 
     build: Callable[..., Any] = _nominal
