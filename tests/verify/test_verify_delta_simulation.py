@@ -15,7 +15,7 @@ import pytest
 from robomech import multibody as mb
 from robomech.verify import _generic as g
 
-# Half of the CLI's horizon; a multiple of (SIM_SAMPLES - 1) * SIM_TIMESTEP so the samples fall on engine steps.
+# Half of the CLI's horizon; a multiple of (SIM_SAMPLES - 1) * SIM_TIMESTEP: the samples fall on engine steps.
 T_SHORT = 0.15
 # The motion must be large enough for the relative error to mean something (0.385 rad measured).
 MIN_MOTION = 0.1
