@@ -80,3 +80,54 @@ def test_cli_verifies_a_users_file(capsys, monkeypatch):
     assert main(["verify", "bennett"]) == 0  # a gallery name: the generic checks
     assert "bennett (generic)" in capsys.readouterr().out
     assert main(["verify", "missing.xml"]) == 2
+
+
+PENDULUM = """<mujoco model="double_pendulum"><worldbody>
+  <body name="l1" pos="0 0 1"><joint name="j1" axis="0 1 0"/>
+    <geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.02" mass="1"/>
+    <body name="l2" pos="0.5 0 0"><joint name="j2" axis="0 1 0"/>
+      <geom type="capsule" fromto="0 0 0 0.4 0 0" size="0.02" mass="0.7"/>
+      <site name="tip" pos="0.4 0 0"/></body></body>
+</worldbody></mujoco>"""
+
+
+@pytest.mark.parametrize("case", ["passive double pendulum", "passive four-bar", "underactuated stewart"])
+def test_passive_and_underactuated_descriptions_are_verified(case):
+    """Without actuators (or with too few to determine the state) the checks follow a motion driven through
+    virtual actuators on the first free hinges; the passive simulation applies no force, so the description
+    is verified as it is.  Every check passes, and the virtual actuators are named."""
+    if case == "passive double pendulum":
+        mech = mb.from_mjcf(PENDULUM)
+        expect = ("j1", "j2")
+    elif case == "passive four-bar":
+        mech = dataclasses.replace(mb.gallery.load("four_bar"), actuated=())
+        expect = ("theta2",)
+    else:
+        full = mb.gallery.load("stewart")
+        mech = dataclasses.replace(full, actuated=full.actuated[:3])
+        expect = None
+    assert mech.actuated != expect
+    driven, added = g._virtually_actuated(mech)
+    assert added and len(driven.actuated) == mb.mobility(mech).dof
+    if expect is not None:
+        assert added == expect
+    checks = g.check_mechanism(mech, case, simulate=case != "underactuated stewart")
+    assert all(c.passed for c in checks), [(c.quantity, c.max_error) for c in checks if not c.passed]
+    assert "virtual actuators on " + ", ".join(added) in checks[0].detail
+
+
+def test_passive_verification_has_teeth():
+    """The same passive pendulum with a 1 % heavier link on the engine side fails the dynamics checks."""
+    mech = mb.from_mjcf(PENDULUM)
+    wrong = mb.from_mjcf(PENDULUM.replace('mass="0.7"', 'mass="0.707"'))
+    real = g.engine_model
+
+    def engine_of_the_wrong_one(m):
+        return real(wrong)
+
+    import unittest.mock as um
+
+    with um.patch.object(g, "engine_model", engine_of_the_wrong_one):
+        checks = g.check_mechanism(mech, "pendulum", simulate=False)
+    failed = {c.quantity for c in checks if not c.passed}
+    assert "inverse dynamics (mj_rne through efc_J)" in failed

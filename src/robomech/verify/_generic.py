@@ -269,6 +269,18 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
         # to_mjcf lets MuJoCo derive these bodies' inertia from their visual geoms; verify the mechanism
         # as exported, with those inertias on both sides (read back from the engine's compiled model)
         mech = mb.from_mjcf(mb.to_mjcf(mech))
+    mech, virtual = _virtually_actuated(mech)
+    if virtual is None:
+        return [
+            Check(
+                name,
+                "actuated rates determine the state",
+                1.0,
+                TOL_ASSEMBLY,
+                "no set of hinge/slide joints determines the state (a floating base): the engine checks "
+                "need a test motion driven through joints; check generalized_forces / mass_matrix directly",
+            )
+        ]
     tree = mech.tree
     L = tree.length
     checks: list[Check] = []
@@ -284,7 +296,8 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
             float(np.mean(~conv)),  # the fraction that failed (finite: --json stays strict JSON)
             TOL_ASSEMBLY,
             f"{int(conv.sum())}/{len(conv)} converged"
-            + (f"; inertia of {len(inferred)} bodies from the exported geoms" if inferred else ""),
+            + (f"; inertia of {len(inferred)} bodies from the exported geoms" if inferred else "")
+            + (f"; driven through virtual actuators on {', '.join(virtual)}" if virtual else ""),
         )
     )
     q, qa, qda, qdda = q[conv], qa[conv], qda[conv], qdda[conv]
@@ -372,6 +385,37 @@ def _engine_energy(m, d, q, qd) -> float:
     mujoco.mj_energyPos(m, d)
     mujoco.mj_energyVel(m, d)
     return float(d.energy[0] + d.energy[1])
+
+
+def _virtually_actuated(mech):
+    """``(mech, ())`` where the actuated rates determine the state; otherwise the same mechanism with
+    actuators added on hinge/slide joints, in file order, each one that the actuators so far leave free
+    (it lowers the passive rates' nullity at the reference), until none is left free: ``(mech', added
+    names)``.  The added actuators only give the checks a motion to follow and forces to compare (the
+    passive simulation applies none), so a passive or underactuated description is verified as it is.
+    ``(mech, None)`` where no such set exists (a floating base)."""
+    from robomech import multibody as mb
+
+    def nullity(m) -> int:
+        inf = mb.influence(m, m.q0, second_order=False)
+        return int(m.tree.nv - len(m.actuated) - int(inf.passive_rank))
+
+    free = nullity(mech)
+    if free == 0:
+        return mech, ()
+    added: list[str] = []
+    for body in mech.bodies:
+        for j in body.joints:
+            if j.type not in ("hinge", "slide") or j.name in mech.actuated:
+                continue
+            trial = dataclasses.replace(mech, actuated=(*mech.actuated, *added, j.name))
+            n = nullity(trial)
+            if n < free:
+                added.append(j.name)
+                free = n
+            if free == 0:
+                return trial, tuple(added)
+    return mech, None
 
 
 def _driver(mech):
