@@ -66,6 +66,7 @@ LAZY_ONLY = {
     ("multibody", "_draw.py"): {"matplotlib"},
     ("multibody", "_animate.py"): {"matplotlib", "PIL"},
     ("multibody", "_repr.py"): {"matplotlib"},
+    ("multibody", "_pinocchio.py"): {"pinocchio"},  # the Pinocchio bridge (the pinocchio extra)
     ("viewer", "_server.py"): {"viser", "imageio", "webbrowser"},
     ("viewer", "_geoms.py"): {"mujoco"},  # an MJCF file's geoms, compiled by MuJoCo (the verify extra)
 }

@@ -67,6 +67,7 @@ from ._influence import (
 from ._mjcf import from_mjcf, to_mjcf
 from ._mobility import MobilityReport, mobility
 from ._model import Body, Builder, Closure, Coupling, Inertial, Joint, Mechanism, Site
+from ._pinocchio import PinocchioModel, to_pinocchio
 from ._repr import install_compact_repr
 from ._rnea import generalized_forces, mass_matrix
 from ._singularity import SingularityMapResult, SingularityResult, singularities, singularity_map
@@ -102,6 +103,7 @@ __all__ = [
     "Joint",
     "Mechanism",
     "MobilityReport",
+    "PinocchioModel",
     "SimulationResult",
     "SingularityMapResult",
     "SingularityResult",
@@ -135,5 +137,6 @@ __all__ = [
     "site_wrench",
     "statics",
     "to_mjcf",
+    "to_pinocchio",
     "view",
 ]

@@ -283,7 +283,10 @@ SPECS = {
     P + "gallery.NAMES": CONSTANT,
     P + "gallery.BUILDERS": CONSTANT,
     P + "CONVERGED_RTOL": CONSTANT,
+    P + "to_pinocchio": Spec(args={"mech": MECH}, params=("mech",)),
     **exempt(
-        "FKResult IKResult Influence MobilityReport SingularityResult SingularityMapResult", RESULT_TYPE, P
+        "FKResult IKResult Influence MobilityReport SingularityResult SingularityMapResult PinocchioModel",
+        RESULT_TYPE,
+        P,
     ),
 }
