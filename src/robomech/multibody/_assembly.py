@@ -69,7 +69,7 @@ def check_q(mech: Mechanism, q: object, name: str = "q", *, nan_rows: bool = Fal
     return normalize_quaternions(mech.tree, q)
 
 
-def on_rows(mech: Mechanism, qf: np.ndarray, compute: Callable[[np.ndarray], tuple], *others: np.ndarray):
+def on_rows(mech: Mechanism, qf: np.ndarray, compute: Callable[..., tuple], *others: np.ndarray):
     """``compute(q_rows, *other_rows)`` on the samples of ``qf (N, nq)`` without NaN only.
 
     Returns ``(ok (N,), outputs)`` with each output (leading axis N) NaN (float), False (bool) or 0

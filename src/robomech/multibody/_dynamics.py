@@ -1616,7 +1616,10 @@ def energy(mech: Mechanism, q: object, qd: object) -> tuple[np.ndarray, np.ndarr
     batch = broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     qf = np.broadcast_to(q, (*batch, mech.nq)).reshape(-1, mech.nq)
     qdf = np.broadcast_to(qd, (*batch, mech.nv)).reshape(-1, mech.nv)
-    _, (T, U) = on_rows(mech, qf, lambda qs, qds: _energy_flat(mech, qs, qds), qdf)
+    def energies(qs: np.ndarray, qds: np.ndarray) -> tuple:
+        return _energy_flat(mech, qs, qds)
+
+    _, (T, U) = on_rows(mech, qf, energies, qdf)
     return np.reshape(T, batch), np.reshape(U, batch)
 
 

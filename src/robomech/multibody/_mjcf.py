@@ -252,7 +252,8 @@ def mechanism_from_model(mujoco, m, *, actuated: tuple[str, ...] | None = None) 
                 "Expected path_or_xml with connect, weld and joint equalities only (robomech.multibody "
                 f"supports those), got equality {name!r} of type {kind}."
             )
-    actuated_given, actuated = actuated, []
+    actuated_given = actuated
+    motors: list[str] = []
     for a in range(m.nu):
         if int(m.actuator_trntype[a]) != int(mujoco.mjtTrn.mjTRN_JOINT):
             raise ValueError(
@@ -260,16 +261,16 @@ def mechanism_from_model(mujoco, m, *, actuated: tuple[str, ...] | None = None) 
                 f"transmissions), got actuator {m.actuator(a).name or f'number {a} (unnamed)'!r} with a "
                 f"{mujoco.mjtTrn(int(m.actuator_trntype[a])).name} transmission."
             )
-        actuated.append(jnt_names[m.actuator_trnid[a, 0]])
+        motors.append(jnt_names[m.actuator_trnid[a, 0]])
     if actuated_given is not None:
-        actuated = list(actuated_given)
+        motors = list(actuated_given)
     name = m.names[: m.names.index(b"\0")].decode() if m.names else "mechanism"
     mech = Mechanism(
         tuple(bodies),
         tuple(closures),
         tuple(couplings),
         tuple(sites),
-        tuple(actuated),
+        tuple(motors),
         tuple(m.opt.gravity),
         name or "mechanism",
     )

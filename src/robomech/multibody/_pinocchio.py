@@ -47,13 +47,14 @@ class PinocchioModel:
 
         Hinge and slide angles are measured from the joint's reference; quaternions ``(w, x, y, z)``
         become ``(x, y, z, w)``; a free joint's world linear velocity and acceleration become body-frame
-        ones (``a`` the time derivative of ``v``).  Returns ``(q,)``, ``(q, v)`` or ``(q, v, a)``.
+        ones (``a`` the time derivative of ``v``).  ``qd`` and ``qdd`` default to zero.  Returns
+        ``(q, v, a)`` in Pinocchio's coordinates.
         """
         import pinocchio as pin
 
-        q = np.asarray(q, dtype=float)
-        qd = np.zeros(self.model.nv) if qd is None else np.asarray(qd, dtype=float)
-        qdd = np.zeros(self.model.nv) if qdd is None else np.asarray(qdd, dtype=float)
+        q = self._one(q, "q", self._nq)
+        qd = np.zeros(self.model.nv) if qd is None else self._one(qd, "qd", self.model.nv)
+        qdd = np.zeros(self.model.nv) if qdd is None else self._one(qdd, "qdd", self.model.nv)
         qp, vp, ap = np.zeros(self.model.nq), np.zeros(self.model.nv), np.zeros(self.model.nv)
         for typ, qa, da, ref, iq, iv in self._joints:
             if typ in (_HINGE, _SLIDE):
@@ -74,6 +75,20 @@ class PinocchioModel:
                 ap[iv + 3 : iv + 6] = qdd[da + 3 : da + 6]
         return qp, vp, ap
 
+    @property
+    def _nq(self) -> int:
+        typ_nq = {_HINGE: 1, _SLIDE: 1, _BALL: 4, _FREE: 7}
+        return sum(typ_nq[j[0]] for j in self._joints)
+
+    @staticmethod
+    def _one(x: object, name: str, n: int) -> np.ndarray:
+        from robomech._validation import as_array
+
+        a = as_array(x, name, (n,))
+        if a.shape != (n,):
+            raise ValueError(f"Expected {name} to be one sample of shape ({n},), got shape {a.shape}.")
+        return a
+
     def velocity_map(self, q: object) -> np.ndarray:
         """``T (nv, model.nv)`` at one MuJoCo ``qpos`` with ``qvel = T @ v``: a permutation for hinge,
         slide and ball joints, the base rotation on a free joint's linear part (world in MuJoCo, body
@@ -81,7 +96,7 @@ class PinocchioModel:
         ``M_pin = T.T @ M @ T``."""
         import pinocchio as pin
 
-        q = np.asarray(q, dtype=float)
+        q = self._one(q, "q", self._nq)
         T = np.zeros((self.model.nv, self.model.nv))
         for typ, qa, da, _ref, _iq, iv in self._joints:
             if typ == _FREE:
@@ -142,11 +157,12 @@ def to_pinocchio(mech: Mechanism) -> PinocchioModel:
                     place = M * pin.SE3(np.eye(3), p)
                 else:  # a body's later joints act in the frame after the earlier ones
                     place = pin.SE3(np.eye(3), p - last_pos)
-                jm = {
-                    _HINGE: lambda a=axis: pin.JointModelRevoluteUnaligned(a),
-                    _SLIDE: lambda a=axis: pin.JointModelPrismaticUnaligned(a),
-                    _BALL: lambda: pin.JointModelSpherical(),
-                }[typ]()
+                if typ == _HINGE:
+                    jm = pin.JointModelRevoluteUnaligned(axis)
+                elif typ == _SLIDE:
+                    jm = pin.JointModelPrismaticUnaligned(axis)
+                else:
+                    jm = pin.JointModelSpherical()
             j_parent = model.addJoint(j_parent, jm, place, str(t.jnt_names[k]))
             last_pos = p
             idx = model.joints[j_parent]
