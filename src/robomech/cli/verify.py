@@ -59,6 +59,13 @@ def _add_arguments(p: argparse.ArgumentParser) -> None:
         help="start configuration of that simulation (MuJoCo qpos, nq numbers; default: the trajectory's)",
     )
     p.add_argument(
+        "--engine",
+        choices=("mujoco", "pinocchio"),
+        default="mujoco",
+        help="the independent engine of the generic checks (pinocchio: gallery names, the rigid paper "
+        "descriptions and MJCF/URDF files, against robomech[pinocchio])",
+    )
+    p.add_argument(
         "--qd0",
         type=float,
         nargs="+",
@@ -66,6 +73,35 @@ def _add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="QD",
         help="start rates of the actuated joints for that simulation (n_act numbers; default 0 with --q0)",
     )
+
+
+def _run_pinocchio(args: argparse.Namespace, out) -> int:
+    """``--engine pinocchio``: the generic checks of every target against Pinocchio."""
+    import importlib.util
+    from pathlib import Path
+
+    from robomech.verify import VerificationReport, dumps_json
+    from robomech.verify._generic import describe
+    from robomech.verify._pinocchio_engine import check_mechanism_pinocchio
+
+    if importlib.util.find_spec("pinocchio") is None:
+        raise CliError('--engine pinocchio needs Pinocchio: install robomech[pinocchio]')
+    if not args.mechanisms:
+        raise CliError("--engine pinocchio needs a mechanism: a gallery name, a paper description or a file")
+    report = VerificationReport()
+    for t in args.mechanisms:
+        if looks_like_file(t):
+            input_file(t)
+        try:
+            mech = describe(t)
+        except (ValueError, OSError) as exc:
+            raise CliError(str(exc)) from exc
+        label = Path(t).stem if t.endswith((".xml", ".urdf")) else t
+        report.checks.extend(check_mechanism_pinocchio(mech, label))
+    if out is not None:
+        (out / "verify-pinocchio.json").write_text(dumps_json(report.as_dict()), encoding="utf-8")
+    print(dumps_json(report.as_dict()) if args.json else report.table())
+    return EXIT_OK if report.passed else EXIT_CHECK_FAILED
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -93,6 +129,8 @@ def _run(args: argparse.Namespace) -> int:
         why = skip_reason(available[n].requires)
         if why:
             raise CliError(f"{n} cannot run here: {why}")
+    if args.engine == "pinocchio":
+        return _run_pinocchio(args, out)
     announce_compiles(enabled=not args.quiet)
     show_bars(not args.quiet)  # stage bars on a terminal (robomech._progress)
     report = VerificationReport()

@@ -400,9 +400,10 @@ def _virtually_actuated(mech):
         inf = mb.influence(m, m.q0, second_order=False)
         return int(m.tree.nv - len(m.actuated) - int(inf.passive_rank))
 
-    free = nullity(mech)
-    if free == 0:
+    dof = mb.mobility(mech).dof
+    if len(mech.actuated) >= dof:  # idle motions (a Delta's forearm spins) need no actuator
         return mech, ()
+    free = nullity(mech)
     added: list[str] = []
     for body in mech.bodies:
         for j in body.joints:
@@ -413,8 +414,8 @@ def _virtually_actuated(mech):
             if n < free:
                 added.append(j.name)
                 free = n
-            if free == 0:
-                return trial, tuple(added)
+            if len(mech.actuated) + len(added) == dof:
+                return dataclasses.replace(mech, actuated=(*mech.actuated, *added)), tuple(added)
     return mech, None
 
 

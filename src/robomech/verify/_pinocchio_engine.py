@@ -1,0 +1,117 @@
+"""Any described mechanism against Pinocchio, a second independent engine (``robomech verify --engine
+pinocchio``).
+
+The model is :func:`robomech.multibody.to_pinocchio` of the description; the checks use Pinocchio's own
+algorithms along the generic test trajectory of :mod:`robomech.verify._generic`: the closure of its rigid
+constraint models (frame placements), the admissible velocity (its frame Jacobians), the body frames
+(``framesForwardKinematics``), the mass matrix (``crba``) and the inverse dynamics (``rnea`` projected
+through the null space of its constraint Jacobian onto the actuators, by least squares).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import _generic as g
+from ._core import Check
+
+__all__ = ["check_mechanism_pinocchio"]
+
+
+def check_mechanism_pinocchio(mech, name: str | None = None) -> list[Check]:
+    """The Pinocchio checks of ``mech`` (rows of the ``robomech verify --engine pinocchio`` table)."""
+    import pinocchio as pin
+
+    from robomech import multibody as mb
+    from robomech.multibody._compile import compile_model
+    from robomech.multibody._tree import kinematics
+
+    name = f"{name or mech.name} (pinocchio)"
+    mech, virtual = g._virtually_actuated(mech)
+    if virtual is None:
+        return [Check(name, "actuated rates determine the state", 1.0, g.TOL_ASSEMBLY, "a floating base")]
+    drv = g._driver(mech)
+    t, at = g.trajectory(drv)
+    qa, qda, qdda = at(t)
+    q, conv = g._assemble_along(drv, qa)
+    checks = [
+        Check(name, "assembly along the test trajectory", float(np.mean(~conv)), g.TOL_ASSEMBLY,
+              f"{int(conv.sum())}/{len(conv)} converged"),
+    ]  # fmt: skip
+    q, qa, qda, qdda = q[conv], qa[conv], qda[conv], qdda[conv]
+    if not len(q):
+        return checks
+    tree = compile_model(mech).tree
+    if drv is not mech:
+        rd = mb.inverse_dynamics(drv, q, qda, qdda)
+        qa, qda, qdda = q[:, tree.act_qadr], rd.qd[:, tree.act_dof], rd.qdd[:, tree.act_dof]
+    inv = mb.inverse_dynamics(mech, q, qda, qdda)
+    M_engine = mb.mass_matrix(mech, q)
+    P = mb.to_pinocchio(mech)
+    model = P.model
+    pairs = []  # per constraint model: its two frames and whether it holds orientation too
+    for i, cm in enumerate(P.constraints):
+        op = pin.FrameType.OP_FRAME
+        f1 = model.addFrame(pin.Frame(f"closure{i}_1", cm.joint1_id, cm.joint1_placement, op))
+        f2 = model.addFrame(pin.Frame(f"closure{i}_2", cm.joint2_id, cm.joint2_placement, op))
+        pairs.append((f1, f2, cm.type == pin.ContactType.CONTACT_6D))
+    data = model.createData()
+    E = np.zeros((mech.nv, len(mech.actuated)))
+    E[tree.act_dof, np.arange(len(mech.actuated))] = 1.0
+    LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+    L = tree.length
+    closure = adm = frames = 0.0
+    tau_err = tau_scale = m_err = m_scale = vscale = 0.0
+    Tw = kinematics(tree, q).T
+    for i in range(len(q)):
+        qp, vp, ap = P.state(q[i], inv.qd[i], inv.qdd[i])
+        T = P.velocity_map(q[i])
+        pin.forwardKinematics(model, data, qp)
+        pin.updateFramePlacements(model, data)
+        pin.computeJointJacobians(model, data, qp)
+        rows = []
+        for f1, f2, six in pairs:
+            o1, o2 = data.oMf[f1], data.oMf[f2]
+            closure = max(closure, float(np.abs(o1.translation - o2.translation).max()) / L)
+            if six:
+                closure = max(closure, float(np.abs(pin.log3(o1.rotation.T @ o2.rotation)).max()))
+            J = pin.getFrameJacobian(model, data, f1, LWA) - pin.getFrameJacobian(model, data, f2, LWA)
+            rows.append(J if six else J[:3])
+        for c in mech.couplings:  # q1 - ref1 = poly(q2 - ref2): a velocity row v1 - poly'(x) v2 = 0
+            row = np.zeros(model.nv)
+            row[model.joints[model.getJointId(c.joint1)].idx_v] = 1.0
+            if c.joint2 is not None:
+                k2 = tree.joint_index(c.joint2)
+                x = q[i, tree.jnt_qadr[k2]] - tree.jnt_ref[k2]
+                a = np.asarray(c.polycoef, float)
+                slope = a[1] + 2 * a[2] * x + 3 * a[3] * x**2 + 4 * a[4] * x**3
+                row[model.joints[model.getJointId(c.joint2)].idx_v] -= slope
+            rows.append(row[None])
+        K = np.concatenate(rows) if rows else np.zeros((0, model.nv))
+        vscale = max(vscale, float(np.abs(vp).max()))
+        adm = max(adm, float(np.abs(K @ vp).max()) if len(K) else 0.0)
+        for b, fid in P.body_frames.items():
+            gap = float(np.abs(data.oMf[fid].homogeneous - Tw[i, tree.body_index(b)]).max())
+            frames = max(frames, gap / L)
+        Mp = pin.crba(model, data, qp)
+        Mp = np.triu(Mp) + np.triu(Mp, 1).T
+        Me = T.T @ M_engine[i] @ T
+        m_err, m_scale = max(m_err, float(np.abs(Mp - Me).max())), max(m_scale, float(np.abs(Me).max()))
+        f = pin.rnea(model, data, qp, vp, ap)
+        if len(K):
+            _, s, Vt = np.linalg.svd(K)
+            Nn = Vt[int(np.sum(s > 1e-9 * s[0])) :].T
+        else:
+            Nn = np.eye(model.nv)
+        tau = np.linalg.lstsq(Nn.T @ (T.T @ E), Nn.T @ f, rcond=None)[0]
+        tau_err = max(tau_err, float(np.abs(tau - inv.tau[i]).max()))
+        tau_scale = max(tau_scale, float(np.abs(inv.tau[i]).max()))
+    checks += [
+        Check(name, "closure (constraint-model frames)", closure, g.TOL_CLOSURE, ""),
+        Check(name, "admissible velocity (frame Jacobians . v)", g._rel(adm, vscale * L), g.TOL_VELOCITY, ""),
+        Check(name, "body frames (framesForwardKinematics)", frames, g.TOL_CLOSURE, ""),
+        Check(name, "mass matrix (crba)", g._rel(m_err, m_scale), g.TOL_TORQUE, ""),
+        Check(name, "inverse dynamics (rnea through the constraint Jacobian)", g._rel(tau_err, tau_scale),
+              g.TOL_TORQUE, ""),
+    ]  # fmt: skip
+    return checks
