@@ -1,4 +1,4 @@
-"""``robomech verify --engine pinocchio``: the generic checks against Pinocchio, a second independent engine."""
+"""``robomech verify --engine pinocchio``: the generic checks against Pinocchio, a second engine."""
 
 from __future__ import annotations
 
