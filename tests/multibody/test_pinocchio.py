@@ -95,3 +95,30 @@ def test_couplings_are_named_and_foreign_objects_refused():
     assert mb.to_pinocchio(mech).couplings == tuple(c.name for c in mech.couplings) != ()
     with pytest.raises(ValueError, match="mech"):
         mb.to_pinocchio("delta")
+
+
+@pytest.mark.parametrize("name", list(mb.gallery.NAMES))
+def test_constrained_forward_dynamics_agrees_with_pinocchio(name):
+    """``mb.forward_dynamics`` under random actuator forces at an admissible state = Pinocchio's
+    ``constraintDynamics`` with the bridge's constraint models (no Baumgarte terms; an exact KKT solve)."""
+    mech = mb.gallery.load(name)
+    P = mb.to_pinocchio(mech)
+    model, data = P.model, P.model.createData()
+    rng = np.random.default_rng(7)
+    q, _, _ = _state(mech, 7)
+    G = mb.influence(mech, q, second_order=False).G
+    qd = G @ rng.normal(size=len(mech.actuated))  # an admissible velocity
+    tau_a = rng.normal(size=len(mech.actuated))
+    fd = mb.forward_dynamics(mech, q, qd[mech.tree.act_dof], tau_a)
+    assert fd.valid
+    qp, vp, a_engine = P.state(q, qd, fd.qdd)
+    E = np.zeros((mech.nv, len(mech.actuated)))
+    E[mech.tree.act_dof, np.arange(len(mech.actuated))] = 1.0
+    models, datas = pin.StdVec_RigidConstraintModel(), pin.StdVec_RigidConstraintData()
+    for cm in P.constraints:
+        models.append(cm)
+        datas.append(cm.createData())
+    pin.initConstraintDynamics(model, data, models, datas)
+    prox = pin.ProximalSettings(1e-14, 1e-12, 100)
+    a = pin.constraintDynamics(model, data, qp, vp, P.velocity_map(q).T @ (E @ tau_a), models, datas, prox)
+    np.testing.assert_allclose(a, a_engine, rtol=0, atol=AGREE_RTOL * np.abs(a_engine).max())
