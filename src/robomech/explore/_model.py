@@ -718,8 +718,8 @@ class _Template:
 def template_builder(path: Path | str) -> Callable[..., Any]:
     """``build(**params)`` from an MJCF/URDF file whose numbers are named parameters.
 
-    Placeholders are ``$NAME`` / ``${NAME}`` (:class:`string.Template`) when the file holds a ``$``,
-    else ``{NAME}`` (:meth:`str.format`; write literal braces as ``{{ }}``).  Each design substitutes
+    Placeholders are ``$NAME`` / ``${NAME}`` (Python's ``string.Template``) when the file holds a ``$``,
+    else ``{NAME}`` (``str.format``; write literal braces as ``{{ }}``).  Each design substitutes
     its variables' values and loads the text with :func:`robomech.multibody.from_mjcf` (MuJoCo's
     parser: MJCF or URDF).
 

@@ -241,7 +241,7 @@ class FKResult:
     mode_changed : ndarray of bool, shape (...)
         The solution is on another assembly mode than the start (the guess, or the previous
         continuation stage): the passive block of the constraint Jacobian, written in the start's
-        singular vectors, changed the sign of its determinant (:func:`assembly_mode_sign`), so the
+        singular vectors, changed the sign of its determinant (``assembly_mode_sign``), so the
         solver crossed a type II singularity.  ``converged`` is False there.
     """
 

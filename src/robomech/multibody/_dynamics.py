@@ -1066,7 +1066,7 @@ class StaticsResult:
     unactuated : ndarray, shape (..., nv)
         With fewer actuators than degrees of freedom: the generalized force the unactuated
         coordinates would need to hold the mechanism at rest (a floating base: the base wrench), as
-        :attr:`InverseDynamicsResult.unactuated`; zero where the actuators determine the motion.
+        ``InverseDynamicsResult.unactuated``; zero where the actuators determine the motion.
     valid : ndarray of bool, shape (...)
         False at a singular configuration, an unassembled ``q``, a non-finite input, or where the
         actuators cannot hold the mechanism (``unactuated`` not zero).

@@ -478,14 +478,14 @@ class Mechanism:
     # -- derived: the compiled model (``_compile.compile_model``, built once, kept outside the description)
     @property
     def tree(self):
-        """The compiled spanning tree (``_tree.Tree``) of :func:`_compile.compile_model`."""
+        """The compiled spanning tree (``_tree.Tree``) of ``_compile.compile_model``."""
         from ._compile import compile_model
 
         return compile_model(self).tree
 
     @property
     def constraints(self):
-        """The compiled closure rows (``_constraints.Constraints``) of :func:`_compile.compile_model`."""
+        """The compiled closure rows (``_constraints.Constraints``) of ``_compile.compile_model``."""
         from ._compile import compile_model
 
         return compile_model(self).constraints
