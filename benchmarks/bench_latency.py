@@ -13,7 +13,7 @@
   1e-10); at 10^5 samples ``mb.generalized_forces`` against ``pinocchio.rneaInParallel`` with the same
   thread counts (1 and all), and against a Python loop of ``pinocchio.rnea``;
 * the Delta at batch 1 also against a Pinocchio-written closed-loop inverse dynamics
-  (:func:`pinocchio_closed_loop`: the Pinocchio model built from the description's tree, ``pin.rnea``,
+  (:func:`pinocchio_closed_loop`: the Pinocchio model of ``mb.to_pinocchio``, ``pin.rnea``,
   the closure rows from ``getFrameJacobian``, the lean MuJoCo loop's projection; same answer to 1e-8).
 
 ``python benchmarks/bench_latency.py`` prints the table recorded in docs/performance.md (per-call
@@ -72,64 +72,28 @@ def lean_mujoco(mech):
 
 
 def pinocchio_closed_loop(mech):
-    """A Pinocchio-written closed-loop inverse dynamics of ``mech`` (one joint per body: hinges, balls,
-    free joints; closures ``point`` rows): the Pinocchio model built from the description's tree, then
-    per sample ``pin.rnea``, the closure rows from ``getFrameJacobian`` at the closure points, and the
-    same projection as :func:`lean_mujoco`.  Returns (one(q, v, a) in Pinocchio's coordinates, to_pin)."""
+    """A Pinocchio-written closed-loop inverse dynamics of ``mech`` (point closures): the model of
+    ``mb.to_pinocchio``, then per sample ``pin.rnea``, the closure rows from ``getFrameJacobian`` at the
+    closure frames, and the same projection as :func:`lean_mujoco`.  Returns (one(q, v, a) in
+    Pinocchio's coordinates, to_pin: MuJoCo (qpos, qvel, qacc) -> Pinocchio (q, v, a))."""
     import pinocchio as pin
 
-    t = mech.tree
-    model = pin.Model()
-    model.gravity = pin.Motion(np.array(mech.gravity, float), np.zeros(3))
-    jid = {0: 0}  # tree body -> Pinocchio joint
-    shift = {0: np.zeros(3)}  # body frame origin in its Pinocchio joint frame
-    for b in range(1, len(t.body_names)):
-        (k,) = t.body_jnts[b]
-        typ = int(t.jnt_type[k])
-        p = np.asarray(t.jnt_pos[k], float)
-        Toff = np.array(t.T_off[b], float)
-        if typ == 3:
-            assert t.parent[b] == 0
-            place, jm, p = pin.SE3.Identity(), pin.JointModelFreeFlyer(), np.zeros(3)
-        else:
-            R, x = Toff[:3, :3], Toff[:3, 3] - shift[int(t.parent[b])] + Toff[:3, :3] @ p
-            place = pin.SE3(R, x)
-            jm = (
-                pin.JointModelRevoluteUnaligned(np.asarray(t.jnt_axis[k], float))
-                if typ == 0
-                else pin.JointModelSpherical()
-            )
-            assert typ in (0, 2)
-        jid[b] = model.addJoint(jid[int(t.parent[b])], jm, place, t.jnt_names[k])
-        shift[b] = p
-        body = mech.bodies[b - 1]
-        if body.inertial is not None:
-            it = body.inertial
-            Rq = pin.Quaternion(*it.quat).toRotationMatrix()  # (w, x, y, z)
-            I = Rq @ np.diag(it.diaginertia) @ Rq.T
-            model.appendBodyToJoint(
-                jid[b], pin.Inertia(it.mass, np.asarray(it.pos) - p, I), pin.SE3.Identity()
-            )
+    P = mb.to_pinocchio(mech)
+    model = P.model
     frames = []
-    for kind, d in mech.constraints.blocks:
-        assert kind == "point"
-        b1, x1, b2, x2 = d
-        pair = []
-        for bb, xx in ((b1, x1), (b2, x2)):
-            f = pin.Frame(
-                f"c{len(frames)}_{len(pair)}",
-                jid[bb],
-                pin.SE3(np.eye(3), xx[:3] - shift[bb]),
-                pin.FrameType.OP_FRAME,
+    for i, cm in enumerate(P.constraints):
+        assert cm.type == pin.ContactType.CONTACT_3D
+        op = pin.FrameType.OP_FRAME
+        frames.append(
+            (
+                model.addFrame(pin.Frame(f"c{i}_0", cm.joint1_id, cm.joint1_placement, op)),
+                model.addFrame(pin.Frame(f"c{i}_1", cm.joint2_id, cm.joint2_placement, op)),
             )
-            pair.append(model.addFrame(f))
-        frames.append(pair)
+        )
     data = model.createData()
-    act = []
-    for name in mech.actuated:
-        act.append(model.joints[model.getJointId(name)].idx_v)
-    E = np.zeros((model.nv, len(act)))
-    E[act, np.arange(len(act))] = 1.0
+    E = np.zeros((model.nv, len(mech.actuated)))
+    for col, name in enumerate(mech.actuated):  # hinge / slide actuators: one column each
+        E[model.joints[model.getJointId(name)].idx_v, col] = 1.0
     K = np.zeros((3 * len(frames), model.nv))
     LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -145,34 +109,7 @@ def pinocchio_closed_loop(mech):
         Nn = Vt[int(np.sum(s > 1e-9 * s[0])) :].T
         return np.linalg.lstsq(Nn.T @ E, Nn.T @ f, rcond=None)[0]
 
-    def to_pin(q, qd, qdd):
-        """MuJoCo (qpos, qvel, qacc) -> Pinocchio (q, v, a): quaternions (w, x, y, z) -> (x, y, z, w);
-        a free joint's world linear velocity and acceleration -> body axes (a = d/dt of v)."""
-        qp, vp, ap = np.zeros(model.nq), np.zeros(model.nv), np.zeros(model.nv)
-        for b in range(1, len(t.body_names)):
-            (k,) = t.body_jnts[b]
-            typ, qa, da = int(t.jnt_type[k]), int(t.jnt_qadr[k]), int(t.jnt_dadr[k])
-            jm = model.joints[jid[b]]
-            iq, iv = jm.idx_q, jm.idx_v
-            if typ == 0:
-                qp[iq], vp[iv], ap[iv] = q[qa] - t.jnt_ref[k], qd[da], qdd[da]  # angle from the reference
-            elif typ == 2:
-                w, x, y, z = q[qa : qa + 4]
-                qp[iq : iq + 4] = (x, y, z, w)
-                vp[iv : iv + 3], ap[iv : iv + 3] = qd[da : da + 3], qdd[da : da + 3]
-            else:
-                w, x, y, z = q[qa + 3 : qa + 7]
-                qp[iq : iq + 3] = q[qa : qa + 3]
-                qp[iq + 3 : iq + 7] = (x, y, z, w)
-                R = pin.Quaternion(w, x, y, z).toRotationMatrix()
-                om = qd[da + 3 : da + 6]
-                vl = R.T @ qd[da : da + 3]
-                vp[iv : iv + 3], vp[iv + 3 : iv + 6] = vl, om
-                ap[iv : iv + 3] = R.T @ qdd[da : da + 3] - np.cross(om, vl)
-                ap[iv + 3 : iv + 6] = qdd[da + 3 : da + 6]
-        return qp, vp, ap
-
-    return one, to_pin
+    return one, P.state
 
 
 def workloads() -> list:
