@@ -1,4 +1,4 @@
-"""``robomech export MECHANISM --mjcf FILE`` (issue 13): the MJCF of a described mechanism.
+"""``robomech export MECHANISM --mjcf FILE``: the MJCF of a described mechanism.
 
 ``MECHANISM`` is a paper mechanism with a multibody description (its ``to_multibody`` at the paper's
 parameters: ``spherical-leg``, ``omnileg``, ``vectored-thrust``), a gallery mechanism (``four_bar``,

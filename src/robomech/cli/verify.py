@@ -111,7 +111,7 @@ def _run(args: argparse.Namespace) -> int:
 
     out = output_folder(args.out) if args.out is not None else None
     available = available_verifications()
-    # MJCF paths and gallery / description names get the generic engine checks (issue 13)
+    # MJCF paths and gallery / description names get the generic engine checks
     names, generic = split_targets(args.mechanisms, available)
     for n in [*names, *generic]:  # a file that is missing or malformed: say so in one line
         if n not in available and looks_like_file(n):
