@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 
 from robomech import multibody as mb
 from robomech.multibody import _assembly, _compiled, _dynamics
+from robomech.multibody._options import SINGULAR_COND
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -384,7 +385,9 @@ def test_singular_mass_matrix_and_nan_sample_stay_alone():
     qd, tau = np.array([0.2, -0.1]), np.array([0.3, 0.1])
     fd = mb.forward_dynamics(mech, q, qd, tau)
     assert fd.valid.tolist() == [True, False, False]
-    assert np.isnan(fd.qdd[1:]).all() and np.isinf(fd.cond[1])
+    # the straight arm's M is singular: its condition number is inf or the rounding of one (~1e17,
+    # depending on the LAPACK path); either is far above the singular threshold
+    assert np.isnan(fd.qdd[1:]).all() and fd.cond[1] > SINGULAR_COND
     alone = mb.forward_dynamics(mech, q[0], qd, tau)
     assert np.array_equal(alone.qdd, fd.qdd[0])
     r = mb.inverse_dynamics(mech, q, qd, [0.1, 0.2])
