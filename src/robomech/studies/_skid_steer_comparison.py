@@ -1,5 +1,5 @@
 """Paper 4 on contact physics: no-slip kinematics, the ICR model, the EKF and the 30×11 estimate against
-MuJoCo's body motion (issue 17).  Used by ``studies/skid_steer.py``; kept apart so it can be tested with
+MuJoCo's body motion.  Used by ``studies/skid_steer.py``; kept apart so it can be tested with
 short runs.
 
 Every manoeuvre is an engine run of ``robomech.verify.skid_steer.simulate_engine`` (six rolling wheels
@@ -25,7 +25,7 @@ from robomech.verify.skid_steer import (
     simulate_engine,
 )
 
-from ._core import Progress, Table
+from ._core import Figure, Progress, Table
 from ._plot import plt, save_figure
 
 __all__ = ["MANOEUVRES", "Comparison", "compare", "figures", "tables"]
@@ -356,9 +356,26 @@ def tables(comp: Comparison, robot: ss.ExplorationRobot) -> list[Table]:
     return out
 
 
-def figures(comp: Comparison, out_dir: Path) -> list:
-    figs = []
-    colors = dict(zip(ESTIMATORS, ("C3", "C1", "C4", "C2", "C5", "C0", "C9"), strict=True))
+ESTIMATOR_COLORS = dict(zip(ESTIMATORS, ("C3", "C1", "C4", "C2", "C5", "C0", "C9"), strict=True))
+
+
+def figures(comp: Comparison, out_dir: Path) -> list[Figure]:
+    """The comparison's five figures."""
+    return [
+        tracks_figure(comp, out_dir),
+        yaw_rate_figure(comp, out_dir),
+        drift_figure(comp, out_dir),
+        slip_figure(comp, out_dir),
+        chi_figure(comp, out_dir),
+    ]
+
+
+def _flat_turn(comp: Comparison) -> dict:
+    return next(x for x in comp.rows if x["name"] == "turn, flat")
+
+
+def tracks_figure(comp: Comparison, out_dir: Path) -> Figure:
+    colors = ESTIMATOR_COLORS
     n = len(comp.rows)
     cols = 4
     fig, axes = plt.subplots(2, cols, figsize=(16, 8))
@@ -374,30 +391,33 @@ def figures(comp: Comparison, out_dir: Path) -> list:
     handles, labels = axes.flat[0].get_legend_handles_labels()
     list(axes.flat)[-1].legend(handles, labels, loc="center", fontsize=8)
     fig.suptitle("Ground tracks (m): MuJoCo vs the estimators")
-    figs.append(
-        save_figure(fig, out_dir, "engine_tracks", "Ground tracks on contact physics (MuJoCo) and estimates")
+    return save_figure(
+        fig, out_dir, "engine_tracks", "Ground tracks on contact physics (MuJoCo) and estimates"
     )
 
-    r = next(x for x in comp.rows if x["name"] == "turn, flat")
+
+def yaw_rate_figure(comp: Comparison, out_dir: Path) -> Figure:
+    r = _flat_turn(comp)
     fig, ax = plt.subplots(figsize=(11, 4))
     ax.plot(r["t"], r["yaw_true"], "k", lw=2, label="MuJoCo")
     for e in ESTIMATORS[:5]:
-        ax.plot(r["t"], r["est_yaw"][e], lw=0.9, color=colors[e], label=e)
+        ax.plot(r["t"], r["est_yaw"][e], lw=0.9, color=ESTIMATOR_COLORS[e], label=e)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("yaw rate (rad/s)")
     ax.set_title("Yaw rate in a flat turn: the no-slip formula vs the skid")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
-    figs.append(
-        save_figure(fig, out_dir, "engine_yaw_rate", "Yaw rate in a flat turn (MuJoCo vs estimators)")
-    )
+    return save_figure(fig, out_dir, "engine_yaw_rate", "Yaw rate in a flat turn (MuJoCo vs estimators)")
 
+
+def drift_figure(comp: Comparison, out_dir: Path) -> Figure:
+    n = len(comp.rows)
     fig, ax = plt.subplots(figsize=(13, 4.8))
     width = 0.8 / len(ESTIMATORS)
     x = np.arange(n)
     for j, e in enumerate(ESTIMATORS):
         vals = [max(rr["drift_per_m"][e], 1e-5) for rr in comp.rows]
-        ax.bar(x + (j - len(ESTIMATORS) / 2 + 0.5) * width, vals, width, color=colors[e], label=e)
+        ax.bar(x + (j - len(ESTIMATORS) / 2 + 0.5) * width, vals, width, color=ESTIMATOR_COLORS[e], label=e)
     ax.set_yscale("log")
     ax.set_xticks(x, [rr["name"] for rr in comp.rows], rotation=15, fontsize=8)
     ax.set_ylabel("drift per metre travelled (m/m)")
@@ -405,10 +425,13 @@ def figures(comp: Comparison, out_dir: Path) -> list:
     ax.grid(True, alpha=0.3, which="both", axis="y")
     ax.set_ylim(top=30.0)  # room for the legend above the bars
     ax.legend(fontsize=7, ncol=4, loc="upper center")
-    figs.append(
-        save_figure(fig, out_dir, "engine_drift", "Dead-reckoning drift per metre by estimator and manoeuvre")
+    return save_figure(
+        fig, out_dir, "engine_drift", "Dead-reckoning drift per metre by estimator and manoeuvre"
     )
 
+
+def slip_figure(comp: Comparison, out_dir: Path) -> Figure:
+    r = _flat_turn(comp)
     fig, axes = plt.subplots(1, 2, figsize=(13, 4))
     for w, name in enumerate(ss.WHEELS):
         axes[0].plot(r["t"], r["slip"].ratio[:, w], lw=0.9, label=name)
@@ -420,10 +443,12 @@ def figures(comp: Comparison, out_dir: Path) -> list:
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7)
     fig.suptitle("Per-wheel slip in a flat turn (MuJoCo truth)")
-    figs.append(
-        save_figure(fig, out_dir, "engine_slip", "Per-wheel slip ratios and lateral sliding in a flat turn")
+    return save_figure(
+        fig, out_dir, "engine_slip", "Per-wheel slip ratios and lateral sliding in a flat turn"
     )
 
+
+def chi_figure(comp: Comparison, out_dir: Path) -> Figure:
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     turns = [rr for rr in comp.rows if np.isfinite(rr["chi_own"])]
     ax.plot([abs(rr["radius_m"]) for rr in turns], [rr["chi_own"] for rr in turns], "o")
@@ -435,5 +460,4 @@ def figures(comp: Comparison, out_dir: Path) -> list:
     ax.set_ylabel("χ identified on the manoeuvre")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
-    figs.append(save_figure(fig, out_dir, "engine_chi", "Effective track-width factor χ per manoeuvre"))
-    return figs
+    return save_figure(fig, out_dir, "engine_chi", "Effective track-width factor χ per manoeuvre")
