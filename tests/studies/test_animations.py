@@ -1,4 +1,4 @@
-"""The animations of the paper reports show the models' motion (issue 13, "pictures that move").
+"""The animations of the paper reports show the models' motion ("pictures that move").
 
 For each of the three GIFs: the file has one frame per trajectory sample at the stated rate, is
 small, the drawn mechanism changes where the motion changes (and not where it does not), and the
