@@ -585,30 +585,27 @@ def exactness_table(ik51: InverseEq51, fk52: ForwardEq52, gait: GaitFig19) -> Ta
 # ---- figures: each draws computed data -----------------------------------------------------------------
 
 
-def _three_panel(t, rows, labels, title, ylabels, legend_prefix):
+def _three_panel(t, rows, labels, title, ylabels, out_dir: Path, name: str, caption: str) -> Figure:
+    """One panel per quantity in ``rows`` (each (n, 3), one line per component) over time ``t``."""
     fig, axs = plt.subplots(len(rows), 1, figsize=(8, 2.6 * len(rows)), sharex=True)
     for ax, data, yl in zip(axs, rows, ylabels, strict=True):
         for j in range(data.shape[-1]):
-            ax.plot(t, data[:, j], label=f"{legend_prefix}{labels[j]}")
+            ax.plot(t, data[:, j], label=labels[j])
         ax.set_ylabel(yl)
         ax.grid(True, alpha=0.3)
         ax.legend(loc="best", fontsize=8)
     axs[-1].set_xlabel("time t (s)")
     axs[0].set_title(title)
-    return fig
+    return save_figure(fig, out_dir, name, caption)
 
 
 def ik_foot_figure(ik51: InverseEq51, out_dir: Path) -> Figure:
-    fig = _three_panel(
+    return _three_panel(
         ik51.t,
         [ik51.displacement, ik51.foot.qd, ik51.foot.qdd],
         AXES,
         "Fig. 9 — foot trajectory eq. (51) (displacement from FK(0, 0, 60°))",
         ["displacement (m)", "velocity (m/s)", "acceleration (m/s²)"],
-        "",
-    )
-    return save_figure(
-        fig,
         out_dir,
         "fig09_ik_foot",
         "Fig. 9: foot position, velocity and acceleration of eq. (51), T = 5 s; Z is a lift (against Z0).",
@@ -616,16 +613,12 @@ def ik_foot_figure(ik51: InverseEq51, out_dir: Path) -> Figure:
 
 
 def ik_joints_figure(ik51: InverseEq51, out_dir: Path) -> Figure:
-    fig = _three_panel(
+    return _three_panel(
         ik51.t,
         [np.degrees(ik51.ik.q), np.degrees(ik51.rates.qd), np.degrees(ik51.rates.qdd)],
         ("α", "β", "γ"),
         "Fig. 9 — joint motion from the inverse kinematics of eq. (51)",
         ["angle (deg)", "rate (deg/s)", "acceleration (deg/s²)"],
-        "",
-    )
-    return save_figure(
-        fig,
         out_dir,
         "fig09_ik_joints",
         "Fig. 9: joint angles, rates and accelerations from the IK; FK of them returns the foot trajectory.",
@@ -633,16 +626,12 @@ def ik_joints_figure(ik51: InverseEq51, out_dir: Path) -> Figure:
 
 
 def fk_foot_figure(fk52: ForwardEq52, out_dir: Path) -> Figure:
-    fig = _three_panel(
+    return _three_panel(
         fk52.t,
         [fk52.position, fk52.velocity, fk52.acceleration],
         AXES,
         "Fig. 10 — foot motion for the joint trajectory eq. (52)",
         ["position (m)", "velocity (m/s)", "acceleration (m/s²)"],
-        "",
-    )
-    return save_figure(
-        fig,
         out_dir,
         "fig10_fk_foot",
         "Fig. 10: foot position, velocity and acceleration (hip frame, Z0 down) for eq. (52).",
