@@ -109,6 +109,8 @@ class Estimates:
     """The 50 s run estimated from exact and noisy measurements, dead-reckoned, and its turning."""
 
     noisy: Array  # (n, 22) measurements with sensor noise
+    contact_true: Array  # (n, 6, 3) contact velocities of the six wheels, in their contact frames
+    contact_measured: Array  # (n, 6, 3) the same with sensor noise
     exact: Any  # body_velocity of the exact measurements (QR)
     noisy_qr: Any  # body_velocity of the noisy measurements (QR)
     noisy_ne: Any  # body_velocity of the noisy measurements (normal equations)
@@ -141,6 +143,8 @@ def estimates(robot: ExplorationRobot, gt: Any, rng: np.random.Generator) -> Est
     first5 = gt.t < 5.0
     return Estimates(
         noisy=noisy,
+        contact_true=vP,
+        contact_measured=noisy[:, :18].reshape(n, 6, 3),
         exact=exact,
         noisy_qr=est,
         noisy_ne=est_ne,
@@ -372,12 +376,7 @@ def _plot_step(n: int) -> int:
 
 
 def road_wheel_velocity_figure(gt: Any, e: Estimates, out_dir: Path) -> Figure:
-    t, n = gt.t, gt.t.size
-    vP_true, vP_meas, step = (
-        gt.measured[:, :18].reshape(n, 6, 3),
-        e.noisy[:, :18].reshape(n, 6, 3),
-        _plot_step(n),
-    )
+    t, vP_true, vP_meas, step = gt.t, e.contact_true, e.contact_measured, _plot_step(gt.t.size)
     fig, axes = plt.subplots(2, 2, figsize=(11, 6.5), sharex=True)
     for col, (w, title) in enumerate([(0, "right front road wheel"), (1, "right rear road wheel")]):
         for row, (k, lab) in enumerate([(0, "X"), (2, "Z")]):
@@ -399,12 +398,7 @@ def road_wheel_velocity_figure(gt: Any, e: Estimates, out_dir: Path) -> Figure:
 
 
 def rear_wheel_velocity_figure(gt: Any, e: Estimates, out_dir: Path) -> Figure:
-    t, n = gt.t, gt.t.size
-    vP_true, vP_meas, step = (
-        gt.measured[:, :18].reshape(n, 6, 3),
-        e.noisy[:, :18].reshape(n, 6, 3),
-        _plot_step(n),
-    )
+    t, vP_true, vP_meas, step = gt.t, e.contact_true, e.contact_measured, _plot_step(gt.t.size)
     fig, axes = plt.subplots(2, 1, figsize=(11, 5.5), sharex=True)
     for ax, (k, lab) in zip(axes, [(0, "X"), (2, "Z")], strict=True):
         ax.plot(t[::step], vP_meas[::step, 2, k], ".", ms=1.5, color="0.6", label="measured (noisy)")
