@@ -675,7 +675,7 @@ def report_data(mob: Mobility, ws: Workspace, tr: Trajectory, st: InverseAndStat
     }
 
 
-def summary(th: vt.VectoredThruster, ws: Workspace, tr: Trajectory, data: dict) -> str:
+def summary(ws: Workspace, tr: Trajectory, data: dict) -> str:
     """The report's opening paragraph, from the computed results."""
     err_w, err_wd, miss = (
         tr.max_engine_error_omega,
@@ -756,7 +756,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         name="vectored-thrust",
         title="Paper 5: RRR-RR vectored-thrust spherical mechanism",
         source=cite(5),
-        summary=summary(th, ws, tr, data),
+        summary=summary(ws, tr, data),
         tables=tables,
         figures=figures,
         data=data,
