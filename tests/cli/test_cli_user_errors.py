@@ -39,13 +39,13 @@ def _one_line_usage_error(capsys, argv):
     return err
 
 
-@pytest.mark.parametrize("command", ["verify", "export"])
+@pytest.mark.parametrize("command", ["verify", "export", "view"])
 def test_a_missing_file_says_so(capsys, tmp_path, command):
     err = _one_line_usage_error(capsys, [command, str(tmp_path / "x.xml")])
     assert err.endswith(f"no such file: {tmp_path / 'x.xml'}")
 
 
-@pytest.mark.parametrize("command", ["verify", "export"])
+@pytest.mark.parametrize("command", ["verify", "export", "view"])
 def test_malformed_xml_is_reported_with_file_and_line(capsys, tmp_path, command):
     bad = tmp_path / "bad.xml"
     bad.write_text("<mujoco>\n<worldbody>\n<body>\n</worldbody>\n</mujoco>\n")

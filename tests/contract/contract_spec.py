@@ -1,8 +1,9 @@
 """The bad-input specification format of the contract suite (see README.md in this folder).
 
-A spec file in ``specs/`` defines ``SPECS: dict[str, Spec | Exempt]`` keyed by the full dotted public
-name (``"robomech.spatial.exp_so3"``).  ``test_contract.py`` discovers every public name and drives
-each spec with bad inputs.
+A spec file ``contract_specs*.py`` beside a module's tests (``tests/multibody/contract_specs.py``)
+defines ``SPECS: dict[str, Spec | Exempt]`` keyed by the full dotted public name
+(``"robomech.spatial.exp_so3"``).  ``test_contract.py`` discovers every public name and drives each
+spec with bad inputs; ``tests/conftest.py`` also runs a folder's cases with ``pytest tests/<folder>``.
 """
 
 from __future__ import annotations
@@ -18,7 +19,8 @@ from pathlib import Path
 from typing import Any
 
 HERE = Path(__file__).resolve().parent
-SPEC_DIR = HERE / "specs"
+TESTS = HERE.parent  # spec files live beside each module's tests: tests/<module>/contract_specs*.py
+SPEC_GLOB = "contract_specs*.py"
 
 NAN = float("nan")
 INF = float("inf")
@@ -161,40 +163,53 @@ def public_names() -> dict[str, object]:
     return out
 
 
-def load_specs() -> tuple[dict[str, Spec | Exempt], dict[str, str]]:
-    """All specs from ``specs/*.py``: (name -> spec, name -> defining file).  Duplicates raise."""
+def spec_files() -> list[Path]:
+    """Every spec file: ``tests/**/contract_specs*.py`` (not in this folder), sorted."""
+    return sorted(p for p in TESTS.rglob(SPEC_GLOB) if HERE not in p.parents and p.parent != HERE)
+
+
+def load_spec_file(path: Path) -> dict[str, Spec | Exempt]:
+    """The ``SPECS`` of one spec file (imported once per process under a name unique to its path)."""
     if str(HERE) not in sys.path:
         sys.path.insert(0, str(HERE))
+    rel = path.resolve().relative_to(TESTS).with_suffix("")
+    modname = "contract_specs__" + "__".join(rel.parts)
+    if modname in sys.modules:
+        mod = sys.modules[modname]
+    else:
+        spec = importlib.util.spec_from_file_location(modname, path)
+        mod = importlib.util.module_from_spec(spec)
+        sys.modules[modname] = mod
+        spec.loader.exec_module(mod)
+    return mod.SPECS
+
+
+def load_specs() -> tuple[dict[str, Spec | Exempt], dict[str, str]]:
+    """All specs of every spec file: (name -> spec, name -> defining file relative to ``tests/``).
+    Duplicates raise."""
     specs: dict[str, Spec | Exempt] = {}
     where: dict[str, str] = {}
-    for path in sorted(SPEC_DIR.glob("*.py")):
-        if path.name.startswith("_"):
-            continue
-        modname = f"contract_specs_{path.stem}"
-        if modname in sys.modules:
-            mod = sys.modules[modname]
-        else:
-            spec = importlib.util.spec_from_file_location(modname, path)
-            mod = importlib.util.module_from_spec(spec)
-            sys.modules[modname] = mod
-            spec.loader.exec_module(mod)
-        for key, value in mod.SPECS.items():
+    for path in spec_files():
+        rel = str(path.relative_to(TESTS))
+        for key, value in load_spec_file(path).items():
             if key in specs:
-                raise ValueError(f"{key} is specified twice: in {where[key]} and in {path.name}")
+                raise ValueError(f"{key} is specified twice: in {where[key]} and in {rel}")
             if not isinstance(value, Spec | Exempt):
-                raise TypeError(f"{path.name}: SPECS[{key!r}] must be a Spec or an Exempt")
+                raise TypeError(f"{rel}: SPECS[{key!r}] must be a Spec or an Exempt")
             specs[key] = value
-            where[key] = path.name
+            where[key] = rel
     return specs, where
 
 
 def spec_file_for(name: str) -> str:
-    """The spec file a public name belongs in: its subpackage path after ``robomech``, dots -> '_'
-    (``robomech.analysis.lstsq.solve`` -> ``specs/analysis.py``;
-    ``robomech.mechanisms.omnileg.jacobian`` -> ``specs/mechanisms_omnileg.py``)."""
+    """The spec file a public name belongs in, beside its module's tests (relative to ``tests/``):
+    ``robomech.analysis.lstsq.solve`` -> ``analysis/contract_specs.py``;
+    ``robomech.mechanisms.omnileg.jacobian`` -> ``mechanisms/omnileg/contract_specs.py``;
+    a top-level module without a test folder (``robomech.testing``) -> ``contract_specs_testing.py``."""
     parts = name.split(".")[1:-1]
     if not parts:
-        return "specs/robomech.py"
-    if parts[0] == "mechanisms" and len(parts) > 1:
-        return f"specs/mechanisms_{parts[1]}.py"
-    return f"specs/{parts[0]}.py"
+        return "contract_specs.py"
+    folder = parts[:2] if parts[0] == "mechanisms" and len(parts) > 1 else parts[:1]
+    if not (TESTS.joinpath(*folder)).is_dir():
+        return f"contract_specs_{parts[0]}.py"
+    return "/".join(folder) + "/contract_specs.py"

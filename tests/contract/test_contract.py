@@ -253,7 +253,7 @@ ARRAY_CASES, PARAM_CASES, OPTION_CASES = _cases()
 def test_every_public_name_has_a_spec():
     missing = [n for n in sorted(PUBLIC) if n not in SPECS]
     assert not missing, "public names without a bad-input spec (see tests/contract/README.md):\n" + "\n".join(
-        f"  {n}  -> add it to tests/contract/{spec_file_for(n)}" for n in missing
+        f"  {n}  -> add it to tests/{spec_file_for(n)}" for n in missing
     )
 
 

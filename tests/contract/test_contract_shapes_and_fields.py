@@ -24,16 +24,6 @@ import pytest
 from contract_spec import Spec
 from test_contract import ACTIVE, GOOD_CALL_SECONDS, _call, _mask_of, _names, _target
 
-# Known failures of the field rule, in packages other engineers are changing: strict xfails, so each
-# turns into a failure (remove it here) the day its dataclass checks the field.
-FIELD_XFAIL = {
-    **{f"robomech.explore.DesignStudy-{f}-{v}": "explore: a tuple-of-str field takes any object"
-       for f in ("notes", "error_names") for v in ("None", "str", "object")},
-    **{f"robomech.explore.Variable-sigma-{v}": "explore: sigma is not checked"
-       for v in ("None", "str", "object")},
-    "robomech.multibody.Coupling-joint2-str": "multibody: a str joint2 is refused without naming it",
-}  # fmt: skip
-
 # --- zero-width cores -----------------------------------------------------------------------------
 
 
@@ -167,6 +157,10 @@ def test_the_single_sample_rule_fails_a_kernel_that_stacks_unbroadcast_slices():
 # --- parameter dataclass fields -------------------------------------------------------------------
 
 
+# Annotations of a text field (``from __future__ import annotations`` keeps them as strings).
+TEXT_TYPES = ("str", str, "str | None", "Optional[str]")
+
+
 class _Foreign:
     """Something that is no field value of any parameter dataclass."""
 
@@ -183,12 +177,10 @@ def _field_cases():
             for label in ("None", "str", "object"):
                 if label == "None" and f.default is None:
                     continue
-                if label == "str" and (f.type in ("str", str) or isinstance(f.default, str)):
-                    continue  # a text field takes any str
+                if label == "str" and (f.type in TEXT_TYPES or isinstance(f.default, str)):
+                    continue  # a text field (a name, optional or not) takes any str
                 marks = [pytest.mark.slow] if spec.slow else []
                 case = f"{name}-{f.name}-{label}"
-                if case in FIELD_XFAIL:
-                    marks.append(pytest.mark.xfail(reason=FIELD_XFAIL[case], strict=True))
                 out.append(pytest.param(name, f.name, label, marks=marks, id=case))
     return out
 

@@ -26,7 +26,7 @@ from robomech.explore._runner import sweep_fingerprint
 from robomech.explore._store import prepare_store
 
 P = "robomech.explore."
-_FIVE_BAR = Path(__file__).resolve().parents[3] / "examples" / "models" / "five_bar.py"
+_FIVE_BAR = Path(__file__).resolve().parents[2] / "examples" / "models" / "five_bar.py"
 
 
 def _metric_fn(mech, params):

@@ -157,18 +157,6 @@ def test_an_mjcf_that_can_never_assemble_is_refused_at_load():
         mb.from_mjcf(bad)
 
 
-def test_a_latin1_mjcf_is_a_value_error(tmp_path):
-    path = tmp_path / "l1.xml"
-    path.write_bytes(
-        b'<?xml version="1.0" encoding="ISO-8859-1"?>\n<mujoco model="caf\xe9"><worldbody>'
-        b'<body name="b\xe9"><joint name="j" type="hinge"/><geom size=".1"/></body></worldbody></mujoco>'
-    )
-    with pytest.raises(ValueError, match="Expected path_or_xml to be UTF-8"):
-        mb.from_mjcf(path)
-    path.write_bytes(path.read_bytes().replace(b"\xe9", b"e"))  # control: the ASCII file loads
-    assert mb.from_mjcf(path).nq == 1
-
-
 def test_unsupported_mjcf_messages_say_expected_and_name_an_unnamed_site_actuator():
     xml = (
         "<mujoco><worldbody><body><joint name='j' type='hinge'/><geom size='.1'/><site name='s'/></body>"

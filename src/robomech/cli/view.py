@@ -14,7 +14,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from ._core import EXIT_INTERRUPTED, EXIT_OK, CliError, Command
+from ._core import EXIT_INTERRUPTED, EXIT_OK, CliError, Command, input_file, looks_like_file
 
 
 def _port(text: str) -> int:
@@ -56,6 +56,8 @@ def _describe(target: str):
     from robomech import multibody as mb
     from robomech.verify._generic import describe  # verify may import the mechanisms; cli may not
 
+    if looks_like_file(target):  # missing, a folder or malformed XML: one line with file:line
+        input_file(target)
     if target.lower().endswith(".urdf"):
         from_urdf = getattr(mb, "from_urdf", None)
         if from_urdf is None:

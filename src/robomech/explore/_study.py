@@ -91,9 +91,12 @@ class Variable:
                 )
             object.__setattr__(self, "low", lo)
             object.__setattr__(self, "high", hi)
+            object.__setattr__(self, "sigma", _unused_real(self.sigma, "sigma"))
         else:
             s = check_positive(self.sigma, "sigma")
             object.__setattr__(self, "sigma", s)
+            object.__setattr__(self, "low", _unused_real(self.low, "low"))
+            object.__setattr__(self, "high", _unused_real(self.high, "high"))
 
     def from_unit(self, u: np.ndarray) -> np.ndarray:
         """Map samples ``u`` in the open unit interval onto this variable (uniform or normal)."""
@@ -268,6 +271,8 @@ class DesignStudy:
     def __post_init__(self) -> None:
         for n in ("name", "title", "mechanism"):
             _check_text(getattr(self, n), n)
+        for n in ("notes", "error_names"):
+            object.__setattr__(self, n, _check_texts(getattr(self, n), n))
         if self.summarize is not None and not callable(self.summarize):
             raise ValueError(
                 f"Expected summarize to be callable or None, got {type(self.summarize).__name__}."
@@ -374,6 +379,22 @@ class DesignStudy:
 def _check_text(value: object, name: str) -> None:
     if not isinstance(value, str):
         raise ValueError(f"Expected {name} to be a str, got {type(value).__name__}.")
+
+
+def _check_texts(value: object, name: str) -> tuple[str, ...]:
+    """A sequence of str (not one str) as a tuple."""
+    if isinstance(value, str | bytes) or not isinstance(value, Sequence):
+        raise ValueError(f"Expected {name} to be a tuple of str, got {type(value).__name__}.")
+    for v in value:
+        _check_text(v, f"each of {name}")
+    return tuple(value)
+
+
+def _unused_real(value: object, name: str) -> float:
+    """A field the variable's kind does not use: a real number, NaN (the default) for not given."""
+    if isinstance(value, float) and math.isnan(value):
+        return value
+    return check_real(value, name, finite=False)
 
 
 def check_variables(variables: object, name: str = "variables") -> tuple[Variable, ...]:

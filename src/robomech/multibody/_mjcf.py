@@ -10,6 +10,7 @@ MuJoCo is an optional dependency (``pip install robomech[verify]``): only :func:
 
 from __future__ import annotations
 
+import codecs
 import os
 import re
 import xml.etree.ElementTree as ET
@@ -53,6 +54,43 @@ def _is_xml(text: str) -> bool:
     return text.lstrip().startswith("<")
 
 
+_XML_DECLARATION = re.compile(rb"""^\s*<\?xml[^>]*?\bencoding\s*=\s*["']([A-Za-z0-9._-]+)["']""")
+
+
+def _declared_encoding_text(path: Path) -> str | None:
+    """The file's text, transcoded, when its XML declaration names an encoding other than UTF-8.
+
+    MuJoCo's parser reads bytes as UTF-8 whatever the declaration says; an XML file may be in any
+    encoding its declaration names (XML 1.0, section 4.3.3), so such a file is decoded here and
+    handed over as text.  None for a UTF-8 (or undeclared) file, which MuJoCo reads itself.
+    """
+    with path.open("rb") as fh:
+        head = fh.read(200)
+    match = _XML_DECLARATION.match(head)
+    if match is None:
+        return None
+    name = match.group(1).decode("ascii")
+    try:
+        codec = codecs.lookup(name).name
+    except LookupError as exc:
+        raise ValueError(
+            f"Expected path_or_xml to declare an encoding Python knows, got encoding={name!r} "
+            f"in {str(path)!r}."
+        ) from exc
+    if codec in ("utf-8", "ascii"):
+        return None
+    try:
+        text = path.read_bytes().decode(codec)
+    except UnicodeDecodeError as exc:
+        raise ValueError(
+            f"Expected path_or_xml to be {name}-encoded as its XML declaration says, got a byte that is not "
+            f"{name} ({exc.reason} at byte {exc.start}) in {str(path)!r}."
+        ) from exc
+    # the declaration now describes the text handed over, not the file's bytes
+    declaration = r"^(\s*<\?xml[^>]*?\bencoding\s*=\s*)([\"'])[A-Za-z0-9._-]+\2"
+    return re.sub(declaration, r"\1\2UTF-8\2", text, count=1)
+
+
 def _compile(mujoco, source: str | os.PathLike):
     try:
         if isinstance(source, str) and _is_xml(source):
@@ -63,7 +101,12 @@ def _compile(mujoco, source: str | os.PathLike):
                 raise ValueError(
                     f"Expected path_or_xml to be MJCF text or an existing file, got {str(source)!r}."
                 )
-            spec = mujoco.MjSpec.from_file(str(path))
+            text = _declared_encoding_text(path)
+            if text is None:
+                spec = mujoco.MjSpec.from_file(str(path))
+            else:
+                spec = mujoco.MjSpec.from_string(text)
+                spec.modelfiledir = str(path.parent.resolve())  # meshes/textures relative to the file
         return spec.compile()
     except ValueError as exc:
         if "Expected path_or_xml" in str(exc):
@@ -126,8 +169,8 @@ def _refuse_urdf(source: str | os.PathLike) -> None:
             root = ET.parse(Path(source)).getroot()
         else:
             return
-    except ET.ParseError:
-        return  # MuJoCo reports malformed XML in its own words
+    except (ET.ParseError, LookupError):  # malformed XML, an encoding Python does not know
+        return  # reported by _compile
     if root.tag == "robot":
         raise ValueError(
             "Expected path_or_xml to be MJCF (root <mujoco>), got URDF (root <robot>): "

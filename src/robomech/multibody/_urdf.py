@@ -48,6 +48,8 @@ def _read(path_or_text: str | os.PathLike) -> tuple[ET.Element, Path | None]:
         raise ValueError(
             f"Expected path_or_text to be well-formed URDF XML; the XML parser says: {exc}"
         ) from exc
+    except LookupError as exc:  # an encoding declaration Python does not know
+        raise ValueError(f"Expected path_or_text to declare an encoding Python knows; {exc}.") from exc
 
 
 def _drop_missing_meshes(root: ET.Element, folder: Path | None) -> None:

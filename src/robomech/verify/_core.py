@@ -328,7 +328,8 @@ class VerificationReport:
         }
 
     def table(self) -> str:
-        """A plain-text table: one line per check (error, tolerance, pass/FAIL), skips and counts."""
+        """A plain-text table: one line per check (error, tolerance, pass/FAIL; a failure's detail on
+        the next line), skips and counts."""
         wq = max([len("quantity"), *(len(c.quantity) for c in self.checks)])
         wm = max([len("mechanism"), *(len(c.mechanism) for c in self.checks)])
         header = f"{'mechanism':<{wm}} {'quantity':<{wq}} {'max error':>11} {'tolerance':>11}      result"
@@ -339,6 +340,8 @@ class VerificationReport:
                 f"{c.mechanism:<{wm}} {c.quantity:<{wq}} {c.max_error:>11.3e} "
                 f"{c.tolerance.value:>11.1e}{kind:4}  {'pass' if c.passed else 'FAIL'}"
             )
+            if not c.passed and c.detail:  # a failure says why under its line
+                lines.append(f"{'':<{wm}}   why: {c.detail}")
         n_fail = sum(not c.passed for c in self.checks)
         lines += [f"skipped: {n} — {r}" for n, r in self.skipped]
         tail = f", {len(self.skipped)} skipped" if self.skipped else ""

@@ -59,6 +59,17 @@ MEET_MERGE = 1
 # decides wrongly).  Measured on Fig. 5(a) (grids 0.01-1 s, 10-100 nm of noise) and on random sways:
 # docs/mechanisms/spherical_leg.md.
 MEET_WINDOW = 16
+# Where MEET_WINDOW leaves a meeting ambiguous, the shorter windows are tried: on a coarse grid (0.25 s
+# or coarser on Fig. 5(a)) 16 samples span several seconds, over which no cubic follows the motion,
+# so both models misfit alike; a window of a few samples is short enough in time for the cubic
+# again.  Their answer is taken only if every shorter window decides (AMBIGUITY_RATIO) and all call
+# the same meetings crossings: noise that leaves the long window undecided (0.1-1 um on a fine grid)
+# makes short windows disagree, where a lone short window could decide wrongly (measured: one in 40
+# runs at 0.1 um on 2001 samples).  Measured on Fig. 5(a) (10 seeds per case): grids of 0.25-0.4 s
+# are then decided, all right, at up to 0.1 um of noise (most 1 um runs stay ambiguous); at 0.5 s and
+# coarser the dip beyond the curve is one or two samples and stays ambiguous; fine grids (1001-3001
+# samples, 40 seeds, 1 nm-1 um) never put a valid sample on the wrong branch.
+MEET_WINDOWS = (MEET_WINDOW, 6, 4)
 MEET_FIT_DEGREE = 3
 # The crossing model places the passage through the curve within this many samples of the sample
 # nearest it (noise of the order of a step moves that sample to either side).
@@ -174,6 +185,14 @@ def _decide(t: np.ndarray, d: np.ndarray, ks: list[int]) -> tuple[list[int | Non
     return splits, bool(r_win > AMBIGUITY_RATIO * r_other)
 
 
+def _short_windows_agree(tries: list[tuple[list[int | None], bool, int]]) -> bool:
+    """Every shorter window decided, and all call the same meetings crossings (see MEET_WINDOWS)."""
+    if not tries or any(amb for _, amb, _ in tries):
+        return False
+    kinds = {tuple(sp is None for sp in splits) for splits, _, _ in tries}
+    return len(kinds) == 1
+
+
 def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> BranchTrack:
     """Platform angles along a trajectory of leg lengths ``(..., N, 3)`` (m), starting on ``branch``.
 
@@ -267,7 +286,15 @@ def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> Br
         for c, ks in enumerate(clusters):
             lo = max(clusters[c - 1][-1] + 1 if c else 0, ks[0] - MEET_WINDOW)
             hi = min(clusters[c + 1][0] if c + 1 < len(clusters) else M, ks[-1] + MEET_WINDOW + 1)
-            splits, amb = _decide(tpos[lo:hi], 0.5 * s[lo:hi], [k - lo for k in ks])
+            tries = []  # (splits, ambiguous, window start) per window of MEET_WINDOWS
+            for window in MEET_WINDOWS:
+                lo_w, hi_w = max(lo, ks[0] - window), min(hi, ks[-1] + window + 1)
+                tries.append((*_decide(tpos[lo_w:hi_w], 0.5 * s[lo_w:hi_w], [k - lo_w for k in ks]), lo_w))
+                if len(tries) == 1 and not tries[0][1]:
+                    break
+            splits, amb, lo = tries[0]
+            if amb and _short_windows_agree(tries[1:]):
+                splits, amb, lo = tries[-1]
             for k, sp in zip(ks, splits, strict=True):
                 meeting[i, idx[k]] = True
                 if sp is None:
