@@ -27,13 +27,13 @@ the exported engine model too, so both sides model the same rigid mechanism.
 from __future__ import annotations
 
 import dataclasses
-import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
 
 from robomech._progress import stages
 
+from . import _mujoco
 from ._core import Check, Tolerance, VerificationReport
 
 __all__ = [
@@ -84,70 +84,16 @@ TOL_ASSEMBLY = Tolerance(1e-12, "every sample must assemble (FK converged); erro
 N_TRAJ = 12
 T_TRAJ = 1.0
 AMP = 0.15
-# Null-space rank decision on the engine's efc_J (equality rows, length units): as in the multibody layer.
-ENGINE_RANK_RTOL = 1e-10
-
-
-def engine_options(
-    xml: str,
-    *,
-    timestep: float,
-    integrator: str | None = None,
-    jacobian: str | None = None,
-    solref: str | None = None,
-    solimp: str | None = None,
-    contact: bool = True,
-) -> ET.Element:
-    """The exported MJCF ``xml`` with the engine options a check simulates with (not part of a mechanism
-    description): ``<option timestep integrator jacobian>``, contacts off with ``contact=False``, and
-    ``solref`` / ``solimp`` on every equality constraint; ``None`` leaves MuJoCo's default. Returns the
-    root element (serialise with ``ET.tostring(root, encoding="unicode")``)."""
-    root = ET.fromstring(xml)
-    opt = root.find("option")
-    if opt is None:  # to_mjcf always writes <option gravity=...>; kept robust
-        opt = ET.SubElement(root, "option")
-    opt.set("timestep", repr(timestep))
-    for key, value in (("integrator", integrator), ("jacobian", jacobian)):
-        if value is not None:
-            opt.set(key, value)
-    if not contact:
-        ET.SubElement(opt, "flag", contact="disable")
-    eq = root.find("equality")
-    for e in [] if eq is None else list(eq):
-        for key, value in (("solref", solref), ("solimp", solimp)):
-            if value is not None:
-                e.set(key, value)
-    return root
 
 
 def engine_model(mech, *, simulation: bool = False):
     """MuJoCo model of ``mech`` from ``mb.to_mjcf``; ``simulation=True`` sets the stiff equality
     constraints and the RK4 step used by the forward-simulation check."""
-    import mujoco
-
-    from robomech import multibody as mb
-
-    xml = mb.to_mjcf(mech)
     if simulation:
-        root = engine_options(
-            xml, timestep=SIM_TIMESTEP, integrator="RK4", solref=SIM_SOLREF, solimp=SIM_SOLIMP
+        return _mujoco.engine_model(
+            mech, timestep=SIM_TIMESTEP, integrator="RK4", solref=SIM_SOLREF, solimp=SIM_SOLIMP
         )
-        xml = ET.tostring(root, encoding="unicode")
-    return mujoco.MjModel.from_xml_string(xml)
-
-
-def _efc_equality(m, d) -> np.ndarray:
-    import mujoco
-
-    eq = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
-    if d.nefc == 0:
-        return np.zeros((0, m.nv))
-    if mujoco.mj_isSparse(m):
-        J = np.zeros((d.nefc, m.nv))
-        mujoco.mju_sparse2dense(J, d.efc_J, d.efc_J_rownnz, d.efc_J_rowadr, d.efc_J_colind)
-    else:
-        J = np.array(d.efc_J)[: d.nefc * m.nv].reshape(d.nefc, m.nv)
-    return J[eq]
+    return _mujoco.engine_model(mech)
 
 
 def trajectory(mech, n: int = N_TRAJ, t_end: float = T_TRAJ, seed: int = 0):
@@ -169,40 +115,10 @@ def trajectory(mech, n: int = N_TRAJ, t_end: float = T_TRAJ, seed: int = 0):
     return t, at
 
 
-def _assemble_along(mech, qa: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """FK along a sequence of inputs, each from the previous solution (continuation keeps the branch)."""
-    from robomech import multibody as mb
-
-    q = np.empty((len(qa), mech.nq))
-    conv = np.empty(len(qa), dtype=bool)
-    guess = None
-    for i, x in enumerate(qa):
-        r = mb.forward_kinematics(mech, x, guess=guess, steps=1 if guess is not None else 4)
-        q[i], conv[i] = r.q, r.converged
-        guess = r.q if r.converged else guess
-    return q, conv
-
-
 def engine_inverse_dynamics(m, d, mech, q, qd, qdd) -> np.ndarray:
-    """Actuator forces from the engine: ``mj_rne`` tree dynamics projected through its ``efc_J``."""
-    import mujoco
-
-    d.qpos[:] = q
-    d.qvel[:] = qd
-    mujoco.mj_forward(m, d)
-    d.qacc[:] = qdd
-    f = np.zeros(m.nv)
-    mujoco.mj_rne(m, d, 1, f)
-    Jc = _efc_equality(m, d)
-    if Jc.shape[0]:
-        _, s, Vt = np.linalg.svd(Jc)
-        r = int(np.sum(s > ENGINE_RANK_RTOL * max(s[0], 1e-300)))
-        Nn = Vt[r:].T
-    else:
-        Nn = np.eye(m.nv)
-    E = np.zeros((m.nv, len(mech.actuated)))
-    E[mech.tree.act_dof, np.arange(len(mech.actuated))] = 1.0
-    return np.linalg.lstsq(Nn.T @ E, Nn.T @ f, rcond=None)[0]
+    """Actuator forces from the engine: ``mj_rne`` tree dynamics projected through its ``efc_J``
+    (:meth:`Engine.inverse_dynamics <robomech.verify._mujoco.Engine.inverse_dynamics>` on ``m, d``)."""
+    return _mujoco.Engine(m, d).inverse_dynamics(q, qd, qdd, mech.tree.act_dof)
 
 
 def _rel(err: float, scale: float) -> float:
@@ -288,7 +204,8 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
     drv = _driver(mech)  # redundant actuation: a consistent motion is driven through `dof` actuators
     t, at = trajectory(drv)
     qa, qda, qdda = at(t)
-    q, conv = _assemble_along(drv, qa)
+    fk = _mujoco.assemble_along(drv, qa)
+    q, conv = fk.q, fk.converged
     checks.append(
         Check(
             name,
@@ -309,8 +226,8 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
         qa, qda, qdda = q[:, tree.act_qadr], rd.qd[:, tree.act_dof], rd.qdd[:, tree.act_dof]
     inv = mb.inverse_dynamics(mech, q, qda, qdda)
     st.next()
-    m = engine_model(mech)
-    d = mujoco.MjData(m)
+    eng = _mujoco.Engine(engine_model(mech))
+    m, d = eng.model, eng.data
     closure = vel = acc = 0.0
     vscale = ascale = 0.0
     tau_e = np.zeros_like(inv.tau)
@@ -318,17 +235,14 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
     sites = [s.name for s in mech.sites]
     J = {s: mb.site_jacobian(mech, q, s) for s in sites}
     H = {s: mb.site_hessian(mech, q, s) for s in sites}
+    wv = np.array([L, L, L, 1, 1, 1])
     adm = 0.0
     for i in range(len(q)):
-        d.qpos[:] = q[i]
-        d.qvel[:] = inv.qd[i]
-        mujoco.mj_forward(m, d)
-        eq = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
-        if np.any(eq):
-            closure = max(closure, float(np.max(np.abs(d.efc_pos[eq]))))
-            Jc = _efc_equality(m, d)
+        eng.set_state(q[i], inv.qd[i], inv.qdd[i])
+        Jc, pos = eng.equality()
+        if len(pos):
+            closure = max(closure, float(np.max(np.abs(pos))))
             adm = max(adm, float(np.max(np.abs(Jc @ inv.qd[i]))))
-        d.qacc[:] = inv.qdd[i]
         mujoco.mj_rnePostConstraint(m, d)
         for s in sites:
             sid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, s)
@@ -339,12 +253,11 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
             a6[3:] += g  # the engine's accelerations include -g (an accelerometer's reading)
             mine_v = J[s][i] @ qda[i]
             mine_a = J[s][i] @ qdda[i] + np.einsum("ijk,j,k->i", H[s][i], qda[i], qda[i])
-            wv = np.array([L, L, L, 1, 1, 1])
             vel = max(vel, float(np.max(np.abs((mine_v - v6) * wv))))
             acc = max(acc, float(np.max(np.abs((mine_a - a6) * wv))))
             vscale = max(vscale, float(np.max(np.abs(mine_v * wv))))
             ascale = max(ascale, float(np.max(np.abs(mine_a * wv))))
-        tau_e[i] = engine_inverse_dynamics(m, d, mech, q[i], inv.qd[i], inv.qdd[i])
+        tau_e[i] = eng.inverse_dynamics(q[i], inv.qd[i], inv.qdd[i], tree.act_dof)
     qdscale = L * max(float(np.max(np.abs(inv.qd))), 1e-300)
     checks += [
         Check(name, "closure (engine efc_pos)", closure / L, TOL_CLOSURE, "max |efc_pos| / L"),
@@ -368,23 +281,12 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
         )
     )
     st.next()
-    checks.append(_power_check(drv, name, m, d, at, t[conv], q, inv.tau, inv.qd[:, tree.act_dof]))
+    checks.append(_power_check(drv, name, eng, at, t[conv], q, inv.tau, inv.qd[:, tree.act_dof]))
     if simulate:
         st.next()
         q_s, qd_s = (q[0], qda[0]) if start is None else start
         checks += _simulation_checks(mech, name, q_s, qd_s, duration)
     return checks
-
-
-def _engine_energy(m, d, q, qd) -> float:
-    import mujoco
-
-    d.qpos[:] = q
-    d.qvel[:] = qd
-    mujoco.mj_forward(m, d)
-    mujoco.mj_energyPos(m, d)
-    mujoco.mj_energyVel(m, d)
-    return float(d.energy[0] + d.energy[1])
 
 
 def _virtually_actuated(mech):
@@ -436,14 +338,11 @@ def _driver(mech):
     return mech
 
 
-def _power_check(mech, name, m, d, at, t, q, tau, qd_act) -> Check:
+def _power_check(mech, name, eng, at, t, q, tau, qd_act) -> Check:
     """``tau . qd_act`` (every actuator's force and rate) against dE/dt of the engine's energy along the
     motion driven through ``mech``'s actuators (``at``)."""
-    import mujoco
-
     from robomech import multibody as mb
 
-    m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
     h = H_POWER
     err = 0.0
     scale = 0.0
@@ -451,7 +350,7 @@ def _power_check(mech, name, m, d, at, t, q, tau, qd_act) -> Check:
         qa, qda, qdda = at(ti + h * np.arange(-2, 3))
         fk = mb.forward_kinematics(mech, qa, guess=q[i])
         r = mb.inverse_dynamics(mech, fk.q, qda, qdda)
-        E = np.array([_engine_energy(m, d, fk.q[k], r.qd[k]) for k in range(5)])
+        E = np.array([sum(eng.energies(fk.q[k], r.qd[k])) for k in range(5)])
         dE = (E[0] - 8 * E[1] + 8 * E[3] - E[4]) / (12 * h)
         P = float(tau[i] @ qd_act[i])
         err = max(err, abs(P - dE))
@@ -481,24 +380,14 @@ def _why(mech, t: np.ndarray, q: np.ndarray, off: np.ndarray) -> str:
 
 
 def _simulation_checks(mech, name, q0, qd_act0, duration: float = T_SIM) -> list[Check]:
-    import mujoco
-
     from robomech import multibody as mb
 
     t = np.linspace(0.0, duration, SIM_SAMPLES)
     sim = mb.simulate(mech, q0, qd_act0, t)
-    m = engine_model(mech, simulation=True)
-    d = mujoco.MjData(m)
+    engine = _mujoco.Engine(engine_model(mech, simulation=True))
     G = mb.influence(mech, q0, second_order=False).G
-    d.qpos[:] = q0
-    d.qvel[:] = G @ qd_act0
-    mujoco.mj_forward(m, d)
-    out = [d.qpos[mech.tree.act_qadr].copy()]
-    for k in range(1, len(t)):
-        while d.time < t[k] - 0.5 * SIM_TIMESTEP:
-            mujoco.mj_step(m, d)
-        out.append(d.qpos[mech.tree.act_qadr].copy())
-    eng = np.array(out)
+    engine.set_state(q0, G @ qd_act0)
+    eng = np.array(engine.simulate(t, lambda d: d.qpos[mech.tree.act_qadr].copy()))
     tree = mech.tree
     if not bool(sim.success):
         ok = np.all(np.isfinite(sim.q), axis=-1)

@@ -14,6 +14,7 @@ import numpy as np
 
 from . import _generic as g
 from ._core import Check
+from ._mujoco import assemble_along
 
 __all__ = ["check_mechanism_pinocchio"]
 
@@ -33,7 +34,8 @@ def check_mechanism_pinocchio(mech, name: str | None = None) -> list[Check]:
     drv = g._driver(mech)
     t, at = g.trajectory(drv)
     qa, qda, qdda = at(t)
-    q, conv = g._assemble_along(drv, qa)
+    fk = assemble_along(drv, qa)
+    q, conv = fk.q, fk.converged
     checks = [
         Check(name, "assembly along the test trajectory", float(np.mean(~conv)), g.TOL_ASSEMBLY,
               f"{int(conv.sum())}/{len(conv)} converged"),
