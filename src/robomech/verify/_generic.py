@@ -78,6 +78,19 @@ TOL_DRIFT = Tolerance(
     "DOP853 at rtol 1e-10 with projection onto the manifold; relative to the energy exchanged",
     relative=True,
 )
+# Floating bases: the tree quantities of two exact rigid-body codes of the same bodies (RNEA, CRBA,
+# tree forward dynamics) agree to rounding (acceptance: 1e-9 relative), at N_FLOAT random states
+# moved FLOAT_AMP (rad, or L) from the reference.
+TOL_TREE = Tolerance(1e-9, "exact tree dynamics both sides (RNEA, CRBA); rounding only", relative=True)
+N_FLOAT = 12
+FLOAT_AMP = 0.5
+# A free flight of a tree has no soft constraint: the engine's RK4 (0.1 ms) error is ~h^4 and the
+# multibody DOP853 (rtol 1e-10) ~1e-10 relative; measured 6e-13 relative on the test quadruped (0.3 s).
+TOL_FLIGHT = Tolerance(1e-7, "engine RK4 at 0.1 ms vs DOP853 at rtol 1e-10 (no constraints)", relative=True)
+# Momentum along the multibody flight: the integration error of DOP853 at rtol 1e-10 (~1e-10 relative).
+TOL_MOMENTUM = Tolerance(
+    1e-7, "DOP853 at rtol 1e-10 with projection; relative to the momentum", relative=True
+)
 # Every test configuration must assemble: the error is the fraction that failed (any failure >= 1/N_TRAJ).
 TOL_ASSEMBLY = Tolerance(1e-12, "every sample must assemble (FK converged); error = fraction failed")
 # Trajectory: N_TRAJ samples over T_TRAJ seconds, amplitudes AMP rad (AMP L for slides).
@@ -121,8 +134,20 @@ def engine_inverse_dynamics(m, d, mech, q, qd, qdd) -> np.ndarray:
     return _mujoco.Engine(m, d).inverse_dynamics(q, qd, qdd, mech.tree.act_dof)
 
 
+def _sample_times(duration: float) -> np.ndarray:
+    """SIM_SAMPLES output times over ``duration``, on the engine's step grid (SIM_TIMESTEP): the engine
+    is read at exactly the times the multibody simulation reports."""
+    steps = max(1, round(duration / SIM_TIMESTEP))
+    return np.unique(np.round(np.linspace(0.0, steps, SIM_SAMPLES))) * SIM_TIMESTEP
+
+
 def _rel(err: float, scale: float) -> float:
     return float(err / scale) if scale > 0 else float(err)
+
+
+def _rel_diff(mine: np.ndarray, engine: np.ndarray) -> float:
+    """Largest difference relative to the engine's largest value."""
+    return _rel(float(np.max(np.abs(mine - engine))), float(np.max(np.abs(engine))))
 
 
 # The stages of check_mechanism, reported as progress (robomech._progress).
@@ -138,30 +163,45 @@ def check_mechanism(
     duration: float = T_SIM,
     q0: object = None,
     qd_act0: object = None,
+    qd0: object = None,
 ) -> list[Check]:
     """Every check of this module for ``mech`` (the rows of the ``robomech verify`` table).
 
     ``duration`` (s, ``0 < duration <= MAX_SIM_DURATION``) is the length of the passive forward
-    simulation; ``q0`` (nq,) and ``qd_act0`` (n_act,) its start (default: the test trajectory's first
-    state; ``q0`` must be assembled, ``qd_act0`` defaults to zero when ``q0`` is given).
+    simulation; ``q0`` (nq,) its start configuration (assembled) and its start rates either
+    ``qd_act0`` (n_act,: the actuated rates, where the actuators determine the state) or ``qd0`` (nv,:
+    every coordinate's rate, MuJoCo ``qvel``, any mechanism: passive, underactuated, floating);
+    zero rates when only ``q0`` is given; default: the test trajectory's first state (for a floating
+    base a tumbling start, see :func:`_floating_checks`).
     """
     from robomech._validation import as_array, check_bool, check_real
 
     simulate = check_bool(simulate, "simulate")
     duration = check_real(duration, "duration", low=0.0, high=MAX_SIM_DURATION, low_open=True)
     start = None
-    if q0 is not None or qd_act0 is not None:
+    if q0 is not None or qd_act0 is not None or qd0 is not None:
         from robomech import multibody as mb
 
         if q0 is None:
-            raise ValueError("Expected q0 with qd_act0 (the start configuration), got None.")
+            raise ValueError("Expected q0 with the start rates (the start configuration), got None.")
+        if qd_act0 is not None and qd0 is not None:
+            raise ValueError("Expected one of qd_act0 (actuated rates) and qd0 (every rate), got both.")
         q0 = as_array(q0, "q0", (mech.nq,))
         if q0.ndim != 1:
             raise ValueError(f"Expected q0 to have shape ({mech.nq},), got {q0.shape}.")
         na = len(mech.actuated)
-        qd = np.zeros(na) if qd_act0 is None else as_array(qd_act0, "qd_act0", (na,))
-        if qd.ndim != 1:
-            raise ValueError(f"Expected qd_act0 to have shape ({na},), got {qd.shape}.")
+        if qd_act0 is not None:
+            if _virtually_actuated(mech)[1] != ():
+                raise ValueError(
+                    f"Expected qd0 (every coordinate's rate, {mech.nv} numbers; CLI --qvel0) for a "
+                    f"mechanism whose actuators do not determine its state, got qd_act0 (actuated rates)."
+                )
+            qd = as_array(qd_act0, "qd_act0", (na,))
+            if qd.ndim != 1:
+                raise ValueError(f"Expected qd_act0 to have shape ({na},), got {qd.shape}.")
+        full = np.zeros(mech.nv) if qd0 is None else as_array(qd0, "qd0", (mech.nv,))
+        if full.ndim != 1:
+            raise ValueError(f"Expected qd0 to have shape ({mech.nv},), got {full.shape}.")
         r = mb.constraint_residual(mech, q0)
         miss = float(np.max(np.abs(r))) if r.size else 0.0
         if not miss <= mb.CONVERGED_RTOL * mech.tree.length:
@@ -169,7 +209,7 @@ def check_mechanism(
                 f"Expected q0 to be an assembled configuration (e.g. forward_kinematics(mech, q_act).q), "
                 f"got closure residual {miss:.3g} m."
             )
-        start = (q0, qd)
+        start = {"q0": q0, **({"qd_act0": qd} if qd_act0 is not None else {"qd0": full})}
     with stages(f"verify {name or getattr(mech, 'name', 'mechanism')}", _STAGES[: 4 + simulate]) as st:
         return _checks(mech, name, simulate, st, duration, start)
 
@@ -186,17 +226,8 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
         # as exported, with those inertias on both sides (read back from the engine's compiled model)
         mech = mb.from_mjcf(mb.to_mjcf(mech))
     mech, virtual = _virtually_actuated(mech)
-    if virtual is None:
-        return [
-            Check(
-                name,
-                "actuated rates determine the state",
-                1.0,
-                TOL_ASSEMBLY,
-                "no set of hinge/slide joints determines the state (a floating base): the engine checks "
-                "need a test motion driven through joints; check generalized_forces / mass_matrix directly",
-            )
-        ]
+    if virtual is None:  # a floating base: no joints drive a test motion; its tree dynamics are checked
+        return _floating_checks(mech, name, simulate, st, duration, start)
     tree = mech.tree
     L = tree.length
     checks: list[Check] = []
@@ -284,8 +315,136 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
     checks.append(_power_check(drv, name, eng, at, t[conv], q, inv.tau, inv.qd[:, tree.act_dof]))
     if simulate:
         st.next()
-        q_s, qd_s = (q[0], qda[0]) if start is None else start
-        checks += _simulation_checks(mech, name, q_s, qd_s, duration)
+        start = {"q0": q[0], "qd_act0": qda[0]} if start is None else start
+        checks += _simulation_checks(mech, name, duration=duration, **start)
+    return checks
+
+
+def _floating_states(eng, mech, n: int, rng) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``n`` random states ``q (n, nq), qd, qdd (n, nv)`` around the reference: every coordinate moved
+    by ``mj_integratePos`` (quaternions stay unit) by FLOAT_AMP (rad; FLOAT_AMP L along translations),
+    rates and accelerations of order 1 rad/s (L/s) and 10 rad/s^2 (10 L/s^2)."""
+    import mujoco
+
+    tree = mech.tree
+    scale = np.where(tree.dof_translational, tree.length, 1.0)
+    q = np.tile(np.asarray(tree.q0, float), (n, 1))
+    for i in range(n):
+        mujoco.mj_integratePos(eng.model, q[i], FLOAT_AMP * scale * rng.standard_normal(mech.nv), 1.0)
+    return q, scale * rng.standard_normal((n, mech.nv)), 10 * scale * rng.standard_normal((n, mech.nv))
+
+
+def _free_system(m) -> bool:
+    """Every body hangs from a free joint on the world and nothing ties a body to the world: the
+    system's linear momentum changes by its weight only and its angular momentum about its centre of
+    mass is conserved."""
+    import mujoco
+
+    top = [b for b in range(1, m.nbody) if m.body_parentid[b] == 0]
+    free = int(mujoco.mjtJoint.mjJNT_FREE)
+    return m.neq == 0 and all(m.body_jntnum[b] > 0 and m.jnt_type[m.body_jntadr[b]] == free for b in top)
+
+
+def _floating_checks(mech, name, simulate: bool, st, duration: float, start) -> list[Check]:
+    """The checks of a mechanism whose state no set of hinge/slide joints determines (a floating base):
+    at N_FLOAT random states, the tree's generalized forces (:func:`multibody.generalized_forces` vs
+    ``mj_rne``), mass matrix (:func:`multibody.mass_matrix` vs ``mj_fullM``) and, for a tree, forward
+    dynamics under random actuator forces (:func:`multibody.forward_dynamics` vs the engine's
+    ``qacc``); then a free flight (:func:`multibody.simulate`, no actuator force) from a tumbling start
+    (or ``start``) against the engine's RK4 integration (every body's position), its momentum (the
+    engine's ``mj_subtreeVel`` of the multibody trajectory: linear momentum changes by the weight only,
+    angular momentum about the centre of mass is constant) and its energy drift."""
+    from robomech import multibody as mb
+
+    rng = np.random.default_rng(0)
+    eng = _mujoco.Engine(engine_model(mech))
+    L = mech.tree.length
+    st.next()
+    q, qd, qdd = _floating_states(eng, mech, N_FLOAT, rng)
+    st.next()
+    f = mb.generalized_forces(mech, q, qd, qdd)
+    M = mb.mass_matrix(mech, q)
+    f_e, M_e = np.zeros_like(f), np.zeros_like(M)
+    for i in range(N_FLOAT):
+        eng.set_state(q[i], qd[i], qdd[i])
+        f_e[i], M_e[i] = eng.tree_forces(), eng.mass_matrix()
+    st.next()
+    states = f"{N_FLOAT} random states of the floating tree"
+    checks = [
+        Check(name, "generalized forces (vs mj_rne)", _rel_diff(f, f_e), TOL_TREE, states),
+        Check(name, "mass matrix (vs mj_fullM)", _rel_diff(M, M_e), TOL_TREE, states),
+    ]
+    if not (mech.closures or mech.couplings):  # the engine's closures are soft: compared in the flight only
+        tau = float(np.max(np.abs(f_e))) * rng.standard_normal((N_FLOAT, len(mech.actuated)))
+        fd = mb.forward_dynamics(mech, q, tau=tau, qd=qd)
+        acc = np.zeros_like(fd.qdd)
+        for i in range(N_FLOAT):
+            eng.data.qfrc_applied[:] = 0.0
+            eng.data.qfrc_applied[mech.tree.act_dof] = tau[i]
+            acc[i] = eng.set_state(q[i], qd[i]).qacc
+        eng.data.qfrc_applied[:] = 0.0
+        err = _rel_diff(fd.qdd, acc)
+        checks.append(
+            Check(name, "forward dynamics under actuator forces (vs engine qacc)",
+                  err if bool(np.all(fd.valid)) else 1.0, TOL_TREE,
+                  f"{int(np.sum(fd.valid))}/{N_FLOAT} valid; random forces of the size of the tree's")
+        )  # fmt: skip
+    st.next()
+    if simulate:
+        st.next()
+        if start is None:  # a tumbling start: the reference pose with random rates
+            tree = mech.tree
+            start = {"q0": np.asarray(tree.q0, float), "qd0": np.where(tree.dof_translational, L, 1.0)
+                     * rng.standard_normal(mech.nv)}  # fmt: skip
+        checks += _flight_checks(mech, name, start["q0"], start.get("qd0"), duration, eng)
+    return checks
+
+
+def _flight_checks(mech, name, q0, qd0, duration: float, eng) -> list[Check]:
+    """Free flight from ``(q0, qd0)``: body positions against the engine's RK4 integration, momentum
+    (where the system is free) and energy drift of the multibody simulation."""
+    import mujoco
+
+    from robomech import multibody as mb
+
+    t = _sample_times(duration)
+    sim = mb.simulate(mech, q0, t=t, qd0=np.zeros(mech.nv) if qd0 is None else qd0)
+    if not bool(sim.success):
+        return [Check(name, "free flight vs engine", 1.0, TOL_SIM, "integration failed (error: 1)")]
+    engine = _mujoco.Engine(engine_model(mech, simulation=True))
+    engine.set_state(sim.q[0], sim.qd[0])
+    xe = np.array(engine.simulate(t, lambda d: d.xpos[1:].copy()))
+    m, d = eng.model, eng.data
+    xm = np.empty_like(xe)
+    p, h = np.empty((len(t), 3)), np.empty((len(t), 3))
+    for k in range(len(t)):
+        eng.set_state(sim.q[k], sim.qd[k])
+        mujoco.mj_subtreeVel(m, d)
+        xm[k] = d.xpos[1:]
+        p[k] = m.body_subtreemass[0] * d.subtree_linvel[0]
+        h[k] = d.subtree_angmom[0]
+    moved = float(np.max(np.linalg.norm(xm - xm[0], axis=-1))) / mech.tree.length
+    err = float(np.max(np.linalg.norm(xm - xe, axis=-1))) / mech.tree.length
+    tol = TOL_SIM if mech.closures or mech.couplings else TOL_FLIGHT
+    checks = [
+        Check(name, f"free flight vs engine ({duration:g} s, passive)", _rel(err, max(moved, 1e-3)), tol,
+              f"max body position difference {err:.2e} L for a motion of {moved:.3g} L"),
+    ]  # fmt: skip
+    if _free_system(m):
+        weight = m.body_subtreemass[0] * np.asarray(mech.gravity) * t[:, None]
+        p_err = float(np.max(np.abs(p - p[0] - weight)))
+        p_scale = max(float(np.max(np.abs(p))), float(np.max(np.abs(weight))), 1e-300)
+        h_err = float(np.max(np.abs(h - h[0])))
+        h_scale = max(float(np.max(np.abs(h))), 1e-300)
+        checks.append(
+            Check(name, "momentum of the free flight", max(p_err / p_scale, h_err / h_scale), TOL_MOMENTUM,
+                  f"linear {p_err / p_scale:.1e} (less the weight's impulse), angular about the CoM "
+                  f"{h_err / h_scale:.1e}; engine mj_subtreeVel of the multibody trajectory")
+        )  # fmt: skip
+    checks.append(
+        Check(name, "energy drift of the simulation", float(sim.energy_drift_rel), TOL_DRIFT,
+              f"{float(sim.energy_drift):.2e} J")
+    )  # fmt: skip
     return checks
 
 
@@ -379,14 +538,20 @@ def _why(mech, t: np.ndarray, q: np.ndarray, off: np.ndarray) -> str:
     return "; ".join(words)
 
 
-def _simulation_checks(mech, name, q0, qd_act0, duration: float = T_SIM) -> list[Check]:
+def _simulation_checks(mech, name, q0, qd_act0=None, duration: float = T_SIM, *, qd0=None) -> list[Check]:
+    """The passive simulation from ``q0`` with the actuated rates ``qd_act0`` or every rate ``qd0``
+    against the engine's, and the energy drift of the multibody simulation."""
     from robomech import multibody as mb
 
-    t = np.linspace(0.0, duration, SIM_SAMPLES)
-    sim = mb.simulate(mech, q0, qd_act0, t)
+    t = _sample_times(duration)
+    if qd0 is None:
+        sim = mb.simulate(mech, q0, qd_act0, t)
+        qvel = mb.influence(mech, q0, second_order=False).G @ qd_act0
+    else:  # the multibody side projects qd0 onto the admissible rates: the engine starts from those
+        sim = mb.simulate(mech, q0, t=t, qd0=qd0)
+        qvel = sim.qd[0]
     engine = _mujoco.Engine(engine_model(mech, simulation=True))
-    G = mb.influence(mech, q0, second_order=False).G
-    engine.set_state(q0, G @ qd_act0)
+    engine.set_state(q0, qvel)
     eng = np.array(engine.simulate(t, lambda d: d.qpos[mech.tree.act_qadr].copy()))
     tree = mech.tree
     if not bool(sim.success):
