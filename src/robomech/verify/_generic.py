@@ -72,6 +72,16 @@ MAX_SIM_DURATION = 10.0
 SIM_SAMPLES = 31
 # A passive block whose smallest singular value is below this fraction of L is at a type II singularity.
 SINGULAR_SIGMA_RTOL = 1e-6
+# Locating a crossing between samples (only when a simulation check fails): each local minimum of the
+# sampled sigma_min, the latest MAX_ZOOMS before the divergence, is simulated again on ZOOM_SAMPLES
+# times and narrowed ZOOM_LEVELS times (a factor (ZOOM_SAMPLES - 1) / 2 each): a 30 ms sample interval
+# shrinks to ~2 ns, where a crossing at 10 rad/s x 1 m falls below SINGULAR_SIGMA_RTOL L.  Near a
+# crossing sigma_min falls linearly (each level lowers it ~(ZOOM_SAMPLES - 1) / 2 times); a level that
+# lowers it by less than a factor 1 / ZOOM_NEAR_MISS has found a positive minimum: the zoom stops.
+ZOOM_SAMPLES = 41
+ZOOM_LEVELS = 7
+ZOOM_NEAR_MISS = 0.5
+MAX_ZOOMS = 1
 TOL_SIM = Tolerance(1e-3, "soft engine constraints (0.5 ms, 0.9999) and 0.1 ms RK4 steps", relative=True)
 TOL_DRIFT = Tolerance(
     1e-7,
@@ -517,24 +527,73 @@ def _power_check(mech, name, eng, at, t, q, tau, qd_act) -> Check:
     return Check(name, "power balance tau.qd = dE/dt (engine energy)", _rel(err, scale), TOL_POWER, "")
 
 
-def _why(mech, t: np.ndarray, q: np.ndarray, off: np.ndarray) -> str:
-    """Why a simulation disagrees: when it first left the engine, and the closest type II singularity
-    (smallest singular value of the passive block of K, in m, from :func:`multibody.influence`)."""
+def _smallest_sigma(mech, q: np.ndarray, full_rank: int) -> np.ndarray:
+    """Smallest singular value of the passive block of K (m) at each ``q``; 0 where its rank drops."""
+    from robomech import multibody as mb
+
+    inf = mb.influence(mech, q, second_order=False)
+    return np.where(inf.passive_rank < full_rank, 0.0, inf.sigma_min)
+
+
+def _zoom(mech, t0: float, t1: float, q0: np.ndarray, qd0: np.ndarray, full_rank: int) -> tuple[float, float]:
+    """``(sigma_min, t)`` at the closest approach to a type II singularity of the passive motion from
+    ``(q0, qd0)`` at ``t0`` within ``[t0, t1]``: the motion is simulated again on ZOOM_SAMPLES times and
+    the interval narrowed around the smallest value, up to ZOOM_LEVELS times (a crossing, where sigma_min
+    falls linearly to 0, resolves below SINGULAR_SIGMA_RTOL L; a near miss to its positive minimum)."""
+    from robomech import multibody as mb
+
+    best = (np.inf, t0)
+    for _ in range(ZOOM_LEVELS):
+        tt = np.linspace(t0, t1, ZOOM_SAMPLES)
+        sim = mb.simulate(mech, q0, t=tt, qd0=qd0)
+        ok = np.all(np.isfinite(sim.q), axis=-1)
+        if not ok.any():
+            break
+        smin = _smallest_sigma(mech, sim.q[ok], full_rank)
+        j = int(np.nanargmin(smin))
+        before, best = best[0], min(best, (float(smin[j]), float(tt[ok][j])))
+        crossing = best[0] < SINGULAR_SIGMA_RTOL * mech.tree.length
+        if crossing or not bool(sim.success) or best[0] > ZOOM_NEAR_MISS * before:
+            break  # a crossing; or a positive minimum the narrowing no longer lowers (a near miss)
+        lo, hi = max(j - 1, 0), min(j + 1, int(ok.sum()) - 1)
+        t0, t1, q0, qd0 = float(tt[lo]), float(tt[hi]), sim.q[lo], sim.qd[lo]
+    return best
+
+
+def _why(mech, t: np.ndarray, q: np.ndarray, off: np.ndarray, qd: np.ndarray | None = None) -> str:
+    """Why a simulation disagrees: when it first left the engine, and the type II singularity it crossed
+    last before (or came closest to: smallest singular value of the passive block of K, in m, from
+    :func:`multibody.influence`).  With the rates ``qd`` each local minimum of the sampled values is
+    resolved between its neighbouring samples by :func:`_zoom` (a crossing falls between samples)."""
     from robomech import multibody as mb
 
     words = []
+    end = len(t) - 1
     if off.any():
-        words.append(f"diverged from the engine after t = {t[int(np.argmax(off))]:.3g} s")
+        end = int(np.argmax(off))
+        words.append(f"diverged from the engine after t = {t[end]:.3g} s")
     inf = mb.influence(mech, q, second_order=False)
-    if inf.n_passive:
-        smin = np.where(inf.passive_rank < inf.passive_rank.max(initial=0), 0.0, inf.sigma_min)
-        k = int(np.nanargmin(smin))
-        if smin[k] < SINGULAR_SIGMA_RTOL * mech.tree.length or inf.passive_rank[k] < inf.passive_rank.max():
-            words.append(
-                f"crossed a type II singularity near t = {t[k]:.3g} s (sigma_min {inf.sigma_min[k]:.1e} m)"
-            )
-        else:
-            words.append(f"closest to a type II singularity at t = {t[k]:.3g} s (sigma_min {smin[k]:.1e} m)")
+    if not inf.n_passive:
+        return "; ".join(words)
+    full = int(inf.passive_rank.max(initial=0))
+    smin = np.where(inf.passive_rank < full, 0.0, inf.sigma_min)
+    found = [(float(smin[k]), float(t[k])) for k in range(len(t))]
+    if qd is not None:  # resolve the local minima up to the divergence, the latest first
+        pad = np.concatenate([[np.inf], smin, [np.inf]])
+        minima = [k for k in range(end + 1) if pad[k + 1] <= pad[k] and pad[k + 1] <= pad[k + 2]]
+        found = []
+        for k in minima[::-1][:MAX_ZOOMS]:
+            lo, hi = max(k - 1, 0), min(k + 1, len(t) - 1)
+            found.append(_zoom(mech, float(t[lo]), float(t[hi]), q[lo], qd[lo], full))
+            if found[-1][0] < SINGULAR_SIGMA_RTOL * mech.tree.length:
+                break
+    crossed = [f for f in found if f[0] < SINGULAR_SIGMA_RTOL * mech.tree.length]
+    if crossed:
+        sigma, tc = crossed[0] if qd is not None else min(crossed, key=lambda f: f[1])
+        words.append(f"crossed a type II singularity near t = {tc:.4g} s (sigma_min {sigma:.1e} m)")
+    elif found:
+        sigma, tc = min(found)
+        words.append(f"closest to a type II singularity at t = {tc:.4g} s (sigma_min {sigma:.1e} m)")
     return "; ".join(words)
 
 
@@ -556,7 +615,7 @@ def _simulation_checks(mech, name, q0, qd_act0=None, duration: float = T_SIM, *,
     tree = mech.tree
     if not bool(sim.success):
         ok = np.all(np.isfinite(sim.q), axis=-1)
-        why = _why(mech, t[ok], sim.q[ok], np.zeros(int(ok.sum()), bool)) if ok.any() else ""
+        why = _why(mech, t[ok], sim.q[ok], np.zeros(int(ok.sum()), bool), sim.qd[ok]) if ok.any() else ""
         return [
             Check(
                 name,
@@ -573,7 +632,7 @@ def _simulation_checks(mech, name, q0, qd_act0=None, duration: float = T_SIM, *,
     rel = _rel(err, max(moved, 1e-3))
     detail = f"max |q_act - engine| {err:.2e} (rad, slides / L) for a motion of {moved:.3g}"
     if not rel <= TOL_SIM.value:
-        detail += "; " + _why(mech, t, sim.q, dev > TOL_SIM.value * max(moved, 1e-3))
+        detail += "; " + _why(mech, t, sim.q, dev > TOL_SIM.value * max(moved, 1e-3), sim.qd)
     return [
         Check(name, f"forward simulation vs engine ({duration:g} s, passive)", rel, TOL_SIM, detail),
         Check(
