@@ -27,7 +27,9 @@ the exported engine model too, so both sides model the same rigid mechanism.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -37,8 +39,10 @@ from . import _mujoco
 from ._core import Check, Tolerance, VerificationReport
 
 __all__ = [
+    "DrivenMotion",
     "check_mechanism",
     "describe",
+    "driven_motion",
     "engine_inverse_dynamics",
     "engine_model",
     "run_generic",
@@ -224,6 +228,52 @@ def check_mechanism(
         return _checks(mech, name, simulate, st, duration, start)
 
 
+@dataclasses.dataclass(frozen=True)
+class DrivenMotion:
+    """The test motion of a mechanism whose actuators (real or virtual) determine its state, at the
+    samples that assembled: times ``t``, configurations ``q``, every actuator's ``qa, qda, qdda``, the
+    multibody ``inv = inverse_dynamics(mech, q, qda, qdda)``; ``drv`` the mechanism driven (``mech`` or,
+    for redundant actuation, a determining subset, :func:`_driver`) and ``at(t)`` its inputs."""
+
+    mech: Any
+    drv: Any
+    at: Callable
+    t: np.ndarray
+    q: np.ndarray
+    qa: np.ndarray
+    qda: np.ndarray
+    qdda: np.ndarray
+    inv: Any  # multibody.InverseDynamicsResult
+
+
+def driven_motion(mech, name: str, note: str = "") -> tuple[Check, DrivenMotion | None]:
+    """The assembly row of ``mech``'s test trajectory (``note`` appended to its detail) and the motion
+    along it (None where no sample assembled); the engine checks (MuJoCo, Pinocchio) compare along it."""
+    from robomech import multibody as mb
+
+    tree = mech.tree
+    drv = _driver(mech)  # redundant actuation: a consistent motion is driven through `dof` actuators
+    t, at = trajectory(drv)
+    qa, qda, qdda = at(t)
+    fk = _mujoco.assemble_along(drv, qa)
+    conv = fk.converged
+    row = Check(
+        name,
+        "assembly along the test trajectory",
+        float(np.mean(~conv)),  # the fraction that failed (finite: --json stays strict JSON)
+        TOL_ASSEMBLY,
+        f"{int(conv.sum())}/{len(conv)} converged{note}",
+    )
+    if not conv.any():
+        return row, None
+    q, qa, qda, qdda = fk.q[conv], qa[conv], qda[conv], qdda[conv]
+    if drv is not mech:  # every actuator's rates along the driven (consistent) motion
+        rd = mb.inverse_dynamics(drv, q, qda, qdda)
+        qa, qda, qdda = q[:, tree.act_qadr], rd.qd[:, tree.act_dof], rd.qdd[:, tree.act_dof]
+    inv = mb.inverse_dynamics(mech, q, qda, qdda)
+    return row, DrivenMotion(mech, drv, at, t[conv], q, qa, qda, qdda, inv)
+
+
 def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM, start=None) -> list[Check]:
     import mujoco
 
@@ -240,32 +290,15 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
         return _floating_checks(mech, name, simulate, st, duration, start)
     tree = mech.tree
     L = tree.length
-    checks: list[Check] = []
     st.next()
-    drv = _driver(mech)  # redundant actuation: a consistent motion is driven through `dof` actuators
-    t, at = trajectory(drv)
-    qa, qda, qdda = at(t)
-    fk = _mujoco.assemble_along(drv, qa)
-    q, conv = fk.q, fk.converged
-    checks.append(
-        Check(
-            name,
-            "assembly along the test trajectory",
-            float(np.mean(~conv)),  # the fraction that failed (finite: --json stays strict JSON)
-            TOL_ASSEMBLY,
-            f"{int(conv.sum())}/{len(conv)} converged"
-            + (f"; inertia of {len(inferred)} bodies from the exported geoms" if inferred else "")
-            + (f"; driven through virtual actuators on {', '.join(virtual)}" if virtual else ""),
-        )
+    note = (f"; inertia of {len(inferred)} bodies from the exported geoms" if inferred else "") + (
+        f"; driven through virtual actuators on {', '.join(virtual)}" if virtual else ""
     )
-    q, qa, qda, qdda = q[conv], qa[conv], qda[conv], qdda[conv]
-    if not len(q):
+    row, mo = driven_motion(mech, name, note)
+    checks = [row]
+    if mo is None:
         return checks
-    st.next()
-    if drv is not mech:  # every actuator's rates along the driven (consistent) motion
-        rd = mb.inverse_dynamics(drv, q, qda, qdda)
-        qa, qda, qdda = q[:, tree.act_qadr], rd.qd[:, tree.act_dof], rd.qdd[:, tree.act_dof]
-    inv = mb.inverse_dynamics(mech, q, qda, qdda)
+    q, qda, qdda, inv = mo.q, mo.qda, mo.qdda, mo.inv
     st.next()
     eng = _mujoco.Engine(engine_model(mech))
     m, d = eng.model, eng.data
@@ -322,7 +355,7 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
         )
     )
     st.next()
-    checks.append(_power_check(drv, name, eng, at, t[conv], q, inv.tau, inv.qd[:, tree.act_dof]))
+    checks.append(_power_check(mo.drv, name, eng, mo.at, mo.t, q, inv.tau, inv.qd[:, tree.act_dof]))
     if simulate:
         st.next()
         start = {"q0": q[0], "qd_act0": qda[0]} if start is None else start

@@ -25,7 +25,7 @@ from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ._core import optional_module
 
@@ -140,9 +140,9 @@ class Engine:
 
     def set_state(
         self,
-        qpos: Array,
-        qvel: Array | None = None,
-        qacc: Array | None = None,
+        qpos: ArrayLike,
+        qvel: ArrayLike | None = None,
+        qacc: ArrayLike | None = None,
         *,
         qpos_index: NDArray[np.intp] | None = None,
         dof_index: NDArray[np.intp] | None = None,

@@ -14,7 +14,6 @@ import numpy as np
 
 from . import _generic as g
 from ._core import Check
-from ._mujoco import assemble_along
 
 __all__ = ["check_mechanism_pinocchio"]
 
@@ -31,23 +30,12 @@ def check_mechanism_pinocchio(mech, name: str | None = None) -> list[Check]:
     mech, virtual = g._virtually_actuated(mech)
     if virtual is None:
         return [Check(name, "actuated rates determine the state", 1.0, g.TOL_ASSEMBLY, "a floating base")]
-    drv = g._driver(mech)
-    t, at = g.trajectory(drv)
-    qa, qda, qdda = at(t)
-    fk = assemble_along(drv, qa)
-    q, conv = fk.q, fk.converged
-    checks = [
-        Check(name, "assembly along the test trajectory", float(np.mean(~conv)), g.TOL_ASSEMBLY,
-              f"{int(conv.sum())}/{len(conv)} converged"),
-    ]  # fmt: skip
-    q, qa, qda, qdda = q[conv], qa[conv], qda[conv], qdda[conv]
-    if not len(q):
+    assembly, mo = g.driven_motion(mech, name)
+    checks = [assembly]
+    if mo is None:
         return checks
     tree = compile_model(mech).tree
-    if drv is not mech:
-        rd = mb.inverse_dynamics(drv, q, qda, qdda)
-        qa, qda, qdda = q[:, tree.act_qadr], rd.qd[:, tree.act_dof], rd.qdd[:, tree.act_dof]
-    inv = mb.inverse_dynamics(mech, q, qda, qdda)
+    q, inv = mo.q, mo.inv
     M_engine = mb.mass_matrix(mech, q)
     P = mb.to_pinocchio(mech)
     model = P.model

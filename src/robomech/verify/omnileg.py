@@ -26,6 +26,7 @@ Checks of the *analytic* model (``mechanisms/omnileg``, Lagrange) against the en
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -156,12 +157,16 @@ def engine_inverse_dynamics(
     jacp = np.zeros((3, m.nv))
     eng = em.engine
 
-    def foot(n: int):  # the foot force's generalized force J_footᵀ F at the state written
+    def foot(n: int) -> Callable[[mujoco.MjData], Array] | None:  # J_footᵀ F at the state written
+        if F is None:
+            return None
+        Fn = F[n]
+
         def applied(d: mujoco.MjData) -> Array:
             mujoco.mj_jacSite(m, d, jacp, None, em.foot_site)
-            return jacp.T @ F[n]
+            return np.asarray(jacp.T @ Fn)
 
-        return None if F is None else applied
+        return applied
 
     for n in range(N):  # the per-sample engine loop (this is what the analytic model is compared with)
         idx = {"qpos_index": em.qpos_index, "dof_index": em.dof_index}
