@@ -14,6 +14,10 @@ import numpy as np
 
 from . import _generic as g
 from ._core import Check
+from ._mujoco import null_space
+
+# Null-space rank decision on the stacked constraint Jacobian (frame Jacobians and coupling rows).
+PIN_RANK_RTOL = 1e-9
 
 __all__ = ["check_mechanism_pinocchio"]
 
@@ -88,11 +92,7 @@ def check_mechanism_pinocchio(mech, name: str | None = None) -> list[Check]:
         Me = T.T @ M_engine[i] @ T
         m_err, m_scale = max(m_err, float(np.abs(Mp - Me).max())), max(m_scale, float(np.abs(Me).max()))
         f = pin.rnea(model, data, qp, vp, ap)
-        if len(K):
-            _, s, Vt = np.linalg.svd(K)
-            Nn = Vt[int(np.sum(s > 1e-9 * s[0])) :].T
-        else:
-            Nn = np.eye(model.nv)
+        Nn = null_space(K, PIN_RANK_RTOL)
         tau = np.linalg.lstsq(Nn.T @ (T.T @ E), Nn.T @ f, rcond=None)[0]
         tau_err = max(tau_err, float(np.abs(tau - inv.tau[i]).max()))
         tau_scale = max(tau_scale, float(np.abs(inv.tau[i]).max()))
