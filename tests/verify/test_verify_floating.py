@@ -107,3 +107,22 @@ def test_a_passive_fall_starts_where_asked():
         assert "forward simulation vs engine (0.2 s, passive)" in {c.quantity for c in checks}
     with pytest.raises(ValueError, match=r"Expected qd0 .*--qvel0"):
         g.check_mechanism(mech, "pendulum", q0=[0.3, 0.2], qd_act0=[1.0, 0.0])
+
+
+def test_a_floating_base_is_checked_against_pinocchio_with_teeth():
+    """``--engine pinocchio``: rnea, crba and aba at the same random states; an engine model with one
+    thigh 1 % heavier fails all three."""
+    pytest.importorskip("pinocchio")
+    from robomech.verify import _pinocchio_engine as pe
+
+    checks = pe.check_mechanism_pinocchio(QUAD, "quadruped")
+    assert [c.quantity for c in checks] == [
+        "generalized forces (vs rnea)",
+        "mass matrix (vs crba)",
+        "forward dynamics under actuator forces (vs aba)",
+    ]
+    assert all(c.passed for c in checks), [(c.quantity, c.max_error) for c in checks]
+    wrong = mb.from_mjcf(quadruped(thigh_mass=1.313))
+    real = mb.to_pinocchio
+    with um.patch.object(mb, "to_pinocchio", lambda mech: real(wrong)):
+        assert not any(c.passed for c in pe.check_mechanism_pinocchio(QUAD, "quadruped"))

@@ -45,6 +45,7 @@ __all__ = [
     "driven_motion",
     "engine_inverse_dynamics",
     "engine_model",
+    "floating_states",
     "run_generic",
     "split_targets",
     "trajectory",
@@ -363,18 +364,42 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
     return checks
 
 
-def _floating_states(eng, mech, n: int, rng) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``n`` random states ``q (n, nq), qd, qdd (n, nv)`` around the reference: every coordinate moved
-    by ``mj_integratePos`` (quaternions stay unit) by FLOAT_AMP (rad; FLOAT_AMP L along translations),
-    rates and accelerations of order 1 rad/s (L/s) and 10 rad/s^2 (10 L/s^2)."""
-    import mujoco
+def floating_states(mech, n: int, rng) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``n`` random states ``q (n, nq), qd, qdd (n, nv)`` around the reference (engine-free: the MuJoCo
+    and Pinocchio checks share them): coordinates moved by FLOAT_AMP (rad; FLOAT_AMP L along
+    translations), each quaternion turned by a random rotation of that order (kept unit), rates and
+    accelerations of order 1 rad/s (L/s) and 10 rad/s^2 (10 L/s^2)."""
+    from robomech.multibody._tree import _TYPES
 
     tree = mech.tree
-    scale = np.where(tree.dof_translational, tree.length, 1.0)
-    q = np.tile(np.asarray(tree.q0, float), (n, 1))
-    for i in range(n):
-        mujoco.mj_integratePos(eng.model, q[i], FLOAT_AMP * scale * rng.standard_normal(mech.nv), 1.0)
-    return q, scale * rng.standard_normal((n, mech.nv)), 10 * scale * rng.standard_normal((n, mech.nv))
+    L = tree.length
+    dof_scale = np.where(tree.dof_translational, L, 1.0)
+    q_scale = np.zeros(mech.nq)  # quaternions are turned below
+    moved = {
+        _TYPES["hinge"]: (1, FLOAT_AMP),
+        _TYPES["slide"]: (1, FLOAT_AMP * L),
+        _TYPES["free"]: (3, FLOAT_AMP * L),
+    }
+    for typ, a in zip(tree.jnt_type, tree.jnt_qadr, strict=True):
+        width, scale = moved.get(typ, (0, 0.0))
+        q_scale[a : a + width] = scale
+    q = np.asarray(tree.q0, float) + q_scale * rng.standard_normal((n, mech.nq))
+    for a in np.atleast_1d(tree.quat_adr).astype(int):  # q0's orientation turned by exp(FLOAT_AMP w / 2)
+        w = FLOAT_AMP * rng.standard_normal((n, 3))
+        angle = np.linalg.norm(w, axis=-1, keepdims=True)
+        dq = np.concatenate([np.cos(angle / 2), np.sin(angle / 2) * w / np.maximum(angle, 1e-300)], -1)
+        q[:, a : a + 4] = _quat_mul(dq, np.asarray(tree.q0[a : a + 4], float))
+    qd = dof_scale * rng.standard_normal((n, mech.nv))
+    return q, qd, 10 * dof_scale * rng.standard_normal((n, mech.nv))
+
+
+def _quat_mul(p: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Hamilton product of ``(w, x, y, z)`` quaternions (broadcast)."""
+    pw, pv = p[..., :1], p[..., 1:]
+    rw, rv = r[..., :1], r[..., 1:]
+    return np.concatenate(
+        [pw * rw - np.sum(pv * rv, -1, keepdims=True), pw * rv + rw * pv + np.cross(pv, rv)], -1
+    )
 
 
 def _free_system(m) -> bool:
@@ -403,7 +428,7 @@ def _floating_checks(mech, name, simulate: bool, st, duration: float, start) -> 
     eng = _mujoco.Engine(engine_model(mech))
     L = mech.tree.length
     st.next()
-    q, qd, qdd = _floating_states(eng, mech, N_FLOAT, rng)
+    q, qd, qdd = floating_states(mech, N_FLOAT, rng)
     st.next()
     f = mb.generalized_forces(mech, q, qd, qdd)
     M = mb.mass_matrix(mech, q)
