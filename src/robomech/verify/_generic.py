@@ -19,6 +19,10 @@ multibody layer with the engine's *own* computations along a smooth trajectory o
   (gravity only), against MuJoCo's RK4 integration with stiff equality constraints; and the energy
   drift of the multibody simulation.
 
+A floating base (no hinge/slide joints determine its state) gets, at random states, its generalized
+forces (``mj_rne``), mass matrix (``mj_fullM``) and, for a tree, forward dynamics under actuator forces
+(the engine's ``qacc``), then a free flight against MuJoCo's RK4 with its momentum and energy.
+
 MuJoCo is imported inside the functions (the engine is the optional ``verify`` extra).  Joint damping,
 armature, springs, limits and contacts are not part of a multibody description and are absent from
 the exported engine model too, so both sides model the same rigid mechanism.
@@ -403,14 +407,23 @@ def _quat_mul(p: np.ndarray, r: np.ndarray) -> np.ndarray:
 
 
 def _free_system(m) -> bool:
-    """Every body hangs from a free joint on the world and nothing ties a body to the world: the
-    system's linear momentum changes by its weight only and its angular momentum about its centre of
-    mass is conserved."""
+    """Every body hangs from a free joint on the world and no closure ties a body to the world (closures
+    and couplings inside the system are internal forces): the system's linear momentum changes by its
+    weight only and its angular momentum about its centre of mass is conserved."""
     import mujoco
 
     top = [b for b in range(1, m.nbody) if m.body_parentid[b] == 0]
     free = int(mujoco.mjtJoint.mjJNT_FREE)
-    return m.neq == 0 and all(m.body_jntnum[b] > 0 and m.jnt_type[m.body_jntadr[b]] == free for b in top)
+    if not all(m.body_jntnum[b] > 0 and m.jnt_type[m.body_jntadr[b]] == free for b in top):
+        return False
+    site = int(mujoco.mjtObj.mjOBJ_SITE)
+    for e in range(m.neq):
+        if m.eq_type[e] in (mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD):
+            ids = (m.eq_obj1id[e], m.eq_obj2id[e])
+            bodies = [m.site_bodyid[i] if m.eq_objtype[e] == site else i for i in ids]
+            if 0 in bodies:
+                return False
+    return True
 
 
 def _floating_checks(mech, name, simulate: bool, st, duration: float, start) -> list[Check]:
