@@ -104,7 +104,7 @@ TOL_TREE = Tolerance(1e-9, "exact tree dynamics both sides (RNEA, CRBA); roundin
 N_FLOAT = 12
 FLOAT_AMP = 0.5
 # A free flight of a tree has no soft constraint: the engine's RK4 (0.1 ms) error is ~h^4 and the
-# multibody DOP853 (rtol 1e-10) ~1e-10 relative; measured 6e-13 relative on the test quadruped (0.3 s).
+# multibody DOP853 (rtol 1e-10) ~1e-10 relative; measured 3e-13 relative on the test quadruped (0.3 s).
 TOL_FLIGHT = Tolerance(1e-7, "engine RK4 at 0.1 ms vs DOP853 at rtol 1e-10 (no constraints)", relative=True)
 # Momentum along the multibody flight: the integration error of DOP853 at rtol 1e-10 (~1e-10 relative).
 TOL_MOMENTUM = Tolerance(
