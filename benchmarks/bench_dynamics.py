@@ -28,6 +28,7 @@ from robomech import multibody as mb
 from robomech.mechanisms import omnileg as ol
 from robomech.mechanisms import spherical_leg as sl
 from robomech.verify import _generic as g
+from robomech.verify._mujoco import assemble_along
 
 from _harness import Workload
 
@@ -45,7 +46,8 @@ def _tile(*xs: np.ndarray) -> tuple[np.ndarray, ...]:
 def _gallery_states(mech):
     t, at = g.trajectory(mech, n=N_DISTINCT, t_end=N_DISTINCT * 0.01)
     qa, qd, qdd = at(t)
-    q, conv = g._assemble_along(mech, qa)  # continuation along the trajectory keeps the branch
+    fk = assemble_along(mech, qa)  # continuation along the trajectory keeps the branch
+    q, conv = fk.q, fk.converged
     assert conv.all()
     return _tile(q, qd, qdd)
 
@@ -126,8 +128,9 @@ def _omnileg() -> list[Workload]:
         mech = mb.from_mjcf(mb.to_mjcf(mech))
     t = np.linspace(0.0, 6.0, N_DISTINCT)
     prof = ol.joint_trajectory_eq52(t)  # the gait of paper 2, (alpha, beta, gamma) = q_act order
-    q, conv = g._assemble_along(mech, prof.q)
-    assert conv.all()
+    fk = assemble_along(mech, prof.q)
+    assert fk.converged.all()
+    q = fk.q
     Q, QA, QD, QDD = _tile(q, prof.q, prof.qd, prof.qdd)
 
     def analytic():

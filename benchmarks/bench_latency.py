@@ -28,6 +28,7 @@ import numpy as np
 
 from robomech import multibody as mb
 from robomech.verify import _generic as g
+from robomech.verify._mujoco import Engine, assemble_along
 
 N_BATCH1 = 2000  # batch-1 calls timed
 N_LARGE = 100_000
@@ -38,8 +39,9 @@ REPEATS = 3  # large-batch runs per thread count (best kept)
 def _states(mech, n):
     t, at = g.trajectory(mech, n=200, t_end=2.0)
     qa, qd, qdd = at(t)
-    q, conv = g._assemble_along(mech, qa)
-    assert conv.all()
+    fk = assemble_along(mech, qa)
+    assert fk.converged.all()
+    q = fk.q
     reps = -(-n // q.shape[0])
     return tuple(np.tile(x, (reps, 1))[:n] for x in (q, qd, qdd))
 
@@ -50,6 +52,7 @@ def lean_mujoco(mech):
 
     m = g.engine_model(mech)
     d = mujoco.MjData(m)
+    eng = Engine(m, d)
     E = np.zeros((m.nv, len(mech.actuated)))
     E[mech.tree.act_dof, np.arange(len(mech.actuated))] = 1.0
     f = np.zeros(m.nv)
@@ -63,7 +66,7 @@ def lean_mujoco(mech):
         mujoco.mj_makeConstraint(m, d)
         mujoco.mj_comVel(m, d)
         mujoco.mj_rne(m, d, 1, f)
-        Jc = g._efc_equality(m, d)
+        Jc = eng.equality()[0]
         _, s, Vt = np.linalg.svd(Jc)
         Nn = Vt[int(np.sum(s > 1e-9 * s[0])) :].T
         return np.linalg.lstsq(Nn.T @ E, Nn.T @ f, rcond=None)[0]

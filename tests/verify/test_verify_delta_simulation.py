@@ -14,6 +14,7 @@ import pytest
 
 from robomech import multibody as mb
 from robomech.verify import _generic as g
+from robomech.verify._mujoco import assemble_along
 
 # Half of the CLI's horizon; a multiple of (SIM_SAMPLES - 1) * SIM_TIMESTEP: the samples fall on engine steps.
 T_SHORT = 0.15
@@ -27,7 +28,8 @@ def test_delta_passive_simulation_tracks_the_engine():
     drv = g._driver(mech)
     t, at = g.trajectory(drv)
     qa, qda, _ = at(t[:1])
-    q, conv = g._assemble_along(drv, qa)
+    fk = assemble_along(drv, qa)
+    q, conv = fk.q, fk.converged
     assert conv.all()
     checks = g._simulation_checks(mech, "delta", q[0], qda[0], duration=T_SHORT)
     assert [c.quantity for c in checks] == [

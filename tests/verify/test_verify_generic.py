@@ -12,6 +12,7 @@ from robomech import multibody as mb
 from robomech.cli import main
 from robomech.verify import _generic as g
 from robomech.verify._core import Tolerance
+from robomech.verify._mujoco import assemble_along
 
 FAST = ["four_bar", "bennett", "planar_3rrr", "rps_3"]
 
@@ -48,7 +49,8 @@ def test_inverse_dynamics_check_has_teeth():
     mech = dataclasses.replace(mb.gallery.load("four_bar"), gravity=(0.0, -9.81, 0.0))
     t, at = g.trajectory(mech)
     qa, qd, qdd = at(t[:4])
-    q, conv = g._assemble_along(mech, qa)
+    fk = assemble_along(mech, qa)
+    q, conv = fk.q, fk.converged
     assert conv.all()
     import mujoco
 
@@ -131,3 +133,31 @@ def test_passive_verification_has_teeth():
         checks = g.check_mechanism(mech, "pendulum", simulate=False)
     failed = {c.quantity for c in checks if not c.passed}
     assert "inverse dynamics (mj_rne through efc_J)" in failed
+
+
+# A parallelogram four-bar (crank = rocker = 0.5 m, coupler = ground = 1 m), passive, falling from 1 rad:
+# each time the crank passes horizontal every link is collinear (a change point, where the
+# anti-parallelogram branch meets this one): the multibody motion switches branch at the second pass.
+PARALLELOGRAM = """<mujoco model="parallelogram"><compiler angle="radian"/><option gravity="0 0 -9.81"/>
+<default><geom contype="0" conaffinity="0" density="1000"/></default><worldbody>
+ <body name="crank"><joint name="crank" axis="0 1 0"/>
+  <geom type="capsule" fromto="0 0 0 0 0 0.5" size="0.02"/>
+  <body name="coupler" pos="0 0 0.5"><joint name="elbow" axis="0 1 0"/>
+   <geom type="capsule" fromto="0 0 0 1 0 0" size="0.02"/></body></body>
+ <body name="rocker" pos="1 0 0"><joint name="rocker" axis="0 1 0"/>
+  <geom type="capsule" fromto="0 0 0 0 0 0.5" size="0.02"/></body></worldbody>
+<equality><connect body1="coupler" body2="rocker" anchor="1 0 0"/></equality></mujoco>"""
+
+
+@pytest.mark.slow
+def test_a_passive_fall_through_a_singular_pose_says_where_it_crossed():
+    """The fall leaves the engine after the second change point (crank at 3 pi / 2, t ~ 0.694 s, between
+    two samples 33 ms apart); the failed check names the crossing, resolved between the samples."""
+    mech = mb.from_mjcf(PARALLELOGRAM)
+    checks = g.check_mechanism(mech, "parallelogram", duration=1.0, q0=[1.0, -1.0, 1.0])
+    sim = next(c for c in checks if c.quantity.startswith("forward simulation"))
+    assert not sim.passed
+    assert "crossed a type II singularity near t = 0.69" in sim.detail, sim.detail
+    sigma = float(sim.detail.rsplit("sigma_min ", 1)[1].split()[0])
+    assert sigma < g.SINGULAR_SIGMA_RTOL * mech.tree.length
+    assert all(c.passed for c in checks if c is not sim)  # the rest of the description is right

@@ -73,6 +73,15 @@ def _add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="QD",
         help="start rates of the actuated joints for that simulation (n_act numbers; default 0 with --q0)",
     )
+    p.add_argument(
+        "--qvel0",
+        type=float,
+        nargs="+",
+        default=None,
+        metavar="V",
+        help="instead of --qd0: every coordinate's start rate (MuJoCo qvel, nv numbers), for passive, "
+        "underactuated and floating-base mechanisms",
+    )
 
 
 def _run_pinocchio(args: argparse.Namespace, out) -> int:
@@ -85,7 +94,7 @@ def _run_pinocchio(args: argparse.Namespace, out) -> int:
     from robomech.verify._pinocchio_engine import check_mechanism_pinocchio
 
     if importlib.util.find_spec("pinocchio") is None:
-        raise CliError('--engine pinocchio needs Pinocchio: install robomech[pinocchio]')
+        raise CliError("--engine pinocchio needs Pinocchio: install robomech[pinocchio]")
     if not args.mechanisms:
         raise CliError("--engine pinocchio needs a mechanism: a gallery name, a paper description or a file")
     report = VerificationReport()
@@ -136,13 +145,12 @@ def _run(args: argparse.Namespace) -> int:
     report = VerificationReport()
     sim = {
         k: v
-        for k, v in (("duration", args.duration), ("q0", args.q0), ("qd_act0", args.qd0))
+        for k, v in (("duration", args.duration), ("q0", args.q0), ("qd_act0", args.qd0), ("qd0", args.qvel0))
         if v is not None
     }
     if sim and not generic:
-        raise CliError(
-            f"--{next(iter(sim)).replace('qd_act0', 'qd0')} applies to MJCF files and gallery mechanisms only"
-        )
+        flag = {"qd_act0": "qd0", "qd0": "qvel0"}.get(next(iter(sim)), next(iter(sim)))
+        raise CliError(f"--{flag} applies to MJCF files and gallery mechanisms only")
     try:
         report.checks.extend(run_generic(generic, **sim))
     except ValueError as exc:

@@ -19,6 +19,10 @@ multibody layer with the engine's *own* computations along a smooth trajectory o
   (gravity only), against MuJoCo's RK4 integration with stiff equality constraints; and the energy
   drift of the multibody simulation.
 
+A floating base (no hinge/slide joints determine its state) gets, at random states, its generalized
+forces (``mj_rne``), mass matrix (``mj_fullM``) and, for a tree, forward dynamics under actuator forces
+(the engine's ``qacc``), then a free flight against MuJoCo's RK4 with its momentum and energy.
+
 MuJoCo is imported inside the functions (the engine is the optional ``verify`` extra).  Joint damping,
 armature, springs, limits and contacts are not part of a multibody description and are absent from
 the exported engine model too, so both sides model the same rigid mechanism.
@@ -27,20 +31,25 @@ the exported engine model too, so both sides model the same rigid mechanism.
 from __future__ import annotations
 
 import dataclasses
-import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from robomech._progress import stages
 
+from . import _mujoco
 from ._core import Check, Tolerance, VerificationReport
 
 __all__ = [
+    "DrivenMotion",
     "check_mechanism",
     "describe",
+    "driven_motion",
     "engine_inverse_dynamics",
     "engine_model",
+    "floating_states",
     "run_generic",
     "split_targets",
     "trajectory",
@@ -72,11 +81,34 @@ MAX_SIM_DURATION = 10.0
 SIM_SAMPLES = 31
 # A passive block whose smallest singular value is below this fraction of L is at a type II singularity.
 SINGULAR_SIGMA_RTOL = 1e-6
+# Locating a crossing between samples (only when a simulation check fails): each local minimum of the
+# sampled sigma_min, the latest MAX_ZOOMS before the divergence, is simulated again on ZOOM_SAMPLES
+# times and narrowed ZOOM_LEVELS times (a factor (ZOOM_SAMPLES - 1) / 2 each): a 30 ms sample interval
+# shrinks to ~2 ns, where a crossing at 10 rad/s x 1 m falls below SINGULAR_SIGMA_RTOL L.  Near a
+# crossing sigma_min falls linearly (each level lowers it ~(ZOOM_SAMPLES - 1) / 2 times); a level that
+# lowers it by less than a factor 1 / ZOOM_NEAR_MISS has found a positive minimum: the zoom stops.
+ZOOM_SAMPLES = 41
+ZOOM_LEVELS = 7
+ZOOM_NEAR_MISS = 0.5
+MAX_ZOOMS = 1
 TOL_SIM = Tolerance(1e-3, "soft engine constraints (0.5 ms, 0.9999) and 0.1 ms RK4 steps", relative=True)
 TOL_DRIFT = Tolerance(
     1e-7,
     "DOP853 at rtol 1e-10 with projection onto the manifold; relative to the energy exchanged",
     relative=True,
+)
+# Floating bases: the tree quantities of two exact rigid-body codes of the same bodies (RNEA, CRBA,
+# tree forward dynamics) agree to rounding (acceptance: 1e-9 relative), at N_FLOAT random states
+# moved FLOAT_AMP (rad, or L) from the reference.
+TOL_TREE = Tolerance(1e-9, "exact tree dynamics both sides (RNEA, CRBA); rounding only", relative=True)
+N_FLOAT = 12
+FLOAT_AMP = 0.5
+# A free flight of a tree has no soft constraint: the engine's RK4 (0.1 ms) error is ~h^4 and the
+# multibody DOP853 (rtol 1e-10) ~1e-10 relative; measured 3e-13 relative on the test quadruped (0.3 s).
+TOL_FLIGHT = Tolerance(1e-7, "engine RK4 at 0.1 ms vs DOP853 at rtol 1e-10 (no constraints)", relative=True)
+# Momentum along the multibody flight: the integration error of DOP853 at rtol 1e-10 (~1e-10 relative).
+TOL_MOMENTUM = Tolerance(
+    1e-7, "DOP853 at rtol 1e-10 with projection; relative to the momentum", relative=True
 )
 # Every test configuration must assemble: the error is the fraction that failed (any failure >= 1/N_TRAJ).
 TOL_ASSEMBLY = Tolerance(1e-12, "every sample must assemble (FK converged); error = fraction failed")
@@ -84,70 +116,16 @@ TOL_ASSEMBLY = Tolerance(1e-12, "every sample must assemble (FK converged); erro
 N_TRAJ = 12
 T_TRAJ = 1.0
 AMP = 0.15
-# Null-space rank decision on the engine's efc_J (equality rows, length units): as in the multibody layer.
-ENGINE_RANK_RTOL = 1e-10
-
-
-def engine_options(
-    xml: str,
-    *,
-    timestep: float,
-    integrator: str | None = None,
-    jacobian: str | None = None,
-    solref: str | None = None,
-    solimp: str | None = None,
-    contact: bool = True,
-) -> ET.Element:
-    """The exported MJCF ``xml`` with the engine options a check simulates with (not part of a mechanism
-    description): ``<option timestep integrator jacobian>``, contacts off with ``contact=False``, and
-    ``solref`` / ``solimp`` on every equality constraint; ``None`` leaves MuJoCo's default. Returns the
-    root element (serialise with ``ET.tostring(root, encoding="unicode")``)."""
-    root = ET.fromstring(xml)
-    opt = root.find("option")
-    if opt is None:  # to_mjcf always writes <option gravity=...>; kept robust
-        opt = ET.SubElement(root, "option")
-    opt.set("timestep", repr(timestep))
-    for key, value in (("integrator", integrator), ("jacobian", jacobian)):
-        if value is not None:
-            opt.set(key, value)
-    if not contact:
-        ET.SubElement(opt, "flag", contact="disable")
-    eq = root.find("equality")
-    for e in [] if eq is None else list(eq):
-        for key, value in (("solref", solref), ("solimp", solimp)):
-            if value is not None:
-                e.set(key, value)
-    return root
 
 
 def engine_model(mech, *, simulation: bool = False):
     """MuJoCo model of ``mech`` from ``mb.to_mjcf``; ``simulation=True`` sets the stiff equality
     constraints and the RK4 step used by the forward-simulation check."""
-    import mujoco
-
-    from robomech import multibody as mb
-
-    xml = mb.to_mjcf(mech)
     if simulation:
-        root = engine_options(
-            xml, timestep=SIM_TIMESTEP, integrator="RK4", solref=SIM_SOLREF, solimp=SIM_SOLIMP
+        return _mujoco.engine_model(
+            mech, timestep=SIM_TIMESTEP, integrator="RK4", solref=SIM_SOLREF, solimp=SIM_SOLIMP
         )
-        xml = ET.tostring(root, encoding="unicode")
-    return mujoco.MjModel.from_xml_string(xml)
-
-
-def _efc_equality(m, d) -> np.ndarray:
-    import mujoco
-
-    eq = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
-    if d.nefc == 0:
-        return np.zeros((0, m.nv))
-    if mujoco.mj_isSparse(m):
-        J = np.zeros((d.nefc, m.nv))
-        mujoco.mju_sparse2dense(J, d.efc_J, d.efc_J_rownnz, d.efc_J_rowadr, d.efc_J_colind)
-    else:
-        J = np.array(d.efc_J)[: d.nefc * m.nv].reshape(d.nefc, m.nv)
-    return J[eq]
+    return _mujoco.engine_model(mech)
 
 
 def trajectory(mech, n: int = N_TRAJ, t_end: float = T_TRAJ, seed: int = 0):
@@ -169,44 +147,26 @@ def trajectory(mech, n: int = N_TRAJ, t_end: float = T_TRAJ, seed: int = 0):
     return t, at
 
 
-def _assemble_along(mech, qa: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """FK along a sequence of inputs, each from the previous solution (continuation keeps the branch)."""
-    from robomech import multibody as mb
-
-    q = np.empty((len(qa), mech.nq))
-    conv = np.empty(len(qa), dtype=bool)
-    guess = None
-    for i, x in enumerate(qa):
-        r = mb.forward_kinematics(mech, x, guess=guess, steps=1 if guess is not None else 4)
-        q[i], conv[i] = r.q, r.converged
-        guess = r.q if r.converged else guess
-    return q, conv
-
-
 def engine_inverse_dynamics(m, d, mech, q, qd, qdd) -> np.ndarray:
-    """Actuator forces from the engine: ``mj_rne`` tree dynamics projected through its ``efc_J``."""
-    import mujoco
+    """Actuator forces from the engine: ``mj_rne`` tree dynamics projected through its ``efc_J``
+    (:meth:`Engine.inverse_dynamics <robomech.verify._mujoco.Engine.inverse_dynamics>` on ``m, d``)."""
+    return _mujoco.Engine(m, d).inverse_dynamics(q, qd, qdd, mech.tree.act_dof)
 
-    d.qpos[:] = q
-    d.qvel[:] = qd
-    mujoco.mj_forward(m, d)
-    d.qacc[:] = qdd
-    f = np.zeros(m.nv)
-    mujoco.mj_rne(m, d, 1, f)
-    Jc = _efc_equality(m, d)
-    if Jc.shape[0]:
-        _, s, Vt = np.linalg.svd(Jc)
-        r = int(np.sum(s > ENGINE_RANK_RTOL * max(s[0], 1e-300)))
-        Nn = Vt[r:].T
-    else:
-        Nn = np.eye(m.nv)
-    E = np.zeros((m.nv, len(mech.actuated)))
-    E[mech.tree.act_dof, np.arange(len(mech.actuated))] = 1.0
-    return np.linalg.lstsq(Nn.T @ E, Nn.T @ f, rcond=None)[0]
+
+def _sample_times(duration: float) -> np.ndarray:
+    """SIM_SAMPLES output times over ``duration``, on the engine's step grid (SIM_TIMESTEP): the engine
+    is read at exactly the times the multibody simulation reports."""
+    steps = max(1, round(duration / SIM_TIMESTEP))
+    return np.unique(np.round(np.linspace(0.0, steps, SIM_SAMPLES))) * SIM_TIMESTEP
 
 
 def _rel(err: float, scale: float) -> float:
     return float(err / scale) if scale > 0 else float(err)
+
+
+def _rel_diff(mine: np.ndarray, engine: np.ndarray) -> float:
+    """Largest difference relative to the engine's largest value."""
+    return _rel(float(np.max(np.abs(mine - engine))), float(np.max(np.abs(engine))))
 
 
 # The stages of check_mechanism, reported as progress (robomech._progress).
@@ -222,30 +182,45 @@ def check_mechanism(
     duration: float = T_SIM,
     q0: object = None,
     qd_act0: object = None,
+    qd0: object = None,
 ) -> list[Check]:
     """Every check of this module for ``mech`` (the rows of the ``robomech verify`` table).
 
     ``duration`` (s, ``0 < duration <= MAX_SIM_DURATION``) is the length of the passive forward
-    simulation; ``q0`` (nq,) and ``qd_act0`` (n_act,) its start (default: the test trajectory's first
-    state; ``q0`` must be assembled, ``qd_act0`` defaults to zero when ``q0`` is given).
+    simulation; ``q0`` (nq,) its start configuration (assembled) and its start rates either
+    ``qd_act0`` (n_act,: the actuated rates, where the actuators determine the state) or ``qd0`` (nv,:
+    every coordinate's rate, MuJoCo ``qvel``, any mechanism: passive, underactuated, floating);
+    zero rates when only ``q0`` is given; default: the test trajectory's first state (for a floating
+    base a tumbling start, see :func:`_floating_checks`).
     """
     from robomech._validation import as_array, check_bool, check_real
 
     simulate = check_bool(simulate, "simulate")
     duration = check_real(duration, "duration", low=0.0, high=MAX_SIM_DURATION, low_open=True)
     start = None
-    if q0 is not None or qd_act0 is not None:
+    if q0 is not None or qd_act0 is not None or qd0 is not None:
         from robomech import multibody as mb
 
         if q0 is None:
-            raise ValueError("Expected q0 with qd_act0 (the start configuration), got None.")
+            raise ValueError("Expected q0 with the start rates (the start configuration), got None.")
+        if qd_act0 is not None and qd0 is not None:
+            raise ValueError("Expected one of qd_act0 (actuated rates) and qd0 (every rate), got both.")
         q0 = as_array(q0, "q0", (mech.nq,))
         if q0.ndim != 1:
             raise ValueError(f"Expected q0 to have shape ({mech.nq},), got {q0.shape}.")
         na = len(mech.actuated)
-        qd = np.zeros(na) if qd_act0 is None else as_array(qd_act0, "qd_act0", (na,))
-        if qd.ndim != 1:
-            raise ValueError(f"Expected qd_act0 to have shape ({na},), got {qd.shape}.")
+        if qd_act0 is not None:
+            if _virtually_actuated(mech)[1] != ():
+                raise ValueError(
+                    f"Expected qd0 (every coordinate's rate, {mech.nv} numbers; CLI --qvel0) for a "
+                    f"mechanism whose actuators do not determine its state, got qd_act0 (actuated rates)."
+                )
+            qd = as_array(qd_act0, "qd_act0", (na,))
+            if qd.ndim != 1:
+                raise ValueError(f"Expected qd_act0 to have shape ({na},), got {qd.shape}.")
+        full = np.zeros(mech.nv) if qd0 is None else as_array(qd0, "qd0", (mech.nv,))
+        if full.ndim != 1:
+            raise ValueError(f"Expected qd0 to have shape ({mech.nv},), got {full.shape}.")
         r = mb.constraint_residual(mech, q0)
         miss = float(np.max(np.abs(r))) if r.size else 0.0
         if not miss <= mb.CONVERGED_RTOL * mech.tree.length:
@@ -253,9 +228,55 @@ def check_mechanism(
                 f"Expected q0 to be an assembled configuration (e.g. forward_kinematics(mech, q_act).q), "
                 f"got closure residual {miss:.3g} m."
             )
-        start = (q0, qd)
+        start = {"q0": q0, **({"qd_act0": qd} if qd_act0 is not None else {"qd0": full})}
     with stages(f"verify {name or getattr(mech, 'name', 'mechanism')}", _STAGES[: 4 + simulate]) as st:
         return _checks(mech, name, simulate, st, duration, start)
+
+
+@dataclasses.dataclass(frozen=True)
+class DrivenMotion:
+    """The test motion of a mechanism whose actuators (real or virtual) determine its state, at the
+    samples that assembled: times ``t``, configurations ``q``, every actuator's ``qa, qda, qdda``, the
+    multibody ``inv = inverse_dynamics(mech, q, qda, qdda)``; ``drv`` the mechanism driven (``mech`` or,
+    for redundant actuation, a determining subset, :func:`_driver`) and ``at(t)`` its inputs."""
+
+    mech: Any
+    drv: Any
+    at: Callable
+    t: np.ndarray
+    q: np.ndarray
+    qa: np.ndarray
+    qda: np.ndarray
+    qdda: np.ndarray
+    inv: Any  # multibody.InverseDynamicsResult
+
+
+def driven_motion(mech, name: str, note: str = "") -> tuple[Check, DrivenMotion | None]:
+    """The assembly row of ``mech``'s test trajectory (``note`` appended to its detail) and the motion
+    along it (None where no sample assembled); the engine checks (MuJoCo, Pinocchio) compare along it."""
+    from robomech import multibody as mb
+
+    tree = mech.tree
+    drv = _driver(mech)  # redundant actuation: a consistent motion is driven through `dof` actuators
+    t, at = trajectory(drv)
+    qa, qda, qdda = at(t)
+    fk = _mujoco.assemble_along(drv, qa)
+    conv = fk.converged
+    row = Check(
+        name,
+        "assembly along the test trajectory",
+        float(np.mean(~conv)),  # the fraction that failed (finite: --json stays strict JSON)
+        TOL_ASSEMBLY,
+        f"{int(conv.sum())}/{len(conv)} converged{note}",
+    )
+    if not conv.any():
+        return row, None
+    q, qa, qda, qdda = fk.q[conv], qa[conv], qda[conv], qdda[conv]
+    if drv is not mech:  # every actuator's rates along the driven (consistent) motion
+        rd = mb.inverse_dynamics(drv, q, qda, qdda)
+        qa, qda, qdda = q[:, tree.act_qadr], rd.qd[:, tree.act_dof], rd.qdd[:, tree.act_dof]
+    inv = mb.inverse_dynamics(mech, q, qda, qdda)
+    return row, DrivenMotion(mech, drv, at, t[conv], q, qa, qda, qdda, inv)
 
 
 def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM, start=None) -> list[Check]:
@@ -270,47 +291,22 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
         # as exported, with those inertias on both sides (read back from the engine's compiled model)
         mech = mb.from_mjcf(mb.to_mjcf(mech))
     mech, virtual = _virtually_actuated(mech)
-    if virtual is None:
-        return [
-            Check(
-                name,
-                "actuated rates determine the state",
-                1.0,
-                TOL_ASSEMBLY,
-                "no set of hinge/slide joints determines the state (a floating base): the engine checks "
-                "need a test motion driven through joints; check generalized_forces / mass_matrix directly",
-            )
-        ]
+    if virtual is None:  # a floating base: no joints drive a test motion; its tree dynamics are checked
+        return _floating_checks(mech, name, simulate, st, duration, start)
     tree = mech.tree
     L = tree.length
-    checks: list[Check] = []
     st.next()
-    drv = _driver(mech)  # redundant actuation: a consistent motion is driven through `dof` actuators
-    t, at = trajectory(drv)
-    qa, qda, qdda = at(t)
-    q, conv = _assemble_along(drv, qa)
-    checks.append(
-        Check(
-            name,
-            "assembly along the test trajectory",
-            float(np.mean(~conv)),  # the fraction that failed (finite: --json stays strict JSON)
-            TOL_ASSEMBLY,
-            f"{int(conv.sum())}/{len(conv)} converged"
-            + (f"; inertia of {len(inferred)} bodies from the exported geoms" if inferred else "")
-            + (f"; driven through virtual actuators on {', '.join(virtual)}" if virtual else ""),
-        )
+    note = (f"; inertia of {len(inferred)} bodies from the exported geoms" if inferred else "") + (
+        f"; driven through virtual actuators on {', '.join(virtual)}" if virtual else ""
     )
-    q, qa, qda, qdda = q[conv], qa[conv], qda[conv], qdda[conv]
-    if not len(q):
+    row, mo = driven_motion(mech, name, note)
+    checks = [row]
+    if mo is None:
         return checks
+    q, qda, qdda, inv = mo.q, mo.qda, mo.qdda, mo.inv
     st.next()
-    if drv is not mech:  # every actuator's rates along the driven (consistent) motion
-        rd = mb.inverse_dynamics(drv, q, qda, qdda)
-        qa, qda, qdda = q[:, tree.act_qadr], rd.qd[:, tree.act_dof], rd.qdd[:, tree.act_dof]
-    inv = mb.inverse_dynamics(mech, q, qda, qdda)
-    st.next()
-    m = engine_model(mech)
-    d = mujoco.MjData(m)
+    eng = _mujoco.Engine(engine_model(mech))
+    m, d = eng.model, eng.data
     closure = vel = acc = 0.0
     vscale = ascale = 0.0
     tau_e = np.zeros_like(inv.tau)
@@ -318,17 +314,14 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
     sites = [s.name for s in mech.sites]
     J = {s: mb.site_jacobian(mech, q, s) for s in sites}
     H = {s: mb.site_hessian(mech, q, s) for s in sites}
+    wv = np.array([L, L, L, 1, 1, 1])
     adm = 0.0
     for i in range(len(q)):
-        d.qpos[:] = q[i]
-        d.qvel[:] = inv.qd[i]
-        mujoco.mj_forward(m, d)
-        eq = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
-        if np.any(eq):
-            closure = max(closure, float(np.max(np.abs(d.efc_pos[eq]))))
-            Jc = _efc_equality(m, d)
+        eng.set_state(q[i], inv.qd[i], inv.qdd[i])
+        Jc, pos = eng.equality()
+        if len(pos):
+            closure = max(closure, float(np.max(np.abs(pos))))
             adm = max(adm, float(np.max(np.abs(Jc @ inv.qd[i]))))
-        d.qacc[:] = inv.qdd[i]
         mujoco.mj_rnePostConstraint(m, d)
         for s in sites:
             sid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, s)
@@ -339,12 +332,11 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
             a6[3:] += g  # the engine's accelerations include -g (an accelerometer's reading)
             mine_v = J[s][i] @ qda[i]
             mine_a = J[s][i] @ qdda[i] + np.einsum("ijk,j,k->i", H[s][i], qda[i], qda[i])
-            wv = np.array([L, L, L, 1, 1, 1])
             vel = max(vel, float(np.max(np.abs((mine_v - v6) * wv))))
             acc = max(acc, float(np.max(np.abs((mine_a - a6) * wv))))
             vscale = max(vscale, float(np.max(np.abs(mine_v * wv))))
             ascale = max(ascale, float(np.max(np.abs(mine_a * wv))))
-        tau_e[i] = engine_inverse_dynamics(m, d, mech, q[i], inv.qd[i], inv.qdd[i])
+        tau_e[i] = eng.inverse_dynamics(q[i], inv.qd[i], inv.qdd[i], tree.act_dof)
     qdscale = L * max(float(np.max(np.abs(inv.qd))), 1e-300)
     checks += [
         Check(name, "closure (engine efc_pos)", closure / L, TOL_CLOSURE, "max |efc_pos| / L"),
@@ -368,23 +360,173 @@ def _checks(mech, name: str | None, simulate: bool, st, duration: float = T_SIM,
         )
     )
     st.next()
-    checks.append(_power_check(drv, name, m, d, at, t[conv], q, inv.tau, inv.qd[:, tree.act_dof]))
+    checks.append(_power_check(mo.drv, name, eng, mo.at, mo.t, q, inv.tau, inv.qd[:, tree.act_dof]))
     if simulate:
         st.next()
-        q_s, qd_s = (q[0], qda[0]) if start is None else start
-        checks += _simulation_checks(mech, name, q_s, qd_s, duration)
+        start = {"q0": q[0], "qd_act0": qda[0]} if start is None else start
+        checks += _simulation_checks(mech, name, duration=duration, **start)
     return checks
 
 
-def _engine_energy(m, d, q, qd) -> float:
+def floating_states(mech, n: int, rng) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``n`` random states ``q (n, nq), qd, qdd (n, nv)`` around the reference (engine-free: the MuJoCo
+    and Pinocchio checks share them): coordinates moved by FLOAT_AMP (rad; FLOAT_AMP L along
+    translations), each quaternion turned by a random rotation of that order (kept unit), rates and
+    accelerations of order 1 rad/s (L/s) and 10 rad/s^2 (10 L/s^2)."""
+    from robomech.multibody._tree import _TYPES
+
+    tree = mech.tree
+    L = tree.length
+    dof_scale = np.where(tree.dof_translational, L, 1.0)
+    q_scale = np.zeros(mech.nq)  # quaternions are turned below
+    moved = {
+        _TYPES["hinge"]: (1, FLOAT_AMP),
+        _TYPES["slide"]: (1, FLOAT_AMP * L),
+        _TYPES["free"]: (3, FLOAT_AMP * L),
+    }
+    for typ, a in zip(tree.jnt_type, tree.jnt_qadr, strict=True):
+        width, scale = moved.get(typ, (0, 0.0))
+        q_scale[a : a + width] = scale
+    q = np.asarray(tree.q0, float) + q_scale * rng.standard_normal((n, mech.nq))
+    for a in np.atleast_1d(tree.quat_adr).astype(int):  # q0's orientation turned by exp(FLOAT_AMP w / 2)
+        w = FLOAT_AMP * rng.standard_normal((n, 3))
+        angle = np.linalg.norm(w, axis=-1, keepdims=True)
+        dq = np.concatenate([np.cos(angle / 2), np.sin(angle / 2) * w / np.maximum(angle, 1e-300)], -1)
+        q[:, a : a + 4] = _quat_mul(dq, np.asarray(tree.q0[a : a + 4], float))
+    qd = dof_scale * rng.standard_normal((n, mech.nv))
+    return q, qd, 10 * dof_scale * rng.standard_normal((n, mech.nv))
+
+
+def _quat_mul(p: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Hamilton product of ``(w, x, y, z)`` quaternions (broadcast)."""
+    pw, pv = p[..., :1], p[..., 1:]
+    rw, rv = r[..., :1], r[..., 1:]
+    return np.concatenate(
+        [pw * rw - np.sum(pv * rv, -1, keepdims=True), pw * rv + rw * pv + np.cross(pv, rv)], -1
+    )
+
+
+def _free_system(m) -> bool:
+    """Every body hangs from a free joint on the world and no closure ties a body to the world (closures
+    and couplings inside the system are internal forces): the system's linear momentum changes by its
+    weight only and its angular momentum about its centre of mass is conserved."""
     import mujoco
 
-    d.qpos[:] = q
-    d.qvel[:] = qd
-    mujoco.mj_forward(m, d)
-    mujoco.mj_energyPos(m, d)
-    mujoco.mj_energyVel(m, d)
-    return float(d.energy[0] + d.energy[1])
+    top = [b for b in range(1, m.nbody) if m.body_parentid[b] == 0]
+    free = int(mujoco.mjtJoint.mjJNT_FREE)
+    if not all(m.body_jntnum[b] > 0 and m.jnt_type[m.body_jntadr[b]] == free for b in top):
+        return False
+    site = int(mujoco.mjtObj.mjOBJ_SITE)
+    for e in range(m.neq):
+        if m.eq_type[e] in (mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD):
+            ids = (m.eq_obj1id[e], m.eq_obj2id[e])
+            bodies = [m.site_bodyid[i] if m.eq_objtype[e] == site else i for i in ids]
+            if 0 in bodies:
+                return False
+    return True
+
+
+def _floating_checks(mech, name, simulate: bool, st, duration: float, start) -> list[Check]:
+    """The checks of a mechanism whose state no set of hinge/slide joints determines (a floating base):
+    at N_FLOAT random states, the tree's generalized forces (:func:`multibody.generalized_forces` vs
+    ``mj_rne``), mass matrix (:func:`multibody.mass_matrix` vs ``mj_fullM``) and, for a tree, forward
+    dynamics under random actuator forces (:func:`multibody.forward_dynamics` vs the engine's
+    ``qacc``); then a free flight (:func:`multibody.simulate`, no actuator force) from a tumbling start
+    (or ``start``) against the engine's RK4 integration (every body's position), its momentum (the
+    engine's ``mj_subtreeVel`` of the multibody trajectory: linear momentum changes by the weight only,
+    angular momentum about the centre of mass is constant) and its energy drift."""
+    from robomech import multibody as mb
+
+    rng = np.random.default_rng(0)
+    eng = _mujoco.Engine(engine_model(mech))
+    L = mech.tree.length
+    st.next()
+    q, qd, qdd = floating_states(mech, N_FLOAT, rng)
+    st.next()
+    f = mb.generalized_forces(mech, q, qd, qdd)
+    M = mb.mass_matrix(mech, q)
+    f_e, M_e = np.zeros_like(f), np.zeros_like(M)
+    for i in range(N_FLOAT):
+        eng.set_state(q[i], qd[i], qdd[i])
+        f_e[i], M_e[i] = eng.tree_forces(), eng.mass_matrix()
+    st.next()
+    states = f"{N_FLOAT} random states of the floating tree"
+    checks = [
+        Check(name, "generalized forces (vs mj_rne)", _rel_diff(f, f_e), TOL_TREE, states),
+        Check(name, "mass matrix (vs mj_fullM)", _rel_diff(M, M_e), TOL_TREE, states),
+    ]
+    if not (mech.closures or mech.couplings):  # the engine's closures are soft: compared in the flight only
+        tau = float(np.max(np.abs(f_e))) * rng.standard_normal((N_FLOAT, len(mech.actuated)))
+        fd = mb.forward_dynamics(mech, q, tau=tau, qd=qd)
+        acc = np.zeros_like(fd.qdd)
+        for i in range(N_FLOAT):
+            eng.data.qfrc_applied[:] = 0.0
+            eng.data.qfrc_applied[mech.tree.act_dof] = tau[i]
+            acc[i] = eng.set_state(q[i], qd[i]).qacc
+        eng.data.qfrc_applied[:] = 0.0
+        err = _rel_diff(fd.qdd, acc)
+        checks.append(
+            Check(name, "forward dynamics under actuator forces (vs engine qacc)",
+                  err if bool(np.all(fd.valid)) else 1.0, TOL_TREE,
+                  f"{int(np.sum(fd.valid))}/{N_FLOAT} valid; random forces of the size of the tree's")
+        )  # fmt: skip
+    st.next()
+    if simulate:
+        st.next()
+        if start is None:  # a tumbling start: the reference pose with random rates
+            tree = mech.tree
+            start = {"q0": np.asarray(tree.q0, float), "qd0": np.where(tree.dof_translational, L, 1.0)
+                     * rng.standard_normal(mech.nv)}  # fmt: skip
+        checks += _flight_checks(mech, name, start["q0"], start.get("qd0"), duration, eng)
+    return checks
+
+
+def _flight_checks(mech, name, q0, qd0, duration: float, eng) -> list[Check]:
+    """Free flight from ``(q0, qd0)``: body positions against the engine's RK4 integration, momentum
+    (where the system is free) and energy drift of the multibody simulation."""
+    import mujoco
+
+    from robomech import multibody as mb
+
+    t = _sample_times(duration)
+    sim = mb.simulate(mech, q0, t=t, qd0=np.zeros(mech.nv) if qd0 is None else qd0)
+    if not bool(sim.success):
+        return [Check(name, "free flight vs engine", 1.0, TOL_SIM, "integration failed (error: 1)")]
+    engine = _mujoco.Engine(engine_model(mech, simulation=True))
+    engine.set_state(sim.q[0], sim.qd[0])
+    xe = np.array(engine.simulate(t, lambda d: d.xpos[1:].copy()))
+    m, d = eng.model, eng.data
+    xm = np.empty_like(xe)
+    p, h = np.empty((len(t), 3)), np.empty((len(t), 3))
+    for k in range(len(t)):
+        eng.set_state(sim.q[k], sim.qd[k])
+        mujoco.mj_subtreeVel(m, d)
+        xm[k] = d.xpos[1:]
+        p[k] = m.body_subtreemass[0] * d.subtree_linvel[0]
+        h[k] = d.subtree_angmom[0]
+    moved = float(np.max(np.linalg.norm(xm - xm[0], axis=-1))) / mech.tree.length
+    err = float(np.max(np.linalg.norm(xm - xe, axis=-1))) / mech.tree.length
+    tol = TOL_SIM if mech.closures or mech.couplings else TOL_FLIGHT
+    checks = [
+        Check(name, f"free flight vs engine ({duration:g} s, passive)", _rel(err, max(moved, 1e-3)), tol,
+              f"max body position difference {err:.2e} L for a motion of {moved:.3g} L"),
+    ]  # fmt: skip
+    if _free_system(m):
+        weight = m.body_subtreemass[0] * np.asarray(mech.gravity) * t[:, None]
+        p_err = float(np.max(np.abs(p - p[0] - weight)))
+        p_scale = max(float(np.max(np.abs(p))), float(np.max(np.abs(weight))), 1e-300)
+        h_err = float(np.max(np.abs(h - h[0])))
+        h_scale = max(float(np.max(np.abs(h))), 1e-300)
+        checks.append(
+            Check(name, "momentum of the free flight", max(p_err / p_scale, h_err / h_scale), TOL_MOMENTUM,
+                  f"linear {p_err / p_scale:.1e} (less the weight's impulse), angular about the CoM "
+                  f"{h_err / h_scale:.1e}; engine mj_subtreeVel of the multibody trajectory")
+        )  # fmt: skip
+    checks.append(
+        Check(name, "energy drift of the simulation", float(sim.energy_drift_rel), TOL_DRIFT,
+              f"{float(sim.energy_drift):.2e} J")
+    )  # fmt: skip
+    return checks
 
 
 def _virtually_actuated(mech):
@@ -436,14 +578,11 @@ def _driver(mech):
     return mech
 
 
-def _power_check(mech, name, m, d, at, t, q, tau, qd_act) -> Check:
+def _power_check(mech, name, eng, at, t, q, tau, qd_act) -> Check:
     """``tau . qd_act`` (every actuator's force and rate) against dE/dt of the engine's energy along the
     motion driven through ``mech``'s actuators (``at``)."""
-    import mujoco
-
     from robomech import multibody as mb
 
-    m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
     h = H_POWER
     err = 0.0
     scale = 0.0
@@ -451,7 +590,7 @@ def _power_check(mech, name, m, d, at, t, q, tau, qd_act) -> Check:
         qa, qda, qdda = at(ti + h * np.arange(-2, 3))
         fk = mb.forward_kinematics(mech, qa, guess=q[i])
         r = mb.inverse_dynamics(mech, fk.q, qda, qdda)
-        E = np.array([_engine_energy(m, d, fk.q[k], r.qd[k]) for k in range(5)])
+        E = np.array([sum(eng.energies(fk.q[k], r.qd[k])) for k in range(5)])
         dE = (E[0] - 8 * E[1] + 8 * E[3] - E[4]) / (12 * h)
         P = float(tau[i] @ qd_act[i])
         err = max(err, abs(P - dE))
@@ -459,56 +598,109 @@ def _power_check(mech, name, m, d, at, t, q, tau, qd_act) -> Check:
     return Check(name, "power balance tau.qd = dE/dt (engine energy)", _rel(err, scale), TOL_POWER, "")
 
 
-def _why(mech, t: np.ndarray, q: np.ndarray, off: np.ndarray) -> str:
-    """Why a simulation disagrees: when it first left the engine, and the closest type II singularity
-    (smallest singular value of the passive block of K, in m, from :func:`multibody.influence`)."""
+def _smallest_sigma(mech, q: np.ndarray, full_rank: int) -> np.ndarray:
+    """Smallest singular value of the passive block of K (m) at each ``q``; 0 where its rank drops."""
+    from robomech import multibody as mb
+
+    inf = mb.influence(mech, q, second_order=False)
+    return np.where(inf.passive_rank < full_rank, 0.0, inf.sigma_min)
+
+
+def _zoom(mech, t0: float, t1: float, q0: np.ndarray, qd0: np.ndarray, full_rank: int) -> tuple[float, float]:
+    """``(sigma_min, t)`` at the closest approach to a type II singularity of the passive motion from
+    ``(q0, qd0)`` at ``t0`` within ``[t0, t1]``: the motion is simulated again on ZOOM_SAMPLES times and
+    the interval narrowed around the smallest value, up to ZOOM_LEVELS times (a crossing, where sigma_min
+    falls linearly to 0, resolves below SINGULAR_SIGMA_RTOL L; a near miss to its positive minimum)."""
+    from robomech import multibody as mb
+
+    best = (np.inf, t0)
+    for _ in range(ZOOM_LEVELS):
+        tt = np.linspace(t0, t1, ZOOM_SAMPLES)
+        sim = mb.simulate(mech, q0, t=tt, qd0=qd0)
+        ok = np.all(np.isfinite(sim.q), axis=-1)
+        if not ok.any():
+            break
+        smin = _smallest_sigma(mech, sim.q[ok], full_rank)
+        j = int(np.nanargmin(smin))
+        before, best = best[0], min(best, (float(smin[j]), float(tt[ok][j])))
+        crossing = best[0] < SINGULAR_SIGMA_RTOL * mech.tree.length
+        if crossing or not bool(sim.success) or best[0] > ZOOM_NEAR_MISS * before:
+            break  # a crossing; or a positive minimum the narrowing no longer lowers (a near miss)
+        lo, hi = max(j - 1, 0), min(j + 1, int(ok.sum()) - 1)
+        t0, t1, q0, qd0 = float(tt[lo]), float(tt[hi]), sim.q[lo], sim.qd[lo]
+    return best
+
+
+def _redundant_words(mech) -> list[str]:
+    """Why an overconstrained mechanism's simulation departs from the engine's (empty where it is not)."""
+    from robomech import multibody as mb
+
+    redundant = mb.mobility(mech).redundant_constraints
+    if not redundant:  # MuJoCo regularises a rank-deficient constraint set: its closures become compliant
+        return []
+    return [
+        f"the closures have {redundant} redundant row(s) (an overconstrained mechanism): the engine "
+        "solves them as soft constraints, which lets its motion depart from the rigid model"
+    ]
+
+
+def _why(mech, t: np.ndarray, q: np.ndarray, off: np.ndarray, qd: np.ndarray | None = None) -> str:
+    """Why a simulation disagrees: when it first left the engine, and the type II singularity it crossed
+    last before (or came closest to: smallest singular value of the passive block of K, in m, from
+    :func:`multibody.influence`).  With the rates ``qd`` each local minimum of the sampled values is
+    resolved between its neighbouring samples by :func:`_zoom` (a crossing falls between samples)."""
     from robomech import multibody as mb
 
     words = []
+    end = len(t) - 1
     if off.any():
-        words.append(f"diverged from the engine after t = {t[int(np.argmax(off))]:.3g} s")
+        end = int(np.argmax(off))
+        words.append(f"diverged from the engine after t = {t[end]:.3g} s")
     inf = mb.influence(mech, q, second_order=False)
-    if inf.n_passive:
-        smin = np.where(inf.passive_rank < inf.passive_rank.max(initial=0), 0.0, inf.sigma_min)
-        k = int(np.nanargmin(smin))
-        if smin[k] < SINGULAR_SIGMA_RTOL * mech.tree.length or inf.passive_rank[k] < inf.passive_rank.max():
-            words.append(
-                f"crossed a type II singularity near t = {t[k]:.3g} s (sigma_min {inf.sigma_min[k]:.1e} m)"
-            )
-        else:
-            words.append(f"closest to a type II singularity at t = {t[k]:.3g} s (sigma_min {smin[k]:.1e} m)")
-    redundant = mb.mobility(mech).redundant_constraints
-    if redundant:  # MuJoCo regularises a rank-deficient constraint set: its closures become compliant
-        words.append(
-            f"the closures have {redundant} redundant row(s) (an overconstrained mechanism): the engine "
-            "solves them as soft constraints, which lets its motion depart from the rigid model"
-        )
+    if not inf.n_passive:
+        return "; ".join(words + _redundant_words(mech))
+    full = int(inf.passive_rank.max(initial=0))
+    smin = np.where(inf.passive_rank < full, 0.0, inf.sigma_min)
+    found = [(float(smin[k]), float(t[k])) for k in range(len(t))]
+    if qd is not None:  # resolve the local minima up to the divergence, the latest first
+        pad = np.concatenate([[np.inf], smin, [np.inf]])
+        minima = [k for k in range(end + 1) if pad[k + 1] <= pad[k] and pad[k + 1] <= pad[k + 2]]
+        found = []
+        for k in minima[::-1][:MAX_ZOOMS]:
+            lo, hi = max(k - 1, 0), min(k + 1, len(t) - 1)
+            found.append(_zoom(mech, float(t[lo]), float(t[hi]), q[lo], qd[lo], full))
+            if found[-1][0] < SINGULAR_SIGMA_RTOL * mech.tree.length:
+                break
+    crossed = [f for f in found if f[0] < SINGULAR_SIGMA_RTOL * mech.tree.length]
+    if crossed:
+        sigma, tc = crossed[0] if qd is not None else min(crossed, key=lambda f: f[1])
+        words.append(f"crossed a type II singularity near t = {tc:.4g} s (sigma_min {sigma:.1e} m)")
+    elif found:
+        sigma, tc = min(found)
+        words.append(f"closest to a type II singularity at t = {tc:.4g} s (sigma_min {sigma:.1e} m)")
+    words += _redundant_words(mech)
     return "; ".join(words)
 
 
-def _simulation_checks(mech, name, q0, qd_act0, duration: float = T_SIM) -> list[Check]:
-    import mujoco
-
+def _simulation_checks(mech, name, q0, qd_act0=None, duration: float = T_SIM, *, qd0=None) -> list[Check]:
+    """The passive simulation from ``q0`` with the actuated rates ``qd_act0`` or every rate ``qd0``
+    against the engine's, and the energy drift of the multibody simulation."""
     from robomech import multibody as mb
 
-    t = np.linspace(0.0, duration, SIM_SAMPLES)
-    sim = mb.simulate(mech, q0, qd_act0, t)
-    m = engine_model(mech, simulation=True)
-    d = mujoco.MjData(m)
-    G = mb.influence(mech, q0, second_order=False).G
-    d.qpos[:] = q0
-    d.qvel[:] = G @ qd_act0
-    mujoco.mj_forward(m, d)
-    out = [d.qpos[mech.tree.act_qadr].copy()]
-    for k in range(1, len(t)):
-        while d.time < t[k] - 0.5 * SIM_TIMESTEP:
-            mujoco.mj_step(m, d)
-        out.append(d.qpos[mech.tree.act_qadr].copy())
-    eng = np.array(out)
+    t = _sample_times(duration)
+    if qd0 is None:
+        sim = mb.simulate(mech, q0, qd_act0, t)
+        qvel = mb.influence(mech, q0, second_order=False).G @ qd_act0
+    else:  # the multibody side projects qd0 onto the admissible rates: the engine starts from those
+        sim = mb.simulate(mech, q0, t=t, qd0=qd0)
+        qvel = sim.qd[0]
+    engine = _mujoco.Engine(engine_model(mech, simulation=True))
+    engine.set_state(q0, qvel)
+    eng = np.array(engine.simulate(t, lambda d: d.qpos[mech.tree.act_qadr].copy()))
     tree = mech.tree
     if not bool(sim.success):
         ok = np.all(np.isfinite(sim.q), axis=-1)
-        why = _why(mech, t[ok], sim.q[ok], np.zeros(int(ok.sum()), bool)) if ok.any() else ""
+        why = _why(mech, t[ok], sim.q[ok], np.zeros(int(ok.sum()), bool), sim.qd[ok]) if ok.any() else ""
         return [
             Check(
                 name,
@@ -525,7 +717,7 @@ def _simulation_checks(mech, name, q0, qd_act0, duration: float = T_SIM) -> list
     rel = _rel(err, max(moved, 1e-3))
     detail = f"max |q_act - engine| {err:.2e} (rad, slides / L) for a motion of {moved:.3g}"
     if not rel <= TOL_SIM.value:
-        detail += "; " + _why(mech, t, sim.q, dev > TOL_SIM.value * max(moved, 1e-3))
+        detail += "; " + _why(mech, t, sim.q, dev > TOL_SIM.value * max(moved, 1e-3), sim.qd)
     drift = f"{float(sim.energy_drift):.2e} J"
     if not float(sim.energy_drift_rel) <= TOL_DRIFT.value:
         drift += "; " + _why(mech, t, sim.q, np.zeros(len(t), bool))

@@ -5,7 +5,8 @@ The model is :func:`robomech.multibody.to_pinocchio` of the description; the che
 algorithms along the generic test trajectory of :mod:`robomech.verify._generic`: the closure of its rigid
 constraint models (frame placements), the admissible velocity (its frame Jacobians), the body frames
 (``framesForwardKinematics``), the mass matrix (``crba``) and the inverse dynamics (``rnea`` projected
-through the null space of its constraint Jacobian onto the actuators, by least squares).
+through the null space of its constraint Jacobian onto the actuators, by least squares); a floating
+base at random states: ``rnea``, ``crba`` and (a tree) ``aba`` under random actuator forces.
 """
 
 from __future__ import annotations
@@ -14,6 +15,10 @@ import numpy as np
 
 from . import _generic as g
 from ._core import Check
+from ._mujoco import null_space
+
+# Null-space rank decision on the stacked constraint Jacobian (frame Jacobians and coupling rows).
+PIN_RANK_RTOL = 1e-9
 
 __all__ = ["check_mechanism_pinocchio"]
 
@@ -28,24 +33,14 @@ def check_mechanism_pinocchio(mech, name: str | None = None) -> list[Check]:
 
     name = f"{name or mech.name} (pinocchio)"
     mech, virtual = g._virtually_actuated(mech)
-    if virtual is None:
-        return [Check(name, "actuated rates determine the state", 1.0, g.TOL_ASSEMBLY, "a floating base")]
-    drv = g._driver(mech)
-    t, at = g.trajectory(drv)
-    qa, qda, qdda = at(t)
-    q, conv = g._assemble_along(drv, qa)
-    checks = [
-        Check(name, "assembly along the test trajectory", float(np.mean(~conv)), g.TOL_ASSEMBLY,
-              f"{int(conv.sum())}/{len(conv)} converged"),
-    ]  # fmt: skip
-    q, qa, qda, qdda = q[conv], qa[conv], qda[conv], qdda[conv]
-    if not len(q):
+    if virtual is None:  # a floating base: its tree dynamics at random states
+        return _floating_checks(mech, name)
+    assembly, mo = g.driven_motion(mech, name)
+    checks = [assembly]
+    if mo is None:
         return checks
     tree = compile_model(mech).tree
-    if drv is not mech:
-        rd = mb.inverse_dynamics(drv, q, qda, qdda)
-        qa, qda, qdda = q[:, tree.act_qadr], rd.qd[:, tree.act_dof], rd.qdd[:, tree.act_dof]
-    inv = mb.inverse_dynamics(mech, q, qda, qdda)
+    q, inv = mo.q, mo.inv
     M_engine = mb.mass_matrix(mech, q)
     P = mb.to_pinocchio(mech)
     model = P.model
@@ -98,11 +93,7 @@ def check_mechanism_pinocchio(mech, name: str | None = None) -> list[Check]:
         Me = T.T @ M_engine[i] @ T
         m_err, m_scale = max(m_err, float(np.abs(Mp - Me).max())), max(m_scale, float(np.abs(Me).max()))
         f = pin.rnea(model, data, qp, vp, ap)
-        if len(K):
-            _, s, Vt = np.linalg.svd(K)
-            Nn = Vt[int(np.sum(s > 1e-9 * s[0])) :].T
-        else:
-            Nn = np.eye(model.nv)
+        Nn = null_space(K, PIN_RANK_RTOL)
         tau = np.linalg.lstsq(Nn.T @ (T.T @ E), Nn.T @ f, rcond=None)[0]
         tau_err = max(tau_err, float(np.abs(tau - inv.tau[i]).max()))
         tau_scale = max(tau_scale, float(np.abs(inv.tau[i]).max()))
@@ -114,4 +105,46 @@ def check_mechanism_pinocchio(mech, name: str | None = None) -> list[Check]:
         Check(name, "inverse dynamics (rnea through the constraint Jacobian)", g._rel(tau_err, tau_scale),
               g.TOL_TORQUE, ""),
     ]  # fmt: skip
+    return checks
+
+
+def _floating_checks(mech, name: str) -> list[Check]:
+    """A floating base against Pinocchio at the random states of the MuJoCo check
+    (:func:`_generic.floating_states`): ``rnea`` and ``crba`` against :func:`multibody.generalized_forces`
+    and :func:`multibody.mass_matrix` (mapped by the model's ``velocity_map``) and, for a tree, ``aba``
+    under random actuator forces against :func:`multibody.forward_dynamics`."""
+    import pinocchio as pin
+
+    from robomech import multibody as mb
+
+    rng = np.random.default_rng(0)
+    q, qd, qdd = g.floating_states(mech, g.N_FLOAT, rng)
+    P = mb.to_pinocchio(mech)
+    model = P.model
+    data = model.createData()
+    f, M = mb.generalized_forces(mech, q, qd, qdd), mb.mass_matrix(mech, q)
+    f_pin, f_mine = np.zeros_like(f), np.zeros_like(f)
+    M_pin, M_mine = np.zeros_like(M), np.zeros_like(M)
+    for i in range(g.N_FLOAT):
+        qp, vp, ap = P.state(q[i], qd[i], qdd[i])
+        T = P.velocity_map(q[i])
+        f_pin[i], f_mine[i] = pin.rnea(model, data, qp, vp, ap), T.T @ f[i]
+        Mp = pin.crba(model, data, qp)
+        M_pin[i], M_mine[i] = np.triu(Mp) + np.triu(Mp, 1).T, T.T @ M[i] @ T
+    states = f"{g.N_FLOAT} random states of the floating tree"
+    checks = [
+        Check(name, "generalized forces (vs rnea)", g._rel_diff(f_mine, f_pin), g.TOL_TREE, states),
+        Check(name, "mass matrix (vs crba)", g._rel_diff(M_mine, M_pin), g.TOL_TREE, states),
+    ]
+    if not (mech.closures or mech.couplings):
+        tau = float(np.max(np.abs(f_pin))) * rng.standard_normal((g.N_FLOAT, len(mech.actuated)))
+        fd = mb.forward_dynamics(mech, q, tau=tau, qd=qd)
+        a_pin, a_mine = np.zeros_like(fd.qdd), np.zeros_like(fd.qdd)
+        for i in range(g.N_FLOAT):
+            qp, vp, a_mine[i] = P.state(q[i], qd[i], fd.qdd[i])
+            force = np.zeros(mech.nv)
+            force[mech.tree.act_dof] = tau[i]
+            a_pin[i] = pin.aba(model, data, qp, vp, P.velocity_map(q[i]).T @ force)
+        err = g._rel_diff(a_mine, a_pin) if bool(np.all(fd.valid)) else 1.0
+        checks.append(Check(name, "forward dynamics under actuator forces (vs aba)", err, g.TOL_TREE, states))
     return checks

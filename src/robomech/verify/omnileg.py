@@ -16,16 +16,17 @@ Checks of the *analytic* model (``mechanisms/omnileg``, Lagrange) against the en
   ``efc_pos`` and the foot site against eq. (11); analytic joint rates in ``qvel`` -> ``efc_J qvel`` and
   the foot site velocity against ``J q̇``;
 * energy: analytic kinetic and potential energy against the engine's ``mj_energyPos``/``mj_energyVel``;
-* inverse dynamics: the engine's tree inverse dynamics (``M q̈ + c`` from ``mj_inverse``/``mj_mulM``,
-  constraint forces left out) along eq. (52) with Fig. 11's foot force, projected through the
-  constraint Jacobian (``τ_tree = Sᵀ τ + J_cᵀ λ``, least squares) -> motor torques, against the analytic
-  model;
+* inverse dynamics: the engine's tree inverse dynamics (``M q̈ + c`` from ``mj_rne``, constraint
+  forces left out) along eq. (52) with Fig. 11's foot force, projected on the null space of the
+  constraint Jacobian (``Nᵀ (Sᵀ τ - τ_tree) = 0``, least squares) -> motor torques, against the
+  analytic model;
 * forward simulation: the engine driven only by the analytic torques follows eq. (52).
 """
 
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -38,7 +39,7 @@ from robomech._validation import as_array, broadcast_batch, check_params
 from robomech.trajectory import Profile
 
 from ._core import Check, Tolerance, Verification, optional_module
-from ._generic import engine_options
+from ._mujoco import Engine, engine_options
 
 if TYPE_CHECKING:
     import mujoco
@@ -112,29 +113,25 @@ class EngineModel:
     actuated: NDArray[np.intp]  # dof addresses of (α, β, γ) = (theta21, theta11, drive_in)
     foot_site: int
 
+    @property
+    def engine(self) -> Engine:
+        """The shared harness on this model and data."""
+        return Engine(self.model, self.data)
+
+    def set_state(self, qpos: Array, qvel: Array, qacc: Array | None = None) -> mujoco.MjData:
+        """Write tree-joint values (``TREE_JOINTS`` order) and run ``mj_forward``."""
+        return self.engine.set_state(qpos, qvel, qacc, qpos_index=self.qpos_index, dof_index=self.dof_index)
+
 
 def build_model(leg: ol.OmniLeg) -> EngineModel:
     """The engine model of :func:`build_mjcf` with the address maps of ``TREE_JOINTS`` and the foot site."""
     check_params(leg, ol.OmniLeg, "leg")
-    m = mujoco.MjModel.from_xml_string(build_mjcf(leg))
-    d = mujoco.MjData(m)
-    jid = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n) for n in ol.TREE_JOINTS]
-    qadr = np.array([m.jnt_qposadr[j] for j in jid], dtype=np.intp)
-    dadr = np.array([m.jnt_dofadr[j] for j in jid], dtype=np.intp)
+    eng = Engine(mujoco.MjModel.from_xml_string(build_mjcf(leg)))
+    m = eng.model
+    qadr, dadr = eng.joint_addresses(ol.TREE_JOINTS)
     act = dadr[[ol.TREE_JOINTS.index(n) for n in ACTUATED_JOINTS]]
     site = int(mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, FOOT_SITE))
-    return EngineModel(m, d, qadr, dadr, act, site)
-
-
-def _set_state(em: EngineModel, qpos: Array, qvel: Array, qacc: Array | None = None) -> None:
-    em.data.qpos[em.qpos_index] = qpos
-    em.data.qvel[em.dof_index] = qvel
-    if qacc is not None:
-        em.data.qacc[em.dof_index] = qacc
-
-
-def _eq_rows(em: EngineModel) -> NDArray[np.intp]:
-    return np.flatnonzero(em.data.efc_type[: em.data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+    return EngineModel(m, eng.data, qadr, dadr, act, site)
 
 
 def engine_inverse_dynamics(
@@ -142,14 +139,14 @@ def engine_inverse_dynamics(
 ) -> Array:
     """Motor torques (N, 3) from the engine, one sample at a time (the per-sample alternative).
 
-    Per sample: ``mj_inverse`` (which also builds the constraint Jacobian ``efc_J``), the tree forces
-    ``τ_tree = M q̈ + c(q, q̇) - J_footᵀ F`` (``mj_mulM`` + ``qfrc_bias``: the constraint forces are left
-    out), then least squares on ``[Sᵀ J_cᵀ] [τ; λ] = τ_tree`` (minimum norm: the thigh's redundant
-    closure rows leave λ, not τ, undetermined).
+    Per sample (:meth:`Engine.inverse_dynamics <robomech.verify._mujoco.Engine.inverse_dynamics>`): the
+    tree forces ``τ_tree = M q̈ + c(q, q̇) - J_footᵀ F`` (``mj_rne``: the constraint forces are left out),
+    balanced by the motors in the null space ``N`` of the equality-constraint Jacobian,
+    ``Nᵀ (Sᵀ τ - τ_tree) = 0`` (least squares; the thigh's redundant closure rows drop out of ``N``).
     """
     check_params(em, EngineModel, "em")
     check_params(jm, ol.JointMotion, "jm")
-    m, d = em.model, em.data
+    m = em.model
     N = jm.q.shape[0]
     F: Array | None = None
     if foot_force is not None:
@@ -157,23 +154,23 @@ def engine_inverse_dynamics(
         broadcast_batch((F, 1, "foot_force"), (jm.q, 1, "jm.q"))
         F = np.broadcast_to(F, (N, 3))
     out = np.empty((N, 3))
-    nv = m.nv
-    S = np.zeros((3, nv))
-    S[[0, 1, 2], em.actuated] = 1.0
-    jacp = np.zeros((3, nv))
-    Mqacc = np.zeros(nv)
-    for n in range(N):  # the per-sample engine loop (this is what the analytic model is compared with)
-        _set_state(em, jm.q[n], jm.qd[n], jm.qdd[n])
-        mujoco.mj_inverse(m, d)
-        rows = _eq_rows(em)
-        Jc = d.efc_J.reshape(-1, nv)[rows]
-        mujoco.mj_mulM(m, d, Mqacc, d.qacc)
-        tau_tree = Mqacc + d.qfrc_bias
-        if F is not None:
+    jacp = np.zeros((3, m.nv))
+    eng = em.engine
+
+    def foot(n: int) -> Callable[[mujoco.MjData], Array] | None:  # J_footᵀ F at the state written
+        if F is None:
+            return None
+        Fn = F[n]
+
+        def applied(d: mujoco.MjData) -> Array:
             mujoco.mj_jacSite(m, d, jacp, None, em.foot_site)
-            tau_tree = tau_tree - jacp.T @ F[n]
-        sol = np.linalg.lstsq(np.vstack([S, Jc]).T, tau_tree, rcond=None)[0]
-        out[n] = sol[:3]
+            return np.asarray(jacp.T @ Fn)
+
+        return applied
+
+    for n in range(N):  # the per-sample engine loop (this is what the analytic model is compared with)
+        idx = {"qpos_index": em.qpos_index, "dof_index": em.dof_index}
+        out[n] = eng.inverse_dynamics(jm.q[n], jm.qd[n], jm.qdd[n], em.actuated, applied=foot(n), **idx)
     return out
 
 
@@ -202,18 +199,16 @@ def kinematic_checks(leg: ol.OmniLeg, em: EngineModel) -> list[Check]:
     q = np.concatenate([prof.q, qr])
     qd = np.concatenate([prof.qd, qdr])
     jm = ol.joint_motion(leg, q, qd, np.zeros_like(q))
-    m, d = em.model, em.data
+    m = em.model
     closure, foot, cvel, fvel = 0.0, 0.0, 0.0, 0.0
     jacp = np.zeros((3, m.nv))
     p_an = ol.forward_kinematics(leg, q)
     v_an = ol.foot_velocity(leg, q, qd)
     for n in range(q.shape[0]):
-        _set_state(em, jm.q[n], jm.qd[n])
-        mujoco.mj_forward(m, d)
-        rows = _eq_rows(em)
-        closure = max(closure, float(np.abs(d.efc_pos[rows]).max()))
+        d = em.set_state(jm.q[n], jm.qd[n])
+        J, pos = em.engine.equality()
+        closure = max(closure, float(np.abs(pos).max()))
         foot = max(foot, float(np.abs(d.site_xpos[em.foot_site] - p_an[n]).max()))
-        J = d.efc_J.reshape(-1, m.nv)[rows]
         cvel = max(cvel, float(np.abs(J @ d.qvel).max()))
         mujoco.mj_jacSite(m, d, jacp, None, em.foot_site)
         fvel = max(fvel, float(np.abs(jacp @ d.qvel - v_an[n]).max()))
@@ -243,15 +238,10 @@ def energy_error(leg_analytic: ol.OmniLeg, em: EngineModel, n: int = 60) -> floa
     q, qd = _random_states(leg_analytic, n, 11)
     T_an, U_an = ol.energy(leg_analytic, q, qd)
     jm = ol.joint_motion(leg_analytic, q, qd, np.zeros_like(q))
-    m, d = em.model, em.data
-    m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
     T_en, U_en = np.empty(n), np.empty(n)
+    idx = {"qpos_index": em.qpos_index, "dof_index": em.dof_index}
     for k in range(n):
-        _set_state(em, jm.q[k], jm.qd[k])
-        mujoco.mj_forward(m, d)
-        mujoco.mj_energyPos(m, d)
-        mujoco.mj_energyVel(m, d)
-        U_en[k], T_en[k] = d.energy
+        U_en[k], T_en[k] = em.engine.energies(jm.q[k], jm.qd[k], **idx)
     eT = float(np.abs(T_an - T_en).max() / np.abs(T_en).max())
     eU = float(np.abs(U_an - U_en).max() / np.abs(U_en).max())
     return max(eT, eU)
@@ -279,20 +269,18 @@ def forward_simulation(leg: ol.OmniLeg, em: EngineModel, duration: float = 2.0) 
     tau = ol.inverse_dynamics(leg, prof.q, prof.qd, prof.qdd).tau
     jm0 = ol.joint_motion(leg, prof.q[0], prof.qd[0], prof.qdd[0])
     mujoco.mj_resetData(m, d)
-    _set_state(em, jm0.q, jm0.qd)
-    mujoco.mj_forward(m, d)
-    q_sim = np.empty((n_steps + 1, 3))
-    closure = 0.0
-    rows = _eq_rows(em)  # no contacts or limits: the equality rows are fixed
+    em.set_state(jm0.q, jm0.qd)
+    rows = np.flatnonzero(d.efc_type[: d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)  # fixed: no contacts
     act_q = em.qpos_index[[ol.TREE_JOINTS.index(n) for n in ACTUATED_JOINTS]]
-    for k in range(n_steps + 1):  # time stepping (inherently sequential)
-        q_sim[k] = d.qpos[act_q]
-        closure = max(closure, float(np.abs(d.efc_pos[rows]).max()))
-        if k == n_steps:
-            break
+
+    def drive(d: mujoco.MjData) -> None:  # the analytic torques, averaged over the step
+        k = round(d.time / m.opt.timestep)
         d.qfrc_applied[:] = 0.0
         d.qfrc_applied[em.actuated] = 0.5 * (tau[k] + tau[k + 1])
-        mujoco.mj_step(m, d)
+
+    rec = em.engine.simulate(t, lambda d: (d.qpos[act_q].copy(), float(np.abs(d.efc_pos[rows]).max())), drive)
+    q_sim = np.array([r[0] for r in rec])
+    closure = max(r[1] for r in rec)
     drift = float(np.abs(q_sim - prof.q).max())
     return {"t": t, "q_sim": q_sim, "q_ref": prof.q, "drift": drift, "closure": closure}
 

@@ -43,7 +43,7 @@ from robomech._validation import as_array, check_bool, check_int, check_params, 
 from robomech.mechanisms import spherical_leg as sl
 
 from ._core import Check, Tolerance, Verification, optional_module
-from ._generic import engine_options
+from ._mujoco import Engine, engine_options
 
 if TYPE_CHECKING:
     import mujoco
@@ -88,8 +88,6 @@ SIM_PD_MASS = 5.0  # kg, the order of the platform's effective mass at the legs 
 # Stiff equality constraints for the forward simulation (time constant 10 x the step, as MuJoCo advises).
 _SOLREF = "0.002 1"
 _SOLIMP = "0.9999 0.9999 0.001 0.5 2"
-# Null-space rank decision on the engine's equality Jacobian (rows in m and rad, columns per dof).
-_RANK_RTOL = 1e-10
 
 
 def build_model(leg: sl.SphericalLeg, timestep: float = SIM_TIMESTEP) -> mujoco.MjModel:
@@ -124,10 +122,8 @@ class _Layout:
 
     def __init__(self, m: mujoco.MjModel, leg: sl.SphericalLeg) -> None:
         def jnt(n: str) -> tuple[int, int]:
-            j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n)
-            if j < 0:
-                raise ValueError(f"Expected the engine model to have joint {n!r}.")
-            return int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
+            qadr, dadr = Engine(m).joint_addresses([n])
+            return int(qadr[0]), int(dadr[0])
 
         def body(n: str) -> int:
             return int(mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n))
@@ -219,42 +215,6 @@ def _engine_states(
     return qpos, qvel, qacc
 
 
-def _equality_jacobian(m: mujoco.MjModel, d: mujoco.MjData) -> tuple[Array, Array]:
-    rows = np.nonzero(d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY)[0]
-    return np.array(d.efc_J)[: d.nefc * m.nv].reshape(d.nefc, m.nv)[rows], np.array(d.efc_pos)[rows]
-
-
-def _null_space(Jc: Array) -> Array:
-    _, sv, Vt = np.linalg.svd(Jc)
-    r = int(np.sum(sv > _RANK_RTOL * max(float(sv[0]), 1e-300)))
-    return np.asarray(Vt[r:].T)
-
-
-def _engine_forces(
-    m: mujoco.MjModel,
-    d: mujoco.MjData,
-    lay: _Layout,
-    qpos: Array,
-    qvel: Array,
-    qacc: Array,
-    legs: tuple[int, ...],
-) -> Array:
-    """Actuator forces of ``legs`` from the engine at one state: ``mj_rne`` tree forces projected on
-    the null space N of the engine's equality Jacobian, ``N^T (E f - tau_tree) = 0`` (minimum norm)."""
-    d.qpos[:], d.qvel[:] = qpos, qvel
-    mujoco.mj_forward(m, d)
-    d.qacc[:] = qacc
-    tau = np.zeros(m.nv)
-    mujoco.mj_rne(m, d, 1, tau)
-    N = _null_space(_equality_jacobian(m, d)[0])
-    E = np.zeros((m.nv, len(legs)))
-    for c, i in enumerate(legs):
-        E[lay.slide[i][1], c] = 1.0
-    f = np.zeros(3)
-    f[list(legs)] = np.linalg.lstsq(N.T @ E, N.T @ tau, rcond=None)[0]
-    return f
-
-
 def inverse_dynamics_engine(
     leg: sl.SphericalLeg,
     q: object,
@@ -284,15 +244,15 @@ def inverse_dynamics_engine(
             raise ValueError(
                 f"Expected driven_legs to be None or two different leg indices in 0..2, got {driven_legs!r}."
             )
-    m = build_model(leg)
-    d = mujoco.MjData(m)
-    lay = _Layout(m, leg)
-    qpos, qvel, qacc = _engine_states(m, lay, leg, qa, qda, qdda)
+    eng = Engine(build_model(leg))
+    lay = _Layout(eng.model, leg)
+    qpos, qvel, qacc = _engine_states(eng.model, lay, leg, qa, qda, qdda)
     forces = np.zeros((len(qa), 3))
     closure = np.zeros(len(qa))
-    for t in range(len(qa)):
-        forces[t] = _engine_forces(m, d, lay, qpos[t], qvel[t], qacc[t], legs)
-        closure[t] = float(np.max(np.abs(_equality_jacobian(m, d)[1])))
+    slides = [lay.slide[i][1] for i in legs]
+    for t in range(len(qa)):  # the slide forces of the driven legs; the others carry none
+        forces[t, list(legs)] = eng.inverse_dynamics(qpos[t], qvel[t], qacc[t], slides)
+        closure[t] = float(np.max(np.abs(eng.equality()[1])))
     return forces, closure
 
 
@@ -327,11 +287,9 @@ def _state_errors(
 ) -> dict[str, float]:
     """Kinematic and dynamic errors of ``leg``'s analytic model at the states of a trajectory, in the
     engine built from ``engine_leg``; relative errors as (max error, max scale) pairs folded later."""
-    m = build_model(engine_leg)
-    d = mujoco.MjData(m)
-    d2 = mujoco.MjData(m)
+    eng = Engine(build_model(engine_leg))
+    m, d = eng.model, eng.data
     lay = _Layout(m, engine_leg)
-    m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
     qpos, qvel, _ = _engine_states(m, lay, leg, q, qd, qdd)
     n = len(q)
     # unit platform rates: the engine's qvel per unit alpha_dot, beta_dot (G, from the analytic joint map)
@@ -346,13 +304,9 @@ def _state_errors(
     def up(key: str, e: float) -> None:
         err[key] = max(err.get(key, 0.0), float(e))
 
-    Mfull = np.zeros((m.nv, m.nv))
     for t in range(n):
-        d.qpos[:], d.qvel[:] = qpos[t], qvel[t]
-        mujoco.mj_forward(m, d)
-        mujoco.mj_energyPos(m, d)
-        mujoco.mj_energyVel(m, d)
-        Jc, pos = _equality_jacobian(m, d)
+        Ve, Te = eng.energies(qpos[t], qvel[t])
+        Jc, pos = eng.equality()
         up("closure", np.max(np.abs(pos)))
         up("velocity closure", np.max(np.abs(Jc @ d.qvel)))
         Bt = ik.platform_points[t]
@@ -374,14 +328,12 @@ def _state_errors(
             s = (B_plat - A) / np.linalg.norm(B_plat - A)
             Jeng[i] = s @ jacp[:, [lay.alpha[1], lay.beta[1]]]
         up("jacobian", np.max(np.abs(Jeng - Ja[t])) / np.max(np.abs(Ja[t])))
-        mujoco.mj_fullM(m, d, Mfull)
         Gt = np.stack([G[0][t], G[1][t]], -1)
-        Me = Gt.T @ Mfull @ Gt
+        Me = Gt.T @ eng.mass_matrix() @ Gt
         up("mass matrix", np.max(np.abs(Me - Ma[t])) / np.max(np.abs(Ma[t])))
-        Te, Ve = float(d.energy[1]), float(d.energy[0])
         up("energy", max(abs(Te - Ta[t]), abs(Ve - Va[t])) / max(abs(Ta[t]) + abs(Va[t]), 1e-300))
     # FK of the engine's own leg lengths (only alpha, beta set: the platform placed by the engine)
-    L = _engine_leg_lengths(m, d2, lay, q)
+    L = _engine_leg_lengths(m, mujoco.MjData(m), lay, q)
     fk = sl.forward_kinematics(leg, L)
     fk_err = np.abs(np.stack([fk.alpha, fk.beta], -1) - q)
     up("fk", float(np.max(fk_err)) if bool(np.all(fk.valid)) else np.inf)
@@ -418,8 +370,8 @@ def forward_simulation(
 ) -> tuple[float, float, dict[str, Array]]:
     """Drive the engine with ``analytic``'s feed-forward forces (legs 1, 3) plus a weak PD on the leg
     lengths along the brisk test motion; returns (max pose error rad, feedback share, traces)."""
-    m = build_model(leg, SIM_TIMESTEP)
-    d = mujoco.MjData(m)
+    eng = Engine(build_model(leg, SIM_TIMESTEP))
+    m = eng.model
     lay = _Layout(m, leg)
     t = np.arange(0.0, SIM_DURATION, SIM_TIMESTEP)
     q, qd, qdd = _fast_motion(t)
@@ -430,19 +382,24 @@ def forward_simulation(
     kp = SIM_PD_MASS * SIM_PD_BANDWIDTH**2
     kd = 2.0 * SIM_PD_MASS * SIM_PD_BANDWIDTH
     qpos, qvel, _ = _engine_states(m, lay, leg, q[:1], qd[:1], qdd[:1])
-    d.qpos[:], d.qvel[:] = qpos[0], qvel[0]
-    mujoco.mj_forward(m, d)
+    eng.set_state(qpos[0], qvel[0])
     act = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, f"act_l{i + 1}") for i in range(3)]
-    err = np.zeros(len(t))
     fb_max = 0.0
-    for k in range(len(t)):
-        err[k] = max(abs(d.qpos[lay.alpha[0]] - q[k, 0]), abs(d.qpos[lay.beta[0]] - q[k, 1]))
+
+    def servo(d: mujoco.MjData) -> None:  # feed-forward leg forces plus the weak PD on the lengths
+        nonlocal fb_max
+        k = round(d.time / SIM_TIMESTEP)
         for i in sl.PAPER_DRIVEN_LEGS:
             li = d.qpos[lay.slide[i][0]] + lay.l0[i]
             fb = kp * (l_ref[k, i] - li) + kd * (ld_ref[k, i] - d.qvel[lay.slide[i][1]])
             fb_max = max(fb_max, abs(fb))
             d.ctrl[act[i]] = ff[k, i] + fb
-        mujoco.mj_step(m, d)
+
+    def pose_error(d: mujoco.MjData) -> float:
+        k = round(d.time / SIM_TIMESTEP)
+        return max(abs(d.qpos[lay.alpha[0]] - q[k, 0]), abs(d.qpos[lay.beta[0]] - q[k, 1]))
+
+    err = np.array(eng.simulate(t, pose_error, servo))
     share = fb_max / float(np.max(np.abs(ff)))
     return float(err.max()), share, {"t": t, "error": err}
 

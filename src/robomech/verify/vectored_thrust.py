@@ -41,7 +41,7 @@ from robomech.mechanisms import vectored_thrust as vt
 from robomech.spatial import exp_so3
 
 from ._core import Check, Tolerance, Verification, optional_module
-from ._generic import engine_options
+from ._mujoco import Engine, engine_options
 
 if TYPE_CHECKING:
     import mujoco
@@ -113,11 +113,10 @@ def build_mjcf(th: vt.VectoredThruster, *, actuated: bool = False) -> str:
 def _servo_model(th: vt.VectoredThruster) -> mujoco.MjModel:
     """The actuated engine model with its q1, q2 actuators made position servos (MuJoCo's
     ``<position>``: gain kp, bias ``-kp q - kv qd``), gains from the engine's own inertia."""
-    m = mujoco.MjModel.from_xml_string(build_mjcf(th, actuated=True))
-    d = mujoco.MjData(m)
-    mujoco.mj_forward(m, d)
-    M = np.zeros((m.nv, m.nv))
-    mujoco.mj_fullM(m, d, M)
+    eng = Engine(mujoco.MjModel.from_xml_string(build_mjcf(th, actuated=True)))
+    m = eng.model
+    eng.set_state(np.zeros(m.nq))
+    M = eng.mass_matrix()
     w = SIM_SERVO_BANDWIDTH
     for a in range(m.nu):
         dof = int(m.jnt_dofadr[m.actuator_trnid[a, 0]])
@@ -200,15 +199,11 @@ def engine_trace(
     mech = vt.to_multibody(th)
     hinge = mech.closures[0]  # the RRR chain's s13 joint, a revolute closure rrr_arc2 -> platform
     s13_local = np.asarray(hinge.axis, dtype=float)
-    m = mujoco.MjModel.from_xml_string(build_mjcf(th))
-    d = mujoco.MjData(m)
+    eng = Engine(mujoco.MjModel.from_xml_string(build_mjcf(th)))
+    m, d = eng.model, eng.data
     pos, vel, acc = _joint_data(an, q, qd, qdd)
-    adr = {}
-    for j in range(m.njnt):
-        adr[mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j)] = (
-            int(m.jnt_qposadr[j]),
-            int(m.jnt_dofadr[j]),
-        )
+    names = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(m.njnt)]
+    qadr, dadr = eng.joint_addresses(names)
     bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "platform")
     bid_rrr = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, hinge.body1)
     sid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "propeller")
@@ -219,13 +214,15 @@ def engine_trace(
     res = np.zeros(6)
     E3 = exp_so3(s13_local * pos["rho3"][:, None])  # (n, 3, 3) the closure hinge at its analytic angle
     for i in range(n):  # the engine is per-sample by nature
-        d.qpos[:], d.qvel[:], d.qacc[:] = 0.0, 0.0, 0.0
-        for name, (qa, va) in adr.items():
-            d.qpos[qa], d.qvel[va] = pos[name][i], vel[name][i]
-        mujoco.mj_forward(m, d)
-        eq = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
-        closure[i] = np.abs(d.efc_pos[eq]).max()
-        Jc = np.array(d.efc_J)[: d.nefc * m.nv].reshape(d.nefc, m.nv)[eq]
+        eng.set_state(
+            [pos[k][i] for k in names],
+            [vel[k][i] for k in names],
+            [acc[k][i] for k in names],
+            qpos_index=qadr,
+            dof_index=dadr,
+        )
+        Jc, efc_pos = eng.equality()
+        closure[i] = np.abs(efc_pos).max()
         closure_rate[i] = np.abs(Jc @ d.qvel).max()
         out["tip"][i] = d.site_xpos[sid]
         R[i] = d.site_xmat[sid].reshape(3, 3)
@@ -237,8 +234,6 @@ def engine_trace(
         mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, bid_rrr, res, 0)
         w_arc2 = res[:3].copy()
         out["w3"][i] = w_arc2 + vel["rho3"][i] * s13
-        for name, (_, va) in adr.items():
-            d.qacc[va] = acc[name][i]
         mujoco.mj_rnePostConstraint(m, d)
         mujoco.mj_objectAcceleration(m, d, mujoco.mjtObj.mjOBJ_BODY, bid, res, 0)
         out["wd"][i] = res[:3]
@@ -279,26 +274,24 @@ def forward_simulation(
     Returns time, engine inputs (n, 2), engine propeller axis (n, 3) and the analytic FK of those inputs
     (``analytic``'s, default ``th``'s).
     """
-    m = _servo_model(th)
-    d = mujoco.MjData(m)
+    eng = Engine(_servo_model(th))
+    m = eng.model
     sid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "propeller")
-    jq1 = m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "q1")]
-    jq2 = m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "q2")]
-    a1 = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "act_q1")
-    a2 = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "act_q2")
+    jq, _ = eng.joint_addresses(["q1", "q2"])
+    act = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, n) for n in ("act_q1", "act_q2")]
     w = 2 * np.pi / 4.0
-    steps = round(duration / m.opt.timestep)
-    every = 50
-    ts, qs, axes = [], [], []
-    mujoco.mj_forward(m, d)
-    for k in range(steps):
-        q_ref, _, _ = table1_trajectory(np.array(d.time), omega=w)
-        d.ctrl[a1], d.ctrl[a2] = q_ref[0], q_ref[1]
-        mujoco.mj_step(m, d)
-        if k % every == 0:
-            ts.append(d.time)
-            qs.append([d.qpos[jq1], d.qpos[jq2]])
-            axes.append(d.site_xpos[sid] / th.propeller_arm)
+    every = 50  # record every 50th step
+    dt = m.opt.timestep
+    times = dt * (1 + np.arange(0, round(duration / dt), every))
+    eng.set_state(np.zeros(m.nq), np.zeros(m.nv))
+
+    def servo(d: mujoco.MjData) -> None:  # position servos along the slowed Table 1 trajectory
+        d.ctrl[act] = table1_trajectory(np.array(d.time), omega=w)[0]
+
+    rec = eng.simulate(
+        times, lambda d: (d.time, d.qpos[jq].copy(), d.site_xpos[sid] / th.propeller_arm), servo
+    )
+    ts, qs, axes = zip(*rec, strict=True)
     q = np.array(qs)
     return {
         "t": np.array(ts),
