@@ -61,7 +61,6 @@ def chain_screws(leg: OmniLeg) -> tuple[np.ndarray, np.ndarray]:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
 
     Returns
     -------
@@ -69,11 +68,6 @@ def chain_screws(leg: OmniLeg) -> tuple[np.ndarray, np.ndarray]:
         Screw ``[ω; v]`` (space frame O0; v in m) of joint i of chain k as ``S[k, i]``.
     M : ndarray, shape (4, 4)
         Home pose ``T_O0 O0'`` of the knee plate (eq. (3)).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     w1 = np.array([[0.0, 1, 0], [1, 0, 0], [1, 0, 0], [0, 1, 0]])  # paper 2, eq. (1)
@@ -138,19 +132,12 @@ def thigh_closure(leg: OmniLeg, alpha: object, beta: object) -> ThighClosure:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
     alpha, beta : array_like, shape (...)
         Active angles α = θ21 and β = θ11 (rad); broadcast together.
 
     Returns
     -------
     :class:`ThighClosure`
-        The thigh's joint angles and knee pose per sample, with convergence flags.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -250,17 +237,11 @@ def shank_frames(leg: OmniLeg) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (``shank_azimuth``, rad).
 
     Returns
     -------
     ndarray, shape (3, 3, 3)
         ``S[i - 1]``: rotation of chain i's frame in the knee-plate frame.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     psi = leg.shank_azimuth + 2.0 * np.pi * np.arange(3) / 3.0
@@ -281,19 +262,12 @@ def shank_crank_slider(leg: OmniLeg, gamma: object) -> ShankResult:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
     gamma : array_like, shape (...)
         Crank angle γ (rad); samples with ``|γ| >= π/2`` are flagged, not raised.
 
     Returns
     -------
     :class:`ShankResult`
-        The shank's joint points and slider per sample, with a ``valid`` mask.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------

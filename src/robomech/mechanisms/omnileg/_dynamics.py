@@ -300,7 +300,6 @@ def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
     Parameters
     ----------
     leg : OmniLeg
-        Leg geometry and body inertias.
     q : array_like, shape (..., 3)
         Joint coordinates ``(α, β, γ)`` (rad).
 
@@ -310,11 +309,6 @@ def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
         Rotation of each body (hip frame), in the order of ``BODY_NAMES``.
     p : ndarray, shape (..., 22, 3)
         Mass centre of each body (m, hip frame), in the order of ``BODY_NAMES``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -373,7 +367,6 @@ def inverse_dynamics(
     Parameters
     ----------
     leg : OmniLeg
-        Leg geometry, body inertias and gravity (hip frame).
     q, qd, qdd : array_like, shape (..., 3)
         Joint coordinates (rad), rates (rad/s) and accelerations (rad/s²); broadcast together.
     foot_force : array_like, shape (..., 3), optional
@@ -384,13 +377,6 @@ def inverse_dynamics(
     Returns
     -------
     :class:`DynamicsResult`
-        Actuator torques per sample and the terms that sum to them.
-
-    Raises
-    ------
-    ValueError
-        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3),
-        the shapes do not broadcast, or ``paper_as_printed`` is not a bool.
 
     Examples
     --------
@@ -437,7 +423,6 @@ def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        Leg geometry and body inertias.
     q : array_like, shape (..., 3)
         Joint coordinates ``(α, β, γ)`` (rad).
 
@@ -445,11 +430,6 @@ def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
     -------
     ndarray, shape (..., 3, 3)
         ``M(q)`` (kg m² on the diagonal; α, β, γ order), the kinetic energy being ``½ q̇ᵀ M q̇``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -472,7 +452,6 @@ def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        Leg geometry, body masses and gravity (hip frame).
     q : array_like, shape (..., 3)
         Joint coordinates ``(α, β, γ)`` (rad).
 
@@ -480,11 +459,6 @@ def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
     -------
     ndarray, shape (..., 3)
         Gravity torques (N·m), α, β, γ order (``gravity_terms`` of :func:`inverse_dynamics`).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -502,7 +476,6 @@ def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]
     Parameters
     ----------
     leg : OmniLeg
-        Leg geometry, body inertias and gravity (hip frame).
     q, qd : array_like, shape (..., 3)
         Joint coordinates (rad) and rates (rad/s); broadcast together.
 
@@ -512,11 +485,6 @@ def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]
         Kinetic energy (J).
     potential : ndarray, shape (...)
         Potential energy (J).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -537,7 +505,6 @@ def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        Leg geometry.
     q : array_like, shape (..., 3)
         Joint coordinates ``(α, β, γ)`` (rad).
     force : array_like, shape (..., 3)
@@ -547,11 +514,6 @@ def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
     -------
     ndarray, shape (..., 3)
         Motor torques (N·m), α, β, γ order.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -608,7 +570,6 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     Parameters
     ----------
     leg : OmniLeg
-        Leg geometry.
     q : array_like, shape (..., 3)
         Joint coordinates ``(α, β, γ)`` (rad).
     tau : array_like, shape (..., 3)
@@ -617,12 +578,6 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     Returns
     -------
     :class:`FootForceResult`
-        Foot force per sample, with a singular mask and residual.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))

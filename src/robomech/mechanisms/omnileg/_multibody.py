@@ -110,18 +110,12 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m), inertias and gravity (hip frame).
 
     Returns
     -------
     Mechanism
         The spanning tree of ``TREE_JOINTS`` with its bodies and inertials, the loop closures, and the
         actuated coordinates ``(α, β, γ)``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     L1, L3, L4 = leg.L1, leg.L3, leg.L4

@@ -88,7 +88,6 @@ def joint_rates(
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
     q : array_like, shape (..., 3)
         Joint angles ``(α, β, γ)`` (rad).
     foot_velocity : array_like, shape (..., 3)
@@ -101,13 +100,6 @@ def joint_rates(
     Returns
     -------
     :class:`JointRatesResult`
-        Joint rates and accelerations per sample, with singular mask and residuals.
-
-    Raises
-    ------
-    ValueError
-        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3),
-        the batch shapes do not broadcast, or ``damping`` is negative or not a finite real number.
 
     Examples
     --------

@@ -87,7 +87,6 @@ def joint_grid(leg: OmniLeg, n: int | tuple[int, int, int]) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        The leg and its joint limits (rad).
     n : int or tuple of int
         Samples per joint (each >= 2): one count for all three, or ``(n_α, n_β, n_γ)``.
 
@@ -95,11 +94,6 @@ def joint_grid(leg: OmniLeg, n: int | tuple[int, int, int]) -> np.ndarray:
     -------
     ndarray, shape (n_α, n_β, n_γ, 3)
         Joint samples ``(α, β, γ)`` (rad), the range ends included.
-
-    Raises
-    ------
-    ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``n`` is not an int >= 2 or three of them.
 
     Examples
     --------
@@ -130,19 +124,12 @@ def workspace_map(leg: OmniLeg, q: object) -> WorkspaceMap:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m) and joint limits (rad).
     q : array_like, shape (..., 3)
         Joint samples ``(α, β, γ)`` (rad).
 
     Returns
     -------
     :class:`WorkspaceMap`
-        Per-sample workspace and singularity measures.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -173,7 +160,6 @@ def singular_surface(leg: OmniLeg, alpha: object, beta: object) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
     alpha, beta : array_like, shape (...)
         Thigh angles (rad); broadcast together.
 
@@ -181,11 +167,6 @@ def singular_surface(leg: OmniLeg, alpha: object, beta: object) -> np.ndarray:
     -------
     ndarray, shape (..., 3)
         Foot positions ``FK(α, β, 0)`` in the hip frame (m).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     _leg(leg)
     a = as_array(alpha, "alpha")
@@ -239,19 +220,12 @@ def foot_workspace(leg: OmniLeg, *, nodes: int = AREA_NODES) -> FootWorkspace:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m) and joint limits (rad).
     nodes : int, optional
         Gauss-Legendre nodes per joint coordinate (>= 2; default ``AREA_NODES``).
 
     Returns
     -------
     :class:`FootWorkspace`
-        Volume, area and extent of the foot workspace.
-
-    Raises
-    ------
-    ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``nodes`` is not an int >= 2.
 
     Examples
     --------
@@ -323,19 +297,12 @@ def workspace_symmetry(leg: OmniLeg, p_foot: object) -> SymmetryResult:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m) and joint limits (rad).
     p_foot : array_like, shape (..., 3)
         Foot positions in the hip frame (m); non-finite samples allowed.
 
     Returns
     -------
     :class:`SymmetryResult`
-        Per-sample masks of the workspace's symmetries.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------

@@ -258,7 +258,6 @@ def generalized_forces(
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m) and mass properties (kg, kg m^2); ``leg.gravity`` (m/s^2, base frame).
     q : array_like, shape (..., 2)
         Platform angles ``(alpha, beta)`` (rad).
     qd : array_like, shape (..., 2)
@@ -275,11 +274,6 @@ def generalized_forces(
     -------
     ndarray, shape (..., 2)
         Generalized forces ``tau`` on (alpha, beta) (N m).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -304,7 +298,6 @@ def mass_matrix(leg: SphericalLeg, q: object, *, paper_as_printed: bool = False)
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m) and mass properties (kg, kg m^2).
     q : array_like, shape (..., 2)
         Platform angles ``(alpha, beta)`` (rad).
     paper_as_printed : bool, optional
@@ -314,11 +307,6 @@ def mass_matrix(leg: SphericalLeg, q: object, *, paper_as_printed: bool = False)
     -------
     ndarray, shape (..., 2, 2)
         ``M(q)`` (kg m^2), symmetric positive definite.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -353,7 +341,6 @@ def mechanical_energy(
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m), mass properties (kg, kg m^2) and ``gravity`` (m/s^2, base frame).
     q : array_like, shape (..., 2)
         Platform angles ``(alpha, beta)`` (rad).
     qd : array_like, shape (..., 2)
@@ -367,11 +354,6 @@ def mechanical_energy(
         Kinetic energy (J).
     V : ndarray, shape (...)
         Gravitational potential energy (J), zero with every centre of mass at O.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -467,13 +449,6 @@ def distribute_forces(
     Returns
     -------
     :class:`ForceDistribution`
-        Leg forces per sample, with residual and conditioning.
-
-    Raises
-    ------
-    ValueError
-        If ``J`` or ``tau`` has a wrong shape or a non-real dtype, ``driven_legs`` is not two
-        different indices in 0..2, or ``sigma_min_bound`` is negative or not a real number.
 
     Examples
     --------
@@ -603,7 +578,6 @@ def inverse_dynamics(
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m) and mass properties (kg, kg m^2); ``leg.gravity`` (m/s^2, base frame).
     q : array_like, shape (..., 2)
         Platform angles ``(alpha, beta)`` (rad).
     qd : array_like, shape (..., 2)
@@ -622,14 +596,6 @@ def inverse_dynamics(
     Returns
     -------
     :class:`InverseDynamicsResult`
-        Generalized and leg forces per sample, with residual and conditioning.
-
-    Raises
-    ------
-    ValueError
-        If ``leg`` is not a :class:`SphericalLeg`, or an input has a wrong shape, is not real and
-        finite, or the inputs do not broadcast.
-        Also if ``driven_legs`` is not two different indices in 0..2.
 
     Examples
     --------

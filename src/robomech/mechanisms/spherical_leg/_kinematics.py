@@ -88,11 +88,6 @@ def platform_rotation(alpha: object, beta: object) -> np.ndarray:
     ndarray, shape (..., 3, 3)
         The rotation of the platform frame relative to the base frame (``R_base_platform``).
 
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
-
     Examples
     --------
     >>> from robomech.mechanisms import spherical_leg as sl
@@ -161,14 +156,12 @@ def inverse_kinematics(leg: SphericalLeg, alpha: object, beta: object) -> Invers
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m).
     alpha, beta : array_like, shape (...)
         Platform angles (rad); broadcast together.
 
     Returns
     -------
     :class:`InverseKinematicsResult`
-        Leg lengths, directions and platform points per pose, with stroke masks.
 
     Examples
     --------
@@ -265,7 +258,6 @@ def forward_kinematics(
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m), e.g. ``SphericalLeg.paper()``.
     lengths : array_like, shape (..., 3)
         Leg lengths ``(l1, l2, l3)`` (m).
     branch : {0, 1}, optional
@@ -276,7 +268,6 @@ def forward_kinematics(
     Returns
     -------
     :class:`ForwardKinematicsResult`
-        Platform angles per sample, with residual and ``valid``/``converged`` masks.
 
     Examples
     --------
@@ -457,7 +448,6 @@ def jacobian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m).
     alpha, beta : array_like, shape (...)
         Platform angles (rad); broadcast together.
 
@@ -533,7 +523,6 @@ def hessian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m).
     alpha, beta : array_like, shape (...)
         Platform angles (rad); broadcast together.
 
@@ -541,11 +530,6 @@ def hessian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
     -------
     ndarray, shape (..., 3, 2, 2)
         ``d^2 l_i / dq_j dq_k`` (m/rad^2), symmetric in (j, k); the derivative of :func:`jacobian`.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -577,11 +561,6 @@ def angular_velocity_jacobian(alpha: object) -> np.ndarray:
         ``E`` (rad/s of omega, base frame, per rad/s of (alpha_dot, beta_dot)): columns ``x`` and
         ``Rx(alpha) y``.
 
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
-
     Examples
     --------
     >>> from robomech.mechanisms import spherical_leg as sl
@@ -609,7 +588,6 @@ def influence_coefficients(leg: SphericalLeg, alpha: object, beta: object) -> np
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m).
     alpha, beta : array_like, shape (...)
         Platform angles (rad); broadcast together.
 
@@ -618,11 +596,6 @@ def influence_coefficients(leg: SphericalLeg, alpha: object, beta: object) -> np
     ndarray, shape (..., 3, 6)
         ``G``: row i is ``[(B_i - O) x s_i; s_i]`` (first three columns in m, last three unit-free),
         base frame, so that ``ldot = G @ [omega; v_O]`` (m/s).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -649,7 +622,6 @@ def leg_rates(
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m).
     q : array_like, shape (..., 2)
         Platform angles ``(alpha, beta)`` (rad).
     qd : array_like, shape (..., 2)
@@ -665,11 +637,6 @@ def leg_rates(
         Leg extension rates (m/s).
     lddot : ndarray, shape (..., 3)
         Leg extension accelerations (m/s^2).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------

@@ -134,12 +134,6 @@ def inverse_rates(
     Returns
     -------
     InverseRatesResult
-        Input rates and accelerations with their conditioning and masks.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -246,12 +240,6 @@ def static_torques(th: VectoredThruster, q: object, wrench: object) -> StaticsRe
     Returns
     -------
     StaticsResult
-        ``tau`` (..., 2) N·m, the ``moment`` and its ``unloaded`` part (..., 3) N·m, and ``valid``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------

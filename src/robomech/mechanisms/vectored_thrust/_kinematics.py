@@ -320,12 +320,6 @@ def joint_axes(th: VectoredThruster, q: object) -> JointAxes:
     Returns
     -------
     JointAxes
-        ``s11, s12, s13, s21, s22, s0`` (..., 3), ``distance`` and ``valid`` (...).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -424,11 +418,6 @@ def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
     ndarray, shape (...)
         Angular distance between the arcs (rad), in [0, π].
 
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
-
     Examples
     --------
     >>> round(float(arc_clearance([1, 0, 0], [0, 1, 0], [0, 0, 1], [0, 1, 0])), 12)   # share an end
@@ -510,12 +499,6 @@ def link_clearance(th: VectoredThruster, q: object) -> LinkClearanceResult:
     Returns
     -------
     LinkClearanceResult
-        Clearance (rad, compare with ``th.interference_clearance``) and its mask.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -590,7 +573,6 @@ def forward_kinematics(th: VectoredThruster, q: object) -> FKResult:
     Returns
     -------
     FKResult
-        Propeller axis, tip, tilt and the validity and limit masks.
 
     Examples
     --------
@@ -616,12 +598,6 @@ def platform_rotation(th: VectoredThruster, q: object) -> RotationResult:
     Returns
     -------
     RotationResult
-        ``R`` (..., 3, 3) (NaN where singular) and ``valid`` (...).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -726,7 +702,6 @@ def inverse_kinematics(th: VectoredThruster, s: object) -> IKResult:
     Returns
     -------
     IKResult
-        ``q (..., 2)`` inputs (rad) and the masks ``solved``, ``in_range``, ``tilt_ok``, ``valid``.
 
     Examples
     --------
@@ -782,12 +757,6 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
     Returns
     -------
     PassiveResult
-        ``values`` (..., 3) the angles (theta, rho2, rho3), rad (NaN where singular), and ``valid``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
     """
     check_params(th, VectoredThruster, "th")
     q = _q(q)
@@ -826,12 +795,6 @@ def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
     Returns
     -------
     PassiveResult
-        ``values`` (..., 3) passive rates (rad/s; NaN where singular) and ``valid``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
     """
     check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
@@ -890,7 +853,6 @@ def jacobian(th: VectoredThruster, q: object) -> JacobianResult:
     Returns
     -------
     JacobianResult
-        ``J (..., 3, 2)``, its mask and the distance to the singularity.
 
     Examples
     --------
@@ -935,12 +897,6 @@ def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityRes
     Returns
     -------
     VelocityResult
-        ``omega`` (..., 3) rad/s, base frame (NaN where singular), and ``valid``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -984,12 +940,6 @@ def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: objec
     Returns
     -------
     AccelerationResult
-        Platform angular velocity and acceleration, passive accelerations, mask.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
     """
     check_params(th, VectoredThruster, "th")
     q, qd, qdd = _q(q), as_array(qd, "qd", (2,)), as_array(qdd, "qdd", (2,))

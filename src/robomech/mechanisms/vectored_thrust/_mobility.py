@@ -102,12 +102,6 @@ def platform_mobility(
     Returns
     -------
     MobilityResult
-        Mobility analysis (:mod:`robomech.analysis.mobility`).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -163,12 +157,6 @@ def mechanism_mobility(
     Returns
     -------
     MechanismMobility
-        The ``platform`` and ``propeller`` ``MobilityResult``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
