@@ -37,6 +37,10 @@ the foot site ``foot`` is the foot point, whose position is eq. (11).
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -101,6 +105,48 @@ def _inertial(body: RigidBody, Q: Matrix) -> Inertial:
     )
 
 
+def chain_axes(L1: float, L3: float) -> tuple[Matrix, Matrix]:
+    """Axes ``w`` and points ``p`` (3, 4, 3) of the UU chains' joints at the home pose (eqs. (1)-(7))."""
+    w1 = np.array([[0.0, 1, 0], [1, 0, 0], [1, 0, 0], [0, 1, 0]])  # paper 2, eq. (1)
+    p1 = np.array([[0.0, L3, 0], [0, L3, 0], [0, L3, L1], [0, L3, L1]])  # eq. (2)
+    return np.stack([w1 @ _kR(k).T for k in range(3)]), np.stack(
+        [p1 @ _kR(k).T for k in range(3)]
+    )  # eqs. (6), (7)
+
+
+def _add_thigh(
+    b: Builder, L1: float, L3: float, inertial: Callable[[str, str], Inertial] | None = None
+) -> None:
+    """The three UU chains and the knee plate; chains 2 and 3 close on it through their fourth joint."""
+    knee = np.array([0.0, 0.0, L1])  # O0' at the home pose (eq. (3))
+
+    def body(name: str, parent: str, kind: str, **kw: Any) -> None:
+        b.body(name, parent, inertial=None if inertial is None else inertial(name, kind), **kw)
+
+    for k, (w, p) in enumerate(zip(*chain_axes(L1, L3), strict=True)):
+        c = k + 1
+        # every body frame is parallel to the hip frame at the home pose, so qpos = the PoE angles
+        hc, tr, kc = f"hip_cross_{c}", f"thigh_rod_{c}", f"knee_cross_{c}"
+        body(hc, "world", "hip_cross", pos=p[0], joints=[b.hinge(f"theta{c}1", axis=w[0])])
+        body(tr, hc, "thigh_rod", joints=[b.hinge(f"theta{c}2", axis=w[1])])
+        body(kc, tr, "knee_cross", pos=p[2] - p[0], joints=[b.hinge(f"theta{c}3", axis=w[2])])
+        if k == 0:
+            hinge = b.hinge("theta14", axis=w[3], pos=p[3] - knee)
+            body("knee_plate", kc, "knee_plate", pos=knee - p[2], joints=[hinge])
+        else:
+            b.revolute(f"theta{c}4", kc, "knee_plate", anchor1=(0.0, 0.0, 0.0), axis=w[3])
+
+
+@functools.lru_cache(maxsize=8)
+def thigh_mechanism(L1: float, L3: float) -> Mechanism:
+    """The thigh alone (no inertias): q_act = (α, β) = (θ21, θ11), site ``knee`` at O0'."""
+    b = Builder("omnileg_thigh")
+    _add_thigh(b, L1, L3)
+    b.site("knee", "knee_plate")
+    b.actuate("theta21", "theta11")
+    return b.build()
+
+
 def to_multibody(leg: OmniLeg) -> Mechanism:
     """The generic description of ``leg`` (an :class:`OmniLeg`), with its inertias; q_act = (α, β, γ).
 
@@ -118,41 +164,15 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
         actuated coordinates ``(α, β, γ)``.
     """
     check_params(leg, OmniLeg, "leg")
-    L1, L3, L4 = leg.L1, leg.L3, leg.L4
+    L1, L4 = leg.L1, leg.L4
     bodies = leg.bodies
 
     def inertial(name: str, kind: str) -> Inertial:
         return _inertial(bodies[kind], _frame(name))
 
     b = Builder("omnileg", gravity=leg.gravity)
-    w1 = np.array([[0.0, 1, 0], [1, 0, 0], [1, 0, 0], [0, 1, 0]])  # paper 2, eq. (1)
-    p1 = np.array([[0.0, L3, 0], [0, L3, 0], [0, L3, L1], [0, L3, L1]])  # eq. (2)
-    knee = np.array([0.0, 0.0, L1])  # O0' at the home pose (eq. (3))
+    _add_thigh(b, leg.L1, leg.L3, inertial)
     g0 = REFERENCE_GAMMA
-    for k in range(3):
-        w, p = w1 @ _kR(k).T, p1 @ _kR(k).T  # eqs. (6), (7)
-        c = k + 1
-        # every body frame is parallel to the hip frame at the home pose, so qpos = the PoE angles
-        hc, tr, kc = f"hip_cross_{c}", f"thigh_rod_{c}", f"knee_cross_{c}"
-        b.body(hc, pos=p[0], joints=[b.hinge(f"theta{c}1", axis=w[0])], inertial=inertial(hc, "hip_cross"))
-        b.body(tr, hc, joints=[b.hinge(f"theta{c}2", axis=w[1])], inertial=inertial(tr, "thigh_rod"))
-        b.body(
-            kc,
-            tr,
-            pos=p[2] - p[0],
-            joints=[b.hinge(f"theta{c}3", axis=w[2])],
-            inertial=inertial(kc, "knee_cross"),
-        )
-        if k == 0:
-            b.body(
-                "knee_plate",
-                kc,
-                pos=knee - p[2],
-                joints=[b.hinge("theta14", axis=w[3], pos=p[3] - knee)],
-                inertial=inertial("knee_plate", "knee_plate"),
-            )
-        else:
-            b.revolute(f"theta{c}4", kc, "knee_plate", anchor1=(0.0, 0.0, 0.0), axis=w[3])
     # drive (paper 2, Fig. 7): input shaft about Z0 turned by γ, U joint A4 at O0, rod A4B4, U joint B4
     # at O0', output shaft about Z0' in the knee plate; every frame is Rz(γ) at α = β = 0.
     # paper 2, eqs. (26)-(31): the paper decouples the drive's spin from the thigh motion; here the
