@@ -24,6 +24,7 @@ import numpy as np
 
 from robomech._batching import chunked
 from robomech._validation import as_array, broadcast_batch, check_bool, check_params
+from robomech.analysis.lstsq import _damped_svd_solve
 
 from . import _jet as jt
 from ._chains import shank_frames
@@ -590,9 +591,8 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     lam = DAMPING_RELATIVE * s[..., :1]
     # Jᵀ = V Σ Uᵀ, so F = U Σ⁺ Vᵀ τ; only the directions with σ_i < SINGULAR_RCOND σ_max are damped
     weak = s < SINGULAR_RCOND * s[..., :1]
-    coef = np.where(weak, s / (s * s + lam * lam), 1.0 / np.where(weak, 1.0, s))
     # paper 2, eq. (47): F_f = (Jᵀ)⁻¹ τ for the force the foot delivers; the force applied to it is -F_f
-    F = -np.einsum("...ij,...j->...i", U, coef * np.einsum("...ij,...j->...i", Vt, tau))
+    F = -_damped_svd_solve(np.swapaxes(Vt, -1, -2), s, np.swapaxes(U, -1, -2), tau, lam, weak)
     resid = np.linalg.norm(-np.einsum("...ij,...i->...j", J, F) - tau, axis=-1)
     # the per-sample fields have the batch of every argument (q may be one configuration for many tau)
     return FootForceResult(

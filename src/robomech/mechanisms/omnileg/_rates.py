@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomech._validation import as_array, broadcast_batch, check_params, check_real
+from robomech.analysis.lstsq import _damped_svd_solve
 
 from ._dynamics import SINGULAR_RCOND
 from ._kinematics import hessian, jacobian
@@ -56,13 +57,6 @@ class JointRatesResult:
     velocity_residual: np.ndarray
     acceleration_residual: np.ndarray
     valid: np.ndarray
-
-
-def _damped_solve(U, s, Vt, b, lam, weak):
-    """x = V diag(c) Uᵀ b with c = 1/σ on regular directions and σ/(σ² + λ²) on weak ones."""
-    den = s * s + lam * lam
-    coef = np.where(weak, s / np.where(den > 0, den, 1.0), 1.0 / np.where(weak, 1.0, s))  # 0 if σ = λ = 0
-    return np.einsum("...ji,...j->...i", Vt, coef * np.einsum("...ji,...j->...i", U, b))
 
 
 def joint_rates(
@@ -130,7 +124,7 @@ def _joint_rates(leg, q, pd, pdd, damping, batch) -> JointRatesResult:
     rcond = s[..., -1] / smax[..., 0]
     weak = s < SINGULAR_RCOND * smax
     lam = float(damping) * smax
-    qd = _damped_solve(U, s, Vt, pd, lam, weak)
+    qd = _damped_svd_solve(U, s, Vt, pd, lam, weak)
     v_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qd) - pd, axis=-1)
     if pdd is None:
         qdd = np.full((*batch, 3), np.nan)
@@ -138,7 +132,7 @@ def _joint_rates(leg, q, pd, pdd, damping, batch) -> JointRatesResult:
     else:
         pdd = np.broadcast_to(pdd, (*batch, 3))
         bias = np.einsum("...ijk,...j,...k->...i", hessian(leg, q), qd, qd)  # q̇ᵀ H q̇
-        qdd = _damped_solve(U, s, Vt, pdd - bias, lam, weak)
+        qdd = _damped_svd_solve(U, s, Vt, pdd - bias, lam, weak)
         a_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qdd) + bias - pdd, axis=-1)
     singular = rcond < SINGULAR_RCOND
     finite = np.all(np.isfinite(qd), -1) & (pdd is None or np.all(np.isfinite(qdd), -1))

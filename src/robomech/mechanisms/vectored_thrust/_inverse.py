@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomech._validation import as_array, broadcast_batch, check_params, check_real
+from robomech.analysis.lstsq import _damped_svd_solve
 
 from ._kinematics import _chunked, _jacobian, _q, angular_acceleration
 from ._params import VectoredThruster
@@ -86,13 +87,6 @@ class InverseRatesResult:
     omega_residual: np.ndarray
     omega_dot_residual: np.ndarray
     valid: np.ndarray
-
-
-def _damped_pinv_apply(U, s, Vt, b, lam, weak):
-    """V diag(c) Uᵀ b for J = U diag(s) Vt (thin SVD, U (..., 3, 2)); c = σ/(σ² + λ²) on weak directions."""
-    den = s * s + lam * lam
-    coef = np.where(weak, s / np.where(den > 0, den, 1.0), 1.0 / np.where(weak, 1.0, s))
-    return np.einsum("...ki,...k->...i", Vt, coef * np.einsum("...ki,...k->...i", U, b))
 
 
 def _check_damping(damping: object) -> float:
@@ -165,7 +159,7 @@ def _inverse_rates(th, q, w, wd, lam_rel, batch) -> InverseRatesResult:
     bound = 1.0 / INPUT_GAIN_MAX
     weak = s < bound
     lam = lam_rel * smax
-    qd = _damped_pinv_apply(U, s, Vt, w, lam, weak)
+    qd = _damped_svd_solve(U, s, Vt, w, lam, weak)
     w_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qd) - w, axis=-1)
     sigma_min = np.where(exists, s[..., -1], 0.0)
     singular = ~exists | (sigma_min < bound)
@@ -179,7 +173,7 @@ def _inverse_rates(th, q, w, wd, lam_rel, batch) -> InverseRatesResult:
         qd_safe = np.where(exists[..., None], qd, 0.0)
         vp = angular_acceleration(th, q_safe, qd_safe, np.zeros_like(qd_safe)).velocity_product
         vp = np.where(exists[..., None], vp, 0.0)
-        qdd = _damped_pinv_apply(U, s, Vt, wd - vp, lam, weak)
+        qdd = _damped_svd_solve(U, s, Vt, wd - vp, lam, weak)
         wd_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qdd) + vp - wd, axis=-1)
         qdd = np.where(exists[..., None], qdd, np.nan)
         wd_res = np.where(exists, wd_res, np.nan)
