@@ -81,7 +81,7 @@ class ThighClosure:
     residual : ndarray, shape (...)
         Largest component of the closure twists ``log(T_k T_1^-1)`` (rad or m).
     converged : ndarray of bool, shape (...)
-        The Gauss-Newton solve converged.
+        The closure holds: ``residual <= 10 CLOSURE_TOL``.
     rotation_error : ndarray, shape (...)
         Rotation angle of the knee plate (rad); zero for an exact closure.
     translation_only : ndarray of bool, shape (...)

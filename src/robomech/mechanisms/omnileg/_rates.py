@@ -69,15 +69,9 @@ def joint_rates(
 ) -> JointRatesResult:
     """Joint rates ``q̇`` (and accelerations ``q̈``) realising the foot velocity ``ṗ`` (and acceleration ``p̈``).
 
-    ``q (..., 3)`` rad (typically from :func:`inverse_kinematics`), ``foot_velocity (..., 3)`` m/s,
-    ``foot_acceleration (..., 3)`` m/s² or None; all broadcast.  ``damping`` (>= 0, relative to
-    sigma_max) damps the directions with ``sigma < SINGULAR_RCOND sigma_max``: ``c = σ / (σ² + λ²)``,
-    ``λ = damping sigma_max`` (selectively damped least squares: the well-determined components stay
-    exact).  ``damping = 0`` inverts the weak directions fully (``c = 1/σ``: the exact inverse,
-    unbounded as σ -> 0; only a direction with σ = 0 exactly gets ``c = 0``), so near γ = 0 the
-    rates grow like 1/σ and ``valid`` is False there as for any damping.
-
-    Paper 2, eq. (47)'s inverse of the foot Jacobian (eq. (14)), regularised at the singularity γ = 0.
+    Paper 2, eq. (47)'s inverse of the foot Jacobian (eq. (14)), regularised at γ = 0: the directions
+    with ``σ < SINGULAR_RCOND σ_max`` get ``c = σ / (σ² + λ²)``, ``λ = damping σ_max``; ``damping = 0``
+    inverts them exactly (unbounded as σ -> 0).  ``valid`` is False there for any damping.
 
     Parameters
     ----------
