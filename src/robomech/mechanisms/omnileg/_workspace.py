@@ -100,7 +100,7 @@ def joint_grid(leg: OmniLeg, n: int | tuple[int, int, int]) -> np.ndarray:
     >>> joint_grid(OmniLeg.paper(), (3, 4, 5)).shape
     (3, 4, 5, 3)
     """
-    _leg(leg)
+    check_params(leg, OmniLeg, "leg")
     if isinstance(n, tuple | list):
         if len(n) != 3:
             raise ValueError(f"Expected n to be an int >= 2 or three of them, got {n!r}.")
@@ -109,11 +109,6 @@ def joint_grid(leg: OmniLeg, n: int | tuple[int, int, int]) -> np.ndarray:
         counts = (check_int(n, "n", low=2),) * 3
     ranges = [(-leg.alpha_max, leg.alpha_max), (-leg.beta_max, leg.beta_max), (leg.gamma_min, leg.gamma_max)]
     return grid(ranges, list(counts))
-
-
-def _leg(leg: object) -> OmniLeg:
-    check_params(leg, OmniLeg, "leg")
-    return leg  # type: ignore[return-value]
 
 
 def workspace_map(leg: OmniLeg, q: object) -> WorkspaceMap:
@@ -138,7 +133,7 @@ def workspace_map(leg: OmniLeg, q: object) -> WorkspaceMap:
     >>> w.foot.shape, bool(w.singular[..., 0].all()), bool(w.singular[..., 1:].any())  # γ = 0 singular
     ((5, 5, 5, 3), True, False)
     """
-    _leg(leg)
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     J = jacobian(leg, q)
     sm = singularity_map(J, rtol=SINGULAR_RCOND)
@@ -168,7 +163,7 @@ def singular_surface(leg: OmniLeg, alpha: object, beta: object) -> np.ndarray:
     ndarray, shape (..., 3)
         Foot positions ``FK(α, β, 0)`` in the hip frame (m).
     """
-    _leg(leg)
+    check_params(leg, OmniLeg, "leg")
     a = as_array(alpha, "alpha")
     b = as_array(beta, "beta")
     a, b = broadcast_to_batch((a, 0, "alpha"), (b, 0, "beta"))
@@ -233,7 +228,7 @@ def foot_workspace(leg: OmniLeg, *, nodes: int = AREA_NODES) -> FootWorkspace:
     >>> bool(np.isclose(ws.volume, ws.projected_area * ws.stroke)), ws.boundary.shape
     (True, (800, 2))
     """
-    _leg(leg)
+    check_params(leg, OmniLeg, "leg")
     nodes = check_int(nodes, "nodes", low=2)
     x, w = np.polynomial.legendre.leggauss(nodes)
     A, B = leg.alpha_max, leg.beta_max
@@ -312,7 +307,7 @@ def workspace_symmetry(leg: OmniLeg, p_foot: object) -> SymmetryResult:
     >>> bool(r.reachable), bool(r.holds)
     (True, True)
     """
-    _leg(leg)
+    check_params(leg, OmniLeg, "leg")
     p = as_array(p_foot, "p_foot", (3,), finite=False)
     images = np.stack(
         [

@@ -89,14 +89,6 @@ class InverseRatesResult:
     valid: np.ndarray
 
 
-def _check_damping(damping: object) -> float:
-    return check_real(damping, "damping", low=0.0)
-
-
-def _check_thruster(th: object) -> None:
-    check_params(th, VectoredThruster, "th")
-
-
 def inverse_rates(
     th: VectoredThruster,
     q: object,
@@ -136,11 +128,11 @@ def inverse_rates(
     >>> r.qd.shape, bool(r.valid.all()), bool(np.allclose(r.qd, 0.0))
     ((3, 2), True, True)
     """
-    _check_thruster(th)
+    check_params(th, VectoredThruster, "th")
     q = _q(q)
     w = as_array(omega, "omega", (3,))
     wd = None if omega_dot is None else as_array(omega_dot, "omega_dot", (3,))
-    lam_rel = _check_damping(damping)
+    lam_rel = check_real(damping, "damping", low=0.0)
     with_wd = [] if wd is None else [(wd, 1, "omega_dot")]
     batch = broadcast_batch((q, 1, "q"), (w, 1, "omega"), *with_wd)
     q = np.broadcast_to(q, (*batch, 2))
@@ -242,7 +234,7 @@ def static_torques(th: VectoredThruster, q: object, wrench: object) -> StaticsRe
     >>> bool(np.allclose(r.tau, 0.0)), bool(r.valid)
     (True, True)
     """
-    _check_thruster(th)
+    check_params(th, VectoredThruster, "th")
     q = _q(q)
     wr = as_array(wrench, "wrench", (6,))
     batch = broadcast_batch((q, 1, "q"), (wr, 1, "wrench"))
