@@ -258,8 +258,7 @@ def compensated_drive(
     Raises
     ------
     ValueError
-        Bad input (see docs/conventions.md); also ``method="disk"`` combined with ``model="arc"`` or a
-        ``wrench``.
+        ``method="disk"`` combined with ``model="arc"`` or a ``wrench``.
 
     Examples
     --------
@@ -645,8 +644,7 @@ def simulate_history(
     Raises
     ------
     ValueError
-        Bad input (see docs/conventions.md); also ``times`` not strictly increasing, or
-        ``memory="elastic"`` combined with ``model="arc"`` or a pulley.
+        ``times`` not strictly increasing, or ``memory="elastic"`` combined with ``model="arc"`` or a pulley.
 
     Examples
     --------
@@ -876,7 +874,7 @@ def disk_equilibrium(
     Raises
     ------
     ValueError
-        Bad input (see docs/conventions.md); also both or neither of ``tension`` and ``drive`` given.
+        Both or neither of ``tension`` and ``drive`` given.
 
     Examples
     --------

@@ -312,8 +312,7 @@ def capstan_tension_ratio(
     Raises
     ------
     ValueError
-        Bad input (see docs/conventions.md); ``rho = inf`` is allowed; also ``rho`` too large for the
-        explicit integration with n < 1 (use ``rho=np.inf``).
+        ``rho`` too large for the explicit integration with n < 1 (use ``rho=np.inf``, which is allowed).
 
     Examples
     --------
@@ -461,8 +460,7 @@ def identify_friction(
     Raises
     ------
     ValueError
-        Bad input (see docs/conventions.md); also a batch element with no measurement of nonzero wrap
-        and direction.
+        A batch element with no measurement of nonzero wrap and direction.
 
     Examples
     --------

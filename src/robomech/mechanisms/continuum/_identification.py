@@ -246,7 +246,7 @@ def identify_friction_from_tip(
     Raises
     ------
     ValueError
-        Bad input (see docs/conventions.md); also only one of ``sigma_t``, ``sigma_tip`` given.
+        Only one of ``sigma_t``, ``sigma_tip`` given.
     """
     from ._compensation import disk_equilibrium
 

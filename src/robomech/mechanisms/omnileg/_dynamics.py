@@ -355,10 +355,9 @@ def inverse_dynamics(
 ) -> DynamicsResult:
     """Motor torques (α, β, γ order) for the motion (q, q̇, q̈), optionally with a force on the foot.
 
-    All inputs ``(..., 3)`` broadcast.  ``foot_force (..., 3)`` (N, hip frame) is
-    ``FOOT_FORCE_CONVENTION``: the external force applied *to* the foot (as a force applied to the
-    foot body in a multibody simulation); it enters as ``-Jᵀ F`` (= :func:`static_torques`).  Paper 2,
-    eqs. (49)-(50) add ``+Jᵀ F_f``, i.e. read F_f as the force the foot delivers: pass ``-F_f``.
+    ``foot_force`` is ``FOOT_FORCE_CONVENTION``: the force applied *to* the foot; it enters as ``-Jᵀ F``
+    (= :func:`static_torques`).  Paper 2, eqs. (49)-(50) add ``+Jᵀ F_f`` (F_f the force the foot
+    delivers): pass ``-F_f``.
 
     ``paper_as_printed=True`` replaces the exact double-Cardan drive by paper 2's simplification (eqs.
     (26)-(31): the crosses CS_A4, CS_B4 and the rod A4B4 turn like chain 1's cross CS_A1, rod A1B1, cross

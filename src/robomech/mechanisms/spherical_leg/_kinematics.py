@@ -247,8 +247,7 @@ def forward_kinematics(
     ``atan2`` form built from l2^2 - l1^2 and l1^2 + l2^2; alpha then matches l3 exactly:
     ``h cos b sin a - r cos a = (l3^2 - K) / (2R)``, i.e. ``sin(a - phi) = s`` with
     ``phi = atan2(r, h cos b)``. ``branch=0`` is the assembly ``a = phi + asin(s)`` that contains
-    alpha = 0; ``branch=1`` is ``a = phi + pi - asin(s)``. Bad samples (non-finite, non-positive, no
-    assembly) are flagged in ``.valid``; a wrong shape raises ``ValueError``.
+    alpha = 0; ``branch=1`` is ``a = phi + pi - asin(s)``.
 
     ``paper_as_printed=True`` runs paper 1's printed pipeline instead (eq. (6), the quartic of eq. (7)
     with its lost square, Ferrari with the misprinted resolvent, α = arctan(2a); ``_as_printed.py``),
