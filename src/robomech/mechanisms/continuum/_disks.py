@@ -2,12 +2,9 @@
 
 Paper 3 models each segment as one arc (eqs. (1)-(4)) and multiplies the tensions by one friction
 factor per segment (eq. (24)).  With friction at the holes the span tensions fall (pulled cable) or
-rise (paid-out cables) from disk to disk, so the bending moment and the curvature do too: measured on
-the disk-resolved Cosserat reference (paper robot: 1.0 mm core, 10 N pretension), the tensions of a
-45 deg arc at beta = 0 with Table 1 mu bend the five intervals by 12.5, 10.2, 8.3, 6.8 and 5.6 deg
-(43.3 deg in all) instead of equally.  The segment-wise model cannot represent that shape, which puts the
-tip 5.3 mm away from the arc's tip for the same total bend, and the paper's compensation (adding the
-stretch delta, eq. (37)) makes the drive's tip error worse (2.16 -> 5.29 mm).
+rise (paid-out cables) from disk to disk, so the bending moment and the curvature do too (12.5 ... 5.6 deg
+over the five intervals of a 45 deg arc, ``docs/mechanisms/continuum_cosserat.md``): one arc per segment
+cannot represent that shape.
 
 This module relaxes constant curvature to one arc per disk interval (the same cable chords, wrap angles,
 capstan friction and elastic cables as the segment model, see :mod:`._compensation`); it reduces to the

@@ -1,38 +1,12 @@
 """The OmniLeg described generically (``robomech.multibody``), from its parameters.
 
-Nothing is derived by hand here: the generic layer assembles the closures and differentiates them,
-and the tests compare the result with the analytic model (eq. (11) FK, the PoE thigh closure, the
-foot J and H, and the Lagrange inverse dynamics of ``_dynamics.py``).
-
-The 22 bodies and 22 tree joints are those of the analytic model (``BODY_NAMES``, ``TREE_JOINTS``),
-with the same names, and every joint's ``qpos`` is the value :func:`joint_motion` gives it:
-
-* Thigh (paper 2, eqs. (1)-(7)): chain k's joints are chain 1's screws (axes y, x at A1 = (0, L3, 0);
-  x, y at B1 = (0, L3, L1)) rotated by kR = Rz(-δ), δ = (k-1) π/2, as printed (eq. (5)).  Chain 1's four
-  hinges carry the knee plate; chains 2 and 3 keep three hinges in the tree and close on the knee plate
-  through their fourth joint (a hinge cut, ``revolute`` closure).  qpos of ``theta{k}{j}`` = θ_kj.
-* Drive (paper 2, Section 3, Fig. 7): the universal-joint coupling G_J1 A4 B4 U_E G_J2.  The input
-  shaft G_J1A4 (``drive_shaft_in``, hinge ``drive_in`` about Z0, motor M3) carries the cross CS_A4
-  (``drive_cross_a``, hinge ``drive_phi1`` about the shaft's yoke arm), the rod A4B4 (``drive_rod``,
-  hinge ``drive_phi2`` about the rod's yoke arm) and the cross CS_B4 at its far end (``drive_cross_b``,
-  hinge ``drive_phi3``); CS_B4 closes on the output shaft B4U_E (``drive_shaft_out``, hinge
-  ``drive_out`` about Z0' in the knee plate) through a hinge cut about the output yoke arm.  At the
-  reference (α = β = 0) the yokes are parallel to the U joints A1, B1 (as the paper sets them up).
-  The output shaft, the cross CS_UE, the shaft U_E G_J2 and the output bevel gear turn as one body
-  about Z0' (the paper's statement after eq. (25)); the 1:1 bevel gears are joint couplings
-  ``crank_i = drive_out``.  The double-Cardan kinematics is exact (solved by the closure), not the
-  paper's simplification of eqs. (26)-(31).
-* Shank (eq. (10), Fig. 4e): each chain C_iD_iE_i is a crank (hinge about its radial axis at C_i,
-  ``knee_to_crank`` below O0'), a coupler (hinge at D_i) and the foot (hinge at E_i on chain 1, hinge
-  cuts on chains 2 and 3).  The reference configuration is γ = 60° (γ = 0 folds every chain straight,
-  a singular configuration).
-* Inertias (the analytic model's assumptions, ``OmniLeg.bodies``): each body's mass, centre of mass
-  and inertia tensor are given in the analytic model's body frame (``docs/mechanisms/omnileg.md``);
-  here they are rotated into this description's body frame (a constant rotation per body, ``_FRAME``)
-  and written as MuJoCo's principal inertia (``Inertial(mass, pos, quat, diaginertia)``).
-
-``q_act = (α, β, γ)`` in the analytic model's order (actuators ``theta21``, ``theta11``, ``drive_in``);
-the foot site ``foot`` is the foot point, whose position is eq. (11).
+Nothing is derived by hand: the 22 bodies and tree joints of the analytic model (``BODY_NAMES``,
+``TREE_JOINTS``, each joint's ``qpos`` that of :func:`joint_motion`), the thigh's UU chains, the exact
+double-Cardan drive and the shank closed by hinge cuts, the 1:1 bevel gears as joint couplings, and the
+analytic inertias rotated into these body frames.  ``q_act = (α, β, γ)`` (actuators ``theta21``,
+``theta11``, ``drive_in``), site ``foot`` at the foot point (eq. (11)), reference γ = 60°.  Body by body:
+``docs/mechanisms/omnileg.md``, "Generic description"; the tests compare it with the analytic model
+(eq. (11) FK, the thigh closure, J, H and the Lagrange inverse dynamics of ``_dynamics.py``).
 """
 
 from __future__ import annotations

@@ -1,30 +1,17 @@
 """Rigid-body inverse dynamics of the spherical parallel leg and its redundant force distribution.
 
 Replaces paper 1, eqs. (19)-(28), which cannot be reproduced as printed (errata): the generalized
-coordinates here are the platform angles q = (alpha, beta) (the printed model uses the three leg
-lengths as coordinates of a 2-DOF platform), the platform lever arm is OP = h (the print uses the
-thickness h_p), and every body's kinetic energy is complete (eq. (25)'s dE/dqdot lost its squares).
-
-Method (Kane's equations = d'Alembert's principle, exact for this holonomic mechanism once the loop
-closure is solved): with each body's centre-of-mass velocity ``v_b = Pv_b qd`` and angular velocity
-``w_b = Pw_b qd``,
+coordinates are the platform angles q = (alpha, beta) (the print uses the three leg lengths of a 2-DOF
+platform), the platform lever arm is OP = h (the print uses the thickness h_p), and every body's kinetic
+energy is complete (eq. (25)'s dE/dqdot lost its squares).  Kane's equations, exact once the closure is
+solved, over the platform and each leg's lower and upper body:
 
     tau = sum_b Pv_b^T m_b (a_b - g) + Pw_b^T (I_b dw_b + w_b x I_b w_b) - E^T m_ext.
 
-Bodies: the platform (rotating about O), and per leg a lower body (centre of mass fixed on the leg
-axis at half its length from A_i) and an upper body (centre of mass at half its length from B_i). The
-leg bodies are inertially axisymmetric.  Each leg hangs on a universal (Cardan) joint at A_i (first
-axis ``a_i = leg.cardan_axes[i]`` fixed in the base, second axis across the leg): the joint forces
-both bodies of the leg to spin about the leg axis s at
-
-    sigma = w . s = sin(u_b) du_a/dt = (a . s) (a . (s x sdot)) / (1 - (a . s)^2)
-
-(u_a about a, u_b about the turned second axis; ``_cardan_spin``), and the lead screws of legs 1
-and 3 spin at ``2 pi ldot / lead`` more (helical joint) when ``leg.screw_spin`` is set.  Paper 1's
-leg energy, eq. (23), has no spin about the leg axis at all; ``paper_as_printed=True`` drops the
-Cardan spin (paper 1 as printed), for comparison only.  Leg forces f (positive = extending
-the leg) satisfy ``J^T f = tau`` (virtual work, power f . ldot): three legs drive two coordinates,
-so a rule picks f.
+The base universal joints make both bodies of a leg spin about its axis (``_cardan_spin``), the lead
+screws of legs 1 and 3 spin more when ``leg.screw_spin`` is set; ``paper_as_printed=True`` drops the
+Cardan spin (eq. (23) has none).  Leg forces f (positive extending) satisfy ``J^T f = tau``: three legs
+drive two coordinates, so a rule picks f.  Assumptions, one by one: ``docs/mechanisms/spherical_leg.md``.
 """
 
 from __future__ import annotations
