@@ -26,11 +26,7 @@ from robomech._validation import as_array, check_real
 __all__ = [
     "RANK_RTOL",
     "UNIT_SCREW_ATOL",
-    "ChainScrews",
-    "MobilityResult",
-    "analyze",
-    "constraint_wrenches",
-    "reciprocal_basis",
+    "ChainScrews", "MobilityResult", "analyze", "constraint_wrenches", "reciprocal_basis",
 ]
 
 # Singular values below RANK_RTOL * max(1, sigma_max) count as zero.  Unit screws of a mechanism of
