@@ -31,7 +31,7 @@ from robomech._validation import (
     finite_samples,
 )
 
-from ._kinematics import LENGTH_FLOOR, _rotation
+from ._kinematics import LENGTH_FLOOR, _check_state, _rotation
 from ._params import SphericalLeg
 
 __all__ = [
@@ -163,19 +163,17 @@ def _motion(
     return _Motion(E, w, dw, p, Rp, s, sd, sdd, l, ld, ldd, Jl, Ps, sig, sigd, Psig, lock)
 
 
-_NO_QDD = object()
-
-
-def _check_state(q: object, qd: object, qdd: object = _NO_QDD):
-    qa = as_array(q, "q", (2,))
-    qda = as_array(qd, "qd", (2,))
-    qdda = None if qdd is _NO_QDD else as_array(qdd, "qdd", (2,))
-    with_qdd = [] if qdda is None else [(qdda, 1, "qdd")]
-    shape = (*broadcast_batch((qa, 1, "q"), (qda, 1, "qd"), *with_qdd), 2)
-    out = [np.broadcast_to(qa, shape), np.broadcast_to(qda, shape)]
-    if qdda is not None:
-        out.append(np.broadcast_to(qdda, shape))
-    return out
+def _driven_motion(
+    leg: SphericalLeg, q: object, qd: object, qdd: object, platform_wrench: object, paper_as_printed: bool
+) -> tuple[_Motion, np.ndarray | None]:
+    """The validated boundary of the force functions: the motion and the platform wrench (or None)."""
+    check_params(leg, SphericalLeg, "leg")
+    qa, qda, qdda = _check_state(q, qd, qdd)
+    w = None if platform_wrench is None else as_array(platform_wrench, "platform_wrench", (6,))
+    if w is not None:
+        broadcast_batch((qa, 1, "q, qd, qdd"), (w, 1, "platform_wrench"))
+    cardan = not check_bool(paper_as_printed, "paper_as_printed")
+    return _motion(leg, qa, qda, qdda, cardan), w
 
 
 def _cross_cols(s: np.ndarray, P: np.ndarray) -> np.ndarray:
@@ -268,13 +266,7 @@ def generalized_forces(
     >>> sl.generalized_forces(sl.SphericalLeg.paper(), [0.1, 0.05], [0.0, 0.0], [0.0, 0.0]).shape
     (2,)
     """
-    check_params(leg, SphericalLeg, "leg")
-    qa, qda, qdda = _check_state(q, qd, qdd)
-    w = None if platform_wrench is None else as_array(platform_wrench, "platform_wrench", (6,))
-    if w is not None:
-        broadcast_batch((qa, 1, "q, qd, qdd"), (w, 1, "platform_wrench"))
-    cardan = not check_bool(paper_as_printed, "paper_as_printed")
-    return _generalized(leg, _motion(leg, qa, qda, qdda, cardan), w)
+    return _generalized(leg, *_driven_motion(leg, q, qd, qdd, platform_wrench, paper_as_printed))
 
 
 def mass_matrix(leg: SphericalLeg, q: object, *, paper_as_printed: bool = False) -> NDArray[np.float64]:
@@ -592,13 +584,7 @@ def inverse_dynamics(
     >>> res.leg_forces.shape, res.valid
     ((2, 3), array([ True,  True]))
     """
-    check_params(leg, SphericalLeg, "leg")
-    qa, qda, qdda = _check_state(q, qd, qdd)
-    w = None if platform_wrench is None else as_array(platform_wrench, "platform_wrench", (6,))
-    if w is not None:
-        broadcast_batch((qa, 1, "q, qd, qdd"), (w, 1, "platform_wrench"))
-    cardan = not check_bool(paper_as_printed, "paper_as_printed")
-    m = _motion(leg, qa, qda, qdda, cardan)
+    m, w = _driven_motion(leg, q, qd, qdd, platform_wrench, paper_as_printed)
     tau = _generalized(leg, m, w)
     dist = distribute_forces(m.Jl, tau, driven_legs)
     valid = dist.valid & ~m.lock

@@ -75,6 +75,17 @@ def _angles(alpha: object, beta: object) -> tuple[np.ndarray, np.ndarray]:
     return a, b
 
 
+_NO_QDD = object()
+
+
+def _check_state(q: object, qd: object, qdd: object = _NO_QDD) -> tuple[np.ndarray, ...]:
+    """``q``, ``qd`` (and ``qdd`` if given) (..., 2) validated and broadcast to their common batch."""
+    items = [(as_array(q, "q", (2,)), 1, "q"), (as_array(qd, "qd", (2,)), 1, "qd")]
+    if qdd is not _NO_QDD:
+        items.append((as_array(qdd, "qdd", (2,)), 1, "qdd"))
+    return broadcast_to_batch(*items)
+
+
 def platform_rotation(alpha: object, beta: object) -> np.ndarray:
     """Platform rotation ``T = Rx(alpha) Ry(beta)`` (paper 1, eq. (1)).
 
@@ -645,10 +656,7 @@ def leg_rates(
     (array([0.10621, 0.11305, 0.11637]), array([0., 0., 0.]))
     """
     check_params(leg, SphericalLeg, "leg")
-    qa = as_array(q, "q", (2,))
-    qda = as_array(qd, "qd", (2,))
-    qdda = as_array(qdd, "qdd", (2,))
-    qa, qda, qdda = broadcast_to_batch((qa, 1, "q"), (qda, 1, "qd"), (qdda, 1, "qdd"))
+    qa, qda, qdda = _check_state(q, qd, qdd)
     a, b = qa[..., 0], qa[..., 1]
     sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
     qq, dq, d2q = _derivatives(leg, sa, ca, sb, cb)
