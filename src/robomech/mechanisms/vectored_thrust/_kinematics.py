@@ -277,17 +277,22 @@ def _q(q: object) -> np.ndarray:
     return as_array(q, "q", (2,))
 
 
-def _axes(th: VectoredThruster, q: np.ndarray) -> JointAxes:
-    """Kernel: joint axes at inputs ``q (..., 2)`` (trusted)."""
+def _closure(th: VectoredThruster, q: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Kernel: sin, cos of q1 and q2 and ``(x, y) = |s22 x s12| (cos theta, sin theta)``."""
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
     s1, c1 = sincos(q[..., 0])  # see _theta_cs: one tangent instead of np.sin + np.cos
     s2, c2 = sincos(q[..., 1])
+    return s1, c1, s2, c2, sa * c1 * c2 - ca * s2, -sa * s1
+
+
+def _axes(th: VectoredThruster, q: np.ndarray) -> JointAxes:
+    """Kernel: joint axes at inputs ``q (..., 2)`` (trusted)."""
+    ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
+    # theta: RR passive angle, R = Ry(q2) Rx(-theta); (cos, sin)(theta) ~ (x, y), D = |s22 x s12|.
+    s1, c1, s2, c2, x, y = _closure(th, q)
     zero, one = np.zeros_like(c1), np.ones_like(c1)
     s12 = np.stack([ca * one, sa * s1, -sa * c1], axis=-1)  # paper 5, eq. (7), with a = pi/4
     s22 = np.stack([-c2, zero, s2], axis=-1)  # paper 5, eq. (5)
-    # theta: RR passive angle, R = Ry(q2) Rx(-theta); (cos, sin)(theta) ~ (x, y), D = |s22 x s12|.
-    x = sa * c1 * c2 - ca * s2
-    y = -sa * s1
     d = np.sqrt(x * x + y * y)  # x, y are O(1): no overflow, so no need for (slow) np.hypot
     valid = d > SINGULAR_TOL
     dd = np.where(valid, d, 1.0)
@@ -443,10 +448,7 @@ def _interference(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
 
 def _interference_unmasked(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    s1, c1 = sincos(q[..., 0])
-    s2, c2 = sincos(q[..., 1])
-    x = sa * c1 * c2 - ca * s2
-    y = -sa * s1
+    s1, c1, s2, c2, x, y = _closure(th, q)
     d = np.sqrt(x * x + y * y)  # |s12 x s22|
     valid = d > SINGULAR_TOL
     inv = 1.0 / np.where(valid, d, np.nan)
@@ -807,10 +809,7 @@ def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
 
 def _jacobian(th: VectoredThruster, q: np.ndarray) -> JacobianResult:
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    s1, c1 = sincos(q[..., 0])  # see _theta_cs: one tangent instead of np.sin + np.cos
-    s2, c2 = sincos(q[..., 1])
-    x = sa * c1 * c2 - ca * s2
-    y = -sa * s1
+    s1, c1, s2, c2, x, y = _closure(th, q)
     d2 = x * x + y * y
     valid = d2 > SINGULAR_TOL**2
     inv = sa / np.where(valid, d2, np.nan)  # NaN where singular; a select is cheaper than a masked divide
