@@ -279,15 +279,13 @@ def _terms(
 
 
 def _terms_chunked(
-    leg: OmniLeg,
-    q: np.ndarray,
-    qd: np.ndarray,
-    qdd: np.ndarray,
-    poses: bool = False,
-    paper_drive: bool = False,
+    leg: OmniLeg, q: np.ndarray, qd: np.ndarray | None = None, qdd: np.ndarray | None = None, **options: bool
 ) -> _Terms:
-    """:func:`_terms` over cache-sized chunks of samples (identical results, far fewer cache misses)."""
-    return chunked(lambda s: _terms(leg, q[s], qd[s], qdd[s], poses, paper_drive), q.shape[0], DYN_CHUNK)
+    """:func:`_terms` over cache-sized chunks of samples (identical results, far fewer cache misses);
+    ``qd``, ``qdd`` zero where not given."""
+    qd = np.zeros_like(q) if qd is None else qd
+    qdd = np.zeros_like(q) if qdd is None else qdd
+    return chunked(lambda s: _terms(leg, q[s], qd[s], qdd[s], **options), q.shape[0], DYN_CHUNK)
 
 
 def _flat(*arrays: np.ndarray) -> tuple[tuple[int, ...], list[np.ndarray]]:
@@ -314,7 +312,7 @@ def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
-    t = _terms_chunked(leg, qf, np.zeros_like(qf), np.zeros_like(qf), poses=True)
+    t = _terms_chunked(leg, qf, poses=True)
     B = len(BODY_NAMES)
     return t.R.reshape(*batch, B, 3, 3), t.p.reshape(*batch, B, 3)
 
@@ -440,8 +438,7 @@ def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
-    z = np.zeros_like(qf)
-    return _terms_chunked(leg, qf, z, z).M.reshape(*batch, 3, 3)
+    return _terms_chunked(leg, qf).M.reshape(*batch, 3, 3)
 
 
 def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
@@ -463,8 +460,7 @@ def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
-    z = np.zeros_like(qf)
-    return _terms_chunked(leg, qf, z, z).tau_gravity.reshape(*batch, 3)
+    return _terms_chunked(leg, qf).tau_gravity.reshape(*batch, 3)
 
 
 def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
@@ -491,7 +487,7 @@ def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]
     qd = as_array(qd, "qd", (3,))
     broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     batch, (qf, qdf) = _flat(q, qd)
-    t = _terms_chunked(leg, qf, qdf, np.zeros_like(qf))
+    t = _terms_chunked(leg, qf, qdf)
     return t.kinetic.reshape(batch), t.potential.reshape(batch)
 
 
