@@ -177,6 +177,17 @@ def solve(
     )
 
 
+def _damped_svd_solve(
+    U: np.ndarray, s: np.ndarray, Vt: np.ndarray, b: np.ndarray, lam: np.ndarray, weak: np.ndarray
+) -> np.ndarray:
+    """``V diag(c) Uᵀ b`` for ``A = U diag(s) Vt`` (full or thin SVD), batched: ``c = 1/σ`` on the regular
+    directions and ``σ/(σ² + λ²)`` on the ``weak`` ones (selectively damped least squares; 0 where
+    σ = λ = 0).  The mechanisms' damped rate and force inversions near a singularity."""
+    den = s * s + lam * lam
+    coef = np.where(weak, s / np.where(den > 0, den, 1.0), 1.0 / np.where(weak, 1.0, s))
+    return np.einsum("...ji,...j->...i", Vt, coef * np.einsum("...ji,...j->...i", U, b))
+
+
 def rank_cond_limit(m: int, n: int) -> float:
     """Condition number above which a system counts as rank deficient: ``1 / (10 max(m, n) eps)``.
 

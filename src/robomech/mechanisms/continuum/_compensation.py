@@ -116,11 +116,6 @@ def cable_elongation(
         Elongation delta of every cable (m), positive = stretched beyond its pretensioned straight
         length; the batch shape is the broadcast of those of ``psi``, ``tension`` and ``direction``.
 
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
-
     Examples
     --------
     >>> import numpy as np
@@ -158,11 +153,6 @@ def theoretical_drive(robot: ContinuumRobot, psi: object, model: CableModel = "a
     -------
     ndarray, shape (..., 3 n)
         Cable length pulled in by every actuator since the straight pose (m); 0 at ``psi = 0``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -264,13 +254,11 @@ def compensated_drive(
     Returns
     -------
     DriveResult
-        Drive displacements, elongations and tensions per sample.
 
     Raises
     ------
     ValueError
-        Bad input (see docs/conventions.md); also ``method="disk"`` combined with ``model="arc"`` or a
-        ``wrench``.
+        ``method="disk"`` combined with ``model="arc"`` or a ``wrench``.
 
     Examples
     --------
@@ -445,12 +433,6 @@ def simulate(
     Returns
     -------
     SimulationResult
-        Equilibrium bending, tensions, masks and residual per sample.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -658,13 +640,11 @@ def simulate_history(
     Returns
     -------
     HistoryResult
-        The quasi-static history along the time axis, with its masks.
 
     Raises
     ------
     ValueError
-        Bad input (see docs/conventions.md); also ``times`` not strictly increasing, or
-        ``memory="elastic"`` combined with ``model="arc"`` or a pulley.
+        ``times`` not strictly increasing, or ``memory="elastic"`` combined with ``model="arc"`` or a pulley.
 
     Examples
     --------
@@ -890,12 +870,11 @@ def disk_equilibrium(
     Returns
     -------
     DiskEquilibrium
-        The disk-wise pose, tensions and per-sample flags (see :class:`DiskEquilibrium`).
 
     Raises
     ------
     ValueError
-        Bad input (see docs/conventions.md); also both or neither of ``tension`` and ``drive`` given.
+        Both or neither of ``tension`` and ``drive`` given.
 
     Examples
     --------

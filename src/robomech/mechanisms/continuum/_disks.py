@@ -2,12 +2,9 @@
 
 Paper 3 models each segment as one arc (eqs. (1)-(4)) and multiplies the tensions by one friction
 factor per segment (eq. (24)).  With friction at the holes the span tensions fall (pulled cable) or
-rise (paid-out cables) from disk to disk, so the bending moment and the curvature do too: measured on
-the disk-resolved Cosserat reference (paper robot: 1.0 mm core, 10 N pretension), the tensions of a
-45 deg arc at beta = 0 with Table 1 mu bend the five intervals by 12.5, 10.2, 8.3, 6.8 and 5.6 deg
-(43.3 deg in all) instead of equally.  The segment-wise model cannot represent that shape, which puts the
-tip 5.3 mm away from the arc's tip for the same total bend, and the paper's compensation (adding the
-stretch delta, eq. (37)) makes the drive's tip error worse (2.16 -> 5.29 mm).
+rise (paid-out cables) from disk to disk, so the bending moment and the curvature do too (12.5 ... 5.6 deg
+over the five intervals of a 45 deg arc, ``docs/mechanisms/continuum_cosserat.md``): one arc per segment
+cannot represent that shape.
 
 This module relaxes constant curvature to one arc per disk interval (the same cable chords, wrap angles,
 capstan friction and elastic cables as the segment model, see :mod:`._compensation`); it reduces to the
@@ -225,6 +222,20 @@ def _state(
     return _forces(robot, k, th, be, w, dth, dbe), t_raw, P, ell_path, T, w
 
 
+def _backtrack(
+    norm: Callable[[Array], Array], x: Array, step: Array, f0: Array, conv: NDArray[np.bool_]
+) -> Array:
+    """``x - t step`` per sample, ``t`` halved (at most DISK_BACKTRACKS times) until the residual norm
+    ``norm`` falls below ``f0``; converged samples stay at ``x``."""
+    scale = np.ones(conv.shape)
+    for _ in range(DISK_BACKTRACKS):
+        worse = ~(norm(x - scale[..., None] * step) < f0) & ~conv
+        if not np.any(worse):
+            break
+        scale = np.where(worse, 0.5 * scale, scale)
+    return np.where(conv[..., None], x, x - scale[..., None] * step)
+
+
 def _newton(fun: Callable[[Array], Array], k0: Array) -> tuple[Array, NDArray[np.bool_]]:
     """Newton with backtracking on ``fun(k) = 0`` from ``k0 (..., 2 J)``, central-difference Jacobian,
     batched; returns (k, converged).  A singular or non-finite sample does not stop the others."""
@@ -244,14 +255,7 @@ def _newton(fun: Callable[[Array], Array], k0: Array) -> tuple[Array, NDArray[np
             Jm = np.nan_to_num(np.stack(cols, -1))
             # pinv: a singular Newton matrix in one sample must not abort the batch
             step = np.einsum("...ij,...j->...i", np.linalg.pinv(Jm), np.nan_to_num(F))
-            scale = np.ones(batch)
-            for _ in range(DISK_BACKTRACKS):
-                trial = np.linalg.norm(fun(k - scale[..., None] * step), axis=-1)
-                worse = ~(trial < f0) & ~conv
-                if not np.any(worse):
-                    break
-                scale = np.where(worse, 0.5 * scale, scale)
-            k = np.where(conv[..., None], k, k - scale[..., None] * step)
+            k = _backtrack(lambda kk: np.linalg.norm(fun(kk), axis=-1), k, step, f0, conv)
     return k, conv
 
 
@@ -422,14 +426,7 @@ def _memory_step(
             Jm = np.nan_to_num(np.swapaxes(diff, -1, -2))
             step = np.zeros_like(x)
             step[..., lo_idx:] = np.einsum("...ij,...j->...i", np.linalg.pinv(Jm), np.nan_to_num(r))
-            scale = np.ones(batch)
-            for _ in range(DISK_BACKTRACKS):
-                trial = np.linalg.norm(fun(x - scale[..., None] * step)[0], axis=-1)
-                worse = ~(trial < f0) & ~conv
-                if not np.any(worse):
-                    break
-                scale = np.where(worse, 0.5 * scale, scale)
-            x = np.where(conv[..., None], x, x - scale[..., None] * step)
+            x = _backtrack(lambda xx: np.linalg.norm(fun(xx)[0], axis=-1), x, step, f0, conv)
         k, s = x[..., :J2], x[..., J2:].reshape(*batch, C, K)
         r, own, tp, m, a, T, _ = _memory_eval(robot, k, s, m_prev, dq)
     res = np.linalg.norm(r[..., lo_idx:], axis=-1)

@@ -73,11 +73,6 @@ def wrap_angles(robot: ContinuumRobot, psi: object) -> np.ndarray:
     ndarray, shape (..., 3 n, n N)
         Wrap angle eta (rad) of cable c at the hole where span k starts (``N = disks_per_segment``).
 
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
-
     Examples
     --------
     >>> import numpy as np
@@ -140,11 +135,6 @@ def friction_factors(robot: ContinuumRobot, psi: object, direction: object | Non
         Span tension / base-plate tension (unit-free) of every cable and span (cumulative capstan
         factors ``exp(-direction mu sum eta)``; constant beyond a cable's termination disk).
 
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
-
     Examples
     --------
     >>> import numpy as np
@@ -202,11 +192,6 @@ def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np
         The coefficient ``c`` of eq. (29) (units of ``N^(-(1-n)/n)``; unit-free for n = 1), broadcast
         shape.
 
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
-
     Examples
     --------
     >>> import numpy as np
@@ -236,11 +221,6 @@ def classical_capstan_ratio(phi: object, mu: object) -> np.ndarray:
     -------
     ndarray
         The tension ratio ``exp(mu phi)`` (unit-free), broadcast shape.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -332,8 +312,7 @@ def capstan_tension_ratio(
     Raises
     ------
     ValueError
-        Bad input (see docs/conventions.md); ``rho = inf`` is allowed; also ``rho`` too large for the
-        explicit integration with n < 1 (use ``rho=np.inf``).
+        ``rho`` too large for the explicit integration with n < 1 (use ``rho=np.inf``, which is allowed).
 
     Examples
     --------
@@ -477,13 +456,11 @@ def identify_friction(
     Returns
     -------
     FrictionEstimate
-        ``mu``, ``std``, ``chi2_per_dof`` and ``n_used``, each of the batch shape ``(...)``.
 
     Raises
     ------
     ValueError
-        Bad input (see docs/conventions.md); also a batch element with no measurement of nonzero wrap
-        and direction.
+        A batch element with no measurement of nonzero wrap and direction.
 
     Examples
     --------
@@ -566,7 +543,6 @@ def stick_slip_tensions(
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m), with ``friction`` per cable.
     psi : array_like, shape (n_t, ..., 2 n)
         Pose ``[theta_1, beta_1, ...]`` (rad) at each of the n_t steps.
     t_act : array_like, shape (n_t, ..., 3 n)
@@ -578,12 +554,6 @@ def stick_slip_tensions(
     Returns
     -------
     TensionHistory
-        Span tensions, stick/slip states and distal tensions along the time axis.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------

@@ -83,8 +83,6 @@ def identify_friction_from_pose(
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m); its ``friction`` is the starting guess, its pretension and core
-        stiffness are used as given.
     psi : array_like, shape (m, 2 n)
         Measured pose ``[theta_1, beta_1, ...]`` (rad) of each of the m samples.
     t_act : array_like, shape (m, 3 n)
@@ -99,12 +97,6 @@ def identify_friction_from_pose(
     Returns
     -------
     PoseFrictionEstimate
-        Friction estimate with its uncertainty and identifiability.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -232,8 +224,6 @@ def identify_friction_from_tip(
     Parameters
     ----------
     robot : ContinuumRobot
-        The robot's parameters (m); its ``friction`` is the starting guess and its ``core_modulus`` the
-        reference of the stiffness factor.
     tip : array_like, shape (m, 3)
         Tracked tip positions (m, base frame).
     t_act : array_like, shape (m, 3 n)
@@ -252,12 +242,11 @@ def identify_friction_from_tip(
     Returns
     -------
     TipFrictionEstimate
-        Friction (and stiffness) estimate with its uncertainty and identifiability.
 
     Raises
     ------
     ValueError
-        Bad input (see docs/conventions.md); also only one of ``sigma_t``, ``sigma_tip`` given.
+        Only one of ``sigma_t``, ``sigma_tip`` given.
     """
     from ._compensation import disk_equilibrium
 

@@ -854,7 +854,6 @@ def inverse_kinematics(robot: ContinuumRobot, p_tip: object) -> IKResult:
     Returns
     -------
     IKResult
-        ``psi (..., 2 n)`` (rad), ``residual`` (m), ``reachable``, ``converged`` and ``iterations``.
 
     Examples
     --------

@@ -44,11 +44,6 @@ class Pulley:
     n : float, optional
         Exponent of eq. (25), in (0, 1]; paper Fig. 9: 0.67 or 1; default 1.
 
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
-
     Examples
     --------
     >>> from robomech.mechanisms import continuum as cr

@@ -40,11 +40,6 @@ def elastic_energy(robot: ContinuumRobot, psi: object) -> np.ndarray:
     ndarray, shape (...)
         Elastic energy U (J) of all cores (``EI = robot.bending_stiffness``, ``l = segment_length``).
 
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
-
     Examples
     --------
     >>> import numpy as np
@@ -77,11 +72,6 @@ def elastic_gradient(robot: ContinuumRobot, psi: object) -> np.ndarray:
     ndarray, shape (..., 2 n)
         ``dU/dpsi`` (N m per rad), ordered like ``psi``; the beta entries are 0.
 
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
-
     Examples
     --------
     >>> import numpy as np
@@ -111,11 +101,6 @@ def coupling_moments(robot: ContinuumRobot, psi: object) -> np.ndarray:
     -------
     ndarray, shape (..., n, 2)
         Per segment i, ``(-EI theta_i+1 / l, 0)`` (N m); zero for the last segment.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -199,12 +184,6 @@ def cable_tensions(
     Returns
     -------
     TensionResult
-        Tensions, tautness mask and residual per sample.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------

@@ -4,8 +4,8 @@ Thigh (paper 2, eqs. (1)-(8)): chain k's joint screws are those of chain 1 rotat
 ``kR = [[cos δ, sin δ, 0], [-sin δ, cos δ, 0], [0, 0, 1]]`` with δ = (k - 1) π/2 (eq. (5); this is
 Rz(-δ), and taken literally it yields the signs of eqs. (9) and (11)).  Chain 1's actuated joint θ11 = β
 (about Y0 through A1), chain 2's θ21 = α (about X0 through A2); the other ten joint angles are passive
-and are found here by solving the closure ``T1 = T2 = T3`` (eq. (8)) with Gauss-Newton on the
-12 closure equations, independently of the closed form.
+and are found by assembling the thigh's description on the engine (``robomech.multibody``), independently
+of the closed form; the closure ``T1 = T2 = T3`` (eq. (8)) is then checked by the product of exponentials.
 
 Shank (paper 2, eq. (10), Fig. 4e): each chain C_iD_iE_i is a centred crank-slider with crank C_iD_i
 and coupler D_iE_i of equal length L4 and the slider E_i moving along Z0 directly below C_i.
@@ -17,10 +17,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech import multibody as mb
 from robomech._validation import as_array, broadcast_batch, check_params
-from robomech.kinematics import jacobian_space, poe_fk
+from robomech.kinematics import poe_fk
 from robomech.spatial import inverse_transform, log_se3, screw_from_axis
 
+from ._multibody import chain_axes, thigh_mechanism
 from ._params import OmniLeg
 
 __all__ = [
@@ -32,25 +34,15 @@ __all__ = [
     "thigh_closure",
 ]
 
-# Gauss-Newton on the closure converges quadratically; 1e-14 (m or rad) is a few ulps of the O(0.1)
-# pose entries, below which the residual is rounding noise.
+# The engine assembles to ~1e-16; 1e-14 (m or rad) is a few ulps of the O(0.1) pose entries, below
+# which the product-of-exponentials closure residual is rounding noise.
 CLOSURE_TOL = 1e-14
-# Newton from the home pose straight to (α, β) can jump to another assembly branch near the range
-# limits (seen at |β| > 60° with α ≈ 0); a continuation through CLOSURE_STAGES equally spaced
-# intermediate poses keeps every step inside the translational branch's basin.
-CLOSURE_STAGES = 3
-# Per stage the closure converges in 4-6 iterations over the whole joint range (measured by the
-# tests); 20 leaves ample margin before a sample is flagged as not converged.
-CLOSURE_MAX_ITER = 20
+# Continuation stages from the home pose: fewer let the assembly from the home pose reach another branch
+# beyond |α|, |β| = 90° (tests/mechanisms/omnileg/test_omnileg_beyond_90.py).
+CLOSURE_STAGES = 6
 # The knee plate "only translates" when its rotation differs from I by less than this (rad): a
 # rounding-level bound for a converged closure.
 TRANSLATION_ONLY_TOL = 1e-12
-
-
-def _kR(k: int) -> np.ndarray:
-    d = 0.5 * np.pi * k
-    c, s = np.cos(d), np.sin(d)
-    return np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # paper 2, eq. (5): Rz(-δ), as printed
 
 
 def chain_screws(leg: OmniLeg) -> tuple[np.ndarray, np.ndarray]:
@@ -61,7 +53,6 @@ def chain_screws(leg: OmniLeg) -> tuple[np.ndarray, np.ndarray]:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
 
     Returns
     -------
@@ -69,16 +60,9 @@ def chain_screws(leg: OmniLeg) -> tuple[np.ndarray, np.ndarray]:
         Screw ``[ω; v]`` (space frame O0; v in m) of joint i of chain k as ``S[k, i]``.
     M : ndarray, shape (4, 4)
         Home pose ``T_O0 O0'`` of the knee plate (eq. (3)).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
-    w1 = np.array([[0.0, 1, 0], [1, 0, 0], [1, 0, 0], [0, 1, 0]])  # paper 2, eq. (1)
-    p1 = np.array([[0.0, leg.L3, 0], [0, leg.L3, 0], [0, leg.L3, leg.L1], [0, leg.L3, leg.L1]])  # eq. (2)
-    S = np.stack([screw_from_axis(w1 @ _kR(k).T, p1 @ _kR(k).T) for k in range(3)])  # eqs. (6), (7)
+    S = screw_from_axis(*chain_axes(leg.L1, leg.L3))
     M = np.eye(4)
     M[2, 3] = leg.L1  # eq. (3)
     return S, M
@@ -97,13 +81,13 @@ class ThighClosure:
     residual : ndarray, shape (...)
         Largest component of the closure twists ``log(T_k T_1^-1)`` (rad or m).
     converged : ndarray of bool, shape (...)
-        The Gauss-Newton solve converged.
+        The closure holds: ``residual <= 10 CLOSURE_TOL``.
     rotation_error : ndarray, shape (...)
         Rotation angle of the knee plate (rad); zero for an exact closure.
     translation_only : ndarray of bool, shape (...)
         ``converged & (rotation_error <= TRANSLATION_ONLY_TOL)``.
     iterations : int
-        Gauss-Newton iterations used, summed over the continuation stages.
+        The engine's assembly iterations (largest over the samples).
     knee : ndarray, shape (..., 3)
         Knee point O0' in O0 (m), the translation of ``T_knee``.
     """
@@ -131,26 +115,19 @@ def _closure_residual(S: np.ndarray, M: np.ndarray, theta: np.ndarray) -> tuple[
 def thigh_closure(leg: OmniLeg, alpha: object, beta: object) -> ThighClosure:
     """Solve the closure T1 = T2 = T3 (eq. (8)) for the passive joints, given α = θ21 and β = θ11.
 
-    Gauss-Newton from the home pose: with ``J_k`` the space Jacobian of chain k, a passive step
-    ``dθ`` must satisfy ``J_1 dθ_1 - J_k dθ_k = log(T_k T_1^-1)`` (k = 2, 3), a 12 x 10 least-squares
-    system solved per sample by batched Householder QR.
+    The thigh's description is assembled by :func:`robomech.multibody.forward_kinematics` from the home
+    pose in ``CLOSURE_STAGES`` stages; the cut joints θ24, θ34 follow from the knee plate's rotation, and
+    the residual is that of the product of exponentials of all three chains.
 
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
     alpha, beta : array_like, shape (...)
         Active angles α = θ21 and β = θ11 (rad); broadcast together.
 
     Returns
     -------
     :class:`ThighClosure`
-        The thigh's joint angles and knee pose per sample, with convergence flags.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -162,14 +139,23 @@ def thigh_closure(leg: OmniLeg, alpha: object, beta: object) -> ThighClosure:
     a = as_array(alpha, "alpha")
     b = as_array(beta, "beta")
     batch = broadcast_batch((a, 0, "alpha"), (b, 0, "beta"))
+    mech = thigh_mechanism(leg.L1, leg.L3)
+    fk = mb.forward_kinematics(mech, np.stack(np.broadcast_arrays(a, b), -1), steps=CLOSURE_STAGES)
     S, M = chain_screws(leg)
     theta = np.zeros((*batch, 3, 4))
-    passive = [(0, 1), (0, 2), (0, 3), (1, 1), (1, 2), (1, 3), (2, 0), (2, 1), (2, 2), (2, 3)]
-    total = 0
-    for stage in range(1, CLOSURE_STAGES + 1):
-        theta[..., 0, 0] = b * stage / CLOSURE_STAGES
-        theta[..., 1, 0] = a * stage / CLOSURE_STAGES
-        total += _newton(S, M, theta, passive, batch)
+    for k, j in np.ndindex(3, 4):
+        if k == 0 or j < 3:
+            theta[..., k, j] = fk.q[..., mech.qpos_address(f"theta{k + 1}{j + 1}")]
+    R_knee = mb.site_pose(mech, fk.q, "knee")[..., :3, :3]
+    for k in (1, 2):  # the cut joint turns chain k's first three joints' rotation into the knee plate's
+        R4 = np.swapaxes(poe_fk(np.eye(4), S[k, :3], theta[..., k, :3])[..., :3, :3], -1, -2) @ R_knee
+        w = S[k, 3, :3]
+        sin = 0.5 * (
+            w[0] * (R4[..., 2, 1] - R4[..., 1, 2])
+            + w[1] * (R4[..., 0, 2] - R4[..., 2, 0])
+            + w[2] * (R4[..., 1, 0] - R4[..., 0, 1])
+        )
+        theta[..., k, 3] = np.arctan2(sin, 0.5 * (np.trace(R4, axis1=-2, axis2=-1) - 1.0))
     r, T = _closure_residual(S, M, theta)
     res = np.max(np.abs(r), axis=-1)
     R = T[0][..., :3, :3]
@@ -187,32 +173,8 @@ def thigh_closure(leg: OmniLeg, alpha: object, beta: object) -> ThighClosure:
         converged=converged,
         rotation_error=rot_err,
         translation_only=converged & (rot_err <= TRANSLATION_ONLY_TOL),
-        iterations=total,
+        iterations=int(np.max(fk.iterations, initial=0)),
     )
-
-
-def _newton(
-    S: np.ndarray, M: np.ndarray, theta: np.ndarray, passive: list[tuple[int, int]], batch: tuple[int, ...]
-) -> int:
-    """Gauss-Newton on the passive joints of ``theta`` (in place); returns the iterations used."""
-    from robomech.analysis import lstsq  # deferred: it loads scipy.linalg (0.25 s), keep the import cheap
-
-    for it in range(CLOSURE_MAX_ITER):  # fixed small iteration count, batched over samples
-        r, _ = _closure_residual(S, M, theta)
-        if np.all(np.abs(r) <= CLOSURE_TOL):
-            return it
-        Js = [jacobian_space(S[k], theta[..., k, :]) for k in range(3)]
-        A = np.zeros((*batch, 12, 10))
-        for col, (k, i) in enumerate(passive):
-            if k == 0:
-                A[..., 0:6, col] = Js[0][..., :, i]
-                A[..., 6:12, col] = Js[0][..., :, i]
-            else:
-                A[..., 6 * (k - 1) : 6 * k, col] = -Js[k][..., :, i]
-        step = lstsq.solve(A, r).x
-        for col, (k, i) in enumerate(passive):
-            theta[..., k, i] += step[..., col]
-    return CLOSURE_MAX_ITER
 
 
 @dataclass(frozen=True)
@@ -250,17 +212,11 @@ def shank_frames(leg: OmniLeg) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (``shank_azimuth``, rad).
 
     Returns
     -------
     ndarray, shape (3, 3, 3)
         ``S[i - 1]``: rotation of chain i's frame in the knee-plate frame.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     psi = leg.shank_azimuth + 2.0 * np.pi * np.arange(3) / 3.0
@@ -281,19 +237,12 @@ def shank_crank_slider(leg: OmniLeg, gamma: object) -> ShankResult:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
     gamma : array_like, shape (...)
         Crank angle γ (rad); samples with ``|γ| >= π/2`` are flagged, not raised.
 
     Returns
     -------
     :class:`ShankResult`
-        The shank's joint points and slider per sample, with a ``valid`` mask.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------

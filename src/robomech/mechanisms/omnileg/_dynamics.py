@@ -24,6 +24,7 @@ import numpy as np
 
 from robomech._batching import chunked
 from robomech._validation import as_array, broadcast_batch, check_bool, check_params
+from robomech.analysis.lstsq import _damped_svd_solve
 
 from . import _jet as jt
 from ._chains import shank_frames
@@ -278,15 +279,13 @@ def _terms(
 
 
 def _terms_chunked(
-    leg: OmniLeg,
-    q: np.ndarray,
-    qd: np.ndarray,
-    qdd: np.ndarray,
-    poses: bool = False,
-    paper_drive: bool = False,
+    leg: OmniLeg, q: np.ndarray, qd: np.ndarray | None = None, qdd: np.ndarray | None = None, **options: bool
 ) -> _Terms:
-    """:func:`_terms` over cache-sized chunks of samples (identical results, far fewer cache misses)."""
-    return chunked(lambda s: _terms(leg, q[s], qd[s], qdd[s], poses, paper_drive), q.shape[0], DYN_CHUNK)
+    """:func:`_terms` over cache-sized chunks of samples (identical results, far fewer cache misses);
+    ``qd``, ``qdd`` zero where not given."""
+    qd = np.zeros_like(q) if qd is None else qd
+    qdd = np.zeros_like(q) if qdd is None else qdd
+    return chunked(lambda s: _terms(leg, q[s], qd[s], qdd[s], **options), q.shape[0], DYN_CHUNK)
 
 
 def _flat(*arrays: np.ndarray) -> tuple[tuple[int, ...], list[np.ndarray]]:
@@ -300,7 +299,6 @@ def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
     Parameters
     ----------
     leg : OmniLeg
-        Leg geometry and body inertias.
     q : array_like, shape (..., 3)
         Joint coordinates ``(α, β, γ)`` (rad).
 
@@ -310,16 +308,11 @@ def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
         Rotation of each body (hip frame), in the order of ``BODY_NAMES``.
     p : ndarray, shape (..., 22, 3)
         Mass centre of each body (m, hip frame), in the order of ``BODY_NAMES``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
-    t = _terms_chunked(leg, qf, np.zeros_like(qf), np.zeros_like(qf), poses=True)
+    t = _terms_chunked(leg, qf, poses=True)
     B = len(BODY_NAMES)
     return t.R.reshape(*batch, B, 3, 3), t.p.reshape(*batch, B, 3)
 
@@ -360,10 +353,9 @@ def inverse_dynamics(
 ) -> DynamicsResult:
     """Motor torques (α, β, γ order) for the motion (q, q̇, q̈), optionally with a force on the foot.
 
-    All inputs ``(..., 3)`` broadcast.  ``foot_force (..., 3)`` (N, hip frame) is
-    ``FOOT_FORCE_CONVENTION``: the external force applied *to* the foot (as a force applied to the
-    foot body in a multibody simulation); it enters as ``-Jᵀ F`` (= :func:`static_torques`).  Paper 2,
-    eqs. (49)-(50) add ``+Jᵀ F_f``, i.e. read F_f as the force the foot delivers: pass ``-F_f``.
+    ``foot_force`` is ``FOOT_FORCE_CONVENTION``: the force applied *to* the foot; it enters as ``-Jᵀ F``
+    (= :func:`static_torques`).  Paper 2, eqs. (49)-(50) add ``+Jᵀ F_f`` (F_f the force the foot
+    delivers): pass ``-F_f``.
 
     ``paper_as_printed=True`` replaces the exact double-Cardan drive by paper 2's simplification (eqs.
     (26)-(31): the crosses CS_A4, CS_B4 and the rod A4B4 turn like chain 1's cross CS_A1, rod A1B1, cross
@@ -373,7 +365,6 @@ def inverse_dynamics(
     Parameters
     ----------
     leg : OmniLeg
-        Leg geometry, body inertias and gravity (hip frame).
     q, qd, qdd : array_like, shape (..., 3)
         Joint coordinates (rad), rates (rad/s) and accelerations (rad/s²); broadcast together.
     foot_force : array_like, shape (..., 3), optional
@@ -384,13 +375,6 @@ def inverse_dynamics(
     Returns
     -------
     :class:`DynamicsResult`
-        Actuator torques per sample and the terms that sum to them.
-
-    Raises
-    ------
-    ValueError
-        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3),
-        the shapes do not broadcast, or ``paper_as_printed`` is not a bool.
 
     Examples
     --------
@@ -437,7 +421,6 @@ def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        Leg geometry and body inertias.
     q : array_like, shape (..., 3)
         Joint coordinates ``(α, β, γ)`` (rad).
 
@@ -445,11 +428,6 @@ def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
     -------
     ndarray, shape (..., 3, 3)
         ``M(q)`` (kg m² on the diagonal; α, β, γ order), the kinetic energy being ``½ q̇ᵀ M q̇``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -460,8 +438,7 @@ def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
-    z = np.zeros_like(qf)
-    return _terms_chunked(leg, qf, z, z).M.reshape(*batch, 3, 3)
+    return _terms_chunked(leg, qf).M.reshape(*batch, 3, 3)
 
 
 def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
@@ -472,7 +449,6 @@ def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        Leg geometry, body masses and gravity (hip frame).
     q : array_like, shape (..., 3)
         Joint coordinates ``(α, β, γ)`` (rad).
 
@@ -480,17 +456,11 @@ def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
     -------
     ndarray, shape (..., 3)
         Gravity torques (N·m), α, β, γ order (``gravity_terms`` of :func:`inverse_dynamics`).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     batch, (qf,) = _flat(q)
-    z = np.zeros_like(qf)
-    return _terms_chunked(leg, qf, z, z).tau_gravity.reshape(*batch, 3)
+    return _terms_chunked(leg, qf).tau_gravity.reshape(*batch, 3)
 
 
 def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
@@ -502,7 +472,6 @@ def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]
     Parameters
     ----------
     leg : OmniLeg
-        Leg geometry, body inertias and gravity (hip frame).
     q, qd : array_like, shape (..., 3)
         Joint coordinates (rad) and rates (rad/s); broadcast together.
 
@@ -512,18 +481,13 @@ def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]
         Kinetic energy (J).
     potential : ndarray, shape (...)
         Potential energy (J).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     qd = as_array(qd, "qd", (3,))
     broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     batch, (qf, qdf) = _flat(q, qd)
-    t = _terms_chunked(leg, qf, qdf, np.zeros_like(qf))
+    t = _terms_chunked(leg, qf, qdf)
     return t.kinetic.reshape(batch), t.potential.reshape(batch)
 
 
@@ -537,7 +501,6 @@ def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        Leg geometry.
     q : array_like, shape (..., 3)
         Joint coordinates ``(α, β, γ)`` (rad).
     force : array_like, shape (..., 3)
@@ -547,11 +510,6 @@ def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
     -------
     ndarray, shape (..., 3)
         Motor torques (N·m), α, β, γ order.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -608,7 +566,6 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     Parameters
     ----------
     leg : OmniLeg
-        Leg geometry.
     q : array_like, shape (..., 3)
         Joint coordinates ``(α, β, γ)`` (rad).
     tau : array_like, shape (..., 3)
@@ -617,12 +574,6 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     Returns
     -------
     :class:`FootForceResult`
-        Foot force per sample, with a singular mask and residual.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -635,9 +586,8 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     lam = DAMPING_RELATIVE * s[..., :1]
     # Jᵀ = V Σ Uᵀ, so F = U Σ⁺ Vᵀ τ; only the directions with σ_i < SINGULAR_RCOND σ_max are damped
     weak = s < SINGULAR_RCOND * s[..., :1]
-    coef = np.where(weak, s / (s * s + lam * lam), 1.0 / np.where(weak, 1.0, s))
     # paper 2, eq. (47): F_f = (Jᵀ)⁻¹ τ for the force the foot delivers; the force applied to it is -F_f
-    F = -np.einsum("...ij,...j->...i", U, coef * np.einsum("...ij,...j->...i", Vt, tau))
+    F = -_damped_svd_solve(np.swapaxes(Vt, -1, -2), s, np.swapaxes(U, -1, -2), tau, lam, weak)
     resid = np.linalg.norm(-np.einsum("...ij,...i->...j", J, F) - tau, axis=-1)
     # the per-sample fields have the batch of every argument (q may be one configuration for many tau)
     return FootForceResult(

@@ -62,19 +62,12 @@ def joint_motion(leg: OmniLeg, q: object, qd: object, qdd: object) -> JointMotio
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry.
     q, qd, qdd : array_like, shape (..., 3)
         Angles (rad), rates (rad/s) and accelerations (rad/s²) of ``(α, β, γ)``; broadcast together.
 
     Returns
     -------
     :class:`JointMotion`
-        Angles, rates and accelerations of the 22 tree joints.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------

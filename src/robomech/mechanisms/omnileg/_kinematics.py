@@ -79,11 +79,6 @@ def thigh_direction(alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
     ndarray, shape (..., 3)
         Unit thigh direction in the hip frame (dimensionless).
 
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
-
     Examples
     --------
     >>> thigh_direction(0.0, 0.0)
@@ -104,7 +99,6 @@ def forward_kinematics(leg: OmniLeg, q: object) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m), e.g. ``OmniLeg.paper()``.
     q : array_like, shape (..., 3)
         Joint angles ``(α, β, γ)`` (rad).
 
@@ -151,7 +145,6 @@ def passive_angles(leg: OmniLeg, alpha: object, beta: object) -> tuple[np.ndarra
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry.
     alpha, beta : array_like, shape (...)
         Active thigh angles (rad); broadcast together.
 
@@ -161,11 +154,6 @@ def passive_angles(leg: OmniLeg, alpha: object, beta: object) -> tuple[np.ndarra
         Passive angle of chain 1's second U-joint axis (rad).
     theta22 : ndarray, shape (...)
         Passive angle of chain 2's second U-joint axis (rad).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     a = as_array(alpha, "alpha")
@@ -203,7 +191,6 @@ def jacobian(leg: OmniLeg, q: object) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
     q : array_like, shape (..., 3)
         Joint angles ``(α, β, γ)`` (rad).
 
@@ -247,7 +234,6 @@ def hessian(leg: OmniLeg, q: object) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
     q : array_like, shape (..., 3)
         Joint angles ``(α, β, γ)`` (rad).
 
@@ -255,11 +241,6 @@ def hessian(leg: OmniLeg, q: object) -> np.ndarray:
     -------
     ndarray, shape (..., 3, 3, 3)
         ``∂²p_F,i/∂q_j∂q_k`` (m/rad²), hip frame; symmetric in ``j, k``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     q = _q(q)
@@ -289,7 +270,6 @@ def foot_velocity(leg: OmniLeg, q: object, qd: object) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
     q : array_like, shape (..., 3)
         Joint angles ``(α, β, γ)`` (rad).
     qd : array_like, shape (..., 3)
@@ -299,11 +279,6 @@ def foot_velocity(leg: OmniLeg, q: object, qd: object) -> np.ndarray:
     -------
     ndarray, shape (..., 3)
         Foot velocity in the hip frame (m/s).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -324,7 +299,6 @@ def foot_acceleration(leg: OmniLeg, q: object, qd: object, qdd: object) -> np.nd
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
     q : array_like, shape (..., 3)
         Joint angles ``(α, β, γ)`` (rad).
     qd : array_like, shape (..., 3)
@@ -336,11 +310,6 @@ def foot_acceleration(leg: OmniLeg, q: object, qd: object, qdd: object) -> np.nd
     -------
     ndarray, shape (..., 3)
         Foot acceleration in the hip frame (m/s²).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     qd = as_array(qd, "qd", (3,))
@@ -357,7 +326,6 @@ def within_limits(leg: OmniLeg, q: object) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        The leg and its joint limits (rad).
     q : array_like, shape (..., 3)
         Joint angles ``(α, β, γ)`` (rad); non-finite samples give False.
 
@@ -365,11 +333,6 @@ def within_limits(leg: OmniLeg, q: object) -> np.ndarray:
     -------
     ndarray of bool, shape (...)
         True where every joint is within its range (inclusive, up to ``LIMIT_SLACK``).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -404,7 +367,6 @@ class IKResult:
     reachable : ndarray of bool, shape (...)
         ``exists & within_limits``.
     leg : OmniLeg
-        The leg solved for.
     p_foot : ndarray, shape (..., 3)
         The requested foot positions (m, hip frame).
     residual : ndarray, shape (...)
@@ -438,14 +400,12 @@ def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
     p_foot : array_like, shape (..., 3)
         Foot positions in the hip frame (m).
 
     Returns
     -------
     :class:`IKResult`
-        Joint angles per sample, with existence and joint-limit masks.
 
     Examples
     --------

@@ -1,41 +1,19 @@
 """The OmniLeg described generically (``robomech.multibody``), from its parameters.
 
-Nothing is derived by hand here: the generic layer assembles the closures and differentiates them,
-and the tests compare the result with the analytic model (eq. (11) FK, the PoE thigh closure, the
-foot J and H, and the Lagrange inverse dynamics of ``_dynamics.py``).
-
-The 22 bodies and 22 tree joints are those of the analytic model (``BODY_NAMES``, ``TREE_JOINTS``),
-with the same names, and every joint's ``qpos`` is the value :func:`joint_motion` gives it:
-
-* Thigh (paper 2, eqs. (1)-(7)): chain k's joints are chain 1's screws (axes y, x at A1 = (0, L3, 0);
-  x, y at B1 = (0, L3, L1)) rotated by kR = Rz(-δ), δ = (k-1) π/2, as printed (eq. (5)).  Chain 1's four
-  hinges carry the knee plate; chains 2 and 3 keep three hinges in the tree and close on the knee plate
-  through their fourth joint (a hinge cut, ``revolute`` closure).  qpos of ``theta{k}{j}`` = θ_kj.
-* Drive (paper 2, Section 3, Fig. 7): the universal-joint coupling G_J1 A4 B4 U_E G_J2.  The input
-  shaft G_J1A4 (``drive_shaft_in``, hinge ``drive_in`` about Z0, motor M3) carries the cross CS_A4
-  (``drive_cross_a``, hinge ``drive_phi1`` about the shaft's yoke arm), the rod A4B4 (``drive_rod``,
-  hinge ``drive_phi2`` about the rod's yoke arm) and the cross CS_B4 at its far end (``drive_cross_b``,
-  hinge ``drive_phi3``); CS_B4 closes on the output shaft B4U_E (``drive_shaft_out``, hinge
-  ``drive_out`` about Z0' in the knee plate) through a hinge cut about the output yoke arm.  At the
-  reference (α = β = 0) the yokes are parallel to the U joints A1, B1 (as the paper sets them up).
-  The output shaft, the cross CS_UE, the shaft U_E G_J2 and the output bevel gear turn as one body
-  about Z0' (the paper's statement after eq. (25)); the 1:1 bevel gears are joint couplings
-  ``crank_i = drive_out``.  The double-Cardan kinematics is exact (solved by the closure), not the
-  paper's simplification of eqs. (26)-(31).
-* Shank (eq. (10), Fig. 4e): each chain C_iD_iE_i is a crank (hinge about its radial axis at C_i,
-  ``knee_to_crank`` below O0'), a coupler (hinge at D_i) and the foot (hinge at E_i on chain 1, hinge
-  cuts on chains 2 and 3).  The reference configuration is γ = 60° (γ = 0 folds every chain straight,
-  a singular configuration).
-* Inertias (the analytic model's assumptions, ``OmniLeg.bodies``): each body's mass, centre of mass
-  and inertia tensor are given in the analytic model's body frame (``docs/mechanisms/omnileg.md``);
-  here they are rotated into this description's body frame (a constant rotation per body, ``_FRAME``)
-  and written as MuJoCo's principal inertia (``Inertial(mass, pos, quat, diaginertia)``).
-
-``q_act = (α, β, γ)`` in the analytic model's order (actuators ``theta21``, ``theta11``, ``drive_in``);
-the foot site ``foot`` is the foot point, whose position is eq. (11).
+Nothing is derived by hand: the 22 bodies and tree joints of the analytic model (``BODY_NAMES``,
+``TREE_JOINTS``, each joint's ``qpos`` that of :func:`joint_motion`), the thigh's UU chains, the exact
+double-Cardan drive and the shank closed by hinge cuts, the 1:1 bevel gears as joint couplings, and the
+analytic inertias rotated into these body frames.  ``q_act = (α, β, γ)`` (actuators ``theta21``,
+``theta11``, ``drive_in``), site ``foot`` at the foot point (eq. (11)), reference γ = 60°.  Body by body:
+``docs/mechanisms/omnileg.md``, "Generic description"; the tests compare it with the analytic model
+(eq. (11) FK, the thigh closure, J, H and the Lagrange inverse dynamics of ``_dynamics.py``).
 """
 
 from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -101,6 +79,48 @@ def _inertial(body: RigidBody, Q: Matrix) -> Inertial:
     )
 
 
+def chain_axes(L1: float, L3: float) -> tuple[Matrix, Matrix]:
+    """Axes ``w`` and points ``p`` (3, 4, 3) of the UU chains' joints at the home pose (eqs. (1)-(7))."""
+    w1 = np.array([[0.0, 1, 0], [1, 0, 0], [1, 0, 0], [0, 1, 0]])  # paper 2, eq. (1)
+    p1 = np.array([[0.0, L3, 0], [0, L3, 0], [0, L3, L1], [0, L3, L1]])  # eq. (2)
+    return np.stack([w1 @ _kR(k).T for k in range(3)]), np.stack(
+        [p1 @ _kR(k).T for k in range(3)]
+    )  # eqs. (6), (7)
+
+
+def _add_thigh(
+    b: Builder, L1: float, L3: float, inertial: Callable[[str, str], Inertial] | None = None
+) -> None:
+    """The three UU chains and the knee plate; chains 2 and 3 close on it through their fourth joint."""
+    knee = np.array([0.0, 0.0, L1])  # O0' at the home pose (eq. (3))
+
+    def body(name: str, parent: str, kind: str, **kw: Any) -> None:
+        b.body(name, parent, inertial=None if inertial is None else inertial(name, kind), **kw)
+
+    for k, (w, p) in enumerate(zip(*chain_axes(L1, L3), strict=True)):
+        c = k + 1
+        # every body frame is parallel to the hip frame at the home pose, so qpos = the PoE angles
+        hc, tr, kc = f"hip_cross_{c}", f"thigh_rod_{c}", f"knee_cross_{c}"
+        body(hc, "world", "hip_cross", pos=p[0], joints=[b.hinge(f"theta{c}1", axis=w[0])])
+        body(tr, hc, "thigh_rod", joints=[b.hinge(f"theta{c}2", axis=w[1])])
+        body(kc, tr, "knee_cross", pos=p[2] - p[0], joints=[b.hinge(f"theta{c}3", axis=w[2])])
+        if k == 0:
+            hinge = b.hinge("theta14", axis=w[3], pos=p[3] - knee)
+            body("knee_plate", kc, "knee_plate", pos=knee - p[2], joints=[hinge])
+        else:
+            b.revolute(f"theta{c}4", kc, "knee_plate", anchor1=(0.0, 0.0, 0.0), axis=w[3])
+
+
+@functools.lru_cache(maxsize=8)
+def thigh_mechanism(L1: float, L3: float) -> Mechanism:
+    """The thigh alone (no inertias): q_act = (α, β) = (θ21, θ11), site ``knee`` at O0'."""
+    b = Builder("omnileg_thigh")
+    _add_thigh(b, L1, L3)
+    b.site("knee", "knee_plate")
+    b.actuate("theta21", "theta11")
+    return b.build()
+
+
 def to_multibody(leg: OmniLeg) -> Mechanism:
     """The generic description of ``leg`` (an :class:`OmniLeg`), with its inertias; q_act = (α, β, γ).
 
@@ -110,55 +130,23 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m), inertias and gravity (hip frame).
 
     Returns
     -------
     Mechanism
         The spanning tree of ``TREE_JOINTS`` with its bodies and inertials, the loop closures, and the
         actuated coordinates ``(α, β, γ)``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
-    L1, L3, L4 = leg.L1, leg.L3, leg.L4
+    L1, L4 = leg.L1, leg.L4
     bodies = leg.bodies
 
     def inertial(name: str, kind: str) -> Inertial:
         return _inertial(bodies[kind], _frame(name))
 
     b = Builder("omnileg", gravity=leg.gravity)
-    w1 = np.array([[0.0, 1, 0], [1, 0, 0], [1, 0, 0], [0, 1, 0]])  # paper 2, eq. (1)
-    p1 = np.array([[0.0, L3, 0], [0, L3, 0], [0, L3, L1], [0, L3, L1]])  # eq. (2)
-    knee = np.array([0.0, 0.0, L1])  # O0' at the home pose (eq. (3))
+    _add_thigh(b, leg.L1, leg.L3, inertial)
     g0 = REFERENCE_GAMMA
-    for k in range(3):
-        w, p = w1 @ _kR(k).T, p1 @ _kR(k).T  # eqs. (6), (7)
-        c = k + 1
-        # every body frame is parallel to the hip frame at the home pose, so qpos = the PoE angles
-        hc, tr, kc = f"hip_cross_{c}", f"thigh_rod_{c}", f"knee_cross_{c}"
-        b.body(hc, pos=p[0], joints=[b.hinge(f"theta{c}1", axis=w[0])], inertial=inertial(hc, "hip_cross"))
-        b.body(tr, hc, joints=[b.hinge(f"theta{c}2", axis=w[1])], inertial=inertial(tr, "thigh_rod"))
-        b.body(
-            kc,
-            tr,
-            pos=p[2] - p[0],
-            joints=[b.hinge(f"theta{c}3", axis=w[2])],
-            inertial=inertial(kc, "knee_cross"),
-        )
-        if k == 0:
-            b.body(
-                "knee_plate",
-                kc,
-                pos=knee - p[2],
-                joints=[b.hinge("theta14", axis=w[3], pos=p[3] - knee)],
-                inertial=inertial("knee_plate", "knee_plate"),
-            )
-        else:
-            b.revolute(f"theta{c}4", kc, "knee_plate", anchor1=(0.0, 0.0, 0.0), axis=w[3])
     # drive (paper 2, Fig. 7): input shaft about Z0 turned by γ, U joint A4 at O0, rod A4B4, U joint B4
     # at O0', output shaft about Z0' in the knee plate; every frame is Rz(γ) at α = β = 0.
     # paper 2, eqs. (26)-(31): the paper decouples the drive's spin from the thigh motion; here the

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomech._validation import as_array, broadcast_batch, check_params, check_real
+from robomech.analysis.lstsq import _damped_svd_solve
 
 from ._dynamics import SINGULAR_RCOND
 from ._kinematics import hessian, jacobian
@@ -58,13 +59,6 @@ class JointRatesResult:
     valid: np.ndarray
 
 
-def _damped_solve(U, s, Vt, b, lam, weak):
-    """x = V diag(c) Uᵀ b with c = 1/σ on regular directions and σ/(σ² + λ²) on weak ones."""
-    den = s * s + lam * lam
-    coef = np.where(weak, s / np.where(den > 0, den, 1.0), 1.0 / np.where(weak, 1.0, s))  # 0 if σ = λ = 0
-    return np.einsum("...ji,...j->...i", Vt, coef * np.einsum("...ji,...j->...i", U, b))
-
-
 def joint_rates(
     leg: OmniLeg,
     q: object,
@@ -75,20 +69,13 @@ def joint_rates(
 ) -> JointRatesResult:
     """Joint rates ``q̇`` (and accelerations ``q̈``) realising the foot velocity ``ṗ`` (and acceleration ``p̈``).
 
-    ``q (..., 3)`` rad (typically from :func:`inverse_kinematics`), ``foot_velocity (..., 3)`` m/s,
-    ``foot_acceleration (..., 3)`` m/s² or None; all broadcast.  ``damping`` (>= 0, relative to
-    sigma_max) damps the directions with ``sigma < SINGULAR_RCOND sigma_max``: ``c = σ / (σ² + λ²)``,
-    ``λ = damping sigma_max`` (selectively damped least squares: the well-determined components stay
-    exact).  ``damping = 0`` inverts the weak directions fully (``c = 1/σ``: the exact inverse,
-    unbounded as σ -> 0; only a direction with σ = 0 exactly gets ``c = 0``), so near γ = 0 the
-    rates grow like 1/σ and ``valid`` is False there as for any damping.
-
-    Paper 2, eq. (47)'s inverse of the foot Jacobian (eq. (14)), regularised at the singularity γ = 0.
+    Paper 2, eq. (47)'s inverse of the foot Jacobian (eq. (14)), regularised at γ = 0: the directions
+    with ``σ < SINGULAR_RCOND σ_max`` get ``c = σ / (σ² + λ²)``, ``λ = damping σ_max``; ``damping = 0``
+    inverts them exactly (unbounded as σ -> 0).  ``valid`` is False there for any damping.
 
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
     q : array_like, shape (..., 3)
         Joint angles ``(α, β, γ)`` (rad).
     foot_velocity : array_like, shape (..., 3)
@@ -101,13 +88,6 @@ def joint_rates(
     Returns
     -------
     :class:`JointRatesResult`
-        Joint rates and accelerations per sample, with singular mask and residuals.
-
-    Raises
-    ------
-    ValueError
-        If ``leg`` is not an :class:`OmniLeg`, an array is not a finite real array of shape (..., 3),
-        the batch shapes do not broadcast, or ``damping`` is negative or not a finite real number.
 
     Examples
     --------
@@ -138,7 +118,7 @@ def _joint_rates(leg, q, pd, pdd, damping, batch) -> JointRatesResult:
     rcond = s[..., -1] / smax[..., 0]
     weak = s < SINGULAR_RCOND * smax
     lam = float(damping) * smax
-    qd = _damped_solve(U, s, Vt, pd, lam, weak)
+    qd = _damped_svd_solve(U, s, Vt, pd, lam, weak)
     v_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qd) - pd, axis=-1)
     if pdd is None:
         qdd = np.full((*batch, 3), np.nan)
@@ -146,7 +126,7 @@ def _joint_rates(leg, q, pd, pdd, damping, batch) -> JointRatesResult:
     else:
         pdd = np.broadcast_to(pdd, (*batch, 3))
         bias = np.einsum("...ijk,...j,...k->...i", hessian(leg, q), qd, qd)  # q̇ᵀ H q̇
-        qdd = _damped_solve(U, s, Vt, pdd - bias, lam, weak)
+        qdd = _damped_svd_solve(U, s, Vt, pdd - bias, lam, weak)
         a_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qdd) + bias - pdd, axis=-1)
     singular = rcond < SINGULAR_RCOND
     finite = np.all(np.isfinite(qd), -1) & (pdd is None or np.all(np.isfinite(qdd), -1))

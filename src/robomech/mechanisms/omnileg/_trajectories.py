@@ -53,17 +53,11 @@ def start_point(leg: OmniLeg) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
 
     Returns
     -------
     ndarray, shape (3,)
         Foot position in the hip frame (m).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
     check_params(leg, OmniLeg, "leg")
     return forward_kinematics(leg, np.array([0.0, 0.0, START_GAMMA]))
@@ -84,20 +78,12 @@ def foot_trajectory_eq51(leg: OmniLeg, t: object) -> Profile:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
     t : array_like, shape (...)
         Times (s), in ``[0, EQ51_PERIOD]``.
 
     Returns
     -------
     Profile
-        ``q`` foot position (m), ``qd`` velocity (m/s), ``qdd`` acceleration (m/s²), each (..., 3), hip
-        frame.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -133,12 +119,6 @@ def joint_trajectory_eq52(t: object) -> Profile:
     Returns
     -------
     Profile
-        ``q`` joint angles (rad), ``qd`` rates (rad/s), ``qdd`` accelerations (rad/s²), each (..., 3).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -179,7 +159,6 @@ def gait_eq53(leg: OmniLeg, t: object, periods: int = 6) -> GaitProfile:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
     t : array_like, shape (...)
         Times (s), in ``[0, periods * GAIT_PERIOD]`` (``GAIT_PERIOD`` = 1 s).
     periods : int, optional
@@ -188,13 +167,6 @@ def gait_eq53(leg: OmniLeg, t: object, periods: int = 6) -> GaitProfile:
     Returns
     -------
     :class:`GaitProfile`
-        The foot profile and its ``stance`` mask.
-
-    Raises
-    ------
-    ValueError
-        If ``leg`` is not an :class:`OmniLeg`, ``t`` is not a finite real array, or ``periods`` is not an
-        int >= 1.
 
     Examples
     --------

@@ -87,7 +87,6 @@ def joint_grid(leg: OmniLeg, n: int | tuple[int, int, int]) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        The leg and its joint limits (rad).
     n : int or tuple of int
         Samples per joint (each >= 2): one count for all three, or ``(n_α, n_β, n_γ)``.
 
@@ -96,17 +95,12 @@ def joint_grid(leg: OmniLeg, n: int | tuple[int, int, int]) -> np.ndarray:
     ndarray, shape (n_α, n_β, n_γ, 3)
         Joint samples ``(α, β, γ)`` (rad), the range ends included.
 
-    Raises
-    ------
-    ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``n`` is not an int >= 2 or three of them.
-
     Examples
     --------
     >>> joint_grid(OmniLeg.paper(), (3, 4, 5)).shape
     (3, 4, 5, 3)
     """
-    _leg(leg)
+    check_params(leg, OmniLeg, "leg")
     if isinstance(n, tuple | list):
         if len(n) != 3:
             raise ValueError(f"Expected n to be an int >= 2 or three of them, got {n!r}.")
@@ -117,11 +111,6 @@ def joint_grid(leg: OmniLeg, n: int | tuple[int, int, int]) -> np.ndarray:
     return grid(ranges, list(counts))
 
 
-def _leg(leg: object) -> OmniLeg:
-    check_params(leg, OmniLeg, "leg")
-    return leg  # type: ignore[return-value]
-
-
 def workspace_map(leg: OmniLeg, q: object) -> WorkspaceMap:
     """Foot position and Jacobian conditioning at joint samples ``q (..., 3)`` (e.g. :func:`joint_grid`).
 
@@ -130,19 +119,12 @@ def workspace_map(leg: OmniLeg, q: object) -> WorkspaceMap:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m) and joint limits (rad).
     q : array_like, shape (..., 3)
         Joint samples ``(α, β, γ)`` (rad).
 
     Returns
     -------
     :class:`WorkspaceMap`
-        Per-sample workspace and singularity measures.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -151,7 +133,7 @@ def workspace_map(leg: OmniLeg, q: object) -> WorkspaceMap:
     >>> w.foot.shape, bool(w.singular[..., 0].all()), bool(w.singular[..., 1:].any())  # γ = 0 singular
     ((5, 5, 5, 3), True, False)
     """
-    _leg(leg)
+    check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
     J = jacobian(leg, q)
     sm = singularity_map(J, rtol=SINGULAR_RCOND)
@@ -173,7 +155,6 @@ def singular_surface(leg: OmniLeg, alpha: object, beta: object) -> np.ndarray:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m).
     alpha, beta : array_like, shape (...)
         Thigh angles (rad); broadcast together.
 
@@ -181,13 +162,8 @@ def singular_surface(leg: OmniLeg, alpha: object, beta: object) -> np.ndarray:
     -------
     ndarray, shape (..., 3)
         Foot positions ``FK(α, β, 0)`` in the hip frame (m).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
     """
-    _leg(leg)
+    check_params(leg, OmniLeg, "leg")
     a = as_array(alpha, "alpha")
     b = as_array(beta, "beta")
     a, b = broadcast_to_batch((a, 0, "alpha"), (b, 0, "beta"))
@@ -239,19 +215,12 @@ def foot_workspace(leg: OmniLeg, *, nodes: int = AREA_NODES) -> FootWorkspace:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m) and joint limits (rad).
     nodes : int, optional
         Gauss-Legendre nodes per joint coordinate (>= 2; default ``AREA_NODES``).
 
     Returns
     -------
     :class:`FootWorkspace`
-        Volume, area and extent of the foot workspace.
-
-    Raises
-    ------
-    ValueError
-        If ``leg`` is not an :class:`OmniLeg` or ``nodes`` is not an int >= 2.
 
     Examples
     --------
@@ -259,7 +228,7 @@ def foot_workspace(leg: OmniLeg, *, nodes: int = AREA_NODES) -> FootWorkspace:
     >>> bool(np.isclose(ws.volume, ws.projected_area * ws.stroke)), ws.boundary.shape
     (True, (800, 2))
     """
-    _leg(leg)
+    check_params(leg, OmniLeg, "leg")
     nodes = check_int(nodes, "nodes", low=2)
     x, w = np.polynomial.legendre.leggauss(nodes)
     A, B = leg.alpha_max, leg.beta_max
@@ -323,19 +292,12 @@ def workspace_symmetry(leg: OmniLeg, p_foot: object) -> SymmetryResult:
     Parameters
     ----------
     leg : OmniLeg
-        The leg's geometry (m) and joint limits (rad).
     p_foot : array_like, shape (..., 3)
         Foot positions in the hip frame (m); non-finite samples allowed.
 
     Returns
     -------
     :class:`SymmetryResult`
-        Per-sample masks of the workspace's symmetries.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -345,7 +307,7 @@ def workspace_symmetry(leg: OmniLeg, p_foot: object) -> SymmetryResult:
     >>> bool(r.reachable), bool(r.holds)
     (True, True)
     """
-    _leg(leg)
+    check_params(leg, OmniLeg, "leg")
     p = as_array(p_foot, "p_foot", (3,), finite=False)
     images = np.stack(
         [

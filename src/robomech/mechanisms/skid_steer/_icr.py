@@ -126,14 +126,12 @@ def icr_velocity(model: ICRModel, v_right: ArrayLike, v_left: ArrayLike) -> Plan
     Parameters
     ----------
     model : ICRModel
-        Track ICR positions (m, body axes).
     v_right, v_left : array_like, shape (...)
         Track speeds (m/s); broadcast together.
 
     Returns
     -------
     PlanarVelocity
-        Planar body velocity ``(v_x, v_y, r)`` (m/s, m/s, rad/s) and ``valid`` per sample.
 
     Examples
     --------
@@ -206,14 +204,12 @@ def encoder_track_speeds(robot: ExplorationRobot, wheel_rate: ArrayLike) -> Trac
     Parameters
     ----------
     robot : ExplorationRobot
-        The robot's geometry (wheel radii, m).
     wheel_rate : array_like, shape (..., 6)
         Wheel spin rates (rad/s), ``WHEELS`` order.
 
     Returns
     -------
     TrackSpeeds
-        ``right``, ``left`` (m/s) and ``valid``, each of shape ``(...)``.
 
     Examples
     --------
@@ -286,7 +282,6 @@ def identify_icr(
     Returns
     -------
     ICRIdentification
-        The identified model (or ``None``), its fit and identifiability.
 
     Examples
     --------
@@ -378,7 +373,6 @@ def wheel_slip(
     Returns
     -------
     WheelSlip
-        Per wheel ``(..., 6)``: the slip ``ratio``, the ``lateral_velocity`` (m/s) and ``valid``.
 
     Examples
     --------

@@ -60,11 +60,6 @@ class EncoderModel:
     ----------
     counts_per_rev : int, optional
         Encoder counts per wheel revolution (>= 1).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
     """
 
     counts_per_rev: int = 2048
@@ -95,11 +90,6 @@ class ImuModel:
         Accelerometer white-noise density (m/s²/√Hz, >= 0).
     accel_bias : tuple of float, optional
         Constant accelerometer bias per body axis (m/s²).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
     """
 
     gyro_noise_density: float = math.radians(0.008)  # rad/s/√Hz
@@ -168,7 +158,6 @@ def encoder_rates(
     Returns
     -------
     EncoderReadings
-        ``rate (N, 6)`` measured rates (rad/s; NaN in the first sample) and ``valid (N,)``.
     """
     check_params(model, EncoderModel, "model")
     w = as_array(wheel_rate, "wheel_rate", (None, N_WHEELS), min_ndim=2)
@@ -338,7 +327,6 @@ def planar_ekf(
     gyro_z : array_like, shape (N,)
         Gyro yaw-rate readings (rad/s).
     icr : ICRModel
-        Initial track ICRs (m).
     sigma_track, sigma_gyro : float
         Measurement noise of a track speed (m/s) and of the gyro (rad/s).
     sigma_model : float, optional
@@ -357,7 +345,6 @@ def planar_ekf(
     Returns
     -------
     EKFResult
-        State and covariance histories and the samples used.
     """
     ta = _check_times(t)
     n = ta.size

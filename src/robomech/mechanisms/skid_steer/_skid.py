@@ -73,7 +73,6 @@ def skid_steer_turn(v_right: ArrayLike, v_left: ArrayLike, track_width: float) -
     Returns
     -------
     SkidSteerTurn
-        ``yaw_rate`` (rad/s), ``forward_speed`` (m/s), signed ``radius`` (m) and ``turning``.
 
     Examples
     --------
@@ -168,7 +167,6 @@ def paper_lateral_slip(
     Returns
     -------
     LateralSlip
-        ``lateral_speed`` (m/s) and ``valid`` per sample.
 
     Examples
     --------
@@ -224,11 +222,6 @@ def dead_reckoning(twists: ArrayLike, dt: float, T0: ArrayLike | None = None) ->
     -------
     ndarray, shape (..., N, 4, 4)
         Poses ``T_GB`` at the sample times (the first is ``T0``).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------

@@ -269,7 +269,6 @@ def body_velocity(
     Returns
     -------
     BodyVelocity
-        Body twist, configuration rates, unknowns, conditioning and mask per sample.
 
     Examples
     --------

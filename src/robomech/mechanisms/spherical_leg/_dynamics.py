@@ -1,30 +1,17 @@
 """Rigid-body inverse dynamics of the spherical parallel leg and its redundant force distribution.
 
 Replaces paper 1, eqs. (19)-(28), which cannot be reproduced as printed (errata): the generalized
-coordinates here are the platform angles q = (alpha, beta) (the printed model uses the three leg
-lengths as coordinates of a 2-DOF platform), the platform lever arm is OP = h (the print uses the
-thickness h_p), and every body's kinetic energy is complete (eq. (25)'s dE/dqdot lost its squares).
-
-Method (Kane's equations = d'Alembert's principle, exact for this holonomic mechanism once the loop
-closure is solved): with each body's centre-of-mass velocity ``v_b = Pv_b qd`` and angular velocity
-``w_b = Pw_b qd``,
+coordinates are the platform angles q = (alpha, beta) (the print uses the three leg lengths of a 2-DOF
+platform), the platform lever arm is OP = h (the print uses the thickness h_p), and every body's kinetic
+energy is complete (eq. (25)'s dE/dqdot lost its squares).  Kane's equations, exact once the closure is
+solved, over the platform and each leg's lower and upper body:
 
     tau = sum_b Pv_b^T m_b (a_b - g) + Pw_b^T (I_b dw_b + w_b x I_b w_b) - E^T m_ext.
 
-Bodies: the platform (rotating about O), and per leg a lower body (centre of mass fixed on the leg
-axis at half its length from A_i) and an upper body (centre of mass at half its length from B_i). The
-leg bodies are inertially axisymmetric.  Each leg hangs on a universal (Cardan) joint at A_i (first
-axis ``a_i = leg.cardan_axes[i]`` fixed in the base, second axis across the leg): the joint forces
-both bodies of the leg to spin about the leg axis s at
-
-    sigma = w . s = sin(u_b) du_a/dt = (a . s) (a . (s x sdot)) / (1 - (a . s)^2)
-
-(u_a about a, u_b about the turned second axis; ``_cardan_spin``), and the lead screws of legs 1
-and 3 spin at ``2 pi ldot / lead`` more (helical joint) when ``leg.screw_spin`` is set.  Paper 1's
-leg energy, eq. (23), has no spin about the leg axis at all; ``paper_as_printed=True`` drops the
-Cardan spin (paper 1 as printed), for comparison only.  Leg forces f (positive = extending
-the leg) satisfy ``J^T f = tau`` (virtual work, power f . ldot): three legs drive two coordinates,
-so a rule picks f.
+The base universal joints make both bodies of a leg spin about its axis (``_cardan_spin``), the lead
+screws of legs 1 and 3 spin more when ``leg.screw_spin`` is set; ``paper_as_printed=True`` drops the
+Cardan spin (eq. (23) has none).  Leg forces f (positive extending) satisfy ``J^T f = tau``: three legs
+drive two coordinates, so a rule picks f.  Assumptions, one by one: ``docs/mechanisms/spherical_leg.md``.
 """
 
 from __future__ import annotations
@@ -44,7 +31,7 @@ from robomech._validation import (
     finite_samples,
 )
 
-from ._kinematics import LENGTH_FLOOR, _rotation
+from ._kinematics import LENGTH_FLOOR, _check_state, _rotation
 from ._params import SphericalLeg
 
 __all__ = [
@@ -176,19 +163,17 @@ def _motion(
     return _Motion(E, w, dw, p, Rp, s, sd, sdd, l, ld, ldd, Jl, Ps, sig, sigd, Psig, lock)
 
 
-_NO_QDD = object()
-
-
-def _check_state(q: object, qd: object, qdd: object = _NO_QDD):
-    qa = as_array(q, "q", (2,))
-    qda = as_array(qd, "qd", (2,))
-    qdda = None if qdd is _NO_QDD else as_array(qdd, "qdd", (2,))
-    with_qdd = [] if qdda is None else [(qdda, 1, "qdd")]
-    shape = (*broadcast_batch((qa, 1, "q"), (qda, 1, "qd"), *with_qdd), 2)
-    out = [np.broadcast_to(qa, shape), np.broadcast_to(qda, shape)]
-    if qdda is not None:
-        out.append(np.broadcast_to(qdda, shape))
-    return out
+def _driven_motion(
+    leg: SphericalLeg, q: object, qd: object, qdd: object, platform_wrench: object, paper_as_printed: bool
+) -> tuple[_Motion, np.ndarray | None]:
+    """The validated boundary of the force functions: the motion and the platform wrench (or None)."""
+    check_params(leg, SphericalLeg, "leg")
+    qa, qda, qdda = _check_state(q, qd, qdd)
+    w = None if platform_wrench is None else as_array(platform_wrench, "platform_wrench", (6,))
+    if w is not None:
+        broadcast_batch((qa, 1, "q, qd, qdd"), (w, 1, "platform_wrench"))
+    cardan = not check_bool(paper_as_printed, "paper_as_printed")
+    return _motion(leg, qa, qda, qdda, cardan), w
 
 
 def _cross_cols(s: np.ndarray, P: np.ndarray) -> np.ndarray:
@@ -258,7 +243,6 @@ def generalized_forces(
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m) and mass properties (kg, kg m^2); ``leg.gravity`` (m/s^2, base frame).
     q : array_like, shape (..., 2)
         Platform angles ``(alpha, beta)`` (rad).
     qd : array_like, shape (..., 2)
@@ -276,24 +260,13 @@ def generalized_forces(
     ndarray, shape (..., 2)
         Generalized forces ``tau`` on (alpha, beta) (N m).
 
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
-
     Examples
     --------
     >>> from robomech.mechanisms import spherical_leg as sl
     >>> sl.generalized_forces(sl.SphericalLeg.paper(), [0.1, 0.05], [0.0, 0.0], [0.0, 0.0]).shape
     (2,)
     """
-    check_params(leg, SphericalLeg, "leg")
-    qa, qda, qdda = _check_state(q, qd, qdd)
-    w = None if platform_wrench is None else as_array(platform_wrench, "platform_wrench", (6,))
-    if w is not None:
-        broadcast_batch((qa, 1, "q, qd, qdd"), (w, 1, "platform_wrench"))
-    cardan = not check_bool(paper_as_printed, "paper_as_printed")
-    return _generalized(leg, _motion(leg, qa, qda, qdda, cardan), w)
+    return _generalized(leg, *_driven_motion(leg, q, qd, qdd, platform_wrench, paper_as_printed))
 
 
 def mass_matrix(leg: SphericalLeg, q: object, *, paper_as_printed: bool = False) -> NDArray[np.float64]:
@@ -304,7 +277,6 @@ def mass_matrix(leg: SphericalLeg, q: object, *, paper_as_printed: bool = False)
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m) and mass properties (kg, kg m^2).
     q : array_like, shape (..., 2)
         Platform angles ``(alpha, beta)`` (rad).
     paper_as_printed : bool, optional
@@ -314,11 +286,6 @@ def mass_matrix(leg: SphericalLeg, q: object, *, paper_as_printed: bool = False)
     -------
     ndarray, shape (..., 2, 2)
         ``M(q)`` (kg m^2), symmetric positive definite.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -353,7 +320,6 @@ def mechanical_energy(
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m), mass properties (kg, kg m^2) and ``gravity`` (m/s^2, base frame).
     q : array_like, shape (..., 2)
         Platform angles ``(alpha, beta)`` (rad).
     qd : array_like, shape (..., 2)
@@ -367,11 +333,6 @@ def mechanical_energy(
         Kinetic energy (J).
     V : ndarray, shape (...)
         Gravitational potential energy (J), zero with every centre of mass at O.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -467,13 +428,6 @@ def distribute_forces(
     Returns
     -------
     :class:`ForceDistribution`
-        Leg forces per sample, with residual and conditioning.
-
-    Raises
-    ------
-    ValueError
-        If ``J`` or ``tau`` has a wrong shape or a non-real dtype, ``driven_legs`` is not two
-        different indices in 0..2, or ``sigma_min_bound`` is negative or not a real number.
 
     Examples
     --------
@@ -603,7 +557,6 @@ def inverse_dynamics(
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m) and mass properties (kg, kg m^2); ``leg.gravity`` (m/s^2, base frame).
     q : array_like, shape (..., 2)
         Platform angles ``(alpha, beta)`` (rad).
     qd : array_like, shape (..., 2)
@@ -622,14 +575,6 @@ def inverse_dynamics(
     Returns
     -------
     :class:`InverseDynamicsResult`
-        Generalized and leg forces per sample, with residual and conditioning.
-
-    Raises
-    ------
-    ValueError
-        If ``leg`` is not a :class:`SphericalLeg`, or an input has a wrong shape, is not real and
-        finite, or the inputs do not broadcast.
-        Also if ``driven_legs`` is not two different indices in 0..2.
 
     Examples
     --------
@@ -639,13 +584,7 @@ def inverse_dynamics(
     >>> res.leg_forces.shape, res.valid
     ((2, 3), array([ True,  True]))
     """
-    check_params(leg, SphericalLeg, "leg")
-    qa, qda, qdda = _check_state(q, qd, qdd)
-    w = None if platform_wrench is None else as_array(platform_wrench, "platform_wrench", (6,))
-    if w is not None:
-        broadcast_batch((qa, 1, "q, qd, qdd"), (w, 1, "platform_wrench"))
-    cardan = not check_bool(paper_as_printed, "paper_as_printed")
-    m = _motion(leg, qa, qda, qdda, cardan)
+    m, w = _driven_motion(leg, q, qd, qdd, platform_wrench, paper_as_printed)
     tau = _generalized(leg, m, w)
     dist = distribute_forces(m.Jl, tau, driven_legs)
     valid = dist.valid & ~m.lock

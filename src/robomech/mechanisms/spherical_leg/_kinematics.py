@@ -75,6 +75,17 @@ def _angles(alpha: object, beta: object) -> tuple[np.ndarray, np.ndarray]:
     return a, b
 
 
+_NO_QDD = object()
+
+
+def _check_state(q: object, qd: object, qdd: object = _NO_QDD) -> tuple[np.ndarray, ...]:
+    """``q``, ``qd`` (and ``qdd`` if given) (..., 2) validated and broadcast to their common batch."""
+    items = [(as_array(q, "q", (2,)), 1, "q"), (as_array(qd, "qd", (2,)), 1, "qd")]
+    if qdd is not _NO_QDD:
+        items.append((as_array(qdd, "qdd", (2,)), 1, "qdd"))
+    return broadcast_to_batch(*items)
+
+
 def platform_rotation(alpha: object, beta: object) -> np.ndarray:
     """Platform rotation ``T = Rx(alpha) Ry(beta)`` (paper 1, eq. (1)).
 
@@ -87,11 +98,6 @@ def platform_rotation(alpha: object, beta: object) -> np.ndarray:
     -------
     ndarray, shape (..., 3, 3)
         The rotation of the platform frame relative to the base frame (``R_base_platform``).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -161,14 +167,12 @@ def inverse_kinematics(leg: SphericalLeg, alpha: object, beta: object) -> Invers
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m).
     alpha, beta : array_like, shape (...)
         Platform angles (rad); broadcast together.
 
     Returns
     -------
     :class:`InverseKinematicsResult`
-        Leg lengths, directions and platform points per pose, with stroke masks.
 
     Examples
     --------
@@ -254,8 +258,7 @@ def forward_kinematics(
     ``atan2`` form built from l2^2 - l1^2 and l1^2 + l2^2; alpha then matches l3 exactly:
     ``h cos b sin a - r cos a = (l3^2 - K) / (2R)``, i.e. ``sin(a - phi) = s`` with
     ``phi = atan2(r, h cos b)``. ``branch=0`` is the assembly ``a = phi + asin(s)`` that contains
-    alpha = 0; ``branch=1`` is ``a = phi + pi - asin(s)``. Bad samples (non-finite, non-positive, no
-    assembly) are flagged in ``.valid``; a wrong shape raises ``ValueError``.
+    alpha = 0; ``branch=1`` is ``a = phi + pi - asin(s)``.
 
     ``paper_as_printed=True`` runs paper 1's printed pipeline instead (eq. (6), the quartic of eq. (7)
     with its lost square, Ferrari with the misprinted resolvent, α = arctan(2a); ``_as_printed.py``),
@@ -265,7 +268,6 @@ def forward_kinematics(
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m), e.g. ``SphericalLeg.paper()``.
     lengths : array_like, shape (..., 3)
         Leg lengths ``(l1, l2, l3)`` (m).
     branch : {0, 1}, optional
@@ -276,7 +278,6 @@ def forward_kinematics(
     Returns
     -------
     :class:`ForwardKinematicsResult`
-        Platform angles per sample, with residual and ``valid``/``converged`` masks.
 
     Examples
     --------
@@ -457,7 +458,6 @@ def jacobian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m).
     alpha, beta : array_like, shape (...)
         Platform angles (rad); broadcast together.
 
@@ -533,7 +533,6 @@ def hessian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m).
     alpha, beta : array_like, shape (...)
         Platform angles (rad); broadcast together.
 
@@ -541,11 +540,6 @@ def hessian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
     -------
     ndarray, shape (..., 3, 2, 2)
         ``d^2 l_i / dq_j dq_k`` (m/rad^2), symmetric in (j, k); the derivative of :func:`jacobian`.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -577,11 +571,6 @@ def angular_velocity_jacobian(alpha: object) -> np.ndarray:
         ``E`` (rad/s of omega, base frame, per rad/s of (alpha_dot, beta_dot)): columns ``x`` and
         ``Rx(alpha) y``.
 
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
-
     Examples
     --------
     >>> from robomech.mechanisms import spherical_leg as sl
@@ -609,7 +598,6 @@ def influence_coefficients(leg: SphericalLeg, alpha: object, beta: object) -> np
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m).
     alpha, beta : array_like, shape (...)
         Platform angles (rad); broadcast together.
 
@@ -618,11 +606,6 @@ def influence_coefficients(leg: SphericalLeg, alpha: object, beta: object) -> np
     ndarray, shape (..., 3, 6)
         ``G``: row i is ``[(B_i - O) x s_i; s_i]`` (first three columns in m, last three unit-free),
         base frame, so that ``ldot = G @ [omega; v_O]`` (m/s).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------
@@ -649,7 +632,6 @@ def leg_rates(
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m).
     q : array_like, shape (..., 2)
         Platform angles ``(alpha, beta)`` (rad).
     qd : array_like, shape (..., 2)
@@ -666,11 +648,6 @@ def leg_rates(
     lddot : ndarray, shape (..., 3)
         Leg extension accelerations (m/s^2).
 
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
-
     Examples
     --------
     >>> from robomech.mechanisms import spherical_leg as sl
@@ -679,10 +656,7 @@ def leg_rates(
     (array([0.10621, 0.11305, 0.11637]), array([0., 0., 0.]))
     """
     check_params(leg, SphericalLeg, "leg")
-    qa = as_array(q, "q", (2,))
-    qda = as_array(qd, "qd", (2,))
-    qdda = as_array(qdd, "qdd", (2,))
-    qa, qda, qdda = broadcast_to_batch((qa, 1, "q"), (qda, 1, "qd"), (qdda, 1, "qdd"))
+    qa, qda, qdda = _check_state(q, qd, qdd)
     a, b = qa[..., 0], qa[..., 1]
     sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
     qq, dq, d2q = _derivatives(leg, sa, ca, sb, cb)

@@ -39,11 +39,6 @@ def sway(t: object, about: str, beta0: float = 0.0) -> tuple[np.ndarray, np.ndar
     qdd : ndarray, shape (..., 2)
         Their accelerations (rad/s^2).
 
-    Raises
-    ------
-    ValueError
-        If ``about`` is not ``"x"`` or ``"y"``, or ``t`` or ``beta0`` is not real and finite.
-
     Examples
     --------
     >>> from robomech.mechanisms import spherical_leg as sl
@@ -85,11 +80,6 @@ def fig5_motion(case: str, t: object) -> tuple[np.ndarray, np.ndarray, np.ndarra
         Their rates (rad/s).
     qdd : ndarray, shape (..., 2)
         Their accelerations (rad/s^2).
-
-    Raises
-    ------
-    ValueError
-        If ``case`` is not ``"a"``, ``"b"`` or ``"c"``, or ``t`` is not real and finite.
 
     Examples
     --------

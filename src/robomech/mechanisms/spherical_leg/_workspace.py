@@ -68,19 +68,12 @@ def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMa
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m) and stroke (``length_min``, ``length_max``).
     alpha, beta : array_like, shape (...)
         Platform angles (rad); broadcast together (e.g. a meshgrid).
 
     Returns
     -------
     :class:`WorkspaceMap`
-        Per-sample workspace and singularity measures.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see the contract in ``docs/conventions.md``).
 
     Examples
     --------

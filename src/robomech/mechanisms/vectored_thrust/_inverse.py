@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomech._validation import as_array, broadcast_batch, check_params, check_real
+from robomech.analysis.lstsq import _damped_svd_solve
 
 from ._kinematics import _chunked, _jacobian, _q, angular_acceleration
 from ._params import VectoredThruster
@@ -88,21 +89,6 @@ class InverseRatesResult:
     valid: np.ndarray
 
 
-def _damped_pinv_apply(U, s, Vt, b, lam, weak):
-    """V diag(c) Uᵀ b for J = U diag(s) Vt (thin SVD, U (..., 3, 2)); c = σ/(σ² + λ²) on weak directions."""
-    den = s * s + lam * lam
-    coef = np.where(weak, s / np.where(den > 0, den, 1.0), 1.0 / np.where(weak, 1.0, s))
-    return np.einsum("...ki,...k->...i", Vt, coef * np.einsum("...ki,...k->...i", U, b))
-
-
-def _check_damping(damping: object) -> float:
-    return check_real(damping, "damping", low=0.0)
-
-
-def _check_thruster(th: object) -> None:
-    check_params(th, VectoredThruster, "th")
-
-
 def inverse_rates(
     th: VectoredThruster,
     q: object,
@@ -134,12 +120,6 @@ def inverse_rates(
     Returns
     -------
     InverseRatesResult
-        Input rates and accelerations with their conditioning and masks.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -148,11 +128,11 @@ def inverse_rates(
     >>> r.qd.shape, bool(r.valid.all()), bool(np.allclose(r.qd, 0.0))
     ((3, 2), True, True)
     """
-    _check_thruster(th)
+    check_params(th, VectoredThruster, "th")
     q = _q(q)
     w = as_array(omega, "omega", (3,))
     wd = None if omega_dot is None else as_array(omega_dot, "omega_dot", (3,))
-    lam_rel = _check_damping(damping)
+    lam_rel = check_real(damping, "damping", low=0.0)
     with_wd = [] if wd is None else [(wd, 1, "omega_dot")]
     batch = broadcast_batch((q, 1, "q"), (w, 1, "omega"), *with_wd)
     q = np.broadcast_to(q, (*batch, 2))
@@ -171,7 +151,7 @@ def _inverse_rates(th, q, w, wd, lam_rel, batch) -> InverseRatesResult:
     bound = 1.0 / INPUT_GAIN_MAX
     weak = s < bound
     lam = lam_rel * smax
-    qd = _damped_pinv_apply(U, s, Vt, w, lam, weak)
+    qd = _damped_svd_solve(U, s, Vt, w, lam, weak)
     w_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qd) - w, axis=-1)
     sigma_min = np.where(exists, s[..., -1], 0.0)
     singular = ~exists | (sigma_min < bound)
@@ -185,7 +165,7 @@ def _inverse_rates(th, q, w, wd, lam_rel, batch) -> InverseRatesResult:
         qd_safe = np.where(exists[..., None], qd, 0.0)
         vp = angular_acceleration(th, q_safe, qd_safe, np.zeros_like(qd_safe)).velocity_product
         vp = np.where(exists[..., None], vp, 0.0)
-        qdd = _damped_pinv_apply(U, s, Vt, wd - vp, lam, weak)
+        qdd = _damped_svd_solve(U, s, Vt, wd - vp, lam, weak)
         wd_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qdd) + vp - wd, axis=-1)
         qdd = np.where(exists[..., None], qdd, np.nan)
         wd_res = np.where(exists, wd_res, np.nan)
@@ -246,12 +226,6 @@ def static_torques(th: VectoredThruster, q: object, wrench: object) -> StaticsRe
     Returns
     -------
     StaticsResult
-        ``tau`` (..., 2) N·m, the ``moment`` and its ``unloaded`` part (..., 3) N·m, and ``valid``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -260,7 +234,7 @@ def static_torques(th: VectoredThruster, q: object, wrench: object) -> StaticsRe
     >>> bool(np.allclose(r.tau, 0.0)), bool(r.valid)
     (True, True)
     """
-    _check_thruster(th)
+    check_params(th, VectoredThruster, "th")
     q = _q(q)
     wr = as_array(wrench, "wrench", (6,))
     batch = broadcast_batch((q, 1, "q"), (wr, 1, "wrench"))

@@ -277,17 +277,22 @@ def _q(q: object) -> np.ndarray:
     return as_array(q, "q", (2,))
 
 
-def _axes(th: VectoredThruster, q: np.ndarray) -> JointAxes:
-    """Kernel: joint axes at inputs ``q (..., 2)`` (trusted)."""
+def _closure(th: VectoredThruster, q: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Kernel: sin, cos of q1 and q2 and ``(x, y) = |s22 x s12| (cos theta, sin theta)``."""
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
     s1, c1 = sincos(q[..., 0])  # see _theta_cs: one tangent instead of np.sin + np.cos
     s2, c2 = sincos(q[..., 1])
+    return s1, c1, s2, c2, sa * c1 * c2 - ca * s2, -sa * s1
+
+
+def _axes(th: VectoredThruster, q: np.ndarray) -> JointAxes:
+    """Kernel: joint axes at inputs ``q (..., 2)`` (trusted)."""
+    ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
+    # theta: RR passive angle, R = Ry(q2) Rx(-theta); (cos, sin)(theta) ~ (x, y), D = |s22 x s12|.
+    s1, c1, s2, c2, x, y = _closure(th, q)
     zero, one = np.zeros_like(c1), np.ones_like(c1)
     s12 = np.stack([ca * one, sa * s1, -sa * c1], axis=-1)  # paper 5, eq. (7), with a = pi/4
     s22 = np.stack([-c2, zero, s2], axis=-1)  # paper 5, eq. (5)
-    # theta: RR passive angle, R = Ry(q2) Rx(-theta); (cos, sin)(theta) ~ (x, y), D = |s22 x s12|.
-    x = sa * c1 * c2 - ca * s2
-    y = -sa * s1
     d = np.sqrt(x * x + y * y)  # x, y are O(1): no overflow, so no need for (slow) np.hypot
     valid = d > SINGULAR_TOL
     dd = np.where(valid, d, 1.0)
@@ -320,12 +325,6 @@ def joint_axes(th: VectoredThruster, q: object) -> JointAxes:
     Returns
     -------
     JointAxes
-        ``s11, s12, s13, s21, s22, s0`` (..., 3), ``distance`` and ``valid`` (...).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -424,11 +423,6 @@ def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
     ndarray, shape (...)
         Angular distance between the arcs (rad), in [0, π].
 
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
-
     Examples
     --------
     >>> round(float(arc_clearance([1, 0, 0], [0, 1, 0], [0, 0, 1], [0, 1, 0])), 12)   # share an end
@@ -454,10 +448,7 @@ def _interference(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
 
 def _interference_unmasked(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    s1, c1 = sincos(q[..., 0])
-    s2, c2 = sincos(q[..., 1])
-    x = sa * c1 * c2 - ca * s2
-    y = -sa * s1
+    s1, c1, s2, c2, x, y = _closure(th, q)
     d = np.sqrt(x * x + y * y)  # |s12 x s22|
     valid = d > SINGULAR_TOL
     inv = 1.0 / np.where(valid, d, np.nan)
@@ -510,12 +501,6 @@ def link_clearance(th: VectoredThruster, q: object) -> LinkClearanceResult:
     Returns
     -------
     LinkClearanceResult
-        Clearance (rad, compare with ``th.interference_clearance``) and its mask.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -590,7 +575,6 @@ def forward_kinematics(th: VectoredThruster, q: object) -> FKResult:
     Returns
     -------
     FKResult
-        Propeller axis, tip, tilt and the validity and limit masks.
 
     Examples
     --------
@@ -616,12 +600,6 @@ def platform_rotation(th: VectoredThruster, q: object) -> RotationResult:
     Returns
     -------
     RotationResult
-        ``R`` (..., 3, 3) (NaN where singular) and ``valid`` (...).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -726,7 +704,6 @@ def inverse_kinematics(th: VectoredThruster, s: object) -> IKResult:
     Returns
     -------
     IKResult
-        ``q (..., 2)`` inputs (rad) and the masks ``solved``, ``in_range``, ``tilt_ok``, ``valid``.
 
     Examples
     --------
@@ -782,12 +759,6 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
     Returns
     -------
     PassiveResult
-        ``values`` (..., 3) the angles (theta, rho2, rho3), rad (NaN where singular), and ``valid``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
     """
     check_params(th, VectoredThruster, "th")
     q = _q(q)
@@ -826,12 +797,6 @@ def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
     Returns
     -------
     PassiveResult
-        ``values`` (..., 3) passive rates (rad/s; NaN where singular) and ``valid``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
     """
     check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
@@ -844,10 +809,7 @@ def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
 
 def _jacobian(th: VectoredThruster, q: np.ndarray) -> JacobianResult:
     ca, sa = np.cos(th.arc_angle), np.sin(th.arc_angle)
-    s1, c1 = sincos(q[..., 0])  # see _theta_cs: one tangent instead of np.sin + np.cos
-    s2, c2 = sincos(q[..., 1])
-    x = sa * c1 * c2 - ca * s2
-    y = -sa * s1
+    s1, c1, s2, c2, x, y = _closure(th, q)
     d2 = x * x + y * y
     valid = d2 > SINGULAR_TOL**2
     inv = sa / np.where(valid, d2, np.nan)  # NaN where singular; a select is cheaper than a masked divide
@@ -890,7 +852,6 @@ def jacobian(th: VectoredThruster, q: object) -> JacobianResult:
     Returns
     -------
     JacobianResult
-        ``J (..., 3, 2)``, its mask and the distance to the singularity.
 
     Examples
     --------
@@ -935,12 +896,6 @@ def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityRes
     Returns
     -------
     VelocityResult
-        ``omega`` (..., 3) rad/s, base frame (NaN where singular), and ``valid``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -984,12 +939,6 @@ def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: objec
     Returns
     -------
     AccelerationResult
-        Platform angular velocity and acceleration, passive accelerations, mask.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
     """
     check_params(th, VectoredThruster, "th")
     q, qd, qdd = _q(q), as_array(qd, "qd", (2,)), as_array(qdd, "qdd", (2,))

@@ -32,9 +32,8 @@ def chain_screws(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Unit joint screws ``[s; r x s]`` of the RRR chain (3, 6) and the RR chain (2, 6) at ``q (2,)``.
 
-    ``offsets`` moves named axes (``"s11"``, ``"s12"``, ``"s13"``, ``"s21"``, ``"s22"``) to pass through
-    the given point (3,) in metres instead of through O (a design perturbation; the paper's axes all
-    pass through O, eqs. (5) and (7)).
+    The paper's axes all pass through O (eqs. (5) and (7)); ``offsets`` moves some off it (a design
+    perturbation).
 
     Parameters
     ----------
@@ -55,7 +54,7 @@ def chain_screws(
     Raises
     ------
     ValueError
-        Bad input (see docs/conventions.md); also a singular ``q``.
+        A singular ``q``.
 
     Examples
     --------
@@ -102,12 +101,6 @@ def platform_mobility(
     Returns
     -------
     MobilityResult
-        Mobility analysis (:mod:`robomech.analysis.mobility`).
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -163,12 +156,6 @@ def mechanism_mobility(
     Returns
     -------
     MechanismMobility
-        The ``platform`` and ``propeller`` ``MobilityResult``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------

@@ -116,11 +116,6 @@ def dexterity(th: VectoredThruster, q: object) -> np.ndarray:
     ndarray, shape (...)
         ``sigma_min / sigma_max`` of the platform Jacobian, in [0, 1].
 
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
-
     Examples
     --------
     >>> th = VectoredThruster.paper()
@@ -144,12 +139,6 @@ def workspace_map(th: VectoredThruster, q: object) -> WorkspaceMap:
     Returns
     -------
     WorkspaceMap
-        The Section 4 maps and masks per sample.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
@@ -201,11 +190,6 @@ def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = 
     ndarray, shape (n1, n2, 2)
         Input samples ``(q1, q2)`` (rad), the ends included.
 
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
-
     Examples
     --------
     >>> input_grid(VectoredThruster.paper(), (3, 5)).shape
@@ -229,11 +213,6 @@ def singular_points(th: VectoredThruster) -> np.ndarray:
     -------
     ndarray, shape (2, 2)
         The two singular inputs ``(q1, q2)`` (rad), a = ``th.arc_angle``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
     """
     check_params(th, VectoredThruster, "th")
     a = th.arc_angle
@@ -255,11 +234,6 @@ def idle_input_curve(th: VectoredThruster, q1: object) -> np.ndarray:
     -------
     ndarray, shape (...)
         The input 2 angle q2 (rad) on the curve, ``atan2(tan a, cos q1)``.
-
-    Raises
-    ------
-    ValueError
-        Bad input (see docs/conventions.md).
 
     Examples
     --------
