@@ -134,3 +134,33 @@ def test_a_missing_optional_engine_in_process_is_exit_2(capsys, monkeypatch):
     monkeypatch.setattr(cli, "available_commands", lambda: {"crash": _crashing(exc)})
     assert main(["crash"]) == EXIT_USAGE
     assert "install robomech[verify]" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["frobnicate"],
+        ["verify", "four_bar", "--duration", "abc"],
+        ["verify", "four_bar", "--engine", "bullet"],
+        ["sweep", "--designs", "-3"],
+        ["export"],
+        ["list", "--bogus"],
+    ],
+)
+def test_an_argument_error_is_one_line_naming_the_help(capsys, argv):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    err = capsys.readouterr().err.strip()
+    assert exc.value.code == EXIT_USAGE
+    assert len(err.splitlines()) == 1 and err.endswith("--help)"), err
+
+
+def test_control_help_still_prints_the_usage(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["verify", "--help"])
+    assert exc.value.code == 0 and "usage:" in capsys.readouterr().out
+
+
+def test_start_rates_without_a_start_configuration_are_named_by_their_options(capsys):
+    err = _one_line_usage_error(capsys, ["verify", "four_bar", "--qd0", "1"])
+    assert "--qd0 needs --q0" in err and "qd_act0" not in err

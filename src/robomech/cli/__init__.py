@@ -26,6 +26,7 @@ import os
 import sys
 import traceback
 from collections.abc import Callable, Sequence
+from typing import NoReturn
 
 from robomech._registry import discover
 
@@ -44,6 +45,10 @@ class _Parser(argparse.ArgumentParser):
             self.description = self.lazy_description()
             self.lazy_description = None
         return super().format_help()
+
+    def error(self, message: str) -> NoReturn:
+        """A usage error in one line (argparse would print the whole usage first), exit 2."""
+        self.exit(EXIT_USAGE, f"{self.prog}: {message} (see {self.prog} --help)\n")
 
 
 def available_commands() -> dict[str, Command]:
