@@ -11,6 +11,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+from unittest import mock
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -32,6 +33,11 @@ from ._scene import (
 )
 
 __all__ = ["Viewer", "view"]
+
+
+def _silent(*args: object, **kwargs: object) -> None:
+    """Prints nothing (stands in for a library's banner)."""
+
 
 HOST = "127.0.0.1"  # never another interface: the viewer is a local tool
 FAILED_COLOUR = (220, 30, 30)
@@ -124,7 +130,11 @@ class Viewer:
         self._playing = threading.Event()
         self._closed = threading.Event()
         self._addr = [mech.qpos_address(j) for j in mech.actuated]
-        with contextlib.redirect_stdout(io.StringIO()):  # viser prints a banner; the caller prints the URL
+        # viser (1.1) prints a banner with rich.print even with verbose=False; in Jupyter rich shows
+        # it as an output of the cell, above the viewer.  The caller prints the URL instead.
+        import rich
+
+        with contextlib.redirect_stdout(io.StringIO()), mock.patch.object(rich, "print", _silent):
             self._server = viser.ViserServer(
                 host=HOST, port=port, label=f"robomech: {mech.name}", verbose=False
             )
