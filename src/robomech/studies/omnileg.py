@@ -181,7 +181,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         t51,
         [f51.q - ol.start_point(leg), f51.qd, f51.qdd],
         AXES,
-        "Fig. 9 — foot trajectory eq. (51) (displacement from FK(0, 0, 60°))",
+        "foot trajectory eq. (51) (displacement from FK(0, 0, 60°))",
         ["displacement (m)", "velocity (m/s)", "acceleration (m/s²)"],
         "",
     )
@@ -198,7 +198,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         t51,
         [np.degrees(ik.q), np.degrees(qd51), np.degrees(qdd51)],
         ("α", "β", "γ"),
-        "Fig. 9 — joint motion from the inverse kinematics of eq. (51)",
+        "joint motion from the inverse kinematics of eq. (51)",
         ["angle (deg)", "rate (deg/s)", "acceleration (deg/s²)"],
         "",
     )
@@ -223,7 +223,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         t52,
         [p52, v52, a52],
         AXES,
-        "Fig. 10 — foot motion for the joint trajectory eq. (52)",
+        "foot motion for the joint trajectory eq. (52)",
         ["position (m)", "velocity (m/s)", "acceleration (m/s²)"],
         "",
     )
