@@ -67,6 +67,8 @@ from robomech.studies._papers import PAPERS as _CITED  # noqa: E402
 myst_substitutions = {f"paper{n}": _citation_md(p) for n, p in _CITED.items()}
 
 html_theme = "pydata_sphinx_theme"
+# The light/dark mode a first visit starts in (unset, the theme logs a console error on every fresh load).
+html_context = {"default_mode": "auto"}
 html_title = f"robomech {release}"
 html_theme_options = {
     "show_toc_level": 2,
