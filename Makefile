@@ -69,8 +69,11 @@ typecheck: install
 # gallery mechanisms and reproduces every study for its page (about 4 min on this 2-core machine the
 # first time, reused until a source file changes).  Math is rendered by MathJax served from
 # the site itself: the first build installs it from npm (Node.js) into docs/_build/npm.
-docs: $(DOCS_STAMP)
+# The built site is then checked: a page per public name, every study's report, and the equations
+# typeset offline in headless Chromium (tests/test_docs.py, tests/test_docs_browser.py; ~20 s).
+docs: $(DOCS_STAMP) install-browser
 	ROBOMECH_DOCS_REPORTS=$(REPORTS) $(BIN)/sphinx-build -W --keep-going -n -q -b html docs docs/_build/html
+	$(BIN)/python -m pytest -q -p no:cacheprovider tests/test_docs.py tests/test_docs_browser.py
 	@echo "docs: open docs/_build/html/index.html"
 
 # No extras installed: list, the engine-free study and the engine-free checks must exit 0.
