@@ -99,7 +99,8 @@ class Stages:
         LOGGER.info("%s: %d stages", self.what, len(self.names))
         self._bar = open_bar()
         if self._bar is not None:
-            self._task = self._bar.add_task(self.what, total=len(self.names), stage="")
+            # until the first stage starts (models built, kernels compiled for first use): say so
+            self._task = self._bar.add_task(self.what, total=len(self.names), stage="starting")
         return self
 
     def next(self, name: str | None = None) -> None:
