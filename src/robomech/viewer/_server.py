@@ -11,7 +11,6 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
-from unittest import mock
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -33,10 +32,6 @@ from ._scene import (
 )
 
 __all__ = ["Viewer", "view"]
-
-
-def _silent(*args: object, **kwargs: object) -> None:
-    """Prints nothing (stands in for a library's banner)."""
 
 
 HOST = "127.0.0.1"  # never another interface: the viewer is a local tool
@@ -131,13 +126,19 @@ class Viewer:
         self._closed = threading.Event()
         self._addr = [mech.qpos_address(j) for j in mech.actuated]
         # viser (1.1) prints a banner with rich.print even with verbose=False; in Jupyter rich shows
-        # it as an output of the cell, above the viewer.  The caller prints the URL instead.
+        # it as an output of the cell, above the viewer.  The caller prints the URL instead: rich's
+        # console is quiet while the server starts.
         import rich
 
-        with contextlib.redirect_stdout(io.StringIO()), mock.patch.object(rich, "print", _silent):
-            self._server = viser.ViserServer(
-                host=HOST, port=port, label=f"robomech: {mech.name}", verbose=False
-            )
+        console = rich.get_console()
+        quiet, console.quiet = console.quiet, True
+        try:
+            with contextlib.redirect_stdout(io.StringIO()):
+                self._server = viser.ViserServer(
+                    host=HOST, port=port, label=f"robomech: {mech.name}", verbose=False
+                )
+        finally:
+            console.quiet = quiet
         self.port = int(self._server.get_port())
         self.url = f"http://{HOST}:{self.port}"
         self._nodes: list[tuple[Any, tuple[int, int, int]]] = []  # (handle, normal colour)
