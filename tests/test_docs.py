@@ -261,3 +261,26 @@ def test_every_public_class_and_function_has_numpydoc_sections():
             if not any(s in doc for s in _NUMPYDOC_SECTIONS):
                 missing.append(f"robomech.{pkg}.{name}")
     assert not missing, f"public names without numpydoc sections: {missing}"
+
+
+# An equation written as text: a Greek symbol in an equality or inequality outside math (`β = 0`), or
+# inside inline code (`ω = J q̇`).  The pages write equations as LaTeX ($...$), typeset by MathJax.
+_GREEK = "αβγδεθκλμνξπρστφχψωΔΣΦΨΩ"
+_TEXT_EQUATION = re.compile(rf"(?<![\w$])[{_GREEK}][\w₀-₉]* ?[=<>≤≥≈] ?[−\-\d({_GREEK}]")
+_CODE_EQUATION = re.compile(rf"`[^`]*[{_GREEK}][^`]*[=≤≥][^`]*`|`[^`]*[=≤≥][^`]*[{_GREEK}][^`]*`")
+# Pages other engineers write (their equations are theirs to convert).
+_NOT_CHECKED = ("explore.md", "performance.md")
+
+
+def test_equations_on_the_pages_are_latex_not_unicode():
+    found = []
+    for page in DOCS.rglob("*.md"):
+        rel = page.relative_to(DOCS).as_posix()
+        if rel.startswith(GENERATED) or rel in _NOT_CHECKED:
+            continue
+        text = re.sub(r"```.*?```|\$\$.*?\$\$", "", page.read_text(), flags=re.S)
+        text = re.sub(r"\$[^$\n]+\$", "", text)
+        for line in text.splitlines():
+            prose = re.sub(r"`[^`]*`", "", line)
+            found += [f"{rel}: {m}" for m in _CODE_EQUATION.findall(line) + _TEXT_EQUATION.findall(prose)]
+    assert not found, "\n".join(found[:30])
