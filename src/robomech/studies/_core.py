@@ -281,7 +281,7 @@ class Progress:
 
     Every step is logged at INFO level on the ``"robomech"`` logger.  When ``enabled``, each step is
     also printed on ``stream`` as ``[elapsed s] prefix message``; when, in addition, ``stream`` is
-    stderr and the command line turned the bars on (:func:`robomech._progress.show_bars`: stderr is
+    stderr and the command line turned the bars on (``robomech._progress.show_bars``: stderr is
     a terminal, no ``--quiet``), a bar below those lines shows the steps done, the time and the step
     under way, until :meth:`close` (or the end of a ``with`` block).
 
