@@ -5,7 +5,8 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 DOCS_STAMP := $(VENV)/.installed-docs
 OUT    ?= out
-# `make docs REPORTS=out`: the docs show the reports of that `robomech reproduce --out` folder.
+# `make docs REPORTS=out`: the docs show the reports of that `robomech reproduce --out` folder
+# instead of reproducing the studies.
 REPORTS ?=
 # A second venv with `pip install .` and no extras: what a user without MuJoCo gets.
 MINIMAL := .venv-minimal
@@ -65,11 +66,14 @@ typecheck: install
 
 # The documentation site; -W: a warning is an error, -n: every cross-reference must resolve.
 # docs/conf.py writes an API page per public name, runs examples/*.py (sphinx-gallery), draws the
-# gallery mechanisms and reproduces the fast studies for their pages; `make docs REPORTS=out` also
-# shows the slow studies' reports of an earlier `make run`.  Math is rendered by MathJax served from
+# gallery mechanisms and reproduces every study for its page (about 4 min on this 2-core machine the
+# first time, reused until a source file changes).  Math is rendered by MathJax served from
 # the site itself: the first build installs it from npm (Node.js) into docs/_build/npm.
-docs: $(DOCS_STAMP)
+# The built site is then checked: a page per public name, every study's report, and the equations
+# typeset offline in headless Chromium (tests/test_docs.py, tests/test_docs_browser.py; ~20 s).
+docs: $(DOCS_STAMP) install-browser
 	ROBOMECH_DOCS_REPORTS=$(REPORTS) $(BIN)/sphinx-build -W --keep-going -n -q -b html docs docs/_build/html
+	$(BIN)/python -m pytest -q -p no:cacheprovider tests/test_docs.py tests/test_docs_browser.py
 	@echo "docs: open docs/_build/html/index.html"
 
 # No extras installed: list, the engine-free study and the engine-free checks must exit 0.

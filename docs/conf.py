@@ -67,6 +67,8 @@ from robomech.studies._papers import PAPERS as _CITED  # noqa: E402
 myst_substitutions = {f"paper{n}": _citation_md(p) for n, p in _CITED.items()}
 
 html_theme = "pydata_sphinx_theme"
+# The light/dark mode a first visit starts in (unset, the theme logs a console error on every fresh load).
+html_context = {"default_mode": "auto"}
 html_title = f"robomech {release}"
 html_theme_options = {
     "show_toc_level": 2,
@@ -271,13 +273,13 @@ def _api_pages() -> None:
 
 
 # ----------------------------------------------------------------------------- the studies' reports
-# One page per registered study (docs/papers.md).  The fast studies are reproduced from this
-# checkout by `robomech reproduce` during the build and reused by later builds until a source file
-# changes (together about 25 s on this 2-core machine, after the first-use compile); the slow ones
-# (continuum and skid-steer, minutes each) get a page that says what the study reproduces and how to
-# get its report.  With ROBOMECH_DOCS_REPORTS=DIR (`make docs REPORTS=out` after `make run`) every
-# study folder of that `robomech reproduce --out DIR` is shown as well.
-FAST_STUDIES = ("demo", "spherical-leg", "vectored-thrust", "omnileg", "sweep-demo")
+# One page per registered study (docs/papers.md), each the report of `robomech reproduce NAME` run
+# from this checkout during the build, into docs/_build/reports/ (git-ignored), and reused by later
+# builds until a source file changes.  Measured on this 2-core machine shared with other jobs (load
+# 4-8): skid-steer 178 s (its MuJoCo manoeuvres), continuum 21 s, the five others 25 s together.  A
+# study whose optional dependencies are missing gets a page that says what it reproduces and how to
+# run it.  With ROBOMECH_DOCS_REPORTS=DIR (`make docs REPORTS=out` after `make run`) the reports of
+# that `robomech reproduce --out DIR` folder are shown instead of reproducing them.
 REPORTS_DIR = os.environ.get("ROBOMECH_DOCS_REPORTS", "")
 PAPERS = ROOT / "docs" / "papers"
 _DROP_LINE = re.compile(r"^\[(← all studies|↑ contents)\]")
@@ -311,7 +313,7 @@ def _study_placeholder(study, why: str) -> str:
     source = next((p.citation() for p in CITED.values() if p.short() == study.source), study.source)
     return (
         f"# {study.title}\n\n*Source:* {source}\n\n```{{note}}\n{why}{needs} To see its report "
-        f"here: `robomech reproduce {study.name} --out out`, then `make docs REPORTS=out`.\n```\n\n"
+        "here: install what it needs and run `make docs` again.\n```\n\n"
         f"## What the study reproduces\n\n{_rst_to_md(doc)}\n"
     )
 
@@ -337,9 +339,9 @@ def _paper_pages() -> None:
     if given is not None and not any(given.glob("*/report.md")):
         raise RuntimeError(f"ROBOMECH_DOCS_REPORTS={REPORTS_DIR}: no <study>/report.md in it")
     reports = BUILD / "reports"
-    fast = [s for s in FAST_STUDIES if given is None or not (given / s / "report.md").exists()]
-    fast = [s for s in fast if all(importlib.util.find_spec(m) for m in studies[s].requires)]
-    stale = [s for s in fast if not _report_is_current(reports / s / "report.md")]
+    run = [s for s in studies if given is None or not (given / s / "report.md").exists()]
+    run = [s for s in run if all(importlib.util.find_spec(m) for m in studies[s].requires)]
+    stale = [s for s in run if not _report_is_current(reports / s / "report.md")]
     if stale:
         subprocess.run(
             [sys.executable, "-m", "robomech", "reproduce", *stale, "--out", str(reports), "--quiet"],
@@ -354,6 +356,7 @@ def _paper_pages() -> None:
     (BUILD / "papers-cited.md").write_text(
         "\n".join(f"{p.number}. {_citation_md(p)}" for p in CITED.values()) + "\n", encoding="utf-8"
     )
+
     # the pages in reading order: the demonstration, the papers by number, then the rest
     def order(name: str) -> tuple[int, str]:
         m = re.match(r"Paper (\d+)", studies[name].title)
@@ -367,18 +370,13 @@ def _paper_pages() -> None:
         dst = PAPERS / name
         dst.mkdir(parents=True)
         src = given / name if given is not None and (given / name / "report.md").exists() else reports / name
-        if name in fast or src.parent == given:
+        if name in run or src.parent == given:
             for f in src.iterdir():
                 if f.suffix in (".png", ".svg", ".gif", ".json"):
                     shutil.copy2(f, dst / f.name)
             page = _paper_page(name, (src / "report.md").read_text(encoding="utf-8"))
         else:
-            why = (
-                "This study takes minutes, so the site's default build does not run it."
-                if name not in FAST_STUDIES
-                else "This build could not run the study."
-            )
-            page = _study_placeholder(study, why)
+            page = _study_placeholder(study, "This build could not run the study.")
         (dst / "index.md").write_text(page, encoding="utf-8")
 
 

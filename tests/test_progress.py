@@ -63,3 +63,41 @@ def test_verify_quiet_prints_nothing_on_stderr(capsys):
     assert main(["verify", "four_bar", "--quiet"]) == 0
     assert capsys.readouterr().err == ""
     assert not _progress.bars_enabled()
+
+
+def test_a_study_shows_a_bar_of_its_steps_on_a_terminal_and_lines_elsewhere(monkeypatch):
+    from robomech.studies import Progress
+
+    plain = io.StringIO()
+    with Progress("demo: ", stream=plain) as p:  # not a terminal: one line per step, no bar
+        p.plan(["one", "two"])
+        p.step("one")
+        list(p.iter(range(20), "case"))
+        p.step("two")
+    lines = plain.getvalue().splitlines()
+    assert [line.split("] ", 1)[1] for line in lines][:2] == ["demo: one", "demo: case 1/20"]
+    assert lines[-1].endswith("demo: two") and "\x1b" not in plain.getvalue()
+
+    term = _Terminal()
+    monkeypatch.setattr(sys, "stderr", term)
+    assert _progress.show_bars(True)
+    with Progress("demo: ") as p:
+        p.plan(["one", "two"])
+        p.step("one")
+        for _ in p.iter(range(3), "case"):
+            # a verification inside a step shares the one live display, a line of its own
+            with _progress.stages("verify inner", ["a"]) as st:
+                st.next()
+                shown = [t.description.strip() for t in _progress._LIVE["bar"].tasks]
+                assert shown == ["demo", "case", "verify inner"]
+        p.step("two")
+        assert [t.description for t in _progress._LIVE["bar"].tasks] == ["demo"]
+    shown = term.getvalue()
+    assert "demo: one" in shown and "demo: two" in shown  # the step lines stay above the bar
+    assert "1/2" in shown  # the bar: one of two steps done while the second runs
+    assert _progress._LIVE["bar"] is None  # removed when the study ends
+
+
+def test_reproduce_quiet_prints_nothing_on_stderr(capsys, tmp_path):
+    assert main(["reproduce", "demo", "--out", str(tmp_path), "--quiet"]) == 0
+    assert capsys.readouterr().err == ""

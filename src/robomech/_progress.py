@@ -35,6 +35,49 @@ def bars_enabled() -> bool:
     return _BARS["enabled"]
 
 
+_LIVE: dict[str, Any] = {"bar": None, "users": 0}
+
+
+def open_bar() -> Any:
+    """The ``rich`` progress display on stderr (removed when its last user closes it), or ``None``
+    when :func:`show_bars` did not turn the bars on.
+
+    One display is shared by nested operations (a study step that runs a verification): each adds
+    its own task (a line) and removes it when done, then calls :func:`close_bar`.  Tasks take a
+    ``stage`` field: the text shown after the bar (the step under way).
+    """
+    if not bars_enabled():
+        return None
+    if _LIVE["bar"] is None:
+        try:
+            from rich.console import Console
+            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+        except ImportError:  # pragma: no cover - rich is a dependency
+            return None
+        bar = Progress(
+            TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+            TextColumn("{task.fields[stage]}"),
+            console=Console(stderr=True), transient=True,
+        )  # fmt: skip
+        bar.start()
+        _LIVE["bar"] = bar
+    _LIVE["users"] += 1
+    return _LIVE["bar"]
+
+
+def close_bar(bar: Any, task: Any) -> None:
+    """Release the display of :func:`open_bar` and remove ``task`` from it; the last release draws
+    it once more and removes it from the terminal."""
+    if bar is None or bar is not _LIVE["bar"]:
+        return
+    _LIVE["users"] -= 1
+    if _LIVE["users"] <= 0:
+        bar.stop()
+        _LIVE["bar"], _LIVE["users"] = None, 0
+    else:
+        bar.remove_task(task)
+
+
 class Stages:
     """The named stages of one long operation; use as a context manager, call :meth:`next` per stage.
 
@@ -54,25 +97,10 @@ class Stages:
 
     def __enter__(self) -> Stages:
         LOGGER.info("%s: %d stages", self.what, len(self.names))
-        if bars_enabled():
-            try:
-                from rich.console import Console
-                from rich.progress import (
-                    BarColumn,
-                    MofNCompleteColumn,
-                    Progress,
-                    TextColumn,
-                    TimeElapsedColumn,
-                )
-            except ImportError:  # pragma: no cover - rich is a dependency
-                return self
-            self._bar = Progress(
-                TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                TextColumn("{task.fields[stage]}"),
-                console=Console(stderr=True), transient=True,
-            )  # fmt: skip
-            self._bar.start()
-            self._task = self._bar.add_task(self.what, total=len(self.names), stage="")
+        self._bar = open_bar()
+        if self._bar is not None:
+            # until the first stage starts (models built, kernels compiled for first use): say so
+            self._task = self._bar.add_task(self.what, total=len(self.names), stage="starting")
         return self
 
     def next(self, name: str | None = None) -> None:
@@ -85,7 +113,7 @@ class Stages:
 
     def __exit__(self, *exc: object) -> None:
         if self._bar is not None:
-            self._bar.stop()
+            close_bar(self._bar, self._task)
             self._bar = None
         LOGGER.info("%s: done", self.what)
 

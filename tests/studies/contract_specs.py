@@ -25,7 +25,7 @@ def _in_tmp(fn, key):
 
 SPECS = {
     **exempt("Figure Study StudyResult Table", DATA, P),
-    P + "Progress": Exempt("console progress printer of long study runs (stderr lines), no numeric input"),
+    P + "Progress": Exempt("progress of study runs (stderr lines, a bar on a terminal), no numeric input"),
     P + "available_studies": Spec(args={}),
     P + "get_study": Spec(args={"name": "demo"}, options={"name": ("no-such-study", None, 1)}),
     P + "comparison_table": Spec(

@@ -2,15 +2,17 @@
 the captions), every 3-D panel labels its z axis, a legend names each source once (not "MuJoCo" per
 curve)."""
 
+import importlib.util
 import re
 
 import pytest
 
 from robomech.studies import Progress, get_study
 
-# The quick studies (the demonstration in 1 s, the other two in about 7 s each: marked slow).
-FAST = ("demo", pytest.param("vectored-thrust", marks=pytest.mark.slow),
-        pytest.param("spherical-leg", marks=pytest.mark.slow))  # fmt: skip
+# Every study: the demonstration in 1 s; the others take 7 s (vectored-thrust, spherical-leg) to
+# minutes (skid-steer) and are marked slow.
+FAST = ("demo", *(pytest.param(name, marks=pytest.mark.slow) for name in (
+    "vectored-thrust", "spherical-leg", "omnileg", "continuum", "skid-steer")))  # fmt: skip
 FIGURE_NUMBER = re.compile(r"\bFig(ure)?\.? ?\d")
 
 
@@ -45,5 +47,16 @@ def test_figure_titles_axes_and_legends(name, tmp_path, monkeypatch):
         return real(fig, out_dir, fname, caption)
 
     monkeypatch.setattr(module, "save_figure", checking_save)
+    if hasattr(module, "animation_figure"):  # an animation's title is a figure title too
+        real_animation = module.animation_figure
+
+        def checking_animation(*args, title="", **kwargs):
+            if FIGURE_NUMBER.search(title):
+                problems.append(f"animation title {title!r} carries a figure number")
+            return real_animation(*args, title=title, **kwargs)
+
+        monkeypatch.setattr(module, "animation_figure", checking_animation)
+    if requires := [m for m in study.requires if not importlib.util.find_spec(m)]:
+        pytest.skip(f"{name} needs {requires}")
     study.run(tmp_path, Progress(enabled=False))
     assert not problems, "\n".join(problems)

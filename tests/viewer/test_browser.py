@@ -103,15 +103,22 @@ def _q(text: str) -> np.ndarray:
     return np.array([float(x) for x in m.group(1).split(",")])
 
 
+def open_page(p, url: str, errors: list[str]):
+    """Headless Chromium on ``url``; console errors and page errors are appended to ``errors``.
+    Returns ``(browser, page)``: the caller closes the browser."""
+    browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, timeout=PAGE_S * 1000)
+    page = browser.new_page(viewport={"width": 1280, "height": 900})
+    page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    page.goto(url, timeout=PAGE_S * 1000)
+    return browser, page
+
+
 def test_page_loads_and_a_slider_reassembles(server):
     errors: list[str] = []
     with playwright_sync.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, timeout=PAGE_S * 1000)
+        browser, page = open_page(p, server, errors)
         try:
-            page = browser.new_page(viewport={"width": 1280, "height": 900})
-            page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
-            page.on("pageerror", lambda e: errors.append(str(e)))
-            page.goto(server, timeout=PAGE_S * 1000)
             status = page.get_by_text(re.compile(r"assembled \(initial configuration\)"))
             status.first.wait_for(timeout=PAGE_S * 1000)
             panel = page.locator("body")

@@ -32,6 +32,7 @@ def _add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from robomech._progress import show_bars
     from robomech._registry import skip_reason
     from robomech.studies import Progress, available_studies, write_index
     from robomech.studies._report import publish_study, remove_stale_temporaries
@@ -51,6 +52,7 @@ def _run(args: argparse.Namespace) -> int:
     out_root = output_folder(args.out)
     remove_stale_temporaries(out_root)
     announce_compiles(enabled=not args.quiet)
+    show_bars(not args.quiet)  # a bar per study on a terminal, the step lines above it
     summary, skipped = [], []
     try:
         for name in args.studies or list(studies):
@@ -61,10 +63,10 @@ def _run(args: argparse.Namespace) -> int:
                 if not args.quiet:
                     print(f"{name}: skipped — {why}", file=sys.stderr, flush=True)
                 continue
-            progress = Progress(prefix=f"{name}: ", enabled=not args.quiet)
-            progress.step(f"start — {study.title}")
-            entry = publish_study(study, out_root, progress)
-            progress.step(f"done in {entry['seconds']:.1f} s → {entry['report']}")
+            with Progress(prefix=f"{name}: ", enabled=not args.quiet) as progress:
+                progress.log(f"start — {study.title}")
+                entry = publish_study(study, out_root, progress)
+                progress.log(f"done in {entry['seconds']:.1f} s → {entry['report']}")
             summary.append(entry)
     finally:  # also on Ctrl-C: the index lists exactly the complete study folders that exist now
         index = write_index(out_root, studies, skipped)

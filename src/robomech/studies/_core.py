@@ -20,7 +20,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from robomech._progress import LOGGER
+from robomech._progress import LOGGER, close_bar, open_bar
 
 __all__ = [
     "Figure",
@@ -270,9 +270,20 @@ def comparison_table(
 
 
 class Progress:
-    """Progress lines on stderr for long runs; silent when ``enabled`` is false.
+    """The progress of a study run: a ``rich`` bar on a terminal, log lines otherwise.
 
-    Each line is ``[elapsed s] prefix message``.
+    What a study's ``run(out_dir, progress)`` reports through.  The interface a study uses:
+
+    - :meth:`plan` (optional, once, first): the names of the steps to come, so that the bar knows its
+      length (without it the bar counts steps without a total);
+    - :meth:`step` at the start of each step (``progress.step("Fig. 5: actuator forces")``);
+    - :meth:`iter` around a long loop inside a step (a second bar, or about ten lines).
+
+    Every step is logged at INFO level on the ``"robomech"`` logger.  When ``enabled``, each step is
+    also printed on ``stream`` as ``[elapsed s] prefix message``; when, in addition, ``stream`` is
+    stderr and the command line turned the bars on (``robomech._progress.show_bars``: stderr is
+    a terminal, no ``--quiet``), a bar below those lines shows the steps done, the time and the step
+    under way, until :meth:`close` (or the end of a ``with`` block).
 
     Parameters
     ----------
@@ -288,8 +299,9 @@ class Progress:
     >>> import io
     >>> out = io.StringIO()
     >>> p = Progress("demo: ", stream=out)
-    >>> p.step("done")
-    >>> out.getvalue().rstrip().endswith("demo: done")
+    >>> p.plan(["mobility", "figures"])
+    >>> p.step("mobility")
+    >>> out.getvalue().rstrip().endswith("demo: mobility")
     True
     """
 
@@ -297,20 +309,74 @@ class Progress:
         self.prefix = prefix
         self.enabled = enabled
         self.stream = stream if stream is not None else sys.stderr
+        self._to_stderr = stream is None
         self._t0 = time.perf_counter()
+        self._total: int | None = None
+        self._done = 0
+        self._bar: Any = None
+        self._task: Any = None
+
+    def __enter__(self) -> Progress:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def plan(self, names: Sequence[str]) -> None:
+        """Declare the steps to come (their number is the bar's length); call before the first step."""
+        self._total = len(list(names))
+        if self._bar is not None:
+            self._bar.update(self._task, total=self._total)
 
     def step(self, message: str) -> None:
-        """Print ``message`` with the elapsed time (s) and the prefix."""
+        """Start a step: print ``message`` with the elapsed time (s) and the prefix; advance the bar."""
+        self.log(message)
+        if self._bar is not None:
+            self._bar.update(self._task, completed=self._done, stage=message)
+        self._done += 1
+
+    def log(self, message: str) -> None:
+        """Print ``message`` like a step's line without counting it as a step (a start, a result)."""
         LOGGER.info("%s%s", self.prefix, message)  # the Python API's progress (logger "robomech")
-        if self.enabled:
-            elapsed = time.perf_counter() - self._t0
-            print(f"[{elapsed:7.1f} s] {self.prefix}{message}", file=self.stream, flush=True)
+        if not self.enabled:
+            return
+        line = f"[{time.perf_counter() - self._t0:7.1f} s] {self.prefix}{message}"
+        bar = self._open()
+        if bar is None:
+            print(line, file=self.stream, flush=True)
+        else:
+            bar.console.print(line, highlight=False, markup=False)
 
     def iter(self, items: Sequence[T], label: str, every: int | None = None) -> Iterator[T]:
-        """Yield ``items``, reporting about ten times along the way."""
+        """Yield ``items``: a second bar on a terminal, otherwise about ten lines along the way."""
         n = len(items)
-        every = every or max(1, n // 10)
-        for i, item in enumerate(items):
-            if i % every == 0:
-                self.step(f"{label} {i + 1}/{n}")
-            yield item
+        bar = self._open() if self.enabled else None
+        if bar is None:
+            every = every or max(1, n // 10)
+            for i, item in enumerate(items):
+                if i % every == 0:
+                    self.step(f"{label} {i + 1}/{n}")
+                yield item
+            return
+        LOGGER.info("%s%s: %d", self.prefix, label, n)
+        task = bar.add_task(f"  {label}", total=n, stage="")
+        try:
+            for i, item in enumerate(items):
+                bar.update(task, completed=i)
+                yield item
+        finally:
+            bar.remove_task(task)
+
+    def close(self) -> None:
+        """Remove the bar from the terminal (the printed step lines stay)."""
+        if self._bar is not None:
+            close_bar(self._bar, self._task)
+            self._bar = self._task = None
+
+    def _open(self) -> Any:
+        if self._bar is None and self._to_stderr:
+            self._bar = open_bar()
+            if self._bar is not None:
+                label = self.prefix.rstrip(": ") or "study"
+                self._task = self._bar.add_task(label, total=self._total, stage="")
+        return self._bar

@@ -637,7 +637,7 @@ def fig5_animation(leg: sl.SphericalLeg, out_dir: Path) -> tuple[Animation, dict
         "shorten; a dotted curve traces the platform point.",
         site="platform",
         fps=ANIMATION_FPS,
-        title="paper 1, Fig. 5(b) motion",
+        title="platform tilting back, then swaying about X",
         view=(20.0, -60.0),
     )
     lengths = sl.inverse_kinematics(leg, q[:, 0], q[:, 1]).lengths

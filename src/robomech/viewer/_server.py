@@ -33,6 +33,7 @@ from ._scene import (
 
 __all__ = ["Viewer", "view"]
 
+
 HOST = "127.0.0.1"  # never another interface: the viewer is a local tool
 FAILED_COLOUR = (220, 30, 30)
 JOINT_COLOUR = (90, 90, 90)
@@ -124,10 +125,20 @@ class Viewer:
         self._playing = threading.Event()
         self._closed = threading.Event()
         self._addr = [mech.qpos_address(j) for j in mech.actuated]
-        with contextlib.redirect_stdout(io.StringIO()):  # viser prints a banner; the caller prints the URL
-            self._server = viser.ViserServer(
-                host=HOST, port=port, label=f"robomech: {mech.name}", verbose=False
-            )
+        # viser (1.1) prints a banner with rich.print even with verbose=False; in Jupyter rich shows
+        # it as an output of the cell, above the viewer.  The caller prints the URL instead: rich's
+        # console is quiet while the server starts.
+        import rich
+
+        console = rich.get_console()
+        quiet, console.quiet = console.quiet, True
+        try:
+            with contextlib.redirect_stdout(io.StringIO()):
+                self._server = viser.ViserServer(
+                    host=HOST, port=port, label=f"robomech: {mech.name}", verbose=False
+                )
+        finally:
+            console.quiet = quiet
         self.port = int(self._server.get_port())
         self.url = f"http://{HOST}:{self.port}"
         self._nodes: list[tuple[Any, tuple[int, int, int]]] = []  # (handle, normal colour)
