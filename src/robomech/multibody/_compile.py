@@ -129,6 +129,7 @@ class Model:
     dof: int  # degrees of freedom (idle motions excluded)
     idle_dof: int
     rank_K: int  # generic rank of the full constraint Jacobian
+    locked_dof: int  # admissible motions with every actuated joint locked (idle ones included)
     dyn: DynTables
     q_ref: np.ndarray  # (nq,) the assembled reference configuration (mech.q0), _reference
     rnea: RneaTables
@@ -331,6 +332,7 @@ def _compile(mech: Mechanism) -> Model:
         dof=int(dof),
         idle_dof=int(inst.idle),
         rank_K=int(rank_K),
+        locked_dof=int(inst.locked.shape[1]),
         dyn=dyn,
         q_ref=q_ref,
         rnea=rnea,
