@@ -381,3 +381,64 @@ def test_a_sweep_killed_with_sigkill_resumes_exactly_the_missing_chunks(small, c
     a, b = open_results(out), open_results(ref)
     for name in ("design_ok", *METRICS):
         assert a[name].values.tobytes() == b[name].values.tobytes(), name
+
+
+# Batched and per-design evaluation run the same per-sample kernels on the same numbers: equal to
+# rounding (measured bit for bit on one machine); the bound leaves room for another summation order.
+BATCH_RTOL = 1e-12
+
+
+def _per_design(st, rows):
+    """Each design alone: a chunk of one design (its own batch of one)."""
+    res = [st.evaluate_rows(r[None], None) for r in rows]
+    return {k: np.concatenate([r[k] for r in res]) for k in res[0]}
+
+
+def _assert_same(a, b, names):
+    assert a["design_ok"].tolist() == b["design_ok"].tolist()
+    for name in names:
+        x, y = a[name], b[name]
+        assert np.array_equal(np.isnan(x), np.isnan(y)), name
+        f = ~np.isnan(x)
+        np.testing.assert_allclose(x[f], y[f], rtol=BATCH_RTOL, atol=0, err_msg=name)
+
+
+def test_a_chunk_of_designs_in_one_batch_equals_each_design_alone(build):
+    st = model_study(
+        build, VARS, site="tip", metrics=(*METRICS, "constraint_distance"), task_box=BOX, task_grid_size=12
+    )
+    rng = np.random.default_rng(3)
+    rows = np.column_stack(
+        [rng.uniform(0.15, 0.25, 5), rng.uniform(0.15, 0.25, 5), rng.uniform(0.05, 0.15, 5)]
+    )
+    rows = np.insert(rows, 2, [0.01, 0.01, 0.15], axis=0)  # a design that cannot be built: failed, masked
+    rows = np.insert(rows, 4, [np.nan, 0.2, 0.1], axis=0)  # a non-finite design row
+    batched = st.evaluate_rows(rows, None)
+    assert batched["design_ok"].tolist() == [True, True, False, True, False, True, True]
+    _assert_same(batched, _per_design(st, rows), (*METRICS, "constraint_distance"))
+
+
+@pytest.mark.slow
+def test_delta_designs_in_one_batch_equal_each_design_alone():
+    import sys
+
+    sys.path.insert(0, str(DELTA.parent))
+    import delta
+
+    st = model_study(
+        load_model(f"{DELTA}:build"),
+        [
+            Variable("arm", 0.2, 0.3, "m"),
+            Variable("forearm", 0.5, 0.7, "m"),
+            Variable("R", 0.15, 0.25, "m"),
+            Variable("r", 0.04, 0.06, "m"),
+        ],
+        site="tcp",
+        outputs="xyz",
+        metrics=("peak_force", "rms_force"),
+        trajectory=delta.pick_and_place(),
+    )
+    rows = np.array([[0.25, 0.6, 0.2, 0.05], [0.22, 0.65, 0.18, 0.045], [0.28, 0.55, 0.22, 0.06]])
+    batched = st.evaluate_rows(rows, None)
+    assert batched["design_ok"].all() and np.all(np.isfinite(batched["peak_force"]))
+    _assert_same(batched, _per_design(st, rows), ("peak_force", "rms_force"))

@@ -436,14 +436,16 @@ def model_study(
     )
 
 
-def _task_of(study: ModelStudy, mech: Any) -> tuple[np.ndarray, float]:
-    """The task points of one design (a box's grid is placed at the site's reference off-axis position)."""
-    from robomech import multibody as mb
+def _task_of(study: ModelStudy, batch: Any) -> tuple[np.ndarray, float]:
+    """The task points ``(D, m, 3)`` of a batch of designs and one cell's measure (a box's grid is placed
+    at each design's reference off-axis position of the site)."""
+    from robomech.multibody._designs import site_poses_designs
 
     if study.box is None:
-        return np.asarray(study.task), math.nan
-    z0 = mb.site_pose(mech, mech.q0, study.site)[:3, 3]
-    return task_grid(np.asarray(study.box), study.grid, study.outputs, z0)
+        return np.broadcast_to(np.asarray(study.task), (batch.n, *np.shape(study.task))), math.nan
+    z0 = site_poses_designs(batch, np.arange(batch.n), batch.q_ref)[:, :3, 3]
+    grids = [task_grid(np.asarray(study.box), study.grid, study.outputs, z) for z in z0]
+    return np.stack([g[0] for g in grids]), grids[0][1]
 
 
 def _weights(outputs: str) -> np.ndarray:
@@ -459,62 +461,50 @@ def _targets(points: np.ndarray) -> np.ndarray:
     return T
 
 
-def _one_design(study: ModelStudy, params: dict[str, float]) -> dict[str, float]:
-    """Every metric of one design (raises if the design cannot be built: the caller marks it failed)."""
-    from robomech import multibody as mb
-
-    mech = study.build(**params)
-    if not isinstance(mech, mb.Mechanism):
-        raise TypeError(f"build returned {type(mech).__name__}, not a Mechanism")
-    mech.site(study.site)  # a design without the site fails here
-    out: dict[str, float] = {}
-    gen = set(study.generic)
-    if gen & {
+TASK_METRICS = frozenset(
+    {
         "workspace_measure",
         "task_fraction",
         "dexterity_min",
         "dexterity_mean",
         "type2_distance",
         "constraint_distance",
-    }:
-        pts, cell = _task_of(study, mech)
-        radius = (
-            None
-            if study.box is None
-            else RETRY_CELLS * float(np.max(np.diff(study.box, axis=1))) / study.grid
-        )
-        q, ok = reach(mech, study.site, pts, study.outputs, radius)
-        reached = int(ok.sum())
-        out["workspace_measure"] = reached * cell
-        out["task_fraction"] = reached / pts.shape[0]
-        if gen & {"dexterity_min", "dexterity_mean"}:
-            inv = dexterity(mech, q[ok], study.site, study.outputs, study.length)
-            out["dexterity_min"] = float(inv.min()) if inv.size else math.nan
-            out["dexterity_mean"] = float(inv.mean()) if inv.size else math.nan
-        if gen & {"type2_distance", "constraint_distance"}:
-            if reached:
-                s = mb.singularities(mech, q[ok], study.site, length=study.length)
-                out["type2_distance"] = float(np.min(s.sigma_II))
-                out["constraint_distance"] = float(np.min(s.sigma_C))
-            else:
-                out["type2_distance"] = out["constraint_distance"] = math.nan
-    if "assembly_failure" in gen:
-        box = np.asarray(study.input_box)
-        if box.shape[0] != len(mech.actuated):
-            raise ValueError(
-                f"input_box has {box.shape[0]} rows, the mechanism {len(mech.actuated)} actuators"
+    }
+)
+
+
+def _task_metrics(study: ModelStudy, batch: Any) -> dict[str, np.ndarray]:
+    """The task metrics ``(D,)`` of a batch of designs of one structure: one batched IK over every
+    design's task points (plus the neighbour retries), one batched evaluation of the site Jacobian and
+    the constraint matrix at every reached point."""
+    from robomech.multibody._designs import site_measures_designs
+
+    gen = set(study.generic)
+    pts, cell = _task_of(study, batch)
+    D, P = pts.shape[:2]
+    radius = (
+        None if study.box is None else RETRY_CELLS * float(np.max(np.diff(study.box, axis=1))) / study.grid
+    )
+    q, ok = reach_designs(batch, pts, study.outputs, radius)
+    reached = ok.sum(axis=1)
+    out: dict[str, np.ndarray] = {
+        "workspace_measure": reached * cell,
+        "task_fraction": reached / P,
+    }
+    if gen & {"dexterity_min", "dexterity_mean", "type2_distance", "constraint_distance"}:
+        di = np.repeat(np.arange(D), P)[ok.ravel()]
+        rows = [3 + AXES.index(a) for a in study.outputs]
+        inv, s2, sc = site_measures_designs(batch, di, q.reshape(D * P, -1)[ok.ravel()], rows, study.length)
+        bounds = np.concatenate([[0], np.cumsum(reached)])
+        for name, x, red in (
+            ("dexterity_min", inv, np.min),
+            ("dexterity_mean", inv, np.mean),
+            ("type2_distance", s2, np.min),
+            ("constraint_distance", sc, np.min),
+        ):
+            out[name] = np.array(
+                [float(red(x[bounds[d] : bounds[d + 1]])) if reached[d] else math.nan for d in range(D)]
             )
-        axes = [np.linspace(lo, hi, study.input_grid) for lo, hi in box]
-        qa = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, box.shape[0])
-        fk = mb.forward_kinematics(mech, qa)
-        out["assembly_failure"] = float(1.0 - np.mean(np.asarray(fk.converged, bool)))
-    if gen & {"peak_force", "rms_force"} and study.trajectory is not None:
-        out["peak_force"], out["rms_force"] = task_forces(mech, study.site, study.outputs, study.trajectory)
-    for u in study.user_metrics:
-        try:
-            out[u.name] = float(u.fn(mech, dict(params)))
-        except Exception:  # a user metric failing on one design: NaN for that design only
-            out[u.name] = math.nan
     return out
 
 
@@ -527,46 +517,81 @@ RETRY_CELLS = 1.5
 IK_RETRY_STEPS = 4
 
 
+def _nearest(pts: np.ndarray, ok: np.ndarray, radius: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """The missed points of one design and, for each, its nearest reached point (k-d tree), keeping
+    only those within ``radius`` (m) of it when given."""
+    from scipy.spatial import cKDTree
+
+    miss, have = np.flatnonzero(~ok), np.flatnonzero(ok)
+    dist, near = cKDTree(pts[have]).query(pts[miss], k=1)
+    if radius is not None:
+        keep = dist <= radius
+        miss, near = miss[keep], near[keep]
+    return miss, have[near]
+
+
+def reach_designs(
+    batch: Any, pts: np.ndarray, outputs: str, radius: float | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Configurations ``q (D, m, nq)`` placing the batch's site at each design's task points
+    ``pts (D, m, 3)`` along ``outputs``, and which converged ``(D, m)``.
+
+    One batched inverse kinematics (``multibody._designs.ik_designs``, the Levenberg–Marquardt
+    iteration of :func:`~robomech.multibody.inverse_kinematics`) from each design's reference
+    configuration, then up to ``IK_RETRIES`` rounds re-solving each missed point from the configuration
+    of the nearest reached point of its design (continuation in ``IK_RETRY_STEPS`` stages): the IK is
+    a local solver, and a reachable point far from the reference configuration can be missed from
+    ``q0`` alone.  With ``radius`` (m) only the missed points within ``radius`` of a reached one are
+    re-solved (on a task grid, the cells next to the reached region: each round grows it by one cell).
+    A design stops retrying when a round has nothing to re-solve or reaches nothing new.
+    """
+    from robomech.multibody._designs import ik_designs
+
+    D, P = pts.shape[:2]
+    w = _weights(outputs)
+    di = np.repeat(np.arange(D), P)
+    T = _targets(pts.reshape(-1, 3))
+    qf, conv, _, _, _ = ik_designs(batch, di, T, batch.q_ref[di], w)
+    q = qf.reshape(D, P, -1)
+    ok = conv.reshape(D, P).copy()
+    active = np.ones(D, bool)
+    for _ in range(IK_RETRIES):
+        jobs = []
+        for d in np.flatnonzero(active):
+            if ok[d].all() or not ok[d].any():
+                active[d] = False
+                continue
+            miss, near = _nearest(pts[d], ok[d], radius)
+            if miss.size == 0:
+                active[d] = False
+                continue
+            jobs.append((d, miss, near))
+        if not jobs:
+            break
+        dj = np.concatenate([np.full(m.size, d) for d, m, _ in jobs])
+        Tj = _targets(np.concatenate([pts[d, m] for d, m, _ in jobs]))
+        guess = np.concatenate([q[d, n] for d, _, n in jobs])
+        qj, cj, _, _, _ = ik_designs(batch, dj, Tj, guess, w, steps=IK_RETRY_STEPS)
+        start = 0
+        for d, miss, _ in jobs:
+            got = cj[start : start + miss.size]
+            if not got.any():
+                active[d] = False
+            q[d, miss[got]] = qj[start : start + miss.size][got]
+            ok[d, miss[got]] = True
+            start += miss.size
+    return q, ok
+
+
 def reach(
     mech: Any, site: str, pts: np.ndarray, outputs: str, radius: float | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Configurations ``q (m, nq)`` placing ``site`` at the task points ``pts (m, 3)`` along ``outputs``,
-    and which converged ``(m,)``.
+    """:func:`reach_designs` of one design: ``q (m, nq)`` placing ``site`` at ``pts (m, 3)`` along
+    ``outputs``, and which converged ``(m,)``."""
+    from robomech.multibody._designs import design_batch
 
-    One batched :func:`~robomech.multibody.inverse_kinematics` from ``mech.q0``, then up to
-    ``IK_RETRIES`` rounds re-solving each missed point from the configuration of the nearest reached
-    point (continuation in ``IK_RETRY_STEPS`` stages): the IK is a local solver, and a reachable point far
-    from the reference configuration can be missed from ``q0`` alone.  With ``radius`` (m) only the
-    missed points within ``radius`` of a reached one are re-solved (on a task grid, the cells next to
-    the reached region: each round grows it by one cell).
-    """
-    from robomech import multibody as mb
-
-    w = _weights(outputs)
-    T = _targets(pts)
-    ik = mb.inverse_kinematics(mech, site, T, weights=w)
-    q = np.array(ik.q)
-    ok = np.asarray(ik.converged, bool).copy()
-    for _ in range(IK_RETRIES):
-        miss = np.flatnonzero(~ok)
-        if miss.size == 0 or not ok.any():
-            break
-        have = np.flatnonzero(ok)
-        d = np.linalg.norm(pts[miss, None, :] - pts[None, have, :], axis=-1)
-        near = np.argmin(d, axis=1)
-        if radius is not None:
-            keep = d[np.arange(miss.size), near] <= radius
-            miss, near = miss[keep], near[keep]
-            if miss.size == 0:
-                break
-        guess = q[have[near]]
-        again = mb.inverse_kinematics(mech, site, T[miss], guess, weights=w, steps=IK_RETRY_STEPS)
-        got = np.asarray(again.converged, bool)
-        if not got.any():
-            break
-        q[miss[got]] = again.q[got]
-        ok[miss[got]] = True
-    return q, ok
+    q, ok = reach_designs(design_batch([mech], site), np.asarray(pts, float)[None], outputs, radius)
+    return q[0], ok[0]
 
 
 def dexterity(mech: Any, q: np.ndarray, site: str, outputs: str, length: float | None = None) -> np.ndarray:
@@ -574,65 +599,171 @@ def dexterity(mech: Any, q: np.ndarray, site: str, outputs: str, length: float |
 
     The rows are the site's linear velocity along ``outputs`` (m/s); each hinge actuator's column is
     divided by the characteristic length L (``length``, default ``mech.length``) so that every entry is
-    dimensionless (a slide's column is m/m already).  1 is isotropic, 0 singular.
+    dimensionless (a slide's column is m/m already).  1 is isotropic, 0 singular.  The study's kernel
+    (``multibody._designs.site_measures_designs``) on one design.
     """
-    from robomech import multibody as mb
+    from robomech.multibody._designs import design_batch, site_measures_designs
 
     if q.shape[0] == 0:
         return np.zeros(0)
-    J = mb.site_jacobian(mech, q, site)
     rows = [3 + AXES.index(a) for a in outputs]
-    L = mech.length if length is None else length
-    scale = np.array([1.0 / L if mech.joint(j).type == "hinge" else 1.0 for j in mech.actuated])
-    s = np.linalg.svd(J[:, rows, :] * scale, compute_uv=False)
-    return np.where(s[:, 0] > 0, s[:, -1] / np.where(s[:, 0] > 0, s[:, 0], 1.0), 0.0)
+    return site_measures_designs(design_batch([mech], site), np.zeros(q.shape[0], np.int64), q, rows, length)[
+        0
+    ]
+
+
+def task_forces_designs(
+    mechs: Sequence[Any], batch: Any, site: str, outputs: str, trajectory: tuple[np.ndarray, np.ndarray]
+) -> tuple[np.ndarray, np.ndarray]:
+    """Peak and RMS actuator force ``(D,)`` of each design along ``trajectory = (t, points)``: IK of
+    every design at each time with its previous solution as the guess (one batched call per time),
+    actuator rates by second-order finite differences in time (``numpy.gradient``), then inverse
+    dynamics with gravity per design; NaN for a design where any sample fails (not reached, singular,
+    not valid)."""
+    from robomech import multibody as mb
+    from robomech.multibody._designs import ik_designs
+
+    t, pts = trajectory
+    D = batch.n
+    w = _weights(outputs)
+    alive = np.ones(D, bool)
+    guess = batch.q_ref.copy()
+    qs = np.full((t.size, D, guess.shape[1]), np.nan)
+    for i in range(t.size):
+        di = np.flatnonzero(alive)
+        if di.size == 0:
+            break
+        qi, conv, _, _, _ = ik_designs(
+            batch, di, _targets(np.repeat(pts[i : i + 1], di.size, 0)), guess[di], w, steps=4 if i == 0 else 1
+        )
+        alive[di[~conv]] = False
+        qs[i, di] = qi
+        guess[di] = qi
+    peak, rms = np.full(D, math.nan), np.full(D, math.nan)
+    for d in np.flatnonzero(alive):
+        mech = mechs[d]
+        q = qs[:, d]
+        qa = q[:, [mech.qpos_address(j) for j in mech.actuated]]
+        qd = np.gradient(qa, t, axis=0, edge_order=2)
+        qdd = np.gradient(qd, t, axis=0, edge_order=2)
+        res = mb.inverse_dynamics(mech, q, qd, qdd)
+        if np.all(res.valid):
+            tau = np.asarray(res.tau)
+            peak[d], rms[d] = float(np.max(np.abs(tau))), float(np.sqrt(np.mean(tau**2)))
+    return peak, rms
 
 
 def task_forces(
     mech: Any, site: str, outputs: str, trajectory: tuple[np.ndarray, np.ndarray]
 ) -> tuple[float, float]:
-    """Peak and RMS actuator force along ``trajectory = (t, points)``: IK with the previous solution as
-    the guess, actuator rates by second-order finite differences in time (``numpy.gradient``), then
-    inverse dynamics with gravity; NaN if any sample fails (not reached, singular, not valid)."""
+    """:func:`task_forces_designs` of one design: peak and RMS actuator force along ``trajectory``."""
+    from robomech.multibody._designs import design_batch
+
+    peak, rms = task_forces_designs([mech], design_batch([mech], site), site, outputs, trajectory)
+    return float(peak[0]), float(rms[0])
+
+
+def _build(study: ModelStudy, params: dict[str, float]) -> Any:
+    """The design's mechanism (raises if it cannot be built or lacks the site: a failed design)."""
     from robomech import multibody as mb
 
-    t, pts = trajectory
-    T = _targets(pts)
-    w = _weights(outputs)
-    guess = mech.q0
-    qs = []
-    for i in range(t.size):
-        ik = mb.inverse_kinematics(mech, site, T[i], guess, weights=w, steps=4 if i == 0 else 1)
-        if not bool(ik.converged):
-            return math.nan, math.nan
-        qs.append(ik.q)
-        guess = ik.q
-    q = np.stack(qs)
-    qa = q[:, [mech.qpos_address(j) for j in mech.actuated]]
-    qd = np.gradient(qa, t, axis=0, edge_order=2)
-    qdd = np.gradient(qd, t, axis=0, edge_order=2)
-    res = mb.inverse_dynamics(mech, q, qd, qdd)
-    if not np.all(res.valid):
-        return math.nan, math.nan
-    tau = np.asarray(res.tau)
-    return float(np.max(np.abs(tau))), float(np.sqrt(np.mean(tau**2)))
+    mech = study.build(**params)
+    if not isinstance(mech, mb.Mechanism):
+        raise TypeError(f"build returned {type(mech).__name__}, not a Mechanism")
+    mech.site(study.site)  # a design without the site fails here
+    return mech
+
+
+def _batch_metrics(study: ModelStudy, mechs: Sequence[Any]) -> dict[str, np.ndarray]:
+    """The engine metrics ``(D,)`` of designs of one structure (raises: the caller falls back to one
+    design at a time)."""
+    from robomech.multibody._designs import design_batch
+
+    gen = set(study.generic)
+    batch = design_batch(mechs, study.site)
+    out: dict[str, np.ndarray] = {}
+    if gen & TASK_METRICS:
+        out.update(_task_metrics(study, batch))
+    if gen & {"peak_force", "rms_force"} and study.trajectory is not None:
+        out["peak_force"], out["rms_force"] = task_forces_designs(
+            mechs, batch, study.site, study.outputs, study.trajectory
+        )
+    return out
+
+
+def _design_metrics(study: ModelStudy, mech: Any, params: dict[str, float]) -> dict[str, float]:
+    """The metrics evaluated one design at a time: the assembly failure and the user metrics."""
+    from robomech import multibody as mb
+
+    out: dict[str, float] = {}
+    if "assembly_failure" in study.generic:
+        box = np.asarray(study.input_box)
+        if box.shape[0] != len(mech.actuated):
+            raise ValueError(
+                f"input_box has {box.shape[0]} rows, the mechanism {len(mech.actuated)} actuators"
+            )
+        axes = [np.linspace(lo, hi, study.input_grid) for lo, hi in box]
+        qa = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, box.shape[0])
+        fk = mb.forward_kinematics(mech, qa)
+        out["assembly_failure"] = float(1.0 - np.mean(np.asarray(fk.converged, bool)))
+    for u in study.user_metrics:
+        try:
+            out[u.name] = float(u.fn(mech, dict(params)))
+        except Exception:  # a user metric failing on one design: NaN for that design only
+            out[u.name] = math.nan
+    return out
 
 
 def _evaluate(study: DesignStudy, params: list[Any], rows: np.ndarray, seed: Any) -> dict[str, np.ndarray]:
+    """Every metric of a chunk of designs: each design built (``build`` per design), the designs
+    grouped by compiled structure, each group's engine metrics in one batched kernel call per step
+    (:func:`_batch_metrics`), a group that raises re-run one design at a time (a design that raises
+    alone is a failed design, never the chunk)."""
+    from robomech.multibody._designs import group_designs
+
     assert isinstance(study, ModelStudy)
     n = len(params)
     out = {m.name: np.full(n, np.nan) for m in study.metrics}
     ok = np.zeros(n, bool)
+    mechs: list[Any] = [None] * n
+    vals: list[dict[str, float]] = [{} for _ in range(n)]
     for i, p in enumerate(params):
         if p is None:
             continue
         try:
-            vals = _one_design(study, p)
+            mechs[i] = _build(study, p)
+            vals[i].update(_design_metrics(study, mechs[i], p))
         except Exception:  # build or the engine refused this design: a failed design, never the batch
+            mechs[i] = None
+    live = [i for i in range(n) if mechs[i] is not None]
+    try:
+        groups = group_designs([mechs[i] for i in live], study.site) if live else []
+    except Exception:
+        groups = [(np.array([k]), None) for k in range(len(live))]
+    for idx, _ in groups:
+        members = [live[k] for k in idx]
+        try:
+            res = _batch_metrics(study, [mechs[i] for i in members])
+            per = [{k: float(v[j]) for k, v in res.items()} for j in range(len(members))]
+        except Exception:  # one design at a time: only the designs that raise alone fail
+            per = []
+            for i in members:
+                try:
+                    res = _batch_metrics(study, [mechs[i]])
+                    per.append({k: float(v[0]) for k, v in res.items()})
+                except Exception:
+                    per.append(None)  # type: ignore[arg-type]
+        for i, v in zip(members, per, strict=True):
+            if v is None:
+                mechs[i] = None
+            else:
+                vals[i].update(v)
+    for i in range(n):
+        if mechs[i] is None:
             continue
         ok[i] = True
         for m in study.metrics:
-            out[m.name][i] = vals.get(m.name, math.nan)
+            out[m.name][i] = vals[i].get(m.name, math.nan)
     out["design_ok"] = ok
     return out
 
