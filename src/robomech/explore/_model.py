@@ -515,6 +515,13 @@ IK_RETRIES = 2
 RETRY_CELLS = 1.5
 # Continuation stages of such a re-solve (the neighbour's pose is one task cell or more away).
 IK_RETRY_STEPS = 4
+# The task IK also stops a point at a stationary point of its cost that leaves a residual: every
+# column of the constraint-and-site matrix at an angle to the residual whose cosine is at most this
+# (MINPACK's gtol test; a point out of reach, which would otherwise spend the iteration limit).  On
+# 8 random five-bar designs x 32 x 32 points it lost none of 3,498 reached points and cut the mean
+# iterations 39.5 -> 28.5 (3e-3 lost one); a reachable point it stops early is re-solved from its
+# reached neighbour (IK_RETRIES).
+IK_GTOL = 1e-3
 
 
 def _nearest(pts: np.ndarray, ok: np.ndarray, radius: float | None) -> tuple[np.ndarray, np.ndarray]:
@@ -537,7 +544,8 @@ def reach_designs(
     ``pts (D, m, 3)`` along ``outputs``, and which converged ``(D, m)``.
 
     One batched inverse kinematics (``multibody._designs.ik_designs``, the Levenberg–Marquardt
-    iteration of :func:`~robomech.multibody.inverse_kinematics`) from each design's reference
+    iteration of :func:`~robomech.multibody.inverse_kinematics`, stopped also at a stationary point
+    that leaves a residual: ``IK_GTOL``) from each design's reference
     configuration, then up to ``IK_RETRIES`` rounds re-solving each missed point from the configuration
     of the nearest reached point of its design (continuation in ``IK_RETRY_STEPS`` stages): the IK is
     a local solver, and a reachable point far from the reference configuration can be missed from
@@ -551,7 +559,7 @@ def reach_designs(
     w = _weights(outputs)
     di = np.repeat(np.arange(D), P)
     T = _targets(pts.reshape(-1, 3))
-    qf, conv, _, _, _ = ik_designs(batch, di, T, batch.q_ref[di], w)
+    qf, conv, _, _, _ = ik_designs(batch, di, T, batch.q_ref[di], w, gtol=IK_GTOL)
     q = qf.reshape(D, P, -1)
     ok = conv.reshape(D, P).copy()
     active = np.ones(D, bool)
@@ -571,7 +579,7 @@ def reach_designs(
         dj = np.concatenate([np.full(m.size, d) for d, m, _ in jobs])
         Tj = _targets(np.concatenate([pts[d, m] for d, m, _ in jobs]))
         guess = np.concatenate([q[d, n] for d, _, n in jobs])
-        qj, cj, _, _, _ = ik_designs(batch, dj, Tj, guess, w, steps=IK_RETRY_STEPS)
+        qj, cj, _, _, _ = ik_designs(batch, dj, Tj, guess, w, steps=IK_RETRY_STEPS, gtol=IK_GTOL)
         start = 0
         for d, miss, _ in jobs:
             got = cj[start : start + miss.size]

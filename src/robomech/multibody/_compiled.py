@@ -307,12 +307,15 @@ def _residuals(q, t, T, S, r, K, sb, Tsite, tgt, w):  # pragma: no cover
 
 @_nj
 def lm_solve(
-    q, t, free, wstep, max_iter, stop2, mu0, mu_min, mu_max, max_step, sb, Tsite, tgt, w
+    q, t, free, wstep, max_iter, stop2, mu0, mu_min, mu_max, max_step, sb, Tsite, tgt, w, gtol
 ):  # pragma: no cover
     """The Levenberg–Marquardt solve of one sample ``q (nq,)``, in place, over the coordinates ``free``:
     the closure rows of ``t`` and, with ``sb >= 0``, the site's weighted pose error against ``tgt``
-    (:func:`site_rows`; inverse kinematics).  Returns (largest closure row, iterations, cost
-    ``sum r^2``, largest site row); the cost is inf where the start is not finite."""
+    (:func:`site_rows`; inverse kinematics).  With ``gtol > 0`` it also stops at a stationary point
+    of the cost that leaves a residual: every column of the matrix at an angle to ``r`` whose cosine
+    ``|K_j^T r| / (|K_j| |r|)`` is at most ``gtol`` (MINPACK's ``gtol`` test: a target out of reach).
+    Returns (largest closure row, iterations, cost ``sum r^2``, largest site row); the cost is inf
+    where the start is not finite."""
     nq = q.shape[0]
     nb = t.parent.shape[0]
     nv = t.A.shape[1]
@@ -360,6 +363,13 @@ def lm_solve(
                 for i in range(mt):
                     acc += K[i, fa] * K[i, fc]
                 H[a, c] = acc
+        if gtol > 0.0:
+            cmax = 0.0
+            for a in range(nf):
+                if H[a, a] > 0.0:
+                    cmax = max(cmax, abs(g[a]) / np.sqrt(H[a, a] * cost))
+            if cmax <= gtol:
+                break
         tr = 0.0
         for a in range(nf):
             tr += H[a, a]
@@ -413,7 +423,7 @@ def fk_block(
     for n in range(lo, hi):
         q = Q[n].copy()
         rc, it, cost, _ = lm_solve(
-            q, t, free, wstep, max_iter, stop2, mu0, mu_min, mu_max, max_step, -1, eye, eye, w0
+            q, t, free, wstep, max_iter, stop2, mu0, mu_min, mu_max, max_step, -1, eye, eye, w0, 0.0
         )
         Q[n] = q
         rc_out[n] = rc

@@ -210,6 +210,7 @@ def ik_block(
     mu_min,
     mu_max,
     max_step,
+    gtol,
     rc_out,
     it_out,
     pe_out,
@@ -234,6 +235,7 @@ def ik_block(
             Tsite[d],
             tgt[n],
             w,
+            gtol,
         )
         Q[n] = q
         rc_out[n] = rc
@@ -259,6 +261,7 @@ def ik_par(
     mu_min,
     mu_max,
     max_step,
+    gtol,
     rc_out,
     it_out,
     pe_out,
@@ -285,6 +288,7 @@ def ik_par(
             mu_min,
             mu_max,
             max_step,
+            gtol,
             rc_out,
             it_out,
             pe_out,
@@ -424,11 +428,14 @@ def ik_designs(
     guess: np.ndarray,
     weights: np.ndarray,
     steps: int = 1,
+    gtol: float = 0.0,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Inverse kinematics of the batch's site, sample n on design ``didx[n]``: every coordinate moves
     from ``guess (N, nq)`` to put the site at ``T_target (N, 4, 4)`` with the loops closed, the error
     rows ``[L rot; pos]`` weighted by ``weights (6,)``; ``steps > 1`` moves the target from the guess's
-    site pose in stages (as :func:`~robomech.multibody.inverse_kinematics`).
+    site pose in stages (as :func:`~robomech.multibody.inverse_kinematics`).  ``gtol > 0`` also stops
+    a sample at a stationary point that leaves a residual (``_compiled.lm_solve``): a target out of
+    reach stops there instead of spending the iteration limit (0: the public function's iteration).
 
     Returns ``q (N, nq)`` (NaN where the target is not finite), ``converged (N,)`` (closure and pose
     error both within ``CONVERGED_RTOL * L`` of the design), the largest closure row (m), the pose
@@ -469,6 +476,7 @@ def ik_designs(
             opt.MU_MIN,
             opt.MU_MAX,
             opt.MAX_STEP,
+            float(gtol),
             rc,
             it,
             pe,
