@@ -442,7 +442,8 @@ def _task_of(study: ModelStudy, batch: Any) -> tuple[np.ndarray, float]:
     from robomech.multibody._designs import site_poses_designs
 
     if study.box is None:
-        return np.broadcast_to(np.asarray(study.task), (batch.n, *np.shape(study.task))), math.nan
+        task = np.asarray(study.task, dtype=float)
+        return np.broadcast_to(task, (batch.n, *task.shape)), math.nan
     z0 = site_poses_designs(batch, np.arange(batch.n), batch.q_ref)[:, :3, 3]
     grids = [task_grid(np.asarray(study.box), study.grid, study.outputs, z) for z in z0]
     return np.stack([g[0] for g in grids]), grids[0][1]
@@ -648,7 +649,7 @@ def task_forces_designs(
         qs[i, di] = qi
         guess[di] = qi
     peak, rms = np.full(D, math.nan), np.full(D, math.nan)
-    for d in np.flatnonzero(alive):
+    for d in np.flatnonzero(alive).tolist():
         mech = mechs[d]
         q = qs[:, d]
         qa = q[:, [mech.qpos_address(j) for j in mech.actuated]]
@@ -745,10 +746,10 @@ def _evaluate(study: DesignStudy, params: list[Any], rows: np.ndarray, seed: Any
             mechs[i] = None
     live = [i for i in range(n) if mechs[i] is not None]
     try:
-        groups = group_designs([mechs[i] for i in live], study.site) if live else []
-    except Exception:
-        groups = [(np.array([k]), None) for k in range(len(live))]
-    for idx, _ in groups:
+        groups = [g[0] for g in group_designs([mechs[i] for i in live], study.site)] if live else []
+    except Exception:  # one batch per design: the designs that raise alone fail below
+        groups = [np.array([k]) for k in range(len(live))]
+    for idx in groups:
         members = [live[k] for k in idx]
         try:
             res = _batch_metrics(study, [mechs[i] for i in members])
