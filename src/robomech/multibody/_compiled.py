@@ -49,15 +49,19 @@ def quat_mat(w, x, y, z, R):  # pragma: no cover - compiled
 @_nj
 def kin(q, t, T, S):  # pragma: no cover
     """Body poses ``T (nb, 4, 4)`` and coordinate space screws ``S (nv, 6)`` at ``q`` (``_tree._kin``)."""
+    kin_into(q, t, T, S, np.empty((3, 3)), np.empty((3, 3)), np.empty(3))
+
+
+@_nj
+def kin_into(q, t, T, S, Rj, Rn, anchor):  # pragma: no cover
+    """:func:`kin` with the caller's scratch ``Rj``, ``Rn (3, 3)``, ``anchor (3,)`` (an iteration
+    allocates nothing)."""
     parent, T_off, j0, jtype, jqadr, jdadr = t.parent, t.T_off, t.j0, t.jtype, t.jqadr, t.jdadr
     jpos, jaxis, jref = t.jpos, t.jaxis, t.jref
     nb = parent.shape[0]
     for i in range(4):
         for j in range(4):
             T[0, i, j] = 1.0 if i == j else 0.0
-    Rj = np.empty((3, 3))
-    Rn = np.empty((3, 3))
-    anchor = np.empty(3)
     for b in range(1, nb):
         pb = parent[b]
         for i in range(4):
@@ -144,18 +148,20 @@ def kin(q, t, T, S):  # pragma: no cover
 
 @_nj
 def point_rows(T, S, A, b, x, sign, row, K, r, with_jac):  # pragma: no cover
-    p = np.empty(3)
-    for i in range(3):
-        p[i] = T[b, i, 3] + T[b, i, 0] * x[0] + T[b, i, 1] * x[1] + T[b, i, 2] * x[2]
-        r[row + i] += sign * p[i]
+    p0 = T[b, 0, 3] + T[b, 0, 0] * x[0] + T[b, 0, 1] * x[1] + T[b, 0, 2] * x[2]
+    p1 = T[b, 1, 3] + T[b, 1, 0] * x[0] + T[b, 1, 1] * x[1] + T[b, 1, 2] * x[2]
+    p2 = T[b, 2, 3] + T[b, 2, 0] * x[0] + T[b, 2, 1] * x[1] + T[b, 2, 2] * x[2]
+    r[row] += sign * p0
+    r[row + 1] += sign * p1
+    r[row + 2] += sign * p2
     if with_jac:
         nv = S.shape[0]
         for k in range(nv):
             if A[b, k] != 0.0:
                 w0, w1, w2 = S[k, 0], S[k, 1], S[k, 2]
-                K[row, k] += sign * (S[k, 3] + w1 * p[2] - w2 * p[1])
-                K[row + 1, k] += sign * (S[k, 4] + w2 * p[0] - w0 * p[2])
-                K[row + 2, k] += sign * (S[k, 5] + w0 * p[1] - w1 * p[0])
+                K[row, k] += sign * (S[k, 3] + w1 * p2 - w2 * p1)
+                K[row + 1, k] += sign * (S[k, 4] + w2 * p0 - w0 * p2)
+                K[row + 2, k] += sign * (S[k, 5] + w0 * p1 - w1 * p0)
 
 
 @_nj
@@ -266,16 +272,17 @@ def integrate(q, dv, jtype, jqadr, jdadr, out):  # pragma: no cover
 
 
 @_nj
-def site_rows(T, S, A, sb, Tsite, tgt, w, L, row, K, r):  # pragma: no cover
+def site_rows(T, S, A, sb, Tsite, tgt, w, L, row, K, r, with_jac):  # pragma: no cover
     """Rows ``row:row + 6`` of the weighted pose error ``w * [L rot; pos]`` of the site (body ``sb``,
     pose ``Tsite`` in it) against the world pose ``tgt (4, 4)``, and their matrix (``_assembly._site_error``):
     ``rot = L/2 sum_c (R_t e_c) x (R_s e_c)``, ``pos = p_s - p_t``."""
     nv = S.shape[0]
     for i in range(6):
         r[row + i] = 0.0
-        for k in range(nv):
-            K[row + i, k] = 0.0
-    point_rows(T, S, A, sb, Tsite[:3, 3], 1.0, row + 3, K, r, True)
+        if with_jac:
+            for k in range(nv):
+                K[row + i, k] = 0.0
+    point_rows(T, S, A, sb, Tsite[:3, 3], 1.0, row + 3, K, r, with_jac)
     for i in range(3):
         r[row + 3 + i] -= tgt[i, 3]
     for c in range(3):
@@ -286,23 +293,25 @@ def site_rows(T, S, A, sb, Tsite, tgt, w, L, row, K, r):  # pragma: no cover
         r[row] += 0.5 * L * (a1 * s2 - a2 * s1)
         r[row + 1] += 0.5 * L * (a2 * s0 - a0 * s2)
         r[row + 2] += 0.5 * L * (a0 * s1 - a1 * s0)
-    for k in range(nv):
-        if A[sb, k] != 0.0:
-            for i in range(3):
-                K[row + i, k] = L * S[k, i]
     for i in range(6):
         r[row + i] *= w[i]
+    if with_jac:
         for k in range(nv):
-            K[row + i, k] *= w[i]
+            if A[sb, k] != 0.0:
+                for i in range(3):
+                    K[row + i, k] = L * S[k, i]
+        for i in range(6):
+            for k in range(nv):
+                K[row + i, k] *= w[i]
 
 
 @_nj
-def _residuals(q, t, T, S, r, K, sb, Tsite, tgt, w):  # pragma: no cover
-    """Closure rows of ``t`` and, with ``sb >= 0``, the site rows of :func:`site_rows` after them."""
-    kin(q, t, T, S)
-    resjac(q, t, T, S, r, K, True)
+def _rows(q, t, T, S, r, K, sb, Tsite, tgt, w, with_jac):  # pragma: no cover
+    """Closure rows of ``t`` and, with ``sb >= 0``, the site rows of :func:`site_rows` after them, at
+    the tree state ``T``, ``S`` of ``q``."""
+    resjac(q, t, T, S, r, K, with_jac)
     if sb >= 0:
-        site_rows(T, S, t.A, sb, Tsite, tgt, w, t.L, t.m, K, r)
+        site_rows(T, S, t.A, sb, Tsite, tgt, w, t.L, t.m, K, r, with_jac)
 
 
 @_nj
@@ -329,13 +338,16 @@ def lm_solve(
     K = np.empty((mt, nv))
     qt = np.empty(nq)
     rt = np.empty(mt)
-    Kt = np.empty((mt, nv))
+    Rj = np.empty((3, 3))
+    Rn = np.empty((3, 3))
+    anchor = np.empty(3)
     dv = np.zeros(nv)
     H = np.empty((nf, nf))
     g = np.empty(nf)
     dx = np.empty(nf)
     geo = np.zeros(nf, dtype=np.bool_)
-    _residuals(q, t, T, S, r, K, sb, Tsite, tgt, w)
+    kin_into(q, t, T, S, Rj, Rn, anchor)
+    _rows(q, t, T, S, r, K, sb, Tsite, tgt, w, True)
     cost = 0.0
     for i in range(mt):
         cost += r[i] * r[i]
@@ -386,15 +398,15 @@ def lm_solve(
         for a in range(nf):
             dv[free[a]] = -dx[a] * f
         integrate(q, dv, jtype, jqadr, jdadr, qt)
-        _residuals(qt, t, T, S, rt, Kt, sb, Tsite, tgt, w)
+        kin_into(qt, t, T, S, Rj, Rn, anchor)
+        _rows(qt, t, T, S, rt, K, sb, Tsite, tgt, w, False)  # the trial's rows; its matrix if accepted
         ct = 0.0
         for i in range(mt):
             ct += rt[i] * rt[i]
         it += 1
         if np.isfinite(ct) and ct < cost:
             q[:] = qt
-            r[:] = rt
-            K[:, :] = Kt
+            _rows(q, t, T, S, r, K, sb, Tsite, tgt, w, True)  # the same rows, and their matrix
             cost = ct
             mu = max(mu / 10.0, mu_min)
         else:
