@@ -442,3 +442,33 @@ def test_delta_designs_in_one_batch_equal_each_design_alone():
     batched = st.evaluate_rows(rows, None)
     assert batched["design_ok"].all() and np.all(np.isfinite(batched["peak_force"]))
     _assert_same(batched, _per_design(st, rows), ("peak_force", "rms_force"))
+
+
+def _arm(L=0.2, n=2.0):
+    """A planar arm of 2 links, or 3 when ``n >= 2.5`` (the topology changes with a parameter)."""
+    b = mb.Builder("arm")
+    links = 3 if n >= 2.5 else 2
+    parent = "world"
+    for i in range(links):
+        b.body(f"l{i}", parent, pos=(0, 0, 0) if i == 0 else (L, 0, 0), joints=[b.hinge(f"j{i}", ref=0.3)])
+        parent = f"l{i}"
+    b.site("tip", parent, pos=(L, 0, 0))
+    b.actuate(*[f"j{i}" for i in range(links)])
+    return b.build()
+
+
+def test_designs_of_two_structures_in_one_chunk_equal_each_design_alone():
+    st = model_study(
+        _arm,
+        [Variable("L", 0.1, 0.2, "m"), Variable("n", 2.0, 3.0)],
+        site="tip",
+        metrics=("workspace_measure", "task_fraction", "dexterity_min", "dexterity_mean"),
+        task_box=[[-0.7, 0.7], [-0.7, 0.7]],
+        task_grid_size=8,
+    )
+    rows = np.array([[0.15, 2.0], [0.15, 3.0], [0.12, 2.2], [0.18, 2.9]])
+    batched = st.evaluate_rows(rows, None)
+    assert batched["design_ok"].all()
+    # the 3-link arms reach farther than the 2-link arm of the same link length
+    assert batched["workspace_measure"][1] > batched["workspace_measure"][0]
+    _assert_same(batched, _per_design(st, rows), ("workspace_measure", "task_fraction", "dexterity_min"))
