@@ -113,7 +113,7 @@ def test_dexterity_equals_an_svd_of_the_five_bar_velocity_equations(study, build
     for (L1, L2, B), dmin, dmean in zip(ROWS, res["dexterity_min"], res["dexterity_mean"], strict=True):
         mech = build(L1=L1, L2=L2, B=B)
         pts, _ = task_grid(np.array(BOX), GRID, "xy", np.zeros(3))
-        q, ok = reach(mech, "tip", pts, "xy")  # the engine's configurations; the Jacobian is ours
+        q, ok = reach(mech, "tip", pts, "xy", grid=GRID)  # the study's configurations; the Jacobian is ours
         th = q[ok][:, [mech.qpos_address(j) for j in mech.actuated]]
         P = mb.site_pose(mech, q[ok], "tip")[:, :2, 3]  # the solved tip (the task point to IK tolerance)
         np.testing.assert_allclose(P, pts[ok, :2], atol=1e-6)
@@ -472,3 +472,23 @@ def test_designs_of_two_structures_in_one_chunk_equal_each_design_alone():
     # the 3-link arms reach farther than the 2-link arm of the same link length
     assert batched["workspace_measure"][1] > batched["workspace_measure"][0]
     _assert_same(batched, _per_design(st, rows), ("workspace_measure", "task_fraction", "dexterity_min"))
+
+
+@pytest.mark.slow
+def test_workspace_area_of_64_sobol_designs_equals_the_annuli_count(build):
+    """The grid wavefront (explore._model.reach_grid) over the design space: every design's reached
+    cell count against the closed-form annuli count, cells within EDGE of a boundary either way."""
+    from robomech.explore import design_matrix
+
+    st = model_study(
+        build, VARS, site="tip", metrics=("workspace_measure",), task_box=BOX, task_grid_size=GRID
+    )
+    X = design_matrix(VARS, 64, "sobol", 0, 64)
+    res = st.evaluate_rows(X, None)
+    assert res["design_ok"].all()
+    pts, _ = task_grid(np.array(BOX), GRID, "xy", np.zeros(3))
+    h2 = (1.0 / GRID) ** 2
+    for (L1, L2, B), area in zip(X, res["workspace_measure"], strict=True):
+        inside, margin = _in_annuli(pts[:, :2], L1, L2, B)
+        n_edge = int(np.sum(margin <= EDGE))
+        assert abs(round(area / h2) - inside.sum()) <= n_edge
