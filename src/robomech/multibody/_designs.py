@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 
 from . import _options as opt
 from ._compile import Model, Tables, compile_model
-from ._compiled import BLOCK, _nj, kin, lm_solve, numba, site_jac_one
+from ._compiled import BLOCK, _nj, kin, lm_solve, numba, site_jac_one, writable
 
 __all__ = [
     "DesignBatch",
@@ -408,14 +408,15 @@ def site_pose_block(Q, lo, hi, didx, t, g, sb, Tsite, out):  # pragma: no cover 
 
 
 # ----------------------------------------------------------------------------- drivers
-def _c(x: np.ndarray, dtype: Any = np.float64) -> np.ndarray:
-    a = np.ascontiguousarray(x, dtype=dtype)
+def _index(x: np.ndarray) -> np.ndarray:
+    """Design indices as a C-contiguous, writable int64 array (one kernel specialization)."""
+    a = np.ascontiguousarray(x, dtype=np.int64)
     return a if a.flags.writeable else a.copy()
 
 
 def site_poses_designs(batch: DesignBatch, didx: np.ndarray, q: np.ndarray) -> np.ndarray:
     """World poses ``(N, 4, 4)`` of the batch's site at ``q (N, nq)``, sample n on design ``didx[n]``."""
-    Q, di = _c(q), _c(didx, np.int64)
+    Q, di = writable(q), _index(didx)
     out = np.empty((Q.shape[0], 4, 4))
     site_pose_block(Q, 0, Q.shape[0], di, batch.tables, batch.geometry, batch.site_body, batch.T_site, out)
     return out
@@ -442,9 +443,9 @@ def ik_designs(
     error (m) and the iterations."""
     from ._assembly import _interp_pose
 
-    di = _c(didx, np.int64)
+    di = _index(didx)
     Tf = np.array(T_target, dtype=float).reshape(-1, 4, 4)
-    Q = _c(np.array(guess, dtype=float).reshape(-1, batch.q_ref.shape[1]))
+    Q = writable(np.array(guess, dtype=float).reshape(-1, batch.q_ref.shape[1]))
     N = Q.shape[0]
     ok = np.all(np.isfinite(Tf), axis=(-1, -2)) & np.all(np.isfinite(Q), axis=-1)
     Tf[~ok] = np.eye(4)
@@ -454,7 +455,7 @@ def ik_designs(
     free = np.arange(nv, dtype=np.int64)
     wstep = np.where(batch.dof_translational, 1.0 / batch.length[:, None], 1.0)
     stop2 = (opt.STOP_RTOL * batch.length) ** 2
-    w = _c(weights)
+    w = writable(weights)
     rc, it, pe = np.empty(N), np.zeros(N, dtype=np.int64), np.empty(N)
     iters = np.zeros(N, dtype=np.int64)
     start = site_poses_designs(batch, di, Q) if steps > 1 else None
@@ -462,10 +463,10 @@ def ik_designs(
         Ts = Tf if start is None or s == steps else _interp_pose(start, Tf, s / steps)
         args = (
             di,
-            _c(Ts),
+            writable(Ts),
             w,
             free,
-            _c(wstep),
+            writable(wstep),
             t,
             batch.geometry,
             batch.site_body,
@@ -503,13 +504,13 @@ def site_measures_designs(
     ``sigma_min / sigma_max`` of the site Jacobian's ``rows`` of ``[ω; ṗ]``, hinge actuator columns
     divided by L), and ``sigma_II``, ``sigma_C`` of :func:`~robomech.multibody.singularities`
     (m; L scales rotations).  ``length`` is L (m; default each design's characteristic length)."""
-    di = _c(didx, np.int64)
-    Q = _c(q)
+    di = _index(didx)
+    Q = writable(q)
     N = Q.shape[0]
     L = batch.length if length is None else np.full(batch.n, float(length))
     hinge = ~batch.dof_translational[batch.act]  # an actuated joint is a hinge or a slide
-    colscale = _c(np.where(hinge[None, :], 1.0 / L[:, None], 1.0))
-    col = _c(np.where(batch.dof_translational[None, :], 1.0, L[:, None]))
+    colscale = writable(np.where(hinge[None, :], 1.0 / L[:, None], 1.0))
+    col = writable(np.where(batch.dof_translational[None, :], 1.0, L[:, None]))
     kII = len(batch.pas) - batch.locked_dof
     out = np.empty((N, 3))
     args = (
@@ -524,7 +525,7 @@ def site_measures_designs(
         np.asarray(rows, np.int64),
         colscale,
         col,
-        _c(L),
+        writable(L),
         kII,
         batch.rank_K,
         out,
