@@ -12,7 +12,8 @@ derive from it.
 
 Import order inside the layer (no circle): ``_options`` and ``_model`` (the description) ->
 ``_tree``, ``_constraints`` (numpy tree and closure functions) -> ``_compile`` -> ``_compiled``
-(kernels) -> ``_assembly``, ``_influence`` -> analysis and dynamics modules.
+(kernels) -> ``_designs`` (design-batched drivers), ``_assembly``, ``_influence`` -> analysis and
+dynamics modules.
 """
 
 from __future__ import annotations
