@@ -233,7 +233,7 @@ def model_study(
     objectives: Sequence[Objective] = (),
     length: float | None = None,
     name: str = "model",
-    chunk: int = 8,
+    chunk: int = 32,
 ) -> ModelStudy:
     """A design study of the mechanism ``build(**params)`` over ``variables``.
 
@@ -277,7 +277,7 @@ def model_study(
     name : str, optional
         The study's name (stored in the results).
     chunk : int, optional
-        Designs per Dask task (>= 1; default 8).
+        Designs per Dask task (>= 1; default 32: the designs of a chunk share each batched kernel call).
 
     Returns
     -------
