@@ -495,7 +495,14 @@ def _task_metrics(study: ModelStudy, batch: Any) -> dict[str, np.ndarray]:
     if gen & {"dexterity_min", "dexterity_mean", "type2_distance", "constraint_distance"}:
         di = np.repeat(np.arange(D), P)[ok.ravel()]
         rows = [3 + AXES.index(a) for a in study.outputs]
-        inv, s2, sc = site_measures_designs(batch, di, q.reshape(D * P, -1)[ok.ravel()], rows, study.length)
+        want = (
+            bool(gen & {"dexterity_min", "dexterity_mean"}),
+            "type2_distance" in gen,
+            "constraint_distance" in gen,
+        )
+        inv, s2, sc = site_measures_designs(
+            batch, di, q.reshape(D * P, -1)[ok.ravel()], rows, study.length, want
+        )
         bounds = np.concatenate([[0], np.cumsum(reached)])
         for name, x, red in (
             ("dexterity_min", inv, np.min),
@@ -703,9 +710,8 @@ def dexterity(mech: Any, q: np.ndarray, site: str, outputs: str, length: float |
     if q.shape[0] == 0:
         return np.zeros(0)
     rows = [3 + AXES.index(a) for a in outputs]
-    return site_measures_designs(design_batch([mech], site), np.zeros(q.shape[0], np.int64), q, rows, length)[
-        0
-    ]
+    one, di = design_batch([mech], site), np.zeros(q.shape[0], np.int64)
+    return site_measures_designs(one, di, q, rows, length, (True, False, False))[0]
 
 
 def task_forces_designs(

@@ -119,7 +119,6 @@ class DesignBatch:
     q_ref: np.ndarray
     length: np.ndarray
     dof_translational: np.ndarray  # (nv,) bool
-    act_qadr: np.ndarray  # (na,) qpos addresses of the actuated joints
     rank_K: int
     locked_dof: int
 
@@ -169,7 +168,6 @@ def design_batch(mechs: Sequence[Any], site: str) -> DesignBatch:
         q_ref=np.stack([m.q_ref for m in models]),
         length=np.array([m.tree.length for m in models], dtype=float),
         dof_translational=np.asarray(m0.tree.dof_translational, bool),
-        act_qadr=np.asarray(m0.tree.act_qadr, np.int64),
         rank_K=int(m0.rank_K),
         locked_dof=int(m0.locked_dof),
     )
@@ -297,7 +295,7 @@ def ik_par(
 
 @_nj
 def measures_block(
-    Q, lo, hi, didx, act, pas, sb, Tsite, t, g, rtol, rows, colscale, col, Lc, kII, kC, out
+    Q, lo, hi, didx, act, pas, sb, Tsite, t, g, rtol, rows, colscale, col, Lc, kII, kC, want, out
 ):  # pragma: no cover - compiled
     """Per sample ``n`` of ``lo:hi`` (design ``didx[n]``): ``out[n] = (inverse condition number of the
     site Jacobian's ``rows`` with columns times ``colscale[d]``, sigma_II, sigma_C)``; ``col[d] (nv,)``
@@ -327,21 +325,18 @@ def measures_block(
         for i in range(nr):
             for j in range(na):
                 Jr[i, j] = J[rows[i], j] * colscale[d, j]
-        dex = 0.0
-        if nr > 0 and na > 0 and np.all(np.isfinite(Jr)):
+        dex = np.nan
+        if want & 1 and nr > 0 and na > 0 and np.all(np.isfinite(Jr)):
             s = np.linalg.svd(Jr, full_matrices=False)[1]
-            if s[0] > 0:
-                dex = s[s.shape[0] - 1] / s[0]
-        else:
-            dex = np.nan
+            dex = s[s.shape[0] - 1] / s[0] if s[0] > 0 else 0.0
         out[n, 0] = dex
         for i in range(m):
             for j in range(nv):
                 Ks[i, j] = K[i, j] * col[d, j]
             for j in range(npas):
                 Ksp[i, j] = K[i, pas[j]] * col[d, pas[j]]
-        out[n, 1] = _kth(Ksp, kII, Lc[d])
-        out[n, 2] = _kth(Ks, kC, Lc[d])
+        out[n, 1] = _kth(Ksp, kII, Lc[d]) if want & 2 else np.nan
+        out[n, 2] = _kth(Ks, kC, Lc[d]) if want & 4 else np.nan
 
 
 @_nj
@@ -360,7 +355,7 @@ def _kth(X, k, L):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, error_model="numpy", parallel=True)
 def measures_par(
-    Q, didx, act, pas, sb, Tsite, t, g, rtol, rows, colscale, col, Lc, kII, kC, out
+    Q, didx, act, pas, sb, Tsite, t, g, rtol, rows, colscale, col, Lc, kII, kC, want, out
 ):  # pragma: no cover - compiled
     """:func:`measures_block` in blocks of ``BLOCK`` samples, in parallel."""
     N = Q.shape[0]
@@ -383,6 +378,7 @@ def measures_par(
             Lc,
             kII,
             kC,
+            want,
             out,
         )
 
@@ -499,11 +495,13 @@ def site_measures_designs(
     q: np.ndarray,
     rows: Sequence[int],
     length: float | None = None,
+    want: tuple[bool, bool, bool] = (True, True, True),
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per sample (design ``didx[n]``, assembled ``q[n]``): the dexterity (inverse condition number
     ``sigma_min / sigma_max`` of the site Jacobian's ``rows`` of ``[ω; ṗ]``, hinge actuator columns
     divided by L), and ``sigma_II``, ``sigma_C`` of :func:`~robomech.multibody.singularities`
-    (m; L scales rotations).  ``length`` is L (m; default each design's characteristic length)."""
+    (m; L scales rotations).  ``length`` is L (m; default each design's characteristic length);
+    ``want`` says which of the three to compute (the others are NaN)."""
     di = _index(didx)
     Q = writable(q)
     N = Q.shape[0]
@@ -528,6 +526,7 @@ def site_measures_designs(
         writable(L),
         kII,
         batch.rank_K,
+        int(want[0]) | 2 * int(want[1]) | 4 * int(want[2]),
         out,
     )
     if N <= BLOCK:
