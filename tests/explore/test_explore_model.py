@@ -113,7 +113,7 @@ def test_dexterity_equals_an_svd_of_the_five_bar_velocity_equations(study, build
     for (L1, L2, B), dmin, dmean in zip(ROWS, res["dexterity_min"], res["dexterity_mean"], strict=True):
         mech = build(L1=L1, L2=L2, B=B)
         pts, _ = task_grid(np.array(BOX), GRID, "xy", np.zeros(3))
-        q, ok = reach(mech, "tip", pts, "xy")  # the engine's configurations; the Jacobian is ours
+        q, ok = reach(mech, "tip", pts, "xy", grid=GRID)  # the study's configurations; the Jacobian is ours
         th = q[ok][:, [mech.qpos_address(j) for j in mech.actuated]]
         P = mb.site_pose(mech, q[ok], "tip")[:, :2, 3]  # the solved tip (the task point to IK tolerance)
         np.testing.assert_allclose(P, pts[ok, :2], atol=1e-6)
@@ -381,3 +381,114 @@ def test_a_sweep_killed_with_sigkill_resumes_exactly_the_missing_chunks(small, c
     a, b = open_results(out), open_results(ref)
     for name in ("design_ok", *METRICS):
         assert a[name].values.tobytes() == b[name].values.tobytes(), name
+
+
+# Batched and per-design evaluation run the same per-sample kernels on the same numbers: equal to
+# rounding (measured bit for bit on one machine); the bound leaves room for another summation order.
+BATCH_RTOL = 1e-12
+
+
+def _per_design(st, rows):
+    """Each design alone: a chunk of one design (its own batch of one)."""
+    res = [st.evaluate_rows(r[None], None) for r in rows]
+    return {k: np.concatenate([r[k] for r in res]) for k in res[0]}
+
+
+def _assert_same(a, b, names):
+    assert a["design_ok"].tolist() == b["design_ok"].tolist()
+    for name in names:
+        x, y = a[name], b[name]
+        assert np.array_equal(np.isnan(x), np.isnan(y)), name
+        f = ~np.isnan(x)
+        np.testing.assert_allclose(x[f], y[f], rtol=BATCH_RTOL, atol=0, err_msg=name)
+
+
+def test_a_chunk_of_designs_in_one_batch_equals_each_design_alone(build):
+    st = model_study(
+        build, VARS, site="tip", metrics=(*METRICS, "constraint_distance"), task_box=BOX, task_grid_size=12
+    )
+    rng = np.random.default_rng(3)
+    rows = np.column_stack(
+        [rng.uniform(0.15, 0.25, 5), rng.uniform(0.15, 0.25, 5), rng.uniform(0.05, 0.15, 5)]
+    )
+    rows = np.insert(rows, 2, [0.01, 0.01, 0.15], axis=0)  # a design that cannot be built: failed, masked
+    rows = np.insert(rows, 4, [np.nan, 0.2, 0.1], axis=0)  # a non-finite design row
+    batched = st.evaluate_rows(rows, None)
+    assert batched["design_ok"].tolist() == [True, True, False, True, False, True, True]
+    _assert_same(batched, _per_design(st, rows), (*METRICS, "constraint_distance"))
+
+
+@pytest.mark.slow
+def test_delta_designs_in_one_batch_equal_each_design_alone():
+    import sys
+
+    sys.path.insert(0, str(DELTA.parent))
+    import delta
+
+    st = model_study(
+        load_model(f"{DELTA}:build"),
+        [
+            Variable("arm", 0.2, 0.3, "m"),
+            Variable("forearm", 0.5, 0.7, "m"),
+            Variable("R", 0.15, 0.25, "m"),
+            Variable("r", 0.04, 0.06, "m"),
+        ],
+        site="tcp",
+        outputs="xyz",
+        metrics=("peak_force", "rms_force"),
+        trajectory=delta.pick_and_place(),
+    )
+    rows = np.array([[0.25, 0.6, 0.2, 0.05], [0.22, 0.65, 0.18, 0.045], [0.28, 0.55, 0.22, 0.06]])
+    batched = st.evaluate_rows(rows, None)
+    assert batched["design_ok"].all() and np.all(np.isfinite(batched["peak_force"]))
+    _assert_same(batched, _per_design(st, rows), ("peak_force", "rms_force"))
+
+
+def _arm(L=0.2, n=2.0):
+    """A planar arm of 2 links, or 3 when ``n >= 2.5`` (the topology changes with a parameter)."""
+    b = mb.Builder("arm")
+    links = 3 if n >= 2.5 else 2
+    parent = "world"
+    for i in range(links):
+        b.body(f"l{i}", parent, pos=(0, 0, 0) if i == 0 else (L, 0, 0), joints=[b.hinge(f"j{i}", ref=0.3)])
+        parent = f"l{i}"
+    b.site("tip", parent, pos=(L, 0, 0))
+    b.actuate(*[f"j{i}" for i in range(links)])
+    return b.build()
+
+
+def test_designs_of_two_structures_in_one_chunk_equal_each_design_alone():
+    st = model_study(
+        _arm,
+        [Variable("L", 0.1, 0.2, "m"), Variable("n", 2.0, 3.0)],
+        site="tip",
+        metrics=("workspace_measure", "task_fraction", "dexterity_min", "dexterity_mean"),
+        task_box=[[-0.7, 0.7], [-0.7, 0.7]],
+        task_grid_size=8,
+    )
+    rows = np.array([[0.15, 2.0], [0.15, 3.0], [0.12, 2.2], [0.18, 2.9]])
+    batched = st.evaluate_rows(rows, None)
+    assert batched["design_ok"].all()
+    # the 3-link arms reach farther than the 2-link arm of the same link length
+    assert batched["workspace_measure"][1] > batched["workspace_measure"][0]
+    _assert_same(batched, _per_design(st, rows), ("workspace_measure", "task_fraction", "dexterity_min"))
+
+
+@pytest.mark.slow
+def test_workspace_area_of_64_sobol_designs_equals_the_annuli_count(build):
+    """The grid wavefront (explore._model.reach_grid) over the design space: every design's reached
+    cell count against the closed-form annuli count, cells within EDGE of a boundary either way."""
+    from robomech.explore import design_matrix
+
+    st = model_study(
+        build, VARS, site="tip", metrics=("workspace_measure",), task_box=BOX, task_grid_size=GRID
+    )
+    X = design_matrix(VARS, 64, "sobol", 0, 64)
+    res = st.evaluate_rows(X, None)
+    assert res["design_ok"].all()
+    pts, _ = task_grid(np.array(BOX), GRID, "xy", np.zeros(3))
+    h2 = (1.0 / GRID) ** 2
+    for (L1, L2, B), area in zip(X, res["workspace_measure"], strict=True):
+        inside, margin = _in_annuli(pts[:, :2], L1, L2, B)
+        n_edge = int(np.sum(margin <= EDGE))
+        assert abs(round(area / h2) - inside.sum()) <= n_edge

@@ -12,7 +12,8 @@ derive from it.
 
 Import order inside the layer (no circle): ``_options`` and ``_model`` (the description) ->
 ``_tree``, ``_constraints`` (numpy tree and closure functions) -> ``_compile`` -> ``_compiled``
-(kernels) -> ``_assembly``, ``_influence`` -> analysis and dynamics modules.
+(kernels) -> ``_designs`` (design-batched drivers), ``_assembly``, ``_influence`` -> analysis and
+dynamics modules.
 """
 
 from __future__ import annotations
@@ -129,6 +130,7 @@ class Model:
     dof: int  # degrees of freedom (idle motions excluded)
     idle_dof: int
     rank_K: int  # generic rank of the full constraint Jacobian
+    locked_dof: int  # admissible motions with every actuated joint locked (idle ones included)
     dyn: DynTables
     q_ref: np.ndarray  # (nq,) the assembled reference configuration (mech.q0), _reference
     rnea: RneaTables
@@ -331,6 +333,7 @@ def _compile(mech: Mechanism) -> Model:
         dof=int(dof),
         idle_dof=int(inst.idle),
         rank_K=int(rank_K),
+        locked_dof=int(inst.locked.shape[1]),
         dyn=dyn,
         q_ref=q_ref,
         rnea=rnea,

@@ -49,15 +49,19 @@ def quat_mat(w, x, y, z, R):  # pragma: no cover - compiled
 @_nj
 def kin(q, t, T, S):  # pragma: no cover
     """Body poses ``T (nb, 4, 4)`` and coordinate space screws ``S (nv, 6)`` at ``q`` (``_tree._kin``)."""
+    kin_into(q, t, T, S, np.empty((3, 3)), np.empty((3, 3)), np.empty(3))
+
+
+@_nj
+def kin_into(q, t, T, S, Rj, Rn, anchor):  # pragma: no cover
+    """:func:`kin` with the caller's scratch ``Rj``, ``Rn (3, 3)``, ``anchor (3,)`` (an iteration
+    allocates nothing)."""
     parent, T_off, j0, jtype, jqadr, jdadr = t.parent, t.T_off, t.j0, t.jtype, t.jqadr, t.jdadr
     jpos, jaxis, jref = t.jpos, t.jaxis, t.jref
     nb = parent.shape[0]
     for i in range(4):
         for j in range(4):
             T[0, i, j] = 1.0 if i == j else 0.0
-    Rj = np.empty((3, 3))
-    Rn = np.empty((3, 3))
-    anchor = np.empty(3)
     for b in range(1, nb):
         pb = parent[b]
         for i in range(4):
@@ -144,18 +148,20 @@ def kin(q, t, T, S):  # pragma: no cover
 
 @_nj
 def point_rows(T, S, A, b, x, sign, row, K, r, with_jac):  # pragma: no cover
-    p = np.empty(3)
-    for i in range(3):
-        p[i] = T[b, i, 3] + T[b, i, 0] * x[0] + T[b, i, 1] * x[1] + T[b, i, 2] * x[2]
-        r[row + i] += sign * p[i]
+    p0 = T[b, 0, 3] + T[b, 0, 0] * x[0] + T[b, 0, 1] * x[1] + T[b, 0, 2] * x[2]
+    p1 = T[b, 1, 3] + T[b, 1, 0] * x[0] + T[b, 1, 1] * x[1] + T[b, 1, 2] * x[2]
+    p2 = T[b, 2, 3] + T[b, 2, 0] * x[0] + T[b, 2, 1] * x[1] + T[b, 2, 2] * x[2]
+    r[row] += sign * p0
+    r[row + 1] += sign * p1
+    r[row + 2] += sign * p2
     if with_jac:
         nv = S.shape[0]
         for k in range(nv):
             if A[b, k] != 0.0:
                 w0, w1, w2 = S[k, 0], S[k, 1], S[k, 2]
-                K[row, k] += sign * (S[k, 3] + w1 * p[2] - w2 * p[1])
-                K[row + 1, k] += sign * (S[k, 4] + w2 * p[0] - w0 * p[2])
-                K[row + 2, k] += sign * (S[k, 5] + w0 * p[1] - w1 * p[0])
+                K[row, k] += sign * (S[k, 3] + w1 * p2 - w2 * p1)
+                K[row + 1, k] += sign * (S[k, 4] + w2 * p0 - w0 * p2)
+                K[row + 2, k] += sign * (S[k, 5] + w0 * p1 - w1 * p0)
 
 
 @_nj
@@ -266,98 +272,175 @@ def integrate(q, dv, jtype, jqadr, jdadr, out):  # pragma: no cover
 
 
 @_nj
-def fk_block(
-    Q, lo, hi, free, wstep, t, max_iter, stop2, mu0, mu_min, mu_max, max_step, rc_out, it_out, cost_out
+def site_rows(T, S, A, sb, Tsite, tgt, w, L, row, K, r, with_jac):  # pragma: no cover
+    """Rows ``row:row + 6`` of the weighted pose error ``w * [L rot; pos]`` of the site (body ``sb``,
+    pose ``Tsite`` in it) against the world pose ``tgt (4, 4)``, and their matrix (``_assembly._site_error``):
+    ``rot = L/2 sum_c (R_t e_c) x (R_s e_c)``, ``pos = p_s - p_t``."""
+    nv = S.shape[0]
+    for i in range(6):
+        r[row + i] = 0.0
+        if with_jac:
+            for k in range(nv):
+                K[row + i, k] = 0.0
+    point_rows(T, S, A, sb, Tsite[:3, 3], 1.0, row + 3, K, r, with_jac)
+    for i in range(3):
+        r[row + 3 + i] -= tgt[i, 3]
+    for c in range(3):
+        s0 = T[sb, 0, 0] * Tsite[0, c] + T[sb, 0, 1] * Tsite[1, c] + T[sb, 0, 2] * Tsite[2, c]
+        s1 = T[sb, 1, 0] * Tsite[0, c] + T[sb, 1, 1] * Tsite[1, c] + T[sb, 1, 2] * Tsite[2, c]
+        s2 = T[sb, 2, 0] * Tsite[0, c] + T[sb, 2, 1] * Tsite[1, c] + T[sb, 2, 2] * Tsite[2, c]
+        a0, a1, a2 = tgt[0, c], tgt[1, c], tgt[2, c]
+        r[row] += 0.5 * L * (a1 * s2 - a2 * s1)
+        r[row + 1] += 0.5 * L * (a2 * s0 - a0 * s2)
+        r[row + 2] += 0.5 * L * (a0 * s1 - a1 * s0)
+    for i in range(6):
+        r[row + i] *= w[i]
+    if with_jac:
+        for k in range(nv):
+            if A[sb, k] != 0.0:
+                for i in range(3):
+                    K[row + i, k] = L * S[k, i]
+        for i in range(6):
+            for k in range(nv):
+                K[row + i, k] *= w[i]
+
+
+@_nj
+def _rows(q, t, T, S, r, K, sb, Tsite, tgt, w, with_jac):  # pragma: no cover
+    """Closure rows of ``t`` and, with ``sb >= 0``, the site rows of :func:`site_rows` after them, at
+    the tree state ``T``, ``S`` of ``q``."""
+    resjac(q, t, T, S, r, K, with_jac)
+    if sb >= 0:
+        site_rows(T, S, t.A, sb, Tsite, tgt, w, t.L, t.m, K, r, with_jac)
+
+
+@_nj
+def lm_solve(
+    q, t, free, wstep, max_iter, stop2, mu0, mu_min, mu_max, max_step, sb, Tsite, tgt, w, gtol
 ):  # pragma: no cover
-    """The Levenberg–Marquardt closure solve of samples ``lo:hi`` of ``Q (N, nq)``, in place."""
-    nq = Q.shape[1]
+    """The Levenberg–Marquardt solve of one sample ``q (nq,)``, in place, over the coordinates ``free``:
+    the closure rows of ``t`` and, with ``sb >= 0``, the site's weighted pose error against ``tgt``
+    (:func:`site_rows`; inverse kinematics).  With ``gtol > 0`` it also stops at a stationary point
+    of the cost that leaves a residual: every column of the matrix at an angle to ``r`` whose cosine
+    ``|K_j^T r| / (|K_j| |r|)`` is at most ``gtol`` (MINPACK's ``gtol`` test: a target out of reach).
+    Returns (largest closure row, iterations, cost ``sum r^2``, largest site row); the cost is inf
+    where the start is not finite."""
+    nq = q.shape[0]
     nb = t.parent.shape[0]
     nv = t.A.shape[1]
     nf = free.shape[0]
     m, geom_row = t.m, t.geom_row
+    mt = m + (6 if sb >= 0 else 0)
     jtype, jqadr, jdadr = t.jtype, t.jqadr, t.jdadr
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    r = np.empty(mt)
+    K = np.empty((mt, nv))
+    qt = np.empty(nq)
+    rt = np.empty(mt)
+    Rj = np.empty((3, 3))
+    Rn = np.empty((3, 3))
+    anchor = np.empty(3)
+    dv = np.zeros(nv)
+    H = np.empty((nf, nf))
+    g = np.empty(nf)
+    dx = np.empty(nf)
+    geo = np.zeros(nf, dtype=np.bool_)
+    kin_into(q, t, T, S, Rj, Rn, anchor)
+    _rows(q, t, T, S, r, K, sb, Tsite, tgt, w, True)
+    cost = 0.0
+    for i in range(mt):
+        cost += r[i] * r[i]
+    finite = np.isfinite(cost)
+    mu = mu0
+    it = 0
+    for a in range(nf):  # coordinates that move a closure point or the site (not a coupled spin alone)
+        for i in range(mt):
+            if (i >= m or geom_row[i]) and K[i, free[a]] != 0.0:
+                geo[a] = True
+                break
+    active = finite and nf > 0
+    while active and it < max_iter:
+        if cost <= stop2:
+            break
+        for a in range(nf):
+            fa = free[a]
+            ga = 0.0
+            for i in range(mt):
+                ga += K[i, fa] * r[i]
+            g[a] = ga
+            for c in range(a + 1):
+                fc = free[c]
+                acc = 0.0
+                for i in range(mt):
+                    acc += K[i, fa] * K[i, fc]
+                H[a, c] = acc
+        if gtol > 0.0:
+            cmax = 0.0
+            for a in range(nf):
+                if H[a, a] > 0.0:
+                    cmax = max(cmax, abs(g[a]) / np.sqrt(H[a, a] * cost))
+            if cmax <= gtol:
+                break
+        tr = 0.0
+        for a in range(nf):
+            tr += H[a, a]
+        scale = tr / nf + 1e-300
+        for a in range(nf):
+            H[a, a] += mu * scale
+        chol_solve(H, g, dx)  # (K^T K + mu s I) dx = K^T r; the step is -dx
+        big = 0.0
+        for a in range(nf):
+            if geo[a]:
+                big = max(big, abs(dx[a]) * wstep[a])
+        f = max_step / big if big > max_step else 1.0
+        dv[:] = 0.0
+        for a in range(nf):
+            dv[free[a]] = -dx[a] * f
+        integrate(q, dv, jtype, jqadr, jdadr, qt)
+        kin_into(qt, t, T, S, Rj, Rn, anchor)
+        _rows(qt, t, T, S, rt, K, sb, Tsite, tgt, w, False)  # the trial's rows; its matrix if accepted
+        ct = 0.0
+        for i in range(mt):
+            ct += rt[i] * rt[i]
+        it += 1
+        if np.isfinite(ct) and ct < cost:
+            q[:] = qt
+            _rows(q, t, T, S, r, K, sb, Tsite, tgt, w, True)  # the same rows, and their matrix
+            cost = ct
+            mu = max(mu / 10.0, mu_min)
+        else:
+            mu *= 10.0
+            if mu > mu_max:
+                break
+    rc = 0.0
+    for i in range(m):
+        rc = max(rc, abs(r[i]))
+    pe = 0.0
+    for i in range(m, mt):
+        pe = max(pe, abs(r[i]))
+    if not finite:
+        return np.inf, it, np.inf, np.inf
+    return rc, it, cost, pe
+
+
+@_nj
+def fk_block(
+    Q, lo, hi, free, wstep, t, max_iter, stop2, mu0, mu_min, mu_max, max_step, rc_out, it_out, cost_out
+):  # pragma: no cover
+    """The Levenberg–Marquardt closure solve (:func:`lm_solve`) of samples ``lo:hi`` of ``Q (N, nq)``,
+    in place."""
+    eye = np.eye(4)
+    w0 = np.zeros(6)
     for n in range(lo, hi):
         q = Q[n].copy()
-        T = np.empty((nb, 4, 4))
-        S = np.zeros((nv, 6))
-        r = np.empty(m)
-        K = np.empty((m, nv))
-        qt = np.empty(nq)
-        rt = np.empty(m)
-        Kt = np.empty((m, nv))
-        dv = np.zeros(nv)
-        H = np.empty((nf, nf))
-        g = np.empty(nf)
-        dx = np.empty(nf)
-        geo = np.zeros(nf, dtype=np.bool_)
-        kin(q, t, T, S)
-        resjac(q, t, T, S, r, K, True)
-        cost = 0.0
-        for i in range(m):
-            cost += r[i] * r[i]
-        finite = np.isfinite(cost)
-        mu = mu0
-        it = 0
-        for a in range(nf):  # coordinates that move a closure point (not a coupled spin alone)
-            for i in range(m):
-                if geom_row[i] and K[i, free[a]] != 0.0:
-                    geo[a] = True
-                    break
-        active = finite and nf > 0
-        while active and it < max_iter:
-            if cost <= stop2:
-                break
-            for a in range(nf):
-                fa = free[a]
-                ga = 0.0
-                for i in range(m):
-                    ga += K[i, fa] * r[i]
-                g[a] = ga
-                for c in range(a + 1):
-                    fc = free[c]
-                    acc = 0.0
-                    for i in range(m):
-                        acc += K[i, fa] * K[i, fc]
-                    H[a, c] = acc
-            tr = 0.0
-            for a in range(nf):
-                tr += H[a, a]
-            scale = tr / nf + 1e-300
-            for a in range(nf):
-                H[a, a] += mu * scale
-            chol_solve(H, g, dx)  # (K^T K + mu s I) dx = K^T r; the step is -dx
-            big = 0.0
-            for a in range(nf):
-                if geo[a]:
-                    big = max(big, abs(dx[a]) * wstep[a])
-            f = max_step / big if big > max_step else 1.0
-            dv[:] = 0.0
-            for a in range(nf):
-                dv[free[a]] = -dx[a] * f
-            integrate(q, dv, jtype, jqadr, jdadr, qt)
-            kin(qt, t, T, S)
-            resjac(qt, t, T, S, rt, Kt, True)
-            ct = 0.0
-            for i in range(m):
-                ct += rt[i] * rt[i]
-            it += 1
-            if np.isfinite(ct) and ct < cost:
-                q[:] = qt
-                r[:] = rt
-                K[:, :] = Kt
-                cost = ct
-                mu = max(mu / 10.0, mu_min)
-            else:
-                mu *= 10.0
-                if mu > mu_max:
-                    break
+        rc, it, cost, _ = lm_solve(
+            q, t, free, wstep, max_iter, stop2, mu0, mu_min, mu_max, max_step, -1, eye, eye, w0, 0.0
+        )
         Q[n] = q
-        rc = 0.0
-        for i in range(m):
-            rc = max(rc, abs(r[i]))
-        rc_out[n] = rc if finite else np.inf
+        rc_out[n] = rc
         it_out[n] = it
-        cost_out[n] = cost if finite else np.inf
+        cost_out[n] = cost
 
 
 @numba.njit(cache=True, error_model="numpy", parallel=True)
@@ -387,14 +470,62 @@ def fk_par(
 
 
 @_nj
-def site_jac_block(Q, lo, hi, act, pas, sb, Tsite, t, rtol, J_out):  # pragma: no cover
-    """``J = J_f G`` of the site (body ``sb``, pose ``Tsite`` in it) for samples ``lo:hi`` of ``Q``.
+def site_jac_one(q, act, pas, sb, Tsite, t, rtol, T, S, r, K, G, Kp, P, J):  # pragma: no cover
+    """``J (6, na) = J_f G`` of the site (body ``sb``, pose ``Tsite`` in it) at one ``q``; leaves the
+    tree state in ``T``, ``S`` and the constraint matrix in ``K`` (scratch ``r``, ``G``, ``Kp``, ``P``).
 
     ``G = [I; -K_p^+ K_a]`` with the SVD pseudo-inverse of ``K_p`` (:func:`svd_pinv`, singular values
     below ``rtol`` times the largest dropped): the minimum-norm passive rates, as :func:`influence`."""
-    nb = t.parent.shape[0]
     A, m = t.A, t.m
     nv = A.shape[1]
+    na, npas = act.shape[0], pas.shape[0]
+    kin(q, t, T, S)
+    resjac(q, t, T, S, r, K, True)
+    G[:, :] = 0.0
+    for j in range(na):
+        G[act[j], j] = 1.0
+    if m > 0 and npas > 0:
+        for i in range(m):
+            for j in range(npas):
+                Kp[i, j] = K[i, pas[j]]
+        svd_pinv(Kp, rtol, P)
+        for j in range(na):
+            aj = act[j]
+            for i in range(npas):
+                acc = 0.0
+                for c in range(m):
+                    acc += P[i, c] * K[c, aj]
+                G[pas[i], j] = -acc
+    p0 = T[sb, 0, 3] + T[sb, 0, 0] * Tsite[0, 3] + T[sb, 0, 1] * Tsite[1, 3] + T[sb, 0, 2] * Tsite[2, 3]
+    p1 = T[sb, 1, 3] + T[sb, 1, 0] * Tsite[0, 3] + T[sb, 1, 1] * Tsite[1, 3] + T[sb, 1, 2] * Tsite[2, 3]
+    p2 = T[sb, 2, 3] + T[sb, 2, 0] * Tsite[0, 3] + T[sb, 2, 1] * Tsite[1, 3] + T[sb, 2, 2] * Tsite[2, 3]
+    for j in range(na):
+        for i in range(6):
+            J[i, j] = 0.0
+    for k in range(nv):
+        if A[sb, k] == 0.0:
+            continue
+        w0, w1, w2 = S[k, 0], S[k, 1], S[k, 2]
+        c3 = S[k, 3] + w1 * p2 - w2 * p1
+        c4 = S[k, 4] + w2 * p0 - w0 * p2
+        c5 = S[k, 5] + w0 * p1 - w1 * p0
+        for j in range(na):
+            g = G[k, j]
+            if g != 0.0:
+                J[0, j] += w0 * g
+                J[1, j] += w1 * g
+                J[2, j] += w2 * g
+                J[3, j] += c3 * g
+                J[4, j] += c4 * g
+                J[5, j] += c5 * g
+
+
+@_nj
+def site_jac_block(Q, lo, hi, act, pas, sb, Tsite, t, rtol, J_out):  # pragma: no cover
+    """:func:`site_jac_one` for samples ``lo:hi`` of ``Q`` into ``J_out (N, 6, na)``."""
+    nb = t.parent.shape[0]
+    m = t.m
+    nv = t.A.shape[1]
     na, npas = act.shape[0], pas.shape[0]
     T = np.empty((nb, 4, 4))
     S = np.zeros((nv, 6))
@@ -404,46 +535,7 @@ def site_jac_block(Q, lo, hi, act, pas, sb, Tsite, t, rtol, J_out):  # pragma: n
     Kp = np.empty((m, npas))
     P = np.empty((npas, m))
     for n in range(lo, hi):
-        q = Q[n]
-        kin(q, t, T, S)
-        resjac(q, t, T, S, r, K, True)
-        G[:, :] = 0.0
-        for j in range(na):
-            G[act[j], j] = 1.0
-        if m > 0 and npas > 0:
-            for i in range(m):
-                for j in range(npas):
-                    Kp[i, j] = K[i, pas[j]]
-            svd_pinv(Kp, rtol, P)
-            for j in range(na):
-                aj = act[j]
-                for i in range(npas):
-                    acc = 0.0
-                    for c in range(m):
-                        acc += P[i, c] * K[c, aj]
-                    G[pas[i], j] = -acc
-        p0 = T[sb, 0, 3] + T[sb, 0, 0] * Tsite[0, 3] + T[sb, 0, 1] * Tsite[1, 3] + T[sb, 0, 2] * Tsite[2, 3]
-        p1 = T[sb, 1, 3] + T[sb, 1, 0] * Tsite[0, 3] + T[sb, 1, 1] * Tsite[1, 3] + T[sb, 1, 2] * Tsite[2, 3]
-        p2 = T[sb, 2, 3] + T[sb, 2, 0] * Tsite[0, 3] + T[sb, 2, 1] * Tsite[1, 3] + T[sb, 2, 2] * Tsite[2, 3]
-        for j in range(na):
-            for i in range(6):
-                J_out[n, i, j] = 0.0
-        for k in range(nv):
-            if A[sb, k] == 0.0:
-                continue
-            w0, w1, w2 = S[k, 0], S[k, 1], S[k, 2]
-            c3 = S[k, 3] + w1 * p2 - w2 * p1
-            c4 = S[k, 4] + w2 * p0 - w0 * p2
-            c5 = S[k, 5] + w0 * p1 - w1 * p0
-            for j in range(na):
-                g = G[k, j]
-                if g != 0.0:
-                    J_out[n, 0, j] += w0 * g
-                    J_out[n, 1, j] += w1 * g
-                    J_out[n, 2, j] += w2 * g
-                    J_out[n, 3, j] += c3 * g
-                    J_out[n, 4, j] += c4 * g
-                    J_out[n, 5, j] += c5 * g
+        site_jac_one(Q[n], act, pas, sb, Tsite, t, rtol, T, S, r, K, G, Kp, P, J_out[n])
 
 
 @numba.njit(cache=True, error_model="numpy", parallel=True)
@@ -1407,6 +1499,14 @@ def warm() -> None:
         z = np.zeros((n, len(model.act)))
         _dynamics._inverse_compiled(mech, qf, z, z, {}, None, True)
     inv_dyn_one(model, mech.q0, np.zeros(1), np.zeros(1), mech.gravity, True)
+    from ._designs import design_batch, ik_designs, site_measures_designs
+
+    batch = design_batch([mech, mech], mech.sites[0].name)  # the design-batched drivers
+    for n in (1, 2 * BLOCK + 1):
+        di = np.arange(n) % 2
+        T = np.broadcast_to(np.eye(4), (n, 4, 4)).copy()
+        ik_designs(batch, di, T, batch.q_ref[di], np.ones(6), steps=2)
+        site_measures_designs(batch, di, batch.q_ref[di], [3, 4, 5])
     from ._rnea import generalized_forces, mass_matrix
 
     tree_mech = _open_chain()  # the tree dynamics through the public calls (forward dynamics too)
