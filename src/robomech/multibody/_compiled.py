@@ -510,7 +510,7 @@ def svd_pinv(Kp, rtol, P):  # pragma: no cover - compiled
 
 @_nj
 def passive_inverse(Kp, d, Gi, P):  # pragma: no cover - compiled
-    """``_dynamics._passive_inverse`` for one sample: (mode, rank, sigma_min, cond).
+    """The passive block's pseudo-inverse for one sample: (mode, rank, sigma_min, cond).
 
     Gram path (mode 1 wide, 2 tall) where the generic rank is min(m, n): ``P = Kp^T (Kp Kp^T)^-1`` or
     ``(Kp^T Kp)^-1 Kp^T``, with the Gram inverse ``Gi`` by Cholesky (numpy's path: LU; equal to rounding)
@@ -909,7 +909,7 @@ def inv_dyn_block(
                 acc += G[k, j] * ext[k]
             ex[j] = acc
         ok = True
-        if redundant:  # _dynamics._projector
+        if redundant:  # the redundant-actuation rule's projector Pi (module docstring of _dynamics)
             for i in range(m):
                 for j in range(na):
                     acc = 0.0

@@ -47,7 +47,6 @@ from typing import TypeVar
 import numpy as np
 
 from robomech._validation import MAX_MAGNITUDE, as_array, broadcast_batch, check_bool
-from robomech.dynamics import _com_terms
 
 from ._assembly import check_mechanism, check_q, on_rows, solve_closure
 from ._compile import Bodies, compile_model
@@ -57,9 +56,6 @@ from ._model import Mechanism
 from ._options import (
     ADMISSIBLE_RTOL,
     CLOSURE_RTOL,
-    GRAM_COND_MAX,
-    GRAM_REFINE2_COND,
-    GRAM_REFINE_COND,
     RANK_RTOL,
     RATE_FLOOR,
     SINGULAR_COND,
@@ -140,46 +136,6 @@ def _pinv_rank(K: np.ndarray, r: int) -> tuple[np.ndarray, np.ndarray]:
     return P, np.where(ok, s[:, 0] / np.where(ok, sr, 1.0), np.inf)
 
 
-def _passive_inverse(Kp: np.ndarray, rank0: int, length: float = 1.0):
-    """Pseudo-inverse of the passive block ``Kp (N, m, n)`` with (rank, sigma_min, cond) per sample.
-
-    Fast path where the generic rank is ``min(m, n)`` (no idle motion *and* redundant rows at once):
-    ``P0 = Kp^T (Kp Kp^T)^-1`` (wide) or ``(Kp^T Kp)^-1 Kp^T`` (tall) from a batched inverse, refined
-    ``P_{k+1} = P_k + P0 (I - Kp P_k)`` (once above GRAM_REFINE_COND, twice above GRAM_REFINE2_COND:
-    iterative refinement of the normal equations, for wide and tall alike); ``cond`` is then the 1-norm
-    estimate ``sqrt(||Gram||_1 ||Gram^-1||_1)`` (between the 2-norm one and sqrt(rank) times it) and
-    ``sigma_min`` ``1 / sqrt(||Gram^-1||_1)`` (a lower bound within rank^(1/4)).  Samples above
-    GRAM_COND_MAX, and mechanisms without the fast path, get the SVD pseudo-inverse of the multibody layer.
-    """
-    N, m, n = Kp.shape
-    if m == 0 or n == 0 or rank0 != min(m, n):
-        return _pinv(Kp, length)
-    wide = m <= n
-    KT = Kp.swapaxes(-1, -2)
-    Gm = Kp @ KT if wide else KT @ Kp
-    with np.errstate(all="ignore"):
-        try:
-            Gi = np.linalg.inv(Gm)
-        except np.linalg.LinAlgError:
-            return _pinv(Kp, length)
-        P = KT @ Gi if wide else Gi @ KT
-        ni = np.linalg.norm(Gi, 1, axis=(-2, -1))
-        cond = np.sqrt(np.linalg.norm(Gm, 1, axis=(-2, -1)) * ni)
-        smin = 1.0 / np.sqrt(ni)
-        # refine where the Gram matrix's squared conditioning could show: cond^2 eps > 1e-12
-        for lim in (GRAM_REFINE_COND, GRAM_REFINE2_COND):
-            r = np.flatnonzero(~(cond <= lim))
-            if r.size:
-                P0 = KT[r] @ Gi[r] if wide else Gi[r] @ KT[r]
-                P[r] = P[r] + P0 @ (np.eye(m) - Kp[r] @ P[r])
-    rank = np.full(N, rank0)
-    bad = ~(np.isfinite(cond) & (cond <= GRAM_COND_MAX) & np.all(np.isfinite(P), axis=(-1, -2)))
-    if np.any(bad):
-        Pb, rb, sb, cb = _pinv(Kp[bad], length)
-        P[bad], rank[bad], smin[bad], cond[bad] = Pb, rb, sb, cb
-    return P, rank, smin, cond
-
-
 def _rank_measures(Kp: np.ndarray, rank0: int, length: float) -> tuple[np.ndarray, np.ndarray]:
     """``(sigma_min, cond)`` of ``Kp (N, m, n)`` against the mechanism's generic passive rank ``rank0``:
     the ``rank0``-th singular value and ``s_1`` over it (inf where it is zero).  A truncated
@@ -229,35 +185,6 @@ def _com_jacobians(tree, state, bd: Bodies, qd: np.ndarray | None, Sd: np.ndarra
         pd = V[..., 3:] + np.cross(w, p)
         a0 = np.concatenate([Vd[..., :3], Vd[..., 3:] + np.cross(Vd[..., :3], p) + np.cross(w, pd)], axis=-1)
     return p, J, a0
-
-
-def _cross_rows(a: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """``a_col x p`` for every column of ``a (..., 3, k)`` with ``p (..., 3)`` (component arithmetic:
-    np.cross on broadcast blocks moves axes and is several times slower here)."""
-    x, y, z = p[..., 0, None], p[..., 1, None], p[..., 2, None]
-    a0, a1, a2 = a[..., 0, :], a[..., 1, :], a[..., 2, :]
-    return np.stack([a1 * z - a2 * y, a2 * x - a0 * z, a0 * y - a1 * x], axis=-2)
-
-
-def _com_projected(tree, state, bd: Bodies, qd, Sd, G, extra_qdd):
-    """Centre-of-mass Jacobians through G, ``J_b G (N, B, 6, na)``, and the accelerations
-    ``Jdot_b qd + J_b extra_qdd (N, B, 6)`` — without the (N, B, 6, nv) Jacobians' cross products."""
-    T = state.T[:, bd.idx]
-    p = (T[..., :3, :3] @ bd.com[:, :, None])[..., 0] + T[..., :3, 3]
-    S = state.S
-    A = tree.A[bd.idx]  # (B, nv)
-    SG = np.empty((S.shape[0], len(bd.idx), 6, G.shape[-1]))  # (N, B, 6, na): sum over b's path of S_k G_k
-    St = S.swapaxes(-1, -2)
-    for i, b in enumerate(bd.idx):
-        c = _path(tree, b)
-        SG[:, i] = St[:, :, c] @ G[:, c]
-    JG = np.concatenate([SG[..., :3, :], SG[..., 3:, :] + _cross_rows(SG[..., :3, :], p)], axis=-2)
-    V = A @ (S * qd[..., None])
-    Vd = A @ (Sd * qd[..., None] + S * extra_qdd[..., None])
-    w = V[..., :3]
-    pd = V[..., 3:] + np.cross(w, p)
-    a0 = np.concatenate([Vd[..., :3], Vd[..., 3:] + np.cross(Vd[..., :3], p) + np.cross(w, pd)], axis=-1)
-    return JG, a0
 
 
 def _screw_rates(tree, state, qd: np.ndarray) -> np.ndarray:
@@ -479,102 +406,10 @@ class InverseDynamicsResult:
     valid: np.ndarray
 
 
-def _projector(mech, K, G, dof, w):
-    """Redundant actuation: the rule's projector Pi (N, na, na); False where null(K G) is not ``dof``-wide."""
-    N, _, na = G.shape
-    KG = (K @ G) / mech.tree.length
-    s_full = np.zeros((N, na))
-    if KG.shape[1]:
-        _, s, Vt = np.linalg.svd(KG, full_matrices=True)
-        s_full[:, : s.shape[1]] = s[:, :na]
-    else:
-        Vt = np.broadcast_to(np.eye(na), (N, na, na))
-    # singular values ascending over the right singular vectors: the last `dof` rows of Vt span null(KG)
-    Nc = Vt[:, na - dof :].swapaxes(-1, -2)  # (N, na, dof)
-    top = np.maximum(np.max(s_full, axis=-1), 1.0)
-    gap_ok = np.all(s_full[:, na - dof :] <= RANK_RTOL * 1e2 * top[:, None], axis=-1)
-    if dof < na:
-        gap_ok &= s_full[:, na - dof - 1] > RANK_RTOL * 1e2 * top
-    if w is None:
-        Pi = Nc @ Nc.swapaxes(-1, -2)
-    else:
-        WN = w[:, None] * Nc
-        A = Nc.swapaxes(-1, -2) @ WN
-        ok = np.linalg.cond(A) < 1.0 / RANK_RTOL
-        A = np.where(ok[:, None, None], A, np.eye(dof))
-        Pi = WN @ np.linalg.solve(A, Nc.swapaxes(-1, -2))
-        gap_ok &= ok
-    return Pi, gap_ok
-
-
-def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
-    tree = mech.tree
-    rank0, dof = _reference(mech)
-    na = len(tree.act_dof)
-    act = tree.act_dof
-    pas = np.setdiff1d(np.arange(tree.nv), act)
-    N = q.shape[0]
-    state = kinematics(tree, q)
-    K = _constraint_matrix(mech, state, q)
-    P, rank, smin, cond = _passive_inverse(K[..., pas], rank0, tree.length)
-    G = np.zeros((N, tree.nv, na))
-    G[:, act, np.arange(na)] = 1.0
-    G[:, pas] = -P @ K[..., act]
-    qd = _mv(G, qd_a)
-    Sd = _screw_rates(tree, state, qd)
-    kdq = _kdot_qd(mech, state, q, qd, Sd)
-    qdd = _mv(G, qdd_a)
-    qdd[:, pas] -= _mv(P, kdq)
-    # Project each body's Jacobian through G first (6 x n_act instead of 6 x nv): the tree mass matrix is
-    # never formed.  The convective acceleration J (qdd - G qdd_act) joins the velocity-product terms.
-    bd = _bodies(mech)
-    R = state.T[:, bd.idx, :3, :3]
-    Iw = R @ bd.inertia @ R.swapaxes(-1, -2)
-    conv = qdd - _mv(G, qdd_a)
-    JG, a0 = _com_projected(tree, state, bd, qd, Sd, G, conv)
-    gv = np.asarray(mech.gravity) if gravity else np.zeros(3)
-    terms = _com_terms(np.broadcast_to(bd.mass, (N, len(bd.mass))), Iw, JG, a0, qd_a, qdd_a, gv[None])
-    ext = _site_terms(mech, state, wr)
-    GT = G.swapaxes(-1, -2)
-    M_a = terms.M
-    vel = terms.velocity_terms
-    grav = terms.gravity_terms
-    ex = _mv(GT, ext)
-    ok = np.ones(N, dtype=bool)
-    if na > dof or weights is not None:
-        Pi, ok = _projector(mech, K, G, dof, weights)
-        M_a = Pi @ M_a
-        vel, grav, ex = (_mv(Pi, x) for x in (vel, grav, ex))
-    tau = _mv(M_a, qdd_a) + vel + grav + ex
-    L = tree.length
-    sv = np.max(np.abs(qd), axis=-1) if tree.nv else np.zeros(N)
-    sa = np.max(np.abs(qdd), axis=-1) + sv * sv if tree.nv else np.zeros(N)
-    if K.shape[1]:
-        e1 = np.max(np.abs(_mv(K, qd)), axis=-1) / (L * np.maximum(sv, RATE_FLOOR))
-        e2 = np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
-        adm = np.maximum(e1, e2)
-    else:
-        adm = np.zeros(N)
-    fin = np.all(np.isfinite(tau), axis=-1) & np.all(np.isfinite(M_a), axis=(-1, -2))
-    valid = ok & fin & (rank >= rank0) & (cond <= SINGULAR_COND) & (adm <= ADMISSIBLE_RTOL)
-    return dict(
-        tau=tau,
-        M_a=M_a,
-        velocity_terms=vel,
-        gravity_terms=grav,
-        external_terms=ex,
-        qd=qd,
-        qdd=qdd,
-        cond=cond,
-        sigma_min=smin,
-        admissibility=adm,
-        valid=valid,
-    )
-
-
 def _inverse_compiled(mech, q, qd_a, qdd_a, wr, weights, gravity=True) -> dict[str, np.ndarray]:
-    """:func:`_inverse_flat` by the compiled per-sample kernel (``_compiled.inv_dyn``): same formulas,
-    same flags; the tests check both paths agree to rounding."""
+    """The closed-chain inverse dynamics in actuator space (the derivation of the module docstring) by
+    the compiled per-sample kernel (``_compiled.inv_dyn``), the one implementation at every batch size;
+    its numpy formulation is the tests' reference (tests/multibody/_reference.py)."""
     from ._compiled import inv_dyn
 
     model = compile_model(mech)
@@ -791,7 +626,7 @@ def _inverse_full_flat(mech, q, qd, qdd, wr, weights, gravity=True):
     ``Nb^T E tau = Nb^T f``; ``tau = B f`` is its least-squares solution (minimum norm, or minimum
     ``sum tau_i^2 / w_i``), and what no actuator force can do, ``Nb (Nb^T f - Nb^T E tau)``, is the
     force the unactuated coordinates would need.  Where the actuators determine the motion this is
-    ``G^T f`` of :func:`_inverse_flat`."""
+    ``G^T f`` of :func:`_inverse_compiled`."""
     from ._rnea import _crba_flat, _rnea_flat
 
     tree = mech.tree
@@ -1616,6 +1451,7 @@ def energy(mech: Mechanism, q: object, qd: object) -> tuple[np.ndarray, np.ndarr
     batch = broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     qf = np.broadcast_to(q, (*batch, mech.nq)).reshape(-1, mech.nq)
     qdf = np.broadcast_to(qd, (*batch, mech.nv)).reshape(-1, mech.nv)
+
     def energies(qs: np.ndarray, qds: np.ndarray) -> tuple:
         return _energy_flat(mech, qs, qds)
 
