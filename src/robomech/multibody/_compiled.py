@@ -49,15 +49,19 @@ def quat_mat(w, x, y, z, R):  # pragma: no cover - compiled
 @_nj
 def kin(q, t, T, S):  # pragma: no cover
     """Body poses ``T (nb, 4, 4)`` and coordinate space screws ``S (nv, 6)`` at ``q`` (``_tree._kin``)."""
+    kin_ws(q, t, T, S, np.empty((3, 3)), np.empty((3, 3)), np.empty(3))
+
+
+@_nj
+def kin_ws(q, t, T, S, Rj, Rn, anchor):  # pragma: no cover
+    """:func:`kin` with its scratch ``Rj``, ``Rn (3, 3)``, ``anchor (3,)`` given (a per-sample loop
+    allocates them once)."""
     parent, T_off, j0, jtype, jqadr, jdadr = t.parent, t.T_off, t.j0, t.jtype, t.jqadr, t.jdadr
     jpos, jaxis, jref = t.jpos, t.jaxis, t.jref
     nb = parent.shape[0]
     for i in range(4):
         for j in range(4):
             T[0, i, j] = 1.0 if i == j else 0.0
-    Rj = np.empty((3, 3))
-    Rn = np.empty((3, 3))
-    anchor = np.empty(3)
     for b in range(1, nb):
         pb = parent[b]
         for i in range(4):
@@ -1201,6 +1205,23 @@ def _inertia_apply(mb, c, Ic, X, out):  # pragma: no cover - compiled
 
 
 @_nj
+def inertia_world(T, t, ib, c, Ic, RI):  # pragma: no cover - compiled
+    """World centre of mass ``c (3,)`` and inertia about it ``Ic = R I R^T (3, 3)`` of the massive body
+    ``t.bidx[ib]`` (``RI (3, 3)`` scratch: ``I R^T``)."""
+    b = t.bidx[ib]
+    cx = t.com[ib]
+    Ib = t.inertia[ib]
+    for i in range(3):
+        c[i] = T[b, i, 3] + T[b, i, 0] * cx[0] + T[b, i, 1] * cx[1] + T[b, i, 2] * cx[2]
+    for u in range(3):
+        for j in range(3):
+            RI[u, j] = Ib[u, 0] * T[b, j, 0] + Ib[u, 1] * T[b, j, 1] + Ib[u, 2] * T[b, j, 2]
+    for i in range(3):
+        for j in range(3):
+            Ic[i, j] = T[b, i, 0] * RI[0, j] + T[b, i, 1] * RI[1, j] + T[b, i, 2] * RI[2, j]
+
+
+@_nj
 def rnea_block(lo, hi, Q, QD, QDD, gv, t, tau_o):  # pragma: no cover - compiled
     """The spanning tree's recursive Newton-Euler inverse dynamics of samples ``lo:hi`` (world frame,
     the formulation of ``_rnea``: forward pass of twists and accelerations, the base accelerating at
@@ -1215,11 +1236,15 @@ def rnea_block(lo, hi, Q, QD, QDD, gv, t, tau_o):  # pragma: no cover - compiled
     vj = np.empty(6)
     c = np.empty(3)
     Ic = np.empty((3, 3))
+    RI = np.empty((3, 3))
     h = np.empty(6)
     fa = np.empty(6)
+    Rj = np.empty((3, 3))
+    Rn = np.empty((3, 3))
+    anchor = np.empty(3)
     for n in range(lo, hi):
         q, qd, qdd = Q[n], QD[n], QDD[n]
-        kin(q, t, T, S)
+        kin_ws(q, t, T, S, Rj, Rn, anchor)
         for i in range(6):
             V[0, i] = 0.0
             Acc[0, i] = 0.0
@@ -1266,17 +1291,7 @@ def rnea_block(lo, hi, Q, QD, QDD, gv, t, tau_o):  # pragma: no cover - compiled
         F[:, :] = 0.0
         for ib in range(t.bidx.shape[0]):
             b = t.bidx[ib]
-            cx = t.com[ib]
-            for i in range(3):
-                c[i] = T[b, i, 3] + T[b, i, 0] * cx[0] + T[b, i, 1] * cx[1] + T[b, i, 2] * cx[2]
-            Ib = t.inertia[ib]
-            for i in range(3):
-                for j in range(3):
-                    acc = 0.0
-                    for u in range(3):
-                        ru = Ib[u, 0] * T[b, j, 0] + Ib[u, 1] * T[b, j, 1] + Ib[u, 2] * T[b, j, 2]
-                        acc += T[b, i, u] * ru
-                    Ic[i, j] = acc
+            inertia_world(T, t, ib, c, Ic, RI)
             _inertia_apply(t.mass[ib], c, Ic, Acc[b], fa)
             _inertia_apply(t.mass[ib], c, Ic, V[b], h)
             w0, w1, w2, v0, v1, v2 = V[b, 0], V[b, 1], V[b, 2], V[b, 3], V[b, 4], V[b, 5]

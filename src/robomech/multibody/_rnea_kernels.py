@@ -1,6 +1,6 @@
 """Compiled (numba) per-sample kernel of the tree's composite-rigid-body algorithm (``_rnea``).
 
-Per sample: the tree kinematics of ``_compiled.kin`` (body poses and space screws), then the CRBA in
+Per sample: the tree kinematics of ``_compiled.kin_ws`` (body poses and space screws), then the CRBA in
 world coordinates as the module docstring of :mod:`._rnea` states it; large batches in parallel
 blocks of ``_compiled.BLOCK`` samples (``numba.prange``).  The RNEA kernel is ``_compiled.rnea_block``.
 """
@@ -11,40 +11,22 @@ import numpy as np
 
 from robomech._numba import import_numba
 
-from ._compiled import BLOCK, chol_solve, entry, kin, prepare_one, rnea_block, writable
+from ._compiled import (
+    BLOCK,
+    _inertia_apply,
+    chol_solve,
+    entry,
+    inertia_world,
+    kin_ws,
+    prepare_one,
+    rnea_block,
+    writable,
+)
 
 __all__ = ["crba_batch", "fd_tree"]
 
 numba = import_numba()
 _nj = numba.njit(cache=True, error_model="numpy")
-
-
-@_nj
-def _inertia_world(T, com, inertia, b, ib, c, Ic):  # pragma: no cover - compiled
-    """World centre of mass ``c (3,)`` and inertia about it ``Ic (3, 3)`` of body ``b`` (its mass
-    properties ``com[ib]``, ``inertia[ib]``)."""
-    for i in range(3):
-        c[i] = T[b, i, 3] + T[b, i, 0] * com[ib, 0] + T[b, i, 1] * com[ib, 1] + T[b, i, 2] * com[ib, 2]
-    for i in range(3):
-        for j in range(3):
-            s = 0.0
-            for k in range(3):
-                for m in range(3):
-                    s += T[b, i, k] * inertia[ib, k, m] * T[b, j, m]
-            Ic[i, j] = s
-
-
-@_nj
-def _apply(m, c, Ic, X, out):  # pragma: no cover - compiled
-    """``out = I X``: ``f = m (v + w x c)``, ``n = Ic w + c x f`` (motions about the world origin)."""
-    w0, w1, w2 = X[0], X[1], X[2]
-    f0 = m * (X[3] + w1 * c[2] - w2 * c[1])
-    f1 = m * (X[4] + w2 * c[0] - w0 * c[2])
-    f2 = m * (X[5] + w0 * c[1] - w1 * c[0])
-    out[0] = Ic[0, 0] * w0 + Ic[0, 1] * w1 + Ic[0, 2] * w2 + c[1] * f2 - c[2] * f1
-    out[1] = Ic[1, 0] * w0 + Ic[1, 1] * w1 + Ic[1, 2] * w2 + c[2] * f0 - c[0] * f2
-    out[2] = Ic[2, 0] * w0 + Ic[2, 1] * w1 + Ic[2, 2] * w2 + c[0] * f1 - c[1] * f0
-    out[3], out[4], out[5] = f0, f1, f2
 
 
 @_nj
@@ -60,17 +42,21 @@ def crba_block(Q, lo, hi, t, out):  # pragma: no cover
     col = np.empty(6)
     c = np.empty(3)
     Ic = np.empty((3, 3))
+    RI = np.empty((3, 3))
     Fi = np.empty(6)
+    Rj = np.empty((3, 3))
+    Rn = np.empty((3, 3))
+    anchor = np.empty(3)
     for n in range(lo, hi):
-        kin(Q[n], t, T, S)
+        kin_ws(Q[n], t, T, S, Rj, Rn, anchor)
         I6[:, :, :] = 0.0
         for ib in range(t.bidx.shape[0]):  # bodies without mass or inertia stay zero
             b = t.bidx[ib]
-            _inertia_world(T, t.com, t.inertia, b, ib, c, Ic)
+            inertia_world(T, t, ib, c, Ic, RI)
             for j in range(6):
                 for i in range(6):
                     X[i] = 1.0 if i == j else 0.0
-                _apply(t.mass[ib], c, Ic, X, col)
+                _inertia_apply(t.mass[ib], c, Ic, X, col)
                 for i in range(6):
                     I6[b, i, j] = col[i]
         for b in range(nb - 1, 0, -1):  # composite inertias
@@ -127,6 +113,19 @@ def crba_batch(model, q: np.ndarray) -> np.ndarray:
 
 # ----------------------------------------------------------------------------- tree forward dynamics
 @_nj
+def mass_cond(M, H):  # pragma: no cover - compiled
+    """The 2-norm condition number of ``M (n, n)`` (LAPACK singular values; non-finite entries read as
+    0; inf where the smallest is 0); ``H (n, n)`` scratch."""
+    n = M.shape[0]
+    for i in range(n):
+        for j in range(n):
+            v = M[i, j]
+            H[i, j] = v if np.isfinite(v) else 0.0
+    s = np.linalg.svd(H)[1]
+    return s[0] / s[n - 1] if s[n - 1] > 0 else np.inf
+
+
+@_nj
 def fd_tree_block(lo, hi, Q, QD, F, gv, t, qdd_o, cond_o):  # pragma: no cover - compiled
     """Forward dynamics of an open tree (no closure rows), samples ``lo:hi``: ``M qdd = F - b`` with
     ``M`` the CRBA mass matrix, ``b`` the RNEA forces at zero acceleration (velocity and gravity terms)
@@ -145,12 +144,7 @@ def fd_tree_block(lo, hi, Q, QD, F, gv, t, qdd_o, cond_o):  # pragma: no cover -
         rnea_block(0, 1, q1, QD[n : n + 1], zero, gv, t, b)
         for i in range(nv):
             f[i] = -b[0, i] + F[n, i]
-        for i in range(nv):
-            for j in range(nv):
-                v = M[0, i, j]
-                H[i, j] = v if np.isfinite(v) else 0.0
-        s = np.linalg.svd(H)[1]
-        cond_o[n] = s[0] / s[nv - 1] if s[nv - 1] > 0 else np.inf
+        cond_o[n] = mass_cond(M[0], H)
         for i in range(nv):
             for j in range(nv):
                 H[i, j] = M[0, i, j]
