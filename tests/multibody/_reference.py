@@ -52,15 +52,26 @@ def numpy_site_jacobian(mech, q, site):
 
 @contextlib.contextmanager
 def numpy_reference():
-    """Inside the block, FK, site Jacobians and inverse dynamics run the numpy formulation."""
-    saved = (_compiled.compiled_fk, _compiled.compiled_site_jacobian, _dynamics._inverse_compiled)
+    """Inside the block, FK, site Jacobians, inverse and forward dynamics run the numpy formulation."""
+    saved = (
+        _compiled.compiled_fk,
+        _compiled.compiled_site_jacobian,
+        _dynamics._inverse_compiled,
+        _dynamics._forward_compiled,
+    )
     _compiled.compiled_fk = numpy_fk
     _compiled.compiled_site_jacobian = numpy_site_jacobian
     _dynamics._inverse_compiled = _inverse_flat
+    _dynamics._forward_compiled = numpy_forward
     try:
         yield
     finally:
-        _compiled.compiled_fk, _compiled.compiled_site_jacobian, _dynamics._inverse_compiled = saved
+        (
+            _compiled.compiled_fk,
+            _compiled.compiled_site_jacobian,
+            _dynamics._inverse_compiled,
+            _dynamics._forward_compiled,
+        ) = saved
 
 
 # ----------------------------------------------------------------------------- the tree's RNEA and CRBA
@@ -316,3 +327,72 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
         admissibility=adm,
         valid=valid,
     )
+
+
+# ----------------------------------------------------------------------------- forward dynamics
+# The numpy formulation of _rnea_kernels.fd_block (batched over samples): the closure a constraint on
+# the tree accelerations, qdd = qdd_p + u, K qdd_p = -Kdot qd (minimum norm at the generic rank of K),
+# Mc u = Pn (f - M qdd_p), Pn = I - K^+ K, Mc = Pn M Pn + (I - Pn), solved by LU (LAPACK gesv).
+def _solve_each(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``A x = b`` per sample; an exactly singular matrix gives NaN for its sample only."""
+    try:
+        return np.linalg.solve(A, b[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        out = np.full(b.shape, np.nan)
+        for i in range(A.shape[0]):
+            try:
+                out[i] = np.linalg.solve(A[i], b[i])
+            except np.linalg.LinAlgError:
+                pass
+        return out
+
+
+def numpy_forward(mech, q, rates, tau_a, wr, gravity, act_mode):
+    """``(qd, qdd, cond, admissibility, closure, regular)`` of ``_dynamics._forward_compiled``."""
+    from robomech.multibody._constraints import residual
+
+    tree = mech.tree
+    N, nv = q.shape[0], tree.nv
+    L = tree.length
+    act = tree.act_dof
+    pas = np.setdiff1d(np.arange(nv), act)
+    rank0 = D._reference(mech)[0]
+    state = kinematics(tree, q)
+    K = D._constraint_matrix(mech, state, q)
+    if act_mode:
+        P, rank, _, cK = _pinv(K[..., pas], L)
+        qd = np.zeros((N, nv))
+        qd[:, act] = rates
+        qd[:, pas] = -np.einsum("nij,njk,nk->ni", P, K[..., act], rates)
+        reg = (rank >= rank0) & (cK <= SINGULAR_COND)
+        e1 = np.zeros(N)
+    else:
+        qd = np.array(rates)
+        reg = np.ones(N, dtype=bool)
+        sv = np.max(np.abs(qd), axis=-1)
+        e1 = np.max(np.abs(D._mv(K, qd)), axis=-1, initial=0.0) / (L * np.maximum(sv, RATE_FLOOR))
+    kdq = D._kdot_qd(mech, state, q, qd, D._screw_rates(tree, state, qd))
+    g = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
+    M = numpy_crba(mech, q)
+    f = -numpy_rnea(mech, q, qd, np.zeros_like(qd), g) - D._site_terms(mech, state, wr)
+    f[:, act] += tau_a
+    if K.shape[1]:
+        Kp, _ = D._pinv_rank(K, D._rank_K(mech))  # (N, nv, m)
+        qdd_p = -D._mv(Kp, kdq)
+        Pn = np.eye(nv) - Kp @ K
+    else:
+        qdd_p = np.zeros((N, nv))
+        Pn = np.broadcast_to(np.eye(nv), (N, nv, nv))
+    Mc = Pn @ M @ Pn + (np.eye(nv) - Pn)
+    rhs = D._mv(Pn, f - D._mv(M, qdd_p))
+    s = np.linalg.svd(np.where(np.isfinite(Mc), Mc, 0.0), compute_uv=False)
+    cond = np.where(s[:, -1] > 0, s[:, 0] / np.where(s[:, -1] > 0, s[:, -1], 1.0), np.inf)
+    qdd = qdd_p + _solve_each(Mc, rhs)
+    sa = np.max(np.abs(qdd), axis=-1) + np.max(np.abs(qd), axis=-1) ** 2
+    e2 = np.max(np.abs(D._mv(K, qdd) + kdq), axis=-1, initial=0.0) / (L * np.maximum(sa, RATE_FLOOR))
+    adm = np.maximum(e1, np.where(np.isfinite(e2), e2, np.inf))
+    closure = np.max(np.abs(residual(mech.constraints, tree, state, q)), axis=-1, initial=0.0)
+    if act_mode and np.any(~reg):  # a singular passive block: its measure against the generic rank
+        bad = np.flatnonzero(~reg)
+        cond[bad] = np.maximum(cond[bad], D._rank_measures(K[bad][..., pas], rank0, L)[1])
+    return qd, qdd, cond, adm, closure, reg

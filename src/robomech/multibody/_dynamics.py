@@ -51,7 +51,6 @@ from robomech._validation import MAX_MAGNITUDE, as_array, broadcast_batch, check
 from ._assembly import check_mechanism, check_q, on_rows, solve_closure
 from ._compile import Bodies, compile_model
 from ._constraints import jacobian
-from ._influence import _pinv
 from ._model import Mechanism
 from ._options import (
     ADMISSIBLE_RTOL,
@@ -415,12 +414,7 @@ def _inverse_compiled(mech, q, qd_a, qdd_a, wr, weights, gravity=True) -> dict[s
     model = compile_model(mech)
     tree, t, d = model.tree, model.tables, model.dyn
     N, nv, na = q.shape[0], tree.nv, len(tree.act_dof)
-    sites = list(wr)
-    W = np.zeros((N, len(sites), 6))
-    for i, si in enumerate(sites):
-        W[:, i] = wr[si]
-    wsb = np.array([tree.site_body[si] for si in sites], dtype=np.int64)
-    wT = np.ascontiguousarray(np.array([tree.T_site[si] for si in sites], dtype=float).reshape(-1, 4, 4))
+    W, wsb, wT = _wrench_arrays(tree, wr, N)
     gv = np.asarray(mech.gravity, dtype=float) if gravity else np.zeros(3)
     wts = np.zeros(0) if weights is None else np.ascontiguousarray(weights, dtype=float)
     out = dict(
@@ -1103,55 +1097,35 @@ def site_wrench(
 
 
 # ----------------------------------------------------------------------------- forward dynamics
-def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
-    """Tree accelerations ``qdd (N, nv)`` under actuator forces with the closure enforced, and a
-    conditioning measure of the constrained mass matrix (N,)."""
-    tree = mech.tree
+def _wrench_arrays(tree, wr: dict[int, np.ndarray], N: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Site wrenches packed for the kernels: ``W (N, ns, 6)``, the sites' bodies ``(ns,)`` and frames
+    ``(ns, 4, 4)``."""
+    sites = list(wr)
+    W = np.zeros((N, len(sites), 6))
+    for i, si in enumerate(sites):
+        W[:, i] = wr[si]
+    wsb = np.array([tree.site_body[si] for si in sites], dtype=np.int64)
+    wT = np.ascontiguousarray(np.array([tree.T_site[si] for si in sites], dtype=float).reshape(-1, 4, 4))
+    return W, wsb, wT
+
+
+def _forward_compiled(mech, q, rates, tau_a, wr, gravity, act_mode: bool) -> tuple:
+    """Forward dynamics of normalised ``q (N, nq)`` under actuator forces ``tau_a (N, n_act)`` and site
+    wrenches ``wr``, the closure a constraint on the tree accelerations (module docstring), by the
+    compiled per-sample kernel (``_rnea_kernels.fd_block``), the one implementation at every batch
+    size.  ``rates``: ``qd_act (N, n_act)`` (``act_mode``) or every rate ``qd (N, nv)``.  Returns
+    ``(qd, qdd, cond, admissibility, closure, regular)``; the numpy formulation is the tests'
+    reference (tests/multibody/_reference.py)."""
+    from ._rnea_kernels import forward
+
+    model = compile_model(mech)
+    tree = model.tree
     N = q.shape[0]
-    nv = tree.nv
-    if mech.constraints.m or wr:
-        state = kinematics(tree, q)
-        K = _constraint_matrix(mech, state, q)
-        Sd = _screw_rates(tree, state, qd)
-        kdq = _kdot_qd(mech, state, q, qd, Sd)
-    else:  # a tree without site wrenches: the kernels below are all it needs
-        K, kdq = np.zeros((N, 0, nv)), np.zeros((N, 0))
-    from ._rnea import _crba_flat, _rnea_flat
-
-    # the tree's mass matrix (CRBA) and velocity + gravity forces (RNEA at zero acceleration)
-    g = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
-    if not K.shape[1] and not wr and nv:  # an open tree: CRBA, RNEA and Cholesky in one kernel
-        from ._rnea_kernels import fd_tree
-
-        F = np.zeros((N, nv))
-        F[:, tree.act_dof] = tau_a
-        qdd, cond = fd_tree(compile_model(mech), q, qd, F, g)
-        return qdd, (cond if want_cond else np.ones(N)), K, kdq
-    M = _crba_flat(mech, q)
-    f = -_rnea_flat(mech, q, qd, np.zeros_like(qd), g)
-    if wr:
-        f = f - _site_terms(mech, state, wr)
-    f[:, tree.act_dof] += tau_a
-    if K.shape[1]:
-        Kp, _ = _pinv_rank(K, _rank_K(mech))  # (N, nv, m)
-        qdd_p = -_mv(Kp, kdq)
-        Pn = np.eye(nv) - Kp @ K
-    else:
-        qdd_p = np.zeros((N, nv))
-        Pn = np.broadcast_to(np.eye(nv), (N, nv, nv))
-    Mc = Pn @ M @ Pn + (np.eye(nv) - Pn)
-    rhs = _mv(Pn, f - _mv(M, qdd_p))
-    if want_cond:
-        s = np.linalg.svd(np.where(np.isfinite(Mc), Mc, 0.0), compute_uv=False)
-        # a zero matrix (every body massless) has no condition number: inf, never "0"
-        cond = (
-            np.where(s[:, -1] > 0, s[:, 0] / np.where(s[:, -1] > 0, s[:, -1], 1.0), np.inf)
-            if nv
-            else np.ones(N)
-        )
-    else:
-        cond = np.ones(N)
-    return qdd_p + _solve_each(Mc, rhs), cond, K, kdq
+    F = np.zeros((N, tree.nv))
+    F[:, tree.act_dof] = tau_a
+    W, wsb, wT = _wrench_arrays(tree, wr, N)
+    gv = np.asarray(mech.gravity, dtype=float) if gravity else np.zeros(3)
+    return forward(model, q, rates, F, W, wsb, wT, gv, act_mode)
 
 
 _F64 = np.dtype(np.float64)
@@ -1214,22 +1188,6 @@ def _forward_tree_one(mech, q, tau, qd, gravity) -> ForwardDynamicsResult | None
 
 
 _ZERO3 = np.zeros(3)
-
-
-def _solve_each(A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``A x = b`` per sample (N, n, n), LAPACK ``gesv`` on each matrix: a sample's result never depends on
-    the others.  An exactly singular matrix (a massless motion) makes numpy's batched solve raise for the
-    whole batch; the samples are then solved one by one and the singular ones get NaN."""
-    try:
-        return np.linalg.solve(A, b[..., None])[..., 0]
-    except np.linalg.LinAlgError:
-        out = np.full(b.shape, np.nan)
-        for i in range(A.shape[0]):
-            try:
-                out[i] = np.linalg.solve(A[i], b[i])
-            except np.linalg.LinAlgError:
-                pass
-        return out
 
 
 @dataclass(frozen=True)
@@ -1342,46 +1300,13 @@ def forward_dynamics(
     rates = (qd_act, "qd_act", na) if act_mode else (qd, "qd", nv)
     tau_in = np.zeros(na) if tau is None else tau
     names, batch, ok, flat = _site_inputs(mech, q, [rates, (tau_in, "tau", na)], wrenches)
-    rank0, _ = _reference(mech)
     tree = mech.tree
-    pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
     L = tree.length
 
     def fn(qf, rf, tf, *ws):
-        n = qf.shape[0]
-        if mech.constraints.m:
-            state = kinematics(tree, qf)
-            K = jacobian(mech.constraints, tree, state, qf)
-        else:  # a tree: no closure rows (and _closure_error needs no state)
-            state, K = None, np.zeros((n, 0, tree.nv))
-        if act_mode:
-            P, rank, _, cK = _pinv(K[..., pas], L)
-            qd_f = np.zeros((n, tree.nv))
-            qd_f[:, tree.act_dof] = rf
-            qd_f[:, pas] = -np.einsum("nij,njk,nk->ni", P, K[..., tree.act_dof], rf)
-            reg = (rank >= rank0) & (cK <= SINGULAR_COND)
-            e1 = np.zeros(n)
-        else:
-            qd_f = rf
-            reg = np.ones(n, dtype=bool)
-            cK = np.ones(n)
-            sv = np.max(np.abs(qd_f), axis=-1) if tree.nv else np.zeros(n)
-            e1 = (
-                np.max(np.abs(_mv(K, qd_f)), axis=-1) / (L * np.maximum(sv, RATE_FLOOR))
-                if K.shape[1]
-                else np.zeros(n)
-            )
-        qdd, cond, K, kdq = _forward_full(
-            mech, qf, qd_f, tf, dict(zip(names, ws, strict=True)), gravity, want_cond=True
+        qd_f, qdd, cond, adm, closure, reg = _forward_compiled(
+            mech, qf, rf, tf, dict(zip(names, ws, strict=True)), gravity, act_mode
         )
-        sa = np.max(np.abs(qdd), axis=-1) + np.max(np.abs(qd_f), axis=-1) ** 2 if tree.nv else 0.0
-        e2 = (
-            np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
-            if K.shape[1]
-            else np.zeros(n)
-        )
-        adm = np.maximum(e1, np.where(np.isfinite(e2), e2, np.inf))
-        closure = _closure_error(mech, state, qf)
         valid = (
             reg
             & (cond < 1.0 / RANK_RTOL)
@@ -1389,13 +1314,10 @@ def forward_dynamics(
             & (closure <= CLOSURE_RTOL * L)
             & np.all(np.isfinite(qdd), axis=-1)
         )
-        if act_mode and np.any(~reg):  # a singular passive block: its measure against the generic rank
-            bad = np.flatnonzero(~reg)
-            cond[bad] = np.maximum(cond[bad], _rank_measures(K[bad][..., pas], rank0, L)[1])
         return dict(
             qdd_act=qdd[:, tree.act_dof],
             qdd=qdd,
-            qd=np.array(qd_f),
+            qd=qd_f,
             cond=cond,
             admissibility=adm,
             closure=closure,
@@ -1586,8 +1508,8 @@ def _simulate_one(mech, q0, qd0, t, tau_fn, gravity):
         if not np.all(np.isfinite(tau)):
             raise _SampleFailed
         try:
-            qdd, _, _, _ = _forward_full(mech, qn, qd, tau, None, gravity)
-        except np.linalg.LinAlgError as exc:  # a non-finite state reached the SVD
+            qdd = _forward_compiled(mech, qn, qd, tau, {}, gravity, False)[1]
+        except np.linalg.LinAlgError as exc:  # a non-finite state reached an SVD
             raise _SampleFailed from exc
         if not np.all(np.isfinite(qdd)):  # a singular (massless) motion: no acceleration exists
             raise _SampleFailed
