@@ -305,3 +305,18 @@ def test_compiled_forward_dynamics_equals_numpy(name):
         assert np.max(np.abs(got.qdd - ref.qdd[i])) <= BATCH_TOL
     one = mb.forward_dynamics(mech, q[7], qd[7], tau[7])  # one sample as vectors
     assert np.max(np.abs(one.qdd - ref.qdd[7])) <= BATCH_TOL
+
+
+def test_forward_dynamics_where_the_svd_does_not_converge():
+    """A Delta state (from its verify trajectory) whose projected mass matrix, with its clustered
+    eigenvalues, makes the kernels' LAPACK ``gesdd`` fail to converge: the kernel takes the absolute
+    eigenvalues instead and agrees with the numpy formulation (whose LAPACK converges)."""
+    mech = mb.gallery.load("delta")
+    fk = mb.forward_kinematics(mech, [0.4840417982516419, 0.7126031330937269, 0.5836989511254661])
+    qd = np.array([0.13238181720076647, 0.09335912850589508, 0.6005314480740297])
+    tau = np.array([-0.7684453161520064, -0.8910961554337876, -0.8506684344461466])
+    fast = mb.forward_dynamics(mech, fk.q[None], qd[None], tau[None])
+    with _numpy_path():
+        slow = mb.forward_dynamics(mech, fk.q[None], qd[None], tau[None])
+    assert fk.converged and fast.valid.all()
+    _assert_same_forward(fast, slow)

@@ -494,7 +494,11 @@ def svd_pinv(Kp, rtol, P):  # pragma: no cover - compiled
     if not _all_finite(Kp):  # LAPACK refuses it; the sample is flagged (rank 0)
         P[:, :] = np.nan
         return 0, np.inf, np.inf
-    U, s, Vt = np.linalg.svd(np.ascontiguousarray(Kp), full_matrices=False)
+    try:
+        U, s, Vt = np.linalg.svd(np.ascontiguousarray(Kp), full_matrices=False)
+    except Exception:  # no convergence (LAPACK): flagged as a non-finite block is
+        P[:, :] = np.nan
+        return 0, np.inf, np.inf
     cut = rtol * s[0]
     rank = 0
     smin = np.inf

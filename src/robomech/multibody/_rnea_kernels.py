@@ -125,14 +125,18 @@ def crba_batch(model, q: np.ndarray) -> np.ndarray:
 # ----------------------------------------------------------------------------- tree forward dynamics
 @_nj
 def mass_cond(M, H):  # pragma: no cover - compiled
-    """The 2-norm condition number of ``M (n, n)`` (LAPACK singular values; non-finite entries read as
-    0; inf where the smallest is 0); ``H (n, n)`` scratch."""
+    """The 2-norm condition number of the symmetric ``M (n, n)`` (LAPACK singular values, or the absolute
+    eigenvalues where the SVD does not converge; non-finite entries read as 0; inf where the smallest
+    is 0); ``H (n, n)`` scratch."""
     n = M.shape[0]
     for i in range(n):
         for j in range(n):
             v = M[i, j]
             H[i, j] = v if np.isfinite(v) else 0.0
-    s = np.linalg.svd(H)[1]
+    try:
+        s = np.linalg.svd(H)[1]
+    except Exception:  # gesdd can fail to converge on clustered values: |eigenvalues| of symmetric M
+        s = np.sort(np.abs(np.linalg.eigvalsh(H)))[::-1]
     return s[0] / s[n - 1] if s[n - 1] > 0 else np.inf
 
 
@@ -156,7 +160,11 @@ def solve_constrained(M, f, K, kdq, rank, P, Pn, Mc, H, x, qdd):  # pragma: no c
     if not _all_finite(K):  # LAPACK refuses it: no acceleration (the sample is flagged)
         qdd[:] = np.nan
         return np.inf
-    U, s, Vt = np.linalg.svd(K, full_matrices=False)
+    try:
+        U, s, Vt = np.linalg.svd(K, full_matrices=False)
+    except Exception:  # no convergence (LAPACK): no acceleration, the sample is flagged
+        qdd[:] = np.nan
+        return np.inf
     ok = s[rank - 1] > 0
     P[:, :] = 0.0
     for c in range(rank):
@@ -350,7 +358,10 @@ def rank_cond(Kp, rank0):  # pragma: no cover - compiled
         for j in range(n):
             v = Kp[i, j]
             H[i, j] = v if np.isfinite(v) else 0.0
-    s = np.linalg.svd(H)[1]
+    try:
+        s = np.linalg.svd(H)[1]
+    except Exception:  # no convergence (LAPACK): no measure
+        return np.inf
     sr = s[rank0 - 1] if s.shape[0] >= rank0 else 0.0
     return s[0] / sr if sr > 0 else np.inf
 
