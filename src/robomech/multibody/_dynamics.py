@@ -1131,19 +1131,87 @@ def _forward_compiled(mech, q, rates, tau_a, wr, gravity, act_mode: bool) -> tup
 _F64 = np.dtype(np.float64)
 
 
+def _plain_one(mech, q, rates, tau, gravity) -> bool:
+    """The arguments of a one-sample fast path are of the plain types (arrays, a bool, no subclass)."""
+    return (
+        type(mech) is Mechanism
+        and type(q) is np.ndarray
+        and type(rates) is np.ndarray
+        and (tau is None or type(tau) is np.ndarray)
+        and (gravity is True or gravity is False)
+    )
+
+
+def _forward_one(mech, q, qd_act, tau, gravity) -> ForwardDynamicsResult | None:
+    """One sample in the actuated-rates form (closed chains included), given as C-contiguous float64
+    vectors of the exact shapes, no wrench: checked here (every entry within ``MAX_MAGNITUDE``,
+    quaternions non-zero and normalised), then one call of the kernel block (``_rnea_kernels.fd_block``,
+    the same per-sample code as every batch) with the general path's flags; None (the general path
+    validates, masks and explains) for any other input and for a sample that is not valid."""
+    if not _plain_one(mech, q, qd_act, tau, gravity):
+        return None
+    model = compile_model(mech)
+    tree = model.tree
+    na = len(model.act)
+    if na == 0 or na < model.dof:
+        return None
+    for x, shape in ((q, (tree.nq,)), (qd_act, (na,)), (tau, (na,))):
+        if x is not None and (x.shape != shape or x.dtype is not _F64 or not x.flags.c_contiguous):
+            return None
+    with np.errstate(invalid="ignore"):
+        if not (np.abs(q).max() <= MAX_MAGNITUDE and np.abs(qd_act).max() <= MAX_MAGNITUDE):
+            return None
+        if tau is not None and not np.abs(tau).max() <= MAX_MAGNITUDE:
+            return None
+    if tree.quat_adr:
+        q = q.copy()
+        for a in tree.quat_adr:
+            nrm = float(np.sqrt(q[a] ** 2 + q[a + 1] ** 2 + q[a + 2] ** 2 + q[a + 3] ** 2))
+            if not nrm >= 1e-9:
+                return None
+            q[a : a + 4] /= nrm
+    from ._rnea_kernels import forward
+
+    F = np.zeros((1, tree.nv))
+    if tau is not None:
+        F[0, tree.act_dof] = tau
+    gv = model.cache.get("gravity_vector")
+    if gv is None:
+        gv = model.cache["gravity_vector"] = np.array(mech.gravity, dtype=float)
+    qd, qdd, cond, adm, closure, reg = forward(
+        model, q[None], qd_act[None], F, *_NO_WRENCH, gv if gravity else _ZERO3, True
+    )
+    L = tree.length
+    c, a, cl = cond[0], adm[0], closure[0]
+    if not (
+        reg[0]
+        and c < 1.0 / RANK_RTOL
+        and a <= ADMISSIBLE_RTOL
+        and cl <= CLOSURE_RTOL * L
+        and np.all(np.isfinite(qdd))
+    ):
+        return None
+    return ForwardDynamicsResult(
+        qdd_act=qdd[0, tree.act_dof],
+        qdd=qdd[0],
+        qd=qd[0],
+        cond=np.array(c),
+        admissibility=np.array(a),
+        closure=np.array(cl),
+        valid=np.array(True),
+    )
+
+
+_NO_WRENCH = (np.zeros((1, 0, 6)), np.zeros(0, dtype=np.int64), np.zeros((0, 4, 4)))
+
+
 def _forward_tree_one(mech, q, tau, qd, gravity) -> ForwardDynamicsResult | None:
     """One sample of an open tree (no closure rows) in the full-rate form, given as C-contiguous float64
     vectors of the exact shapes: the kernel checks the entries (within ``MAX_MAGNITUDE``; quaternions
     non-zero) and computes ``qdd`` and ``cond`` in one call, with the general path's flags (no closure:
     admissibility and closure 0, valid where ``cond < 1 / RANK_RTOL`` and every value is finite);
     None (the general path validates and masks) otherwise."""
-    if not (
-        type(mech) is Mechanism
-        and type(q) is np.ndarray
-        and type(qd) is np.ndarray
-        and (tau is None or type(tau) is np.ndarray)
-        and (gravity is True or gravity is False)
-    ):
+    if not _plain_one(mech, q, qd, tau, gravity):
         return None
     model = compile_model(mech)
     tree = model.tree
@@ -1289,9 +1357,15 @@ def forward_dynamics(
     >>> bool(np.allclose(fd.qdd_act, 0.5)), bool(fd.valid)
     (True, True)
     """
-    if qd_act is None and wrenches is None:
-        one = _forward_tree_one(mech, q, tau, qd, gravity)
-        if one is not None:  # one sample of an open tree as float64 vectors: one kernel call
+    if wrenches is None:  # one sample as float64 vectors: one kernel call
+        one = (
+            _forward_tree_one(mech, q, tau, qd, gravity)
+            if qd_act is None
+            else _forward_one(mech, q, qd_act, tau, gravity)
+            if qd is None
+            else None
+        )
+        if one is not None:
             return one
     mech = check_mechanism(mech)
     gravity = check_bool(gravity, "gravity")

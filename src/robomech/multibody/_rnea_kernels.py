@@ -125,19 +125,20 @@ def crba_batch(model, q: np.ndarray) -> np.ndarray:
 # ----------------------------------------------------------------------------- tree forward dynamics
 @_nj
 def mass_cond(M, H):  # pragma: no cover - compiled
-    """The 2-norm condition number of the symmetric ``M (n, n)`` (LAPACK singular values, or the absolute
-    eigenvalues where the SVD does not converge; non-finite entries read as 0; inf where the smallest
-    is 0); ``H (n, n)`` scratch."""
+    """The 2-norm condition number of the symmetric ``M (n, n)`` (its absolute eigenvalues, LAPACK
+    ``syevd``: values only, and it converges where ``gesdd`` may not on clustered values; non-finite
+    entries read as 0; inf where the smallest is 0); ``H (n, n)`` scratch."""
     n = M.shape[0]
     for i in range(n):
         for j in range(n):
             v = M[i, j]
             H[i, j] = v if np.isfinite(v) else 0.0
-    try:
-        s = np.linalg.svd(H)[1]
-    except Exception:  # gesdd can fail to converge on clustered values: |eigenvalues| of symmetric M
-        s = np.sort(np.abs(np.linalg.eigvalsh(H)))[::-1]
-    return s[0] / s[n - 1] if s[n - 1] > 0 else np.inf
+    try:  # symmetric: the singular values are the absolute eigenvalues (LAPACK syevd, values only)
+        e = np.abs(np.linalg.eigvalsh(H))
+    except Exception:  # no convergence: the singular values (gesdd)
+        e = np.linalg.svd(H)[1]
+    hi, lo = np.max(e), np.min(e)
+    return hi / lo if lo > 0 else np.inf
 
 
 @_nj
