@@ -16,6 +16,12 @@
   (:func:`pinocchio_closed_loop`: the Pinocchio model of ``mb.to_pinocchio``, ``pin.rnea``,
   the closure rows from ``getFrameJacobian``, the lean MuJoCo loop's projection; same answer to 1e-8).
 
+* the Delta's closed-chain ``mb.forward_dynamics`` (actuated-rates form) at batch 1 and 10^4 samples.
+
+The compared measurements are taken in interleaved rounds (:func:`_interleaved`: in each round
+robomech and every alternative in turn) and reported as the minimum and the median over the rounds,
+so that the shared machine's background load hits both sides alike; the load average is printed.
+
 ``python benchmarks/bench_latency.py`` prints the table recorded in docs/performance.md (per-call
 latencies are not batched workloads: :func:`workloads` gives ``make bench`` none).
 """
@@ -34,7 +40,7 @@ N_LARGE = 100_000
 N_MJ = 2000  # lean MuJoCo loop samples timed (linear in the count)
 N_FD = 10_000  # closed-chain forward-dynamics samples of the large-batch row
 REPEATS = 3  # batch-1 runs of the arm rows (best kept)
-ROUNDS = 9  # interleaved rounds of the compared measurements (min and median of each reported)
+ROUNDS = 15  # interleaved rounds of the compared measurements (min and median of each reported)
 
 
 def _states(mech, n):
