@@ -16,6 +16,12 @@
   (:func:`pinocchio_closed_loop`: the Pinocchio model of ``mb.to_pinocchio``, ``pin.rnea``,
   the closure rows from ``getFrameJacobian``, the lean MuJoCo loop's projection; same answer to 1e-8).
 
+* the Delta's closed-chain ``mb.forward_dynamics`` (actuated-rates form) at batch 1 and 10^4 samples.
+
+The compared measurements are taken in interleaved rounds (:func:`_interleaved`: in each round
+robomech and every alternative in turn) and reported as the minimum and the median over the rounds,
+so that the shared machine's background load hits both sides alike; the load average is printed.
+
 ``python benchmarks/bench_latency.py`` prints the table recorded in docs/performance.md (per-call
 latencies are not batched workloads: :func:`workloads` gives ``make bench`` none).
 """
@@ -33,7 +39,9 @@ from robomech.verify._mujoco import Engine, assemble_along
 N_BATCH1 = 2000  # batch-1 calls timed
 N_LARGE = 100_000
 N_MJ = 2000  # lean MuJoCo loop samples timed (linear in the count)
-REPEATS = 3  # large-batch runs per thread count (best kept)
+N_FD = 10_000  # closed-chain forward-dynamics samples of the large-batch row
+REPEATS = 3  # batch-1 runs of the arm rows (best kept)
+ROUNDS = 15  # interleaved rounds of the compared measurements (min and median of each reported)
 
 
 def _states(mech, n):
@@ -184,35 +192,61 @@ def _arm_rows() -> list[str]:
     pin.rneaInParallel(threads, pool, QF, QDF, QDDF, TF)
     ours = mb.generalized_forces(mech, Q, QD, QDD)
     assert np.max(np.abs(ours - TF.T)) <= 1e-10 * np.max(np.abs(TF))  # the same answer
-    best = {}
-    for _ in range(REPEATS):  # alternated, best of each: the machine is shared
-        for nt in (threads, 1):
-            numba.set_num_threads(nt)
-            t0 = time.perf_counter()
-            mb.generalized_forces(mech, Q, QD, QDD)
-            t1 = time.perf_counter()
-            pin.rneaInParallel(nt, pool, QF, QDF, QDDF, TF)
-            t2 = time.perf_counter()
-            best[("rm", nt)] = min(best.get(("rm", nt), np.inf), (t1 - t0) / N_LARGE)
-            best[("pin", nt)] = min(best.get(("pin", nt), np.inf), (t2 - t1) / N_LARGE)
+    fns = {}
+    for nt in (threads, 1):  # interleaved: robomech and rneaInParallel in turn, both thread counts
+        fns[("rm", nt)] = _large(lambda: mb.generalized_forces(mech, Q, QD, QDD), N_LARGE, nt)
+        fns[("pin", nt)] = _large(lambda nt=nt: pin.rneaInParallel(nt, pool, QF, QDF, QDDF, TF), N_LARGE, nt)
+    res = _interleaved(fns)
     numba.set_num_threads(threads)
     tl = min(_per(lambda i: pin.rnea(pm, pd, Q[i], QD[i], QDD[i]), N_MJ) for _ in range(REPEATS))
     for nt in (1, threads):
-        a, b = best[("rm", nt)], best[("pin", nt)]
+        a, b = res[("rm", nt)], res[("pin", nt)]
         rows.append(
-            f"| 6-DOF arm generalized_forces, 10^5 samples, {nt} thread(s) (per sample) | {a * 1e6:.2f} us | "
-            f"pinocchio.rneaInParallel({nt}) {b * 1e6:.2f} us | {b / a:.2f}x |"
+            f"| 6-DOF arm generalized_forces, 10^5 samples, {nt} thread(s) (per sample, min / median) | "
+            f"{_mm(a)} | pinocchio.rneaInParallel({nt}) {_mm(b)} | "
+            f"{b[0] / a[0]:.2f}x / {b[1] / a[1]:.2f}x |"
         )
     rows.append(
-        f"| 6-DOF arm generalized_forces, 10^5 samples: parallel speed-up | "
-        f"{best[('rm', 1)] / best[('rm', threads)]:.2f}x | "
-        f"rneaInParallel {best[('pin', 1)] / best[('pin', threads)]:.2f}x | — |"
+        f"| 6-DOF arm generalized_forces, 10^5 samples: parallel speed-up (min / median) | "
+        f"{res[('rm', 1)][0] / res[('rm', threads)][0]:.2f}x / "
+        f"{res[('rm', 1)][1] / res[('rm', threads)][1]:.2f}x | "
+        f"rneaInParallel {res[('pin', 1)][0] / res[('pin', threads)][0]:.2f}x / "
+        f"{res[('pin', 1)][1] / res[('pin', threads)][1]:.2f}x | — |"
     )
     rows.append(
-        f"| 6-DOF arm, 10^5 samples, {threads} threads (per sample) | {best[('rm', threads)] * 1e6:.2f} us | "
-        f"Python loop of pinocchio.rnea {tl * 1e6:.2f} us | {tl / best[('rm', threads)]:.1f}x |"
+        f"| 6-DOF arm, 10^5 samples, {threads} threads (per sample, min) | "
+        f"{res[('rm', threads)][0] * 1e6:.2f} us | "
+        f"Python loop of pinocchio.rnea {tl * 1e6:.2f} us | {tl / res[('rm', threads)][0]:.1f}x |"
     )
     return rows
+
+
+def _interleaved(fns: dict, rounds: int = ROUNDS) -> dict:
+    """``{name: (min, median)}`` of per-sample seconds, the measurements taken in turn in every round
+    (``fns[name]()`` returns one measurement), so that background load hits every one alike."""
+    t: dict = {k: [] for k in fns}
+    for _ in range(rounds):
+        for k, fn in fns.items():
+            t[k].append(fn())
+    return {k: (float(np.min(v)), float(np.median(v))) for k, v in t.items()}
+
+
+def _large(fn, n, threads):
+    """A per-sample timer of one call of ``fn()`` over ``n`` samples on ``threads`` numba threads."""
+    import numba
+
+    def run():
+        numba.set_num_threads(threads)
+        t0 = time.perf_counter()
+        fn()
+        return (time.perf_counter() - t0) / n
+
+    return run
+
+
+def _mm(x: tuple) -> str:
+    """``min / median`` in microseconds."""
+    return f"{x[0] * 1e6:.2f} / {x[1] * 1e6:.2f} us"
 
 
 def _per(fn, n):
@@ -224,7 +258,11 @@ def _per(fn, n):
 
 
 def main() -> None:
+    import os
+
     import numba
+
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
 
     mech = mb.gallery.load("delta")
     q, qd, qdd = _states(mech, N_LARGE)
@@ -233,44 +271,53 @@ def main() -> None:
     one = lean_mujoco(mech)
     tau_mj = np.array([one(q[i], r.qd[i], r.qdd[i]) for i in range(200)])
     assert np.max(np.abs(tau_mj - r.tau)) <= 1e-8 * np.max(np.abs(tau_mj))  # the same answer
-    t1 = min(_per(lambda i: mb.inverse_dynamics(mech, q[i], qd[i], qdd[i]), N_BATCH1) for _ in range(REPEATS))
-    tmj = min(_per(lambda i: one(q[i], r.qd[i % 200], r.qdd[i % 200]), N_MJ) for _ in range(REPEATS))
     pone, to_pin = pinocchio_closed_loop(mech)
     pin_args = [to_pin(q[i], r.qd[i], r.qdd[i]) for i in range(200)]  # converted outside the timing
     tau_pin = np.array([pone(*a) for a in pin_args])
     assert np.max(np.abs(tau_pin - r.tau)) <= 1e-8 * np.max(np.abs(r.tau))  # the same answer
-    tpin = min(_per(lambda i: pone(*pin_args[i % 200]), N_MJ) for _ in range(REPEATS))
     mb.inverse_dynamics(mech, q[:1000], qd[:1000], qdd[:1000])
+    tau = mb.inverse_dynamics(mech, q[:N_FD], qd[:N_FD], qdd[:N_FD]).tau
+    fd = mb.forward_dynamics(mech, q[:N_FD], qd[:N_FD], tau)
+    assert fd.valid.all() and np.max(np.abs(fd.qdd_act - qdd[:N_FD])) <= 1e-4  # the round trip (~1e-5)
     threads = numba.get_num_threads()
-    tp = ts = np.inf
-    for _ in range(REPEATS):  # alternated, best of each: the machine is shared
-        numba.set_num_threads(threads)
-        t0 = time.perf_counter()
-        mb.inverse_dynamics(mech, q, qd, qdd)
-        tp = min(tp, (time.perf_counter() - t0) / N_LARGE)
-        numba.set_num_threads(1)
-        t0 = time.perf_counter()
-        mb.inverse_dynamics(mech, q, qd, qdd)
-        ts = min(ts, (time.perf_counter() - t0) / N_LARGE)
+    n1, nmj = N_BATCH1 // 4, N_MJ // 4  # per round: the rounds are interleaved
+    res = _interleaved(
+        {
+            "id1": lambda: _per(lambda i: mb.inverse_dynamics(mech, q[i], qd[i], qdd[i]), n1),
+            "mj": lambda: _per(lambda i: one(q[i], r.qd[i % 200], r.qdd[i % 200]), nmj),
+            "pin": lambda: _per(lambda i: pone(*pin_args[i % 200]), nmj),
+            "fd1": lambda: _per(lambda i: mb.forward_dynamics(mech, q[i], qd[i], tau[i]), n1),
+            "idN": _large(lambda: mb.inverse_dynamics(mech, q, qd, qdd), N_LARGE, threads),
+            "id1t": _large(lambda: mb.inverse_dynamics(mech, q, qd, qdd), N_LARGE, 1),
+            "fdN": _large(lambda: mb.forward_dynamics(mech, q[:N_FD], qd[:N_FD], tau), N_FD, threads),
+        }
+    )
     numba.set_num_threads(threads)
-    print("| workload | robomech | alternative | alternative / robomech |")
+    t1, tmj, tpin = res["id1"], res["mj"], res["pin"]
+    tp, ts = res["idN"], res["id1t"]
+    print(f"load average (1, 5, 15 min) before the run: {load}")
+    print("| workload | robomech (min / median) | alternative (min / median) | alternative / robomech |")
     print("|---|---|---|---|")
     print(
-        f"| Delta inverse dynamics, batch 1 (per call) | {t1 * 1e6:.0f} us | "
-        f"lean MuJoCo loop {tmj * 1e6:.0f} us | "
-        f"{tmj / t1:.2f}x |"
+        f"| Delta inverse dynamics, batch 1 (per call) | {_mm(t1)} | lean MuJoCo loop {_mm(tmj)} | "
+        f"{tmj[0] / t1[0]:.2f}x |"
     )
     print(
-        f"| Delta inverse dynamics, batch 1 (per call) | {t1 * 1e6:.0f} us | Pinocchio-written loop "
-        f"{tpin * 1e6:.0f} us | {tpin / t1:.2f}x |"
+        f"| Delta inverse dynamics, batch 1 (per call) | {_mm(t1)} | Pinocchio-written loop {_mm(tpin)} | "
+        f"{tpin[0] / t1[0]:.2f}x |"
     )
     print(
-        f"| Delta inverse dynamics, 10^5 samples, {threads} threads (per sample) | {tp * 1e6:.2f} us | "
-        f"{tmj * 1e6:.0f} us | {tmj / tp:.1f}x |"
+        f"| Delta inverse dynamics, 10^5 samples, {threads} threads (per sample) | {_mm(tp)} | "
+        f"lean MuJoCo loop {_mm(tmj)} | {tmj[0] / tp[0]:.1f}x |"
     )
     print(
-        f"| Delta inverse dynamics, 10^5 samples, 1 thread (per sample) | {ts * 1e6:.2f} us | — | "
-        f"parallel speed-up {ts / tp:.2f}x |"
+        f"| Delta inverse dynamics, 10^5 samples, 1 thread (per sample) | {_mm(ts)} | — | "
+        f"parallel speed-up {ts[0] / tp[0]:.2f}x |"
+    )
+    print(f"| Delta forward dynamics (closed chain), batch 1 (per call) | {_mm(res['fd1'])} | — | — |")
+    print(
+        f"| Delta forward dynamics (closed chain), 10^4 samples, {threads} threads (per sample) | "
+        f"{_mm(res['fdN'])} | — | — |"
     )
     for row in _arm_rows():
         print(row)

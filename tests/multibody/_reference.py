@@ -12,9 +12,20 @@ import contextlib
 
 import numpy as np
 
+from robomech.dynamics import _com_terms
 from robomech.multibody import _compiled, _dynamics, _rnea
+from robomech.multibody import _dynamics as D
 from robomech.multibody._assembly import solve_closure
-from robomech.multibody._influence import _influence_flat
+from robomech.multibody._influence import _influence_flat, _pinv
+from robomech.multibody._options import (
+    ADMISSIBLE_RTOL,
+    GRAM_COND_MAX,
+    GRAM_REFINE2_COND,
+    GRAM_REFINE_COND,
+    RANK_RTOL,
+    RATE_FLOOR,
+    SINGULAR_COND,
+)
 from robomech.multibody._tree import frame_jacobian, kinematics
 
 
@@ -41,15 +52,26 @@ def numpy_site_jacobian(mech, q, site):
 
 @contextlib.contextmanager
 def numpy_reference():
-    """Inside the block, FK, site Jacobians and inverse dynamics run the numpy formulation."""
-    saved = (_compiled.compiled_fk, _compiled.compiled_site_jacobian, _dynamics._inverse_compiled)
+    """Inside the block, FK, site Jacobians, inverse and forward dynamics run the numpy formulation."""
+    saved = (
+        _compiled.compiled_fk,
+        _compiled.compiled_site_jacobian,
+        _dynamics._inverse_compiled,
+        _dynamics._forward_compiled,
+    )
     _compiled.compiled_fk = numpy_fk
     _compiled.compiled_site_jacobian = numpy_site_jacobian
-    _dynamics._inverse_compiled = _dynamics._inverse_flat
+    _dynamics._inverse_compiled = _inverse_flat
+    _dynamics._forward_compiled = numpy_forward
     try:
         yield
     finally:
-        _compiled.compiled_fk, _compiled.compiled_site_jacobian, _dynamics._inverse_compiled = saved
+        (
+            _compiled.compiled_fk,
+            _compiled.compiled_site_jacobian,
+            _dynamics._inverse_compiled,
+            _dynamics._forward_compiled,
+        ) = saved
 
 
 # ----------------------------------------------------------------------------- the tree's RNEA and CRBA
@@ -140,3 +162,237 @@ def numpy_crba(mech, q: np.ndarray) -> np.ndarray:
     Mf = F @ S.swapaxes(-1, -2)  # Mf[i, j] = S_i . I^c_{body(i)} S_j
     anc = tree.A[tree.dof_body].astype(bool)  # anc[i, j]: coordinate j moves body(i)
     return np.where(anc, Mf, np.where(anc.T, Mf.swapaxes(-1, -2), 0.0))
+
+
+# ----------------------------------------------------------------------------- closed-chain inverse dynamics
+# The numpy formulation of _compiled.inv_dyn_block (batched over samples): the derivation of
+# _dynamics' module docstring, with the passive pseudo-inverse from a batched LU Gram inverse.
+def _passive_inverse(Kp: np.ndarray, rank0: int, length: float = 1.0):
+    """Pseudo-inverse of the passive block ``Kp (N, m, n)`` with (rank, sigma_min, cond) per sample.
+
+    Fast path where the generic rank is ``min(m, n)`` (no idle motion *and* redundant rows at once):
+    ``P0 = Kp^T (Kp Kp^T)^-1`` (wide) or ``(Kp^T Kp)^-1 Kp^T`` (tall) from a batched inverse, refined
+    ``P_{k+1} = P_k + P0 (I - Kp P_k)`` (once above GRAM_REFINE_COND, twice above GRAM_REFINE2_COND:
+    iterative refinement of the normal equations, for wide and tall alike); ``cond`` is then the 1-norm
+    estimate ``sqrt(||Gram||_1 ||Gram^-1||_1)`` (between the 2-norm one and sqrt(rank) times it) and
+    ``sigma_min`` ``1 / sqrt(||Gram^-1||_1)`` (a lower bound within rank^(1/4)).  Samples above
+    GRAM_COND_MAX, and mechanisms without the fast path, get the SVD pseudo-inverse of the multibody layer.
+    """
+    N, m, n = Kp.shape
+    if m == 0 or n == 0 or rank0 != min(m, n):
+        return _pinv(Kp, length)
+    wide = m <= n
+    KT = Kp.swapaxes(-1, -2)
+    Gm = Kp @ KT if wide else KT @ Kp
+    with np.errstate(all="ignore"):
+        try:
+            Gi = np.linalg.inv(Gm)
+        except np.linalg.LinAlgError:
+            return _pinv(Kp, length)
+        P = KT @ Gi if wide else Gi @ KT
+        ni = np.linalg.norm(Gi, 1, axis=(-2, -1))
+        cond = np.sqrt(np.linalg.norm(Gm, 1, axis=(-2, -1)) * ni)
+        smin = 1.0 / np.sqrt(ni)
+        # refine where the Gram matrix's squared conditioning could show: cond^2 eps > 1e-12
+        for lim in (GRAM_REFINE_COND, GRAM_REFINE2_COND):
+            r = np.flatnonzero(~(cond <= lim))
+            if r.size:
+                P0 = KT[r] @ Gi[r] if wide else Gi[r] @ KT[r]
+                P[r] = P[r] + P0 @ (np.eye(m) - Kp[r] @ P[r])
+    rank = np.full(N, rank0)
+    bad = ~(np.isfinite(cond) & (cond <= GRAM_COND_MAX) & np.all(np.isfinite(P), axis=(-1, -2)))
+    if np.any(bad):
+        Pb, rb, sb, cb = _pinv(Kp[bad], length)
+        P[bad], rank[bad], smin[bad], cond[bad] = Pb, rb, sb, cb
+    return P, rank, smin, cond
+
+
+def _cross_rows(a: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``a_col x p`` for every column of ``a (..., 3, k)`` with ``p (..., 3)`` (component arithmetic:
+    np.cross on broadcast blocks moves axes and is several times slower here)."""
+    x, y, z = p[..., 0, None], p[..., 1, None], p[..., 2, None]
+    a0, a1, a2 = a[..., 0, :], a[..., 1, :], a[..., 2, :]
+    return np.stack([a1 * z - a2 * y, a2 * x - a0 * z, a0 * y - a1 * x], axis=-2)
+
+
+def _com_projected(tree, state, bd, qd, Sd, G, extra_qdd):
+    """Centre-of-mass Jacobians through G, ``J_b G (N, B, 6, na)``, and the accelerations
+    ``Jdot_b qd + J_b extra_qdd (N, B, 6)`` — without the (N, B, 6, nv) Jacobians' cross products."""
+    T = state.T[:, bd.idx]
+    p = (T[..., :3, :3] @ bd.com[:, :, None])[..., 0] + T[..., :3, 3]
+    S = state.S
+    A = tree.A[bd.idx]  # (B, nv)
+    SG = np.empty((S.shape[0], len(bd.idx), 6, G.shape[-1]))  # (N, B, 6, na): sum over b's path of S_k G_k
+    St = S.swapaxes(-1, -2)
+    for i, b in enumerate(bd.idx):
+        c = D._path(tree, b)
+        SG[:, i] = St[:, :, c] @ G[:, c]
+    JG = np.concatenate([SG[..., :3, :], SG[..., 3:, :] + _cross_rows(SG[..., :3, :], p)], axis=-2)
+    V = A @ (S * qd[..., None])
+    Vd = A @ (Sd * qd[..., None] + S * extra_qdd[..., None])
+    w = V[..., :3]
+    pd = V[..., 3:] + np.cross(w, p)
+    a0 = np.concatenate([Vd[..., :3], Vd[..., 3:] + np.cross(Vd[..., :3], p) + np.cross(w, pd)], axis=-1)
+    return JG, a0
+
+
+def _projector(mech, K, G, dof, w):
+    """Redundant actuation: the rule's projector Pi (N, na, na); False where null(K G) is not ``dof``-wide."""
+    N, _, na = G.shape
+    KG = (K @ G) / mech.tree.length
+    s_full = np.zeros((N, na))
+    if KG.shape[1]:
+        _, s, Vt = np.linalg.svd(KG, full_matrices=True)
+        s_full[:, : s.shape[1]] = s[:, :na]
+    else:
+        Vt = np.broadcast_to(np.eye(na), (N, na, na))
+    # singular values ascending over the right singular vectors: the last `dof` rows of Vt span null(KG)
+    Nc = Vt[:, na - dof :].swapaxes(-1, -2)  # (N, na, dof)
+    top = np.maximum(np.max(s_full, axis=-1), 1.0)
+    gap_ok = np.all(s_full[:, na - dof :] <= RANK_RTOL * 1e2 * top[:, None], axis=-1)
+    if dof < na:
+        gap_ok &= s_full[:, na - dof - 1] > RANK_RTOL * 1e2 * top
+    if w is None:
+        Pi = Nc @ Nc.swapaxes(-1, -2)
+    else:
+        WN = w[:, None] * Nc
+        A = Nc.swapaxes(-1, -2) @ WN
+        ok = np.linalg.cond(A) < 1.0 / RANK_RTOL
+        A = np.where(ok[:, None, None], A, np.eye(dof))
+        Pi = WN @ np.linalg.solve(A, Nc.swapaxes(-1, -2))
+        gap_ok &= ok
+    return Pi, gap_ok
+
+
+def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
+    tree = mech.tree
+    rank0, dof = D._reference(mech)
+    na = len(tree.act_dof)
+    act = tree.act_dof
+    pas = np.setdiff1d(np.arange(tree.nv), act)
+    N = q.shape[0]
+    state = kinematics(tree, q)
+    K = D._constraint_matrix(mech, state, q)
+    P, rank, smin, cond = _passive_inverse(K[..., pas], rank0, tree.length)
+    G = np.zeros((N, tree.nv, na))
+    G[:, act, np.arange(na)] = 1.0
+    G[:, pas] = -P @ K[..., act]
+    qd = D._mv(G, qd_a)
+    Sd = D._screw_rates(tree, state, qd)
+    kdq = D._kdot_qd(mech, state, q, qd, Sd)
+    qdd = D._mv(G, qdd_a)
+    qdd[:, pas] -= D._mv(P, kdq)
+    # Project each body's Jacobian through G first (6 x n_act instead of 6 x nv): the tree mass matrix is
+    # never formed.  The convective acceleration J (qdd - G qdd_act) joins the velocity-product terms.
+    bd = D._bodies(mech)
+    R = state.T[:, bd.idx, :3, :3]
+    Iw = R @ bd.inertia @ R.swapaxes(-1, -2)
+    conv = qdd - D._mv(G, qdd_a)
+    JG, a0 = _com_projected(tree, state, bd, qd, Sd, G, conv)
+    gv = np.asarray(mech.gravity) if gravity else np.zeros(3)
+    terms = _com_terms(np.broadcast_to(bd.mass, (N, len(bd.mass))), Iw, JG, a0, qd_a, qdd_a, gv[None])
+    ext = D._site_terms(mech, state, wr)
+    GT = G.swapaxes(-1, -2)
+    M_a = terms.M
+    vel = terms.velocity_terms
+    grav = terms.gravity_terms
+    ex = D._mv(GT, ext)
+    ok = np.ones(N, dtype=bool)
+    if na > dof or weights is not None:
+        Pi, ok = _projector(mech, K, G, dof, weights)
+        M_a = Pi @ M_a
+        vel, grav, ex = (D._mv(Pi, x) for x in (vel, grav, ex))
+    tau = D._mv(M_a, qdd_a) + vel + grav + ex
+    L = tree.length
+    sv = np.max(np.abs(qd), axis=-1) if tree.nv else np.zeros(N)
+    sa = np.max(np.abs(qdd), axis=-1) + sv * sv if tree.nv else np.zeros(N)
+    if K.shape[1]:
+        e1 = np.max(np.abs(D._mv(K, qd)), axis=-1) / (L * np.maximum(sv, RATE_FLOOR))
+        e2 = np.max(np.abs(D._mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
+        adm = np.maximum(e1, e2)
+    else:
+        adm = np.zeros(N)
+    fin = np.all(np.isfinite(tau), axis=-1) & np.all(np.isfinite(M_a), axis=(-1, -2))
+    valid = ok & fin & (rank >= rank0) & (cond <= SINGULAR_COND) & (adm <= ADMISSIBLE_RTOL)
+    return dict(
+        tau=tau,
+        M_a=M_a,
+        velocity_terms=vel,
+        gravity_terms=grav,
+        external_terms=ex,
+        qd=qd,
+        qdd=qdd,
+        cond=cond,
+        sigma_min=smin,
+        admissibility=adm,
+        valid=valid,
+    )
+
+
+# ----------------------------------------------------------------------------- forward dynamics
+# The numpy formulation of _rnea_kernels.fd_block (batched over samples): the closure a constraint on
+# the tree accelerations, qdd = qdd_p + u, K qdd_p = -Kdot qd (minimum norm at the generic rank of K),
+# Mc u = Pn (f - M qdd_p), Pn = I - K^+ K, Mc = Pn M Pn + (I - Pn), solved by LU (LAPACK gesv).
+def _solve_each(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``A x = b`` per sample; an exactly singular matrix gives NaN for its sample only."""
+    try:
+        return np.linalg.solve(A, b[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        out = np.full(b.shape, np.nan)
+        for i in range(A.shape[0]):
+            try:
+                out[i] = np.linalg.solve(A[i], b[i])
+            except np.linalg.LinAlgError:
+                pass
+        return out
+
+
+def numpy_forward(mech, q, rates, tau_a, wr, gravity, act_mode):
+    """``(qd, qdd, cond, admissibility, closure, regular)`` of ``_dynamics._forward_compiled``."""
+    from robomech.multibody._constraints import residual
+
+    tree = mech.tree
+    N, nv = q.shape[0], tree.nv
+    L = tree.length
+    act = tree.act_dof
+    pas = np.setdiff1d(np.arange(nv), act)
+    rank0 = D._reference(mech)[0]
+    state = kinematics(tree, q)
+    K = D._constraint_matrix(mech, state, q)
+    if act_mode:
+        P, rank, _, cK = _pinv(K[..., pas], L)
+        qd = np.zeros((N, nv))
+        qd[:, act] = rates
+        qd[:, pas] = -np.einsum("nij,njk,nk->ni", P, K[..., act], rates)
+        reg = (rank >= rank0) & (cK <= SINGULAR_COND)
+        e1 = np.zeros(N)
+    else:
+        qd = np.array(rates)
+        reg = np.ones(N, dtype=bool)
+        sv = np.max(np.abs(qd), axis=-1)
+        e1 = np.max(np.abs(D._mv(K, qd)), axis=-1, initial=0.0) / (L * np.maximum(sv, RATE_FLOOR))
+    kdq = D._kdot_qd(mech, state, q, qd, D._screw_rates(tree, state, qd))
+    g = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
+    M = numpy_crba(mech, q)
+    f = -numpy_rnea(mech, q, qd, np.zeros_like(qd), g) - D._site_terms(mech, state, wr)
+    f[:, act] += tau_a
+    if K.shape[1]:
+        Kp, _ = D._pinv_rank(K, D._rank_K(mech))  # (N, nv, m)
+        qdd_p = -D._mv(Kp, kdq)
+        Pn = np.eye(nv) - Kp @ K
+    else:
+        qdd_p = np.zeros((N, nv))
+        Pn = np.broadcast_to(np.eye(nv), (N, nv, nv))
+    Mc = Pn @ M @ Pn + (np.eye(nv) - Pn)
+    rhs = D._mv(Pn, f - D._mv(M, qdd_p))
+    s = np.linalg.svd(np.where(np.isfinite(Mc), Mc, 0.0), compute_uv=False)
+    cond = np.where(s[:, -1] > 0, s[:, 0] / np.where(s[:, -1] > 0, s[:, -1], 1.0), np.inf)
+    qdd = qdd_p + _solve_each(Mc, rhs)
+    sa = np.max(np.abs(qdd), axis=-1) + np.max(np.abs(qd), axis=-1) ** 2
+    e2 = np.max(np.abs(D._mv(K, qdd) + kdq), axis=-1, initial=0.0) / (L * np.maximum(sa, RATE_FLOOR))
+    adm = np.maximum(e1, np.where(np.isfinite(e2), e2, np.inf))
+    closure = np.max(np.abs(residual(mech.constraints, tree, state, q)), axis=-1, initial=0.0)
+    if act_mode and np.any(~reg):  # a singular passive block: its measure against the generic rank
+        bad = np.flatnonzero(~reg)
+        cond[bad] = np.maximum(cond[bad], D._rank_measures(K[bad][..., pas], rank0, L)[1])
+    return qd, qdd, cond, adm, closure, reg

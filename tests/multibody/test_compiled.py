@@ -219,3 +219,104 @@ def test_compiled_redundant_weights_and_singular_flags():
     fast, slow = _both(toggle, q, [[0.0], [0.3]], [[0.0], [0.1]])
     assert fast.valid.tolist() == [False, True]
     _assert_same(fast, slow)
+
+
+# ----------------------------------------------------------------------------- forward dynamics
+# The compiled forward dynamics (_rnea_kernels.fd_block) against its numpy formulation
+# (_reference.numpy_forward): the same constrained solve with the projected mass matrix Mc factorised
+# by Cholesky (compiled) instead of LU (numpy).  Accelerations agree to rounding amplified by Mc's
+# conditioning (the Delta's idle leg spins: cond ~3e5, measured difference 3e-10 on |qdd| ~7, i.e.
+# 1.7e-16 * cond * |qdd|); FD_COND_RTOL bounds it with a 60x margin.
+FD_COND_RTOL = 1e-14
+# cond itself is a ratio of LAPACK singular values of two Mc that differ by rounding: relative
+# agreement to ~cond * eps (6e-11 measured on the Delta).
+FD_CONDNUM_RTOL = 1e-9
+# Same samples at any batch size: one kernel, the same per-sample code (measured identical).
+BATCH_TOL = 1e-12
+
+
+def _assert_same_forward(fast, slow):
+    assert np.array_equal(fast.valid, slow.valid)
+    v = slow.valid
+    tol = FD_COND_RTOL * slow.cond[v] * np.maximum(1.0, np.max(np.abs(slow.qdd[v]), axis=-1))
+    assert np.all(np.max(np.abs(fast.qdd[v] - slow.qdd[v]), axis=-1) <= tol)
+    assert np.array_equal(np.isnan(fast.qd), np.isnan(slow.qd))
+    assert np.nanmax(np.abs(fast.qd - slow.qd)) <= ID_RTOL * max(1.0, float(np.nanmax(np.abs(slow.qd))))
+    assert np.all(np.abs(fast.cond[v] - slow.cond[v]) <= FD_CONDNUM_RTOL * slow.cond[v])
+    assert np.max(np.abs(fast.admissibility[v] - slow.admissibility[v]), initial=0.0) <= ADM_ATOL
+    assert np.array_equal(np.isnan(fast.closure), np.isnan(slow.closure))
+    assert np.nanmax(np.abs(fast.closure - slow.closure)) <= ADM_ATOL
+
+
+def _arm():
+    """A 3-DOF open chain with a site (no closure rows): the kernel's tree case."""
+    b = mb.Builder("arm3")
+    parent = "world"
+    for i, ax in enumerate([(0, 0, 1), (0, 1, 0), (1, 0, 0)]):
+        inertial = mb.Inertial(1.0 + 0.2 * i, pos=(0.05, 0.01, 0.02), diaginertia=(0.01, 0.012, 0.008))
+        b.body(
+            f"l{i}",
+            parent=parent,
+            pos=(0.2 * (i > 0), 0, 0),
+            joints=[b.hinge(f"j{i}", axis=ax)],
+            inertial=inertial,
+        )
+        parent = f"l{i}"
+    b.site("tool", parent, pos=(0.1, 0, 0))
+    b.actuate("j0", "j1", "j2")
+    return b.build()
+
+
+@pytest.mark.parametrize("name", ["four_bar", "delta", "bennett", "arm"])
+def test_compiled_forward_dynamics_equals_numpy(name):
+    """Closed chains in both rate forms, with a site wrench and a NaN sample, and an open tree (no
+    closure rows) with a site wrench: kernel = numpy formulation; batch 1, 150, 300 and 1000 agree."""
+    if name == "arm":
+        mech = _arm()
+        rng = np.random.default_rng(5)
+        q, qd = rng.uniform(-1, 1, (40, 3)), rng.normal(size=(40, 3))
+    else:
+        mech = _mechanism(name)
+        q, qd, _ = _states(mech, 6, 40, seed=21)
+    rng = np.random.default_rng(22)
+    tau = rng.normal(size=(q.shape[0], len(mech.actuated)))
+    W = {mech.sites[0].name: rng.normal(size=(q.shape[0], 6))}
+    full = mb.inverse_dynamics(mech, q, qd, np.zeros_like(qd)).qd  # every coordinate's rate
+    qd_bad, full_bad = qd.copy(), full.copy()
+    qd_bad[3, 0] = full_bad[3, 0] = np.nan
+    cases = (
+        dict(qd_act=qd_bad),
+        dict(qd=full_bad),
+        dict(qd_act=qd, wrenches=W),
+        dict(qd=full, gravity=False),
+    )
+    for kw in cases:
+        fast = mb.forward_dynamics(mech, q, tau=tau, **kw)
+        with _numpy_path():
+            slow = mb.forward_dynamics(mech, q, tau=tau, **kw)
+        assert slow.valid.mean() > 0.9
+        _assert_same_forward(fast, slow)
+    bad = mb.forward_dynamics(mech, q, qd_bad, tau)
+    assert not bad.valid[3] and np.all(np.isnan(bad.qdd[3])) and bad.valid[np.r_[0:3, 4:40]].all()
+    ref = mb.forward_dynamics(mech, q, qd, tau)
+    for n in (1, 150, 300, 1000):  # the same samples at any batch size
+        i = np.arange(n) % q.shape[0]
+        got = mb.forward_dynamics(mech, q[i], qd[i], tau[i])
+        assert np.max(np.abs(got.qdd - ref.qdd[i])) <= BATCH_TOL
+    one = mb.forward_dynamics(mech, q[7], qd[7], tau[7])  # one sample as vectors
+    assert np.max(np.abs(one.qdd - ref.qdd[7])) <= BATCH_TOL
+
+
+def test_forward_dynamics_where_the_svd_does_not_converge():
+    """A Delta state (from its verify trajectory) whose projected mass matrix, with its clustered
+    eigenvalues, makes the kernels' LAPACK ``gesdd`` fail to converge: the kernel takes the absolute
+    eigenvalues instead and agrees with the numpy formulation (whose LAPACK converges)."""
+    mech = mb.gallery.load("delta")
+    fk = mb.forward_kinematics(mech, [0.4840417982516419, 0.7126031330937269, 0.5836989511254661])
+    qd = np.array([0.13238181720076647, 0.09335912850589508, 0.6005314480740297])
+    tau = np.array([-0.7684453161520064, -0.8910961554337876, -0.8506684344461466])
+    fast = mb.forward_dynamics(mech, fk.q[None], qd[None], tau[None])
+    with _numpy_path():
+        slow = mb.forward_dynamics(mech, fk.q[None], qd[None], tau[None])
+    assert fk.converged and fast.valid.all()
+    _assert_same_forward(fast, slow)

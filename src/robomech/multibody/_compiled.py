@@ -582,7 +582,11 @@ def svd_pinv(Kp, rtol, P):  # pragma: no cover - compiled
     if not _all_finite(Kp):  # LAPACK refuses it; the sample is flagged (rank 0)
         P[:, :] = np.nan
         return 0, np.inf, np.inf
-    U, s, Vt = np.linalg.svd(np.ascontiguousarray(Kp), full_matrices=False)
+    try:
+        U, s, Vt = np.linalg.svd(np.ascontiguousarray(Kp), full_matrices=False)
+    except Exception:  # no convergence (LAPACK): flagged as a non-finite block is
+        P[:, :] = np.nan
+        return 0, np.inf, np.inf
     cut = rtol * s[0]
     rank = 0
     smin = np.inf
@@ -602,7 +606,7 @@ def svd_pinv(Kp, rtol, P):  # pragma: no cover - compiled
 
 @_nj
 def passive_inverse(Kp, d, Gi, P):  # pragma: no cover - compiled
-    """``_dynamics._passive_inverse`` for one sample: (mode, rank, sigma_min, cond).
+    """The passive block's pseudo-inverse for one sample: (mode, rank, sigma_min, cond).
 
     Gram path (mode 1 wide, 2 tall) where the generic rank is min(m, n): ``P = Kp^T (Kp Kp^T)^-1`` or
     ``(Kp^T Kp)^-1 Kp^T``, with the Gram inverse ``Gi`` by Cholesky (numpy's path: LU; equal to rounding)
@@ -726,6 +730,102 @@ def passive_solve(Kp, Gi, P, mode, nref, b, x, res, dx, tmp):  # pragma: no cove
 
 
 @_nj
+def rates_kdot(q, t, T, S, qd, Sd, V, Vd, kdq):  # pragma: no cover - compiled
+    """At the kinematics ``T``, ``S`` and rates ``qd (nv,)``: the screw rates ``Sd (nv, 6)``, the body
+    twists ``V (nb, 6)`` (space, ``[w; v at the origin]``), ``Vd = sum_k A Sd_k qd_k (nb, 6)`` and the
+    closure rows' velocity-product accelerations ``Kdot qd (m,)``."""
+    A, C, L = t.A, t.C, t.L
+    nb, nv = A.shape
+    # screw rates dS_k = [w_c x w_k; w_c x v_k - w_k x v_c], V_c the carrier twist of coordinate k
+    for k in range(nv):
+        c0 = c1 = c2 = c3 = c4 = c5 = 0.0
+        for j in range(nv):
+            if C[k, j] != 0.0:
+                f = C[k, j] * qd[j]
+                c0 += f * S[j, 0]
+                c1 += f * S[j, 1]
+                c2 += f * S[j, 2]
+                c3 += f * S[j, 3]
+                c4 += f * S[j, 4]
+                c5 += f * S[j, 5]
+        w0, w1, w2, v0, v1, v2 = S[k, 0], S[k, 1], S[k, 2], S[k, 3], S[k, 4], S[k, 5]
+        Sd[k, 0] = c1 * w2 - c2 * w1
+        Sd[k, 1] = c2 * w0 - c0 * w2
+        Sd[k, 2] = c0 * w1 - c1 * w0
+        Sd[k, 3] = (c1 * v2 - c2 * v1) - (w1 * c5 - w2 * c4)
+        Sd[k, 4] = (c2 * v0 - c0 * v2) - (w2 * c3 - w0 * c5)
+        Sd[k, 5] = (c0 * v1 - c1 * v0) - (w0 * c4 - w1 * c3)
+    for b in range(nb):
+        for i in range(6):
+            acc = 0.0
+            acc2 = 0.0
+            for k in range(nv):
+                if A[b, k] != 0.0:
+                    acc += A[b, k] * S[k, i] * qd[k]
+                    acc2 += A[b, k] * Sd[k, i] * qd[k]
+            V[b, i] = acc
+            Vd[b, i] = acc2
+    # Kdot qd, block by block (_dynamics._kdot_qd)
+    for i in range(t.pp.shape[0]):
+        row = t.pp[i, 2]
+        for c in range(3):
+            kdq[row + c] = 0.0
+        for side in range(2):
+            b = t.pp[i, side]
+            x = t.px[i, side]
+            sign = 1.0 if side == 0 else -1.0
+            p0 = T[b, 0, 3] + T[b, 0, 0] * x[0] + T[b, 0, 1] * x[1] + T[b, 0, 2] * x[2]
+            p1 = T[b, 1, 3] + T[b, 1, 0] * x[0] + T[b, 1, 1] * x[1] + T[b, 1, 2] * x[2]
+            p2 = T[b, 2, 3] + T[b, 2, 0] * x[0] + T[b, 2, 1] * x[1] + T[b, 2, 2] * x[2]
+            w0, w1, w2 = V[b, 0], V[b, 1], V[b, 2]
+            pd0 = V[b, 3] + w1 * p2 - w2 * p1
+            pd1 = V[b, 4] + w2 * p0 - w0 * p2
+            pd2 = V[b, 5] + w0 * p1 - w1 * p0
+            e0, e1, e2 = Vd[b, 0], Vd[b, 1], Vd[b, 2]
+            kdq[row] += sign * (Vd[b, 3] + (e1 * p2 - e2 * p1) + (w1 * pd2 - w2 * pd1))
+            kdq[row + 1] += sign * (Vd[b, 4] + (e2 * p0 - e0 * p2) + (w2 * pd0 - w0 * pd2))
+            kdq[row + 2] += sign * (Vd[b, 5] + (e0 * p1 - e1 * p0) + (w0 * pd1 - w1 * pd0))
+    for i in range(t.rr.shape[0]):
+        b1, b2, row = t.rr[i, 0], t.rr[i, 1], t.rr[i, 2]
+        for c in range(3):
+            kdq[row + c] = L * (Vd[b2, c] - Vd[b1, c])
+    for i in range(t.cc.shape[0]):
+        d2, q2, row = t.cc[i, 2], t.cc[i, 3], t.cc[i, 4]
+        if d2 >= 0:
+            x = q[q2] - t.cf[i, 1]
+            dd = 2 * t.cf[i, 4] + x * (6 * t.cf[i, 5] + x * 12 * t.cf[i, 6])
+            kdq[row] = -t.cf[i, 7] * dd * qd[d2] ** 2
+        else:
+            kdq[row] = 0.0
+
+
+@_nj
+def site_forces(T, S, A, Wn, wsb, wT, ps, ext):  # pragma: no cover - compiled
+    """``ext = -sum_s J_s^T W_s (nv,)`` for the wrenches ``Wn (ns, 6)`` applied at the sites on bodies
+    ``wsb`` with frames ``wT (ns, 4, 4)`` (``ps (3,)`` scratch)."""
+    nv = S.shape[0]
+    nw = wsb.shape[0]
+    ext[:] = 0.0
+    for s in range(nw):
+        b = wsb[s]
+        Ts = wT[s]
+        for i in range(3):
+            ps[i] = T[b, i, 3] + T[b, i, 0] * Ts[0, 3] + T[b, i, 1] * Ts[1, 3] + T[b, i, 2] * Ts[2, 3]
+        Wn_s = Wn[s]
+        for k in range(nv):
+            if A[b, k] != 0.0:
+                w0, w1, w2 = S[k, 0], S[k, 1], S[k, 2]
+                ext[k] -= (
+                    w0 * Wn_s[0]
+                    + w1 * Wn_s[1]
+                    + w2 * Wn_s[2]
+                    + (S[k, 3] + w1 * ps[2] - w2 * ps[1]) * Wn_s[3]
+                    + (S[k, 4] + w2 * ps[0] - w0 * ps[2]) * Wn_s[4]
+                    + (S[k, 5] + w0 * ps[1] - w1 * ps[0]) * Wn_s[5]
+                )
+
+
+@_nj
 def inv_dyn_block(
     lo,
     hi,
@@ -754,12 +854,11 @@ def inv_dyn_block(
 ):  # pragma: no cover - compiled
     """The closed-chain inverse dynamics of samples ``lo:hi`` (derivation: ``_dynamics``' docstring)."""
     nb = t.parent.shape[0]
-    A, C, m, L = t.A, t.C, t.m, t.L
+    A, m, L = t.A, t.m, t.L
     nv = A.shape[1]
     act, pas = d.act, d.pas
     na, npas = act.shape[0], pas.shape[0]
     B = d.bidx.shape[0]
-    nw = wsb.shape[0]
     dof = d.dof
     redundant = na > dof or wts.shape[0] > 0
     ps = np.empty(3)
@@ -829,67 +928,7 @@ def inv_dyn_block(
                 acc2 += G[k, j] * qdda[j]
             qd[k] = acc
             qdd[k] = acc2
-        # screw rates dS_k = [w_c x w_k; w_c x v_k - w_k x v_c], V_c the carrier twist of coordinate k
-        for k in range(nv):
-            c0 = c1 = c2 = c3 = c4 = c5 = 0.0
-            for j in range(nv):
-                if C[k, j] != 0.0:
-                    f = C[k, j] * qd[j]
-                    c0 += f * S[j, 0]
-                    c1 += f * S[j, 1]
-                    c2 += f * S[j, 2]
-                    c3 += f * S[j, 3]
-                    c4 += f * S[j, 4]
-                    c5 += f * S[j, 5]
-            w0, w1, w2, v0, v1, v2 = S[k, 0], S[k, 1], S[k, 2], S[k, 3], S[k, 4], S[k, 5]
-            Sd[k, 0] = c1 * w2 - c2 * w1
-            Sd[k, 1] = c2 * w0 - c0 * w2
-            Sd[k, 2] = c0 * w1 - c1 * w0
-            Sd[k, 3] = (c1 * v2 - c2 * v1) - (w1 * c5 - w2 * c4)
-            Sd[k, 4] = (c2 * v0 - c0 * v2) - (w2 * c3 - w0 * c5)
-            Sd[k, 5] = (c0 * v1 - c1 * v0) - (w0 * c4 - w1 * c3)
-        for b in range(nb):
-            for i in range(6):
-                acc = 0.0
-                acc2 = 0.0
-                for k in range(nv):
-                    if A[b, k] != 0.0:
-                        acc += A[b, k] * S[k, i] * qd[k]
-                        acc2 += A[b, k] * Sd[k, i] * qd[k]
-                V[b, i] = acc
-                Vd[b, i] = acc2
-        # Kdot qd, block by block (_dynamics._kdot_qd)
-        for i in range(t.pp.shape[0]):
-            row = t.pp[i, 2]
-            for c in range(3):
-                kdq[row + c] = 0.0
-            for side in range(2):
-                b = t.pp[i, side]
-                x = t.px[i, side]
-                sign = 1.0 if side == 0 else -1.0
-                p0 = T[b, 0, 3] + T[b, 0, 0] * x[0] + T[b, 0, 1] * x[1] + T[b, 0, 2] * x[2]
-                p1 = T[b, 1, 3] + T[b, 1, 0] * x[0] + T[b, 1, 1] * x[1] + T[b, 1, 2] * x[2]
-                p2 = T[b, 2, 3] + T[b, 2, 0] * x[0] + T[b, 2, 1] * x[1] + T[b, 2, 2] * x[2]
-                w0, w1, w2 = V[b, 0], V[b, 1], V[b, 2]
-                pd0 = V[b, 3] + w1 * p2 - w2 * p1
-                pd1 = V[b, 4] + w2 * p0 - w0 * p2
-                pd2 = V[b, 5] + w0 * p1 - w1 * p0
-                e0, e1, e2 = Vd[b, 0], Vd[b, 1], Vd[b, 2]
-                kdq[row] += sign * (Vd[b, 3] + (e1 * p2 - e2 * p1) + (w1 * pd2 - w2 * pd1))
-                kdq[row + 1] += sign * (Vd[b, 4] + (e2 * p0 - e0 * p2) + (w2 * pd0 - w0 * pd2))
-                kdq[row + 2] += sign * (Vd[b, 5] + (e0 * p1 - e1 * p0) + (w0 * pd1 - w1 * pd0))
-        for i in range(t.rr.shape[0]):
-            b1, b2, row = t.rr[i, 0], t.rr[i, 1], t.rr[i, 2]
-            for c in range(3):
-                kdq[row + c] = L * (Vd[b2, c] - Vd[b1, c])
-        for i in range(t.cc.shape[0]):
-            d2, q2, row = t.cc[i, 2], t.cc[i, 3], t.cc[i, 4]
-            if d2 >= 0:
-                x = q[q2] - t.cf[i, 1]
-                dd = 2 * t.cf[i, 4] + x * (6 * t.cf[i, 5] + x * 12 * t.cf[i, 6])
-                kdq[row] = -t.cf[i, 7] * dd * qd[d2] ** 2
-            else:
-                kdq[row] = 0.0
+        rates_kdot(q, t, T, S, qd, Sd, V, Vd, kdq)
         # qdd = G qdd_act - [0; P kdq]; the convective part conv = qdd - G qdd_act
         conv[:] = 0.0
         passive_solve(Kp, Gi, P, mode, nref, kdq, xp, res, dxp, tmpk)
@@ -977,31 +1016,14 @@ def inv_dyn_block(
                         + mb * (JG[3, j] * JG[3, c] + JG[4, j] * JG[4, c] + JG[5, j] * JG[5, c])
                     )
         # site wrenches: ex = -G^T sum_s J_s^T W_s
-        ext[:] = 0.0
-        for s in range(nw):
-            b = wsb[s]
-            Ts = wT[s]
-            for i in range(3):
-                ps[i] = T[b, i, 3] + T[b, i, 0] * Ts[0, 3] + T[b, i, 1] * Ts[1, 3] + T[b, i, 2] * Ts[2, 3]
-            Wn = W[n, s]
-            for k in range(nv):
-                if A[b, k] != 0.0:
-                    w0, w1, w2 = S[k, 0], S[k, 1], S[k, 2]
-                    ext[k] -= (
-                        w0 * Wn[0]
-                        + w1 * Wn[1]
-                        + w2 * Wn[2]
-                        + (S[k, 3] + w1 * ps[2] - w2 * ps[1]) * Wn[3]
-                        + (S[k, 4] + w2 * ps[0] - w0 * ps[2]) * Wn[4]
-                        + (S[k, 5] + w0 * ps[1] - w1 * ps[0]) * Wn[5]
-                    )
+        site_forces(T, S, A, W[n], wsb, wT, ps, ext)
         for j in range(na):
             acc = 0.0
             for k in range(nv):
                 acc += G[k, j] * ext[k]
             ex[j] = acc
         ok = True
-        if redundant:  # _dynamics._projector
+        if redundant:  # the redundant-actuation rule's projector Pi (module docstring of _dynamics)
             for i in range(m):
                 for j in range(na):
                     acc = 0.0
@@ -1293,6 +1315,23 @@ def _inertia_apply(mb, c, Ic, X, out):  # pragma: no cover - compiled
 
 
 @_nj
+def inertia_world(T, t, ib, c, Ic, RI):  # pragma: no cover - compiled
+    """World centre of mass ``c (3,)`` and inertia about it ``Ic = R I R^T (3, 3)`` of the massive body
+    ``t.bidx[ib]`` (``RI (3, 3)`` scratch: ``I R^T``)."""
+    b = t.bidx[ib]
+    cx = t.com[ib]
+    Ib = t.inertia[ib]
+    for i in range(3):
+        c[i] = T[b, i, 3] + T[b, i, 0] * cx[0] + T[b, i, 1] * cx[1] + T[b, i, 2] * cx[2]
+    for u in range(3):
+        for j in range(3):
+            RI[u, j] = Ib[u, 0] * T[b, j, 0] + Ib[u, 1] * T[b, j, 1] + Ib[u, 2] * T[b, j, 2]
+    for i in range(3):
+        for j in range(3):
+            Ic[i, j] = T[b, i, 0] * RI[0, j] + T[b, i, 1] * RI[1, j] + T[b, i, 2] * RI[2, j]
+
+
+@_nj
 def rnea_block(lo, hi, Q, QD, QDD, gv, t, tau_o):  # pragma: no cover - compiled
     """The spanning tree's recursive Newton-Euler inverse dynamics of samples ``lo:hi`` (world frame,
     the formulation of ``_rnea``: forward pass of twists and accelerations, the base accelerating at
@@ -1307,11 +1346,15 @@ def rnea_block(lo, hi, Q, QD, QDD, gv, t, tau_o):  # pragma: no cover - compiled
     vj = np.empty(6)
     c = np.empty(3)
     Ic = np.empty((3, 3))
+    RI = np.empty((3, 3))
     h = np.empty(6)
     fa = np.empty(6)
+    Rj = np.empty((3, 3))
+    Rn = np.empty((3, 3))
+    anchor = np.empty(3)
     for n in range(lo, hi):
         q, qd, qdd = Q[n], QD[n], QDD[n]
-        kin(q, t, T, S)
+        kin_into(q, t, T, S, Rj, Rn, anchor)
         for i in range(6):
             V[0, i] = 0.0
             Acc[0, i] = 0.0
@@ -1358,17 +1401,7 @@ def rnea_block(lo, hi, Q, QD, QDD, gv, t, tau_o):  # pragma: no cover - compiled
         F[:, :] = 0.0
         for ib in range(t.bidx.shape[0]):
             b = t.bidx[ib]
-            cx = t.com[ib]
-            for i in range(3):
-                c[i] = T[b, i, 3] + T[b, i, 0] * cx[0] + T[b, i, 1] * cx[1] + T[b, i, 2] * cx[2]
-            Ib = t.inertia[ib]
-            for i in range(3):
-                for j in range(3):
-                    acc = 0.0
-                    for u in range(3):
-                        ru = Ib[u, 0] * T[b, j, 0] + Ib[u, 1] * T[b, j, 1] + Ib[u, 2] * T[b, j, 2]
-                        acc += T[b, i, u] * ru
-                    Ic[i, j] = acc
+            inertia_world(T, t, ib, c, Ic, RI)
             _inertia_apply(t.mass[ib], c, Ic, Acc[b], fa)
             _inertia_apply(t.mass[ib], c, Ic, V[b], h)
             w0, w1, w2, v0, v1, v2 = V[b, 0], V[b, 1], V[b, 2], V[b, 3], V[b, 4], V[b, 5]
@@ -1498,6 +1531,7 @@ def warm() -> None:
         compiled_site_jacobian(mech, qf, site)
         z = np.zeros((n, len(model.act)))
         _dynamics._inverse_compiled(mech, qf, z, z, {}, None, True)
+        _dynamics.forward_dynamics(mech, qf, z, tau=z)  # the closed-chain forward dynamics kernel
     inv_dyn_one(model, mech.q0, np.zeros(1), np.zeros(1), mech.gravity, True)
     from ._designs import design_batch, ik_designs, site_measures_designs
 

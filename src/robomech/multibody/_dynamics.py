@@ -47,19 +47,14 @@ from typing import TypeVar
 import numpy as np
 
 from robomech._validation import MAX_MAGNITUDE, as_array, broadcast_batch, check_bool
-from robomech.dynamics import _com_terms
 
 from ._assembly import check_mechanism, check_q, on_rows, solve_closure
 from ._compile import Bodies, compile_model
 from ._constraints import jacobian
-from ._influence import _pinv
 from ._model import Mechanism
 from ._options import (
     ADMISSIBLE_RTOL,
     CLOSURE_RTOL,
-    GRAM_COND_MAX,
-    GRAM_REFINE2_COND,
-    GRAM_REFINE_COND,
     RANK_RTOL,
     RATE_FLOOR,
     SINGULAR_COND,
@@ -140,46 +135,6 @@ def _pinv_rank(K: np.ndarray, r: int) -> tuple[np.ndarray, np.ndarray]:
     return P, np.where(ok, s[:, 0] / np.where(ok, sr, 1.0), np.inf)
 
 
-def _passive_inverse(Kp: np.ndarray, rank0: int, length: float = 1.0):
-    """Pseudo-inverse of the passive block ``Kp (N, m, n)`` with (rank, sigma_min, cond) per sample.
-
-    Fast path where the generic rank is ``min(m, n)`` (no idle motion *and* redundant rows at once):
-    ``P0 = Kp^T (Kp Kp^T)^-1`` (wide) or ``(Kp^T Kp)^-1 Kp^T`` (tall) from a batched inverse, refined
-    ``P_{k+1} = P_k + P0 (I - Kp P_k)`` (once above GRAM_REFINE_COND, twice above GRAM_REFINE2_COND:
-    iterative refinement of the normal equations, for wide and tall alike); ``cond`` is then the 1-norm
-    estimate ``sqrt(||Gram||_1 ||Gram^-1||_1)`` (between the 2-norm one and sqrt(rank) times it) and
-    ``sigma_min`` ``1 / sqrt(||Gram^-1||_1)`` (a lower bound within rank^(1/4)).  Samples above
-    GRAM_COND_MAX, and mechanisms without the fast path, get the SVD pseudo-inverse of the multibody layer.
-    """
-    N, m, n = Kp.shape
-    if m == 0 or n == 0 or rank0 != min(m, n):
-        return _pinv(Kp, length)
-    wide = m <= n
-    KT = Kp.swapaxes(-1, -2)
-    Gm = Kp @ KT if wide else KT @ Kp
-    with np.errstate(all="ignore"):
-        try:
-            Gi = np.linalg.inv(Gm)
-        except np.linalg.LinAlgError:
-            return _pinv(Kp, length)
-        P = KT @ Gi if wide else Gi @ KT
-        ni = np.linalg.norm(Gi, 1, axis=(-2, -1))
-        cond = np.sqrt(np.linalg.norm(Gm, 1, axis=(-2, -1)) * ni)
-        smin = 1.0 / np.sqrt(ni)
-        # refine where the Gram matrix's squared conditioning could show: cond^2 eps > 1e-12
-        for lim in (GRAM_REFINE_COND, GRAM_REFINE2_COND):
-            r = np.flatnonzero(~(cond <= lim))
-            if r.size:
-                P0 = KT[r] @ Gi[r] if wide else Gi[r] @ KT[r]
-                P[r] = P[r] + P0 @ (np.eye(m) - Kp[r] @ P[r])
-    rank = np.full(N, rank0)
-    bad = ~(np.isfinite(cond) & (cond <= GRAM_COND_MAX) & np.all(np.isfinite(P), axis=(-1, -2)))
-    if np.any(bad):
-        Pb, rb, sb, cb = _pinv(Kp[bad], length)
-        P[bad], rank[bad], smin[bad], cond[bad] = Pb, rb, sb, cb
-    return P, rank, smin, cond
-
-
 def _rank_measures(Kp: np.ndarray, rank0: int, length: float) -> tuple[np.ndarray, np.ndarray]:
     """``(sigma_min, cond)`` of ``Kp (N, m, n)`` against the mechanism's generic passive rank ``rank0``:
     the ``rank0``-th singular value and ``s_1`` over it (inf where it is zero).  A truncated
@@ -229,35 +184,6 @@ def _com_jacobians(tree, state, bd: Bodies, qd: np.ndarray | None, Sd: np.ndarra
         pd = V[..., 3:] + np.cross(w, p)
         a0 = np.concatenate([Vd[..., :3], Vd[..., 3:] + np.cross(Vd[..., :3], p) + np.cross(w, pd)], axis=-1)
     return p, J, a0
-
-
-def _cross_rows(a: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """``a_col x p`` for every column of ``a (..., 3, k)`` with ``p (..., 3)`` (component arithmetic:
-    np.cross on broadcast blocks moves axes and is several times slower here)."""
-    x, y, z = p[..., 0, None], p[..., 1, None], p[..., 2, None]
-    a0, a1, a2 = a[..., 0, :], a[..., 1, :], a[..., 2, :]
-    return np.stack([a1 * z - a2 * y, a2 * x - a0 * z, a0 * y - a1 * x], axis=-2)
-
-
-def _com_projected(tree, state, bd: Bodies, qd, Sd, G, extra_qdd):
-    """Centre-of-mass Jacobians through G, ``J_b G (N, B, 6, na)``, and the accelerations
-    ``Jdot_b qd + J_b extra_qdd (N, B, 6)`` — without the (N, B, 6, nv) Jacobians' cross products."""
-    T = state.T[:, bd.idx]
-    p = (T[..., :3, :3] @ bd.com[:, :, None])[..., 0] + T[..., :3, 3]
-    S = state.S
-    A = tree.A[bd.idx]  # (B, nv)
-    SG = np.empty((S.shape[0], len(bd.idx), 6, G.shape[-1]))  # (N, B, 6, na): sum over b's path of S_k G_k
-    St = S.swapaxes(-1, -2)
-    for i, b in enumerate(bd.idx):
-        c = _path(tree, b)
-        SG[:, i] = St[:, :, c] @ G[:, c]
-    JG = np.concatenate([SG[..., :3, :], SG[..., 3:, :] + _cross_rows(SG[..., :3, :], p)], axis=-2)
-    V = A @ (S * qd[..., None])
-    Vd = A @ (Sd * qd[..., None] + S * extra_qdd[..., None])
-    w = V[..., :3]
-    pd = V[..., 3:] + np.cross(w, p)
-    a0 = np.concatenate([Vd[..., :3], Vd[..., 3:] + np.cross(Vd[..., :3], p) + np.cross(w, pd)], axis=-1)
-    return JG, a0
 
 
 def _screw_rates(tree, state, qd: np.ndarray) -> np.ndarray:
@@ -479,113 +405,16 @@ class InverseDynamicsResult:
     valid: np.ndarray
 
 
-def _projector(mech, K, G, dof, w):
-    """Redundant actuation: the rule's projector Pi (N, na, na); False where null(K G) is not ``dof``-wide."""
-    N, _, na = G.shape
-    KG = (K @ G) / mech.tree.length
-    s_full = np.zeros((N, na))
-    if KG.shape[1]:
-        _, s, Vt = np.linalg.svd(KG, full_matrices=True)
-        s_full[:, : s.shape[1]] = s[:, :na]
-    else:
-        Vt = np.broadcast_to(np.eye(na), (N, na, na))
-    # singular values ascending over the right singular vectors: the last `dof` rows of Vt span null(KG)
-    Nc = Vt[:, na - dof :].swapaxes(-1, -2)  # (N, na, dof)
-    top = np.maximum(np.max(s_full, axis=-1), 1.0)
-    gap_ok = np.all(s_full[:, na - dof :] <= RANK_RTOL * 1e2 * top[:, None], axis=-1)
-    if dof < na:
-        gap_ok &= s_full[:, na - dof - 1] > RANK_RTOL * 1e2 * top
-    if w is None:
-        Pi = Nc @ Nc.swapaxes(-1, -2)
-    else:
-        WN = w[:, None] * Nc
-        A = Nc.swapaxes(-1, -2) @ WN
-        ok = np.linalg.cond(A) < 1.0 / RANK_RTOL
-        A = np.where(ok[:, None, None], A, np.eye(dof))
-        Pi = WN @ np.linalg.solve(A, Nc.swapaxes(-1, -2))
-        gap_ok &= ok
-    return Pi, gap_ok
-
-
-def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
-    tree = mech.tree
-    rank0, dof = _reference(mech)
-    na = len(tree.act_dof)
-    act = tree.act_dof
-    pas = np.setdiff1d(np.arange(tree.nv), act)
-    N = q.shape[0]
-    state = kinematics(tree, q)
-    K = _constraint_matrix(mech, state, q)
-    P, rank, smin, cond = _passive_inverse(K[..., pas], rank0, tree.length)
-    G = np.zeros((N, tree.nv, na))
-    G[:, act, np.arange(na)] = 1.0
-    G[:, pas] = -P @ K[..., act]
-    qd = _mv(G, qd_a)
-    Sd = _screw_rates(tree, state, qd)
-    kdq = _kdot_qd(mech, state, q, qd, Sd)
-    qdd = _mv(G, qdd_a)
-    qdd[:, pas] -= _mv(P, kdq)
-    # Project each body's Jacobian through G first (6 x n_act instead of 6 x nv): the tree mass matrix is
-    # never formed.  The convective acceleration J (qdd - G qdd_act) joins the velocity-product terms.
-    bd = _bodies(mech)
-    R = state.T[:, bd.idx, :3, :3]
-    Iw = R @ bd.inertia @ R.swapaxes(-1, -2)
-    conv = qdd - _mv(G, qdd_a)
-    JG, a0 = _com_projected(tree, state, bd, qd, Sd, G, conv)
-    gv = np.asarray(mech.gravity) if gravity else np.zeros(3)
-    terms = _com_terms(np.broadcast_to(bd.mass, (N, len(bd.mass))), Iw, JG, a0, qd_a, qdd_a, gv[None])
-    ext = _site_terms(mech, state, wr)
-    GT = G.swapaxes(-1, -2)
-    M_a = terms.M
-    vel = terms.velocity_terms
-    grav = terms.gravity_terms
-    ex = _mv(GT, ext)
-    ok = np.ones(N, dtype=bool)
-    if na > dof or weights is not None:
-        Pi, ok = _projector(mech, K, G, dof, weights)
-        M_a = Pi @ M_a
-        vel, grav, ex = (_mv(Pi, x) for x in (vel, grav, ex))
-    tau = _mv(M_a, qdd_a) + vel + grav + ex
-    L = tree.length
-    sv = np.max(np.abs(qd), axis=-1) if tree.nv else np.zeros(N)
-    sa = np.max(np.abs(qdd), axis=-1) + sv * sv if tree.nv else np.zeros(N)
-    if K.shape[1]:
-        e1 = np.max(np.abs(_mv(K, qd)), axis=-1) / (L * np.maximum(sv, RATE_FLOOR))
-        e2 = np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
-        adm = np.maximum(e1, e2)
-    else:
-        adm = np.zeros(N)
-    fin = np.all(np.isfinite(tau), axis=-1) & np.all(np.isfinite(M_a), axis=(-1, -2))
-    valid = ok & fin & (rank >= rank0) & (cond <= SINGULAR_COND) & (adm <= ADMISSIBLE_RTOL)
-    return dict(
-        tau=tau,
-        M_a=M_a,
-        velocity_terms=vel,
-        gravity_terms=grav,
-        external_terms=ex,
-        qd=qd,
-        qdd=qdd,
-        cond=cond,
-        sigma_min=smin,
-        admissibility=adm,
-        valid=valid,
-    )
-
-
 def _inverse_compiled(mech, q, qd_a, qdd_a, wr, weights, gravity=True) -> dict[str, np.ndarray]:
-    """:func:`_inverse_flat` by the compiled per-sample kernel (``_compiled.inv_dyn``): same formulas,
-    same flags; the tests check both paths agree to rounding."""
+    """The closed-chain inverse dynamics in actuator space (the derivation of the module docstring) by
+    the compiled per-sample kernel (``_compiled.inv_dyn``), the one implementation at every batch size;
+    its numpy formulation is the tests' reference (tests/multibody/_reference.py)."""
     from ._compiled import inv_dyn
 
     model = compile_model(mech)
     tree, t, d = model.tree, model.tables, model.dyn
     N, nv, na = q.shape[0], tree.nv, len(tree.act_dof)
-    sites = list(wr)
-    W = np.zeros((N, len(sites), 6))
-    for i, si in enumerate(sites):
-        W[:, i] = wr[si]
-    wsb = np.array([tree.site_body[si] for si in sites], dtype=np.int64)
-    wT = np.ascontiguousarray(np.array([tree.T_site[si] for si in sites], dtype=float).reshape(-1, 4, 4))
+    W, wsb, wT = _wrench_arrays(tree, wr, N)
     gv = np.asarray(mech.gravity, dtype=float) if gravity else np.zeros(3)
     wts = np.zeros(0) if weights is None else np.ascontiguousarray(weights, dtype=float)
     out = dict(
@@ -791,7 +620,7 @@ def _inverse_full_flat(mech, q, qd, qdd, wr, weights, gravity=True):
     ``Nb^T E tau = Nb^T f``; ``tau = B f`` is its least-squares solution (minimum norm, or minimum
     ``sum tau_i^2 / w_i``), and what no actuator force can do, ``Nb (Nb^T f - Nb^T E tau)``, is the
     force the unactuated coordinates would need.  Where the actuators determine the motion this is
-    ``G^T f`` of :func:`_inverse_flat`."""
+    ``G^T f`` of :func:`_inverse_compiled`."""
     from ._rnea import _crba_flat, _rnea_flat
 
     tree = mech.tree
@@ -1268,58 +1097,112 @@ def site_wrench(
 
 
 # ----------------------------------------------------------------------------- forward dynamics
-def _forward_full(mech, q, qd, tau_a, wr=None, gravity=True, want_cond=False):
-    """Tree accelerations ``qdd (N, nv)`` under actuator forces with the closure enforced, and a
-    conditioning measure of the constrained mass matrix (N,)."""
-    tree = mech.tree
+def _wrench_arrays(tree, wr: dict[int, np.ndarray], N: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Site wrenches packed for the kernels: ``W (N, ns, 6)``, the sites' bodies ``(ns,)`` and frames
+    ``(ns, 4, 4)``."""
+    sites = list(wr)
+    W = np.zeros((N, len(sites), 6))
+    for i, si in enumerate(sites):
+        W[:, i] = wr[si]
+    wsb = np.array([tree.site_body[si] for si in sites], dtype=np.int64)
+    wT = np.ascontiguousarray(np.array([tree.T_site[si] for si in sites], dtype=float).reshape(-1, 4, 4))
+    return W, wsb, wT
+
+
+def _forward_compiled(mech, q, rates, tau_a, wr, gravity, act_mode: bool) -> tuple:
+    """Forward dynamics of normalised ``q (N, nq)`` under actuator forces ``tau_a (N, n_act)`` and site
+    wrenches ``wr``, the closure a constraint on the tree accelerations (module docstring), by the
+    compiled per-sample kernel (``_rnea_kernels.fd_block``), the one implementation at every batch
+    size.  ``rates``: ``qd_act (N, n_act)`` (``act_mode``) or every rate ``qd (N, nv)``.  Returns
+    ``(qd, qdd, cond, admissibility, closure, regular)``; the numpy formulation is the tests'
+    reference (tests/multibody/_reference.py)."""
+    from ._rnea_kernels import forward
+
+    model = compile_model(mech)
+    tree = model.tree
     N = q.shape[0]
-    nv = tree.nv
-    if mech.constraints.m or wr:
-        state = kinematics(tree, q)
-        K = _constraint_matrix(mech, state, q)
-        Sd = _screw_rates(tree, state, qd)
-        kdq = _kdot_qd(mech, state, q, qd, Sd)
-    else:  # a tree without site wrenches: the kernels below are all it needs
-        K, kdq = np.zeros((N, 0, nv)), np.zeros((N, 0))
-    from ._rnea import _crba_flat, _rnea_flat
-
-    # the tree's mass matrix (CRBA) and velocity + gravity forces (RNEA at zero acceleration)
-    g = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
-    if not K.shape[1] and not wr and nv:  # an open tree: CRBA, RNEA and Cholesky in one kernel
-        from ._rnea_kernels import fd_tree
-
-        F = np.zeros((N, nv))
-        F[:, tree.act_dof] = tau_a
-        qdd, cond = fd_tree(compile_model(mech), q, qd, F, g)
-        return qdd, (cond if want_cond else np.ones(N)), K, kdq
-    M = _crba_flat(mech, q)
-    f = -_rnea_flat(mech, q, qd, np.zeros_like(qd), g)
-    if wr:
-        f = f - _site_terms(mech, state, wr)
-    f[:, tree.act_dof] += tau_a
-    if K.shape[1]:
-        Kp, _ = _pinv_rank(K, _rank_K(mech))  # (N, nv, m)
-        qdd_p = -_mv(Kp, kdq)
-        Pn = np.eye(nv) - Kp @ K
-    else:
-        qdd_p = np.zeros((N, nv))
-        Pn = np.broadcast_to(np.eye(nv), (N, nv, nv))
-    Mc = Pn @ M @ Pn + (np.eye(nv) - Pn)
-    rhs = _mv(Pn, f - _mv(M, qdd_p))
-    if want_cond:
-        s = np.linalg.svd(np.where(np.isfinite(Mc), Mc, 0.0), compute_uv=False)
-        # a zero matrix (every body massless) has no condition number: inf, never "0"
-        cond = (
-            np.where(s[:, -1] > 0, s[:, 0] / np.where(s[:, -1] > 0, s[:, -1], 1.0), np.inf)
-            if nv
-            else np.ones(N)
-        )
-    else:
-        cond = np.ones(N)
-    return qdd_p + _solve_each(Mc, rhs), cond, K, kdq
+    F = np.zeros((N, tree.nv))
+    F[:, tree.act_dof] = tau_a
+    W, wsb, wT = _wrench_arrays(tree, wr, N)
+    gv = np.asarray(mech.gravity, dtype=float) if gravity else np.zeros(3)
+    return forward(model, q, rates, F, W, wsb, wT, gv, act_mode)
 
 
 _F64 = np.dtype(np.float64)
+
+
+def _plain_one(mech, q, rates, tau, gravity) -> bool:
+    """The arguments of a one-sample fast path are of the plain types (arrays, a bool, no subclass)."""
+    return (
+        type(mech) is Mechanism
+        and type(q) is np.ndarray
+        and type(rates) is np.ndarray
+        and (tau is None or type(tau) is np.ndarray)
+        and (gravity is True or gravity is False)
+    )
+
+
+def _forward_one(mech, q, qd_act, tau, gravity) -> ForwardDynamicsResult | None:
+    """One sample in the actuated-rates form (closed chains included), given as C-contiguous float64
+    vectors of the exact shapes, no wrench: checked here (every entry within ``MAX_MAGNITUDE``,
+    quaternions non-zero and normalised), then one call of the kernel block (``_rnea_kernels.fd_block``,
+    the same per-sample code as every batch) with the general path's flags; None (the general path
+    validates, masks and explains) for any other input and for a sample that is not valid."""
+    if not _plain_one(mech, q, qd_act, tau, gravity):
+        return None
+    model = compile_model(mech)
+    tree = model.tree
+    na = len(model.act)
+    if na == 0 or na < model.dof:
+        return None
+    for x, shape in ((q, (tree.nq,)), (qd_act, (na,)), (tau, (na,))):
+        if x is not None and (x.shape != shape or x.dtype is not _F64 or not x.flags.c_contiguous):
+            return None
+    with np.errstate(invalid="ignore"):
+        if not (np.abs(q).max() <= MAX_MAGNITUDE and np.abs(qd_act).max() <= MAX_MAGNITUDE):
+            return None
+        if tau is not None and not np.abs(tau).max() <= MAX_MAGNITUDE:
+            return None
+    if tree.quat_adr:
+        q = q.copy()
+        for a in tree.quat_adr:
+            nrm = float(np.sqrt(q[a] ** 2 + q[a + 1] ** 2 + q[a + 2] ** 2 + q[a + 3] ** 2))
+            if not nrm >= 1e-9:
+                return None
+            q[a : a + 4] /= nrm
+    from ._rnea_kernels import forward
+
+    F = np.zeros((1, tree.nv))
+    if tau is not None:
+        F[0, tree.act_dof] = tau
+    gv = model.cache.get("gravity_vector")
+    if gv is None:
+        gv = model.cache["gravity_vector"] = np.array(mech.gravity, dtype=float)
+    qd, qdd, cond, adm, closure, reg = forward(
+        model, q[None], qd_act[None], F, *_NO_WRENCH, gv if gravity else _ZERO3, True
+    )
+    L = tree.length
+    c, a, cl = cond[0], adm[0], closure[0]
+    if not (
+        reg[0]
+        and c < 1.0 / RANK_RTOL
+        and a <= ADMISSIBLE_RTOL
+        and cl <= CLOSURE_RTOL * L
+        and np.all(np.isfinite(qdd))
+    ):
+        return None
+    return ForwardDynamicsResult(
+        qdd_act=qdd[0, tree.act_dof],
+        qdd=qdd[0],
+        qd=qd[0],
+        cond=np.array(c),
+        admissibility=np.array(a),
+        closure=np.array(cl),
+        valid=np.array(True),
+    )
+
+
+_NO_WRENCH = (np.zeros((1, 0, 6)), np.zeros(0, dtype=np.int64), np.zeros((0, 4, 4)))
 
 
 def _forward_tree_one(mech, q, tau, qd, gravity) -> ForwardDynamicsResult | None:
@@ -1328,13 +1211,7 @@ def _forward_tree_one(mech, q, tau, qd, gravity) -> ForwardDynamicsResult | None
     non-zero) and computes ``qdd`` and ``cond`` in one call, with the general path's flags (no closure:
     admissibility and closure 0, valid where ``cond < 1 / RANK_RTOL`` and every value is finite);
     None (the general path validates and masks) otherwise."""
-    if not (
-        type(mech) is Mechanism
-        and type(q) is np.ndarray
-        and type(qd) is np.ndarray
-        and (tau is None or type(tau) is np.ndarray)
-        and (gravity is True or gravity is False)
-    ):
+    if not _plain_one(mech, q, qd, tau, gravity):
         return None
     model = compile_model(mech)
     tree = model.tree
@@ -1379,22 +1256,6 @@ def _forward_tree_one(mech, q, tau, qd, gravity) -> ForwardDynamicsResult | None
 
 
 _ZERO3 = np.zeros(3)
-
-
-def _solve_each(A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``A x = b`` per sample (N, n, n), LAPACK ``gesv`` on each matrix: a sample's result never depends on
-    the others.  An exactly singular matrix (a massless motion) makes numpy's batched solve raise for the
-    whole batch; the samples are then solved one by one and the singular ones get NaN."""
-    try:
-        return np.linalg.solve(A, b[..., None])[..., 0]
-    except np.linalg.LinAlgError:
-        out = np.full(b.shape, np.nan)
-        for i in range(A.shape[0]):
-            try:
-                out[i] = np.linalg.solve(A[i], b[i])
-            except np.linalg.LinAlgError:
-                pass
-        return out
 
 
 @dataclass(frozen=True)
@@ -1496,9 +1357,15 @@ def forward_dynamics(
     >>> bool(np.allclose(fd.qdd_act, 0.5)), bool(fd.valid)
     (True, True)
     """
-    if qd_act is None and wrenches is None:
-        one = _forward_tree_one(mech, q, tau, qd, gravity)
-        if one is not None:  # one sample of an open tree as float64 vectors: one kernel call
+    if wrenches is None:  # one sample as float64 vectors: one kernel call
+        one = (
+            _forward_tree_one(mech, q, tau, qd, gravity)
+            if qd_act is None
+            else _forward_one(mech, q, qd_act, tau, gravity)
+            if qd is None
+            else None
+        )
+        if one is not None:
             return one
     mech = check_mechanism(mech)
     gravity = check_bool(gravity, "gravity")
@@ -1507,46 +1374,13 @@ def forward_dynamics(
     rates = (qd_act, "qd_act", na) if act_mode else (qd, "qd", nv)
     tau_in = np.zeros(na) if tau is None else tau
     names, batch, ok, flat = _site_inputs(mech, q, [rates, (tau_in, "tau", na)], wrenches)
-    rank0, _ = _reference(mech)
     tree = mech.tree
-    pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
     L = tree.length
 
     def fn(qf, rf, tf, *ws):
-        n = qf.shape[0]
-        if mech.constraints.m:
-            state = kinematics(tree, qf)
-            K = jacobian(mech.constraints, tree, state, qf)
-        else:  # a tree: no closure rows (and _closure_error needs no state)
-            state, K = None, np.zeros((n, 0, tree.nv))
-        if act_mode:
-            P, rank, _, cK = _pinv(K[..., pas], L)
-            qd_f = np.zeros((n, tree.nv))
-            qd_f[:, tree.act_dof] = rf
-            qd_f[:, pas] = -np.einsum("nij,njk,nk->ni", P, K[..., tree.act_dof], rf)
-            reg = (rank >= rank0) & (cK <= SINGULAR_COND)
-            e1 = np.zeros(n)
-        else:
-            qd_f = rf
-            reg = np.ones(n, dtype=bool)
-            cK = np.ones(n)
-            sv = np.max(np.abs(qd_f), axis=-1) if tree.nv else np.zeros(n)
-            e1 = (
-                np.max(np.abs(_mv(K, qd_f)), axis=-1) / (L * np.maximum(sv, RATE_FLOOR))
-                if K.shape[1]
-                else np.zeros(n)
-            )
-        qdd, cond, K, kdq = _forward_full(
-            mech, qf, qd_f, tf, dict(zip(names, ws, strict=True)), gravity, want_cond=True
+        qd_f, qdd, cond, adm, closure, reg = _forward_compiled(
+            mech, qf, rf, tf, dict(zip(names, ws, strict=True)), gravity, act_mode
         )
-        sa = np.max(np.abs(qdd), axis=-1) + np.max(np.abs(qd_f), axis=-1) ** 2 if tree.nv else 0.0
-        e2 = (
-            np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
-            if K.shape[1]
-            else np.zeros(n)
-        )
-        adm = np.maximum(e1, np.where(np.isfinite(e2), e2, np.inf))
-        closure = _closure_error(mech, state, qf)
         valid = (
             reg
             & (cond < 1.0 / RANK_RTOL)
@@ -1554,13 +1388,10 @@ def forward_dynamics(
             & (closure <= CLOSURE_RTOL * L)
             & np.all(np.isfinite(qdd), axis=-1)
         )
-        if act_mode and np.any(~reg):  # a singular passive block: its measure against the generic rank
-            bad = np.flatnonzero(~reg)
-            cond[bad] = np.maximum(cond[bad], _rank_measures(K[bad][..., pas], rank0, L)[1])
         return dict(
             qdd_act=qdd[:, tree.act_dof],
             qdd=qdd,
-            qd=np.array(qd_f),
+            qd=qd_f,
             cond=cond,
             admissibility=adm,
             closure=closure,
@@ -1616,6 +1447,7 @@ def energy(mech: Mechanism, q: object, qd: object) -> tuple[np.ndarray, np.ndarr
     batch = broadcast_batch((q, 1, "q"), (qd, 1, "qd"))
     qf = np.broadcast_to(q, (*batch, mech.nq)).reshape(-1, mech.nq)
     qdf = np.broadcast_to(qd, (*batch, mech.nv)).reshape(-1, mech.nv)
+
     def energies(qs: np.ndarray, qds: np.ndarray) -> tuple:
         return _energy_flat(mech, qs, qds)
 
@@ -1750,8 +1582,8 @@ def _simulate_one(mech, q0, qd0, t, tau_fn, gravity):
         if not np.all(np.isfinite(tau)):
             raise _SampleFailed
         try:
-            qdd, _, _, _ = _forward_full(mech, qn, qd, tau, None, gravity)
-        except np.linalg.LinAlgError as exc:  # a non-finite state reached the SVD
+            qdd = _forward_compiled(mech, qn, qd, tau, {}, gravity, False)[1]
+        except np.linalg.LinAlgError as exc:  # a non-finite state reached an SVD
             raise _SampleFailed from exc
         if not np.all(np.isfinite(qdd)):  # a singular (massless) motion: no acceleration exists
             raise _SampleFailed

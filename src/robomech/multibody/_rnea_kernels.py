@@ -1,8 +1,13 @@
-"""Compiled (numba) per-sample kernel of the tree's composite-rigid-body algorithm (``_rnea``).
+"""Compiled (numba) per-sample kernels of the tree's composite-rigid-body algorithm (``_rnea``) and of
+forward dynamics.
 
-Per sample: the tree kinematics of ``_compiled.kin`` (body poses and space screws), then the CRBA in
-world coordinates as the module docstring of :mod:`._rnea` states it; large batches in parallel
-blocks of ``_compiled.BLOCK`` samples (``numba.prange``).  The RNEA kernel is ``_compiled.rnea_block``.
+Per sample: the tree kinematics of ``_compiled.kin_into`` (body poses and space screws), then the CRBA in
+world coordinates as the module docstring of :mod:`._rnea` states it; forward dynamics of any
+mechanism (:func:`fd_block`: the closure a constraint on the tree accelerations, ``_dynamics``' module
+docstring) from the CRBA, the RNEA (``_compiled.rnea_block``), the closure rows and their
+velocity-product accelerations (``_compiled.resjac``, ``_compiled.rates_kdot``); large batches in
+parallel blocks of ``_compiled.BLOCK`` samples (``numba.prange``).  The numpy formulation is the tests'
+reference (tests/multibody/_reference.py).
 """
 
 from __future__ import annotations
@@ -11,40 +16,28 @@ import numpy as np
 
 from robomech._numba import import_numba
 
-from ._compiled import BLOCK, chol_solve, entry, kin, prepare_one, rnea_block, writable
+from ._compiled import (
+    BLOCK,
+    _all_finite,
+    _amax_abs,
+    _inertia_apply,
+    chol_solve,
+    entry,
+    inertia_world,
+    kin_into,
+    prepare_one,
+    rates_kdot,
+    resjac,
+    rnea_block,
+    site_forces,
+    svd_pinv,
+    writable,
+)
 
-__all__ = ["crba_batch", "fd_tree"]
+__all__ = ["crba_batch", "forward"]
 
 numba = import_numba()
 _nj = numba.njit(cache=True, error_model="numpy")
-
-
-@_nj
-def _inertia_world(T, com, inertia, b, ib, c, Ic):  # pragma: no cover - compiled
-    """World centre of mass ``c (3,)`` and inertia about it ``Ic (3, 3)`` of body ``b`` (its mass
-    properties ``com[ib]``, ``inertia[ib]``)."""
-    for i in range(3):
-        c[i] = T[b, i, 3] + T[b, i, 0] * com[ib, 0] + T[b, i, 1] * com[ib, 1] + T[b, i, 2] * com[ib, 2]
-    for i in range(3):
-        for j in range(3):
-            s = 0.0
-            for k in range(3):
-                for m in range(3):
-                    s += T[b, i, k] * inertia[ib, k, m] * T[b, j, m]
-            Ic[i, j] = s
-
-
-@_nj
-def _apply(m, c, Ic, X, out):  # pragma: no cover - compiled
-    """``out = I X``: ``f = m (v + w x c)``, ``n = Ic w + c x f`` (motions about the world origin)."""
-    w0, w1, w2 = X[0], X[1], X[2]
-    f0 = m * (X[3] + w1 * c[2] - w2 * c[1])
-    f1 = m * (X[4] + w2 * c[0] - w0 * c[2])
-    f2 = m * (X[5] + w0 * c[1] - w1 * c[0])
-    out[0] = Ic[0, 0] * w0 + Ic[0, 1] * w1 + Ic[0, 2] * w2 + c[1] * f2 - c[2] * f1
-    out[1] = Ic[1, 0] * w0 + Ic[1, 1] * w1 + Ic[1, 2] * w2 + c[2] * f0 - c[0] * f2
-    out[2] = Ic[2, 0] * w0 + Ic[2, 1] * w1 + Ic[2, 2] * w2 + c[0] * f1 - c[1] * f0
-    out[3], out[4], out[5] = f0, f1, f2
 
 
 @_nj
@@ -60,17 +53,21 @@ def crba_block(Q, lo, hi, t, out):  # pragma: no cover
     col = np.empty(6)
     c = np.empty(3)
     Ic = np.empty((3, 3))
+    RI = np.empty((3, 3))
     Fi = np.empty(6)
+    Rj = np.empty((3, 3))
+    Rn = np.empty((3, 3))
+    anchor = np.empty(3)
     for n in range(lo, hi):
-        kin(Q[n], t, T, S)
+        kin_into(Q[n], t, T, S, Rj, Rn, anchor)
         I6[:, :, :] = 0.0
         for ib in range(t.bidx.shape[0]):  # bodies without mass or inertia stay zero
             b = t.bidx[ib]
-            _inertia_world(T, t.com, t.inertia, b, ib, c, Ic)
+            inertia_world(T, t, ib, c, Ic, RI)
             for j in range(6):
                 for i in range(6):
                     X[i] = 1.0 if i == j else 0.0
-                _apply(t.mass[ib], c, Ic, X, col)
+                _inertia_apply(t.mass[ib], c, Ic, X, col)
                 for i in range(6):
                     I6[b, i, j] = col[i]
         for b in range(nb - 1, 0, -1):  # composite inertias
@@ -127,11 +124,102 @@ def crba_batch(model, q: np.ndarray) -> np.ndarray:
 
 # ----------------------------------------------------------------------------- tree forward dynamics
 @_nj
+def mass_cond(M, H):  # pragma: no cover - compiled
+    """The 2-norm condition number of the symmetric ``M (n, n)`` (its absolute eigenvalues, LAPACK
+    ``syevd``: values only, and it converges where ``gesdd`` may not on clustered values; non-finite
+    entries read as 0; inf where the smallest is 0); ``H (n, n)`` scratch."""
+    n = M.shape[0]
+    for i in range(n):
+        for j in range(n):
+            v = M[i, j]
+            H[i, j] = v if np.isfinite(v) else 0.0
+    try:  # symmetric: the singular values are the absolute eigenvalues (LAPACK syevd, values only)
+        e = np.abs(np.linalg.eigvalsh(H))
+    except Exception:  # no convergence: the singular values (gesdd)
+        e = np.linalg.svd(H)[1]
+    hi, lo = np.max(e), np.min(e)
+    return hi / lo if lo > 0 else np.inf
+
+
+@_nj
+def solve_constrained(M, f, K, kdq, rank, P, Pn, Mc, H, x, qdd):  # pragma: no cover - compiled
+    """``qdd (nv,)`` of ``M qdd = f + K^T lambda`` with ``K qdd = -kdq`` (closure rows ``K (m, nv)``,
+    ``m`` may be 0), the derivation of ``_dynamics``' module docstring: ``qdd = qdd_p + u`` with
+    ``qdd_p = -K^+ kdq`` (``K^+`` truncated to the generic rank ``rank``) and ``u`` from
+    ``Mc u = Pn (f - M qdd_p)``, ``Pn = I - K^+ K``, ``Mc = Pn M Pn + (I - Pn)`` (symmetric positive
+    definite where ``M`` is on ``null(K)``: Cholesky).  Returns the 2-norm condition number of ``Mc``
+    (:func:`mass_cond`); ``f`` is overwritten; ``P (nv, m)``, ``Pn``, ``Mc``, ``H (nv, nv)``, ``x (nv,)``
+    scratch."""
+    nv, m = M.shape[0], K.shape[0]
+    if m == 0 or rank == 0:  # no closure: Pn = I, Mc = M
+        cond = mass_cond(M, H)
+        for i in range(nv):
+            for j in range(nv):
+                H[i, j] = M[i, j]
+        chol_solve(H, f, qdd)
+        return cond
+    if not _all_finite(K):  # LAPACK refuses it: no acceleration (the sample is flagged)
+        qdd[:] = np.nan
+        return np.inf
+    try:
+        U, s, Vt = np.linalg.svd(K, full_matrices=False)
+    except Exception:  # no convergence (LAPACK): no acceleration, the sample is flagged
+        qdd[:] = np.nan
+        return np.inf
+    ok = s[rank - 1] > 0
+    P[:, :] = 0.0
+    for c in range(rank):
+        inv = 1.0 / s[c] if ok else 1.0
+        for i in range(nv):
+            g = Vt[c, i] * inv
+            for j in range(m):
+                P[i, j] += g * U[j, c]
+    for i in range(nv):  # qdd_p = -K^+ kdq, Pn = I - K^+ K
+        acc = 0.0
+        for j in range(m):
+            acc += P[i, j] * kdq[j]
+        qdd[i] = -acc
+        for k in range(nv):
+            acc = 0.0
+            for j in range(m):
+                acc += P[i, j] * K[j, k]
+            Pn[i, k] = (1.0 if i == k else 0.0) - acc
+    for i in range(nv):  # H = M Pn, x = f - M qdd_p
+        acc2 = f[i]
+        for k in range(nv):
+            acc = 0.0
+            for j in range(nv):
+                acc += M[i, j] * Pn[j, k]
+            H[i, k] = acc
+            acc2 -= M[i, k] * qdd[k]
+        x[i] = acc2
+    for i in range(nv):  # Mc = Pn (M Pn) + (I - Pn)
+        for k in range(nv):
+            acc = 0.0
+            for j in range(nv):
+                acc += Pn[i, j] * H[j, k]
+            Mc[i, k] = acc + ((1.0 if i == k else 0.0) - Pn[i, k])
+    for i in range(nv):  # rhs = Pn (f - M qdd_p), into f
+        acc = 0.0
+        for j in range(nv):
+            acc += Pn[i, j] * x[j]
+        f[i] = acc
+    cond = mass_cond(Mc, H)
+    for i in range(nv):
+        for j in range(nv):
+            H[i, j] = Mc[i, j]
+    chol_solve(H, f, x)
+    for i in range(nv):
+        qdd[i] += x[i]
+    return cond
+
+
+@_nj
 def fd_tree_block(lo, hi, Q, QD, F, gv, t, qdd_o, cond_o):  # pragma: no cover - compiled
-    """Forward dynamics of an open tree (no closure rows), samples ``lo:hi``: ``M qdd = F - b`` with
-    ``M`` the CRBA mass matrix, ``b`` the RNEA forces at zero acceleration (velocity and gravity terms)
-    and ``F (N, nv)`` the applied generalized forces, solved by Cholesky; ``cond_o`` the 2-norm
-    condition number of ``M`` (singular values, LAPACK; inf where the smallest is 0)."""
+    """Forward dynamics of an open tree (no closure rows, no site wrench), samples ``lo:hi``:
+    ``M qdd = F - b`` (:func:`solve_constrained` without rows) with ``M`` the CRBA mass matrix, ``b``
+    the RNEA forces at zero acceleration (velocity and gravity terms) and ``F (N, nv)`` the applied
+    generalized forces; ``cond_o`` the 2-norm condition number of ``M``."""
     nv = QD.shape[1]
     M = np.empty((1, nv, nv))
     b = np.empty((1, nv))
@@ -139,36 +227,203 @@ def fd_tree_block(lo, hi, Q, QD, F, gv, t, qdd_o, cond_o):  # pragma: no cover -
     f = np.empty(nv)
     x = np.empty(nv)
     H = np.empty((nv, nv))
+    K0 = np.empty((0, nv))
+    P0 = np.empty((nv, 0))
     for n in range(lo, hi):
         q1 = Q[n : n + 1]
         crba_block(q1, 0, 1, t, M)
         rnea_block(0, 1, q1, QD[n : n + 1], zero, gv, t, b)
         for i in range(nv):
             f[i] = -b[0, i] + F[n, i]
+        cond_o[n] = solve_constrained(M[0], f, K0, f[:0], 0, P0, H, H, H, x, qdd_o[n])
+
+
+@_nj
+def fd_block(
+    lo, hi, Q, R, F, W, wsb, wT, gv, act_mode, rank_K, t, rt, d, qd_o, qdd_o, cond_o, adm_o, clo_o, reg_o
+):  # pragma: no cover - compiled
+    """Forward dynamics of any mechanism, samples ``lo:hi``, the closure a constraint on the tree
+    accelerations (:func:`solve_constrained`), with site wrenches ``W (N, ns, 6)`` on bodies ``wsb``
+    at frames ``wT``, the applied generalized forces ``F (N, nv)`` and gravity ``gv``.  ``R`` the
+    rates: ``(N, n_act)`` actuated rates (``act_mode``: ``qd = G qd_act``, the passive block's SVD
+    pseudo-inverse, ``reg_o`` its rank and conditioning check) or ``(N, nv)`` every rate.  Outputs per
+    sample: ``qd_o``, ``qdd_o (N, nv)``, ``cond_o`` (of the constrained mass matrix, or of the
+    singular passive block against the generic rank if larger), ``adm_o`` (``|K qd|`` and
+    ``|K qdd + Kdot qd|``, relative), ``clo_o`` (max closure row of ``q``) and ``reg_o``.  ``t``,
+    ``rt``, ``d``: the compiled model's ``Tables``, ``RneaTables``, ``DynTables``."""
+    nb = t.parent.shape[0]
+    A, m, L = t.A, t.m, t.L
+    nv = A.shape[1]
+    act, pas = d.act, d.pas
+    na, npas = act.shape[0], pas.shape[0]
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    Rj = np.empty((3, 3))
+    Rn = np.empty((3, 3))
+    anchor = np.empty(3)
+    r = np.empty(m)
+    K = np.empty((m, nv))
+    Kp = np.empty((m, npas))
+    Pp = np.empty((npas, m))
+    qd = np.empty((1, nv))
+    Sd = np.empty((nv, 6))
+    V = np.empty((nb, 6))
+    Vd = np.empty((nb, 6))
+    kdq = np.zeros(m)
+    M = np.empty((1, nv, nv))
+    b = np.empty((1, nv))
+    zero = np.zeros((1, nv))
+    f = np.empty(nv)
+    ext = np.empty(nv)
+    ps = np.empty(3)
+    P = np.empty((nv, m))
+    Pn = np.empty((nv, nv))
+    Mc = np.empty((nv, nv))
+    H = np.empty((nv, nv))
+    x = np.empty(nv)
+    qdd = np.empty(nv)
+    for n in range(lo, hi):
+        q = Q[n]
+        kin_into(q, t, T, S, Rj, Rn, anchor)
+        resjac(q, t, T, S, r, K, True)
+        clo_o[n] = _amax_abs(r)
+        reg = True
+        e1 = 0.0
+        if act_mode:  # qd = G qd_act, G = [I; -K_p^+ K_a]
+            rank, cK = 0, 1.0
+            Pp[:, :] = 0.0
+            if m > 0 and npas > 0:
+                for i in range(m):
+                    for j in range(npas):
+                        Kp[i, j] = K[i, pas[j]]
+                rank, _, cK = svd_pinv(Kp, d.pinv_rtol, Pp)
+            reg = rank >= d.rank0 and cK <= d.singular_cond
+            for j in range(na):
+                qd[0, act[j]] = R[n, j]
+            for i in range(npas):
+                acc = 0.0
+                for c in range(m):
+                    kr = 0.0
+                    for j in range(na):
+                        kr += K[c, act[j]] * R[n, j]
+                    acc += Pp[i, c] * kr
+                qd[0, pas[i]] = -acc
+        else:
+            for i in range(nv):
+                qd[0, i] = R[n, i]
+            if m > 0:
+                sv = _amax_abs(qd[0])
+                for i in range(m):
+                    acc = 0.0
+                    for k in range(nv):
+                        acc += K[i, k] * qd[0, k]
+                    r[i] = acc
+                e1 = _amax_abs(r) / (L * max(sv, d.rate_floor))
+        if m > 0:
+            rates_kdot(q, t, T, S, qd[0], Sd, V, Vd, kdq)
+        q1 = Q[n : n + 1]
+        crba_block(q1, 0, 1, rt, M)
+        rnea_block(0, 1, q1, qd, zero, gv, rt, b)
+        site_forces(T, S, A, W[n], wsb, wT, ps, ext)
         for i in range(nv):
-            for j in range(nv):
-                v = M[0, i, j]
-                H[i, j] = v if np.isfinite(v) else 0.0
+            f[i] = F[n, i] - b[0, i] - ext[i]
+        cond = solve_constrained(M[0], f, K, kdq, rank_K, P, Pn, Mc, H, x, qdd)
+        e2 = 0.0
+        if m > 0:
+            sa = _amax_abs(qdd) + _amax_abs(qd[0]) ** 2
+            for i in range(m):
+                acc = kdq[i]
+                for k in range(nv):
+                    acc += K[i, k] * qdd[k]
+                r[i] = acc
+            e2 = _amax_abs(r) / (L * max(sa, d.rate_floor))
+        adm_o[n] = max(e1, e2) if np.isfinite(e2) else np.inf
+        if act_mode and not reg:  # a singular passive block: its measure against the generic rank
+            cond = max(cond, rank_cond(Kp, d.rank0))
+        for i in range(nv):
+            qd_o[n, i] = qd[0, i]
+            qdd_o[n, i] = qdd[i]
+        cond_o[n] = cond
+        reg_o[n] = reg
+
+
+@_nj
+def rank_cond(Kp, rank0):  # pragma: no cover - compiled
+    """``s_1 / s_rank0`` of ``Kp (m, n)`` (non-finite entries read as 0; inf where ``s_rank0`` is 0; 1
+    for an empty block or a generic rank 0): ``_dynamics._rank_measures``' conditioning."""
+    m, n = Kp.shape
+    if m == 0 or n == 0 or rank0 == 0:
+        return 1.0
+    H = np.empty((m, n))
+    for i in range(m):
+        for j in range(n):
+            v = Kp[i, j]
+            H[i, j] = v if np.isfinite(v) else 0.0
+    try:
         s = np.linalg.svd(H)[1]
-        cond_o[n] = s[0] / s[nv - 1] if s[nv - 1] > 0 else np.inf
-        for i in range(nv):
-            for j in range(nv):
-                H[i, j] = M[0, i, j]
-        chol_solve(H, f, x)
-        for i in range(nv):
-            qdd_o[n, i] = x[i]
+    except Exception:  # no convergence (LAPACK): no measure
+        return np.inf
+    sr = s[rank0 - 1] if s.shape[0] >= rank0 else 0.0
+    return s[0] / sr if sr > 0 else np.inf
 
 
 @numba.njit(cache=True, error_model="numpy", parallel=True)
-def fd_tree_par(Q, QD, F, gv, t, qdd_o, cond_o):  # pragma: no cover - compiled
+def fd_par(
+    Q, R, F, W, wsb, wT, gv, act_mode, rank_K, t, rt, d, qd_o, qdd_o, cond_o, adm_o, clo_o, reg_o
+):  # pragma: no cover - compiled
+    """:func:`fd_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
     N = Q.shape[0]
     for k in numba.prange((N + BLOCK - 1) // BLOCK):
-        fd_tree_block(k * BLOCK, min(N, (k + 1) * BLOCK), Q, QD, F, gv, t, qdd_o, cond_o)
+        fd_block(
+            k * BLOCK,
+            min(N, (k + 1) * BLOCK),
+            Q,
+            R,
+            F,
+            W,
+            wsb,
+            wT,
+            gv,
+            act_mode,
+            rank_K,
+            t,
+            rt,
+            d,
+            qd_o,
+            qdd_o,
+            cond_o,
+            adm_o,
+            clo_o,
+            reg_o,
+        )
+
+
+def forward(model, q, rates, F, W, wsb, wT, gv, act_mode: bool) -> tuple:
+    """:func:`fd_block` on every sample (normalised ``q (N, nq)``): ``(qd, qdd, cond, adm, closure,
+    regular)``; one block in this thread for a small batch, parallel blocks for a large one (the same
+    per-sample code either way)."""
+    Q, Rt, FF, WW, G = writable(q), writable(rates), writable(F), writable(W), writable(gv)
+    N, nv = Q.shape[0], model.tree.nv
+    outs = (
+        np.empty((N, nv)),
+        np.empty((N, nv)),
+        np.empty(N),
+        np.empty(N),
+        np.empty(N),
+        np.empty(N, np.bool_),
+    )
+    args = (Q, Rt, FF, WW, wsb, wT, G, act_mode, model.rank_K, model.tables, model.rnea, model.dyn, *outs)
+    if N <= BLOCK:
+        entry(model, fd_block, f"fd_block_{act_mode}", (0, N, *args))
+    else:
+        fd_par(*args)
+    return outs
 
 
 @_nj
 def fd_tree_one(q, qd, F, gv, t, qs, qdd, cond):  # pragma: no cover - compiled
-    """One sample, checked (``_compiled.prepare_one``), then :func:`fd_tree_block`."""
+    """One sample of an open tree without site wrenches, checked (``_compiled.prepare_one``), then
+    :func:`fd_tree_block` (fewer tables to pass than :func:`fd_block`, the same per-sample code)."""
     if prepare_one(q, (qd, F), t.jtype, t.jqadr, qs) != 0:
         return 1
     nq, nv = qs.shape[0], qd.shape[0]
@@ -176,15 +431,3 @@ def fd_tree_one(q, qd, F, gv, t, qs, qdd, cond):  # pragma: no cover - compiled
         0, 1, qs.reshape(1, nq), qd.reshape(1, nv), F.reshape(1, nv), gv, t, qdd.reshape(1, nv), cond
     )
     return 0
-
-
-def fd_tree(model, q: np.ndarray, qd: np.ndarray, F: np.ndarray, gv: np.ndarray) -> tuple:
-    """``(qdd (N, nv), cond (N,))`` of an open tree at normalised ``q (N, nq)`` (:func:`fd_tree_block`)."""
-    Q, QD, FF, G = writable(q), writable(qd), writable(F), writable(gv)
-    N = Q.shape[0]
-    qdd, cond = np.empty((N, model.tree.nv)), np.empty(N)
-    if N <= BLOCK:
-        entry(model, fd_tree_block, "fd_tree_block", (0, N, Q, QD, FF, G, model.rnea, qdd, cond))
-    else:
-        fd_tree_par(Q, QD, FF, G, model.rnea, qdd, cond)
-    return qdd, cond
