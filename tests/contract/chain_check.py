@@ -42,3 +42,15 @@ def check_chain(call: Callable[[np.ndarray], Any], q: np.ndarray, bad: int, good
         elif v.dtype.kind == "b":
             assert not np.any(v[bad]), f"{k}: the failed sample is flagged True"
         np.testing.assert_allclose(v[good], alone[k], rtol=SAME_RTOL, atol=0.0, err_msg=k)
+
+
+def functions_taking(module: Any, names: set[str]) -> set[str]:
+    """The public functions of ``module`` with a parameter named in ``names`` (a state argument)."""
+    import inspect
+
+    return {
+        n
+        for n in module.__all__
+        if inspect.isfunction(getattr(module, n))
+        and names & set(inspect.signature(getattr(module, n)).parameters)
+    }

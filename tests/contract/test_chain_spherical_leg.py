@@ -5,13 +5,12 @@ and, at the other samples, what they give alone."""
 
 from __future__ import annotations
 
-import inspect
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import pytest
-from chain_check import check_chain
+from chain_check import check_chain, functions_taking
 
 from robomech.mechanisms import spherical_leg as sl
 
@@ -64,12 +63,7 @@ def test_a_failed_sample_chains(name):
 
 
 def test_every_function_taking_a_state_is_in_the_chain():
-    takes = {
-        n
-        for n in sl.__all__
-        if inspect.isfunction(getattr(sl, n)) and STATE & set(inspect.signature(getattr(sl, n)).parameters)
-    }
-    assert takes - set(CHAIN) - MASKED == set()
+    assert functions_taking(sl, STATE) - set(CHAIN) - MASKED == set()
 
 
 @pytest.mark.parametrize("bad", [np.inf, -np.inf, 1e300])
