@@ -54,3 +54,23 @@ def functions_taking(module: Any, names: set[str]) -> set[str]:
         if inspect.isfunction(getattr(module, n))
         and names & set(inspect.signature(getattr(module, n)).parameters)
     }
+
+
+def check_refused(call: Callable[[np.ndarray], Any], q: np.ndarray, match: str) -> None:
+    """±inf and 1e300 in a good sample of ``q`` are no failed sample but a wrong input: ValueError."""
+    import pytest
+
+    good = int(np.flatnonzero(np.isfinite(q).all(axis=-1))[0])
+    for bad in (np.inf, -np.inf, 1e300):
+        b = q.copy()
+        b[good, -1] = bad
+        with pytest.raises(ValueError, match=match):
+            call(b)
+
+
+def check_strict_fails(call: Callable[[np.ndarray], Any], q: np.ndarray, bad: int, good: list[int]) -> None:
+    """Control: ``call``, a function that refuses NaN (the undecorated boundary), fails the chain check."""
+    import pytest
+
+    with pytest.raises(ValueError):
+        check_chain(call, q, bad, good)
