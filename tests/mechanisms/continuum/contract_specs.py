@@ -30,13 +30,16 @@ _D3 = np.array([[1.0, -1.0, -1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0]])
 
 
 def _psi(**extra):
-    return Spec(args={"robot": ROBOT, "psi": PSI, **extra}, arrays={"psi": 1}, params=("robot",))
+    return Spec(
+        args={"robot": ROBOT, "psi": PSI, **extra}, arrays={"psi": 1}, nan_rows=("psi",), params=("robot",)
+    )
 
 
 def _psi_model(default):
     return Spec(
         args={"robot": ROBOT, "psi": PSI, "model": default},
         arrays={"psi": 1},
+        nan_rows=("psi",),
         params=("robot",),
         options={"model": BAD_MODEL},
     )
@@ -108,15 +111,21 @@ SPECS = {
     P + "friction_factors": Spec(
         args={"robot": ROBOT, "psi": PSI, "direction": DIRECTION},
         arrays={"psi": 1, "direction": 1},
+        nan_rows=("psi",),
         params=("robot",),
     ),
     P + "segment_transform": Spec(
         args={"theta": PSI[:, 0], "beta": PSI[:, 1], "length": np.array([0.09, 0.08, 0.1])},
         arrays={"theta": 0, "beta": 0, "length": 0},
+        nan_rows=("theta", "beta"),
         options={"length": (-0.1,)},
     ),
     P + "inverse_kinematics": Spec(
-        args={"robot": ROBOT, "p_tip": TIP}, arrays={"p_tip": 1}, params=("robot",), mask="reachable"
+        args={"robot": ROBOT, "p_tip": TIP},
+        arrays={"p_tip": 1},
+        nan_rows=("p_tip",),
+        params=("robot",),
+        mask="reachable",
     ),
     P + "cable_tensions": Spec(
         args={
@@ -128,6 +137,7 @@ SPECS = {
             "pretension": 5.0,
         },
         arrays={"psi": 1, "wrench": 1, "direction": 1},
+        nan_rows=("psi",),
         params=("robot",),
         mask="taut",
         options={"pretension": tuple(v for v in BAD_NONNEGATIVE if v is not None), "model": BAD_MODEL},
@@ -135,6 +145,7 @@ SPECS = {
     P + "cable_elongation": Spec(
         args={"robot": ROBOT, "psi": PSI, "tension": TENSION, "direction": DIRECTION, "model": "chord"},
         arrays={"psi": 1, "tension": 1, "direction": 1},
+        nan_rows=("psi", "tension"),
         params=("robot",),
         options={"model": BAD_MODEL},
     ),
@@ -149,6 +160,7 @@ SPECS = {
             "pulley": PULLEY,
         },
         arrays={"psi": 1, "direction": 1, "wrench": 1},
+        nan_rows=("psi",),
         params=("robot",),
         mask="taut",
         options={"model": BAD_MODEL, "method": ("segment", None, 1), "pulley": BAD_PULLEY},
@@ -163,6 +175,7 @@ SPECS = {
             "initial": PSI,
         },
         arrays={"q": 1, "direction": 1, "initial": 1},
+        nan_rows=("q",),
         params=("robot",),
         mask="converged",
         options={"model": BAD_MODEL, "pulley": BAD_PULLEY},
@@ -238,6 +251,7 @@ SPECS = {
     P + "disk_equilibrium": Spec(
         args={"robot": ROBOT, "tension": TENSION, "direction": DIRECTION, "initial": PSI},
         arrays={"tension": 1, "direction": 1, "initial": 1},
+        nan_rows=("tension",),
         params=("robot",),
         mask="converged",
         options={"tension": (-np.ones(3),)},
