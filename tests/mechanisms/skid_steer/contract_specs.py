@@ -16,7 +16,9 @@ _FIELDS = {f: getattr(ROBOT, f) for f in ROBOT.__dataclass_fields__}
 
 
 def _cfg():
-    return Spec(args={"robot": ROBOT, "config": CFG}, arrays={"config": 1}, params=("robot",))
+    return Spec(
+        args={"robot": ROBOT, "config": CFG}, arrays={"config": 1}, nan_rows=("config",), params=("robot",)
+    )
 
 
 SPECS = {
@@ -41,6 +43,7 @@ SPECS = {
     P + "wheel_measurements": Spec(
         args={"robot": ROBOT, "config": CFG, "twist": TWIST, "config_rate": QD},
         arrays={"config": 1, "twist": 1, "config_rate": 1},
+        nan_rows=("config", "twist", "config_rate"),
         params=("robot",),
     ),
     P + "body_velocity": Spec(
