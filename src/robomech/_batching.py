@@ -183,15 +183,21 @@ def carries_failed_rows(
     def wrap(fn: F) -> F:
         sig = inspect.signature(fn)
 
+        params = list(sig.parameters)
+        where = {n: params.index(n) for n in nan_rows}  # positional index of each nan_rows argument
+
         @functools.wraps(fn)
         def call(*args: Any, **kwargs: Any) -> Any:
+            if not any(
+                _has_nan(kwargs[n] if n in kwargs else args[i] if i < len(args) else None)
+                for n, i in where.items()
+            ):
+                return fn(*args, **kwargs)  # the common case: no sample failed, no binding
             try:
                 bound = sig.bind(*args, **kwargs)
             except TypeError:
                 return fn(*args, **kwargs)
             given = bound.arguments
-            if not any(_has_nan(given.get(n)) for n in nan_rows):
-                return fn(*args, **kwargs)
             checked = {
                 n: as_array(given[n], n, (None,) * c, nan_rows=True)
                 for n, c in nan_rows.items()
@@ -223,7 +229,11 @@ def carries_failed_rows(
 def _has_nan(x: object) -> bool:
     """True for a real array (or array-like) holding a NaN; False for anything else (the function's
     own boundary check then refuses what it must)."""
-    if x is None or isinstance(x, str | bytes):
+    if isinstance(x, float):
+        return x != x
+    if isinstance(x, np.ndarray):
+        return x.dtype.kind == "f" and bool(np.isnan(x).any())
+    if x is None or isinstance(x, str | bytes | int):
         return False
     try:
         a = np.asarray(x)

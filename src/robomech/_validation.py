@@ -121,7 +121,7 @@ def as_array(
             )
         nan = np.isnan(a)
         if len(tail):
-            nan = nan.any(axis=tuple(range(a.ndim - len(tail), a.ndim)), keepdims=True)
+            nan = np.asarray(nan.any(axis=tuple(range(a.ndim - len(tail), a.ndim)), keepdims=True))
         return np.where(nan, np.nan, a) if nan.any() else a
     if finite == "mask":
         return usable(a)

@@ -164,7 +164,8 @@ class InverseKinematicsResult:
 def inverse_kinematics(leg: SphericalLeg, alpha: object, beta: object) -> InverseKinematicsResult:
     """Leg lengths (paper 1, eq. (4)) for platform angles ``alpha``, ``beta`` (rad, broadcast).
 
-    Every finite (alpha, beta) has a solution; non-finite angles raise ``ValueError``.
+    Every finite (alpha, beta) has a solution; a NaN angle marks a failed sample (NaN lengths, False
+    ``within_limits`` there), ±inf raises ``ValueError``.
 
     Parameters
     ----------
