@@ -61,8 +61,13 @@ CHAIN: dict[str, Callable[[np.ndarray], Any]] = {
     "cable_elongation": lambda psi: c.cable_elongation(ROBOT, psi, _tension(psi), DIRECTION),
     "disk_equilibrium": lambda psi: c.disk_equilibrium(ROBOT, tension=_tension(psi), direction=DIRECTION),
     "simulate": lambda psi: c.simulate(ROBOT, _q(psi), DIRECTION, pulley=PULLEY),
+    # a wrap angle of the failed pose (rad): the bend of its segment, NaN there
+    "classical_capstan_ratio": lambda psi: c.classical_capstan_ratio(np.abs(psi[:, 0]), 0.2),
+    "capstan_tension_ratio": lambda psi: c.capstan_tension_ratio(
+        np.abs(psi[:, 0]), rho=2.5, alpha=1.0, n=0.5
+    ),
 }
-STATE = {"psi", "q", "theta", "beta", "tension", "p_tip"}
+STATE = {"psi", "q", "theta", "beta", "tension", "p_tip", "phi"}
 # a leading time axis (a history) or one estimate from all samples: refuse NaN
 NOT_PER_SAMPLE = {"simulate_history", "stick_slip_tensions", "identify_friction_from_pose"}
 

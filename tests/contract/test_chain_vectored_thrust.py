@@ -24,6 +24,13 @@ GOOD = [0, 2, 3]
 QD = np.array([0.3, -0.2])  # broadcast over the batch: the same for the mixed and the good batch
 W = np.array([0.1, -0.2, 0.3])
 
+
+def _arcs(q: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Two arcs between joint axes of the configurations ``q`` (NaN rows where ``q`` failed)."""
+    ax = vt.joint_axes(TH, q)
+    return ax.s11, ax.s12, ax.s12, ax.s13
+
+
 CHAIN: dict[str, Callable[[np.ndarray], Any]] = {
     "forward_kinematics": lambda q: vt.forward_kinematics(TH, q),
     "platform_rotation": lambda q: vt.platform_rotation(TH, q),
@@ -40,6 +47,7 @@ CHAIN: dict[str, Callable[[np.ndarray], Any]] = {
     "inverse_rates": lambda q: vt.inverse_rates(TH, q, W, W),
     "static_torques": lambda q: vt.static_torques(TH, q, np.concatenate([W, W])),
     # the failed sample's thrust axis and angular velocity (NaN rows of outputs) fed back
+    "arc_clearance": lambda q: vt.arc_clearance(*_arcs(q)),
     "inverse_kinematics(s)": lambda q: vt.inverse_kinematics(TH, vt.forward_kinematics(TH, q).axis),
     "inverse_rates(omega)": lambda q: vt.inverse_rates(
         TH, np.nan_to_num(q), vt.angular_velocity(TH, q, QD).omega
@@ -51,7 +59,7 @@ SINGLE: dict[str, Callable[[np.ndarray], Any]] = {
     "platform_mobility": lambda q: vt.platform_mobility(TH, q[1]),
     "mechanism_mobility": lambda q: vt.mechanism_mobility(TH, q[1]),
 }
-STATE = {"q", "qd", "qdd", "q1", "s", "omega", "omega_dot"}
+STATE = {"q", "qd", "qdd", "q1", "s", "omega", "omega_dot", "a1", "b1", "a2", "b2"}
 
 
 def test_inverse_kinematics_returns_a_failed_sample():

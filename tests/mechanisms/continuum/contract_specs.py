@@ -224,11 +224,14 @@ SPECS = {
             "n": np.array([0.5, 1.0]),
             "t_out": np.array([1.0, 2.0]),
         },
-        arrays={"phi": 0, "alpha": 0, "n": 0, "t_out": 0},  # rho: an option (np.inf is allowed)
+        arrays={"phi": 0, "alpha": 0, "n": 0, "t_out": 0},
+        nan_rows=("phi",),  # rho: an option (np.inf is allowed)
         options={"n": (0.0, 1.5), "rho": (0.0, np.nan, None, "2"), "phi": (-1.0,), "t_out": (0.0,)},
     ),
     P + "classical_capstan_ratio": Spec(
-        args={"phi": np.array([0.5, 1.0]), "mu": np.array([0.3, 0.1])}, arrays={"phi": 0, "mu": 0}
+        args={"phi": np.array([0.5, 1.0]), "mu": np.array([0.3, 0.1])},
+        arrays={"phi": 0, "mu": 0},
+        nan_rows=("phi",),
     ),
     P + "identify_friction": Spec(
         args={

@@ -63,6 +63,7 @@ SPECS = {
     P + "arc_clearance": Spec(
         args={"a1": S, "b1": S[::-1].copy(), "a2": np.eye(3), "b2": np.eye(3)[::-1].copy()},
         arrays={"a1": 1, "b1": 1, "a2": 1, "b2": 1},
+        nan_rows=("a1", "b1", "a2", "b2"),
     ),
     P + "idle_input_curve": Spec(
         args={"th": TH, "q1": Q[:, 0]}, arrays={"q1": 0}, nan_rows=("q1",), params=("th",)

@@ -210,6 +210,7 @@ def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np
     return (rho / n) * ((1.0 + rho) / (alpha * rho)) ** (1.0 / n)
 
 
+@carries_failed_rows({"phi": 0}, {"mu": 0})
 def classical_capstan_ratio(phi: object, mu: object) -> np.ndarray:
     """Euler-Eytelwein capstan law T_in / T_out = exp(mu phi).
 
@@ -279,6 +280,7 @@ def _rk4(phi, rho, c, p, lam, M2):
     return y, z
 
 
+@carries_failed_rows({"phi": 0}, {"alpha": 0, "n": 0, "t_out": 0})
 def capstan_tension_ratio(
     phi: object, *, rho: object, alpha: object, n: object, t_out: object = 1.0
 ) -> np.ndarray:

@@ -407,6 +407,7 @@ def _split(v: np.ndarray) -> _V:
     return (v[..., 0], v[..., 1], v[..., 2])
 
 
+@carries_failed_rows({"a1": 1, "b1": 1, "a2": 1, "b2": 1})
 def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
     """Angular distance (rad) between the minor great-circle arcs (a1 -> b1) and (a2 -> b2) (unit, (..., 3)).
 
