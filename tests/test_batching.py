@@ -133,6 +133,11 @@ def test_carries_failed_rows_masks_a_nan_row_and_still_refuses_wrong_inputs():
         _decorated(np.full((2, 4), np.nan), np.ones(3))  # wrong shape with NaN: still refused
     with pytest.raises(ValueError, match="w"):
         _decorated(np.full((2, 3), np.nan), np.ones((3, 3)))  # batches that do not broadcast
+    w = np.ones((4, 3))
+    w[2, 0] = np.inf  # at the failed sample: dropped from the call, still refused
+    q[0, 0] = 0.0
+    with pytest.raises(ValueError, match="Expected w to be finite"):
+        _decorated(q, w)
 
 
 def test_control_without_the_decorator_a_nan_row_raises():

@@ -165,7 +165,7 @@ def on_rows(
 
 
 def carries_failed_rows(
-    nan_rows: Mapping[str, int], batched: Mapping[str, int] | None = None
+    nan_rows: Mapping[str, int], batched: Mapping[str, int] | None = None, *, masked: Sequence[str] = ()
 ) -> Callable[[F], F]:
     """Decorator: the public function carries the failed samples (NaN rows) of ``nan_rows``.
 
@@ -176,7 +176,9 @@ def carries_failed_rows(
     (±inf and magnitudes above ``MAX_MAGNITUDE`` still raise, naming it), every batched argument is
     broadcast to the common batch, and the function runs on the samples without NaN only
     (:func:`on_rows`): its boundary checks every remaining value, and the failed samples get NaN,
-    False or 0 in every per-sample result array.
+    False or 0 in every per-sample result array.  The other ``batched`` arguments are checked at the
+    failed samples too (finite, magnitudes within ``MAX_MAGNITUDE``), as the function checks them at
+    the others, except those in ``masked``: arguments the function itself masks per sample.
     """
     every = {**(batched or {}), **nan_rows}
 
@@ -214,6 +216,9 @@ def carries_failed_rows(
                 failed = failed | failed_rows(a, nan_rows[n])
             names = list(arrays)
             full = [np.broadcast_to(a, batch + a.shape[a.ndim - every[n] :]) for n, a in arrays.items()]
+            for n, a in zip(names, full, strict=True):
+                if n not in nan_rows and n not in masked:
+                    as_array(a[failed], n)  # the values a failed sample drops: still a wrong input
 
             def run(*rows: np.ndarray) -> Any:
                 bound.arguments.update(zip(names, rows, strict=True))

@@ -354,7 +354,7 @@ class WheelSlip:
     valid: np.ndarray
 
 
-@carries_failed_rows({"body_velocity": 1, "config": 1}, {"wheel_rate": 1})
+@carries_failed_rows({"body_velocity": 1, "config": 1}, {"wheel_rate": 1}, masked=("wheel_rate",))
 def wheel_slip(
     robot: ExplorationRobot, wheel_rate: ArrayLike, body_velocity: ArrayLike, config: ArrayLike | None = None
 ) -> WheelSlip:
