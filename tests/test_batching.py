@@ -94,7 +94,7 @@ def test_on_rows_fills_failed_samples_and_keeps_the_others_bit_identical(failed)
 def test_on_rows_keeps_batch_shapes_ints_and_unbatched_arrays():
     x = X[:6].reshape(2, 3, 3)
     failed = np.array([[False, True, False], [False, False, True]])
-    const = np.eye(3)[:2]  # (2, 3): leading axis differs from the 4 computed samples
+    const = np.eye(4)[:, :3]  # (4, 3), fixed: its leading length is that of the 4 computed samples
 
     def fn(r):
         return (np.cos(r), np.full(r.shape[0], 7), const)

@@ -111,18 +111,25 @@ def _fill(r: np.ndarray, ok: np.ndarray, batch: tuple[int, ...]) -> np.ndarray:
     return full
 
 
-def _scatter(res: Any, ok: np.ndarray, k: int, batch: tuple[int, ...]) -> Any:
-    """Every array of ``res`` (an array, a tuple / NamedTuple or a dataclass of them, nested) whose
-    leading axis has the ``k`` computed samples, spread over ``batch`` with the failed samples filled."""
+def _scatter(res: Any, ok: np.ndarray, k: int, batch: tuple[int, ...], empty: Any = None) -> Any:
+    """Every per-sample array of ``res`` (an array, a tuple / NamedTuple or a dataclass of them,
+    nested), spread over ``batch`` with the failed samples filled.  Per sample: its leading axis has
+    the ``k`` computed samples and, where ``empty`` (the same call on no sample) is given, 0 there;
+    so an array of fixed shape whose leading length happens to be ``k`` is left alone."""
     if isinstance(res, np.ndarray):
-        return _fill(res, ok, batch) if res.ndim >= 1 and res.shape[0] == k else res
+        per_sample = res.ndim >= 1 and res.shape[0] == k
+        if empty is not None:
+            per_sample &= isinstance(empty, np.ndarray) and empty.ndim >= 1 and empty.shape[0] == 0
+        return _fill(res, ok, batch) if per_sample else res
     if dataclasses.is_dataclass(res) and not isinstance(res, type):
         out = copy.copy(res)  # not dataclasses.replace: a result's __post_init__ is not re-run
         for f in dataclasses.fields(res):
-            object.__setattr__(out, f.name, _scatter(getattr(res, f.name), ok, k, batch))
+            e = None if empty is None else getattr(empty, f.name)
+            object.__setattr__(out, f.name, _scatter(getattr(res, f.name), ok, k, batch, e))
         return out
     if isinstance(res, tuple):
-        parts = [_scatter(r, ok, k, batch) for r in res]
+        es = [None] * len(res) if empty is None else list(empty)
+        parts = [_scatter(r, ok, k, batch, e) for r, e in zip(res, es, strict=True)]
         return type(res)(*parts) if hasattr(res, "_fields") else tuple(parts)
     return res
 
@@ -145,8 +152,10 @@ def on_rows(
     *rows : ndarray
         The batched arguments, each of shape ``batch + core``.
     probe : sequence of ndarray, optional
-        One-sample ``rows`` to compute on where every sample failed (for a ``compute`` that cannot
-        take an empty batch); its result only gives the output shapes.  Default: the empty batch.
+        One-sample ``rows`` to compute on where every sample failed, for a ``compute`` that cannot
+        take an empty batch and whose every result array is per sample.  Without it, ``compute`` also
+        runs on the empty batch (cheap): the arrays with leading length 0 there are the per-sample
+        ones, so a fixed-shape result array is never mistaken for one.
 
     Returns
     -------
@@ -159,9 +168,13 @@ def on_rows(
         return compute(*rows)
     ok = ~failed
     k = int(np.count_nonzero(ok))
-    if k == 0 and probe is not None:
-        return _scatter(compute(*probe), ok, 1, failed.shape)  # (1, ...) assigned to no sample
-    return _scatter(compute(*(r[ok] for r in rows)), ok, k, failed.shape)
+    if probe is not None:  # every result array is per sample
+        if k == 0:
+            return _scatter(compute(*probe), ok, 1, failed.shape)  # (1, ...) assigned to no sample
+        return _scatter(compute(*(r[ok] for r in rows)), ok, k, failed.shape)
+    res = compute(*(r[ok] for r in rows))
+    empty = res if k == 0 else compute(*(r[ok][:0] for r in rows))  # tells per-sample arrays
+    return _scatter(res, ok, k, failed.shape, empty)
 
 
 def carries_failed_rows(

@@ -33,6 +33,10 @@ def check_chain(call: Callable[[np.ndarray], Any], q: np.ndarray, bad: int, good
     mixed = arrays_of(call(q))
     alone = arrays_of(call(q[good]))
     n = q.shape[0]
+    filled = q.copy()
+    filled[bad] = q[good[0]]  # the same batch size without a failed sample: the same result shapes
+    shapes = {k: v.shape for k, v in arrays_of(call(filled)).items()}
+    assert {k: v.shape for k, v in mixed.items()} == shapes, "a failed sample changed a result shape"
     batched = [k for k, v in mixed.items() if v.ndim >= 1 and v.shape[0] == n]
     assert batched, "no result array has the batch"
     for k in batched:
