@@ -1,4 +1,5 @@
-"""``robomech._batching.chunked``: a chunked evaluation equals the whole-batch evaluation bit for bit."""
+"""``robomech._batching``: a chunked evaluation equals the whole-batch evaluation bit for bit; a failed
+sample (a NaN row) is filled, the other samples are those of the batch without it."""
 
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -8,7 +9,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from robomech._batching import chunked, slices
+from robomech._batching import carries_failed_rows, chunked, on_rows, slices
+from robomech._validation import as_array
 
 
 @dataclass(frozen=True)
@@ -69,3 +71,75 @@ def test_in_place_kernels_are_called_once_per_chunk():
 def test_empty_batch_calls_the_kernel_once_with_an_empty_slice():
     got = chunked(lambda s: X[s] + 1, 0, 8)
     assert got.shape == (0, 3)
+
+
+# --- failed samples: on_rows, carries_failed_rows ------------------------------------------------
+
+
+def _stats(x: np.ndarray) -> _Pair:
+    """A per-sample result: float (..., 3), bool (...)."""
+    return _Pair(np.sin(x), x[..., 0] > 0)
+
+
+@given(st.lists(st.booleans(), min_size=1, max_size=12))
+def test_on_rows_fills_failed_samples_and_keeps_the_others_bit_identical(failed):
+    failed = np.array(failed)
+    x = X[: failed.size]
+    out = on_rows(failed, _stats, x)
+    alone = _stats(x[~failed])
+    assert np.isnan(out.a[failed]).all() and not out.b[failed].any()
+    assert np.array_equal(out.a[~failed], alone.a) and np.array_equal(out.b[~failed], alone.b)
+
+
+def test_on_rows_keeps_batch_shapes_ints_and_unbatched_arrays():
+    x = X[:6].reshape(2, 3, 3)
+    failed = np.array([[False, True, False], [False, False, True]])
+    const = np.eye(4)[:, :3]  # (4, 3), fixed: its leading length is that of the 4 computed samples
+
+    def fn(r):
+        return (np.cos(r), np.full(r.shape[0], 7), const)
+
+    cos, ints, c = on_rows(failed, fn, x)
+    assert cos.shape == (2, 3, 3) and np.isnan(cos[failed]).all()
+    assert ints.tolist() == [[7, 0, 7], [7, 7, 0]] and c is const
+    every = on_rows(np.ones(4, bool), fn, X[:4])  # no sample left: shapes from the empty batch
+    assert every[0].shape == (4, 3) and np.isnan(every[0]).all()
+
+
+def test_on_rows_with_a_probe_where_every_sample_failed():
+    out = on_rows(np.ones(2, bool), lambda r: (r[:, :1] * 2,), X[:2], probe=(X[:1],))
+    assert out[0].shape == (2, 1) and np.isnan(out[0]).all()
+
+
+@carries_failed_rows({"q": 1}, {"w": 1})
+def _decorated(q, w, *, scale=1.0):
+    q = as_array(q, "q", (3,))  # the strict boundary of the function itself
+    return _Pair(scale * q + w, q[..., 0] > 0)
+
+
+def test_carries_failed_rows_masks_a_nan_row_and_still_refuses_wrong_inputs():
+    q = X[:4].copy()
+    q[2, 1] = np.nan
+    r = _decorated(q, np.ones(3), scale=2.0)
+    good = _decorated(q[[0, 1, 3]], np.ones(3), scale=2.0)
+    assert np.isnan(r.a[2]).all() and not r.b[2]
+    assert np.array_equal(r.a[[0, 1, 3]], good.a)
+    assert np.array_equal(_decorated(X[:4], 0.0).a, X[:4])  # no NaN: the function itself
+    for bad in (np.inf, -1e300):
+        q[0, 0] = bad
+        with pytest.raises(ValueError, match="Expected q finite"):
+            _decorated(q, np.ones(3))
+    with pytest.raises(ValueError, match="q"):
+        _decorated(np.full((2, 4), np.nan), np.ones(3))  # wrong shape with NaN: still refused
+    with pytest.raises(ValueError, match="w"):
+        _decorated(np.full((2, 3), np.nan), np.ones((3, 3)))  # batches that do not broadcast
+    w = np.ones((4, 3))
+    w[2, 0] = np.inf  # at the failed sample: dropped from the call, still refused
+    q[0, 0] = 0.0
+    with pytest.raises(ValueError, match="Expected w to be finite"):
+        _decorated(q, w)
+
+
+def test_control_without_the_decorator_a_nan_row_raises():
+    with pytest.raises(ValueError, match="q"):
+        _decorated.__wrapped__(np.full((2, 3), np.nan), np.ones(3))

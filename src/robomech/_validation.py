@@ -74,6 +74,7 @@ def as_array(
     finite: bool | str = True,
     min_ndim: int | None = None,
     nonempty: bool = False,
+    nan_rows: bool = False,
 ) -> np.ndarray:
     """Return ``x`` as a float64 array whose trailing dimensions are ``tail``.
 
@@ -85,6 +86,9 @@ def as_array(
     :data:`MAX_MAGNITUDE` (and inf) into NaN, for models that mask NaN samples.
     ``nonempty=True`` also requires every free (``None``) trailing dimension to be at least 1: a
     Jacobian ``(..., m, n)`` with no rows or no columns has no condition, rank or solution to report.
+    ``nan_rows=True`` accepts NaN as the mark of a failed sample of an earlier call (docs/conventions.md,
+    "Failed samples chain"): a sample (the trailing ``tail`` axes) with a NaN entry is returned all NaN;
+    ±inf and magnitudes above :data:`MAX_MAGNITUDE` still raise (no failed sample but a wrong input).
     """
     if x is None or isinstance(x, str | bytes):
         raise ValueError(f"Expected {name} to be an array of real numbers, got {type(x).__name__}.")
@@ -108,6 +112,17 @@ def as_array(
         raise ValueError(
             f"Expected {name} to have shape (..., {free}) with no empty dimension, got {a.shape}."
         )
+    if nan_rows:
+        wrong = ~np.isnan(a) & ~(np.abs(a) <= MAX_MAGNITUDE)
+        if np.any(wrong):
+            raise ValueError(
+                f"Expected {name} finite with |value| <= {MAX_MAGNITUDE:g} (NaN marks a failed sample), "
+                f"got {a[wrong].flat[0]:g}."
+            )
+        nan = np.isnan(a)
+        if len(tail):
+            nan = np.asarray(nan.any(axis=tuple(range(a.ndim - len(tail), a.ndim)), keepdims=True))
+        return np.where(nan, np.nan, a) if nan.any() else a
     if finite == "mask":
         return usable(a)
     if finite:

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from chain_check import check_chain
 
 from robomech import multibody as mb
 
@@ -24,8 +25,6 @@ FK = mb.forward_kinematics(MECH, np.array([[0.2], [np.nan], [-0.4]]))  # sample 
 GOOD = [0, 2]
 QD = np.full((3, MECH.nv), 0.1)
 QDA = np.full((3, 1), 0.3)
-# the good samples alone and inside the mixed batch run the same formulas on the same numbers
-SAME_RTOL = 1e-12
 
 # batched functions: call(q) on a batch of configurations
 CHAIN: dict[str, Callable[[np.ndarray], Any]] = {
@@ -59,37 +58,6 @@ SINGLE: dict[str, Callable[[np.ndarray], Any]] = {
     "view": lambda q: mb.view(MECH, q[1]),
     "simulate": lambda q: mb.simulate(MECH, q[1], QDA[1], np.linspace(0.0, 0.01, 3)),
 }
-
-
-def _arrays(res: Any) -> dict[str, np.ndarray]:
-    if isinstance(res, np.ndarray):
-        items = {"result": res}
-    elif isinstance(res, tuple):
-        items = {f"[{i}]": r for i, r in enumerate(res)}
-    else:
-        items = {f.name: getattr(res, f.name) for f in dataclasses.fields(res)}
-        for k, v in list(items.items()):
-            if dataclasses.is_dataclass(v):
-                items.update({f"{k}.{n}": a for n, a in _arrays(v).items()})
-    return {
-        k: np.asarray(v) for k, v in items.items() if isinstance(v, np.ndarray) and v.dtype.kind in "biuf"
-    }
-
-
-def check_chain(call: Callable[[np.ndarray], Any], q: np.ndarray, bad: int, good: list[int]) -> None:
-    """``call(q)`` with ``q[bad]`` failed: NaN / False there, the good samples as when alone."""
-    mixed = _arrays(call(q))
-    alone = _arrays(call(q[good]))
-    n = q.shape[0]
-    batched = [k for k, v in mixed.items() if v.ndim >= 1 and v.shape[0] == n]
-    assert batched, "no result array has the batch"
-    for k in batched:
-        v = mixed[k]
-        if v.dtype.kind == "f":  # NaN, or inf for a residual / condition that has no finite value
-            assert not np.any(np.isfinite(v[bad])), f"{k}: the failed sample is not NaN"
-        elif v.dtype.kind == "b":
-            assert not np.any(v[bad]), f"{k}: the failed sample is flagged True"
-        np.testing.assert_allclose(v[good], alone[k], rtol=SAME_RTOL, atol=0.0, err_msg=k)
 
 
 def _takes_q(name: str) -> bool:

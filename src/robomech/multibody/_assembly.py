@@ -48,18 +48,10 @@ def check_q(mech: Mechanism, q: object, name: str = "q", *, nan_rows: bool = Fal
     ``nan_rows=True`` is the rule of the batched analysis functions (docs/conventions.md, "Failed
     samples chain"): a sample with a NaN entry is a failed sample of an earlier call (what
     :func:`forward_kinematics` returns where it did not converge); the whole row is set to NaN and
-    the caller gives NaN / False for it (:func:`on_rows`).  ±inf and magnitudes above
+    the caller gives NaN / False for it (:func:`robomech._batching.on_rows`).  ±inf and magnitudes above
     ``MAX_MAGNITUDE`` are refused either way: they are no failed sample but a wrong input.
     """
-    q = as_array(q, name, (mech.nq,), finite=not nan_rows)
-    if nan_rows:
-        wrong = ~np.isnan(q) & ~(np.abs(q) <= MAX_MAGNITUDE)
-        if np.any(wrong):
-            raise ValueError(
-                f"Expected {name} finite with |value| <= {MAX_MAGNITUDE:g} (NaN marks a failed sample), "
-                f"got {q[wrong].flat[0]:g}."
-            )
-        q = np.where(np.isnan(q).any(axis=-1, keepdims=True), np.nan, q)
+    q = as_array(q, name, (mech.nq,), nan_rows=nan_rows)
     for a in mech.tree.quat_adr:
         n = np.linalg.norm(q[..., a : a + 4], axis=-1)
         if np.any(n < 1e-9):
@@ -67,32 +59,6 @@ def check_q(mech: Mechanism, q: object, name: str = "q", *, nan_rows: bool = Fal
                 f"Expected the quaternion {name}[..., {a}:{a + 4}] to be non-zero, got norm {np.nanmin(n)}."
             )
     return normalize_quaternions(mech.tree, q)
-
-
-def on_rows(mech: Mechanism, qf: np.ndarray, compute: Callable[..., tuple], *others: np.ndarray):
-    """``compute(q_rows, *other_rows)`` on the samples of ``qf (N, nq)`` without NaN only.
-
-    Returns ``(ok (N,), outputs)`` with each output (leading axis N) NaN (float), False (bool) or 0
-    (int) at the failed samples.  A batch without failed samples is computed as it is (the very
-    same call), so good samples never depend on their failed neighbours.
-    """
-    ok = ~np.isnan(qf).any(axis=-1)
-    if ok.all():
-        return ok, compute(qf, *others)
-    idx = np.flatnonzero(ok)
-    probe = idx.size == 0  # no good sample: compute one at q0 for the output shapes, then drop it
-    rows = np.arange(1) if probe else idx
-    q_in = mech.tree.q0[None].copy() if probe else qf[idx]
-    res = compute(q_in, *(o[np.zeros(1, int)] if probe else o[rows] for o in others))
-    out = []
-    for r in res:
-        r = np.asarray(r)
-        fill: object = np.nan if r.dtype.kind in "fc" else (False if r.dtype.kind == "b" else 0)
-        full = np.full((qf.shape[0], *r.shape[1:]), fill, dtype=r.dtype)
-        if not probe:
-            full[idx] = r
-        out.append(full)
-    return ok, tuple(out)
 
 
 # Singular values of the passive block below this fraction of the largest are the start's idle or

@@ -46,9 +46,10 @@ from typing import TypeVar
 
 import numpy as np
 
+from robomech._batching import failed_rows, on_rows
 from robomech._validation import MAX_MAGNITUDE, as_array, broadcast_batch, check_bool
 
-from ._assembly import check_mechanism, check_q, on_rows, solve_closure
+from ._assembly import check_mechanism, check_q, solve_closure
 from ._compile import Bodies, compile_model
 from ._constraints import jacobian
 from ._model import Mechanism
@@ -1451,7 +1452,7 @@ def energy(mech: Mechanism, q: object, qd: object) -> tuple[np.ndarray, np.ndarr
     def energies(qs: np.ndarray, qds: np.ndarray) -> tuple:
         return _energy_flat(mech, qs, qds)
 
-    _, (T, U) = on_rows(mech, qf, energies, qdf)
+    (T, U) = on_rows(failed_rows(qf), energies, qf, qdf, probe=(mech.tree.q0[None], qdf[:1]))
     return np.reshape(T, batch), np.reshape(U, batch)
 
 

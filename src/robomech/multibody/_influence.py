@@ -21,9 +21,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech._batching import failed_rows, on_rows
 from robomech._validation import as_array, broadcast_batch, check_bool
 
-from ._assembly import check_mechanism, check_q, on_rows
+from ._assembly import check_mechanism, check_q
 from ._constraints import jacobian, jacobian_rate
 from ._model import Mechanism
 from ._options import PASSIVE_RANK_RTOL
@@ -182,7 +183,7 @@ def influence(mech: Mechanism, q: object, *, second_order: bool = True) -> Influ
         _, _, G, dG, _, (rank, _, cons, smin, cond) = _influence_flat(mech, qs, second_order)
         return (G, rank, cons, smin, cond) + (() if dG is None else (dG,))
 
-    _, res = on_rows(mech, qf, run)
+    res = on_rows(failed_rows(qf), run, qf, probe=(mech.tree.q0[None],))
     G, rank, cons, smin, cond = res[:5]
     dG = res[5] if len(res) > 5 else None
     nv, na = G.shape[-2:]
@@ -234,8 +235,11 @@ def site_pose(mech: Mechanism, q: object, site: str) -> np.ndarray:
     qf, batch = _flat(mech, q)
     from ._tree import body_poses
 
-    _, (T,) = on_rows(
-        mech, qf, lambda qs: (body_poses(mech.tree, qs)[:, mech.tree.site_body[si]] @ mech.tree.T_site[si],)
+    (T,) = on_rows(
+        failed_rows(qf),
+        lambda qs: (body_poses(mech.tree, qs)[:, mech.tree.site_body[si]] @ mech.tree.T_site[si],),
+        qf,
+        probe=(mech.tree.q0[None],),
     )
     return T.reshape(*batch, 4, 4)
 
@@ -281,7 +285,9 @@ def site_jacobian(mech: Mechanism, q: object, site: str) -> np.ndarray:
     qf, batch = _flat(mech, q)
     from ._compiled import compiled_site_jacobian  # numba loads on the first kernel call
 
-    _, (J,) = on_rows(mech, qf, lambda qs: (compiled_site_jacobian(mech, qs, si),))
+    (J,) = on_rows(
+        failed_rows(qf), lambda qs: (compiled_site_jacobian(mech, qs, si),), qf, probe=(mech.tree.q0[None],)
+    )
     return J.reshape(*batch, 6, J.shape[-1])
 
 
@@ -337,7 +343,7 @@ def site_hessian(mech: Mechanism, q: object, site: str) -> np.ndarray:
         Jfd = frame_jacobian_rate(tree, state, Sd, b, p, G.swapaxes(-1, -2))  # (N, na_k, 6, nv)
         return (Jfd @ G[:, None] + Jf[:, None] @ dG.transpose(0, 3, 1, 2),)  # (N, k, 6, j)
 
-    _, (Hk,) = on_rows(mech, qf, run)
+    (Hk,) = on_rows(failed_rows(qf), run, qf, probe=(mech.tree.q0[None],))
     return Hk.transpose(0, 2, 3, 1).reshape(*batch, 6, na, na)
 
 
@@ -375,8 +381,11 @@ def constraint_residual(mech: Mechanism, q: object) -> np.ndarray:
 
     mech = check_mechanism(mech)
     qf, batch = _flat(mech, q)
-    _, (r,) = on_rows(
-        mech, qf, lambda qs: (residual(mech.constraints, mech.tree, kinematics(mech.tree, qs), qs),)
+    (r,) = on_rows(
+        failed_rows(qf),
+        lambda qs: (residual(mech.constraints, mech.tree, kinematics(mech.tree, qs), qs),),
+        qf,
+        probe=(mech.tree.q0[None],),
     )
     return r.reshape(*batch, r.shape[-1])
 
@@ -414,8 +423,11 @@ def constraint_jacobian(mech: Mechanism, q: object) -> np.ndarray:
     """
     mech = check_mechanism(mech)
     qf, batch = _flat(mech, q)
-    _, (K,) = on_rows(
-        mech, qf, lambda qs: (jacobian(mech.constraints, mech.tree, kinematics(mech.tree, qs), qs),)
+    (K,) = on_rows(
+        failed_rows(qf),
+        lambda qs: (jacobian(mech.constraints, mech.tree, kinematics(mech.tree, qs), qs),),
+        qf,
+        probe=(mech.tree.q0[None],),
     )
     return K.reshape(*batch, *K.shape[1:])
 
@@ -464,5 +476,5 @@ def constraint_jacobian_rate(mech: Mechanism, q: object, qd: object) -> np.ndarr
         st = kinematics(mech.tree, qs)
         return (jacobian_rate(mech.constraints, mech.tree, st, screw_rates(mech.tree, st, qds), qs, qds),)
 
-    _, (Kd,) = on_rows(mech, qf, run, qdf)
+    (Kd,) = on_rows(failed_rows(qf), run, qf, qdf, probe=(mech.tree.q0[None], qdf[:1]))
     return Kd.reshape(*batch, *Kd.shape[1:])

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from robomech._batching import failed_rows, on_rows
 from robomech._validation import as_array, check_int, check_positive, check_real
 from robomech.analysis import workspace
 
@@ -40,7 +41,6 @@ from ._assembly import (
     check_q,
     forward_kinematics,
     inverse_kinematics,
-    on_rows,
 )
 from ._compile import compile_model
 from ._influence import _influence_flat
@@ -274,7 +274,10 @@ def singularities(
 
     from ._dynamics import CLOSURE_RTOL, _closure_error
 
-    _, (sigma_I, sigma_II, sigma_C, cI, cII, cC, closure) = on_rows(mech, q.reshape(-1, mech.nq), run)
+    qf = q.reshape(-1, mech.nq)
+    sigma_I, sigma_II, sigma_C, cI, cII, cC, closure = on_rows(
+        failed_rows(qf), run, qf, probe=(mech.tree.q0[None],)
+    )
     tI, tII, tC = cI > 1 / rtol, cII > 1 / rtol, cC > 1 / rtol
 
     def sh(x: np.ndarray) -> np.ndarray:

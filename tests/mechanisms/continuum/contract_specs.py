@@ -30,13 +30,16 @@ _D3 = np.array([[1.0, -1.0, -1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0]])
 
 
 def _psi(**extra):
-    return Spec(args={"robot": ROBOT, "psi": PSI, **extra}, arrays={"psi": 1}, params=("robot",))
+    return Spec(
+        args={"robot": ROBOT, "psi": PSI, **extra}, arrays={"psi": 1}, nan_rows=("psi",), params=("robot",)
+    )
 
 
 def _psi_model(default):
     return Spec(
         args={"robot": ROBOT, "psi": PSI, "model": default},
         arrays={"psi": 1},
+        nan_rows=("psi",),
         params=("robot",),
         options={"model": BAD_MODEL},
     )
@@ -108,15 +111,21 @@ SPECS = {
     P + "friction_factors": Spec(
         args={"robot": ROBOT, "psi": PSI, "direction": DIRECTION},
         arrays={"psi": 1, "direction": 1},
+        nan_rows=("psi",),
         params=("robot",),
     ),
     P + "segment_transform": Spec(
         args={"theta": PSI[:, 0], "beta": PSI[:, 1], "length": np.array([0.09, 0.08, 0.1])},
         arrays={"theta": 0, "beta": 0, "length": 0},
+        nan_rows=("theta", "beta"),
         options={"length": (-0.1,)},
     ),
     P + "inverse_kinematics": Spec(
-        args={"robot": ROBOT, "p_tip": TIP}, arrays={"p_tip": 1}, params=("robot",), mask="reachable"
+        args={"robot": ROBOT, "p_tip": TIP},
+        arrays={"p_tip": 1},
+        nan_rows=("p_tip",),
+        params=("robot",),
+        mask="reachable",
     ),
     P + "cable_tensions": Spec(
         args={
@@ -128,6 +137,7 @@ SPECS = {
             "pretension": 5.0,
         },
         arrays={"psi": 1, "wrench": 1, "direction": 1},
+        nan_rows=("psi",),
         params=("robot",),
         mask="taut",
         options={"pretension": tuple(v for v in BAD_NONNEGATIVE if v is not None), "model": BAD_MODEL},
@@ -135,6 +145,7 @@ SPECS = {
     P + "cable_elongation": Spec(
         args={"robot": ROBOT, "psi": PSI, "tension": TENSION, "direction": DIRECTION, "model": "chord"},
         arrays={"psi": 1, "tension": 1, "direction": 1},
+        nan_rows=("psi", "tension"),
         params=("robot",),
         options={"model": BAD_MODEL},
     ),
@@ -149,6 +160,7 @@ SPECS = {
             "pulley": PULLEY,
         },
         arrays={"psi": 1, "direction": 1, "wrench": 1},
+        nan_rows=("psi",),
         params=("robot",),
         mask="taut",
         options={"model": BAD_MODEL, "method": ("segment", None, 1), "pulley": BAD_PULLEY},
@@ -163,6 +175,7 @@ SPECS = {
             "initial": PSI,
         },
         arrays={"q": 1, "direction": 1, "initial": 1},
+        nan_rows=("q",),
         params=("robot",),
         mask="converged",
         options={"model": BAD_MODEL, "pulley": BAD_PULLEY},
@@ -211,11 +224,14 @@ SPECS = {
             "n": np.array([0.5, 1.0]),
             "t_out": np.array([1.0, 2.0]),
         },
-        arrays={"phi": 0, "alpha": 0, "n": 0, "t_out": 0},  # rho: an option (np.inf is allowed)
+        arrays={"phi": 0, "alpha": 0, "n": 0, "t_out": 0},
+        nan_rows=("phi",),  # rho: an option (np.inf is allowed)
         options={"n": (0.0, 1.5), "rho": (0.0, np.nan, None, "2"), "phi": (-1.0,), "t_out": (0.0,)},
     ),
     P + "classical_capstan_ratio": Spec(
-        args={"phi": np.array([0.5, 1.0]), "mu": np.array([0.3, 0.1])}, arrays={"phi": 0, "mu": 0}
+        args={"phi": np.array([0.5, 1.0]), "mu": np.array([0.3, 0.1])},
+        arrays={"phi": 0, "mu": 0},
+        nan_rows=("phi",),
     ),
     P + "identify_friction": Spec(
         args={
@@ -238,6 +254,7 @@ SPECS = {
     P + "disk_equilibrium": Spec(
         args={"robot": ROBOT, "tension": TENSION, "direction": DIRECTION, "initial": PSI},
         arrays={"tension": 1, "direction": 1, "initial": 1},
+        nan_rows=("tension",),
         params=("robot",),
         mask="converged",
         options={"tension": (-np.ones(3),)},

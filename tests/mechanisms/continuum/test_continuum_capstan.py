@@ -117,7 +117,7 @@ def test_batched_broadcasting_equals_per_point():
         ({"n": 1.5}, "n"),
         ({"n": 0.0}, "n"),
         ({"t_out": 0.0}, "t_out"),
-        ({"phi": np.nan}, "phi"),
+        ({"phi": np.inf}, "phi"),
     ],
 )
 def test_bad_input(kwargs, name):

@@ -312,7 +312,7 @@ def test_bad_input():
     with pytest.raises(ValueError, match="psi"):
         C.tip_position(PAPER, [0.1, 0.2, 0.3])
     with pytest.raises(ValueError, match="psi"):
-        C.forward_kinematics(PAPER, [np.nan, 0.0])
+        C.forward_kinematics(PAPER, [np.inf, 0.0])
     with pytest.raises(ValueError, match="theta"):
         C.segment_transform(np.inf, 0.0, 0.09)
     with pytest.raises(ValueError, match="length"):

@@ -152,7 +152,7 @@ def test_bad_input():
     with pytest.raises(ValueError, match="pretension"):
         C.cable_tensions(PAPER, [0.1, 0.0], pretension=-1.0)
     with pytest.raises(ValueError, match="psi"):
-        C.cable_tensions(PAPER, [np.nan, 0.0])
+        C.cable_tensions(PAPER, [np.inf, 0.0])
 
 
 def test_sticking_direction_is_refused_not_frictionless():

@@ -16,7 +16,12 @@ L = {"L1": LEG.L1, "L3": LEG.L3, "L4": LEG.L4, "L5": LEG.L5}
 
 
 def _leg(**kw):
-    return Spec(args={"leg": LEG, **kw}, arrays={k: 1 for k in kw}, params=("leg",))
+    return Spec(
+        args={"leg": LEG, **kw},
+        arrays={k: 1 for k in kw},
+        nan_rows=tuple(k for k in kw if k in ("q", "qd", "qdd")),
+        params=("leg",),
+    )
 
 
 SPECS = {
@@ -65,12 +70,14 @@ SPECS = {
     P + "inverse_dynamics": Spec(
         args={"leg": LEG, "q": Q, "qd": QD, "qdd": QDD, "foot_force": QD, "paper_as_printed": False},
         arrays={"q": 1, "qd": 1, "qdd": 1, "foot_force": 1},
+        nan_rows=("q", "qd", "qdd"),
         params=("leg",),
         options={"paper_as_printed": BAD_BOOL},
     ),
     P + "foot_force_from_torques": Spec(
         args={"leg": LEG, "q": Q, "tau": QD},
         arrays={"q": 1, "tau": 1},
+        nan_rows=("q",),
         params=("leg",),
         mask=lambda r: ~r.singular,
     ),
@@ -84,18 +91,28 @@ SPECS = {
         mask="exists",
         params=("leg",),
     ),
-    P + "thigh_direction": Spec(args={"alpha": Q[:, 0], "beta": Q[:, 1]}, arrays={"alpha": 0, "beta": 0}),
+    P + "thigh_direction": Spec(
+        args={"alpha": Q[:, 0], "beta": Q[:, 1]}, arrays={"alpha": 0, "beta": 0}, nan_rows=("alpha", "beta")
+    ),
     P + "passive_angles": Spec(
-        args={"leg": LEG, "alpha": Q[:, 0], "beta": Q[:, 1]}, arrays={"alpha": 0, "beta": 0}, params=("leg",)
+        args={"leg": LEG, "alpha": Q[:, 0], "beta": Q[:, 1]},
+        arrays={"alpha": 0, "beta": 0},
+        nan_rows=("alpha", "beta"),
+        params=("leg",),
     ),
     P + "thigh_closure": Spec(
         args={"leg": LEG, "alpha": Q[:, 0], "beta": Q[:, 1]},
         arrays={"alpha": 0, "beta": 0},
+        nan_rows=("alpha", "beta"),
         params=("leg",),
         mask="converged",
     ),
     P + "shank_crank_slider": Spec(
-        args={"leg": LEG, "gamma": Q[:, 2]}, arrays={"gamma": 0}, params=("leg",), mask="valid"
+        args={"leg": LEG, "gamma": Q[:, 2]},
+        arrays={"gamma": 0},
+        nan_rows=("gamma",),
+        params=("leg",),
+        mask="valid",
     ),
     P + "chain_screws": Spec(args={"leg": LEG}, params=("leg",)),
     P + "shank_frames": Spec(args={"leg": LEG}, params=("leg",)),

@@ -23,10 +23,11 @@ SPECS = {
     P + "joint_rates": Spec(
         args={"leg": LEG, "q": Q, "foot_velocity": PD, "foot_acceleration": PD[::-1].copy(), "damping": 1e-3},
         arrays={"q": 1, "foot_velocity": 1, "foot_acceleration": 1},
+        nan_rows=("q", "foot_velocity", "foot_acceleration"),
         params=("leg",),
         options={"damping": BAD_NONNEGATIVE},
     ),
-    P + "workspace_map": Spec(args={"leg": LEG, "q": Q}, arrays={"q": 1}, params=("leg",)),
+    P + "workspace_map": Spec(args={"leg": LEG, "q": Q}, arrays={"q": 1}, nan_rows=("q",), params=("leg",)),
     P + "joint_grid": Spec(
         args={"leg": LEG, "n": 3}, params=("leg",), options={"n": (*BAD_INT, 1, 0, (2, 2), (3, 3, 1))}
     ),

@@ -96,7 +96,8 @@ def test_shank_flags_flat_crank_per_sample():
     assert np.all(np.isnan(s.slider[~s.valid])) and np.all(np.isfinite(s.slider[s.valid]))
     assert np.all(np.isnan(s.E[~s.valid]))
     with pytest.raises(ValueError, match="gamma"):
-        ol.shank_crank_slider(LEG, [np.nan])
+        ol.shank_crank_slider(LEG, [np.inf])
+    assert not ol.shank_crank_slider(LEG, [np.nan]).valid.any()  # a failed sample stays failed
 
 
 def test_joint_motion_rates_are_time_derivatives_and_match_the_closure():

@@ -97,7 +97,7 @@ def test_batch_equals_per_sample_and_no_acceleration():
 @pytest.mark.parametrize(
     ("kwargs", "name"),
     [
-        ({"q": np.full(3, np.nan)}, "q"),
+        ({"q": np.full(3, np.inf)}, "q"),
         ({"foot_velocity": np.zeros(4)}, "foot_velocity"),
         ({"foot_acceleration": [np.inf, 0, 0]}, "foot_acceleration"),
         ({"damping": -1.0}, "damping"),

@@ -193,7 +193,8 @@ def test_bad_joint_input_names_q(fn):
     with pytest.raises(ValueError, match="q"):
         fn(LEG, np.zeros((5, 2)))
     with pytest.raises(ValueError, match="q"):
-        fn(LEG, [np.nan, 0.0, 0.0])
+        fn(LEG, [np.inf, 0.0, 0.0])
+    assert np.isnan(fn(LEG, [np.nan, 0.0, 0.0])).all()  # a failed sample: NaN out
 
 
 def test_bad_foot_input_names_p_foot():

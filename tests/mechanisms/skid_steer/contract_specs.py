@@ -16,7 +16,9 @@ _FIELDS = {f: getattr(ROBOT, f) for f in ROBOT.__dataclass_fields__}
 
 
 def _cfg():
-    return Spec(args={"robot": ROBOT, "config": CFG}, arrays={"config": 1}, params=("robot",))
+    return Spec(
+        args={"robot": ROBOT, "config": CFG}, arrays={"config": 1}, nan_rows=("config",), params=("robot",)
+    )
 
 
 SPECS = {
@@ -41,6 +43,7 @@ SPECS = {
     P + "wheel_measurements": Spec(
         args={"robot": ROBOT, "config": CFG, "twist": TWIST, "config_rate": QD},
         arrays={"config": 1, "twist": 1, "config_rate": 1},
+        nan_rows=("config", "twist", "config_rate"),
         params=("robot",),
     ),
     P + "body_velocity": Spec(
@@ -76,6 +79,7 @@ SPECS = {
     P + "skid_steer_turn": Spec(
         args={"v_right": np.array([1.0, 2.0]), "v_left": np.array([0.5, 1.5]), "track_width": 0.5},
         arrays={"v_right": 0, "v_left": 0},
+        nan_rows=("v_right", "v_left"),
         wrong_shapes={"v_left": ((3,),)},
         options={"track_width": BAD_POSITIVE},
         mask="turning",
@@ -87,6 +91,7 @@ SPECS = {
             "icr_x": np.array([0.05, 0.0]),
         },
         arrays={"yaw_rate": 0, "wheel_x": 0, "icr_x": 0},
+        nan_rows=("yaw_rate",),
         wrong_shapes={"wheel_x": ((3,),)},
     ),
     P + "paper_lateral_slip": Spec(
@@ -97,6 +102,7 @@ SPECS = {
             "track_width": 0.4,
         },
         arrays={"v_outer": 0, "radius": 0},
+        nan_rows=("v_outer", "radius"),
         wrong_shapes={"radius": ((3,),)},
         options={"wheelbase": BAD_POSITIVE, "track_width": BAD_POSITIVE},
     ),

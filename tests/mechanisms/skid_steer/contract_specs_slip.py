@@ -81,7 +81,8 @@ SPECS = {
             "body_velocity": np.array([[0.2, 0.0, 0.1], [0.1, 0.0, 0.0]]),
             "config": Q2,
         },
-        arrays={"wheel_rate": 0, "body_velocity": 1, "config": 1},  # wheel_rate masked per wheel
+        arrays={"wheel_rate": 0, "body_velocity": 1, "config": 1},
+        nan_rows=("body_velocity", "config"),  # wheel_rate masked per wheel
         masked=("wheel_rate",),
         mask="valid",
         params=("robot",),

@@ -70,7 +70,7 @@ def test_skid_steer_rejects_bad_track_width():
     with pytest.raises(ValueError, match="track_width"):
         skid_steer_turn(0.1, 0.2, 0.0)
     with pytest.raises(ValueError, match="v_right"):
-        skid_steer_turn(np.nan, 0.2, S)
+        skid_steer_turn(np.inf, 0.2, S)
 
 
 def test_dead_reckoning_of_a_constant_twist_is_the_exponential():

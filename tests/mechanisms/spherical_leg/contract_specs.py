@@ -20,6 +20,9 @@ LEG = sl.SphericalLeg.paper()
 A = np.array([0.1, -0.2, 0.3])
 B = np.array([0.0, 0.2, -0.1])
 Q = np.stack([A, B], -1)  # (3, 2)
+# four samples where a result also holds an unbatched (3, 3) array (base_points): the nan_rows check
+# tells result arrays of the batch by their leading axis
+A4, B4 = np.append(A, 0.05), np.append(B, 0.15)
 QD = np.array([[0.1, 0.2], [-0.3, 0.0], [0.5, -0.1]])
 QDD = QD[::-1].copy()
 LENGTHS = sl.inverse_kinematics(LEG, A, B).lengths  # (3, 3)
@@ -64,7 +67,10 @@ SPECS = {
         },
     ),
     P + "inverse_kinematics": Spec(
-        args={"leg": LEG, "alpha": A, "beta": B}, arrays={"alpha": 0, "beta": 0}, params=("leg",)
+        args={"leg": LEG, "alpha": A4, "beta": B4},
+        arrays={"alpha": 0, "beta": 0},
+        nan_rows=("alpha", "beta"),
+        params=("leg",),
     ),
     P + "forward_kinematics": Spec(
         args={"leg": LEG, "lengths": LENGTHS, "branch": 0, "paper_as_printed": False},
@@ -74,23 +80,38 @@ SPECS = {
         params=("leg",),
         options={"branch": (2, -1, 0.5, None, "0", True), "paper_as_printed": BAD_BOOL},
     ),
-    P + "platform_rotation": Spec(args={"alpha": A, "beta": B}, arrays={"alpha": 0, "beta": 0}),
+    P + "platform_rotation": Spec(
+        args={"alpha": A, "beta": B}, arrays={"alpha": 0, "beta": 0}, nan_rows=("alpha", "beta")
+    ),
     P + "jacobian": Spec(
-        args={"leg": LEG, "alpha": A, "beta": B}, arrays={"alpha": 0, "beta": 0}, params=("leg",)
+        args={"leg": LEG, "alpha": A, "beta": B},
+        arrays={"alpha": 0, "beta": 0},
+        nan_rows=("alpha", "beta"),
+        params=("leg",),
     ),
     P + "hessian": Spec(
-        args={"leg": LEG, "alpha": A, "beta": B}, arrays={"alpha": 0, "beta": 0}, params=("leg",)
+        args={"leg": LEG, "alpha": A, "beta": B},
+        arrays={"alpha": 0, "beta": 0},
+        nan_rows=("alpha", "beta"),
+        params=("leg",),
     ),
     P + "influence_coefficients": Spec(
-        args={"leg": LEG, "alpha": A, "beta": B}, arrays={"alpha": 0, "beta": 0}, params=("leg",)
+        args={"leg": LEG, "alpha": A, "beta": B},
+        arrays={"alpha": 0, "beta": 0},
+        nan_rows=("alpha", "beta"),
+        params=("leg",),
     ),
-    P + "angular_velocity_jacobian": Spec(args={"alpha": A}, arrays={"alpha": 0}),
+    P + "angular_velocity_jacobian": Spec(args={"alpha": A}, arrays={"alpha": 0}, nan_rows=("alpha",)),
     P + "leg_rates": Spec(
-        args={"leg": LEG, "q": Q, "qd": QD, "qdd": QDD}, arrays={"q": 1, "qd": 1, "qdd": 1}, params=("leg",)
+        args={"leg": LEG, "q": Q, "qd": QD, "qdd": QDD},
+        arrays={"q": 1, "qd": 1, "qdd": 1},
+        nan_rows=("q", "qd", "qdd"),
+        params=("leg",),
     ),
     P + "workspace_map": Spec(
         args={"leg": LEG, "alpha": A, "beta": B},
         arrays={"alpha": 0, "beta": 0},
+        nan_rows=("alpha", "beta"),
         params=("leg",),
         mask="reachable",
     ),
@@ -104,18 +125,21 @@ SPECS = {
             "paper_as_printed": False,
         },
         arrays={"q": 1, "qd": 1, "qdd": 1, "platform_wrench": 1},
+        nan_rows=("q", "qd", "qdd"),
         params=("leg",),
         options={"paper_as_printed": BAD_BOOL},
     ),
     P + "mass_matrix": Spec(
         args={"leg": LEG, "q": Q, "paper_as_printed": False},
         arrays={"q": 1},
+        nan_rows=("q",),
         params=("leg",),
         options={"paper_as_printed": BAD_BOOL},
     ),
     P + "mechanical_energy": Spec(
         args={"leg": LEG, "q": Q, "qd": QD, "paper_as_printed": False},
         arrays={"q": 1, "qd": 1},
+        nan_rows=("q", "qd"),
         params=("leg",),
         options={"paper_as_printed": BAD_BOOL},
     ),
@@ -137,6 +161,7 @@ SPECS = {
             "paper_as_printed": False,
         },
         arrays={"q": 1, "qd": 1, "qdd": 1, "platform_wrench": 1},
+        nan_rows=("q", "qd", "qdd"),
         params=("leg",),
         mask="valid",
         options={"driven_legs": BAD_LEGS, "paper_as_printed": BAD_BOOL},

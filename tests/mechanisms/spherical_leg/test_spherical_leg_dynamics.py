@@ -140,7 +140,8 @@ def test_batched_equals_per_sample_and_bad_input():
         assert np.max(np.abs(one.leg_forces - res.leg_forces[k])) <= 1e-12
         assert np.max(np.abs(one.generalized_forces - res.generalized_forces[k])) <= 1e-12
     with pytest.raises(ValueError, match="qdd"):
-        sl.inverse_dynamics(LEG, q, qd, np.full((20, 2), np.nan))
+        sl.inverse_dynamics(LEG, q, qd, np.full((20, 2), 1e300))
+    assert not sl.inverse_dynamics(LEG, q, qd, np.full((20, 2), np.nan)).valid.any()  # failed samples
     with pytest.raises(ValueError, match="q"):
         sl.inverse_dynamics(LEG, np.zeros((20, 3)), qd, qdd)
     with pytest.raises(ValueError, match="platform_wrench"):

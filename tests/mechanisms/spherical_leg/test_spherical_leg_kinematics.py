@@ -122,7 +122,8 @@ def test_unassemblable_and_bad_lengths_are_flagged_per_sample():
 
 def test_bad_inputs_raise_clear_errors():
     with pytest.raises(ValueError, match="alpha"):
-        sl.inverse_kinematics(LEG, np.nan, 0.0)
+        sl.inverse_kinematics(LEG, np.inf, 0.0)
+    assert np.isnan(sl.inverse_kinematics(LEG, np.nan, 0.0).lengths).all()  # a failed sample: masked
     with pytest.raises(ValueError, match="beta"):
         sl.jacobian(LEG, 0.0, np.inf)
     with pytest.raises(ValueError, match="lengths"):

@@ -17,6 +17,7 @@ def _q(mask, **extra):
     return Spec(
         args={"th": TH, "q": Q, **extra},
         arrays={"q": 1, **{k: 1 for k in extra}},
+        nan_rows=("q", *extra),
         params=("th",),
         mask=mask,
     )
@@ -56,12 +57,17 @@ SPECS = {
     P + "passive_rates": _q("valid", qd=QD),
     P + "angular_velocity": _q("valid", qd=QD),
     P + "angular_acceleration": _q("valid", qd=QD, qdd=QD[::-1].copy()),
-    P + "inverse_kinematics": Spec(args={"th": TH, "s": S}, arrays={"s": 1}, params=("th",), mask="valid"),
+    P + "inverse_kinematics": Spec(
+        args={"th": TH, "s": S}, arrays={"s": 1}, nan_rows=("s",), params=("th",), mask="valid"
+    ),
     P + "arc_clearance": Spec(
         args={"a1": S, "b1": S[::-1].copy(), "a2": np.eye(3), "b2": np.eye(3)[::-1].copy()},
         arrays={"a1": 1, "b1": 1, "a2": 1, "b2": 1},
+        nan_rows=("a1", "b1", "a2", "b2"),
     ),
-    P + "idle_input_curve": Spec(args={"th": TH, "q1": Q[:, 0]}, arrays={"q1": 0}, params=("th",)),
+    P + "idle_input_curve": Spec(
+        args={"th": TH, "q1": Q[:, 0]}, arrays={"q1": 0}, nan_rows=("q1",), params=("th",)
+    ),
     P + "singular_points": Spec(args={"th": TH}, params=("th",)),
     P + "input_grid": Spec(
         args={"th": TH, "n": 3, "limits": np.array([[-0.5, 0.5], [-0.3, 0.3]])},

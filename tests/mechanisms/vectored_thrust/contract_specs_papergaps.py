@@ -22,12 +22,14 @@ SPECS = {
     P + "inverse_rates": Spec(
         args={"th": TH, "q": Q, "omega": W, "omega_dot": W[::-1].copy(), "damping": 0.01},
         arrays={"q": 1, "omega": 1, "omega_dot": 1},
+        nan_rows=("q", "omega", "omega_dot"),
         params=("th",),
         options={"damping": BAD_NONNEGATIVE},
     ),
     P + "static_torques": Spec(
         args={"th": TH, "q": Q, "wrench": np.concatenate([W, W], -1)},
         arrays={"q": 1, "wrench": 1},
+        nan_rows=("q",),
         params=("th",),
     ),
 }

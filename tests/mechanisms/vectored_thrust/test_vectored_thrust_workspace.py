@@ -89,4 +89,4 @@ def test_input_grid_and_bad_inputs() -> None:
     with pytest.raises(ValueError, match="b2"):
         vt.arc_clearance([1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0], [0, 1.0])
     with pytest.raises(ValueError, match="a1"):
-        vt.arc_clearance([float("nan"), 0, 0], [0, 1.0, 0], [0, 0, 1.0], [0, 1.0, 0])
+        vt.arc_clearance([float("inf"), 0, 0], [0, 1.0, 0], [0, 0, 1.0], [0, 1.0, 0])

@@ -12,6 +12,7 @@ from typing import Literal
 
 import numpy as np
 
+from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_batch, check_choice, check_params
 
 from ._disks import DiskEquilibrium, _active, _memory_initial, _memory_step, _segment_psi, _solve, _uniform_k
@@ -83,6 +84,7 @@ def _elongation(robot, ell, P, t_base, model):
     return (integral - T0 * (Lf + _l0(robot, model))) / ea
 
 
+@carries_failed_rows({"psi": 1, "tension": 1}, {"direction": 1})
 def cable_elongation(
     robot: ContinuumRobot,
     psi: object,
@@ -134,6 +136,7 @@ def cable_elongation(
     return _elongation(robot, ell, P, t, model)
 
 
+@carries_failed_rows({"psi": 1})
 def theoretical_drive(robot: ContinuumRobot, psi: object, model: CableModel = "arc") -> np.ndarray:
     """Cable pulled in by each actuator for a rigid, frictionless robot: q = -(L(psi) - L(0)).
 
@@ -203,6 +206,7 @@ class DriveResult:
     delta_pulley: np.ndarray
 
 
+@carries_failed_rows({"psi": 1}, {"direction": 1, "wrench": 1})
 def compensated_drive(
     robot: ContinuumRobot,
     psi: object,
@@ -395,6 +399,7 @@ def _sim_residual(robot, k, q, d, model, pulley=None):
     return F, t_raw
 
 
+@carries_failed_rows({"q": 1}, {"direction": 1, "initial": 1})
 def simulate(
     robot: ContinuumRobot,
     q: object,
@@ -841,6 +846,7 @@ def _disk_compensation(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarra
     return _disk_at(robot, u, d)
 
 
+@carries_failed_rows({"tension": 1}, {"direction": 1, "initial": 1})
 def disk_equilibrium(
     robot: ContinuumRobot,
     *,

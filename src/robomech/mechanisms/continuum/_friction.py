@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_batch, check_params, check_positive
 
 from ._kinematics import _disk_T, _split
@@ -55,6 +56,7 @@ def _wrap_from_disks(robot: ContinuumRobot, T: np.ndarray) -> np.ndarray:
     return np.where(active, eta, 0.0)
 
 
+@carries_failed_rows({"psi": 1})
 def wrap_angles(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """Wrap angle of every cable at the hole where each span starts, ``(..., 3 n, n N)`` (rad).
 
@@ -112,6 +114,7 @@ def _factors(robot: ContinuumRobot, eta: np.ndarray, direction: np.ndarray) -> n
     return np.exp(-np.cumsum(direction[..., :, None] * mu[:, None] * eta, axis=-1))
 
 
+@carries_failed_rows({"psi": 1}, {"direction": 1})
 def friction_factors(robot: ContinuumRobot, psi: object, direction: object | None = None) -> np.ndarray:
     """Tension of every span relative to the cable's tension at the base plate, ``(..., 3 n, n N)``.
 
@@ -207,6 +210,7 @@ def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np
     return (rho / n) * ((1.0 + rho) / (alpha * rho)) ** (1.0 / n)
 
 
+@carries_failed_rows({"phi": 0}, {"mu": 0})
 def classical_capstan_ratio(phi: object, mu: object) -> np.ndarray:
     """Euler-Eytelwein capstan law T_in / T_out = exp(mu phi).
 
@@ -276,6 +280,7 @@ def _rk4(phi, rho, c, p, lam, M2):
     return y, z
 
 
+@carries_failed_rows({"phi": 0}, {"alpha": 0, "n": 0, "t_out": 0})
 def capstan_tension_ratio(
     phi: object, *, rho: object, alpha: object, n: object, t_out: object = 1.0
 ) -> np.ndarray:

@@ -13,7 +13,7 @@ from typing import Literal
 
 import numpy as np
 
-from robomech._batching import slices
+from robomech._batching import carries_failed_rows, slices
 from robomech._validation import as_array, broadcast_batch, check_params
 from robomech.spatial import SMALL_ANGLE
 
@@ -237,6 +237,7 @@ def _segment_planes(theta: np.ndarray, beta: np.ndarray, length: np.ndarray | fl
     return P
 
 
+@carries_failed_rows({"theta": 0, "beta": 0}, {"length": 0})
 def segment_transform(theta: object, beta: object, length: object) -> np.ndarray:
     """Pose ``T (..., 4, 4)`` of a constant-curvature segment's end frame in its base frame.
 
@@ -294,6 +295,7 @@ def _fk_planes(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray) -> np
     return P
 
 
+@carries_failed_rows({"psi": 1})
 def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """Poses ``T_0i (..., n, 4, 4)`` of every segment's end frame in the base frame (paper 3, eq. (3)).
 
@@ -324,6 +326,7 @@ def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
     return _fk(robot, theta, beta)
 
 
+@carries_failed_rows({"psi": 1})
 def tip_position(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """Tip position ``(..., 3)`` in the base frame (m).
 
@@ -407,6 +410,7 @@ def _tip_jacobian(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray) ->
     return J.reshape(*theta.shape[:-1], 6, 2 * n)
 
 
+@carries_failed_rows({"psi": 1})
 def tip_jacobian(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """Tip Jacobian ``J_x (..., 6, 2 n)``: ``[omega; v_tip] = J_x psi_dot`` in the base frame.
 
@@ -437,6 +441,7 @@ def tip_jacobian(robot: ContinuumRobot, psi: object) -> np.ndarray:
     return _tip_jacobian(robot, theta, beta)
 
 
+@carries_failed_rows({"psi": 1})
 def disk_transforms(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """Poses of the base plate and of every disk, ``(..., 1 + n N, 4, 4)``, in the base frame.
 
@@ -524,6 +529,7 @@ def _active(robot: ContinuumRobot) -> np.ndarray:
     return robot.cable_segment[:, None] >= np.arange(robot.n_segments)[None, :]
 
 
+@carries_failed_rows({"psi": 1})
 def span_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "chord") -> np.ndarray:
     """Length of every cable span ``(..., 3 n, n N)`` (zero beyond the cable's termination disk).
 
@@ -553,6 +559,7 @@ def span_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "chord"
     return np.repeat(np.where(_active(robot), ell, 0.0), robot.disks_per_segment, axis=-1)
 
 
+@carries_failed_rows({"psi": 1})
 def span_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "chord") -> np.ndarray:
     """``d span / d psi``: ``(..., 3 n, n N, 2 n)``.
 
@@ -586,6 +593,7 @@ def _span_jac(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray, model:
     return np.repeat(J, N, axis=-2)
 
 
+@carries_failed_rows({"psi": 1})
 def cable_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "arc") -> np.ndarray:
     """Geometric length of every cable from the base plate to its termination disk, ``(..., 3 n)`` (m).
 
@@ -619,6 +627,7 @@ def cable_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "arc")
     return robot.disks_per_segment * np.sum(np.where(_active(robot), ell, 0.0), axis=-1)
 
 
+@carries_failed_rows({"psi": 1})
 def cable_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "arc") -> np.ndarray:
     """``J_qpsi = d cable_lengths / d psi``, ``(..., 3 n, 2 n)`` (paper 3, eq. (5) for one segment).
 
@@ -834,6 +843,7 @@ def _single_arc(robot: ContinuumRobot, p: np.ndarray, theta: np.ndarray, beta: n
     return res
 
 
+@carries_failed_rows({"p_tip": 1})
 def inverse_kinematics(robot: ContinuumRobot, p_tip: object) -> IKResult:
     """Bend parameters ``psi`` that put the tip at ``p_tip (..., 3)`` (m).
 

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_batch, check_params, check_positive
 
 from ._friction import _as_direction, _factors, _wrap
@@ -26,6 +27,7 @@ __all__ = [
 TENSION_FLOOR = 0.0
 
 
+@carries_failed_rows({"psi": 1})
 def elastic_energy(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """Bending energy of the cores, U = sum EI theta_i^2 / (2 l) (paper 3, eq. (8)), ``(...)`` in J.
 
@@ -58,6 +60,7 @@ def _grad_u(robot: ContinuumRobot, theta: np.ndarray) -> np.ndarray:
     return g
 
 
+@carries_failed_rows({"psi": 1})
 def elastic_gradient(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """dU/dpsi ``(..., 2 n)``: (EI theta_i / l, 0) per segment (gradient of paper 3, eq. (8)).
 
@@ -84,6 +87,7 @@ def elastic_gradient(robot: ContinuumRobot, psi: object) -> np.ndarray:
     return _grad_u(robot, theta)
 
 
+@carries_failed_rows({"psi": 1})
 def coupling_moments(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """Paper 3, eq. (12): moment of segment i+1 on segment i, ``(..., n, 2)`` = (-EI theta_i+1 / l, 0).
 
@@ -149,6 +153,7 @@ def _effective_jacobian(robot, theta, beta, direction, model):
     return np.einsum("...ck,...ckj->...cj", P, J)
 
 
+@carries_failed_rows({"psi": 1}, {"wrench": 1, "direction": 1})
 def cable_tensions(
     robot: ContinuumRobot,
     psi: object,

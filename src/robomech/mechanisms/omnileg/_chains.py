@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomech import multibody as mb
+from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_batch, check_params
 from robomech.kinematics import poe_fk
 from robomech.spatial import inverse_transform, log_se3, screw_from_axis
@@ -112,6 +113,7 @@ def _closure_residual(S: np.ndarray, M: np.ndarray, theta: np.ndarray) -> tuple[
     return r, T
 
 
+@carries_failed_rows({"alpha": 0, "beta": 0})
 def thigh_closure(leg: OmniLeg, alpha: object, beta: object) -> ThighClosure:
     """Solve the closure T1 = T2 = T3 (eq. (8)) for the passive joints, given α = θ21 and β = θ11.
 
@@ -228,6 +230,7 @@ def shank_frames(leg: OmniLeg) -> np.ndarray:
     return S
 
 
+@carries_failed_rows({"gamma": 0})
 def shank_crank_slider(leg: OmniLeg, gamma: object) -> ShankResult:
     """Centred crank-slider of each shank chain for crank angle ``gamma`` (...), rad (valid for |γ| < π/2).
 

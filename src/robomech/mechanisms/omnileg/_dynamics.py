@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._batching import chunked
+from robomech._batching import carries_failed_rows, chunked
 from robomech._validation import as_array, broadcast_batch, check_bool, check_params
 from robomech.analysis.lstsq import _damped_svd_solve
 
@@ -293,6 +293,7 @@ def _flat(*arrays: np.ndarray) -> tuple[tuple[int, ...], list[np.ndarray]]:
     return batch, [np.ascontiguousarray(np.broadcast_to(a, (*batch, 3)).reshape(-1, 3)) for a in arrays]
 
 
+@carries_failed_rows({"q": 1})
 def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
     """Body rotations ``R_b (..., 22, 3, 3)`` (in the hip frame) and mass centres ``p_b (..., 22, 3)`` (m).
 
@@ -342,6 +343,7 @@ class DynamicsResult:
     foot_terms: np.ndarray
 
 
+@carries_failed_rows({"q": 1, "qd": 1, "qdd": 1}, {"foot_force": 1})
 def inverse_dynamics(
     leg: OmniLeg,
     q: object,
@@ -412,6 +414,7 @@ def inverse_dynamics(
     )
 
 
+@carries_failed_rows({"q": 1})
 def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
     """Joint-space inertia matrix ``M(q) (..., 3, 3)`` (kg m²), symmetric positive definite.
 
@@ -441,6 +444,7 @@ def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
     return _terms_chunked(leg, qf).M.reshape(*batch, 3, 3)
 
 
+@carries_failed_rows({"q": 1})
 def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
     """``G(q) = ∂V/∂q`` (..., 3), N·m: the torques holding the leg still against gravity.
 
@@ -463,6 +467,7 @@ def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
     return _terms_chunked(leg, qf).tau_gravity.reshape(*batch, 3)
 
 
+@carries_failed_rows({"q": 1, "qd": 1})
 def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
     """Kinetic ``½ q̇ᵀ M q̇`` and potential ``-Σ m_b gᵀ p_b`` energy (J), each (...).
 
@@ -491,6 +496,7 @@ def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]
     return t.kinetic.reshape(batch), t.potential.reshape(batch)
 
 
+@carries_failed_rows({"q": 1}, {"force": 1})
 def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
     """Motor torques ``τ = -Jᵀ F`` (..., 3), N·m, holding the leg still against a foot force, gravity aside.
 
@@ -552,6 +558,7 @@ class FootForceResult:
     residual: np.ndarray
 
 
+@carries_failed_rows({"q": 1}, {"tau": 1})
 def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceResult:
     """Solve ``-Jᵀ F = τ`` for the force F applied to the foot (paper 2, eq. (47)), never by a blind inverse.
 

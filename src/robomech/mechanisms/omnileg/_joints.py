@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_batch, check_params
 
 from . import _jet as jt
@@ -51,6 +52,7 @@ class JointMotion:
     qdd: np.ndarray
 
 
+@carries_failed_rows({"q": 1, "qd": 1, "qdd": 1})
 def joint_motion(leg: OmniLeg, q: object, qd: object, qdd: object) -> JointMotion:
     """All tree-joint angles, rates and accelerations for the motion ``(q, q̇, q̈)`` of ``(α, β, γ)``.
 

@@ -16,7 +16,7 @@ from functools import cached_property
 
 import numpy as np
 
-from robomech._batching import slices
+from robomech._batching import carries_failed_rows, slices
 from robomech._validation import as_array, broadcast_batch, check_params
 
 from ._params import OmniLeg
@@ -63,6 +63,7 @@ def _q(q: object) -> np.ndarray:
     return as_array(q, "q", (3,))
 
 
+@carries_failed_rows({"alpha": 0, "beta": 0})
 def thigh_direction(alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
     """Unit vector from O0 to the knee O0' (..., 3), paper 2, eq. (9) divided by L1 (x corrected).
 
@@ -91,6 +92,7 @@ def thigh_direction(alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
     return np.stack([sb * ca * inv, -cb * sa * inv, cb * ca * inv], axis=-1)
 
 
+@carries_failed_rows({"q": 1})
 def forward_kinematics(leg: OmniLeg, q: object) -> np.ndarray:
     """Foot position ``p_F`` in the hip frame (..., 3), metres, from ``q = (α, β, γ)`` (..., 3), rad.
 
@@ -133,6 +135,7 @@ def forward_kinematics(leg: OmniLeg, q: object) -> np.ndarray:
     return out.reshape(q.shape)
 
 
+@carries_failed_rows({"alpha": 0, "beta": 0})
 def passive_angles(leg: OmniLeg, alpha: object, beta: object) -> tuple[np.ndarray, np.ndarray]:
     """Passive U-joint angles θ12 (chain 1, about x at A1) and θ22 (chain 2, about -y at A2), rad.
 
@@ -182,6 +185,7 @@ def _dw(q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     return u, N, W, W2
 
 
+@carries_failed_rows({"q": 1})
 def jacobian(leg: OmniLeg, q: object) -> np.ndarray:
     """Foot Jacobian ``J[..., i, j] = ∂p_F,i/∂q_j`` (..., 3, 3), eq. (14).  Singular whenever γ = 0.
 
@@ -226,6 +230,7 @@ def jacobian(leg: OmniLeg, q: object) -> np.ndarray:
     return J.reshape(*q.shape, 3)
 
 
+@carries_failed_rows({"q": 1})
 def hessian(leg: OmniLeg, q: object) -> np.ndarray:
     """Second-order influence coefficients ``H[..., i, j, k] = ∂²p_F,i/∂q_j∂q_k`` (..., 3, 3, 3).
 
@@ -264,6 +269,7 @@ def hessian(leg: OmniLeg, q: object) -> np.ndarray:
     return H
 
 
+@carries_failed_rows({"q": 1, "qd": 1})
 def foot_velocity(leg: OmniLeg, q: object, qd: object) -> np.ndarray:
     """``v_F = J q̇`` (..., 3), m/s: the foot velocity (paper 2, eq. (14)).
 
@@ -293,6 +299,7 @@ def foot_velocity(leg: OmniLeg, q: object, qd: object) -> np.ndarray:
     return np.einsum("...ij,...j->...i", jacobian(leg, q), qd)
 
 
+@carries_failed_rows({"q": 1, "qd": 1, "qdd": 1})
 def foot_acceleration(leg: OmniLeg, q: object, qd: object, qdd: object) -> np.ndarray:
     """``a_F = J q̈ + q̇ᵀ H q̇`` (..., 3), m/s² (the foot does not rotate, Section 2).
 

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_batch, check_params, check_real
 from robomech.analysis.lstsq import _damped_svd_solve
 
@@ -59,6 +60,7 @@ class JointRatesResult:
     valid: np.ndarray
 
 
+@carries_failed_rows({"q": 1, "foot_velocity": 1, "foot_acceleration": 1})
 def joint_rates(
     leg: OmniLeg,
     q: object,

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_to_batch, check_int, check_params
 from robomech.analysis.workspace import grid, singularity_map
 
@@ -111,6 +112,7 @@ def joint_grid(leg: OmniLeg, n: int | tuple[int, int, int]) -> np.ndarray:
     return grid(ranges, list(counts))
 
 
+@carries_failed_rows({"q": 1})
 def workspace_map(leg: OmniLeg, q: object) -> WorkspaceMap:
     """Foot position and Jacobian conditioning at joint samples ``q (..., 3)`` (e.g. :func:`joint_grid`).
 

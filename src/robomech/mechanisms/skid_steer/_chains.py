@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from robomech._batching import slices
+from robomech._batching import carries_failed_rows, slices
 from robomech._validation import as_array, check_params
 
 from ._params import ExplorationRobot
@@ -114,6 +114,7 @@ def _blocked(kernel, q: np.ndarray, tail: tuple[int, ...]) -> np.ndarray:
     return out.reshape(*batch, *tail)
 
 
+@carries_failed_rows({"config": 1})
 def contact_frames(robot: ExplorationRobot, config: ArrayLike) -> np.ndarray:
     """Poses ``T_BP`` of the six contact frames in the body frame: ``(..., 6, 4, 4)``, order ``WHEELS``.
 
@@ -199,6 +200,7 @@ def _linear_columns(robot: ExplorationRobot, q: np.ndarray) -> tuple[np.ndarray,
     return p, alpha, G
 
 
+@carries_failed_rows({"config": 1})
 def wheel_jacobians(robot: ExplorationRobot, config: ArrayLike) -> np.ndarray:
     """Space Jacobians of the contact frames relative to the body: ``(..., 6, 6, 4)``.
 

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from robomech._batching import carries_failed_rows
 from robomech._validation import (
     as_array,
     broadcast_batch,
@@ -353,6 +354,7 @@ class WheelSlip:
     valid: np.ndarray
 
 
+@carries_failed_rows({"body_velocity": 1, "config": 1}, {"wheel_rate": 1}, masked=("wheel_rate",))
 def wheel_slip(
     robot: ExplorationRobot, wheel_rate: ArrayLike, body_velocity: ArrayLike, config: ArrayLike | None = None
 ) -> WheelSlip:

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_batch, check_positive
 from robomech.spatial import exp_se3
 from robomech.spatial._so3 import ROTATION_ATOL
@@ -55,6 +56,7 @@ class SkidSteerTurn:
     turning: np.ndarray
 
 
+@carries_failed_rows({"v_right": 0, "v_left": 0})
 def skid_steer_turn(v_right: ArrayLike, v_left: ArrayLike, track_width: float) -> SkidSteerTurn:
     """Yaw rate, speed and turning radius of the body centre from the right (``v1``) and left (``v2``)
     track speeds (m/s), for tracks ``track_width`` (m) apart, assuming no longitudinal slip.
@@ -93,6 +95,7 @@ def skid_steer_turn(v_right: ArrayLike, v_left: ArrayLike, track_width: float) -
     return SkidSteerTurn(yaw_rate=diff / S, forward_speed=0.5 * total, radius=radius, turning=turning)
 
 
+@carries_failed_rows({"yaw_rate": 0}, {"wheel_x": 0, "icr_x": 0})
 def wheel_lateral_velocity(yaw_rate: ArrayLike, wheel_x: ArrayLike, icr_x: ArrayLike = 0.0) -> np.ndarray:
     """Lateral (body y) sliding velocity of a contact at body ``x = wheel_x`` (m) of a body turning at
     ``yaw_rate`` about a centre of rotation at longitudinal position ``icr_x`` (m): ``r (x_w - x_icr)``.
@@ -143,6 +146,7 @@ class LateralSlip:
     valid: np.ndarray
 
 
+@carries_failed_rows({"v_outer": 0, "radius": 0})
 def paper_lateral_slip(
     v_outer: ArrayLike, wheelbase: float, radius: ArrayLike, track_width: float
 ) -> LateralSlip:

@@ -21,7 +21,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from robomech._batching import slices
+from robomech._batching import carries_failed_rows, slices
 from robomech._validation import as_array, broadcast_batch, broadcast_to_batch, check_bool, check_params
 from robomech.analysis import lstsq
 
@@ -56,6 +56,7 @@ ASSEMBLY_CHUNK = 256
 _PASSIVE = ((5, 6, 9), (7, 8, 10))
 
 
+@carries_failed_rows({"config": 1})
 def assemble(robot: ExplorationRobot, config: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """``A0 (..., 30, 11)`` and ``J (..., 30, 22)`` of the composite system at ``config (..., 8)``.
 
@@ -140,6 +141,7 @@ def _assemble(robot: ExplorationRobot, q: np.ndarray) -> tuple[np.ndarray, np.nd
     return A0, J
 
 
+@carries_failed_rows({"config": 1, "twist": 1, "config_rate": 1})
 def wheel_measurements(
     robot: ExplorationRobot, config: ArrayLike, twist: ArrayLike, config_rate: ArrayLike
 ) -> np.ndarray:

@@ -21,6 +21,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
+from robomech._batching import carries_failed_rows
 from robomech._validation import (
     as_array,
     broadcast_batch,
@@ -223,6 +224,7 @@ def _generalized(leg: SphericalLeg, m: _Motion, wrench: np.ndarray | None) -> np
     return tau
 
 
+@carries_failed_rows({"q": 1, "qd": 1, "qdd": 1}, {"platform_wrench": 1})
 def generalized_forces(
     leg: SphericalLeg,
     q: object,
@@ -269,6 +271,7 @@ def generalized_forces(
     return _generalized(leg, *_driven_motion(leg, q, qd, qdd, platform_wrench, paper_as_printed))
 
 
+@carries_failed_rows({"q": 1})
 def mass_matrix(leg: SphericalLeg, q: object, *, paper_as_printed: bool = False) -> NDArray[np.float64]:
     """Mass matrix M(q) (..., 2, 2) of the coordinates (alpha, beta): tau = M qdd + c(q, qd) + g(q).
 
@@ -312,6 +315,7 @@ def _replace_gravity(leg: SphericalLeg) -> SphericalLeg:
     return replace(leg, gravity=(0.0, 0.0, 0.0))
 
 
+@carries_failed_rows({"q": 1, "qd": 1})
 def mechanical_energy(
     leg: SphericalLeg, q: object, qd: object, *, paper_as_printed: bool = False
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -534,6 +538,7 @@ class InverseDynamicsResult:
     rcond: np.ndarray
 
 
+@carries_failed_rows({"q": 1, "qd": 1, "qdd": 1}, {"platform_wrench": 1})
 def inverse_dynamics(
     leg: SphericalLeg,
     q: object,

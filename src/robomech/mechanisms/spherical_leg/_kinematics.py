@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomech._batching import chunked, slices
+from robomech._batching import carries_failed_rows, chunked, slices
 from robomech._validation import as_array, broadcast_to_batch, check_bool, check_int, check_params
 
 # the unvalidated kernel: inputs are validated once at this module's public boundary
@@ -86,6 +86,7 @@ def _check_state(q: object, qd: object, qdd: object = _NO_QDD) -> tuple[np.ndarr
     return broadcast_to_batch(*items)
 
 
+@carries_failed_rows({"alpha": 0, "beta": 0})
 def platform_rotation(alpha: object, beta: object) -> np.ndarray:
     """Platform rotation ``T = Rx(alpha) Ry(beta)`` (paper 1, eq. (1)).
 
@@ -159,10 +160,12 @@ class InverseKinematicsResult:
     within_limits: np.ndarray
 
 
+@carries_failed_rows({"alpha": 0, "beta": 0})
 def inverse_kinematics(leg: SphericalLeg, alpha: object, beta: object) -> InverseKinematicsResult:
     """Leg lengths (paper 1, eq. (4)) for platform angles ``alpha``, ``beta`` (rad, broadcast).
 
-    Every finite (alpha, beta) has a solution; non-finite angles raise ``ValueError``.
+    Every finite (alpha, beta) has a solution; a NaN angle marks a failed sample (NaN lengths, False
+    ``within_limits`` there), ±inf raises ``ValueError``.
 
     Parameters
     ----------
@@ -452,6 +455,7 @@ def _fk_numba_kernels():
     return fit, close
 
 
+@carries_failed_rows({"alpha": 0, "beta": 0})
 def jacobian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
     """``J[..., i, j] = d l_i / d (alpha, beta)_j`` -> (..., 3, 2) in m/rad.
 
@@ -527,6 +531,7 @@ def _derivatives(leg: SphericalLeg, sa, ca, sb, cb):
     return q, dq, d2q
 
 
+@carries_failed_rows({"alpha": 0, "beta": 0})
 def hessian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
     """Second derivatives of the leg lengths, ``H[..., i, j, k] = d^2 l_i / dq_j dq_k``, q = (alpha, beta).
 
@@ -555,6 +560,7 @@ def hessian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
     return d2q / (2 * l) - np.einsum("...ij,...ik->...ijk", dq, dq) / (4 * l**3)
 
 
+@carries_failed_rows({"alpha": 0})
 def angular_velocity_jacobian(alpha: object) -> np.ndarray:
     """``E`` with platform angular velocity ``omega = E (alpha_dot, beta_dot)`` (base frame), (..., 3, 2).
 
@@ -587,6 +593,7 @@ def angular_velocity_jacobian(alpha: object) -> np.ndarray:
     return E
 
 
+@carries_failed_rows({"alpha": 0, "beta": 0})
 def influence_coefficients(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
     """First-order influence coefficients: ``ldot = G [omega; v_O]`` -> G (..., 3, 6).
 
@@ -621,6 +628,7 @@ def influence_coefficients(leg: SphericalLeg, alpha: object, beta: object) -> np
     return G
 
 
+@carries_failed_rows({"q": 1, "qd": 1, "qdd": 1})
 def leg_rates(
     leg: SphericalLeg, q: object, qd: object, qdd: object
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech._batching import carries_failed_rows
 from robomech._validation import check_params
 from robomech.analysis.workspace import singularity_map
 
@@ -60,6 +61,7 @@ class WorkspaceMap:
     dl3_dalpha: np.ndarray
 
 
+@carries_failed_rows({"alpha": 0, "beta": 0})
 def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMap:
     """Workspace and singularity map at poses ``alpha``, ``beta`` (rad, broadcast) in closed form.
 

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_batch, check_params, check_real
 from robomech.analysis.lstsq import _damped_svd_solve
 
@@ -89,6 +90,7 @@ class InverseRatesResult:
     valid: np.ndarray
 
 
+@carries_failed_rows({"q": 1, "omega": 1, "omega_dot": 1})
 def inverse_rates(
     th: VectoredThruster,
     q: object,
@@ -207,6 +209,7 @@ class StaticsResult:
     valid: np.ndarray
 
 
+@carries_failed_rows({"q": 1}, {"wrench": 1})
 def static_torques(th: VectoredThruster, q: object, wrench: object) -> StaticsResult:
     """Motor torques ``τ = -Jᵀ m_O`` holding the platform against a wrench ``[m_O; f] (..., 6)``.
 

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
-from robomech._batching import chunked
+from robomech._batching import carries_failed_rows, chunked
 from robomech._validation import as_array, broadcast_batch, check_params
 from robomech.spatial import lie_bracket
 
@@ -311,6 +311,7 @@ def _axes(th: VectoredThruster, q: np.ndarray) -> JointAxes:
     )
 
 
+@carries_failed_rows({"q": 1})
 def joint_axes(th: VectoredThruster, q: object) -> JointAxes:
     """Unit joint axes at inputs ``q (..., 2)`` (rad).
 
@@ -406,6 +407,7 @@ def _split(v: np.ndarray) -> _V:
     return (v[..., 0], v[..., 1], v[..., 2])
 
 
+@carries_failed_rows({"a1": 1, "b1": 1, "a2": 1, "b2": 1})
 def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
     """Angular distance (rad) between the minor great-circle arcs (a1 -> b1) and (a2 -> b2) (unit, (..., 3)).
 
@@ -485,6 +487,7 @@ def _interference_unmasked(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
     return np.where(valid, np.where(crosses, 0.0, ends), np.nan)
 
 
+@carries_failed_rows({"q": 1})
 def link_clearance(th: VectoredThruster, q: object) -> LinkClearanceResult:
     """Angular clearance (rad) between the RRR chain's 45 deg arc and the fixing device at ``q (..., 2)``.
 
@@ -559,6 +562,7 @@ def _fk(th: VectoredThruster, q: np.ndarray) -> FKResult:
     )
 
 
+@carries_failed_rows({"q": 1})
 def forward_kinematics(th: VectoredThruster, q: object) -> FKResult:
     """Propeller axis and tip from the inputs ``q (..., 2)`` = (q1, q2) in rad.
 
@@ -588,6 +592,7 @@ def forward_kinematics(th: VectoredThruster, q: object) -> FKResult:
     return _chunked(_fk, th, _q(q))
 
 
+@carries_failed_rows({"q": 1})
 def platform_rotation(th: VectoredThruster, q: object) -> RotationResult:
     """Platform rotation ``R_OP (..., 3, 3)`` = Ry(q2) Rx(-theta), columns (-s22, -s13, s0).
 
@@ -688,6 +693,7 @@ def _ik_unmasked(th: VectoredThruster, s: np.ndarray) -> IKResult:
     return IKResult(q=q, solved=ok, in_range=in_range, tilt_ok=tilt_ok, valid=in_range & tilt_ok)
 
 
+@carries_failed_rows({"s": 1})
 def inverse_kinematics(th: VectoredThruster, s: object) -> IKResult:
     """Inputs ``q (..., 2)`` pointing the propeller along ``s (..., 3)`` (any positive multiple: axis or tip).
 
@@ -744,6 +750,7 @@ def _rates(ax: JointAxes, qd: np.ndarray) -> np.ndarray:
     return x
 
 
+@carries_failed_rows({"q": 1})
 def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
     """Passive joint angles (..., 3), rad, zero at q = 0, ordered (RR s22, RRR s12, RRR s13).
 
@@ -781,6 +788,7 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
     return PassiveResult(values=np.where(ax.valid[..., None], vals, np.nan), valid=ax.valid)
 
 
+@carries_failed_rows({"q": 1, "qd": 1})
 def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
     """Passive joint rates (..., 3), rad/s, ordered (RR s22, RRR s12, RRR s13), from ``q, qd (..., 2)``.
 
@@ -837,6 +845,7 @@ def _jacobian(th: VectoredThruster, q: np.ndarray) -> JacobianResult:
     return JacobianResult(J=J, valid=valid, distance=np.sqrt(d2))
 
 
+@carries_failed_rows({"q": 1})
 def jacobian(th: VectoredThruster, q: object) -> JacobianResult:
     """``omega = J qd``: J (..., 3, 2) maps input rates to the platform's angular velocity (base frame).
 
@@ -882,6 +891,7 @@ class VelocityResult:
     valid: np.ndarray
 
 
+@carries_failed_rows({"q": 1, "qd": 1})
 def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityResult:
     """Platform angular velocity ``omega = J qd`` (..., 3), rad/s, from ``q, qd (..., 2)``.
 
@@ -916,6 +926,7 @@ def _screw(s: np.ndarray) -> np.ndarray:
     return np.concatenate([s, np.zeros_like(s)], axis=-1)
 
 
+@carries_failed_rows({"q": 1, "qd": 1, "qdd": 1})
 def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: object) -> AccelerationResult:
     """Platform angular acceleration from ``q, qd, qdd (..., 2)`` by screw theory with Lie brackets.
 

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, check_params
 from robomech.analysis.workspace import grid
 
@@ -102,6 +103,7 @@ def _dexterity(J: np.ndarray, ok: np.ndarray) -> np.ndarray:
         return np.where(ok & pos, ratio, 0.0)
 
 
+@carries_failed_rows({"q": 1})
 def dexterity(th: VectoredThruster, q: object) -> np.ndarray:
     """Dexterity 1/cond(J) (...,) in [0, 1] at inputs ``q (..., 2)``; 0 at singular inputs.
 
@@ -127,6 +129,7 @@ def dexterity(th: VectoredThruster, q: object) -> np.ndarray:
     return _dexterity(jr.J, jr.valid)
 
 
+@carries_failed_rows({"q": 1})
 def workspace_map(th: VectoredThruster, q: object) -> WorkspaceMap:
     """Section 4 at each input sample ``q (..., 2)`` (rad): tip, limits, singularity, dexterity.
 
@@ -219,6 +222,7 @@ def singular_points(th: VectoredThruster) -> np.ndarray:
     return np.array([[0.0, a], [np.pi, -a]])
 
 
+@carries_failed_rows({"q1": 0})
 def idle_input_curve(th: VectoredThruster, q1: object) -> np.ndarray:
     """q2 (...,) on the rank-deficient curve ``tan q2 = tan a / cos q1`` for |q1| < pi/2 (rad).
 
