@@ -631,19 +631,6 @@ def _zoom(mech, t0: float, t1: float, q0: np.ndarray, qd0: np.ndarray, full_rank
     return best
 
 
-def _redundant_words(mech) -> list[str]:
-    """Why an overconstrained mechanism's simulation departs from the engine's (empty where it is not)."""
-    from robomech import multibody as mb
-
-    redundant = mb.mobility(mech).redundant_constraints
-    if not redundant:  # MuJoCo regularises a rank-deficient constraint set: its closures become compliant
-        return []
-    return [
-        f"the closures have {redundant} redundant row(s) (an overconstrained mechanism): the engine "
-        "solves them as soft constraints, which lets its motion depart from the rigid model"
-    ]
-
-
 def _why(mech, t: np.ndarray, q: np.ndarray, off: np.ndarray, qd: np.ndarray | None = None) -> str:
     """Why a simulation disagrees: when it first left the engine, and the type II singularity it crossed
     last before (or came closest to: smallest singular value of the passive block of K, in m, from
@@ -658,7 +645,7 @@ def _why(mech, t: np.ndarray, q: np.ndarray, off: np.ndarray, qd: np.ndarray | N
         words.append(f"diverged from the engine after t = {t[end]:.3g} s")
     inf = mb.influence(mech, q, second_order=False)
     if not inf.n_passive:
-        return "; ".join(words + _redundant_words(mech))
+        return "; ".join(words)
     full = int(inf.passive_rank.max(initial=0))
     smin = np.where(inf.passive_rank < full, 0.0, inf.sigma_min)
     found = [(float(smin[k]), float(t[k])) for k in range(len(t))]
@@ -678,7 +665,6 @@ def _why(mech, t: np.ndarray, q: np.ndarray, off: np.ndarray, qd: np.ndarray | N
     elif found:
         sigma, tc = min(found)
         words.append(f"closest to a type II singularity at t = {tc:.4g} s (sigma_min {sigma:.1e} m)")
-    words += _redundant_words(mech)
     return "; ".join(words)
 
 
@@ -716,11 +702,12 @@ def _simulation_checks(mech, name, q0, qd_act0=None, duration: float = T_SIM, *,
     moved = float(np.max(np.abs((sim.q_act - sim.q_act[0]) * scale)))
     rel = _rel(err, max(moved, 1e-3))
     detail = f"max |q_act - engine| {err:.2e} (rad, slides / L) for a motion of {moved:.3g}"
+    off = dev > TOL_SIM.value * max(moved, 1e-3)  # where the motion left the engine's
     if not rel <= TOL_SIM.value:
-        detail += "; " + _why(mech, t, sim.q, dev > TOL_SIM.value * max(moved, 1e-3), sim.qd)
+        detail += "; " + _why(mech, t, sim.q, off, sim.qd)
     drift = f"{float(sim.energy_drift):.2e} J"
     if not float(sim.energy_drift_rel) <= TOL_DRIFT.value:
-        drift += "; " + _why(mech, t, sim.q, np.zeros(len(t), bool))
+        drift += "; " + _why(mech, t, sim.q, off, sim.qd)
     return [
         Check(name, f"forward simulation vs engine ({duration:g} s, passive)", rel, TOL_SIM, detail),
         Check(name, "energy drift of the simulation", float(sim.energy_drift_rel), TOL_DRIFT, drift),
