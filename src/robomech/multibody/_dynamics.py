@@ -1268,7 +1268,8 @@ class ForwardDynamicsResult:
     qdd_act : ndarray, shape (..., n_act)
         Actuated joints' accelerations in actuator order (rad/s^2 or m/s^2); NaN where not ``valid``.
     qdd : ndarray, shape (..., nv)
-        Every tree coordinate's acceleration (MuJoCo ``qvel`` order); NaN where not ``valid``.
+        Every tree coordinate's acceleration (MuJoCo ``qvel`` order), idle motions included (free, no
+        force on them); NaN where not ``valid``.
     qd : ndarray, shape (..., nv)
         Every tree coordinate's rate, ``G qd_act`` or the given ``qd`` (rad/s, m/s).
     cond : ndarray, shape (...)
@@ -1306,7 +1307,12 @@ def forward_dynamics(
     """Accelerations under actuator forces ``tau (..., n_act)`` at ``(q, qd_act)`` or ``(q, qd)``.
 
     The inverse of :func:`inverse_dynamics`: ``forward_dynamics(mech, q, qd, inverse_dynamics(mech, q,
-    qd, qdd).tau).qdd_act == qdd`` wherever both are valid (idle motions decoupled).  Where the
+    qd, qdd).tau).qdd_act == qdd`` wherever both are valid and the mechanism has no idle motions.  Idle
+    motions (a Delta forearm spinning about its axis) are free here: no force acts on them and they
+    accelerate as the tree's dynamics say, whereas the actuator-rate inverse prescribes their
+    acceleration (minimum norm), which needs a small torque on them that no actuator supplies; through
+    the inertia coupling the round trip then misses by that torque's effect (1e-6 to 1e-5 relative on the
+    gallery Delta; ``docs/dynamics.md``).  The full-rate form round-trips exactly.  Where the
     actuators determine the motion, the state is ``(q, qd_act)`` and the passive coordinates' rates are
     ``qd = G qd_act`` (idle motions at rest); for any mechanism — and necessarily where the actuators
     do not determine it (fewer actuators than degrees of freedom, none, a floating base) — every
