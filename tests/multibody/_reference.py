@@ -9,36 +9,158 @@ are checked against: :func:`numpy_reference` swaps them in for the kernels insid
 from __future__ import annotations
 
 import contextlib
+from collections.abc import Callable
 
 import numpy as np
 
 from robomech.dynamics import _com_terms
 from robomech.multibody import _compiled, _dynamics, _rnea
 from robomech.multibody import _dynamics as D
-from robomech.multibody._assembly import solve_closure
+from robomech.multibody._constraints import jacobian, residual
 from robomech.multibody._influence import _influence_flat, _pinv
+from robomech.multibody._model import Mechanism
 from robomech.multibody._options import (
     ADMISSIBLE_RTOL,
+    CONVERGED_RTOL,
     GRAM_COND_MAX,
     GRAM_REFINE2_COND,
     GRAM_REFINE_COND,
+    MAX_ITER,
+    MAX_STEP,
+    MU_MAX,
+    MU_MIN,
+    MU_START,
     RANK_RTOL,
     RATE_FLOOR,
     SINGULAR_COND,
+    STOP_RTOL,
 )
-from robomech.multibody._tree import frame_jacobian, kinematics
+from robomech.multibody._tree import TreeState, frame_jacobian, integrate, kinematics
 
 
-def _no_rows(state, q, idx):
-    """No extra rows: ``solve_closure`` then runs its numpy Levenberg–Marquardt iteration."""
-    n = len(idx)
-    return np.zeros((n, 0)), np.zeros((n, 0, state.S.shape[1]))
+# ----------------------------------------------------------------------------- Levenberg–Marquardt
+# The numpy formulation of _compiled.lm_solve (batched over samples): assembly and inverse kinematics.
+def numpy_lm(
+    mech: Mechanism,
+    q: np.ndarray,
+    free: np.ndarray,
+    extra: Callable[[TreeState, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None,
+    max_iter: int = MAX_ITER,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """LM on the closure rows (plus ``extra(state, q, idx) -> (r, J)`` rows) over the coordinates ``free``.
+
+    ``q (N, nq)`` start (normalised); ``free`` indices of velocity coordinates that may move.
+    Returns ``q, closure residual (N,) max-abs, total residual (N,), iterations (N,)``: the numpy
+    formulation, batched over samples, of ``_compiled.lm_solve`` (FK without extra rows, IK with the
+    site rows of :func:`site_error`).
+    """
+    tree, cs = mech.tree, mech.constraints
+    N = q.shape[0]
+    nf = len(free)
+
+    def fun(qs: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        st = kinematics(tree, qs)
+        r = residual(cs, tree, st, qs)
+        J = jacobian(cs, tree, st, qs)
+        rc = np.max(np.abs(r), axis=-1) if r.shape[-1] else np.zeros(qs.shape[0])
+        if extra is not None:
+            r2, J2 = extra(st, qs, idx)
+            r = np.concatenate([r, r2], axis=-1)
+            J = np.concatenate([J, J2], axis=-2)
+        return r, J[..., free], rc
+
+    q = np.array(q, copy=True)
+    all_idx = np.arange(N)
+    r, J, rc = fun(q, all_idx)
+    finite = np.all(np.isfinite(r), axis=-1) & np.all(np.isfinite(J), axis=(-1, -2))
+    cost = np.where(finite, np.sum(np.where(finite[:, None], r, 0.0) ** 2, axis=-1), np.inf)
+    mu = np.full(N, MU_START)
+    iters = np.zeros(N, dtype=int)
+    active = finite.copy()
+    stop = (STOP_RTOL * tree.length) ** 2
+    wstep = np.where(tree.dof_translational, 1.0 / tree.length, 1.0)[free]
+    geom_rows = np.array([k != "coupling" for k in cs.row_kind] + [True] * (r.shape[-1] - cs.m), dtype=bool)
+    if nf == 0:
+        active[:] = False
+    for _ in range(max_iter):
+        active &= cost > stop
+        idx = np.flatnonzero(active)
+        if idx.size == 0:
+            break
+        Js, rs = J[idx], r[idx]
+        JtJ = np.einsum("nmi,nmj->nij", Js, Js)
+        g = np.einsum("nmi,nm->ni", Js, rs)
+        scale = np.trace(JtJ, axis1=-2, axis2=-1) / nf + 1e-300
+        Amat = JtJ + (mu[idx] * scale)[:, None, None] * np.eye(nf)
+        dx = -np.linalg.solve(Amat, g[..., None])[..., 0]
+        # coordinates that move no closure point or site (e.g. a lead screw's coupled spin) are not capped
+        geo = (
+            np.any(Js[:, geom_rows[: Js.shape[1]]] != 0.0, axis=1)
+            if geom_rows.size
+            else np.ones_like(dx, bool)
+        )
+        big = np.max(np.abs(dx) * wstep * geo, axis=-1)
+        dx *= np.where(big > MAX_STEP, MAX_STEP / np.where(big > 0, big, 1.0), 1.0)[:, None]
+        dv = np.zeros((idx.size, tree.nv))
+        dv[:, free] = dx
+        q_try = integrate(tree, q[idx], dv)
+        r_t, J_t, rc_t = fun(q_try, idx)
+        ok_f = np.all(np.isfinite(r_t), axis=-1) & np.all(np.isfinite(J_t), axis=(-1, -2))
+        c_t = np.where(ok_f, np.sum(np.where(ok_f[:, None], r_t, 0.0) ** 2, axis=-1), np.inf)
+        acc = c_t < cost[idx]
+        ia = idx[acc]
+        q[ia], r[ia], J[ia], rc[ia], cost[ia] = q_try[acc], r_t[acc], J_t[acc], rc_t[acc], c_t[acc]
+        mu[ia] = np.maximum(mu[ia] / 10.0, MU_MIN)
+        ir = idx[~acc]
+        mu[ir] *= 10.0
+        iters[idx] += 1
+        active[ir[mu[ir] > MU_MAX]] = False
+    rc = np.where(finite, rc, np.inf)
+    return q, rc, np.sqrt(cost), iters
 
 
-def numpy_fk(mech, q, free):
+def site_error(tree, state, site: int, T_target: np.ndarray, w: np.ndarray):
+    """Pose error rows ``[L rot; pos]`` (N, 6) of a site against ``T_target`` and their matrix (N, 6, nv)."""
+    b = tree.site_body[site]
+    Ts = state.T[:, b] @ tree.T_site[site]
+    L = tree.length
+    rot = 0.5 * L * np.sum(np.cross(T_target[:, :3, :3], Ts[:, :3, :3], axis=-2), axis=-1)
+    pos = Ts[:, :3, 3] - T_target[:, :3, 3]
+    Jf = frame_jacobian(tree, state, b, Ts[:, :3, 3])
+    Jf = np.concatenate([L * Jf[:, :3], Jf[:, 3:]], axis=-2)
+    return np.concatenate([rot, pos], axis=-1) * w, Jf * w[:, None]
+
+
+def numpy_fk(mech, q, free, max_iter=MAX_ITER):
     """The assembly of ``_compiled.compiled_fk`` by the numpy iteration: (q, rc, iterations, residual)."""
-    q, rc, res, it = solve_closure(mech, np.array(q, dtype=float), np.asarray(free), _no_rows)
+    q, rc, res, it = numpy_lm(mech, np.array(q, dtype=float), np.asarray(free), None, max_iter)
     return q, rc, it, res
+
+
+def numpy_ik(mech, site, T_target, guess, weights, steps=1):
+    """The inverse kinematics of ``mb.inverse_kinematics`` by the numpy iteration, on finite
+    ``T_target (N, 4, 4)`` and ``guess (N, nq)`` (``steps`` continuation stages from the guess's site
+    pose, ``_assembly._interp_pose``): (q, converged, residual, pose error, iterations)."""
+    from robomech.multibody._assembly import _interp_pose
+
+    tree = mech.tree
+    si = tree.site_index(site)
+    w = np.asarray(weights, dtype=float)
+    q = np.array(guess, dtype=float)
+    start = kinematics(tree, q).T[:, tree.site_body[si]] @ tree.T_site[si]
+    iters = np.zeros(q.shape[0], dtype=int)
+    for s in range(1, steps + 1):
+        Ts = T_target if s == steps else _interp_pose(start, T_target, s / steps)
+
+        def extra(state, qs, idx, Ts=Ts):
+            return site_error(tree, state, si, Ts[idx], w)
+
+        q, rc, _, it = numpy_lm(mech, q, np.arange(tree.nv), extra)
+        iters += it
+    e, _ = site_error(tree, kinematics(tree, q), si, T_target, w)
+    pe = np.max(np.abs(e), axis=-1)
+    tol = CONVERGED_RTOL * tree.length
+    return q, (rc <= tol) & (pe <= tol), rc, pe, iters
 
 
 def numpy_site_jacobian(mech, q, site):

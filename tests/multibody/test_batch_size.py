@@ -5,7 +5,7 @@ block and large ones in parallel blocks of the same per-sample code; influence a
 batched numpy), so a sample's result must not depend on the batch around it: here batches of 1, 150,
 300 and 1000 (below and above the kernels' block size and the former numpy/compiled threshold) of the
 same samples agree to ``BATCH_RTOL`` for FK, site Jacobians, site Hessians, influence coefficients and
-inverse dynamics on the gallery.
+inverse dynamics on the gallery; inverse kinematics bit for bit at 1, 150, 255, 256, 257, 300 and 1000.
 """
 
 from __future__ import annotations
@@ -149,3 +149,27 @@ def test_tree_forward_dynamics_one_kernel_at_every_batch_size(name):
     bad[0] = np.nan
     nan = mb.forward_dynamics(mech, q[7], tau=bad, qd=qd[7])
     assert np.all(np.isnan(nan.qdd)) and not nan.valid
+
+
+def test_inverse_kinematics_any_batch_size():
+    mech = mb.gallery.load("stewart")
+    site = mech.sites[0].name
+    rng = np.random.default_rng(5)
+    n = 1000
+    qa = mech.q0[mech.tree.act_qadr] + 0.05 * mech.length * rng.uniform(-1, 1, (n, len(mech.actuated)))
+    fk = mb.forward_kinematics(mech, qa)
+    T = mb.site_pose(mech, fk.q, site)
+    T[3, 0, 3] = np.nan  # a failed sample of an earlier call
+    T[::7, :3, 3] += 20.0 * mech.length  # out of reach
+    guess = np.tile(mech.q0, (n, 1))
+    guess[11] = np.nan  # a failed guess row
+    full = mb.inverse_kinematics(mech, site, T, guess)
+    assert not full.converged[3] and not full.converged[11] and not full.converged[7]
+    assert np.all(np.isnan(full.q[3])) and np.all(np.isnan(full.q[11])) and np.isnan(full.residual[11])
+    assert full.converged.sum() > n // 2
+    for k in (1, 150, 255, 256, 257, 300):
+        part = mb.inverse_kinematics(mech, site, T[:k], guess[:k])
+        for f in ("q", "residual", "pose_error", "converged", "iterations"):
+            np.testing.assert_array_equal(getattr(part, f), getattr(full, f)[:k], err_msg=f"{f} at batch {k}")
+    one = mb.inverse_kinematics(mech, site, T[257], guess[257])  # unbatched
+    np.testing.assert_array_equal(one.q, full.q[257])

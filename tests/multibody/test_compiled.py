@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 
 from robomech import multibody as mb
 from robomech.mechanisms import spherical_leg as sl
+from robomech.multibody import _compiled
 
 from ._reference import numpy_reference
 
@@ -320,3 +321,89 @@ def test_forward_dynamics_where_the_svd_does_not_converge():
         slow = mb.forward_dynamics(mech, fk.q[None], qd[None], tau[None])
     assert fk.converged and fast.valid.all()
     _assert_same_forward(fast, slow)
+
+
+# ----------------------------------------------------------------------------- inverse kinematics
+# The public inverse kinematics runs the compiled Levenberg–Marquardt solve (_compiled.lm_solve through
+# _designs.ik_designs); the numpy iteration of tests/multibody/_reference.py (numpy_ik) is the reference.
+# A full pose target has isolated solutions: the two agree to rounding (~1e-15 measured).
+IK_Q_TOL = 1e-10
+# A point target (rotation weights 0) on a mechanism with more DOF than the 3 targeted rows has a
+# manifold of solutions: the step's component along it is set by the damping alone, whose matrix
+# K^T K + mu s I has a condition number up to 1 / MU_MIN = 1e14, so the two solves' rounding (Cholesky
+# compiled, LU numpy) moves the solution along the manifold: 1.2e-8 L measured (stewart); both are
+# solutions (converged is checked on each), the tolerance bounds that drift with a 100x margin.
+IK_POINT_Q_RTOL = 1e-6
+IK_N = 40
+GALLERY = ["four_bar", "planar_3rrr", "rps_3", "delta", "stewart", "bennett"]
+
+
+def _ik_targets(mech, seed):
+    """Site poses of perturbed assemblies, every fifth moved 0.5 L away (out of reach for most)."""
+    site = mech.sites[0].name
+    rng = np.random.default_rng(seed)
+    scale = np.where(mech.tree.dof_translational[mech.tree.act_dof], mech.length, 1.0)
+    qa = mech.q0[mech.tree.act_qadr] + 0.1 * scale * rng.uniform(-1, 1, (IK_N, len(mech.actuated)))
+    fk = mb.forward_kinematics(mech, qa)
+    T = mb.site_pose(mech, np.where(fk.converged[:, None], fk.q, mech.q0), site)
+    T[::5, :3, 3] += 0.5 * mech.length
+    return site, T
+
+
+@pytest.mark.parametrize("name", GALLERY)
+@pytest.mark.parametrize("point", [False, True])
+def test_compiled_inverse_kinematics_equals_numpy(name, point):
+    from ._reference import numpy_ik
+
+    mech = mb.gallery.load(name)
+    site, T = _ik_targets(mech, 4)
+    w = np.array([0, 0, 0, 1, 1, 1.0]) if point else np.ones(6)
+    ik = mb.inverse_kinematics(mech, site, T, weights=w)
+    q, conv, *_ = numpy_ik(mech, site, T, np.tile(mech.q0, (IK_N, 1)), w)
+    assert np.array_equal(ik.converged, conv)
+    assert conv.sum() >= IK_N // 2  # the comparison covers solved samples
+    tol = IK_POINT_Q_RTOL * mech.length if point else IK_Q_TOL
+    assert np.max(np.abs(ik.q[conv] - q[conv])) <= tol
+    lim = mb.CONVERGED_RTOL * mech.length  # the flags say what the numbers say
+    assert np.all(ik.residual[ik.converged] <= lim) and np.all(ik.pose_error[ik.converged] <= lim)
+    assert np.all(np.isfinite(ik.q[ik.converged]))
+
+
+# The reference assembly of a description typed unassembled (_reference.assembled_reference) runs the
+# compiled closure solve over every coordinate: with more coordinates than closure rows the assemblies
+# form a manifold, and the step's component along it is set by the damping alone (condition number up
+# to 1 / MU_MIN = 1e14), so the compiled and numpy solves' rounding moves the solution along it: up to
+# 2e-5 rad measured on this five-bar (2-dimensional manifold), in the same iterations.  Both close the
+# loops; the difference is tangent to the manifold: |K dq| is second order, the manifold's curvature
+# times |dq|^2 (<= 0.03 |dq|^2 / L measured), where a difference across it would give |K dq| ~ |dq|.
+# ASSEMBLY_DRIFT bounds the drift along the manifold (5x margin), ASSEMBLY_NORMAL_RTOL the normal
+# component in units of |dq|^2 / L (30x margin).
+ASSEMBLY_DRIFT = 1e-4
+ASSEMBLY_NORMAL_RTOL = 1.0
+
+
+def test_reference_assembly_equals_numpy():
+    from robomech.multibody import _reference as R
+    from robomech.multibody._compile import _tables
+    from robomech.multibody._tree import integrate
+
+    from ._reference import numpy_lm
+    from .test_kinematic_classes import _five_bar_by_lengths
+
+    mech = _five_bar_by_lengths(0.5).build()
+    tree = mech.tree
+    free = np.arange(tree.nv)
+    dv = 0.2 * np.random.default_rng(0).uniform(-1.0, 1.0, (R.START_PERTURBATIONS, tree.nv))
+    starts = integrate(tree, np.repeat(tree.q0[None], R.START_PERTURBATIONS, axis=0), dv)
+    wstep = np.where(tree.dof_translational, 1.0 / tree.length, 1.0)
+    qc, rc_c, it_c, _ = _compiled.closure_solve(_tables(tree, mech.constraints), starts, free, wstep, 400)
+    qn, rc_n, _, it_n = numpy_lm(mech, starts, free, None, 400)
+    tol = mb.CONVERGED_RTOL * mech.length
+    assert np.array_equal(rc_c <= tol, rc_n <= tol) and (rc_c <= tol).all()
+    assert np.array_equal(it_c, it_n)
+    K = mb.constraint_jacobian(mech, qc)
+    d = qn - qc
+    assert np.max(np.abs(d)) <= ASSEMBLY_DRIFT
+    dn = np.linalg.norm(d, axis=-1)
+    Kd = np.linalg.norm(np.einsum("nij,nj->ni", K, d), axis=-1)
+    assert np.all(Kd <= ASSEMBLY_NORMAL_RTOL * dn**2 / mech.length + 1e-14)  # + rounding of K dq

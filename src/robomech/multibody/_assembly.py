@@ -1,15 +1,16 @@
 """Assembly (position analysis): forward and inverse kinematics of any described closed chain.
 
-Both solve the closure equations (plus, for IK, the site's pose error) by a batched
-Levenberg–Marquardt iteration on the velocity constraint matrix, in least squares, so that redundant
-constraints (more equations than independent ones) and redundant actuation (more inputs than DOF,
-consistent inputs) work.  Every sample has its own damping, its own acceptance test and its own
-stop; a sample that cannot close stops with ``converged = False`` and does not affect the others.
+Both solve the closure equations (plus, for IK, the site's pose error) by the Levenberg–Marquardt
+iteration on the velocity constraint matrix, in least squares, so that redundant constraints (more
+equations than independent ones) and redundant actuation (more inputs than DOF, consistent inputs)
+work: the compiled per-sample kernel ``_compiled.lm_solve`` at every batch size (FK through
+``_compiled.compiled_fk``, IK through the design-batched driver ``_designs.ik_designs`` on the one
+design).  Every sample has its own damping, its own acceptance test and its own stop; a sample that
+cannot close stops with ``converged = False`` and does not affect the others.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,10 +18,10 @@ from numpy.typing import ArrayLike
 
 from robomech._validation import MAX_MAGNITUDE, as_array, broadcast_batch, check_int
 
-from ._constraints import jacobian, residual
+from ._constraints import jacobian
 from ._model import Mechanism
-from ._options import CONVERGED_RTOL, MAX_ITER, MAX_STEP, MU_MAX, MU_MIN, MU_START, STOP_RTOL
-from ._tree import TreeState, frame_jacobian, integrate, kinematics, normalize_quaternions
+from ._options import CONVERGED_RTOL
+from ._tree import kinematics, normalize_quaternions
 
 __all__ = [
     "CONVERGED_RTOL",
@@ -30,7 +31,6 @@ __all__ = [
     "check_q",
     "forward_kinematics",
     "inverse_kinematics",
-    "solve_closure",
 ]
 
 # (tolerances and iteration limits: _options)
@@ -102,90 +102,6 @@ def assembly_mode_sign(mech: Mechanism, q_start: np.ndarray, q_end: np.ndarray) 
     M = np.where(both, M, np.eye(M.shape[-1]))
     out[ok] = np.where(keep[:, 0], np.sign(np.linalg.det(M)), 0.0)
     return out
-
-
-def solve_closure(
-    mech: Mechanism,
-    q: np.ndarray,
-    free: np.ndarray,
-    extra: Callable[[TreeState, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None,
-    max_iter: int = MAX_ITER,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """LM on the closure rows (plus ``extra(state, q, idx) -> (r, J)`` rows) over the coordinates ``free``.
-
-    ``q (N, nq)`` start (normalised); ``free`` indices of velocity coordinates that may move.
-    Returns ``q, closure residual (N,) max-abs, total residual (N,), iterations (N,)``.  Without extra
-    rows (assembly) this is the compiled kernel (``_compiled.fk_block``), the same iteration per sample;
-    the numpy iteration here serves the rows that only inverse kinematics adds.
-    """
-    if extra is None and max_iter == MAX_ITER:
-        from ._compiled import compiled_fk  # numba loads on the first kernel call, not at import
-
-        q, rc, it, res = compiled_fk(mech, q, np.asarray(free))
-        return q, rc, res, it
-    tree, cs = mech.tree, mech.constraints
-    N = q.shape[0]
-    nf = len(free)
-
-    def fun(qs: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        st = kinematics(tree, qs)
-        r = residual(cs, tree, st, qs)
-        J = jacobian(cs, tree, st, qs)
-        rc = np.max(np.abs(r), axis=-1) if r.shape[-1] else np.zeros(qs.shape[0])
-        if extra is not None:
-            r2, J2 = extra(st, qs, idx)
-            r = np.concatenate([r, r2], axis=-1)
-            J = np.concatenate([J, J2], axis=-2)
-        return r, J[..., free], rc
-
-    q = np.array(q, copy=True)
-    all_idx = np.arange(N)
-    r, J, rc = fun(q, all_idx)
-    finite = np.all(np.isfinite(r), axis=-1) & np.all(np.isfinite(J), axis=(-1, -2))
-    cost = np.where(finite, np.sum(np.where(finite[:, None], r, 0.0) ** 2, axis=-1), np.inf)
-    mu = np.full(N, MU_START)
-    iters = np.zeros(N, dtype=int)
-    active = finite.copy()
-    stop = (STOP_RTOL * tree.length) ** 2
-    wstep = np.where(tree.dof_translational, 1.0 / tree.length, 1.0)[free]
-    geom_rows = np.array([k != "coupling" for k in cs.row_kind] + [True] * (r.shape[-1] - cs.m), dtype=bool)
-    if nf == 0:
-        active[:] = False
-    for _ in range(max_iter):
-        active &= cost > stop
-        idx = np.flatnonzero(active)
-        if idx.size == 0:
-            break
-        Js, rs = J[idx], r[idx]
-        JtJ = np.einsum("nmi,nmj->nij", Js, Js)
-        g = np.einsum("nmi,nm->ni", Js, rs)
-        scale = np.trace(JtJ, axis1=-2, axis2=-1) / nf + 1e-300
-        Amat = JtJ + (mu[idx] * scale)[:, None, None] * np.eye(nf)
-        dx = -np.linalg.solve(Amat, g[..., None])[..., 0]
-        # coordinates that move no closure point or site (e.g. a lead screw's coupled spin) are not capped
-        geo = (
-            np.any(Js[:, geom_rows[: Js.shape[1]]] != 0.0, axis=1)
-            if geom_rows.size
-            else np.ones_like(dx, bool)
-        )
-        big = np.max(np.abs(dx) * wstep * geo, axis=-1)
-        dx *= np.where(big > MAX_STEP, MAX_STEP / np.where(big > 0, big, 1.0), 1.0)[:, None]
-        dv = np.zeros((idx.size, tree.nv))
-        dv[:, free] = dx
-        q_try = integrate(tree, q[idx], dv)
-        r_t, J_t, rc_t = fun(q_try, idx)
-        ok_f = np.all(np.isfinite(r_t), axis=-1) & np.all(np.isfinite(J_t), axis=(-1, -2))
-        c_t = np.where(ok_f, np.sum(np.where(ok_f[:, None], r_t, 0.0) ** 2, axis=-1), np.inf)
-        acc = c_t < cost[idx]
-        ia = idx[acc]
-        q[ia], r[ia], J[ia], rc[ia], cost[ia] = q_try[acc], r_t[acc], J_t[acc], rc_t[acc], c_t[acc]
-        mu[ia] = np.maximum(mu[ia] / 10.0, MU_MIN)
-        ir = idx[~acc]
-        mu[ir] *= 10.0
-        iters[idx] += 1
-        active[ir[mu[ir] > MU_MAX]] = False
-    rc = np.where(finite, rc, np.inf)
-    return q, rc, np.sqrt(cost), iters
 
 
 @dataclass(frozen=True)
@@ -350,18 +266,6 @@ def forward_kinematics(
     )
 
 
-def _site_error(tree, state, site: int, T_target: np.ndarray, w: np.ndarray):
-    """Pose error rows ``[L rot; pos]`` (N, 6) of a site against ``T_target`` and their matrix (N, 6, nv)."""
-    b = tree.site_body[site]
-    Ts = state.T[:, b] @ tree.T_site[site]
-    L = tree.length
-    rot = 0.5 * L * np.sum(np.cross(T_target[:, :3, :3], Ts[:, :3, :3], axis=-2), axis=-1)
-    pos = Ts[:, :3, 3] - T_target[:, :3, 3]
-    Jf = frame_jacobian(tree, state, b, Ts[:, :3, 3])
-    Jf = np.concatenate([L * Jf[:, :3], Jf[:, 3:]], axis=-2)
-    return np.concatenate([rot, pos], axis=-1) * w, Jf * w[:, None]
-
-
 def inverse_kinematics(
     mech: Mechanism,
     site: str,
@@ -413,7 +317,7 @@ def inverse_kinematics(
     tree = mech.tree
     if not isinstance(site, str):
         raise ValueError(f"Expected site to be a site name (str), got {type(site).__name__}.")
-    si = tree.site_index(site)
+    tree.site_index(site)  # a ValueError naming the site if the mechanism has none of that name
     T = as_array(T_target, "T_target", (4, 4), finite="mask")  # beyond 1e100: masked like NaN
     w = np.ones(6) if weights is None else as_array(weights, "weights", (6,))
     if w.ndim != 1 or np.any(w < 0) or not np.any(w > 0):
@@ -429,39 +333,17 @@ def inverse_kinematics(
     orth = np.max(np.abs(Rt.swapaxes(-1, -2) @ Rt - np.eye(3)), axis=(-1, -2))
     if np.any(ok & ((orth > 1e-6) | (np.max(np.abs(Tf[:, 3] - [0, 0, 0, 1]), axis=-1) > 1e-12))):
         raise ValueError("Expected T_target to hold rigid transforms (orthonormal R, last row 0 0 0 1).")
-    Tf[~ok] = np.eye(4)
-    free = np.arange(tree.nv)
-    start = None
-    if steps > 1:
-        st = kinematics(tree, q)
-        start = st.T[:, tree.site_body[si]] @ tree.T_site[si]
-    iters = np.zeros(q.shape[0], dtype=int)
-    pose_err = np.zeros(q.shape[0])
-    rc = np.zeros(q.shape[0])
-    for s in range(1, steps + 1):
-        if start is None or s == steps:
-            Ts = Tf
-        else:
-            Ts = _interp_pose(start, Tf, s / steps)
+    from ._designs import ik_designs, single_design  # numba loads on the first kernel call
 
-        def extra(
-            state: TreeState, qs: np.ndarray, idx: np.ndarray, Ts: np.ndarray = Ts
-        ) -> tuple[np.ndarray, np.ndarray]:
-            return _site_error(tree, state, si, Ts[idx], w)
-
-        q, rc, _, it = solve_closure(mech, q, free, extra)
-        iters += it
-    st = kinematics(tree, q)
-    e, _ = _site_error(tree, st, si, Tf, w)
-    pose_err = np.max(np.abs(e), axis=-1)
-    tol = CONVERGED_RTOL * tree.length
-    conv = ok & (rc <= tol) & (pose_err <= tol)
-    q = np.where(ok[:, None], q, np.nan)
+    # the compiled inverse kinematics of the design-batched drivers, on this one design
+    q, conv, rc, pose_err, iters = ik_designs(
+        single_design(mech, site), np.zeros(Tf.shape[0], dtype=np.int64), Tf, q, w, steps
+    )
     return IKResult(
         q=q.reshape(*batch, mech.nq),
         q_act=q[:, tree.act_qadr].reshape(*batch, len(mech.actuated)),
-        residual=np.where(ok, rc, np.nan).reshape(batch),
-        pose_error=np.where(ok, pose_err, np.nan).reshape(batch),
+        residual=rc.reshape(batch),
+        pose_error=pose_err.reshape(batch),
         converged=conv.reshape(batch),
         iterations=iters.reshape(batch),
     )

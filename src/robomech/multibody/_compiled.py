@@ -274,8 +274,9 @@ def integrate(q, dv, jtype, jqadr, jdadr, out):  # pragma: no cover
 @_nj
 def site_rows(T, S, A, sb, Tsite, tgt, w, L, row, K, r, with_jac):  # pragma: no cover
     """Rows ``row:row + 6`` of the weighted pose error ``w * [L rot; pos]`` of the site (body ``sb``,
-    pose ``Tsite`` in it) against the world pose ``tgt (4, 4)``, and their matrix (``_assembly._site_error``):
-    ``rot = L/2 sum_c (R_t e_c) x (R_s e_c)``, ``pos = p_s - p_t``."""
+    pose ``Tsite`` in it) against the world pose ``tgt (4, 4)``, and their matrix
+    (``site_error`` of tests/multibody/_reference.py): ``rot = L/2 sum_c (R_t e_c) x (R_s e_c)``,
+    ``pos = p_s - p_t``."""
     nv = S.shape[0]
     for i in range(6):
         r[row + i] = 0.0
@@ -1228,27 +1229,34 @@ def inv_dyn_one(model, q: np.ndarray, qd_a: np.ndarray, qdd_a: np.ndarray, gravi
 
 
 def compiled_fk(
-    mech, q: np.ndarray, free: np.ndarray
+    mech, q: np.ndarray, free: np.ndarray, max_iter: int = opt.MAX_ITER
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The closure solve on ``q (N, nq)`` over the velocity coordinates ``free``: (q, rc, iterations,
     total residual ``sqrt(sum r^2)``), ``rc`` the largest closure row (m)."""
     model = compile_model(mech)
-    t = model.tables
     tree = model.tree
-    Q = np.array(q, dtype=np.float64, order="C")
-    N = Q.shape[0]
-    rc, it, cost = np.empty(N), np.zeros(N, dtype=np.int64), np.empty(N)
     key = ("fk_wstep", free.tobytes())
     wstep = model.cache.get(key)
     if wstep is None:
         wstep = model.cache[key] = np.where(tree.dof_translational, 1.0 / tree.length, 1.0)[free].astype(
             float
         )
+    return closure_solve(model.tables, q, free, wstep, max_iter)
+
+
+def closure_solve(
+    t, q: np.ndarray, free: np.ndarray, wstep: np.ndarray, max_iter: int = opt.MAX_ITER
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`compiled_fk` on the packed tables ``t`` (``wstep (nf,)``: 1 / L for a translation of
+    ``free``, 1 for a rotation), for the compile step that assembles a reference before its model exists."""
+    Q = np.array(q, dtype=np.float64, order="C")
+    N = Q.shape[0]
+    rc, it, cost = np.empty(N), np.zeros(N, dtype=np.int64), np.empty(N)
     args = (
         np.ascontiguousarray(free, dtype=np.int64),
-        wstep,
+        writable(wstep),
         t,
-        opt.MAX_ITER,
+        int(max_iter),
         (opt.STOP_RTOL * t.L) ** 2,
         opt.MU_START,
         opt.MU_MIN,

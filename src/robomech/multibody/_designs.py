@@ -38,6 +38,7 @@ __all__ = [
     "design_batch",
     "group_designs",
     "ik_designs",
+    "single_design",
     "site_measures_designs",
     "site_poses_designs",
 ]
@@ -171,6 +172,17 @@ def design_batch(mechs: Sequence[Any], site: str) -> DesignBatch:
         rank_K=int(m0.rank_K),
         locked_dof=int(m0.locked_dof),
     )
+
+
+def single_design(mech: Any, site: str) -> DesignBatch:
+    """:func:`design_batch` of the one design ``mech`` (kept with its compiled model: the public
+    inverse kinematics runs the design-batched driver with every sample on design 0)."""
+    cache = compile_model(mech).cache
+    key = ("design_batch", site)
+    hit = cache.get(key)
+    if hit is None:
+        hit = cache[key] = design_batch([mech], site)
+    return hit
 
 
 def group_designs(mechs: Sequence[Any], site: str) -> list[tuple[np.ndarray, DesignBatch]]:

@@ -49,7 +49,7 @@ import numpy as np
 from robomech._batching import failed_rows, on_rows
 from robomech._validation import MAX_MAGNITUDE, as_array, broadcast_batch, check_bool
 
-from ._assembly import check_mechanism, check_q, solve_closure
+from ._assembly import check_mechanism, check_q
 from ._compile import Bodies, compile_model
 from ._constraints import jacobian
 from ._model import Mechanism
@@ -1542,7 +1542,9 @@ def _project(mech, q, qd):
     """Back onto the manifold: positions by the closure Newton iteration (all coordinates), velocities
     onto ``null(K)`` (minimum-norm correction)."""
     tree = mech.tree
-    q, rc, _, _ = solve_closure(mech, q, np.arange(tree.nv))
+    from ._compiled import compiled_fk  # numba loads on the first kernel call, not at import
+
+    q, rc, _, _ = compiled_fk(mech, q, np.arange(tree.nv))
     st = kinematics(tree, q)
     K = jacobian(mech.constraints, tree, st, q)
     if K.shape[1]:

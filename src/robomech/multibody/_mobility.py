@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike
 
 from robomech.analysis import mobility as screw_mobility
 
-from ._assembly import check_mechanism, check_q, solve_closure
+from ._assembly import check_mechanism, check_q
 from ._compile import _rank, instantaneous_mobility
 from ._constraints import jacobian
 from ._model import Mechanism
@@ -244,7 +244,9 @@ def mobility(mech: Mechanism, q: ArrayLike | None = None, *, platform: str | Non
         from ._tree import integrate
 
         qn = integrate(tree, np.repeat(q, steps.shape[0], axis=0), steps)
-        qn, _rc, _, _ = solve_closure(mech, qn, np.arange(nv))
+        from ._compiled import compiled_fk  # numba loads on the first kernel call, not at import
+
+        qn, _rc, _, _ = compiled_fk(mech, qn, np.arange(nv))
         Kn = _scaled_K(mech, qn)[0]  # one batched evaluation for every neighbour
         nearby = [_rank(Kn[k], kmax) for k in range(Kn.shape[0])]
     singular = any(r != rank for r in nearby)

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from ._assembly import CONVERGED_RTOL, floating_base_dofs, solve_closure
+from ._assembly import CONVERGED_RTOL, floating_base_dofs
 from ._constraints import residual
 from ._tree import integrate, kinematics
 
@@ -46,9 +46,9 @@ def assembled_reference(mech, tree, cs) -> np.ndarray:
     r0 = float(np.max(np.abs(residual(cs, tree, kinematics(tree, q0[None]), q0[None]))))
     if r0 <= tol:
         return q0
-    # the compiled model is being built: the assembly runs on the tree and rows given here (the numpy
-    # iteration of solve_closure reads only .tree and .constraints; floating_base_dofs .closures)
-    view: Any = SimpleNamespace(tree=tree, constraints=cs, closures=mech.closures)
+    # the compiled model is being built: the assembly kernel runs on the tables of the tree and rows
+    # given here (floating_base_dofs reads only .tree and .closures)
+    view: Any = SimpleNamespace(tree=tree, closures=mech.closures)
     free = np.setdiff1d(np.arange(tree.nv), floating_base_dofs(view))
     # the pose itself and a few fixed perturbations of it: a sketch typed with every link along one axis
     # is a singular start (the closure's gradient vanishes there), as a CAD solver also perturbs it
@@ -57,7 +57,11 @@ def assembled_reference(mech, tree, cs) -> np.ndarray:
     w = np.where(tree.dof_translational, tree.length, 1.0)[free]
     dv[1:, free] = PERTURBATION * w * rng.uniform(-1.0, 1.0, (START_PERTURBATIONS, len(free)))
     starts = integrate(tree, np.repeat(q0[None], 1 + START_PERTURBATIONS, axis=0), dv)
-    q, rc, _, _ = solve_closure(view, starts, free, max_iter=ASSEMBLY_MAX_ITER)
+    from ._compile import _tables
+    from ._compiled import closure_solve  # numba loads on the first kernel call, not at import
+
+    wstep = np.where(tree.dof_translational, 1.0 / tree.length, 1.0)[free]
+    q, rc, _, _ = closure_solve(_tables(tree, cs), starts, free, wstep, ASSEMBLY_MAX_ITER)
     ok = rc <= tol
     if not ok.any():
         best = int(np.argmin(rc))
