@@ -48,19 +48,7 @@ def studies():
     sys.path.insert(0, str(MODELS))
     import delta
 
-    dl = model_study(
-        load_model(f"{MODELS / 'delta.py'}:build"),
-        [
-            Variable("arm", 0.2, 0.3, "m"),
-            Variable("forearm", 0.5, 0.7, "m"),
-            Variable("R", 0.15, 0.25, "m"),
-            Variable("r", 0.04, 0.06, "m"),
-        ],
-        site="tcp",
-        outputs="xyz",
-        metrics=("peak_force", "rms_force"),
-        trajectory=delta.pick_and_place(),
-    )
+    dl = delta.study()
     return {"five-bar 32x32": fb, "delta pick-and-place": dl}
 
 

@@ -3,7 +3,8 @@
 ``build(arm, forearm, R, r)``: arm length ``arm``, forearm (rod) length ``forearm``, base radius ``R`` and
 platform radius ``r`` (m); arm masses 0.2 kg, rods 0.02 kg each, platform with payload 0.3 kg.  The
 reference configuration has every arm 30 degrees below the horizontal.  ``pick_and_place()`` is a
-0.5 s pick-and-place path of the platform's ``tcp`` (21 samples)::
+0.5 s pick-and-place path of the platform's ``tcp`` (21 samples); ``study()`` the design study of peak and
+RMS actuator force along it over the four lengths (the tests and ``benchmarks/bench_model_study.py``)::
 
     robomech sweep --model examples/models/delta.py:build ... (Python: see docs/explore.md)
 """
@@ -100,3 +101,22 @@ def pick_and_place(z=-0.6, span=0.2, lift=0.05, duration=0.5, samples=21):
     s = (1 - np.cos(np.pi * t / duration)) / 2
     pts = np.stack([-span / 2 + span * s, np.zeros_like(s), z + lift * np.sin(np.pi * s)], -1)
     return t, pts
+
+
+def study():
+    """Peak and RMS actuator force along ``pick_and_place()`` over arm, forearm, R and r (m)."""
+    from robomech.explore import Variable, load_model, model_study
+
+    return model_study(
+        load_model(f"{__file__}:build"),
+        [
+            Variable("arm", 0.2, 0.3, "m"),
+            Variable("forearm", 0.5, 0.7, "m"),
+            Variable("R", 0.15, 0.25, "m"),
+            Variable("r", 0.04, 0.06, "m"),
+        ],
+        site="tcp",
+        outputs="xyz",
+        metrics=("peak_force", "rms_force"),
+        trajectory=pick_and_place(),
+    )

@@ -425,19 +425,7 @@ def test_delta_designs_in_one_batch_equal_each_design_alone():
     sys.path.insert(0, str(DELTA.parent))
     import delta
 
-    st = model_study(
-        load_model(f"{DELTA}:build"),
-        [
-            Variable("arm", 0.2, 0.3, "m"),
-            Variable("forearm", 0.5, 0.7, "m"),
-            Variable("R", 0.15, 0.25, "m"),
-            Variable("r", 0.04, 0.06, "m"),
-        ],
-        site="tcp",
-        outputs="xyz",
-        metrics=("peak_force", "rms_force"),
-        trajectory=delta.pick_and_place(),
-    )
+    st = delta.study()
     rows = np.array([[0.25, 0.6, 0.2, 0.05], [0.22, 0.65, 0.18, 0.045], [0.28, 0.55, 0.22, 0.06]])
     batched = st.evaluate_rows(rows, None)
     assert batched["design_ok"].all() and np.all(np.isfinite(batched["peak_force"]))
