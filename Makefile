@@ -35,9 +35,11 @@ install-browser:
 	@test -x $(CHROMIUM) || { $(SUDO) apt-get update -qq && $(SUDO) apt-get install -y -qq chromium-headless-shell; } \
 	  || echo "install-browser: could not install chromium-headless-shell; the browser tests will be skipped"
 
+# verify first: it records the engine results the studies also show (OUT/verification-results/),
+# which reproduce then reads instead of computing them again; a failed check still reproduces, and
+# make fails with verify's status.
 run: install
-	$(BIN)/robomech reproduce --out $(OUT)
-	$(BIN)/robomech verify --out $(OUT)
+	$(BIN)/robomech verify --out $(OUT); status=$$?; $(BIN)/robomech reproduce --out $(OUT) && exit $$status
 
 # The fast tier (the README's second command): lint and every test not marked `slow` (a few minutes).
 test: install install-browser

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 
 from robomech._progress import show_bars
@@ -40,7 +41,8 @@ def _add_arguments(p: argparse.ArgumentParser) -> None:
         "--out",
         default=None,
         metavar="DIR",
-        help="also save the checks to DIR/verification.json (the report index shows them)",
+        help="also save the checks to DIR/verification.json (the report index shows them) and the results "
+        "a study also shows to DIR/verification-results/ (robomech reproduce --out DIR reads them)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     p.add_argument(
@@ -117,6 +119,7 @@ def _run(args: argparse.Namespace) -> int:
     from robomech._registry import skip_reason
     from robomech.verify import VerificationReport, available_verifications, dumps_json
     from robomech.verify._generic import run_generic, split_targets
+    from robomech.verify._store import recording
 
     out = output_folder(args.out) if args.out is not None else None
     available = available_verifications()
@@ -157,17 +160,19 @@ def _run(args: argparse.Namespace) -> int:
         report.checks.extend(run_generic(generic, **sim))
     except ValueError as exc:
         raise CliError(str(exc)) from exc
-    for n in names or ([] if generic else list(available)):
-        v = available[n]
-        why = skip_reason(v.requires)
-        if why:
-            report.skipped.append((n, why))
+    # with --out, the results a study also shows are recorded for `robomech reproduce --out` to read
+    with recording(out) if out is not None else contextlib.nullcontext():
+        for n in names or ([] if generic else list(available)):
+            v = available[n]
+            why = skip_reason(v.requires)
+            if why:
+                report.skipped.append((n, why))
+                if not args.quiet:
+                    print(f"verify: {n} skipped — {why}", file=sys.stderr, flush=True)
+                continue
             if not args.quiet:
-                print(f"verify: {n} skipped — {why}", file=sys.stderr, flush=True)
-            continue
-        if not args.quiet:
-            print(f"verify: {n} — {v.title} ...", file=sys.stderr, flush=True)
-        report.checks.extend(v.run())
+                print(f"verify: {n} — {v.title} ...", file=sys.stderr, flush=True)
+            report.checks.extend(v.run())
     if out is not None:
         from robomech.studies import available_studies, write_index
         from robomech.studies._report import write_verification

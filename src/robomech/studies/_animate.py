@@ -5,7 +5,8 @@ with matplotlib's movie writers), so any mechanism with a description animates t
 module adds what a report needs:
 
 * :func:`assemble_path` assembles a described mechanism along a sequence of actuated coordinates
-  as following it frame by frame does (one assembly branch), in two batched solves;
+  as following it frame by frame does (one assembly branch): the input checks around the one
+  branch-following assembly, :func:`robomech.verify._mujoco.assemble_along`;
 * :func:`animate` is :func:`robomech.multibody.animate` (a GIF: every body drawn as its wireframe
   star, one colour per chain from the base; ground attachments, loop closures, one site's path);
 * :func:`animation_figure` does both for a study and returns the report's :class:`Figure` with the
@@ -24,16 +25,11 @@ from numpy.typing import ArrayLike, NDArray
 from robomech import multibody as mb
 from robomech._validation import as_array
 from robomech.multibody._animate import animate, frame_ms
+from robomech.verify._mujoco import CONTINUATION_STEPS, assemble_along
 
 from ._core import Figure
 
-__all__ = ["Animation", "animate", "animation_figure", "assemble_path", "frame_ms"]
-
-# Stages of the continuation from the reference configuration to each frame (assemble_path).
-CONTINUATION_STEPS = 4
-# Two assemblies of one frame on the same branch agree to the solver's tolerance (~1e-12 in every
-# coordinate); distinct branches differ by O(0.1-1) rad or m.  1e-6 separates the two with margin.
-BRANCH_TOL = 1e-6
+__all__ = ["CONTINUATION_STEPS", "Animation", "animate", "animation_figure", "assemble_path", "frame_ms"]
 
 
 @dataclass(frozen=True)
@@ -77,37 +73,17 @@ def _check_mech(mech: object) -> mb.Mechanism:
 def assemble_path(mech: mb.Mechanism, q_act: ArrayLike) -> mb.FKResult:
     """Assemble ``mech`` at each row of ``q_act (nt, n_act)`` on the branch of its reference pose.
 
-    All frames are solved in one batch from ``mech.q0`` (continuation in ``CONTINUATION_STEPS``
-    stages), then each frame is solved again from the frame before it (a second batch); where that
-    continuation from the previous frame lands elsewhere (more than ``BRANCH_TOL``), the batch jumped
-    branch and the frames from there on are solved one by one, each from the previous solution.  So
-    the returned sequence is what following the path frame by frame gives, at the cost of two
-    batched solves when the path stays on one branch.  Returns the stacked
-    :class:`robomech.multibody.FKResult` (``q (nt, nq)``, ``residual``, ``converged``, ``iterations``).
+    The input checks of a report's animation around
+    :func:`robomech.verify._mujoco.assemble_along` (the one branch-following assembly: what following
+    the path frame by frame gives, at the cost of two batched solves when the path stays on one
+    branch).  Returns the stacked :class:`robomech.multibody.FKResult` (``q (nt, nq)``, ``residual``,
+    ``converged``, ``iterations``, ``mode_changed``).
     """
     mech = _check_mech(mech)
     qa = as_array(q_act, "q_act", (len(mech.actuated),))
     if qa.ndim != 2 or qa.shape[0] < 1:
         raise ValueError(f"Expected q_act to have shape (nt, {len(mech.actuated)}), got {qa.shape}.")
-    fk = mb.forward_kinematics(mech, qa, steps=CONTINUATION_STEPS)
-    q, res, conv, it, mc = (
-        np.array(a) for a in (fk.q, fk.residual, fk.converged, fk.iterations, fk.mode_changed)
-    )
-    if qa.shape[0] > 1:
-        again = mb.forward_kinematics(mech, qa[1:], q[:-1])
-        off = np.max(np.abs(again.q - q[1:]), axis=-1) > BRANCH_TOL
-        off |= ~again.converged
-        if np.any(off):
-            for k in range(int(np.argmax(off)) + 1, qa.shape[0]):  # frame by frame from the first jump
-                r = mb.forward_kinematics(mech, qa[k], q[k - 1])
-                q[k], res[k], conv[k], it[k], mc[k] = (
-                    r.q,
-                    r.residual,
-                    r.converged,
-                    r.iterations,
-                    r.mode_changed,
-                )
-    return mb.FKResult(q=q, residual=res, converged=conv, iterations=it, mode_changed=mc)
+    return assemble_along(mech, qa)
 
 
 def animation_figure(

@@ -24,6 +24,7 @@ from typing import Any
 
 from robomech._validation import check_params, check_real
 from robomech.verify._core import dumps_json
+from robomech.verify._store import reading
 
 from ._core import Printed, Progress, Study, StudyResult, Table
 
@@ -342,7 +343,9 @@ def publish_study(
     """Run ``study`` in a temporary folder under ``out_root`` and move it to ``out_root/<name>``.
 
     The folder of a study is therefore either the complete previous run or the complete new one,
-    never a mix, also when the run is interrupted (the temporary folder is removed).
+    never a mix, also when the run is interrupted (the temporary folder is removed).  The study reads
+    the verification results that ``robomech verify --out out_root`` stored, where they were computed
+    by the same code with the same parameters (:mod:`robomech.verify._store`), and computes the rest.
 
     Returns
     -------
@@ -357,7 +360,8 @@ def publish_study(
     old = None
     try:
         t0 = clock()
-        result = study.run(tmp, progress)
+        with reading(out_root):
+            result = study.run(tmp, progress)
         seconds = clock() - t0
         write_study_report(result, tmp, seconds=seconds)
         if final.exists():

@@ -289,30 +289,26 @@ def hysteresis(progress: Progress) -> Hysteresis:
     return Hysteresis(q1, labels, bends, tensions, rows, n_steps, seconds, all_valid)
 
 
+REFERENCE_COMPENSATION_DRIVES = (
+    ("rigid chord lengths (before)", "chord"),
+    ("paper: q~ = q + δ (eq. 37)", "paper"),
+    ("disk-wise model (method='disk')", "disk"),
+)
+
+
 def reference_compensation(progress: Progress) -> tuple[list[list], dict[str, list[float]]]:
     """Before/after compensation measured on the disk-resolved reference (not on the library's own
-    simulate, whose compensated error is 0 by construction): table rows and tip errors (m) per bend."""
-    from robomech.verify._disk_rod import solve_disk_robot
-
-    progress.step("compensation measured on the disk-resolved reference (drive mode, 6 solves)")
+    simulate, whose compensated error is 0 by construction): table rows and tip errors (m) per bend
+    (``robomech.verify.continuum.compensation_on_reference``; the 90° chord and disk cases are the
+    verification's, read from its results when ``robomech verify --out`` stored them)."""
+    progress.step("compensation measured on the disk-resolved reference (drive mode, 3 drives x 2 bends)")
     robot = C.ContinuumRobot.paper()
-    ref = V.disk_robot_for(robot)
-    direction = np.array([1.0, -1.0, -1.0])
     rows, data = [], {}
     for bend in REFERENCE_COMPENSATION_BENDS_DEG:
-        psi = np.array([np.radians(bend), 0.0])
-        tip = C.tip_position(robot, psi)
-        drives = {
-            "rigid chord lengths (before)": C.theoretical_drive(robot, psi, "chord"),
-            "paper: q~ = q + δ (eq. 37)": C.compensated_drive(robot, psi, direction).q_compensated,
-            "disk-wise model (method='disk')": C.compensated_drive(
-                robot, psi, direction, method="disk"
-            ).q_compensated,
-        }
-        sol = solve_disk_robot(ref, drive=np.stack(list(drives.values())), direction=direction)
-        err = np.linalg.norm(sol.T_tip[:, :3, 3] - tip, axis=-1)
-        ok = sol.converged & sol.taut
-        for i, name in enumerate(drives):
+        sols = [V.compensation_on_reference(robot, bend, drive) for _, drive in REFERENCE_COMPENSATION_DRIVES]
+        err = np.array([s["tip_error"] for s in sols])
+        ok = [bool(s["converged"] and s["taut"]) for s in sols]
+        for i, (name, _) in enumerate(REFERENCE_COMPENSATION_DRIVES):
             cell = f"{1e3 * err[i]:.2f}" + ("" if ok[i] else " (slack or not converged)")
             factor = f"{err[0] / err[i]:.2f}" if ok[0] and ok[i] else "—"
             rows.append([f"{bend:g}°", name, cell, factor])

@@ -20,6 +20,7 @@ MuJoCo is imported on first use (the optional ``verify`` extra).
 
 from __future__ import annotations
 
+import hashlib
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any, TypeVar
@@ -42,6 +43,7 @@ __all__ = [
     "assemble_along",
     "engine_model",
     "engine_options",
+    "model_digest",
     "null_space",
 ]
 
@@ -216,11 +218,17 @@ class Engine:
 
     def energies(self, qpos: Array, qvel: Array, **index: Any) -> tuple[float, float]:
         """Potential and kinetic energy ``(U, T)`` of a state (``mj_energyPos``, ``mj_energyVel``; the
-        energy flag is switched on); ``index`` as in :meth:`set_state`."""
-        self.model.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
-        d = self.set_state(qpos, qvel, **index)
-        mujoco.mj_energyPos(self.model, d)
-        mujoco.mj_energyVel(self.model, d)
+        energy flag is switched on for the call and restored: the model is left as it was, so that its
+        bytes, :func:`model_digest`, do not depend on the checks run before); ``index`` as in
+        :meth:`set_state`."""
+        flags = self.model.opt.enableflags
+        self.model.opt.enableflags = flags | int(mujoco.mjtEnableBit.mjENBL_ENERGY)
+        try:
+            d = self.set_state(qpos, qvel, **index)
+            mujoco.mj_energyPos(self.model, d)
+            mujoco.mj_energyVel(self.model, d)
+        finally:
+            self.model.opt.enableflags = flags
         return float(d.energy[0]), float(d.energy[1])
 
     def simulate(
@@ -242,6 +250,13 @@ class Engine:
                 mujoco.mj_step(m, d)
             out.append(read(d))
         return out
+
+
+def model_digest(model: mujoco.MjModel) -> str:
+    """SHA-256 (hex) of a compiled engine model's bytes (``mj_saveModel``): equal models, equal digests."""
+    buf = np.zeros(mujoco.mj_sizeModel(model), dtype=np.uint8)
+    mujoco.mj_saveModel(model, None, buf)
+    return hashlib.sha256(buf.tobytes()).hexdigest()
 
 
 def assemble_along(mech: Any, q_act: Array) -> Any:

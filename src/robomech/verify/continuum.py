@@ -20,6 +20,7 @@ import math
 import numpy as np
 
 from robomech._progress import stages
+from robomech._validation import check_choice, check_params, check_real
 from robomech.mechanisms.continuum import (
     ContinuumRobot,
     cable_elongation,
@@ -40,6 +41,7 @@ from ._cosserat import (
     solve_static,
 )
 from ._disk_rod import DiskRobot, solve_disk_robot, straight_buckling_tension
+from ._store import computed_once
 
 __all__ = ["VERIFICATION"]
 
@@ -386,8 +388,44 @@ COMPENSATION_RATIO = Tolerance(
 )
 
 
+COMPENSATION_DRIVES = ("chord", "paper", "disk")
+"""Drives of :func:`compensation_on_reference`: the rigid chord lengths (before compensation), the
+paper's q + δ (eq. 37) and the disk-wise model's compensation (``method='disk'``)."""
+
+
+def compensation_on_reference(robot: ContinuumRobot, bend_deg: float, drive: str) -> dict[str, float | bool]:
+    """Tip error of a drive on the disk-resolved reference (drive mode), at θ = ``bend_deg``, β = 0.
+
+    ``drive`` one of :data:`COMPENSATION_DRIVES`, computed for that pose by the library with cable 1
+    pulled in and cables 2, 3 paid out (``DISK_CHECK_DIRECTION``); the reference robot
+    (:func:`disk_robot_for`) is driven by it and its tip compared with the commanded constant-curvature
+    tip.  Returns ``tip_error`` (m), ``converged`` and ``taut``.  The ``continuum`` study shows these
+    too: computed once per output folder (:mod:`robomech.verify._store`).
+    """
+    from robomech.mechanisms.continuum import compensated_drive, theoretical_drive, tip_position
+
+    check_params(robot, ContinuumRobot, "robot")
+    bend_deg = check_real(bend_deg, "bend_deg")
+    drive = str(check_choice(drive, "drive", COMPENSATION_DRIVES))
+
+    def compute() -> dict[str, float | bool]:
+        psi, d = np.array([math.radians(bend_deg), 0.0]), DISK_CHECK_DIRECTION
+        if drive == "chord":
+            q = theoretical_drive(robot, psi, "chord")
+        else:
+            q = compensated_drive(robot, psi, d, method="disk" if drive == "disk" else "paper").q_compensated
+        sol = solve_disk_robot(disk_robot_for(robot), drive=q[None], direction=d)
+        return {
+            "tip_error": float(np.linalg.norm(sol.T_tip[0, :3, 3] - tip_position(robot, psi))),
+            "converged": bool(sol.converged[0]),
+            "taut": bool(sol.taut[0]),
+        }
+
+    return computed_once(f"continuum.compensation-{drive}-{bend_deg:g}deg", (robot, bend_deg, drive), compute)
+
+
 def _diskwise_checks(robot: ContinuumRobot) -> list[Check]:
-    from robomech.mechanisms.continuum import compensated_drive, disk_equilibrium, theoretical_drive
+    from robomech.mechanisms.continuum import disk_equilibrium
 
     L = robot.segment_length * robot.n_segments
     psi, d = DISK_CHECK_PSI, DISK_CHECK_DIRECTION[None]
@@ -397,13 +435,9 @@ def _diskwise_checks(robot: ContinuumRobot) -> list[Check]:
     ok = bool(lib.converged.all() and ref.converged.all())
     err = float(np.max(np.linalg.norm(lib.tip - ref.T_tip[:, :3, 3], axis=-1))) / L if ok else math.inf
     # compensation measured on the reference (drive mode): before = rigid chord drive, after = disk method
-    psi_c = np.array([[math.radians(90.0), 0.0]])
-    tip = forward_kinematics(robot, psi_c)[:, -1, :3, 3]
-    q0 = theoretical_drive(robot, psi_c, "chord")
-    q1 = compensated_drive(robot, psi_c, d, method="disk").q_compensated
-    sol = solve_disk_robot(disk_robot_for(robot), drive=np.concatenate([q0, q1]), direction=d[0])
-    e = np.linalg.norm(sol.T_tip[:, :3, 3] - tip[0], axis=-1)
-    good = bool(sol.converged.all() and sol.taut.all())
+    before, after = (compensation_on_reference(robot, 90.0, k) for k in ("chord", "disk"))
+    e = [before["tip_error"], after["tip_error"]]
+    good = all(r["converged"] and r["taut"] for r in (before, after))
     ratio = float(e[1] / e[0]) if good else math.inf
     return [
         Check(

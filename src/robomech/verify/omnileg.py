@@ -35,11 +35,12 @@ from numpy.typing import ArrayLike, NDArray
 
 import robomech.mechanisms.omnileg as ol
 from robomech import multibody as mb
-from robomech._validation import as_array, broadcast_batch, check_params
+from robomech._validation import as_array, broadcast_batch, check_params, check_positive
 from robomech.trajectory import Profile
 
 from ._core import Check, Tolerance, Verification, optional_module
-from ._mujoco import Engine, engine_options
+from ._mujoco import Engine, engine_options, model_digest
+from ._store import computed_once
 
 if TYPE_CHECKING:
     import mujoco
@@ -261,7 +262,22 @@ def torque_error(
 
 
 def forward_simulation(leg: ol.OmniLeg, em: EngineModel, duration: float = 2.0) -> dict[str, Array | float]:
-    """Drive the engine with the analytic torques of eq. (52) (no foot force) and record the drift."""
+    """Drive the engine with the analytic torques of eq. (52) (no foot force) and record the drift.
+
+    Returns ``t (n,)`` s, the actuated joints ``q_sim`` and ``q_ref (n, 3)`` rad, ``drift`` (rad) and
+    ``closure`` (the largest equality violation).  The study draws it too: computed once per output
+    folder (:mod:`robomech.verify._store`; the key holds ``leg``, ``duration`` and the engine model's
+    bytes).
+    """
+    check_params(leg, ol.OmniLeg, "leg")
+    check_params(em, EngineModel, "em")
+    duration = check_positive(duration, "duration")
+    params = (leg, duration, model_digest(em.model))
+    return computed_once("omnileg.forward_simulation", params, lambda: _simulate(leg, em, duration))
+
+
+def _simulate(leg: ol.OmniLeg, em: EngineModel, duration: float) -> dict[str, Array | float]:
+    """:func:`forward_simulation`, computed."""
     m, d = em.model, em.data
     n_steps = round(duration / m.opt.timestep)
     t = np.arange(n_steps + 1) * m.opt.timestep

@@ -42,6 +42,7 @@ from robomech.spatial import exp_so3
 
 from ._core import Check, Tolerance, Verification, optional_module
 from ._mujoco import Engine, engine_options
+from ._store import checks_from_arrays, checks_to_arrays, computed_once
 
 if TYPE_CHECKING:
     import mujoco
@@ -317,6 +318,20 @@ def run(
     an = th if analytic is None else analytic
     if omega_dot_model is not None and not callable(omega_dot_model):
         raise ValueError(f"Expected omega_dot_model to be a callable, got {type(omega_dot_model).__name__}.")
+    if omega_dot_model is not None:  # a callable has no key: computed, never stored
+        return _checks(th, omega_dot_model, an)
+    # the study shows these checks: computed once per output folder (robomech.verify._store)
+    return checks_from_arrays(
+        computed_once("vectored-thrust.checks", (th, an), lambda: checks_to_arrays(_checks(th, None, an)))
+    )
+
+
+def _checks(
+    th: vt.VectoredThruster,
+    omega_dot_model: Callable[[vt.VectoredThruster, Array, Array, Array], Array] | None,
+    an: vt.VectoredThruster,
+) -> list[Check]:
+    """The checks of :func:`run`, computed."""
     t = np.linspace(0.0, 2 * np.pi, N_SAMPLES)
     q, qd, qdd = table1_trajectory(t)
     wd_model = None if omega_dot_model is None else np.asarray(omega_dot_model(an, q, qd, qdd), dtype=float)
