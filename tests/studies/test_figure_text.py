@@ -1,6 +1,6 @@
 """The text of the study figures: titles say what is shown (the paper's figure numbers belong in
 the captions), every 3-D panel labels its z axis, a legend names each source once (not "MuJoCo" per
-curve)."""
+curve).  The same runs check that each study plans its steps (the progress bar's n/N)."""
 
 import importlib.util
 import re
@@ -14,6 +14,26 @@ from robomech.studies import Progress, get_study
 FAST = ("demo", *(pytest.param(name, marks=pytest.mark.slow) for name in (
     "vectored-thrust", "spherical-leg", "omnileg", "continuum", "skid-steer")))  # fmt: skip
 FIGURE_NUMBER = re.compile(r"\bFig(ure)?\.? ?\d")
+
+
+class _CountingProgress(Progress):
+    """Counts the steps taken against the plan (steps of ``iter`` without a bar are not counted)."""
+
+    def __init__(self) -> None:
+        super().__init__(enabled=False)
+        self.planned: int | None = None
+        self.taken = 0
+
+    def plan(self, names) -> None:
+        super().plan(names)
+        self.planned = len(list(names))
+
+    def step(self, message: str) -> None:
+        super().step(message)
+        self.taken += 1
+
+    def iter(self, items, label, every=None):
+        yield from items
 
 
 def _check_figure(fig) -> list[str]:
@@ -58,5 +78,7 @@ def test_figure_titles_axes_and_legends(name, tmp_path, monkeypatch):
         monkeypatch.setattr(module, "animation_figure", checking_animation)
     if requires := [m for m in study.requires if not importlib.util.find_spec(m)]:
         pytest.skip(f"{name} needs {requires}")
-    study.run(tmp_path, Progress(enabled=False))
+    progress = _CountingProgress()
+    study.run(tmp_path, progress)
     assert not problems, "\n".join(problems)
+    assert progress.planned == progress.taken, "the study's plan does not count its steps"

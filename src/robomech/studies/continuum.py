@@ -709,6 +709,18 @@ def notes(s5: Section5, printed_tensions: Any, data: dict) -> list[str]:
 
 
 def run(out_dir: Path, progress: Progress) -> StudyResult:
+    progress.plan(
+        [
+            "capstan",
+            "identification",
+            "planar bending",
+            "spatial circle",
+            "statics",
+            "Cosserat rod",
+            "hysteresis",
+            "compensation on the disk reference",
+        ]
+    )
     progress.step("Figs. 9 and 6: improved capstan equation")
     capstan, loss = capstan_curves(), fig6_loss()
     truth = C.ContinuumRobot.paper()

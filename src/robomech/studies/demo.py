@@ -164,6 +164,7 @@ def dexterity_figure(q3: np.ndarray, dexterity: np.ndarray, out_dir: Path) -> Fi
 
 
 def run(out_dir: Path, progress: Progress) -> StudyResult:
+    progress.plan(["mobility", "UR5"])
     progress.step("mobility of textbook mechanisms")
     mob = textbook_mobility()
     progress.step("UR5 Jacobian and dexterity sweep")

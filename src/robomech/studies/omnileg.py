@@ -895,6 +895,17 @@ def report_data(
 
 def run(out_dir: Path, progress: Progress) -> StudyResult:
     leg = ol.OmniLeg.paper()
+    progress.plan(
+        [
+            "thigh closure",
+            "Figs. 9, 10",
+            "Fig. 11",
+            "Fig. 11 against MuJoCo",
+            "Fig. 19",
+            "workspace",
+            "animation",
+        ]
+    )
     progress.step("thigh closure (product of exponentials) vs eq. (11)")
     closure = thigh_closure(leg)
     progress.step("Figs. 9, 10: inverse kinematics along eq. (51), forward kinematics along eq. (52)")

@@ -601,6 +601,17 @@ def summary(comp: Any, exact_error: float, n_samples: int) -> str:
 
 def run(out_dir: Path, progress: Progress) -> StudyResult:
     robot = ExplorationRobot.paper()
+    progress.plan(
+        [
+            "ground truth",
+            "estimates",
+            "conditioning",
+            "throughput",
+            "contact physics",
+            "ICR identification",
+            "figures",
+        ]
+    )
     progress.step(f"ground truth: {DURATION:.0f} s at {RATE:.0f} Hz on uneven ground (independent model)")
     gt = simulate(robot, DURATION, RATE)
     rng = np.random.default_rng(2012)  # noise of the run, then of the throughput systems

@@ -705,6 +705,7 @@ def summary(data: dict) -> str:
 
 def run(out_dir: Path, progress: Progress) -> StudyResult:
     leg = sl.SphericalLeg.paper()
+    progress.plan(["Table 1", "MuJoCo overlays", "Figs. 3-5", "mechanism, workspace", "animation"])
     progress.step("Table 1 and forward-solution accuracy")
     solutions = table1_solutions(leg)
     engine = engine_overlays(leg, progress)

@@ -32,6 +32,7 @@ def run(out_dir: Path, progress: Progress) -> StudyResult:
         ),
     )
     summaries = {}
+    progress.plan(["LocalCluster", *(f"{name}: {what}" for name, *_ in DEMO for what in ("sweep", "chunks"))])
     progress.step(f"LocalCluster of {DEMO_WORKERS} worker processes on 127.0.0.1")
     with (
         local_cluster(DEMO_WORKERS) as cluster,  # the sweeps' own settings (explore.local_cluster)

@@ -720,6 +720,16 @@ def summary(ws: Workspace, tr: Trajectory, data: dict) -> str:
 
 def run(out_dir: Path, progress: Progress) -> StudyResult:
     th = vt.VectoredThruster.paper()
+    progress.plan(
+        [
+            "mobility, workspace",
+            "Table 1 trajectory",
+            "Section 3.3",
+            "singularity maps",
+            "MuJoCo checks",
+            "animation",
+        ]
+    )
     progress.step("mobility from the joint screws; workspace map over the input ranges")
     mob, ws = mobility(th), workspace(th)
     progress.step("Table 1 trajectory: angular velocity and acceleration, MuJoCo overlay")

@@ -169,7 +169,8 @@ def _save(path: Path, key: str, result: Mapping[str, Any]) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.tmp")
     with open(tmp, "wb") as f:  # a file object: savez would append .npz to a name
-        np.savez(f, **{_KEY: np.array(key)}, **{k: np.asarray(v) for k, v in result.items()})
+        arrays: dict[str, Any] = {_KEY: np.array(key), **{k: np.asarray(v) for k, v in result.items()}}
+        np.savez(f, **arrays)
     tmp.replace(path)  # readers see the old file or the whole new one
 
 
