@@ -28,6 +28,8 @@ import contextlib
 import dataclasses
 import hashlib
 import importlib.metadata
+import os
+import tempfile
 from collections.abc import Callable, Iterator, Mapping
 from contextvars import ContextVar
 from functools import lru_cache
@@ -167,11 +169,15 @@ def _load(path: Path, key: str) -> dict[str, Any] | None:
 
 def _save(path: Path, key: str, result: Mapping[str, Any]) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    with open(tmp, "wb") as f:  # a file object: savez would append .npz to a name
-        arrays: dict[str, Any] = {_KEY: np.array(key), **{k: np.asarray(v) for k, v in result.items()}}
-        np.savez(f, **arrays)
-    tmp.replace(path)  # readers see the old file or the whole new one
+    arrays: dict[str, Any] = {_KEY: np.array(key), **{k: np.asarray(v) for k, v in result.items()}}
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}-", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:  # a file object: savez would append .npz to a name
+            np.savez(f, **arrays)
+        os.replace(tmp, path)  # readers see the old file or the whole new one
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
 
 
 def computed_once(name: str, params: object, compute: Callable[[], Mapping[str, Any]]) -> dict[str, Any]:
