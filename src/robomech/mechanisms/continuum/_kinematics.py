@@ -1,10 +1,5 @@
-"""Constant-curvature kinematics: segment transforms, forward kinematics, cable lengths, Jacobians, IK.
-
-Coordinates: every segment i has psi_i = (theta_i, beta_i) (bend angle, bending-plane angle), stacked
-as ``psi (..., 2 n) = [theta_1, beta_1, theta_2, beta_2, ...]`` (paper 3, Section 1).  Cables are indexed
-``3 i + j`` (segment i, cable j); the drive length of a cable is its geometric length from the base
-plate to its termination disk.
-"""
+"""Constant-curvature kinematics (paper 3, Sec. 1, eqs. (1)-(6)): segment poses, cable lengths,
+Jacobians, IK.  Coordinates ``psi``, frames and cable indexing: ``docs/mechanisms/continuum.md``."""
 
 from __future__ import annotations
 
@@ -40,12 +35,9 @@ __all__ = [
 
 CableModel = Literal["arc", "chord"]
 
-# Samples per chunk of the segment kernels (poses, Jacobian columns, tip positions).  The ~20
-# temporaries of a chunk (128 KB each) stay in cache and are recycled by the allocator; whole-batch
-# temporaries (8 MB per 10^6 samples) are fresh pages every call, ~1 ms of page faults each (measured:
-# the 7 passes of spatial.sincos take 11 ms on 10^6 samples, 5 ms with recycled pages).  Measured on
-# 10^6 one-segment poses (FK / Jacobian / IK, ms): 2048: 46/44/45, 4096: 39/34/38, 8192: 34/30/36,
-# 16384: 32/28/32, 32768: 31/29/37 (~40 numpy calls per chunk: small chunks pay the call overhead).
+# Samples per chunk of the segment kernels: the ~20 temporaries of a chunk stay in cache and are recycled
+# (whole-batch ones are fresh pages, ~1 ms of page faults each).  Measured on 10^6 one-segment poses
+# (FK / Jacobian / IK, ms): 2048: 46/44/45, 8192: 34/30/36, 16384: 32/28/32, 32768: 31/29/37.
 CHUNK = 16384
 
 # IK: a tip position is reached when the residual is below 1e-10 m (0.1 nm: far below any physical
@@ -117,26 +109,6 @@ def _small_fix(t: np.ndarray, closed, series) -> np.ndarray:
     return out
 
 
-def _f_cos(t: np.ndarray) -> np.ndarray:
-    """(1 - cos t) / t."""
-    return _small_fix(t, lambda x: (1.0 - np.cos(x)) / x, _series_f_cos)
-
-
-def _f_sin(t: np.ndarray) -> np.ndarray:
-    """sin t / t."""
-    return _small_fix(t, lambda x: np.sin(x) / x, _series_f_sin)
-
-
-def _df_cos(t: np.ndarray) -> np.ndarray:
-    """d/dt (1 - cos t)/t = (t sin t + cos t - 1) / t^2 (paper 3, eq. (6))."""
-    return _small_fix(t, lambda x: (x * np.sin(x) + np.cos(x) - 1.0) / (x * x), _series_df_cos)
-
-
-def _df_sin(t: np.ndarray) -> np.ndarray:
-    """d/dt sin t / t = (t cos t - sin t) / t^2 (paper 3, eq. (6))."""
-    return _small_fix(t, lambda x: (x * np.cos(x) - np.sin(x)) / (x * x), _series_df_sin)
-
-
 def _half_angle(angle: np.ndarray, one_minus_cos: bool = True) -> tuple[np.ndarray, ...]:
     """``(sin, cos[, 1 - cos])`` of ``angle`` from ``t = tan(angle / 2)`` (the formulas of
     ``robomech.spatial.sincos``: numpy's float64 tan is vectorised, its sin and cos are not, ~10x
@@ -176,16 +148,15 @@ def _flat(a: np.ndarray, shape: tuple) -> np.ndarray:
     return np.broadcast_to(a, shape).reshape(-1)
 
 
-def _split(robot: ContinuumRobot, psi: object, name: str = "psi") -> tuple[np.ndarray, np.ndarray]:
+def _split(
+    robot: ContinuumRobot, psi: object, name: str = "psi", views: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(theta, beta)`` of ``psi``: contiguous copies (numpy's vectorised trigonometry is ~2x faster on
+    contiguous input), or strided ``views`` for the chunked kernels (which copy chunk by chunk)."""
     p = as_array(psi, name, (2 * robot.n_segments,))
-    # contiguous copies: numpy's vectorised trigonometry is ~2x faster on contiguous input
+    if views:
+        return p[..., 0::2], p[..., 1::2]
     return np.ascontiguousarray(p[..., 0::2]), np.ascontiguousarray(p[..., 1::2])
-
-
-def _split_views(robot: ContinuumRobot, psi: object) -> tuple[np.ndarray, np.ndarray]:
-    """Like ``_split`` but strided views, for the chunked kernels (which copy chunk by chunk)."""
-    p = as_array(psi, "psi", (2 * robot.n_segments,))
-    return p[..., 0::2], p[..., 1::2]
 
 
 # ---- one segment --------------------------------------------------------------------------------
@@ -241,22 +212,14 @@ def _segment_planes(theta: np.ndarray, beta: np.ndarray, length: np.ndarray | fl
 def segment_transform(theta: object, beta: object, length: object) -> np.ndarray:
     """Pose ``T (..., 4, 4)`` of a constant-curvature segment's end frame in its base frame.
 
-    ``theta`` bend angle (rad), ``beta`` bending-plane angle (rad), ``length`` arc length (m); all
-    broadcast.  Rotation ``Rz(beta) Ry(theta) Rz(-beta)``; exact and finite at ``theta = 0`` (series).
+    Rotation ``Rz(beta) Ry(theta) Rz(-beta)``; exact and finite at ``theta = 0`` (series).
 
     Parameters
     ----------
-    theta : array_like, shape (...)
-        Bend angle (rad).
-    beta : array_like, shape (...)
-        Bending-plane angle about the base z axis (rad).
+    theta, beta : array_like, shape (...)
+        Bend angle and bending-plane angle about the base z axis (rad).
     length : array_like, shape (...)
-        Arc length of the segment (m).
-
-    Returns
-    -------
-    ndarray, shape (..., 4, 4)
-        ``T`` of the segment's end frame in its base frame (m).
+        Arc length of the segment (m).  The three arguments broadcast.
 
     Examples
     --------
@@ -305,12 +268,8 @@ def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
     ----------
     robot : ContinuumRobot
     psi : array_like, shape (..., 2 n)
-        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
-
-    Returns
-    -------
-    ndarray, shape (..., n, 4, 4)
-        ``T_0i`` of each segment's end frame in the base frame (m).
+        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad); the
+        same argument in every function of the package.
 
     Examples
     --------
@@ -322,32 +281,13 @@ def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
     ((1, 4, 4), array([0.057296, 0.      , 0.057296]))
     """
     check_params(robot, ContinuumRobot, "robot")
-    theta, beta = _split_views(robot, psi)
+    theta, beta = _split(robot, psi, views=True)
     return _fk(robot, theta, beta)
 
 
 @carries_failed_rows({"psi": 1})
 def tip_position(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """Tip position ``(..., 3)`` in the base frame (m).
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        Bend and bending-plane angles of the segments (rad).
-
-    Returns
-    -------
-    ndarray, shape (..., 3)
-        Tip position in the base frame (m).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> cr.tip_position(cr.ContinuumRobot.paper(), np.zeros(2))     # straight: the segment length on z
-    array([0.  , 0.  , 0.09])
-    """
+    """Tip position ``(..., 3)`` in the base frame (m) at ``psi (..., 2 n)``."""
     check_params(robot, ContinuumRobot, "robot")
     return forward_kinematics(robot, psi)[..., -1, :3, 3]
 
@@ -416,53 +356,16 @@ def tip_jacobian(robot: ContinuumRobot, psi: object) -> np.ndarray:
 
     ``omega`` is the tip frame's angular velocity and ``v_tip`` the velocity of the tip point (paper 3,
     eq. (6): J_xomega stacked on J_xv, angular first as in robomech's twists).
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        Bend and bending-plane angles of the segments (rad).
-
-    Returns
-    -------
-    ndarray, shape (..., 6, 2 n)
-        ``[omega; v_tip]`` per unit ``psi_dot`` (rad/s, m/s), base frame.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> J = cr.tip_jacobian(cr.ContinuumRobot.paper(), np.array([np.pi / 2, 0.0]))
-    >>> J.shape, J[:3, 0].round(12) + 0.0          # bending turns the tip about the base y axis
-    ((6, 2), array([0., 1., 0.]))
     """
     check_params(robot, ContinuumRobot, "robot")
-    theta, beta = _split_views(robot, psi)
+    theta, beta = _split(robot, psi, views=True)
     return _tip_jacobian(robot, theta, beta)
 
 
 @carries_failed_rows({"psi": 1})
 def disk_transforms(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """Poses of the base plate and of every disk, ``(..., 1 + n N, 4, 4)``, in the base frame.
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        Bend and bending-plane angles of the segments (rad).
-
-    Returns
-    -------
-    ndarray, shape (..., 1 + n N, 4, 4)
-        The base plate, then the N disks of each segment, in the base frame (m).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> cr.disk_transforms(cr.ContinuumRobot.paper(), np.zeros(2)).shape     # base + 5 disks
-    (6, 4, 4)
-    """
+    """Poses ``(..., 1 + n N, 4, 4)`` of the base plate, then the N disks of each segment, in the base
+    frame (m)."""
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     return _disk_T(robot, theta, beta)
@@ -483,7 +386,8 @@ def _disk_T(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray) -> np.nd
 
 # ---- cable lengths --------------------------------------------------------------------------------
 def _sinc(x: np.ndarray) -> np.ndarray:
-    return _f_sin(x)
+    """sin x / x, finite at 0."""
+    return _small_fix(x, lambda v: np.sin(v) / v, _series_f_sin)
 
 
 def _dsinc_over_x(x: np.ndarray) -> np.ndarray:
@@ -494,16 +398,9 @@ def _dsinc_over_x(x: np.ndarray) -> np.ndarray:
 def _segment_spans(
     robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray, model: str
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Span length of every cable in every segment, d/dtheta and (d/dbeta)/theta: (..., 3n, n) each.
-
-    d/dbeta is proportional to theta; returning it divided by theta keeps it finite in coordinates
-    (theta cos beta, theta sin beta) that are smooth through the straight pose.
-
-    Arc model (paper 3, eq. (4)): the cable is parallel to the core, span = (l - r theta cos(beta -
-    sigma)) / N.  Chord model: the cable is straight between consecutive holes (paper 3, eq. (21)); both
-    holes lie at distance 1/kappa - d from the centre of curvature, d = r cos(beta - sigma), so the
-    span is 2 (1/kappa - d) sin(theta / 2N) = (l - d theta)/N * sinc(theta / 2N).
-    """
+    """Span length of every cable in every segment, d/dtheta and (d/dbeta)/theta (finite through the
+    straight pose): (..., 3n, n) each.  Arc (paper 3, eq. (4)) and chord spans
+    ``(l - d theta)/N * sinc(theta / 2N)``, ``d = r cos(beta - sigma)`` (docs/mechanisms/continuum.md)."""
     N, L, r = robot.disks_per_segment, robot.segment_length, robot.hole_radius
     sig = robot.hole_angles  # (3n,)
     th = theta[..., None, :]  # (..., 1, n)
@@ -529,29 +426,17 @@ def _active(robot: ContinuumRobot) -> np.ndarray:
     return robot.cable_segment[:, None] >= np.arange(robot.n_segments)[None, :]
 
 
+def _span_active(robot: ContinuumRobot) -> np.ndarray:
+    """(3 n, n N) mask: cable c runs over span (disk interval) j."""
+    N = robot.disks_per_segment
+    return np.arange(robot.n_segments * N)[None, :] < (N * (robot.cable_segment + 1))[:, None]
+
+
 @carries_failed_rows({"psi": 1})
 def span_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "chord") -> np.ndarray:
-    """Length of every cable span ``(..., 3 n, n N)`` (zero beyond the cable's termination disk).
+    """Length (m) of every cable span between consecutive disks, ``(..., 3 n, n N)`` (zero beyond the
+    cable's termination disk); ``model`` the cable path, as in :func:`cable_lengths`.
 
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        Bend and bending-plane angles of the segments (rad).
-    model : {"chord", "arc"}, optional
-        Cable path model.
-
-    Returns
-    -------
-    ndarray, shape (..., 3 n, n N)
-        Length of each cable's span between consecutive disks (m).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> cr.span_lengths(cr.ContinuumRobot.paper(), np.zeros(2))[0]   # straight: 0.09 m / 5 disks
-    array([0.018, 0.018, 0.018, 0.018, 0.018])
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -561,21 +446,7 @@ def span_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "chord"
 
 @carries_failed_rows({"psi": 1})
 def span_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "chord") -> np.ndarray:
-    """``d span / d psi``: ``(..., 3 n, n N, 2 n)``.
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        Bend and bending-plane angles of the segments (rad).
-    model : {"chord", "arc"}, optional
-        Cable path model.
-
-    Returns
-    -------
-    ndarray, shape (..., 3 n, n N, 2 n)
-        ``d span / d psi`` (m/rad).
-    """
+    """``d span_lengths / d psi`` (m/rad): ``(..., 3 n, n N, 2 n)``."""
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     return _span_jac(robot, theta, beta, model)
@@ -598,20 +469,8 @@ def cable_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "arc")
     """Geometric length of every cable from the base plate to its termination disk, ``(..., 3 n)`` (m).
 
     ``model="arc"`` is paper 3, eq. (4) (cable parallel to the core); ``model="chord"`` takes straight
-    cable spans between the holes of consecutive disks (what a real cable does).
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        Bend and bending-plane angles of the segments (rad).
-    model : {"arc", "chord"}, optional
-        Cable path model (see above).
-
-    Returns
-    -------
-    ndarray, shape (..., 3 n)
-        Cable lengths (m), cable ``3 i + j`` of segment i.
+    cable spans between the holes of consecutive disks (what a real cable does).  Cable ``3 i + j``
+    belongs to segment i.
 
     Examples
     --------
@@ -629,30 +488,7 @@ def cable_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "arc")
 
 @carries_failed_rows({"psi": 1})
 def cable_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "arc") -> np.ndarray:
-    """``J_qpsi = d cable_lengths / d psi``, ``(..., 3 n, 2 n)`` (paper 3, eq. (5) for one segment).
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        Bend and bending-plane angles of the segments (rad).
-    model : {"arc", "chord"}, optional
-        Cable path model.
-
-    Returns
-    -------
-    ndarray, shape (..., 3 n, 2 n)
-        ``d l / d psi`` (m/rad).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> cr.cable_jacobian(cr.ContinuumRobot.paper(), np.array([np.pi / 2, 0.0])).round(5)
-    array([[-0.004  ,  0.     ],
-           [ 0.002  , -0.00544],
-           [ 0.002  ,  0.00544]])
-    """
+    """``J_qpsi = d cable_lengths / d psi`` (m/rad), ``(..., 3 n, 2 n)`` (paper 3, eq. (5), one segment)."""
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     return _span_jac(robot, theta, beta, model).sum(axis=-2)
@@ -666,16 +502,14 @@ class IKResult:
     Attributes
     ----------
     psi : ndarray, shape (..., 2 n)
-        ``[theta_1, beta_1, ...]`` (rad) with theta >= 0 and beta in (-pi, pi] (beta = 0 where
-        theta = 0); where not ``reachable``, the best least-squares pose found (a local minimum of the
-        tip distance).
+        ``[theta_1, beta_1, ...]`` (rad), theta >= 0, beta in (-pi, pi] (0 where theta = 0); where not
+        ``reachable``, the best least-squares pose found.
     residual : ndarray, shape (...)
         Distance of the pose's tip from the target (m).
     reachable : ndarray of bool, shape (...)
         ``residual`` below ``IK_TOLERANCE``.
     converged : ndarray of bool, shape (...)
-        The solver stopped on its own criterion (target reached, or a step below ``IK_TOLERANCE``: a
-        stationary point) rather than on ``IK_MAX_ITERATIONS``.
+        The solver stopped on its own criterion (reached, or a stationary point), not on the iteration cap.
     iterations : ndarray of int, shape (...)
         Iterations of all starts tried for the sample.
     """
@@ -748,14 +582,9 @@ def _lm_step(J: np.ndarray, e: np.ndarray, lam: np.ndarray) -> np.ndarray:
 
 
 def _ik_solve(robot: ContinuumRobot, p: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Levenberg-Marquardt on the tip position in bending-vector coordinates, from ``u (k, n, 2)``.
-
-    Per-sample adaptive damping ``lam = mu l^2``: a step is accepted when it lowers the residual (then mu
-    shrinks by IK_DAMPING_DECREASE), otherwise rejected (mu grows by IK_DAMPING_INCREASE).  A sample stops
-    (``converged``) when its residual is below IK_TOLERANCE or its trial step moves it by less than
-    IK_TOLERANCE (a stationary point: the least-squares pose, or a local minimum).  Every iteration acts on
-    the whole unconverged subset.  Returns ``u, residual, converged, iterations``.
-    """
+    """Levenberg-Marquardt on the tip position in bending-vector coordinates from ``u (k, n, 2)``, with
+    per-sample adaptive damping ``lam = mu l^2``, on the whole unconverged subset at every iteration
+    (docs/mechanisms/continuum.md).  Returns ``u, residual, converged, iterations``."""
     L2 = robot.segment_length**2
     u = u.copy()
     e_all = p - _tip_u(robot, u)
@@ -845,25 +674,10 @@ def _single_arc(robot: ContinuumRobot, p: np.ndarray, theta: np.ndarray, beta: n
 
 @carries_failed_rows({"p_tip": 1})
 def inverse_kinematics(robot: ContinuumRobot, p_tip: object) -> IKResult:
-    """Bend parameters ``psi`` that put the tip at ``p_tip (..., 3)`` (m).
+    """Bend parameters ``psi`` that put the tip at ``p_tip (..., 3)`` (m, base frame): :class:`IKResult`.
 
-    Start: the single constant-curvature arc through all segments (exact for every reachable tip of a
-    one-segment robot: beta = atan2(y, x), theta = 2 atan2(sqrt(x^2 + y^2), z)), refined by
-    Levenberg-Marquardt on the tip position in the bending vectors u_i = theta_i (cos beta_i, sin beta_i)
-    (smooth through the straight pose, where beta is undefined).  For n >= 2, the targets within the
-    robot's reach (|p| <= n l) that are still not reached are restarted from a small fixed set of other
-    shapes (IK_STARTS: segments bent in opposite or crossed planes, different bends); the pose with the
-    smallest residual is kept, with its ``converged`` flag.  Targets beyond the reach get one solve only.
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    p_tip : array_like, shape (..., 3)
-        Tip targets in the base frame (m).
-
-    Returns
-    -------
-    IKResult
+    The single constant-curvature arc through the tip, refined by Levenberg-Marquardt in the bending
+    vectors, with restarts from ``IK_STARTS`` for n >= 2 (``docs/mechanisms/continuum.md``, Models).
 
     Examples
     --------
