@@ -50,19 +50,16 @@ __all__ = [
     "theoretical_drive",
 ]
 
-# Newton on the equilibrium of the simulated robot: converged when the generalized force residual is
-# below 1e-10 N m (1e-9 of the ~0.03 N m bending moments) ...
+# Newton on the simulated robot: converged below 1e-10 N m (1e-9 of the ~0.03 N m bending moments) ...
 SIM_TOLERANCE = 1e-10
-# ... within 40 iterations (quadratic convergence needs ~5 from a nearby start; the margin covers starts
-# far from the solution and the Coulomb kink of the wrap angles at theta = 0).
+# ... within 40 iterations (~5 from a nearby start; margin for far starts and the kink at theta = 0).
 SIM_MAX_ITERATIONS = 40
 # Step halvings of the backtracking line search (2^-12 ~ 2e-4 of a Newton step is the smallest tried).
 SIM_BACKTRACKS = 12
 # Central-difference step (rad) for the 2n x 2n Newton matrix: eps^(1/3) for O(1) curvature.
 SIM_FD_STEP = 6e-6
-# compensated_drive(method="disk"): Gauss-Newton on the commanded pose psi' (bending vectors), stopped
-# when the step is below 1e-10 rad (the segment ends then sit at their least-squares point to ~1e-11 m;
-# the residual itself is not 0: a 2n-parameter family cannot hit 3n coordinates exactly) ...
+# compensated_drive(method="disk"): Gauss-Newton on psi' stopped at a step below 1e-10 rad (the ends then
+# sit at their least-squares point to ~1e-11 m; 2n parameters cannot hit 3n coordinates exactly) ...
 COMPENSATION_STEP_TOL = 1e-10
 # ... or after 12 iterations (3-5 are needed from psi' = psi; the Jacobian is a central difference).
 COMPENSATION_ITERATIONS = 12
@@ -131,6 +128,10 @@ def cable_elongation(
 def theoretical_drive(robot: ContinuumRobot, psi: object, model: CableModel = "arc") -> np.ndarray:
     """Cable ``(..., 3 n)`` (m) pulled in by each actuator of a rigid, frictionless robot since the
     straight pose: q = -(L(psi) - L(0)), paper 3, eq. (37) before delta is added.
+
+    Returns
+    -------
+    ndarray, shape (..., 3 n)
     """
     check_params(robot, ContinuumRobot, "robot")
     return -(span_lengths(robot, psi, model).sum(axis=-1) - _l0(robot, model))
@@ -204,7 +205,6 @@ def compensated_drive(
     ------
     ValueError
         ``method="disk"`` combined with ``model="arc"`` or a ``wrench``.
-
     """
     check_params(robot, ContinuumRobot, "robot")
     check_choice(method, "method", ("paper", "disk"))
@@ -262,10 +262,8 @@ class SimulationResult:
         Equilibrium pose ``[theta_1, beta_1, ...]`` (rad).
     tension : ndarray, shape (..., 3 n)
         Cable tension where it enters the base plate (N, >= 0; 0 for a slack cable).
-    taut : ndarray of bool, shape (...)
-        No cable went slack.
-    converged : ndarray of bool, shape (...)
-        Newton met ``SIM_TOLERANCE``.
+    taut, converged : ndarray of bool, shape (...)
+        No cable went slack; Newton met ``SIM_TOLERANCE``.
     residual : ndarray, shape (...)
         Norm of the generalized-force residual (N m).
     iterations : ndarray of int, shape (...)
@@ -335,13 +333,15 @@ def simulate(
     cables flagged; Newton in the bending vectors from ``initial`` (``None``: the rigid-arc-cable pose
     for ``q``); ``pulley`` as in :func:`compensated_drive` (``docs/mechanisms/continuum.md``).
 
+    Returns
+    -------
+    SimulationResult
+
     Examples
     --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> robot = cr.ContinuumRobot.paper()
-    >>> q = cr.compensated_drive(robot, np.array([0.5, 0.0])).q_compensated
-    >>> res = cr.simulate(robot, q)
+    >>> robot = ContinuumRobot.paper()
+    >>> q = compensated_drive(robot, np.array([0.5, 0.0])).q_compensated
+    >>> res = simulate(robot, q)
     >>> bool(res.converged), bool(res.taut), round(float(res.psi[0]), 4)
     (True, True, 0.5)
     """
@@ -370,8 +370,7 @@ def simulate(
         th0, be0 = _split(robot, initial, "initial")
         k = np.stack([th0 * np.cos(be0), th0 * np.sin(be0)], -1).reshape(*th0.shape[:-1], 2 * n)
     k = np.broadcast_to(k, (*batch, 2 * n)).copy()
-    # Newton with backtracking (the slack clip and the Coulomb kink at theta = 0 make F only piecewise
-    # smooth), over the whole batch
+    # Newton with backtracking: the slack clip and the Coulomb kink at theta = 0 make F piecewise smooth
     fun = lambda kk: _sim_residual(robot, kk, qa, d, model, pulley)[0]  # noqa: E731
     k, _, iterations = _newton(fun, k, SIM_TOLERANCE, SIM_MAX_ITERATIONS, SIM_FD_STEP, SIM_BACKTRACKS)
     F, t_raw = _sim_residual(robot, k, qa, d, model, pulley)
@@ -403,10 +402,8 @@ class HistoryResult:
     ----------
     psi : ndarray, shape (n_t, ..., 2 n)
         Pose at every step (rad); ``memory="elastic"``: the arcs with each segment's end-disk orientation.
-    tension : ndarray, shape (n_t, ..., 3 n)
-        Cable tension between the actuator and the base plate (N, >= 0).
-    actuator_tension : ndarray, shape (n_t, ..., 3 n)
-        Tension at the actuator, beyond the pulley (N); equal to ``tension`` without a pulley.
+    tension, actuator_tension : ndarray, shape (n_t, ..., 3 n)
+        Cable tension between the actuator and the base plate, and at the actuator beyond the pulley (N).
     direction : ndarray, shape (n_t, ..., 3 n)
         Sign of every cable's last nonzero drive increment (+1 before it moved): ``memory="slip"``'s
         sliding direction; for information only with ``"elastic"`` (each hole's own is ``state``).
@@ -416,10 +413,8 @@ class HistoryResult:
     state : ndarray of int, shape (n_t, ..., 3 n, n N)
         Every hole in that step (the hole where each span starts): +1 cable sliding toward the actuator,
         -1 away from it, 0 stuck.
-    taut : ndarray of bool, shape (n_t, ...)
-        No cable (piece) went slack.
-    converged : ndarray of bool, shape (n_t, ...)
-        The step's equilibrium met its tolerance (``SIM_TOLERANCE`` / ``DISK_TOLERANCE``).
+    taut, converged : ndarray of bool, shape (n_t, ...)
+        No cable (piece) went slack; the step met its tolerance (``SIM_TOLERANCE`` / ``DISK_TOLERANCE``).
     residual : ndarray, shape (n_t, ...)
         Norm of the equilibrium residual (N m; with ``"elastic"`` including the hole conditions, N
         times the disk spacing).
@@ -466,20 +461,14 @@ def simulate_history(
     of its last drive increment, each step :func:`simulate`.  Both: ``docs/mechanisms/continuum.md``,
     "Stick-slip with memory that the pose feels" and departure 15.  ``times`` (s) are only checked.
 
+    Returns
+    -------
+    HistoryResult
+
     Raises
     ------
     ValueError
         ``times`` not strictly increasing, or ``memory="elastic"`` combined with ``model="arc"`` or a pulley.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> robot = cr.ContinuumRobot.paper()
-    >>> q = np.linspace(0.0, 1e-3, 3)[:, None] * np.array([1.0, -0.5, -0.5])   # pull cable 1 (m)
-    >>> res = cr.simulate_history(robot, np.concatenate([q, q[-2::-1]]))      # and release it
-    >>> res.psi.shape, bool(res.valid.all()), bool(res.psi[3, 0] > res.psi[1, 0])  # unloading above
-    ((5, 2), True, True)
     """
     check_params(robot, ContinuumRobot, "robot")
     if pulley is not None:
@@ -670,6 +659,10 @@ def disk_equilibrium(
 
     Loaded by exactly one of ``tension`` (actuator side, N) and ``drive`` (m pulled in); ``initial``
     the segment pose ``psi`` to start from (``None``: straight).
+
+    Returns
+    -------
+    DiskEquilibrium
 
     Raises
     ------

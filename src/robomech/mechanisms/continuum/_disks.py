@@ -36,9 +36,8 @@ COLUMN_PASSES = 8
 DISK_FD_STEP = 6e-6
 """Central-difference step (rad) of the Newton matrix: eps^(1/3) for O(0.1) interval bends."""
 MEMORY_MAX_ITERATIONS = 40
-"""Semi-smooth Newton iterations of one stick-slip history step (pose and hole fluxes together; the
-branch of every hole is re-read at each iterate; measured 5-8 per step on the study's load-unload
-cycle, 13 at most)."""
+"""Semi-smooth Newton iterations of one stick-slip history step (measured 5-8 per step on the study's
+load-unload cycle, 13 at most)."""
 MEMORY_FD_FLUX = 1e-8
 """Central-difference step (m) of the hole fluxes in the Newton matrix (tensions are linear in the
 flux up to the column shortening, so any small step works; 1e-8 m is ~1e-3 N of tension)."""
@@ -65,10 +64,8 @@ class DiskEquilibrium:
     drive : ndarray, shape (..., 3 n)
         Cable length pulled in by each actuator that holds this equilibrium (m; the given drive in
         drive mode).
-    taut : ndarray of bool, shape (...)
-        No cable slack.
-    converged : ndarray of bool, shape (...)
-        ``residual`` below ``DISK_TOLERANCE``.
+    taut, converged : ndarray of bool, shape (...)
+        No cable slack; ``residual`` below ``DISK_TOLERANCE``.
     residual : ndarray, shape (...)
         Generalized-force residual of the equilibrium (N m).
     """

@@ -62,14 +62,9 @@ def wrap_angles(robot: ContinuumRobot, psi: object) -> np.ndarray:
     Span 0 starts at the base plate, where the cable arrives along the base z axis; span k at disk k.
     Zero beyond the cable's termination disk.
 
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> cr.wrap_angles(cr.ContinuumRobot.paper(), np.array([0.5, 0.0])).round(4)   # theta = 0.5 rad
-    array([[0.05, 0.1 , 0.1 , 0.1 , 0.1 ],
-           [0.05, 0.1 , 0.1 , 0.1 , 0.1 ],
-           [0.05, 0.1 , 0.1 , 0.1 , 0.1 ]])
+    Returns
+    -------
+    ndarray, shape (..., 3 n, n N)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -108,6 +103,10 @@ def friction_factors(robot: ContinuumRobot, psi: object, direction: object | Non
 
     ``direction (..., 3 n)``: +1 pulled in, -1 paid out, ``None`` frictionless; 0 (eq. (19)'s stuck
     branch) raises ValueError for a cable with friction (its tension needs a stick-slip memory).
+
+    Returns
+    -------
+    ndarray, shape (..., 3 n, n N)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -140,6 +139,10 @@ def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np
 
     ``rho`` pulley radius / cable radius (> 0), ``alpha`` (> 0) and ``n`` (in (0, 1]) of the friction law
     ``f = alpha N^n`` (eq. (25)), as in :func:`capstan_tension_ratio`.
+
+    Returns
+    -------
+    ndarray
     """
     rho, alpha, n = as_array(rho, "rho"), as_array(alpha, "alpha"), as_array(n, "n")
     broadcast_batch((rho, 0, "rho"), (alpha, 0, "alpha"), (n, 0, "n"))
@@ -152,7 +155,12 @@ def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np
 @carries_failed_rows({"phi": 0}, {"mu": 0})
 def classical_capstan_ratio(phi: object, mu: object) -> np.ndarray:
     """Euler-Eytelwein capstan law T_in / T_out = exp(mu phi): wrap angle ``phi`` (rad) and Coulomb
-    coefficient ``mu`` broadcast."""
+    coefficient ``mu`` broadcast.
+
+    Returns
+    -------
+    ndarray
+    """
     mu_a, phi_a = as_array(mu, "mu"), as_array(phi, "phi")
     broadcast_batch((phi_a, 0, "phi"), (mu_a, 0, "mu"))
     return np.exp(mu_a * phi_a)
@@ -208,12 +216,9 @@ def capstan_tension_ratio(
 ) -> np.ndarray:
     """Input/output tension ratio kappa of a cable over a pulley, paper 3, eqs. (29)-(32).
 
-    Solves T'' + c T^((1-n)/n) T' - rho T = 0, c = (rho/n)((1 + rho)/(alpha rho))^(1/n), from the output
-    side: T(0) = t_out, T'(0) = 0 (eq. (31) with theta_1 = 0), and returns
-    kappa = sqrt(rho^2 T(phi)^2 + T'(phi)^2) / (rho T(0)).
-
-    n = 1 and rho = inf are solved in closed form; otherwise the ODE is integrated (see the CAPSTAN_*
-    constants).  All arguments broadcast.
+    Solves T'' + c T^((1-n)/n) T' - rho T = 0 (c: :func:`capstan_coefficient`) from the output side,
+    T(0) = t_out, T'(0) = 0 (eq. (31), theta_1 = 0): kappa = sqrt(rho^2 T(phi)^2 + T'(phi)^2) / (rho T(0)).
+    Closed forms for n = 1 and rho = inf, else integrated (CAPSTAN_* constants); arguments broadcast.
 
     Parameters
     ----------
@@ -235,12 +240,8 @@ def capstan_tension_ratio(
 
     Examples
     --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> np.round(cr.capstan_tension_ratio(np.pi, rho=np.inf, alpha=0.1, n=1.0), 4)   # = exp(0.1 pi)
+    >>> np.round(capstan_tension_ratio(np.pi, rho=np.inf, alpha=0.1, n=1.0), 4)   # = exp(0.1 pi)
     np.float64(1.3691)
-    >>> cr.capstan_tension_ratio([0.5, np.pi], rho=20.0, alpha=0.1, n=0.8).round(4)
-    array([1.0212, 1.1396])
     """
     phi_a = as_array(phi, "phi")
     rho_a = as_array(rho, "rho", finite=False)
@@ -348,10 +349,8 @@ def identify_friction(
     ----------
     wrap : array_like, shape (..., m)
         Total wrap angle eta (rad) of each of the m measurements.
-    t_in : array_like, shape (..., m)
-        Actuator-side tension (N, > 0).
-    t_out : array_like, shape (..., m)
-        Distal tension (N, > 0).
+    t_in, t_out : array_like, shape (..., m)
+        Actuator-side and distal tension (N, > 0).
     direction : array_like, shape (..., m)
         Sliding direction s of each measurement: +1 pulled in, -1 paid out, 0 ignored.
         The four arrays broadcast together.
@@ -399,9 +398,8 @@ class TensionHistory:
     span_tension : ndarray, shape (n_t, ..., 3 n, n N)
         Tension of every span (N); zero beyond a cable's termination disk.
     state : ndarray of int, shape (n_t, ..., 3 n, n N)
-        Per hole (the hole where each span starts): +1 sliding with the cable pulled in (span at its
-        lower friction bound), -1 sliding paid out (upper bound), 0 stuck (tension kept from the
-        previous step, strictly within the bounds).
+        Per hole (where each span starts): +1 sliding pulled in (span at its lower friction bound), -1
+        paid out (upper bound), 0 stuck (tension kept from the previous step, within the bounds).
     distal : ndarray, shape (n_t, ..., 3 n)
         Tension of each cable's last span (N).
     """
@@ -422,14 +420,16 @@ def stick_slip_tensions(
     (``docs/mechanisms/continuum.md``, "Stick-slip with memory").  ``initial (..., 3 n, n N)``: span
     tensions before the first step (N, > 0; ``None``: every span at the first actuator tension).
 
+    Returns
+    -------
+    TensionHistory
+
     Examples
     --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> robot = cr.ContinuumRobot.paper()
+    >>> robot = ContinuumRobot.paper()
     >>> psi = np.tile([0.5, 0.0], (3, 1))                      # 3 steps at one pose (rad)
     >>> t_act = np.array([[5.0, 5, 5], [6, 5, 5], [5, 5, 5]])  # cable 0 pulled, then released (N)
-    >>> h = cr.stick_slip_tensions(robot, psi, t_act)
+    >>> h = stick_slip_tensions(robot, psi, t_act)
     >>> h.span_tension.shape, h.distal[:, 0].round(4)          # the released cable keeps 5.34 N
     ((3, 3, 5), array([5.    , 5.3375, 5.3375]))
     """
@@ -496,8 +496,6 @@ def stick_slip_tensions(
 
 
 # ---- stick-slip of an elastic cable through the holes (docs/mechanisms/continuum.md) --------------
-# Pieces: 0 the free length, p >= 1 the span starting at hole p - 1; T_p = EA (1 - m_p / g_p) (the linear
-# law of the segment model's compatibility: full slip reproduces disk_equilibrium(drive=...) exactly).
 # paper 3, eq. (19): the print keeps the stuck TENSION T(t^-1) and gives no criterion for sticking;
 # here the stuck hole keeps the material on both sides (its span tensions then change elastically with
 # the pose) and sticks while its tension ratio lies inside the capstan cone.

@@ -32,19 +32,15 @@ _Z95 = 1.959963984540054  # two-sided 95 % quantile of the standard normal
 
 @dataclass(frozen=True)
 class PoseFrictionEstimate:
-    """Friction coefficients fitted to tensions at measured poses (:func:`identify_friction_from_pose`).
-
-    Uncertainties are linearised: covariance s² (JᵀJ)⁻¹, s² from ``sigma_t`` if given, else from the
-    residuals.
+    """Friction coefficients fitted to tensions at measured poses (:func:`identify_friction_from_pose`);
+    linearised uncertainties (``docs/mechanisms/continuum.md``, Identification).
 
     Attributes
     ----------
     mu : ndarray, shape (3 n,)
         Estimated Coulomb friction coefficient per cable (unit-free).
-    std : ndarray, shape (3 n,)
-        Its standard deviation (inf where not identifiable).
-    ci_low, ci_high : ndarray, shape (3 n,)
-        Bounds of the 95 % confidence interval.
+    std, ci_low, ci_high : ndarray, shape (3 n,)
+        Its standard deviation (inf where not identifiable) and 95 % confidence bounds.
     residual_rms : float
         RMS of the tension fit residual (N).
     identifiable : ndarray of bool, shape (3 n,)
@@ -77,17 +73,9 @@ def identify_friction_from_pose(
     residuals); ``model`` the cable path of :func:`cable_tensions`.  The paper fits the factors
     exp(−μη) linearly; μ is fitted here (bounded, nonlinear; ``docs/mechanisms/continuum.md``).
 
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> truth = cr.ContinuumRobot(friction=(0.2, 0.3, 0.25))
-    >>> psi = np.array([[0.3, 0.0], [0.6, 1.0], [0.9, 2.0], [0.4, 4.0]])   # rad
-    >>> d = np.ones((4, 3))                                                 # all pulled in
-    >>> t = cr.cable_tensions(truth, psi, direction=d).tension             # N, synthetic
-    >>> est = cr.identify_friction_from_pose(cr.ContinuumRobot.paper(), psi, t, d)
-    >>> est.mu.round(6), est.success
-    (array([0.2 , 0.3 , 0.25]), True)
+    Returns
+    -------
+    PoseFrictionEstimate
     """
     check_params(robot, ContinuumRobot, "robot")
     n_c = robot.n_cables
@@ -123,10 +111,8 @@ core diameter is not printed: a factor 4 either way covers any plausible core)."
 
 @dataclass(frozen=True)
 class TipFrictionEstimate:
-    """Output-error fit of the disk-wise model to tracked tips (:func:`identify_friction_from_tip`).
-
-    Uncertainties are linearised: covariance s² (JᵀJ)⁻¹ with s² the residual variance of the tip fit
-    (model error included, not only the tracker noise), or 1 in the errors-in-variables fit.
+    """Output-error fit of the disk-wise model to tracked tips (:func:`identify_friction_from_tip`);
+    linearised uncertainties, s² the tip fit's residual variance (model error included) or 1 (EIV).
 
     Attributes
     ----------
@@ -174,6 +160,10 @@ def identify_friction_from_tip(
     ``sigma_t`` (N) and ``sigma_tip`` (m) errors in variables (the measured tensions are noisy inputs:
     taking them as exact biases EI by +5 % and μ by −15 % on reference data).  Departure from paper 3,
     eq. (38) (which fits the tensions at the measured pose): ``docs/mechanisms/continuum.md``, item 13.
+
+    Returns
+    -------
+    TipFrictionEstimate
 
     Raises
     ------

@@ -44,34 +44,27 @@ CHUNK = 16384
 # tolerance, above the ~1e-16 * 0.1 m rounding of the forward kinematics).
 IK_TOLERANCE = 1e-10
 # Levenberg-Marquardt iterations per start: over 10^5 random 2- and 3-segment targets, 99.9 % of those
-# reached from the single-arc start need <= 17 (theta_i <= pi) or <= 22 (theta_i <= 6 rad) iterations, the
-# alternative starts <= 48; 40 keeps all but a handful (which another start then reaches) and bounds the
-# cost of unreachable targets (~1 us per sample and iteration).
+# reached need <= 17 (theta_i <= pi) or <= 22 (<= 6 rad) from the single arc, <= 48 from the others; 40
+# keeps all but a handful (another start reaches them) and bounds the cost of unreachable targets.
 IK_MAX_ITERATIONS = 40
-# Damping lam = mu l^2 (J J^T ~ l^2): mu starts at 1e-3, a mild trust region that still takes nearly the
-# full Gauss-Newton step where the linearisation is good.
+# Damping lam = mu l^2 (J J^T ~ l^2): mu starts at 1e-3, a mild trust region (nearly a Gauss-Newton step).
 IK_DAMPING_INITIAL = 1e-3
 # After an accepted step mu /= 3, after a rejected one mu *= 4: the usual asymmetric Levenberg factors
 # (damping grows faster than it shrinks, so a run of rejections quickly reaches a gradient step).
 IK_DAMPING_DECREASE = 1.0 / 3.0
 IK_DAMPING_INCREASE = 4.0
-# mu stays in [1e-12, 1e12]: the lower bound keeps J J^T + lam I positive definite at the singular straight
-# pose (condition <= ~1e12, still solved to ~1e-4 relative, enough for a damped step) and is far below the
-# point where the damping slows convergence; the upper bound keeps lam finite (a step of ~1e-12 of the
-# gradient step already ends the iteration through the step criterion).
+# mu in [1e-12, 1e12]: the lower bound keeps J J^T + lam I positive definite at the singular straight pose
+# (condition <= ~1e12, solved to ~1e-4 relative: enough for a damped step) without slowing convergence;
+# the upper bound keeps lam finite (a 1e-12 gradient step already ends the iteration).
 IK_DAMPING_MIN = 1e-12
 IK_DAMPING_MAX = 1e12
-# The Jacobian in the bending vector u needs (d p / d beta) / theta, 0/0 at theta = 0.  p(u) is smooth and
-# its Jacobian continuous in u, so it is evaluated at theta = max(theta, 1e-12 rad): any positive floor
-# avoids the 0/0, and this one moves the Jacobian by only ~floor * |d^2 p / d u^2| ~ 1e-12 * n l m/rad
-# (the residual itself is always exact), while (d p / d beta) ~ theta l, divided by theta, stays accurate
-# to ~1e-16 of its size (small-angle series below SMALL_ANGLE; no underflow at 1e-12).
+# The Jacobian in u needs (d p / d beta) / theta, 0/0 at theta = 0; it is continuous in u, so it is taken
+# at theta = max(theta, 1e-12 rad): this moves it by ~1e-12 * n l m/rad (the residual stays exact), and
+# (d p / d beta) / theta stays accurate to ~1e-16 (series below SMALL_ANGLE; no underflow at 1e-12).
 IK_THETA_FLOOR = 1e-12
-# Alternative starts for n >= 2 where the single arc fails, in the target's azimuthal frame (rotated by
-# beta_t = atan2(y, x)): (theta, plane angle) of the proximal segments, then of the distal segment (rad).
-# Chosen greedily on the failures of the single-arc start over 2 x 10^5 random 2- and 3-segment targets
-# (theta_i <= pi and <= 6 rad): strongly curled in the target's plane; S-shapes in crossed and in the same
-# plane (segments bent against each other); one curl out of the target's plane.  Tried in this order.
+# Alternative starts for n >= 2, in the target's azimuthal frame: (theta, plane angle) of the proximal
+# segments, then of the distal one (rad), chosen greedily on the single arc's failures over 2 x 10^5
+# random 2- and 3-segment targets (curled in the target's plane, S-shapes, curled out of it), in order.
 IK_STARTS = (
     ((3.0, 0.0), (3.0, 0.0)),
     ((2.0, -np.pi / 2), (2.0, np.pi)),
@@ -109,17 +102,14 @@ def _small_fix(t: np.ndarray, closed, series) -> np.ndarray:
     return out
 
 
-def _half_angle(angle: np.ndarray, one_minus_cos: bool = True) -> tuple[np.ndarray, ...]:
-    """``(sin, cos[, 1 - cos])`` of ``angle`` from ``t = tan(angle / 2)`` (the formulas of
-    ``robomech.spatial.sincos``: numpy's float64 tan is vectorised, its sin and cos are not, ~10x
-    slower).  ``1 - cos = 2 t^2 / (1 + t^2)`` has no cancellation at small angles."""
+def _half_angle(angle: np.ndarray) -> tuple[np.ndarray, ...]:
+    """``(sin, cos, 1 - cos)`` of ``angle``: ``robomech.spatial.sincos``'s half-angle formulas, with
+    ``1 - cos = 2 t^2 / (1 + t^2)`` (no cancellation at small angles) from the same ``t``."""
     t = np.tan(0.5 * angle)
     t2 = t * t
     d = 1.0 / (1.0 + t2)
     s = 2.0 * t * d
     c = (1.0 - t2) * d
-    if not one_minus_cos:
-        return s, c
     t2 *= 2.0
     t2 *= d
     return s, c, t2
@@ -178,7 +168,7 @@ def _segment_planes(theta: np.ndarray, beta: np.ndarray, length: np.ndarray | fl
     for c in slices(th.size, CHUNK):
         t = np.ascontiguousarray(th[c])
         st, ct, omc = _half_angle(t)
-        sb, cb = _half_angle(be[c], one_minus_cos=False)
+        sb, cb = sincos(be[c])
         fc, fs = _bend_scalars(t, st, ct, omc, derivatives=False)
         # R = Rz(beta) Ry(theta) Rz(-beta) = I - (1 - cos theta) [cb^2, cb sb, .; cb sb, sb^2, .; ...] + ...
         # paper 3, eq. (1): printed element (2,1) c(beta)s(beta)c(theta); the product gives
@@ -220,13 +210,6 @@ def segment_transform(theta: object, beta: object, length: object) -> np.ndarray
         Bend angle and bending-plane angle about the base z axis (rad).
     length : array_like, shape (...)
         Arc length of the segment (m).  The three arguments broadcast.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> T = segment_transform(np.pi / 2, 0.0, 0.09)          # a quarter circle of radius 0.0573 m
-    >>> T[:3, 3].round(4), T[:3, 2].round(12) + 0.0         # end point; the end tangent is +x
-    (array([0.0573, 0.    , 0.0573]), array([1., 0., 0.]))
     """
     t = as_array(theta, "theta")
     b = as_array(beta, "beta")
@@ -287,15 +270,19 @@ def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
 
 @carries_failed_rows({"psi": 1})
 def tip_position(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """Tip position ``(..., 3)`` in the base frame (m) at ``psi (..., 2 n)``."""
+    """Tip position ``(..., 3)`` in the base frame (m) at ``psi (..., 2 n)``.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+    """
     check_params(robot, ContinuumRobot, "robot")
     return forward_kinematics(robot, psi)[..., -1, :3, 3]
 
 
 def _local_columns(theta: np.ndarray, beta: np.ndarray, length: float) -> np.ndarray:
-    """Every segment's local Jacobian columns as contiguous planes ``(6, 2, ...)`` (paper 3, eq. (6):
-    angular and linear velocity of the segment end in the segment's base frame; verified correct),
-    in chunks of CHUNK samples; inputs of any strides."""
+    """Every segment's local Jacobian columns (paper 3, eq. (6), in the segment's base frame) as
+    contiguous planes ``(6, 2, ...)``, in chunks of CHUNK samples; inputs of any strides."""
     shape = np.broadcast_shapes(np.shape(theta), np.shape(beta))
     P = np.empty((6, 2, *shape))
     Pf = P.reshape(12, -1)
@@ -303,7 +290,7 @@ def _local_columns(theta: np.ndarray, beta: np.ndarray, length: float) -> np.nda
     for c in slices(th.size, CHUNK):
         t = np.ascontiguousarray(th[c])
         st, ct, omc = _half_angle(t)
-        sb, cb = _half_angle(be[c], one_minus_cos=False)
+        sb, cb = sincos(be[c])
         fc, _, g1, g2 = _bend_scalars(t, st, ct, omc, derivatives=True)
         np.negative(sb, out=Pf[0, c])  # row 0: omega_x, columns (theta, beta)
         np.multiply(cb, st, out=Pf[1, c])
@@ -356,6 +343,10 @@ def tip_jacobian(robot: ContinuumRobot, psi: object) -> np.ndarray:
 
     ``omega`` is the tip frame's angular velocity and ``v_tip`` the velocity of the tip point (paper 3,
     eq. (6): J_xomega stacked on J_xv, angular first as in robomech's twists).
+
+    Returns
+    -------
+    ndarray, shape (..., 6, 2 n)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi, views=True)
@@ -365,7 +356,12 @@ def tip_jacobian(robot: ContinuumRobot, psi: object) -> np.ndarray:
 @carries_failed_rows({"psi": 1})
 def disk_transforms(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """Poses ``(..., 1 + n N, 4, 4)`` of the base plate, then the N disks of each segment, in the base
-    frame (m)."""
+    frame (m).
+
+    Returns
+    -------
+    ndarray, shape (..., 1 + n N, 4, 4)
+    """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     return _disk_T(robot, theta, beta)
@@ -437,6 +433,9 @@ def span_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "chord"
     """Length (m) of every cable span between consecutive disks, ``(..., 3 n, n N)`` (zero beyond the
     cable's termination disk); ``model`` the cable path, as in :func:`cable_lengths`.
 
+    Returns
+    -------
+    ndarray, shape (..., 3 n, n N)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -446,7 +445,12 @@ def span_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "chord"
 
 @carries_failed_rows({"psi": 1})
 def span_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "chord") -> np.ndarray:
-    """``d span_lengths / d psi`` (m/rad): ``(..., 3 n, n N, 2 n)``."""
+    """``d span_lengths / d psi`` (m/rad): ``(..., 3 n, n N, 2 n)``.
+
+    Returns
+    -------
+    ndarray, shape (..., 3 n, n N, 2 n)
+    """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     return _span_jac(robot, theta, beta, model)
@@ -472,13 +476,9 @@ def cable_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "arc")
     cable spans between the holes of consecutive disks (what a real cable does).  Cable ``3 i + j``
     belongs to segment i.
 
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> robot = cr.ContinuumRobot.paper()                    # holes at r = 4 mm, 0 and ±120 deg
-    >>> cr.cable_lengths(robot, np.array([np.pi / 2, 0.0])).round(6)   # L - theta r cos(beta - phi_j)
-    array([0.083717, 0.093142, 0.093142])
+    Returns
+    -------
+    ndarray, shape (..., 3 n)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -488,7 +488,12 @@ def cable_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "arc")
 
 @carries_failed_rows({"psi": 1})
 def cable_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "arc") -> np.ndarray:
-    """``J_qpsi = d cable_lengths / d psi`` (m/rad), ``(..., 3 n, 2 n)`` (paper 3, eq. (5), one segment)."""
+    """``J_qpsi = d cable_lengths / d psi`` (m/rad), ``(..., 3 n, 2 n)`` (paper 3, eq. (5), one segment).
+
+    Returns
+    -------
+    ndarray, shape (..., 3 n, 2 n)
+    """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
     return _span_jac(robot, theta, beta, model).sum(axis=-2)
@@ -506,10 +511,9 @@ class IKResult:
         ``reachable``, the best least-squares pose found.
     residual : ndarray, shape (...)
         Distance of the pose's tip from the target (m).
-    reachable : ndarray of bool, shape (...)
-        ``residual`` below ``IK_TOLERANCE``.
-    converged : ndarray of bool, shape (...)
-        The solver stopped on its own criterion (reached, or a stationary point), not on the iteration cap.
+    reachable, converged : ndarray of bool, shape (...)
+        ``residual`` below ``IK_TOLERANCE``; the solver stopped on its own criterion (reached, or a
+        stationary point), not on the iteration cap.
     iterations : ndarray of int, shape (...)
         Iterations of all starts tried for the sample.
     """
@@ -634,9 +638,8 @@ def _ik_start(robot: ContinuumRobot, p: np.ndarray, shape: tuple) -> np.ndarray:
 
 def _single_arc(robot: ContinuumRobot, p: np.ndarray, theta: np.ndarray, beta: np.ndarray) -> np.ndarray:
     """The single constant-curvature arc through every tip ``p (k, 3)``: writes ``theta, beta (k, n)``
-    (every segment bent by theta = 2 atan2(sqrt(x^2 + y^2), z) / n in the plane beta = atan2(y, x)) and
-    returns the tip residual ``(k,)`` of that pose.  One segment: chunks of CHUNK samples, the residual
-    from the tip of the arc (the formulas of _segment_T); n >= 2: from the composed forward kinematics."""
+    and returns the tip residual ``(k,)`` of that pose (one segment: chunked, with the formulas of
+    _segment_T; n >= 2: from the composed forward kinematics)."""
     n, L = robot.n_segments, robot.segment_length
     res = np.empty(p.shape[0])
     for c in slices(p.shape[0], CHUNK):
@@ -654,7 +657,7 @@ def _single_arc(robot: ContinuumRobot, p: np.ndarray, theta: np.ndarray, beta: n
         if n > 1:
             continue
         st, ct, omc = _half_angle(th)
-        sb, cb = _half_angle(be, one_minus_cos=False)
+        sb, cb = sincos(be)
         fc, fs = _bend_scalars(th, st, ct, omc, derivatives=False)
         fc *= L
         fs *= L
@@ -679,11 +682,13 @@ def inverse_kinematics(robot: ContinuumRobot, p_tip: object) -> IKResult:
     The single constant-curvature arc through the tip, refined by Levenberg-Marquardt in the bending
     vectors, with restarts from ``IK_STARTS`` for n >= 2 (``docs/mechanisms/continuum.md``, Models).
 
+    Returns
+    -------
+    IKResult
+
     Examples
     --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> ik = cr.inverse_kinematics(cr.ContinuumRobot.paper(), np.array([0.057296, 0.0, 0.057296]))
+    >>> ik = inverse_kinematics(ContinuumRobot.paper(), np.array([0.057296, 0.0, 0.057296]))
     >>> ik.psi.round(4), bool(ik.converged)
     (array([1.5708, 0.    ]), True)
     """

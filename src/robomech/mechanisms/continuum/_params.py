@@ -22,12 +22,10 @@ class ContinuumRobot:
 
     Parameters
     ----------
-    n_segments : int
-        Number of segments n (>= 1).
+    n_segments, disks_per_segment : int
+        Number of segments n and of disks N per segment (chord spans, >= 1); paper: 1 and 5.
     segment_length : float
         Arc length of every segment (m); paper: 90 mm.
-    disks_per_segment : int
-        Disks N per segment (chord spans per segment, >= 1); paper: 5 disks.
     hole_radius : float
         Distance r of the cable holes from the core axis (m); not printed, default 4 mm; below
         ``segment_length / n_segments`` and ``>= (core_diameter + cable_diameter) / 2``.

@@ -23,14 +23,18 @@ __all__ = [
     "elastic_gradient",
 ]
 
-# A cable counts as taut when its tension is at least 0 N: a cable cannot push; any positive
-# tension keeps it straight between the holes in this (massless, inextensible-path) model.
+# A cable counts as taut at >= 0 N: it cannot push; any tension keeps it straight (massless cable model).
 TENSION_FLOOR = 0.0
 
 
 @carries_failed_rows({"psi": 1})
 def elastic_energy(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """Bending energy ``(...)`` (J) of the cores, U = sum EI theta_i^2 / (2 l) (paper 3, eq. (8))."""
+    """Bending energy ``(...)`` (J) of the cores, U = sum EI theta_i^2 / (2 l) (paper 3, eq. (8)).
+
+    Returns
+    -------
+    ndarray, shape (...)
+    """
     check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
     return 0.5 * robot.bending_stiffness / robot.segment_length * np.sum(theta**2, axis=-1)
@@ -44,7 +48,12 @@ def _grad_u(robot: ContinuumRobot, theta: np.ndarray) -> np.ndarray:
 
 @carries_failed_rows({"psi": 1})
 def elastic_gradient(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """dU/dpsi ``(..., 2 n)`` (N m/rad): (EI theta_i / l, 0) per segment (gradient of paper 3, eq. (8))."""
+    """dU/dpsi ``(..., 2 n)`` (N m/rad): (EI theta_i / l, 0) per segment (gradient of paper 3, eq. (8)).
+
+    Returns
+    -------
+    ndarray, shape (..., 2 n)
+    """
     check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
     return _grad_u(robot, theta)
@@ -54,7 +63,12 @@ def elastic_gradient(robot: ContinuumRobot, psi: object) -> np.ndarray:
 def coupling_moments(robot: ContinuumRobot, psi: object) -> np.ndarray:
     """Paper 3, eq. (12): moment (N m) of segment i+1 on segment i, ``(..., n, 2)`` = (-EI theta_i+1 / l, 0)
     (zero for the last segment): the paper's one-neighbour form, for comparison (the virtual work of
-    :func:`cable_tensions` contains this coupling exactly)."""
+    :func:`cable_tensions` contains this coupling exactly).
+
+    Returns
+    -------
+    ndarray, shape (..., n, 2)
+    """
     check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
     M = np.zeros((*theta.shape, 2))
@@ -112,11 +126,13 @@ def cable_tensions(
     ``tau = -(G^T)^+ (grad U - J_x^T W) + (I - (G^T)^+ G^T) pretension * 1`` (``pretension`` N,
     default ``robot.pretension``).
 
+    Returns
+    -------
+    TensionResult
+
     Examples
     --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> res = cr.cable_tensions(cr.ContinuumRobot.paper(), np.array([0.5, 0.0]))
+    >>> res = cable_tensions(ContinuumRobot.paper(), np.array([0.5, 0.0]))
     >>> res.tension.round(4), bool(res.taut), bool(res.residual < 1e-9)
     (array([12.0483,  9.087 ,  9.087 ]), True, True)
     """
