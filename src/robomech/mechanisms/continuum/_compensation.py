@@ -13,7 +13,6 @@ from robomech._validation import as_array, broadcast_batch, check_choice, check_
 
 from ._disks import (
     DiskEquilibrium,
-    _active,
     _fd_jacobian,
     _gauss_newton_step,
     _memory_initial,
@@ -25,8 +24,7 @@ from ._disks import (
     _uniform_k,
 )
 from ._friction import STUCK_FLUX_TOL, _as_direction, _factors, _wrap, stick_slip_tensions
-from ._kinematics import CableModel, _disk_T, _fk, _segment_spans, _split, span_lengths
-from ._kinematics import _active as _segment_active
+from ._kinematics import CableModel, _active, _disk_T, _fk, _segment_spans, _span_active, _split, span_lengths
 from ._params import ContinuumRobot
 from ._pulley import PULLEY_FIXED_POINT_ITERATIONS, Pulley, pulley_chain, pulley_stretch
 from ._statics import TensionResult, cable_tensions
@@ -311,7 +309,7 @@ def _sim_residual(robot, k, q, d, model, pulley=None):
     # Virtual work of the span tensions, with d/dbeta divided by theta (finite at the straight pose).
     _, dth, dbe_t = _segment_spans(robot, theta, beta, model)
     Pseg = P.reshape(*P.shape[:-1], robot.n_segments, robot.disks_per_segment).sum(axis=-1)  # (..., 3n, n)
-    w = np.where(_segment_active(robot), Pseg, 0.0) * t[..., :, None]
+    w = np.where(_active(robot), Pseg, 0.0) * t[..., :, None]
     f_th = -np.sum(w * dth, axis=-2) - robot.bending_stiffness / robot.segment_length * theta
     return _to_bending_vector(k, f_th, -np.sum(w * dbe_t, axis=-2), beta), t_raw
 
@@ -361,7 +359,7 @@ def simulate(
     n = robot.n_segments
     if initial is None:
         # Rigid arc cables: q_c = r sum_{m <= seg(c)} k_m . (cos s_c, sin s_c); least squares for k.
-        sig, act = robot.hole_angles, _segment_active(robot)
+        sig, act = robot.hole_angles, _active(robot)
         A = np.zeros((robot.n_cables, 2 * n))
         A[:, 0::2] = robot.hole_radius * np.cos(sig)[:, None] * act
         A[:, 1::2] = robot.hole_radius * np.sin(sig)[:, None] * act
@@ -403,7 +401,8 @@ class HistoryResult:
     psi : ndarray, shape (n_t, ..., 2 n)
         Pose at every step (rad); ``memory="elastic"``: the arcs with each segment's end-disk orientation.
     tension, actuator_tension : ndarray, shape (n_t, ..., 3 n)
-        Cable tension between the actuator and the base plate, and at the actuator beyond the pulley (N).
+        Cable tension between the actuator and the base plate, and at the actuator beyond the pulley (N;
+        the same without a pulley).
     direction : ndarray, shape (n_t, ..., 3 n)
         Sign of every cable's last nonzero drive increment (+1 before it moved): ``memory="slip"``'s
         sliding direction; for information only with ``"elastic"`` (each hole's own is ``state``).
@@ -519,7 +518,7 @@ def _elastic_history(robot: ContinuumRobot, qa: np.ndarray) -> HistoryResult:
     batch = qa.shape[1:-1]
     k, m, _ = _memory_initial(robot, batch)
     prev_q = np.zeros((*batch, robot.n_cables))
-    act = _active(robot)
+    act = _span_active(robot)
     rows = []
     for i in range(qa.shape[0]):  # a history is sequential
         st = _memory_step(robot, k, m, qa[i] - prev_q)
@@ -587,7 +586,7 @@ def _slip_history(
     span_t = np.nan_to_num(tension)[..., None] * _factors(
         robot, _wrap(robot, psi0[..., 0::2], psi0[..., 1::2]), dirs
     )
-    act = _active(robot)
+    act = _span_active(robot)
     mat = np.where(act, ell * (1.0 - span_t / robot.cable_axial_stiffness), 0.0)
     h0 = robot.segment_length / N
     rest = np.where(act, h0 * (1.0 - robot.pretension / robot.cable_axial_stiffness), 0.0)

@@ -13,8 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ._friction import _factors, _hole_residual, _wrap_from_disks
-from ._kinematics import _dsinc_over_x, _segment_T, _sinc
-from ._kinematics import _span_active as _active
+from ._kinematics import _dsinc_over_x, _segment_T, _sinc, _span_active
 from ._params import ContinuumRobot
 
 __all__ = ["DISK_MAX_ITERATIONS", "DISK_TOLERANCE", "MEMORY_MAX_ITERATIONS", "DiskEquilibrium"]
@@ -121,7 +120,7 @@ def _column_shortening(th: Array, u: Array, h: float) -> Array:
 
 def _tension_estimate(robot: ContinuumRobot, ell: Array, P: Array, q: Array) -> Array:
     """Base tension from each cable's compatibility (path = L0 - q + stretch), linear in it."""
-    act = _active(robot)
+    act = _span_active(robot)
     L0 = act.sum(axis=-1) * (robot.segment_length / robot.disks_per_segment)
     ea, T0, Lf = robot.cable_axial_stiffness, robot.pretension, robot.free_length
     return (ea * (ell.sum(axis=-1) - L0 + q) + T0 * (Lf + L0)) / (Lf + np.sum(P * ell, axis=-1))
@@ -151,7 +150,7 @@ def _geometry(robot: ContinuumRobot, k: Array) -> tuple[Array, Array, Array, Arr
     """Interval bends, chord lengths (0 beyond a cable's termination) and their derivatives, disk poses."""
     th, be = _k_split(k)
     ell, dth, dbe = _interval_spans(robot, th, be)
-    ell = np.where(_active(robot), ell, 0.0)
+    ell = np.where(_span_active(robot), ell, 0.0)
     return th, be, ell, dth, dbe, _chain(robot, th, be)
 
 
@@ -159,7 +158,7 @@ def _path(robot: ContinuumRobot, th: Array, ell: Array, w: Array) -> Array:
     """Cable paths: chords minus the column shape's extra shortening under span tensions ``w``."""
     h = robot.segment_length / robot.disks_per_segment
     u_path = 0.5 * h * np.sqrt(np.sum(np.maximum(w, 0.0), axis=-2) / robot.bending_stiffness)
-    return ell - np.where(_active(robot), _column_shortening(th, u_path, h)[..., None, :], 0.0)
+    return ell - np.where(_span_active(robot), _column_shortening(th, u_path, h)[..., None, :], 0.0)
 
 
 def _forces(robot: ContinuumRobot, k: Array, th: Array, be: Array, w: Array, dth: Array, dbe: Array) -> Array:
@@ -191,7 +190,7 @@ def _state(
 ) -> tuple[Array, Array, Array, Array, Array, Array]:
     """Generalized force (..., 2 J) and (t_raw, P, ell, disk poses) at bending vectors ``k``."""
     th, be, ell, dth, dbe, T = _geometry(robot, k)
-    act = _active(robot)
+    act = _span_active(robot)
     P = np.where(act, _factors(robot, _wrap_from_disks(robot, T), d), 0.0)
     # The column shape's extra shortening, in the cable paths only; in drive mode a fixed point (the
     # compression depends on the tensions): the drive-mode round trip is off by 2e-7 N at 80 deg after 5
@@ -270,7 +269,7 @@ def _solve(robot: ContinuumRobot, k0: Array, load: Array, d: Array, mode: Mode) 
     res = np.linalg.norm(F, axis=-1)
     th, be = _k_split(k)
     t = np.maximum(t_raw, 0.0)
-    act = _active(robot)
+    act = _span_active(robot)
     L0 = act.sum(axis=-1) * (robot.segment_length / robot.disks_per_segment)
     ea, T0, Lf = robot.cable_axial_stiffness, robot.pretension, robot.free_length
     elong = (t * (Lf + np.sum(P * ell, axis=-1)) - T0 * (Lf + L0)) / ea
@@ -322,7 +321,7 @@ def _pieces(robot: ContinuumRobot, ell_path: Array) -> Array:
     """Piece lengths (..., 3 n, 1 + n N): the free length, then the spans (1 beyond the termination: a
     dummy piece of material 1 and tension 0, cut off by a stuck hole)."""
     free = np.full((*ell_path.shape[:-1], 1), robot.free_length)
-    return np.concatenate([free, np.where(_active(robot), ell_path, 1.0)], -1)
+    return np.concatenate([free, np.where(_span_active(robot), ell_path, 1.0)], -1)
 
 
 def _memory_initial(robot: ContinuumRobot, batch: tuple[int, ...]) -> tuple[Array, Array, Array]:
@@ -330,7 +329,7 @@ def _memory_initial(robot: ContinuumRobot, batch: tuple[int, ...]) -> tuple[Arra
     J = robot.n_segments * robot.disks_per_segment
     h = robot.segment_length / robot.disks_per_segment
     g = _pieces(robot, np.full((robot.n_cables, J), h))
-    live = np.concatenate([np.ones((robot.n_cables, 1), dtype=bool), _active(robot)], -1)
+    live = np.concatenate([np.ones((robot.n_cables, 1), dtype=bool), _span_active(robot)], -1)
     m = np.where(live, g * (1.0 - robot.pretension / robot.cable_axial_stiffness), 1.0)
     k = np.zeros((*batch, 2 * J))
     return k, np.broadcast_to(m, (*batch, *m.shape)).copy(), np.zeros((*batch, robot.n_cables, J))
@@ -348,7 +347,7 @@ def _memory_eval(
     fluxes ``s (..., 3 n, n N)``: the interval equilibrium (N m) and the hole complementarity (times h),
     with own branch, piece tensions, material, mu eta, disk poses and generalized force."""
     th, be, ell, dth, dbe, T = _geometry(robot, k)
-    act = _active(robot)
+    act = _span_active(robot)
     a = robot.friction_array[:, None] * np.where(act, _wrap_from_disks(robot, T), 0.0)
     ea = robot.cable_axial_stiffness
     h = robot.segment_length / robot.disks_per_segment
@@ -417,7 +416,7 @@ def _memory_step(
         r, own, tp, m, a, T, _ = _memory_eval(robot, k, s, m_prev, dq)
     res = np.linalg.norm(r[..., lo_idx:], axis=-1)
     finite = np.isfinite(res) & np.all(np.isfinite(x), axis=-1)
-    act = _active(robot)
+    act = _span_active(robot)
     return MemoryStep(
         k=k,
         material=m,
