@@ -194,7 +194,7 @@ def test_fixed_geometry_is_the_rigid_cable_memory(stiffer):
     N = robot.disks_per_segment
     k = _disks._uniform_k(robot, psi[0::2], psi[1::2])
     th, be = _disks._k_split(k)
-    ell = np.where(_disks._active(robot), _disks._interval_spans(robot, th, be)[0], 0.0)
+    ell = np.where(_disks._span_active(robot), _disks._interval_spans(robot, th, be)[0], 0.0)
     g = _disks._pieces(robot, ell)
     m = g * (1.0 - 5.0 / ea)  # every piece at 5 N
     targets = [9.0, 12.0, 10.0, 7.5, 11.0, 4.0]  # actuator tensions of cable 0 (N)

@@ -1,9 +1,5 @@
 """Paper 3: the cable-driven continuum robot — kinematics, statics, cable friction, compensation,
-identification.
-
-Constant-curvature segments ``psi = [theta_1, beta_1, ...]``; cables indexed ``3 i + j``; SI units.
-See ``docs/mechanisms/continuum.md`` for every assumption and every departure from the print.
-"""
+identification.  Coordinates, assumptions and departures: ``docs/mechanisms/continuum.md``."""
 
 from ._compensation import (
     COMPENSATION_ITERATIONS,

@@ -1,9 +1,5 @@
-"""Cable elongation, the compensated drive q~ = q + delta, and a quasi-static simulated robot.
-
-Drive convention: ``q (..., 3 n)`` is the length of cable each actuator has pulled in since the straight,
-pretensioned pose (m); the theoretical drive is ``q = -(L(psi) - L(0))`` (paper 3, eq. (37) adds the
-elongation delta to it).
-"""
+"""Cable elongation, the compensated drive q~ = q + delta (paper 3, eqs. (33)-(37)) and a quasi-static
+simulated robot; the drive convention ``q = -(L(psi) - L(0))``: ``docs/mechanisms/continuum.md``."""
 
 from __future__ import annotations
 
@@ -15,9 +11,20 @@ import numpy as np
 from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_batch, check_choice, check_params
 
-from ._disks import DiskEquilibrium, _active, _memory_initial, _memory_step, _segment_psi, _solve, _uniform_k
+from ._disks import (
+    DiskEquilibrium,
+    _fd_jacobian,
+    _gauss_newton_step,
+    _memory_initial,
+    _memory_step,
+    _newton,
+    _segment_psi,
+    _solve,
+    _to_bending_vector,
+    _uniform_k,
+)
 from ._friction import STUCK_FLUX_TOL, _as_direction, _factors, _wrap, stick_slip_tensions
-from ._kinematics import CableModel, _disk_T, _fk, _segment_spans, _split, span_lengths
+from ._kinematics import CableModel, _active, _disk_T, _fk, _segment_spans, _span_active, _split, span_lengths
 from ._params import ContinuumRobot
 from ._pulley import PULLEY_FIXED_POINT_ITERATIONS, Pulley, pulley_chain, pulley_stretch
 from ._statics import TensionResult, cable_tensions
@@ -41,19 +48,16 @@ __all__ = [
     "theoretical_drive",
 ]
 
-# Newton on the equilibrium of the simulated robot: converged when the generalized force residual is
-# below 1e-10 N m (1e-9 of the ~0.03 N m bending moments) ...
+# Newton on the simulated robot: converged below 1e-10 N m (1e-9 of the ~0.03 N m bending moments) ...
 SIM_TOLERANCE = 1e-10
-# ... within 40 iterations (quadratic convergence needs ~5 from a nearby start; the margin covers starts
-# far from the solution and the Coulomb kink of the wrap angles at theta = 0).
+# ... within 40 iterations (~5 from a nearby start; margin for far starts and the kink at theta = 0).
 SIM_MAX_ITERATIONS = 40
 # Step halvings of the backtracking line search (2^-12 ~ 2e-4 of a Newton step is the smallest tried).
 SIM_BACKTRACKS = 12
 # Central-difference step (rad) for the 2n x 2n Newton matrix: eps^(1/3) for O(1) curvature.
 SIM_FD_STEP = 6e-6
-# compensated_drive(method="disk"): Gauss-Newton on the commanded pose psi' (bending vectors), stopped
-# when the step is below 1e-10 rad (the segment ends then sit at their least-squares point to ~1e-11 m;
-# the residual itself is not 0: a 2n-parameter family cannot hit 3n coordinates exactly) ...
+# compensated_drive(method="disk"): Gauss-Newton on psi' stopped at a step below 1e-10 rad (the ends then
+# sit at their least-squares point to ~1e-11 m; 2n parameters cannot hit 3n coordinates exactly) ...
 COMPENSATION_STEP_TOL = 1e-10
 # ... or after 12 iterations (3-5 are needed from psi' = psi; the Jacobian is a central difference).
 COMPENSATION_ITERATIONS = 12
@@ -92,40 +96,22 @@ def cable_elongation(
     direction: object | None = None,
     model: CableModel = "chord",
 ) -> np.ndarray:
-    """Stretch of every cable relative to the straight pose at pretension, ``(..., 3 n)`` (m).
+    """Stretch ``(..., 3 n)`` (m) of every cable beyond its straight, pretensioned length (paper 3, eq. (33)).
 
-    Hooke's law along the cable (paper 3, eq. (33)): delta = (int T ds - T0 (L_free + L(0))) / (E A), with
-    ``tension (..., 3 n)`` the tension at the base plate, constant over the free length between the
-    actuator and the base and reduced span by span by the disk friction (``direction``).  This is the
-    discrete form of eq. (36) (which integrates an exponential tension profile).
+    delta = (int T ds - T0 (L_free + L(0))) / (E A), the discrete form of eq. (36): ``tension (..., 3 n)``
+    (N) at the base plate, constant over the free length and reduced span by span by the disk friction.
 
     Parameters
     ----------
     robot : ContinuumRobot
     psi : array_like, shape (..., 2 n)
-        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
     tension : array_like, shape (..., 3 n)
         Tension of every cable where it enters the base plate (N), e.g. ``cable_tensions(...).tension``.
     direction : array_like, shape (..., 3 n), optional
         Sliding direction of each cable (+1 pulled in, -1 paid out, see :func:`friction_factors`);
-        ``None``: frictionless.
+        ``None``: frictionless.  The same argument in every function of the package.
     model : {"chord", "arc"}, optional
-        Cable path model of the spans (straight chords between holes, or arcs); default ``"chord"``.
-
-    Returns
-    -------
-    ndarray, shape (..., 3 n)
-        Elongation delta of every cable (m), positive = stretched beyond its pretensioned straight
-        length; the batch shape is the broadcast of those of ``psi``, ``tension`` and ``direction``.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> robot = cr.ContinuumRobot.paper()
-    >>> t = cr.cable_tensions(robot, np.array([0.5, 0.0])).tension
-    >>> cr.cable_elongation(robot, np.array([0.5, 0.0]), t).shape
-    (3,)
+        Cable path model of the spans (see :func:`cable_lengths`).
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -138,43 +124,20 @@ def cable_elongation(
 
 @carries_failed_rows({"psi": 1})
 def theoretical_drive(robot: ContinuumRobot, psi: object, model: CableModel = "arc") -> np.ndarray:
-    """Cable pulled in by each actuator for a rigid, frictionless robot: q = -(L(psi) - L(0)).
-
-    The theoretical drive of paper 3, eq. (37) (before the elongation delta is added): the change of the
-    geometric cable length between the straight pose and ``psi``, sign flipped so that a cable that
-    shortens is pulled in (q > 0).
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
-    model : {"chord", "arc"}, optional
-        Cable path model of the spans (straight chords between holes, or arcs); default ``"arc"``.
+    """Cable ``(..., 3 n)`` (m) pulled in by each actuator of a rigid, frictionless robot since the
+    straight pose: q = -(L(psi) - L(0)), paper 3, eq. (37) before delta is added.
 
     Returns
     -------
     ndarray, shape (..., 3 n)
-        Cable length pulled in by every actuator since the straight pose (m); 0 at ``psi = 0``.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> cr.theoretical_drive(cr.ContinuumRobot.paper(), np.array([0.5, 0.0])).round(6)
-    array([ 0.002, -0.001, -0.001])
     """
     check_params(robot, ContinuumRobot, "robot")
-    theta, beta = _split(robot, psi)
-    psi_a = np.stack([theta, beta], -1).reshape(*theta.shape[:-1], 2 * theta.shape[-1])
-    return -(span_lengths(robot, psi_a, model).sum(axis=-1) - _l0(robot, model))
+    return -(span_lengths(robot, psi, model).sum(axis=-1) - _l0(robot, model))
 
 
 @dataclass(frozen=True)
 class DriveResult:
-    """Compensated drive, the result of :func:`compensated_drive` (paper 3, eq. (37)).
-
-    ``q_compensated = q + delta``; where ``taut`` is false the compensation is not meaningful.
+    """Compensated drive ``q_compensated = q + delta`` (paper 3, eq. (37)), from :func:`compensated_drive`.
 
     Attributes
     ----------
@@ -217,60 +180,29 @@ def compensated_drive(
     method: CompensationMethod = "paper",
     pulley: Pulley | None = None,
 ) -> DriveResult:
-    """Feed-forward drive for pose ``psi (..., 2 n)``: q~ = q + delta (paper 3, eq. (37), Fig. 10).
+    """Feed-forward drive q~ = q + delta at ``psi (..., 2 n)`` (paper 3, eq. (37)): :class:`DriveResult`.
 
-    ``method="paper"``: the tensions come from :func:`cable_tensions` (virtual work, friction along the
-    disks in the sliding ``direction``, pretension in the null space), the elongation from
-    :func:`cable_elongation`, q~ = q + delta.
-
-    ``method="disk"`` (not in the paper): the drive that puts the segment ends of the
-    disk-wise constant-curvature model (:func:`disk_equilibrium`: one arc per disk interval, so the
-    curvature can fall from disk to disk under friction) on the commanded ones.  A pose psi' is sought
-    (Gauss-Newton, least squares over the 3 n end coordinates) whose library tensions
-    (:func:`cable_tensions` at psi', same pretension rule) hold the disk-wise robot with its segment ends
-    at those of psi; q~ is the drive of that equilibrium (chord lengths and cable stretch included), and
-    ``delta = q~ - q``.  Chord cables only (``model="chord"``), no ``wrench``.
-
-    ``pulley`` (paper 3, eqs. (29)-(35)): the guide pulley at every actuator.  The tension entering the
-    robot is the model tension above; the actuator side differs by the improved-capstan ratio kappa
-    (eq. (32), in the cable's sliding ``direction``), and the cable wrapped over the pulley stretches by
-    delta_c (eq. (34)), which is added to delta.  None (default): no pulley, today's drive exactly.
+    ``method="paper"``: tensions from :func:`cable_tensions`, delta from :func:`cable_elongation`.
+    ``method="disk"`` (not in the paper): the drive whose :func:`disk_equilibrium` puts the segment ends
+    on the commanded ones (chord cables, no ``wrench``).  ``pulley``: the guide pulley at every actuator
+    (eqs. (29)-(35)), its stretch added to delta.  Both: ``docs/mechanisms/continuum.md``.
 
     Parameters
     ----------
     robot : ContinuumRobot
     psi : array_like, shape (..., 2 n)
-        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
     direction : array_like, shape (..., 3 n), optional
-        Sliding direction of each cable (+1 pulled in, -1 paid out, see :func:`friction_factors`);
-        ``None``: frictionless.
     model : {"chord", "arc"}, optional
-        Cable path model of the spans (straight chords between holes, or arcs); default ``"chord"``.
     wrench : array_like, shape (..., 6), optional
-        External wrench ``[m; f]`` (N m, N) at the tip, base frame (``method="paper"`` only); ``None``:
-        unloaded.
+        External wrench ``[m; f]`` (N m, N) at the tip, base frame; ``None``: unloaded.
     method : {"paper", "disk"}, optional
-        ``"paper"`` (default): segment-wise constant curvature as printed; ``"disk"``: the disk-wise
-        model, see above.
     pulley : Pulley, optional
-        Guide pulley at every actuator (eqs. (29)-(35)); ``None``: no pulley.
-
-    Returns
-    -------
-    DriveResult
+        ``None``: no pulley.
 
     Raises
     ------
     ValueError
         ``method="disk"`` combined with ``model="arc"`` or a ``wrench``.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> res = cr.compensated_drive(cr.ContinuumRobot.paper(), np.array([0.5, 0.0]))
-    >>> res.q_compensated.shape, bool(res.taut)
-    ((3,), True)
     """
     check_params(robot, ContinuumRobot, "robot")
     check_choice(method, "method", ("paper", "disk"))
@@ -298,21 +230,14 @@ def compensated_drive(
         delta = cable_elongation(robot, psi_a, tr.tension, direction, model)
         tension, taut = tr.tension, tr.taut
     if pulley is None:
-        return DriveResult(
-            q=q,
-            delta=delta,
-            q_compensated=q + delta,
-            tension=tension,
-            taut=taut,
-            actuator_tension=tension,
-            delta_pulley=np.zeros_like(delta),
-        )
-    d = np.broadcast_to(_as_direction(robot, direction, theta.shape[:-1]), tension.shape)
-    with np.errstate(invalid="ignore", over="ignore"):
-        t_act, d_c = pulley_stretch(robot, pulley, np.nan_to_num(tension), d)
-    ok = taut & np.all(np.isfinite(tension) & (tension > 0.0), axis=-1)
-    t_act = np.where(ok[..., None], t_act, np.nan)
-    d_c = np.where(ok[..., None], d_c, np.nan)
+        t_act, d_c, ok = tension, np.zeros_like(delta), taut
+    else:
+        d = np.broadcast_to(_as_direction(robot, direction, theta.shape[:-1]), tension.shape)
+        with np.errstate(invalid="ignore", over="ignore"):
+            t_act, d_c = pulley_stretch(robot, pulley, np.nan_to_num(tension), d)
+        ok = taut & np.all(np.isfinite(tension) & (tension > 0.0), axis=-1)
+        t_act = np.where(ok[..., None], t_act, np.nan)
+        d_c = np.where(ok[..., None], d_c, np.nan)
     return DriveResult(
         q=q,
         delta=delta + d_c,
@@ -327,7 +252,7 @@ def compensated_drive(
 # ---- the simulated robot --------------------------------------------------------------------------
 @dataclass(frozen=True)
 class SimulationResult:
-    """Quasi-static equilibrium of the simulated robot under a drive, the result of :func:`simulate`.
+    """Quasi-static equilibrium of the simulated robot under a drive (from :func:`simulate`).
 
     Attributes
     ----------
@@ -335,10 +260,8 @@ class SimulationResult:
         Equilibrium pose ``[theta_1, beta_1, ...]`` (rad).
     tension : ndarray, shape (..., 3 n)
         Cable tension where it enters the base plate (N, >= 0; 0 for a slack cable).
-    taut : ndarray of bool, shape (...)
-        No cable went slack.
-    converged : ndarray of bool, shape (...)
-        Newton met ``SIM_TOLERANCE``.
+    taut, converged : ndarray of bool, shape (...)
+        No cable went slack; Newton met ``SIM_TOLERANCE``.
     residual : ndarray, shape (...)
         Norm of the generalized-force residual (N m).
     iterations : ndarray of int, shape (...)
@@ -383,20 +306,12 @@ def _sim_residual(robot, k, q, d, model, pulley=None):
             t_raw = num / (den + R * integral / t_lvl)
             t_lvl = np.maximum(t_raw, np.finfo(float).tiny)
     t = np.maximum(t_raw, 0.0)
-    # Virtual work of the span tensions, with d/dbeta divided by theta (finite at the straight pose):
-    # d/dk = d/dtheta (cos b, sin b) + (d/dbeta)/theta (-sin b, cos b).
+    # Virtual work of the span tensions, with d/dbeta divided by theta (finite at the straight pose).
     _, dth, dbe_t = _segment_spans(robot, theta, beta, model)
-    act = robot.cable_segment[:, None] >= np.arange(robot.n_segments)[None, :]
-    N = robot.disks_per_segment
-    Pseg = P.reshape(*P.shape[:-1], robot.n_segments, N).sum(axis=-1)  # (..., 3n, n)
-    w = np.where(act, Pseg, 0.0) * t[..., :, None]
+    Pseg = P.reshape(*P.shape[:-1], robot.n_segments, robot.disks_per_segment).sum(axis=-1)  # (..., 3n, n)
+    w = np.where(_active(robot), Pseg, 0.0) * t[..., :, None]
     f_th = -np.sum(w * dth, axis=-2) - robot.bending_stiffness / robot.segment_length * theta
-    f_bt = -np.sum(w * dbe_t, axis=-2)
-    cb, sb = np.cos(beta), np.sin(beta)
-    F = np.empty_like(k)
-    F[..., 0::2] = f_th * cb - f_bt * sb
-    F[..., 1::2] = f_th * sb + f_bt * cb
-    return F, t_raw
+    return _to_bending_vector(k, f_th, -np.sum(w * dbe_t, axis=-2), beta), t_raw
 
 
 @carries_failed_rows({"q": 1}, {"direction": 1, "initial": 1})
@@ -409,31 +324,12 @@ def simulate(
     initial: object | None = None,
     pulley: Pulley | None = None,
 ) -> SimulationResult:
-    """Equilibrium pose of a robot whose actuators have pulled in ``q (..., 3 n)`` (m): a simulated robot.
+    """Equilibrium pose of a simulated robot whose actuators have pulled in ``q (..., 3 n)`` (m):
+    :class:`SimulationResult`.
 
-    Model: constant-curvature segments with the core energy of eq. (8); elastic cables (E A) over the
-    free length and the spans; Coulomb friction at every hole in the sliding ``direction``; cables that
-    would push go slack (tension 0, ``taut`` false).  Solved by Newton in bending-vector coordinates
-    (smooth through the straight pose), starting from ``initial`` psi or the rigid-cable arc solution.
-    ``pulley``: the guide pulley at every actuator (eqs. (29)-(34)): its wrapped cable stretches with the
-    improved-capstan tension profile; ``actuator_tension`` is the tension beyond it.  None: no pulley.
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    q : array_like, shape (..., 3 n)
-        Cable pulled in by each actuator since the straight, pretensioned pose (m), e.g.
-        ``compensated_drive(...).q_compensated``.
-    direction : array_like, shape (..., 3 n), optional
-        Sliding direction of each cable (+1 pulled in, -1 paid out, see :func:`friction_factors`);
-        ``None``: frictionless.
-    model : {"chord", "arc"}, optional
-        Cable path model of the spans (straight chords between holes, or arcs); default ``"chord"``.
-    initial : array_like, shape (..., 2 n), optional
-        Pose ``[theta_1, beta_1, ...]`` (rad) to start Newton from; ``None``: the least-squares
-        rigid-arc-cable pose for ``q``.
-    pulley : Pulley, optional
-        Guide pulley at every actuator (eqs. (29)-(34)); ``None``: no pulley.
+    Constant-curvature segments, elastic cables, Coulomb friction at every hole in ``direction``, slack
+    cables flagged; Newton in the bending vectors from ``initial`` (``None``: the rigid-arc-cable pose
+    for ``q``); ``pulley`` as in :func:`compensated_drive` (``docs/mechanisms/continuum.md``).
 
     Returns
     -------
@@ -441,11 +337,9 @@ def simulate(
 
     Examples
     --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> robot = cr.ContinuumRobot.paper()
-    >>> q = cr.compensated_drive(robot, np.array([0.5, 0.0])).q_compensated
-    >>> res = cr.simulate(robot, q)
+    >>> robot = ContinuumRobot.paper()
+    >>> q = compensated_drive(robot, np.array([0.5, 0.0])).q_compensated
+    >>> res = simulate(robot, q)
     >>> bool(res.converged), bool(res.taut), round(float(res.psi[0]), 4)
     (True, True, 0.5)
     """
@@ -465,7 +359,7 @@ def simulate(
     n = robot.n_segments
     if initial is None:
         # Rigid arc cables: q_c = r sum_{m <= seg(c)} k_m . (cos s_c, sin s_c); least squares for k.
-        sig, act = robot.hole_angles, robot.cable_segment[:, None] >= np.arange(n)[None, :]
+        sig, act = robot.hole_angles, _active(robot)
         A = np.zeros((robot.n_cables, 2 * n))
         A[:, 0::2] = robot.hole_radius * np.cos(sig)[:, None] * act
         A[:, 1::2] = robot.hole_radius * np.sin(sig)[:, None] * act
@@ -474,44 +368,12 @@ def simulate(
         th0, be0 = _split(robot, initial, "initial")
         k = np.stack([th0 * np.cos(be0), th0 * np.sin(be0)], -1).reshape(*th0.shape[:-1], 2 * n)
     k = np.broadcast_to(k, (*batch, 2 * n)).copy()
-    converged = np.zeros(batch, dtype=bool)
-    iterations = np.zeros(batch, dtype=int)
-    eye = np.eye(2 * n)
-    for _ in range(SIM_MAX_ITERATIONS):  # Newton iterations over the whole batch
-        F, _ = _sim_residual(robot, k, qa, d, model, pulley)
-        converged = np.linalg.norm(F, axis=-1) < SIM_TOLERANCE
-        if np.all(converged):
-            break
-        cols = []
-        for j in range(2 * n):
-            e = SIM_FD_STEP * eye[j]
-            cols.append(
-                (
-                    _sim_residual(robot, k + e, qa, d, model, pulley)[0]
-                    - _sim_residual(robot, k - e, qa, d, model, pulley)[0]
-                )
-                / (2 * SIM_FD_STEP)
-            )
-        Jm = np.stack(cols, -1)
-        # pinv, not solve: a singular Newton matrix in one sample must not abort the batch
-        step = np.einsum("...ij,...j->...i", np.linalg.pinv(Jm), F)
-        # Backtracking: halve the step where it does not reduce |F| (the slack clip and the Coulomb
-        # kink at theta = 0 make F only piecewise smooth).
-        f0 = np.linalg.norm(F, axis=-1)
-        scale = np.ones(batch)
-        for _ in range(SIM_BACKTRACKS):
-            F_try, _ = _sim_residual(robot, k - scale[..., None] * step, qa, d, model, pulley)
-            trial = np.linalg.norm(F_try, axis=-1)
-            worse = (trial >= f0) & ~converged
-            if not np.any(worse):
-                break
-            scale = np.where(worse, 0.5 * scale, scale)
-        k = np.where(converged[..., None], k, k - scale[..., None] * step)
-        iterations = iterations + ~converged
+    # Newton with backtracking: the slack clip and the Coulomb kink at theta = 0 make F piecewise smooth
+    fun = lambda kk: _sim_residual(robot, kk, qa, d, model, pulley)[0]  # noqa: E731
+    k, _, iterations = _newton(fun, k, SIM_TOLERANCE, SIM_MAX_ITERATIONS, SIM_FD_STEP, SIM_BACKTRACKS)
     F, t_raw = _sim_residual(robot, k, qa, d, model, pulley)
     res = np.linalg.norm(F, axis=-1)
-    theta, beta = _k_to_psi(k)
-    psi = np.stack([theta, beta], -1).reshape(*batch, 2 * n)
+    psi = _psi_from_u(k)
     tension = np.maximum(t_raw, 0.0)
     if pulley is None:
         t_act = tension
@@ -532,33 +394,26 @@ def simulate(
 
 @dataclass(frozen=True)
 class HistoryResult:
-    """Quasi-static response to a history of drives, the result of :func:`simulate_history`.
-
-    Time axis first (``n_t`` samples), then the batch shape ``...``.
+    """Quasi-static response to a history of drives (from :func:`simulate_history`), time axis first.
 
     Attributes
     ----------
     psi : ndarray, shape (n_t, ..., 2 n)
-        Pose at every step (rad); with ``memory="elastic"`` the constant-curvature arc with each
-        segment's end-disk orientation (bend between the segment's base and end disk normals).
-    tension : ndarray, shape (n_t, ..., 3 n)
-        Cable tension between the actuator and the base plate (N, >= 0).
-    actuator_tension : ndarray, shape (n_t, ..., 3 n)
-        Tension at the actuator, beyond the pulley (N); equal to ``tension`` without a pulley.
+        Pose at every step (rad); ``memory="elastic"``: the arcs with each segment's end-disk orientation.
+    tension, actuator_tension : ndarray, shape (n_t, ..., 3 n)
+        Cable tension between the actuator and the base plate, and at the actuator beyond the pulley (N;
+        the same without a pulley).
     direction : ndarray, shape (n_t, ..., 3 n)
-        Sign of every cable's last nonzero drive increment (+1 pulled in, -1 paid out; +1 before it
-        moved).  With ``memory="slip"`` the sliding direction used at every hole; with ``"elastic"``
-        for information only (each hole's own state is ``state``).
+        Sign of every cable's last nonzero drive increment (+1 before it moved): ``memory="slip"``'s
+        sliding direction; for information only with ``"elastic"`` (each hole's own is ``state``).
     span_tension : ndarray, shape (n_t, ..., 3 n, n N)
-        Tension of every span (N, 0 beyond a cable's termination): with ``memory="elastic"`` those that
-        hold the pose; with ``"slip"`` :func:`stick_slip_tensions` fed with the base tensions afterwards.
+        Tension of every span (N, 0 beyond a cable's termination); ``"slip"``: from
+        :func:`stick_slip_tensions`, not acting on the pose.
     state : ndarray of int, shape (n_t, ..., 3 n, n N)
         Every hole in that step (the hole where each span starts): +1 cable sliding toward the actuator,
         -1 away from it, 0 stuck.
-    taut : ndarray of bool, shape (n_t, ...)
-        No cable (piece) went slack.
-    converged : ndarray of bool, shape (n_t, ...)
-        The step's equilibrium met its tolerance (``SIM_TOLERANCE`` / ``DISK_TOLERANCE``).
+    taut, converged : ndarray of bool, shape (n_t, ...)
+        No cable (piece) went slack; the step met its tolerance (``SIM_TOLERANCE`` / ``DISK_TOLERANCE``).
     residual : ndarray, shape (n_t, ...)
         Norm of the equilibrium residual (N m; with ``"elastic"`` including the hole conditions, N
         times the disk spacing).
@@ -569,9 +424,8 @@ class HistoryResult:
     bend : ndarray, shape (n_t, ..., n N, 2)
         ``[theta_j, beta_j]`` (rad) of every disk interval (``"slip"``: the segment arcs spread evenly).
     slip : ndarray, shape (n_t, ..., 3 n, n N)
-        Cable length that crossed every hole toward the actuator during the step (m; 0 where stuck).
-        ``"slip"``: the length implied by the sliding model's span lengths and tensions (its sign need
-        not agree with the assumed direction: the model does not enforce it).
+        Cable length that crossed every hole toward the actuator during the step (m; 0 where stuck;
+        ``"slip"``: implied by the sliding model, whose sign it does not enforce).
     """
 
     psi: np.ndarray
@@ -598,49 +452,13 @@ def simulate_history(
     pulley: Pulley | None = None,
     memory: HistoryMemory = "elastic",
 ) -> HistoryResult:
-    """The simulated robot driven through a history ``q (n_t, ..., 3 n)`` (m, leading time axis).
+    """The simulated robot driven through a history ``q (n_t, ..., 3 n)`` (m, time axis first) from the
+    straight pretensioned pose: :class:`HistoryResult`, path-dependent (paper 3, eq. (19) with memory).
 
-    Path-dependent (paper 3 eq. (19) with memory), from the straight pretensioned pose
-    (q = 0, every span at the pretension).
-
-    ``memory="elastic"`` (default): stick-slip with memory that the pose feels, on the disk-wise robot
-    (:func:`disk_equilibrium`: one arc per disk interval, chord spans, beam-column correction).  The
-    state is the unstretched cable material of every piece (the free length and each span between two
-    holes); a piece's tension follows Hooke's law on its current length, so a stuck span's tension
-    changes elastically with the pose, and the actuator changes the material of the free length.  At
-    every hole the ratio of the neighbouring span tensions lies in the capstan cone
-    ``[exp(-mu eta), exp(+mu eta)]`` (eta the wrap angle of the current pose): inside, the hole is
-    stuck (no material crosses it); on a bound it slides in the direction that bound says.  Each step
-    solves the pose and the material crossing every hole together (semi-smooth Newton, a primal-dual
-    active set on the holes' branches, from the previous step with every hole stuck).  Monotone
-    driving gives the full-slip equilibrium; at a reversal the pose stands still until the tensions
-    have crossed the friction cone (dead band); a cable held still is stuck.  Chord cables only, no
-    pulley.
-
-    ``memory="slip"`` (the earlier model, kept for the arc cables and the pulley): every cable slides
-    at every hole in the direction of its last nonzero drive increment (+1 before it moved), each step
-    is :func:`simulate` (segment-wise constant curvature) in those directions; the span tensions with
-    memory come from :func:`stick_slip_tensions` afterwards and do not act on the pose.
-    Cables that would push are flagged per sample (``taut`` false), not raised.
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    q : array_like, shape (n_t, ..., 3 n)
-        Drive history: cable pulled in by each actuator since the straight, pretensioned pose (m),
-        time axis first (``n_t >= 1``).
-    times : array_like, shape (n_t,), optional
-        Strictly increasing time stamps (s); the quasi-static model does not use them beyond the
-        check (rate-independent friction).  ``None``: no time stamps.
-    model : {"chord", "arc"}, optional
-        Cable path model of the spans (straight chords between holes, or arcs); default ``"chord"``
-        (``memory="elastic"`` needs ``"chord"``).
-    pulley : Pulley, optional
-        Guide pulley at every actuator (eqs. (29)-(34)); ``None``: no pulley (``memory="elastic"``
-        needs ``None``).
-    memory : {"elastic", "slip"}, optional
-        ``"elastic"`` (default): stick-slip fed back into the pose, see above; ``"slip"``: the sliding
-        approximation.
+    ``memory="elastic"`` (default; chord cables, no pulley): stick-slip of elastic cables through the
+    holes, fed back into the pose of the disk-wise robot; ``"slip"``: every cable slides in the direction
+    of its last drive increment, each step :func:`simulate`.  Both: ``docs/mechanisms/continuum.md``,
+    "Stick-slip with memory that the pose feels" and departure 15.  ``times`` (s) are only checked.
 
     Returns
     -------
@@ -650,16 +468,6 @@ def simulate_history(
     ------
     ValueError
         ``times`` not strictly increasing, or ``memory="elastic"`` combined with ``model="arc"`` or a pulley.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> robot = cr.ContinuumRobot.paper()
-    >>> q = np.linspace(0.0, 1e-3, 3)[:, None] * np.array([1.0, -0.5, -0.5])   # pull cable 1 (m)
-    >>> res = cr.simulate_history(robot, np.concatenate([q, q[-2::-1]]))      # and release it
-    >>> res.psi.shape, bool(res.valid.all()), bool(res.psi[3, 0] > res.psi[1, 0])  # unloading above
-    ((5, 2), True, True)
     """
     check_params(robot, ContinuumRobot, "robot")
     if pulley is not None:
@@ -710,7 +518,7 @@ def _elastic_history(robot: ContinuumRobot, qa: np.ndarray) -> HistoryResult:
     batch = qa.shape[1:-1]
     k, m, _ = _memory_initial(robot, batch)
     prev_q = np.zeros((*batch, robot.n_cables))
-    act = _active(robot)
+    act = _span_active(robot)
     rows = []
     for i in range(qa.shape[0]):  # a history is sequential
         st = _memory_step(robot, k, m, qa[i] - prev_q)
@@ -778,7 +586,7 @@ def _slip_history(
     span_t = np.nan_to_num(tension)[..., None] * _factors(
         robot, _wrap(robot, psi0[..., 0::2], psi0[..., 1::2]), dirs
     )
-    act = _active(robot)
+    act = _span_active(robot)
     mat = np.where(act, ell * (1.0 - span_t / robot.cable_axial_stiffness), 0.0)
     h0 = robot.segment_length / N
     rest = np.where(act, h0 * (1.0 - robot.pretension / robot.cable_axial_stiffness), 0.0)
@@ -826,19 +634,9 @@ def _disk_compensation(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarra
     target = _fk(robot, theta, beta)[..., :3, 3].reshape(*theta.shape[:-1], 3 * n)
     u = np.stack([theta * np.cos(beta), theta * np.sin(beta)], -1).reshape(*theta.shape[:-1], 2 * n)
     done = np.zeros(theta.shape[:-1], dtype=bool)
-    eye = np.eye(2 * n)
+    ends = lambda uu: _ends_of(robot, _disk_at(robot, uu, d))  # noqa: E731
     for _ in range(COMPENSATION_ITERATIONS):
-        e = _ends_of(robot, _disk_at(robot, u, d)) - target
-        cols = [
-            (
-                _ends_of(robot, _disk_at(robot, u + COMPENSATION_FD_STEP * v, d))
-                - _ends_of(robot, _disk_at(robot, u - COMPENSATION_FD_STEP * v, d))
-            )
-            / (2.0 * COMPENSATION_FD_STEP)
-            for v in eye
-        ]
-        Jm = np.nan_to_num(np.stack(cols, -1))
-        step = np.einsum("...ij,...j->...i", np.linalg.pinv(Jm), np.nan_to_num(e))
+        step = _gauss_newton_step(_fd_jacobian(ends, u, COMPENSATION_FD_STEP), ends(u) - target)
         u = np.where(done[..., None], u, u - step)
         done = done | (np.max(np.abs(step), axis=-1) < COMPENSATION_STEP_TOL)
         if np.all(done):
@@ -855,23 +653,11 @@ def disk_equilibrium(
     direction: object | None = None,
     initial: object | None = None,
 ) -> DiskEquilibrium:
-    """Equilibrium of the disk-wise constant-curvature robot: one arc per disk interval.
+    """Equilibrium of the disk-wise constant-curvature robot, one arc per disk interval (not in paper 3;
+    ``docs/mechanisms/continuum.md``): :class:`DiskEquilibrium`.
 
-    Exactly one of ``tension`` and ``drive`` loads the robot.  Chord spans, wrap angles, capstan
-    friction and cable stretch as in the segment model; the curvature may differ from interval to
-    interval.  Not in paper 3 (which keeps one arc per segment); see ``docs/mechanisms/continuum.md``.
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    tension : array_like, shape (..., 3 n), optional
-        Actuator-side tensions (N, >= 0).
-    drive : array_like, shape (..., 3 n), optional
-        Cable pulled in since the straight pretensioned pose (m); elastic cables, slack ones flagged.
-    direction : array_like, shape (..., 3 n), optional
-        Sliding direction of every cable (+1 pulled in, -1 paid out); ``None``: frictionless.
-    initial : array_like, shape (..., 2 n), optional
-        Segment pose ``[theta_1, beta_1, ...]`` (rad) to start from; ``None``: the straight robot.
+    Loaded by exactly one of ``tension`` (actuator side, N) and ``drive`` (m pulled in); ``initial``
+    the segment pose ``psi`` to start from (``None``: straight).
 
     Returns
     -------
@@ -881,16 +667,6 @@ def disk_equilibrium(
     ------
     ValueError
         Both or neither of ``tension`` and ``drive`` given.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> robot = cr.ContinuumRobot.paper()
-    >>> t = cr.compensated_drive(robot, np.array([0.5, 0.0])).tension
-    >>> eq = cr.disk_equilibrium(robot, tension=t)
-    >>> eq.tip.shape, bool(eq.converged)
-    ((3,), True)
     """
     check_params(robot, ContinuumRobot, "robot")
     if (tension is None) == (drive is None):

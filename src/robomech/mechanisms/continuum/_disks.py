@@ -1,17 +1,6 @@
-"""Disk-wise constant curvature: every disk interval its own arc.
-
-Paper 3 models each segment as one arc (eqs. (1)-(4)) and multiplies the tensions by one friction
-factor per segment (eq. (24)).  With friction at the holes the span tensions fall (pulled cable) or
-rise (paid-out cables) from disk to disk, so the bending moment and the curvature do too (12.5 ... 5.6 deg
-over the five intervals of a 45 deg arc, ``docs/mechanisms/continuum_cosserat.md``): one arc per segment
-cannot represent that shape.
-
-This module relaxes constant curvature to one arc per disk interval (the same cable chords, wrap angles,
-capstan friction and elastic cables as the segment model, see :mod:`._compensation`); it reduces to the
-segment model when all span tensions are equal (no friction).  Equilibrium of interval j by virtual
-work with its own span tensions: ``EI theta_j / h = -sum_c T_cj d ell_cj / d theta_j`` (and the beta
-component), the chord length ``ell_cj`` of cable c over interval j depending on that interval's
-bend only.  Solved by Newton in bending-vector coordinates k_j = theta_j (cos beta_j, sin beta_j).
+"""Disk-wise constant curvature (not in paper 3): every disk interval its own arc, so that the curvature
+can fall from disk to disk under friction; equilibrium by virtual work per interval, Newton in the
+bending vectors.  Model and measurements: ``docs/mechanisms/continuum.md``, "Disk-wise constant curvature".
 """
 
 from __future__ import annotations
@@ -24,7 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ._friction import _factors, _hole_residual, _wrap_from_disks
-from ._kinematics import _dsinc_over_x, _segment_T, _sinc
+from ._kinematics import _dsinc_over_x, _segment_T, _sinc, _span_active
 from ._params import ContinuumRobot
 
 __all__ = ["DISK_MAX_ITERATIONS", "DISK_TOLERANCE", "MEMORY_MAX_ITERATIONS", "DiskEquilibrium"]
@@ -46,9 +35,8 @@ COLUMN_PASSES = 8
 DISK_FD_STEP = 6e-6
 """Central-difference step (rad) of the Newton matrix: eps^(1/3) for O(0.1) interval bends."""
 MEMORY_MAX_ITERATIONS = 40
-"""Semi-smooth Newton iterations of one stick-slip history step (pose and hole fluxes together; the
-branch of every hole is re-read at each iterate; measured 5-8 per step on the study's load-unload
-cycle, 13 at most)."""
+"""Semi-smooth Newton iterations of one stick-slip history step (measured 5-8 per step on the study's
+load-unload cycle, 13 at most)."""
 MEMORY_FD_FLUX = 1e-8
 """Central-difference step (m) of the hole fluxes in the Newton matrix (tensions are linear in the
 flux up to the column shortening, so any small step works; 1e-8 m is ~1e-3 N of tension)."""
@@ -56,7 +44,7 @@ flux up to the column shortening, so any small step works; 1e-8 m is ~1e-3 N of 
 
 @dataclass(frozen=True)
 class DiskEquilibrium:
-    """Equilibrium of the disk-wise constant-curvature robot (batch shape ``...``), SI units.
+    """Equilibrium of the disk-wise constant-curvature robot (from :func:`disk_equilibrium`).
 
     Attributes
     ----------
@@ -75,10 +63,8 @@ class DiskEquilibrium:
     drive : ndarray, shape (..., 3 n)
         Cable length pulled in by each actuator that holds this equilibrium (m; the given drive in
         drive mode).
-    taut : ndarray of bool, shape (...)
-        No cable slack.
-    converged : ndarray of bool, shape (...)
-        ``residual`` below ``DISK_TOLERANCE``.
+    taut, converged : ndarray of bool, shape (...)
+        No cable slack; ``residual`` below ``DISK_TOLERANCE``.
     residual : ndarray, shape (...)
         Generalized-force residual of the equilibrium (N m).
     """
@@ -134,16 +120,10 @@ def _column_shortening(th: Array, u: Array, h: float) -> Array:
 
 def _tension_estimate(robot: ContinuumRobot, ell: Array, P: Array, q: Array) -> Array:
     """Base tension from each cable's compatibility (path = L0 - q + stretch), linear in it."""
-    act = _active(robot)
+    act = _span_active(robot)
     L0 = act.sum(axis=-1) * (robot.segment_length / robot.disks_per_segment)
     ea, T0, Lf = robot.cable_axial_stiffness, robot.pretension, robot.free_length
     return (ea * (ell.sum(axis=-1) - L0 + q) + T0 * (Lf + L0)) / (Lf + np.sum(P * ell, axis=-1))
-
-
-def _active(robot: ContinuumRobot) -> NDArray[np.bool_]:
-    """(3 n, n N): cable c runs over interval j."""
-    N = robot.disks_per_segment
-    return np.arange(robot.n_segments * N)[None, :] < (N * (robot.cable_segment + 1))[:, None]
 
 
 def _chain(robot: ContinuumRobot, th: Array, be: Array) -> Array:
@@ -170,7 +150,7 @@ def _geometry(robot: ContinuumRobot, k: Array) -> tuple[Array, Array, Array, Arr
     """Interval bends, chord lengths (0 beyond a cable's termination) and their derivatives, disk poses."""
     th, be = _k_split(k)
     ell, dth, dbe = _interval_spans(robot, th, be)
-    ell = np.where(_active(robot), ell, 0.0)
+    ell = np.where(_span_active(robot), ell, 0.0)
     return th, be, ell, dth, dbe, _chain(robot, th, be)
 
 
@@ -178,7 +158,7 @@ def _path(robot: ContinuumRobot, th: Array, ell: Array, w: Array) -> Array:
     """Cable paths: chords minus the column shape's extra shortening under span tensions ``w``."""
     h = robot.segment_length / robot.disks_per_segment
     u_path = 0.5 * h * np.sqrt(np.sum(np.maximum(w, 0.0), axis=-2) / robot.bending_stiffness)
-    return ell - np.where(_active(robot), _column_shortening(th, u_path, h)[..., None, :], 0.0)
+    return ell - np.where(_span_active(robot), _column_shortening(th, u_path, h)[..., None, :], 0.0)
 
 
 def _forces(robot: ContinuumRobot, k: Array, th: Array, be: Array, w: Array, dth: Array, dbe: Array) -> Array:
@@ -192,7 +172,12 @@ def _forces(robot: ContinuumRobot, k: Array, th: Array, be: Array, w: Array, dth
     u = 0.5 * h * np.sqrt(np.sum(w, axis=-2) / ei)
     stiff = ei * (1.0 + _column_correction(u))
     f_th = -np.sum(w * dth, axis=-2) - stiff / h * th
-    f_bt = -np.sum(w * dbe, axis=-2)
+    return _to_bending_vector(k, f_th, -np.sum(w * dbe, axis=-2), be)
+
+
+def _to_bending_vector(k: Array, f_th: Array, f_bt: Array, be: Array) -> Array:
+    """Generalized forces in ``(theta, beta / theta)`` rotated to the bending vectors ``k (..., 2 J)``:
+    d/dk = d/dtheta (cos b, sin b) + (d/dbeta)/theta (-sin b, cos b)."""
     cb, sb = np.cos(be), np.sin(be)
     F = np.empty_like(k)
     F[..., 0::2] = f_th * cb - f_bt * sb
@@ -205,14 +190,11 @@ def _state(
 ) -> tuple[Array, Array, Array, Array, Array, Array]:
     """Generalized force (..., 2 J) and (t_raw, P, ell, disk poses) at bending vectors ``k``."""
     th, be, ell, dth, dbe, T = _geometry(robot, k)
-    act = _active(robot)
+    act = _span_active(robot)
     P = np.where(act, _factors(robot, _wrap_from_disks(robot, T), d), 0.0)
-    # The column shape shortens the interval more than its arc (see _column_shortening): in the cable
-    # paths only (the virtual work has it through the stiffness correction below).  In drive mode the
-    # compression depends on the tensions that depend on the paths: a fixed point (the shortening is
-    # ~1e-5 m, and 1e-5 m of path is ~0.1 N of tension); measured: after 5 passes the drive-mode round
-    # trip is off by 2e-7 N at 80 deg, after COLUMN_PASSES = 8 by 1e-9 N (paper robot, 1.0 mm core at
-    # 10 N; 2e-5 / 6e-8 N with a 0.8 mm core at 5 N).
+    # The column shape's extra shortening, in the cable paths only; in drive mode a fixed point (the
+    # compression depends on the tensions): the drive-mode round trip is off by 2e-7 N at 80 deg after 5
+    # passes, by 1e-9 N after COLUMN_PASSES = 8 (paper robot).
     ell_path, t_raw = ell, load
     for _ in range(1 if mode == "tension" else COLUMN_PASSES):
         t_u = load if mode == "tension" else _tension_estimate(robot, ell_path, P, load)
@@ -223,12 +205,17 @@ def _state(
 
 
 def _backtrack(
-    norm: Callable[[Array], Array], x: Array, step: Array, f0: Array, conv: NDArray[np.bool_]
+    norm: Callable[[Array], Array],
+    x: Array,
+    step: Array,
+    f0: Array,
+    conv: NDArray[np.bool_],
+    backtracks: int = DISK_BACKTRACKS,
 ) -> Array:
-    """``x - t step`` per sample, ``t`` halved (at most DISK_BACKTRACKS times) until the residual norm
+    """``x - t step`` per sample, ``t`` halved (at most ``backtracks`` times) until the residual norm
     ``norm`` falls below ``f0``; converged samples stay at ``x``."""
     scale = np.ones(conv.shape)
-    for _ in range(DISK_BACKTRACKS):
+    for _ in range(backtracks):
         worse = ~(norm(x - scale[..., None] * step) < f0) & ~conv
         if not np.any(worse):
             break
@@ -236,38 +223,53 @@ def _backtrack(
     return np.where(conv[..., None], x, x - scale[..., None] * step)
 
 
-def _newton(fun: Callable[[Array], Array], k0: Array) -> tuple[Array, NDArray[np.bool_]]:
+def _fd_jacobian(fun: Callable[[Array], Array], x: Array, step: float) -> Array:
+    """Central-difference Jacobian ``(..., m, k)`` of ``fun`` at ``x (..., k)``, non-finite entries 0."""
+    cols = [(fun(x + step * e) - fun(x - step * e)) / (2.0 * step) for e in np.eye(x.shape[-1])]
+    return np.nan_to_num(np.stack(cols, -1))
+
+
+def _gauss_newton_step(J: Array, F: Array) -> Array:
+    """``J^+ F`` per sample; pinv: a singular Newton matrix in one sample must not abort the batch."""
+    return np.einsum("...ij,...j->...i", np.linalg.pinv(J), np.nan_to_num(F))
+
+
+def _newton(
+    fun: Callable[[Array], Array],
+    k0: Array,
+    tol: float = DISK_TOLERANCE,
+    max_iterations: int = DISK_MAX_ITERATIONS,
+    fd_step: float = DISK_FD_STEP,
+    backtracks: int = DISK_BACKTRACKS,
+) -> tuple[Array, NDArray[np.bool_], NDArray[np.int_]]:
     """Newton with backtracking on ``fun(k) = 0`` from ``k0 (..., 2 J)``, central-difference Jacobian,
-    batched; returns (k, converged).  A singular or non-finite sample does not stop the others."""
+    batched; returns (k, converged, iterations).  A singular or non-finite sample does not stop the
+    others."""
     k = k0.copy()
-    batch = k.shape[:-1]
-    eye = np.eye(k.shape[-1])
-    conv = np.zeros(batch, dtype=bool)
+    conv = np.zeros(k.shape[:-1], dtype=bool)
+    iterations = np.zeros(k.shape[:-1], dtype=int)
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-        for _ in range(DISK_MAX_ITERATIONS):
+        for _ in range(max_iterations):
             F = fun(k)
             f0 = np.linalg.norm(F, axis=-1)
-            conv = f0 < DISK_TOLERANCE
+            conv = f0 < tol
             if np.all(conv | ~np.isfinite(f0)):
                 break
-            h2 = 2.0 * DISK_FD_STEP
-            cols = [(fun(k + DISK_FD_STEP * e) - fun(k - DISK_FD_STEP * e)) / h2 for e in eye]
-            Jm = np.nan_to_num(np.stack(cols, -1))
-            # pinv: a singular Newton matrix in one sample must not abort the batch
-            step = np.einsum("...ij,...j->...i", np.linalg.pinv(Jm), np.nan_to_num(F))
-            k = _backtrack(lambda kk: np.linalg.norm(fun(kk), axis=-1), k, step, f0, conv)
-    return k, conv
+            step = _gauss_newton_step(_fd_jacobian(fun, k, fd_step), F)
+            k = _backtrack(lambda kk: np.linalg.norm(fun(kk), axis=-1), k, step, f0, conv, backtracks)
+            iterations += ~conv
+    return k, conv, iterations
 
 
 def _solve(robot: ContinuumRobot, k0: Array, load: Array, d: Array, mode: Mode) -> DiskEquilibrium:
     """Newton with backtracking from ``k0 (..., 2 J)`` (all arrays already validated/broadcast)."""
-    k, _ = _newton(lambda kk: _state(robot, kk, load, d, mode)[0], k0)
+    k = _newton(lambda kk: _state(robot, kk, load, d, mode)[0], k0)[0]
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
         F, t_raw, P, ell, T, w = _state(robot, k, load, d, mode)
     res = np.linalg.norm(F, axis=-1)
     th, be = _k_split(k)
     t = np.maximum(t_raw, 0.0)
-    act = _active(robot)
+    act = _span_active(robot)
     L0 = act.sum(axis=-1) * (robot.segment_length / robot.disks_per_segment)
     ea, T0, Lf = robot.cable_axial_stiffness, robot.pretension, robot.free_length
     elong = (t * (Lf + np.sum(P * ell, axis=-1)) - T0 * (Lf + L0)) / ea
@@ -300,14 +302,9 @@ def _uniform_k(robot: ContinuumRobot, theta: Array, beta: Array) -> Array:
 # ---- stick-slip with memory fed back into the pose -------------------------------------------------
 @dataclass(frozen=True)
 class MemoryStep:
-    """One step of the stick-slip history of the disk-wise robot (internal; see simulate_history).
-
-    ``k (..., 2 J)`` bending vectors, ``material (..., 3 n, 1 + n N)`` unstretched cable of every piece
-    (free length first), ``slide (..., 3 n, n N)`` branch of every hole (0 stuck, +-1 sliding at the lower /
-    upper capstan bound), ``piece_tension`` (N, may be < 0 where slack), ``flux`` material crossing every
-    hole toward the actuator in this step (m), ``wrap_mu`` mu eta of every hole, ``disk_T`` disk poses,
-    ``converged`` (residual below DISK_TOLERANCE), ``residual`` (N m, pose and holes).
-    """
+    """One step of the stick-slip history of the disk-wise robot (internal; see simulate_history):
+    bending vectors, unstretched ``material (..., 3 n, 1 + n N)`` of every piece (free length first), the
+    branch of every hole, piece tensions (N, < 0 where slack), ``flux`` (m) and mu eta of every hole."""
 
     k: Array
     material: Array
@@ -324,7 +321,7 @@ def _pieces(robot: ContinuumRobot, ell_path: Array) -> Array:
     """Piece lengths (..., 3 n, 1 + n N): the free length, then the spans (1 beyond the termination: a
     dummy piece of material 1 and tension 0, cut off by a stuck hole)."""
     free = np.full((*ell_path.shape[:-1], 1), robot.free_length)
-    return np.concatenate([free, np.where(_active(robot), ell_path, 1.0)], -1)
+    return np.concatenate([free, np.where(_span_active(robot), ell_path, 1.0)], -1)
 
 
 def _memory_initial(robot: ContinuumRobot, batch: tuple[int, ...]) -> tuple[Array, Array, Array]:
@@ -332,7 +329,7 @@ def _memory_initial(robot: ContinuumRobot, batch: tuple[int, ...]) -> tuple[Arra
     J = robot.n_segments * robot.disks_per_segment
     h = robot.segment_length / robot.disks_per_segment
     g = _pieces(robot, np.full((robot.n_cables, J), h))
-    live = np.concatenate([np.ones((robot.n_cables, 1), dtype=bool), _active(robot)], -1)
+    live = np.concatenate([np.ones((robot.n_cables, 1), dtype=bool), _span_active(robot)], -1)
     m = np.where(live, g * (1.0 - robot.pretension / robot.cable_axial_stiffness), 1.0)
     k = np.zeros((*batch, 2 * J))
     return k, np.broadcast_to(m, (*batch, *m.shape)).copy(), np.zeros((*batch, robot.n_cables, J))
@@ -346,17 +343,11 @@ def _memory_eval(
     dq: Array,
     branch: Array | None = None,
 ) -> tuple[Array, Array, Array, Array, Array, Array, Array]:
-    """Residual of one history step at bending vectors ``k (..., 2 J)`` and hole fluxes ``s (..., 3 n, n N)``.
-
-    The material moved by the fluxes gives every piece its tension, T = EA (1 - m / g) on its current
-    length g (chord minus the column shortening, whose dependence on the tensions is the fixed point
-    of ``_state`` in drive mode, the same passes); the interval equilibrium under the span tensions
-    (N m) and the hole complementarity (N, scaled by the interval length h to N m) form the residual.
-    Returns (residual (..., 2 J + 3 n n N), own branch, piece tensions, material, mu eta, disk poses,
-    generalized force).
-    """
+    """Residual ``(..., 2 J + 3 n n N)`` of one history step at bending vectors ``k (..., 2 J)`` and hole
+    fluxes ``s (..., 3 n, n N)``: the interval equilibrium (N m) and the hole complementarity (times h),
+    with own branch, piece tensions, material, mu eta, disk poses and generalized force."""
     th, be, ell, dth, dbe, T = _geometry(robot, k)
-    act = _active(robot)
+    act = _span_active(robot)
     a = robot.friction_array[:, None] * np.where(act, _wrap_from_disks(robot, T), 0.0)
     ea = robot.cable_axial_stiffness
     h = robot.segment_length / robot.disks_per_segment
@@ -384,15 +375,9 @@ def _memory_eval(
 def _memory_step(
     robot: ContinuumRobot, k0: Array, m_prev: Array, dq: Array, *, fixed_pose: bool = False
 ) -> MemoryStep:
-    """One quasi-static step of the history: the drive moves by ``dq (..., 3 n)`` from (k0, m_prev).
-
-    Pose and hole fluxes are solved together by a semi-smooth Newton method (a primal-dual active set:
-    at every iterate each hole's branch - stuck, sliding at the lower or the upper capstan bound - is
-    read from the iterate itself, the Newton matrix is the central difference of the residual on those
-    branches, backtracking on the true residual).  It starts from the previous pose with no flux: the
-    elastic predictor with every hole stuck.  ``fixed_pose``: the pose is held (only the cables move;
-    the rigid-geometry case of :func:`stick_slip_tensions`).
-    """
+    """One quasi-static step of the history, the drive moved by ``dq (..., 3 n)`` from (k0, m_prev): pose
+    and hole fluxes by semi-smooth Newton from the elastic predictor (docs/mechanisms/continuum.md).
+    ``fixed_pose``: the pose is held (the rigid-geometry case of :func:`stick_slip_tensions`)."""
     C, K = robot.n_cables, robot.n_segments * robot.disks_per_segment
     J2 = k0.shape[-1]
     batch = k0.shape[:-1]
@@ -425,13 +410,13 @@ def _memory_step(
             diff = (RR[..., :n_free, :] - RR[..., n_free:, :]) / (2.0 * steps[lo_idx:, None])
             Jm = np.nan_to_num(np.swapaxes(diff, -1, -2))
             step = np.zeros_like(x)
-            step[..., lo_idx:] = np.einsum("...ij,...j->...i", np.linalg.pinv(Jm), np.nan_to_num(r))
+            step[..., lo_idx:] = _gauss_newton_step(Jm, r)
             x = _backtrack(lambda xx: np.linalg.norm(fun(xx)[0], axis=-1), x, step, f0, conv)
         k, s = x[..., :J2], x[..., J2:].reshape(*batch, C, K)
         r, own, tp, m, a, T, _ = _memory_eval(robot, k, s, m_prev, dq)
     res = np.linalg.norm(r[..., lo_idx:], axis=-1)
     finite = np.isfinite(res) & np.all(np.isfinite(x), axis=-1)
-    act = _active(robot)
+    act = _span_active(robot)
     return MemoryStep(
         k=k,
         material=m,

@@ -11,7 +11,7 @@ import numpy as np
 from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_batch, check_params, check_positive
 
-from ._kinematics import _disk_T, _split
+from ._kinematics import _disk_T, _span_active, _split
 from ._params import ContinuumRobot
 
 __all__ = [
@@ -51,38 +51,20 @@ def _wrap_from_disks(robot: ContinuumRobot, T: np.ndarray) -> np.ndarray:
     # paper 3, eq. (22): eta = arccos(b_k . b_k+1); 2 atan2(|a - b|, |a + b|) is the same angle without
     # arccos's loss of accuracy near 0.
     eta = 2.0 * np.arctan2(np.linalg.norm(b - incoming, axis=-1), np.linalg.norm(b + incoming, axis=-1))
-    n_spans = robot.disks_per_segment * (robot.cable_segment + 1)
-    active = np.arange(robot.n_segments * robot.disks_per_segment)[None, :] < n_spans[:, None]
-    return np.where(active, eta, 0.0)
+    return np.where(_span_active(robot), eta, 0.0)
 
 
 @carries_failed_rows({"psi": 1})
 def wrap_angles(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """Wrap angle of every cable at the hole where each span starts, ``(..., 3 n, n N)`` (rad).
+    """Wrap angle eta ``(..., 3 n, n N)`` (rad) of every cable at the hole where each span starts
+    (paper 3, eqs. (21)-(22)).
 
     Span 0 starts at the base plate, where the cable arrives along the base z axis; span k at disk k.
-    Zero beyond the cable's termination disk.  Under constant curvature every cable of a segment wraps
-    theta / (2 N) at the segment's base and theta / N at each interior disk (paper 3, eqs. (21)-(22)).
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
+    Zero beyond the cable's termination disk.
 
     Returns
     -------
     ndarray, shape (..., 3 n, n N)
-        Wrap angle eta (rad) of cable c at the hole where span k starts (``N = disks_per_segment``).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> cr.wrap_angles(cr.ContinuumRobot.paper(), np.array([0.5, 0.0])).round(4)   # theta = 0.5 rad
-    array([[0.05, 0.1 , 0.1 , 0.1 , 0.1 ],
-           [0.05, 0.1 , 0.1 , 0.1 , 0.1 ],
-           [0.05, 0.1 , 0.1 , 0.1 , 0.1 ]])
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -116,35 +98,15 @@ def _factors(robot: ContinuumRobot, eta: np.ndarray, direction: np.ndarray) -> n
 
 @carries_failed_rows({"psi": 1}, {"direction": 1})
 def friction_factors(robot: ContinuumRobot, psi: object, direction: object | None = None) -> np.ndarray:
-    """Tension of every span relative to the cable's tension at the base plate, ``(..., 3 n, n N)``.
+    """Tension of every span over the cable's base-plate tension, ``(..., 3 n, n N)``: the cumulative
+    capstan factors ``exp(-direction mu sum eta)`` (paper 3, eqs. (17)-(19), (23), physical sign).
 
-    ``direction (..., 3 n)``: +1 where the cable slides toward the actuator (pulled in), -1 where it is
-    paid out; ``None``: frictionless.  0 (sticking, eq. (19)'s stuck branch) raises ValueError for a cable
-    with friction: its tension is undetermined within the friction band without a stick-slip memory.
-    Paper 3, eqs. (17)-(19) and (23), with the physical sign: a cable pulled in loses tension
-    distally, ``T_k+1 = T_k exp(-mu eta_k)`` (the print has ``exp(+sgn(q_dot) mu eta)``).
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
-    direction : array_like, shape (..., 3 n), optional
-        Sliding direction of each cable (+1 pulled in, -1 paid out); ``None``: no friction (all 1).
+    ``direction (..., 3 n)``: +1 pulled in, -1 paid out, ``None`` frictionless; 0 (eq. (19)'s stuck
+    branch) raises ValueError for a cable with friction (its tension needs a stick-slip memory).
 
     Returns
     -------
     ndarray, shape (..., 3 n, n N)
-        Span tension / base-plate tension (unit-free) of every cable and span (cumulative capstan
-        factors ``exp(-direction mu sum eta)``; constant beyond a cable's termination disk).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> P = cr.friction_factors(cr.ContinuumRobot.paper(), np.array([0.5, 0.0]), [1.0, 1.0, 1.0])
-    >>> P.shape, bool(np.all(P <= 1.0))
-    ((3, 5), True)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -154,17 +116,12 @@ def friction_factors(robot: ContinuumRobot, psi: object, direction: object | Non
 
 
 # ---- the improved capstan equation ----------------------------------------------------------------
-# Fixed-step classical Runge-Kutta 4, vectorised over the whole grid, every point with its own steps:
-#   1. a geometrically graded boundary layer next to the output side: CAPSTAN_LAYER_STEPS steps, the
-#      first with |lambda h| = CAPSTAN_FIRST_STEP (lambda = c T^p, the stiff eigenvalue of eq. (31)),
-#      growing to the phase-2 step (the transient e^(-lambda phi) decays faster than the steps grow, so
-#      its local error stays ~ (lambda h0)^5 / 120 ~ 1e-7 of a transient that is itself ~ rho/c^2 small);
-#   2. uniform steps with |lambda h| <= CAPSTAN_STABILITY (inside RK4's real stability interval
-#      [-2.78, 0]) and h <= CAPSTAN_ACCURACY / (rho / c) (RK4's slow-mode error scales with
-#      (h * growth rate)^4 and the growth rate of T is at most rho / c), capped at CAPSTAN_H_MAX.
-# Points are grouped into buckets of equal phase-2 step count (factors of sqrt 2) so that a stiff point
-# does not set the step count of the whole grid.  Measured error ~1e-9; the accuracy, 1e-8 against a
-# tight reference integration over the paper's parameter box, is proven by test_continuum_capstan.py.
+# Fixed-step RK4, vectorised, every point with its own steps: (1) a geometrically graded boundary layer,
+# CAPSTAN_LAYER_STEPS steps from |lambda h| = CAPSTAN_FIRST_STEP (lambda = c T^p, the stiff eigenvalue of
+# eq. (31); the transient decays faster than the steps grow: local error ~ (lambda h0)^5 / 120 ~ 1e-7 of
+# a transient itself ~ rho/c^2 small); (2) uniform steps with |lambda h| <= CAPSTAN_STABILITY (inside
+# RK4's real stability interval [-2.78, 0]) and h <= CAPSTAN_ACCURACY c / rho (see _layer), capped at
+# CAPSTAN_H_MAX.  Buckets of equal step count (factors of sqrt 2).  Measured error ~1e-9 (1e-8 tested).
 CAPSTAN_LAYER_STEPS = 60
 CAPSTAN_FIRST_STEP = 0.1
 CAPSTAN_STABILITY = 2.0
@@ -178,29 +135,14 @@ _GROWTH_MARGIN = 1.1
 
 
 def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np.ndarray:
-    """c = (rho / n) ((1 + rho) / (alpha rho))^(1/n) of paper 3, eq. (29); rho, alpha > 0, n in (0, 1].
+    """c = (rho / n) ((1 + rho) / (alpha rho))^(1/n) of paper 3, eq. (29) (``N^(-(1-n)/n)``), broadcast.
 
-    Parameters
-    ----------
-    rho : array_like
-        Pulley radius / cable radius (unit-free, > 0).
-    alpha : array_like
-        Coefficient of the friction law ``f = alpha N^n`` (paper 3, eq. (25); > 0).
-    n : array_like
-        Exponent of that law, in (0, 1]. The three arguments broadcast together.
+    ``rho`` pulley radius / cable radius (> 0), ``alpha`` (> 0) and ``n`` (in (0, 1]) of the friction law
+    ``f = alpha N^n`` (eq. (25)), as in :func:`capstan_tension_ratio`.
 
     Returns
     -------
     ndarray
-        The coefficient ``c`` of eq. (29) (units of ``N^(-(1-n)/n)``; unit-free for n = 1), broadcast
-        shape.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> np.round(cr.capstan_coefficient(10.0, 0.3, 1.0), 4)
-    np.float64(36.6667)
     """
     rho, alpha, n = as_array(rho, "rho"), as_array(alpha, "alpha"), as_array(n, "n")
     broadcast_batch((rho, 0, "rho"), (alpha, 0, "alpha"), (n, 0, "n"))
@@ -212,36 +154,28 @@ def capstan_coefficient(rho: np.ndarray, alpha: np.ndarray, n: np.ndarray) -> np
 
 @carries_failed_rows({"phi": 0}, {"mu": 0})
 def classical_capstan_ratio(phi: object, mu: object) -> np.ndarray:
-    """Euler-Eytelwein capstan law T_in / T_out = exp(mu phi).
-
-    Parameters
-    ----------
-    phi : array_like
-        Wrap angle (rad).
-    mu : array_like
-        Coulomb friction coefficient (unit-free); broadcast with ``phi``.
+    """Euler-Eytelwein capstan law T_in / T_out = exp(mu phi): wrap angle ``phi`` (rad) and Coulomb
+    coefficient ``mu`` broadcast.
 
     Returns
     -------
     ndarray
-        The tension ratio ``exp(mu phi)`` (unit-free), broadcast shape.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> np.round(cr.classical_capstan_ratio(np.pi, 0.1), 4)
-    np.float64(1.3691)
     """
     mu_a, phi_a = as_array(mu, "mu"), as_array(phi, "phi")
     broadcast_batch((phi_a, 0, "phi"), (mu_a, 0, "mu"))
     return np.exp(mu_a * phi_a)
 
 
-def _accuracy_step(rho: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """Largest step for the slow mode: RK4's error scales with (h * growth rate)^4, the growth rate of
-    T is at most rho / c (slow manifold), so h = CAPSTAN_ACCURACY / rate, capped at CAPSTAN_H_MAX."""
-    return np.minimum(CAPSTAN_ACCURACY * c / rho, CAPSTAN_H_MAX)
+def _layer(rho: np.ndarray, c: np.ndarray, lam: np.ndarray) -> tuple[np.ndarray, ...]:
+    """First step h0, growth factor g and length of the boundary layer, and the phase-2 step cap.  The
+    slow mode's step: RK4's error scales with (h * growth rate)^4, the growth rate of T is at most rho / c
+    (slow manifold), so h = CAPSTAN_ACCURACY / rate, capped at CAPSTAN_H_MAX."""
+    M1 = CAPSTAN_LAYER_STEPS
+    h0 = CAPSTAN_FIRST_STEP / lam
+    h_cap = np.minimum(CAPSTAN_STABILITY / lam, np.minimum(CAPSTAN_ACCURACY * c / rho, CAPSTAN_H_MAX))
+    g = np.maximum((h_cap / h0) ** (1.0 / M1), 1.0)
+    layer = np.where(g > 1.0, h0 * (g**M1 - 1.0) / np.where(g > 1.0, g - 1.0, 1.0), h0 * M1)
+    return h0, g, layer, h_cap
 
 
 def _rk4(phi, rho, c, p, lam, M2):
@@ -265,13 +199,9 @@ def _rk4(phi, rho, c, p, lam, M2):
             w + h6 * (c1 + 2.0 * (c2 + c3) + c4),
         )
 
-    M1 = CAPSTAN_LAYER_STEPS
-    h0 = CAPSTAN_FIRST_STEP / lam
-    h_cap = np.minimum(CAPSTAN_STABILITY / lam, _accuracy_step(rho, c))
-    g = np.maximum((h_cap / h0) ** (1.0 / M1), 1.0)
-    layer = np.where(g > 1.0, h0 * (g**M1 - 1.0) / np.where(g > 1.0, g - 1.0, 1.0), h0 * M1)
+    h0, g, layer, _ = _layer(rho, c, lam)
     h = h0 * np.minimum(1.0, phi / layer)  # a short wrap is covered by the layer alone
-    for _ in range(M1):  # time steps; every step acts on the whole bucket
+    for _ in range(CAPSTAN_LAYER_STEPS):  # time steps; every step acts on the whole bucket
         y, z, w = step(y, z, w, h)
         h = h * g
     h = np.maximum(phi - np.minimum(layer, phi), 0.0) / M2
@@ -286,15 +216,9 @@ def capstan_tension_ratio(
 ) -> np.ndarray:
     """Input/output tension ratio kappa of a cable over a pulley, paper 3, eqs. (29)-(32).
 
-    Solves T'' + c T^((1-n)/n) T' - rho T = 0, c = (rho/n)((1 + rho)/(alpha rho))^(1/n), from the output
-    side: T(0) = t_out, T'(0) = 0 (eq. (31) with theta_1 = 0), and returns
-    kappa = sqrt(rho^2 T(phi)^2 + T'(phi)^2) / (rho T(0)).
-
-    All arguments broadcast: ``phi`` wrap angle (rad, >= 0), ``rho`` = pulley radius / cable radius
-    (> 0; ``np.inf`` is the limit of vanishing cable bending stiffness), ``alpha`` > 0 and ``n`` in
-    (0, 1] of the friction law f = alpha N^n (eq. (25)), ``t_out`` output tension (N, > 0; the ratio
-    depends on it when n != 1).  n = 1 and rho = inf are solved in closed form; otherwise the ODE is
-    integrated (see the CAPSTAN_* constants).
+    Solves T'' + c T^((1-n)/n) T' - rho T = 0 (c: :func:`capstan_coefficient`) from the output side,
+    T(0) = t_out, T'(0) = 0 (eq. (31), theta_1 = 0): kappa = sqrt(rho^2 T(phi)^2 + T'(phi)^2) / (rho T(0)).
+    Closed forms for n = 1 and rho = inf, else integrated (CAPSTAN_* constants); arguments broadcast.
 
     Parameters
     ----------
@@ -309,11 +233,6 @@ def capstan_tension_ratio(
     t_out : array_like, optional
         Output-side tension (N, > 0); default 1 N.
 
-    Returns
-    -------
-    ndarray
-        ``kappa = T_in / T_out`` (unit-free, >= 1), the broadcast shape of the arguments.
-
     Raises
     ------
     ValueError
@@ -321,12 +240,8 @@ def capstan_tension_ratio(
 
     Examples
     --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> np.round(cr.capstan_tension_ratio(np.pi, rho=np.inf, alpha=0.1, n=1.0), 4)   # = exp(0.1 pi)
+    >>> np.round(capstan_tension_ratio(np.pi, rho=np.inf, alpha=0.1, n=1.0), 4)   # = exp(0.1 pi)
     np.float64(1.3691)
-    >>> cr.capstan_tension_ratio([0.5, np.pi], rho=20.0, alpha=0.1, n=0.8).round(4)
-    array([1.0212, 1.1396])
     """
     phi_a = as_array(phi, "phi")
     rho_a = as_array(rho, "rho", finite=False)
@@ -385,14 +300,7 @@ def capstan_tension_ratio(
         c = capstan_coefficient(r, alpha_b[m], nn) * t_b[m] ** p
         # A-priori bound of y: on the slow manifold y'/y = rho / (c y^p) <= rho / c.
         lam = c * (_GROWTH_MARGIN * np.exp(ph * r / c)) ** p
-        h0 = CAPSTAN_FIRST_STEP / lam
-        h_cap = np.minimum(CAPSTAN_STABILITY / lam, _accuracy_step(r, c))
-        g = np.maximum((h_cap / h0) ** (1.0 / CAPSTAN_LAYER_STEPS), 1.0)
-        layer = np.where(
-            g > 1.0,
-            h0 * (g**CAPSTAN_LAYER_STEPS - 1.0) / np.where(g > 1.0, g - 1.0, 1.0),
-            h0 * CAPSTAN_LAYER_STEPS,
-        )
+        _, _, layer, h_cap = _layer(r, c, lam)
         need = np.maximum(ph - layer, 0.0) / h_cap
         if np.any(need > CAPSTAN_MAX_STEPS):
             raise ValueError(
@@ -411,7 +319,7 @@ def capstan_tension_ratio(
 # ---- identification -------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class FrictionEstimate:
-    """Least-squares friction coefficients with their standard uncertainty (from :func:`identify_friction`).
+    """Least-squares friction coefficients with their uncertainty (from :func:`identify_friction`).
 
     Attributes
     ----------
@@ -434,23 +342,15 @@ class FrictionEstimate:
 def identify_friction(
     wrap: object, t_in: object, t_out: object, direction: object, *, sigma_t: float | None = None
 ) -> FrictionEstimate:
-    """Friction coefficient per cable from measured input and output tensions, by weighted least squares.
-
-    The capstan law along the disks gives ln(t_in / t_out) = s mu eta (eq. (18) with the physical sign:
-    s = +1 for a cable pulled in, whose input tension exceeds its output tension), linear in mu.  Arrays
-    ``(..., m)``: ``wrap`` total wrap angle eta (rad) of each measurement, ``t_in`` actuator-side and
-    ``t_out`` distal tension (N, > 0), ``direction`` s in {-1, 0, +1} (0 rows are ignored: no sliding).
-    ``sigma_t`` (N): standard deviation of each tension reading; the log-ratio's variance is then
-    sigma_t^2 (1/t_in^2 + 1/t_out^2) (first order) and weights the fit.  Solves over the last axis.
+    """Friction coefficient per cable from measured input and output tensions: :class:`FrictionEstimate`
+    (weighted least squares on ln(t_in / t_out) = s mu eta, eq. (18) with the physical sign, last axis).
 
     Parameters
     ----------
     wrap : array_like, shape (..., m)
         Total wrap angle eta (rad) of each of the m measurements.
-    t_in : array_like, shape (..., m)
-        Actuator-side tension (N, > 0).
-    t_out : array_like, shape (..., m)
-        Distal tension (N, > 0).
+    t_in, t_out : array_like, shape (..., m)
+        Actuator-side and distal tension (N, > 0).
     direction : array_like, shape (..., m)
         Sliding direction s of each measurement: +1 pulled in, -1 paid out, 0 ignored.
         The four arrays broadcast together.
@@ -458,24 +358,10 @@ def identify_friction(
         Standard deviation of each tension reading (N, > 0); ``None``: unweighted, the uncertainty
         taken from the residual scatter.
 
-    Returns
-    -------
-    FrictionEstimate
-
     Raises
     ------
     ValueError
         A batch element with no measurement of nonzero wrap and direction.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> eta = np.array([0.5, 1.0, 1.5])                        # rad
-    >>> t_in = np.full(3, 2.0)                                 # N
-    >>> est = cr.identify_friction(eta, t_in, t_in * np.exp(-0.3 * eta), [1.0, 1.0, 1.0])
-    >>> np.round(est.mu, 6), int(est.n_used)
-    (np.float64(0.3), 3)
     """
     eta = as_array(wrap, "wrap", (None,))
     ti = as_array(t_in, "t_in", (None,))
@@ -505,18 +391,15 @@ def identify_friction(
 # ---- stick-slip with memory (eq. (19)) --------------------------------------------------------------
 @dataclass(frozen=True)
 class TensionHistory:
-    """Span tensions of every cable over a history (the result of :func:`stick_slip_tensions`).
-
-    The time axis is first (n_t steps), then the batch axes ``...``.
+    """Span tensions of every cable over a history (from :func:`stick_slip_tensions`), time axis first.
 
     Attributes
     ----------
     span_tension : ndarray, shape (n_t, ..., 3 n, n N)
         Tension of every span (N); zero beyond a cable's termination disk.
     state : ndarray of int, shape (n_t, ..., 3 n, n N)
-        Per hole (the hole where each span starts): +1 sliding with the cable pulled in (span at its
-        lower friction bound), -1 sliding paid out (upper bound), 0 stuck (tension kept from the
-        previous step, strictly within the bounds).
+        Per hole (where each span starts): +1 sliding pulled in (span at its lower friction bound), -1
+        paid out (upper bound), 0 stuck (tension kept from the previous step, within the bounds).
     distal : ndarray, shape (n_t, ..., 3 n)
         Tension of each cable's last span (N).
     """
@@ -529,32 +412,13 @@ class TensionHistory:
 def stick_slip_tensions(
     robot: ContinuumRobot, psi: object, t_act: object, *, initial: object | None = None
 ) -> TensionHistory:
-    """Paper 3, eq. (19) with memory: span tensions along the disks for a history of actuator tensions.
+    """Paper 3, eq. (19) with memory: span tensions along the disks for a history of poses ``psi
+    (n_t, ..., 2 n)`` and actuator-side tensions ``t_act (n_t, ..., 3 n)`` (N, > 0): :class:`TensionHistory`.
 
-    ``psi (n_t, ..., 2 n)`` the pose at every step (wrap angles from :func:`wrap_angles`), ``t_act
-    (n_t, ..., 3 n)`` actuator-side tensions (N, > 0: a slack cable has no friction state).  Starting
-    from ``initial (..., 3 n, n N)`` span tensions (default: every span at the first actuator tension,
-    i.e. the cable laid in without friction history), every step goes from the actuator to the tip: the
-    span beyond hole k keeps its previous tension where that lies within the Coulomb-capstan bounds
-    ``[T_{k-1} exp(-mu eta_k), T_{k-1} exp(mu eta_k)]`` of its new proximal neighbour (stuck, eq. (19)'s
-    q_dot = 0 branch T(t^-1)), else it slides and takes the bound (eq. (19)'s q_dot != 0 branch, with the
-    physical sign of departure 4).  Loading and unloading therefore give hysteresis loops; the result is
-    path-dependent.  This is the fixed-geometry limit of an elastic cable through the holes: at a fixed
-    pose a stuck span's tension depends on its own cable only, for every EA (the rigid-cable limit);
-    with a changing pose a stuck span's tension changes with its length, which this function ignores:
-    :func:`simulate_history` (``memory="elastic"``) models that and feeds the tensions back into the
-    pose.
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (n_t, ..., 2 n)
-        Pose ``[theta_1, beta_1, ...]`` (rad) at each of the n_t steps.
-    t_act : array_like, shape (n_t, ..., 3 n)
-        Actuator-side tension of each cable at each step (N, > 0); the batch axes broadcast with psi's.
-    initial : array_like, shape (..., 3 n, n N), optional
-        Span tensions before the first step (N, > 0 on every active span); ``None``: every span at the
-        first actuator tension.
+    A span keeps its previous tension while it lies within the Coulomb-capstan bounds of its proximal
+    neighbour, else it slides at the bound; the fixed-geometry limit of :func:`simulate_history`
+    (``docs/mechanisms/continuum.md``, "Stick-slip with memory").  ``initial (..., 3 n, n N)``: span
+    tensions before the first step (N, > 0; ``None``: every span at the first actuator tension).
 
     Returns
     -------
@@ -562,12 +426,10 @@ def stick_slip_tensions(
 
     Examples
     --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> robot = cr.ContinuumRobot.paper()
+    >>> robot = ContinuumRobot.paper()
     >>> psi = np.tile([0.5, 0.0], (3, 1))                      # 3 steps at one pose (rad)
     >>> t_act = np.array([[5.0, 5, 5], [6, 5, 5], [5, 5, 5]])  # cable 0 pulled, then released (N)
-    >>> h = cr.stick_slip_tensions(robot, psi, t_act)
+    >>> h = stick_slip_tensions(robot, psi, t_act)
     >>> h.span_tension.shape, h.distal[:, 0].round(4)          # the released cable keeps 5.34 N
     ((3, 3, 5), array([5.    , 5.3375, 5.3375]))
     """
@@ -588,8 +450,7 @@ def stick_slip_tensions(
             "Expected t_act > 0 at every step (a cable at or below zero tension is slack and has no friction "
             f"state), got min {t.min()!r} N."
         )
-    n_spans = robot.disks_per_segment * (robot.cable_segment + 1)
-    active = np.arange(robot.n_segments * robot.disks_per_segment)[None, :] < n_spans[:, None]
+    active = _span_active(robot)
     init = None if initial is None else as_array(initial, "initial", active.shape)
     # the batch axes follow the time axis: align them from the right (NumPy rules) after it; an
     # initial state (no time axis) may extend the history's batch
@@ -629,23 +490,12 @@ def stick_slip_tensions(
             proximal = np.where(active[:, k], new, proximal)
         out[i] = cur
         prev = cur
-    last = n_spans - 1
+    last = robot.disks_per_segment * (robot.cable_segment + 1) - 1
     distal = np.take_along_axis(out, np.broadcast_to(last[:, None], (*out.shape[:-1], 1)), axis=-1)[..., 0]
     return TensionHistory(span_tension=out, state=state, distal=distal)
 
 
-# ---- stick-slip of an elastic cable through the holes ---------------------------------------------
-# A cable is a chain of pieces: piece 0 the free length between the actuator and the base plate, piece
-# p >= 1 the span that starts at hole p - 1 (hole 0 the base plate, hole k >= 1 disk k).  The state is
-# the unstretched material m_p of every piece; its tension follows Hooke's law on the current length g_p,
-# T_p = EA (1 - m_p / g_p) (the linear law of the segment model's compatibility, so that full slip
-# reproduces disk_equilibrium(drive=...) exactly; T = EA (g/m - 1) is larger by the factor g/m =
-# 1 + eps, eps = T/EA <= 0.6 % at 15 N: a strain difference of eps^2, second order).  In a step the
-# actuator reels in dq; s_h is the material crossing hole h toward the actuator (m_p gains s_p, loses
-# s_{p-1}; s_{-1} = dq, the anchor s_K = 0).  Coulomb-capstan at hole h: T_{h+1} / T_h in
-# [exp(-mu eta_h), exp(+mu eta_h)]; s_h > 0 only at the lower bound (pulled in, eq. (19)'s sliding
-# branch with the physical sign), s_h < 0 only at the upper one, s_h = 0 (stuck, eq. (19)'s T(t^-1)
-# branch: the material, not the tension, is kept) anywhere inside.
+# ---- stick-slip of an elastic cable through the holes (docs/mechanisms/continuum.md) --------------
 # paper 3, eq. (19): the print keeps the stuck TENSION T(t^-1) and gives no criterion for sticking;
 # here the stuck hole keeps the material on both sides (its span tensions then change elastically with
 # the pose) and sticks while its tension ratio lies inside the capstan cone.
@@ -657,15 +507,10 @@ is ~0.02 m, its rounding ~1e-18 m; the step's equilibrium leaves < 4e-14 m of fl
 def _hole_residual(
     T: np.ndarray, s: np.ndarray, a: np.ndarray, c: float, branch: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Coulomb-capstan complementarity of every hole, ``(..., C, K)`` (N), and the branch it is on.
-
-    ``T (..., C, K + 1)`` piece tensions, ``s (..., C, K)`` hole fluxes (m), ``a`` mu eta, ``c`` (N/m) a
-    positive scale.  R = T_{h+1} - clip(T_{h+1} - c s_h, T_h e^{-a}, T_h e^{a}) is zero exactly when the
-    hole is stuck with its ratio in the cone (s = 0), or slides toward the actuator at the lower bound
-    (s > 0), or away at the upper one (s < 0).  ``branch``: 0 inside (R = c s), +1 below (R = T_{h+1} -
-    T_h e^{-a}), -1 above; given, R is evaluated on it (the smooth piece for the Newton matrix), else on
-    its own.  With a = 0 both bounds coincide and every branch gives R = T_{h+1} - T_h (no friction).
-    """
+    """Coulomb-capstan complementarity R = T_{h+1} - clip(T_{h+1} - c s_h, T_h e^{-a}, T_h e^{a}) of every
+    hole, ``(..., C, K)`` (N), and its own branch (0 inside the cone, +1 below, -1 above), from piece
+    tensions ``T (..., C, K + 1)``, fluxes ``s (..., C, K)`` (m), ``a`` mu eta and a scale ``c`` (N/m).
+    With ``branch`` given, R is evaluated on it (the smooth piece for the Newton matrix)."""
     prox, dist = T[..., :-1], T[..., 1:]
     lo, hi = prox * np.exp(-a), prox * np.exp(a)
     z = dist - c * s

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from robomech._validation import as_array, check_bool, check_params, check_positive
+from robomech._validation import as_array, check_bool, check_choice, check_params, check_positive
 
 from ._kinematics import CableModel
 from ._params import ContinuumRobot
@@ -32,19 +32,15 @@ _Z95 = 1.959963984540054  # two-sided 95 % quantile of the standard normal
 
 @dataclass(frozen=True)
 class PoseFrictionEstimate:
-    """Friction coefficients fitted to tensions at measured poses (:func:`identify_friction_from_pose`).
-
-    Uncertainties are linearised: covariance s² (JᵀJ)⁻¹, s² from ``sigma_t`` if given, else from the
-    residuals.
+    """Friction coefficients fitted to tensions at measured poses (:func:`identify_friction_from_pose`);
+    linearised uncertainties (``docs/mechanisms/continuum.md``, Identification).
 
     Attributes
     ----------
     mu : ndarray, shape (3 n,)
         Estimated Coulomb friction coefficient per cable (unit-free).
-    std : ndarray, shape (3 n,)
-        Its standard deviation (inf where not identifiable).
-    ci_low, ci_high : ndarray, shape (3 n,)
-        Bounds of the 95 % confidence interval.
+    std, ci_low, ci_high : ndarray, shape (3 n,)
+        Its standard deviation (inf where not identifiable) and 95 % confidence bounds.
     residual_rms : float
         RMS of the tension fit residual (N).
     identifiable : ndarray of bool, shape (3 n,)
@@ -71,52 +67,22 @@ def identify_friction_from_pose(
     sigma_t: float | None = None,
     model: CableModel = "chord",
 ) -> PoseFrictionEstimate:
-    """Paper 3, eq. (38): μ minimising ||τ̃ − τ(μ)|| over measurements ``psi (m, 2 n)`` (the pose measured
-    at each sample, e.g. by IK of the tracked tip), ``t_act (m, 3 n)`` actuator-side tensions (load cells)
-    and ``direction (m, 3 n)`` (±1, the sliding direction the drive imposed).  τ(μ) is
-    :func:`cable_tensions` of ``robot`` with friction μ (pretension and stiffness from ``robot``).
-
-    paper 3, eq. (38) fits the friction factors ε by "linear least squares"; the factors are exp(−μη)
-    of the geometry, so μ itself is fitted here, nonlinearly (scipy.optimize.least_squares, bounds
-    0 ≤ μ ≤ IDENTIFY_MU_MAX).  Table 1's λ (mm) is not defined in the paper and is not fitted.
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (m, 2 n)
-        Measured pose ``[theta_1, beta_1, ...]`` (rad) of each of the m samples.
-    t_act : array_like, shape (m, 3 n)
-        Measured actuator-side tension of each cable (N, > 0).
-    direction : array_like, shape (m, 3 n)
-        Sliding direction of each cable (+1 pulled in, -1 paid out).
-    sigma_t : float, optional
-        Standard deviation of a tension reading (N, > 0); ``None``: from the residuals.
-    model : {"chord", "arc"}, optional
-        Cable path model of :func:`cable_tensions`.
+    """Paper 3, eq. (38): μ minimising ||τ̃ − τ(μ)||, τ(μ) :func:`cable_tensions` at the measured poses
+    ``psi (m, 2 n)``, τ̃ the actuator-side tensions ``t_act (m, 3 n)`` (N) under the sliding ``direction
+    (m, 3 n)`` (±1): :class:`PoseFrictionEstimate`.  ``sigma_t`` (N): load-cell noise (``None``: from the
+    residuals); ``model`` the cable path of :func:`cable_tensions`.  The paper fits the factors
+    exp(−μη) linearly; μ is fitted here (bounded, nonlinear; ``docs/mechanisms/continuum.md``).
 
     Returns
     -------
     PoseFrictionEstimate
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> truth = cr.ContinuumRobot(friction=(0.2, 0.3, 0.25))
-    >>> psi = np.array([[0.3, 0.0], [0.6, 1.0], [0.9, 2.0], [0.4, 4.0]])   # rad
-    >>> d = np.ones((4, 3))                                                 # all pulled in
-    >>> t = cr.cable_tensions(truth, psi, direction=d).tension             # N, synthetic
-    >>> est = cr.identify_friction_from_pose(cr.ContinuumRobot.paper(), psi, t, d)
-    >>> est.mu.round(6), est.success
-    (array([0.2 , 0.3 , 0.25]), True)
     """
     check_params(robot, ContinuumRobot, "robot")
     n_c = robot.n_cables
     p, t, d = _measurements(psi, "psi", 2 * robot.n_segments, t_act, direction, n_c)
     if sigma_t is not None:
         sigma_t = check_positive(sigma_t, "sigma_t")
-    if model not in ("arc", "chord"):
-        raise ValueError(f"Expected model 'arc' or 'chord', got {model!r}.")
+    check_choice(model, "model", ("arc", "chord"))
 
     # paper 3, eq. (38): printed as a linear least-squares fit of the factors eps; eps = exp(-mu eta) of
     # the measured geometry, so mu is fitted here (nonlinear), per cable, with bounds.
@@ -126,17 +92,7 @@ def identify_friction_from_pose(
 
     mu0 = np.clip(robot.friction_array, 0.0, IDENTIFY_MU_MAX)
     sol = least_squares(residual, mu0, bounds=(0.0, IDENTIFY_MU_MAX), x_scale=0.1)
-    J = sol.jac
-    dof = max(J.shape[0] - J.shape[1], 1)
-    s2 = sigma_t**2 if sigma_t is not None else float(np.sum(sol.fun**2)) / dof
-    identifiable = np.linalg.norm(J, axis=0) > 0.0
-    cov = np.full((n_c, n_c), np.inf)
-    idx = np.flatnonzero(identifiable)
-    if idx.size:
-        Ji = J[:, idx]
-        cov_i = s2 * np.linalg.pinv(Ji.T @ Ji)
-        cov[np.ix_(idx, idx)] = cov_i
-    std = np.sqrt(np.diag(cov))
+    std, identifiable = _linearised_std(sol.jac, sol.fun, sigma_t**2 if sigma_t is not None else None)
     return PoseFrictionEstimate(
         mu=sol.x,
         std=std,
@@ -155,10 +111,8 @@ core diameter is not printed: a factor 4 either way covers any plausible core)."
 
 @dataclass(frozen=True)
 class TipFrictionEstimate:
-    """Output-error fit of the disk-wise model to tracked tips (:func:`identify_friction_from_tip`).
-
-    Uncertainties are linearised: covariance s² (JᵀJ)⁻¹ with s² the residual variance of the tip fit
-    (model error included, not only the tracker noise), or 1 in the errors-in-variables fit.
+    """Output-error fit of the disk-wise model to tracked tips (:func:`identify_friction_from_tip`);
+    linearised uncertainties, s² the tip fit's residual variance (model error included) or 1 (EIV).
 
     Attributes
     ----------
@@ -198,46 +152,14 @@ def identify_friction_from_tip(
     sigma_t: float | None = None,
     sigma_tip: float | None = None,
 ) -> TipFrictionEstimate:
-    """Friction coefficients (and optionally the core stiffness) from tracked tips.
+    """Friction coefficients (and, with ``fit_stiffness``, the core-stiffness factor EI / EI_robot) from
+    tracked tips ``tip (m, 3)`` (m) under measured tensions ``t_act (m, 3 n)`` (N) and ``direction (m, 3 n)``
+    (±1): :class:`TipFrictionEstimate`.
 
-    Measurements: ``tip (m, 3)`` tracked tip positions (m), ``t_act (m, 3 n)`` actuator-side tensions
-    (load cells, N), ``direction (m, 3 n)`` the sliding direction (±1).  Model: the disk-wise
-    constant-curvature robot (:func:`disk_equilibrium`: one arc per disk interval, capstan friction at
-    every hole) carrying the measured tensions; ``scipy.optimize.least_squares`` minimises the tip
-    residual over μ (0 ≤ μ ≤ ``IDENTIFY_MU_MAX``) and, if ``fit_stiffness``, the factor EI / EI_robot
-    (within ``IDENTIFY_STIFFNESS_BOUNDS``).  ``initial (m, 2 n)``: segment poses to start the
-    equilibria from (e.g. IK of the tips; default straight).
-
-    With ``sigma_t`` (load-cell noise, N) and ``sigma_tip`` (tracker noise, m) the fit is errors in
-    variables: the true tensions are unknowns too, residuals ``(t - t_act)/sigma_t`` and
-    ``(tip(t) - tip)/sigma_tip`` (the measured tensions are noisy inputs of the model; an output-error
-    fit that takes them as exact biases the stiffness factor and μ with it: measured on reference data,
-    EI +5 %, μ −15 %).  The covariance then uses s² = 1 (the stated noise levels); without them s²
-    is the residual variance of the tip fit.
-
-    Departure from paper 3, eq. (38): the paper fits the model tensions at the measured pose to the
-    measured tensions (an inverse-model residual, its constant-curvature pose taken from the tip).
-    Under friction the shape is not one arc per segment, and that fit absorbs the shape error into μ
-    (−25 % on reference data); here the forward model predicts the tip from the measured tensions
-    (output error), which needs no pose inversion.
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    tip : array_like, shape (m, 3)
-        Tracked tip positions (m, base frame).
-    t_act : array_like, shape (m, 3 n)
-        Measured actuator-side tensions (N, > 0).
-    direction : array_like, shape (m, 3 n)
-        Sliding direction of each cable (+1 pulled in, -1 paid out).
-    fit_stiffness : bool, optional
-        Also fit the core-stiffness factor EI / EI_robot.
-    initial : array_like, shape (m, 2 n), optional
-        Poses ``[theta_1, beta_1, ...]`` (rad) to start the equilibria from; ``None``: straight.
-    sigma_t : float, optional
-        Load-cell noise (N, > 0); give it together with ``sigma_tip`` for the errors-in-variables fit.
-    sigma_tip : float, optional
-        Tracker noise (m, > 0); together with ``sigma_t``.
+    Output error of :func:`disk_equilibrium` started from ``initial (m, 2 n)`` (default straight); with
+    ``sigma_t`` (N) and ``sigma_tip`` (m) errors in variables (the measured tensions are noisy inputs:
+    taking them as exact biases EI by +5 % and μ by −15 % on reference data).  Departure from paper 3,
+    eq. (38) (which fits the tensions at the measured pose): ``docs/mechanisms/continuum.md``, item 13.
 
     Returns
     -------
@@ -308,16 +230,8 @@ def identify_friction_from_tip(
     )
     residual(sol.x)  # the final state's convergence
     J = sol.jac.toarray() if hasattr(sol.jac, "toarray") else np.asarray(sol.jac)
-    dof = max(J.shape[0] - J.shape[1], 1)
-    s2 = 1.0 if eiv else float(np.sum(sol.fun**2)) / dof
-    identifiable = np.linalg.norm(J, axis=0) > 0.0
-    k = J.shape[1]
-    cov = np.full((k, k), np.inf)
-    idx = np.flatnonzero(identifiable)
-    if idx.size:
-        Ji = J[:, idx]
-        cov[np.ix_(idx, idx)] = s2 * np.linalg.pinv(Ji.T @ Ji)
-    std = np.sqrt(np.diag(cov))[:k_par]
+    std, identifiable = _linearised_std(J, sol.fun, 1.0 if eiv else None)
+    std = std[:k_par]
     xp = sol.x[:k_par]
     tip_res = sol.fun[: 3 * m] * (sig_p if eiv else 1.0)
     return TipFrictionEstimate(
@@ -330,6 +244,20 @@ def identify_friction_from_tip(
         identifiable=identifiable[:k_par],
         success=bool(sol.success) and state["ok"],
     )
+
+
+def _linearised_std(J: np.ndarray, fun: np.ndarray, s2: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """Standard deviations from the covariance s² (JᵀJ)⁻¹ over the identifiable parameters (inf for the
+    others) and the identifiable mask; ``s2`` ``None``: the residual variance."""
+    if s2 is None:
+        s2 = float(np.sum(fun**2)) / max(J.shape[0] - J.shape[1], 1)
+    identifiable = np.linalg.norm(J, axis=0) > 0.0
+    cov = np.full((J.shape[1], J.shape[1]), np.inf)
+    idx = np.flatnonzero(identifiable)
+    if idx.size:
+        Ji = J[:, idx]
+        cov[np.ix_(idx, idx)] = s2 * np.linalg.pinv(Ji.T @ Ji)
+    return np.sqrt(np.diag(cov)), identifiable
 
 
 def _measurements(

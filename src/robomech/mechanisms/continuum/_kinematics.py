@@ -1,10 +1,5 @@
-"""Constant-curvature kinematics: segment transforms, forward kinematics, cable lengths, Jacobians, IK.
-
-Coordinates: every segment i has psi_i = (theta_i, beta_i) (bend angle, bending-plane angle), stacked
-as ``psi (..., 2 n) = [theta_1, beta_1, theta_2, beta_2, ...]`` (paper 3, Section 1).  Cables are indexed
-``3 i + j`` (segment i, cable j); the drive length of a cable is its geometric length from the base
-plate to its termination disk.
-"""
+"""Constant-curvature kinematics (paper 3, Sec. 1, eqs. (1)-(6)): segment poses, cable lengths,
+Jacobians, IK.  Coordinates ``psi``, frames and cable indexing: ``docs/mechanisms/continuum.md``."""
 
 from __future__ import annotations
 
@@ -40,46 +35,36 @@ __all__ = [
 
 CableModel = Literal["arc", "chord"]
 
-# Samples per chunk of the segment kernels (poses, Jacobian columns, tip positions).  The ~20
-# temporaries of a chunk (128 KB each) stay in cache and are recycled by the allocator; whole-batch
-# temporaries (8 MB per 10^6 samples) are fresh pages every call, ~1 ms of page faults each (measured:
-# the 7 passes of spatial.sincos take 11 ms on 10^6 samples, 5 ms with recycled pages).  Measured on
-# 10^6 one-segment poses (FK / Jacobian / IK, ms): 2048: 46/44/45, 4096: 39/34/38, 8192: 34/30/36,
-# 16384: 32/28/32, 32768: 31/29/37 (~40 numpy calls per chunk: small chunks pay the call overhead).
+# Samples per chunk of the segment kernels: the ~20 temporaries of a chunk stay in cache and are recycled
+# (whole-batch ones are fresh pages, ~1 ms of page faults each).  Measured on 10^6 one-segment poses
+# (FK / Jacobian / IK, ms): 2048: 46/44/45, 8192: 34/30/36, 16384: 32/28/32, 32768: 31/29/37.
 CHUNK = 16384
 
 # IK: a tip position is reached when the residual is below 1e-10 m (0.1 nm: far below any physical
 # tolerance, above the ~1e-16 * 0.1 m rounding of the forward kinematics).
 IK_TOLERANCE = 1e-10
 # Levenberg-Marquardt iterations per start: over 10^5 random 2- and 3-segment targets, 99.9 % of those
-# reached from the single-arc start need <= 17 (theta_i <= pi) or <= 22 (theta_i <= 6 rad) iterations, the
-# alternative starts <= 48; 40 keeps all but a handful (which another start then reaches) and bounds the
-# cost of unreachable targets (~1 us per sample and iteration).
+# reached need <= 17 (theta_i <= pi) or <= 22 (<= 6 rad) from the single arc, <= 48 from the others; 40
+# keeps all but a handful (another start reaches them) and bounds the cost of unreachable targets.
 IK_MAX_ITERATIONS = 40
-# Damping lam = mu l^2 (J J^T ~ l^2): mu starts at 1e-3, a mild trust region that still takes nearly the
-# full Gauss-Newton step where the linearisation is good.
+# Damping lam = mu l^2 (J J^T ~ l^2): mu starts at 1e-3, a mild trust region (nearly a Gauss-Newton step).
 IK_DAMPING_INITIAL = 1e-3
 # After an accepted step mu /= 3, after a rejected one mu *= 4: the usual asymmetric Levenberg factors
 # (damping grows faster than it shrinks, so a run of rejections quickly reaches a gradient step).
 IK_DAMPING_DECREASE = 1.0 / 3.0
 IK_DAMPING_INCREASE = 4.0
-# mu stays in [1e-12, 1e12]: the lower bound keeps J J^T + lam I positive definite at the singular straight
-# pose (condition <= ~1e12, still solved to ~1e-4 relative, enough for a damped step) and is far below the
-# point where the damping slows convergence; the upper bound keeps lam finite (a step of ~1e-12 of the
-# gradient step already ends the iteration through the step criterion).
+# mu in [1e-12, 1e12]: the lower bound keeps J J^T + lam I positive definite at the singular straight pose
+# (condition <= ~1e12, solved to ~1e-4 relative: enough for a damped step) without slowing convergence;
+# the upper bound keeps lam finite (a 1e-12 gradient step already ends the iteration).
 IK_DAMPING_MIN = 1e-12
 IK_DAMPING_MAX = 1e12
-# The Jacobian in the bending vector u needs (d p / d beta) / theta, 0/0 at theta = 0.  p(u) is smooth and
-# its Jacobian continuous in u, so it is evaluated at theta = max(theta, 1e-12 rad): any positive floor
-# avoids the 0/0, and this one moves the Jacobian by only ~floor * |d^2 p / d u^2| ~ 1e-12 * n l m/rad
-# (the residual itself is always exact), while (d p / d beta) ~ theta l, divided by theta, stays accurate
-# to ~1e-16 of its size (small-angle series below SMALL_ANGLE; no underflow at 1e-12).
+# The Jacobian in u needs (d p / d beta) / theta, 0/0 at theta = 0; it is continuous in u, so it is taken
+# at theta = max(theta, 1e-12 rad): this moves it by ~1e-12 * n l m/rad (the residual stays exact), and
+# (d p / d beta) / theta stays accurate to ~1e-16 (series below SMALL_ANGLE; no underflow at 1e-12).
 IK_THETA_FLOOR = 1e-12
-# Alternative starts for n >= 2 where the single arc fails, in the target's azimuthal frame (rotated by
-# beta_t = atan2(y, x)): (theta, plane angle) of the proximal segments, then of the distal segment (rad).
-# Chosen greedily on the failures of the single-arc start over 2 x 10^5 random 2- and 3-segment targets
-# (theta_i <= pi and <= 6 rad): strongly curled in the target's plane; S-shapes in crossed and in the same
-# plane (segments bent against each other); one curl out of the target's plane.  Tried in this order.
+# Alternative starts for n >= 2, in the target's azimuthal frame: (theta, plane angle) of the proximal
+# segments, then of the distal one (rad), chosen greedily on the single arc's failures over 2 x 10^5
+# random 2- and 3-segment targets (curled in the target's plane, S-shapes, curled out of it), in order.
 IK_STARTS = (
     ((3.0, 0.0), (3.0, 0.0)),
     ((2.0, -np.pi / 2), (2.0, np.pi)),
@@ -117,37 +102,14 @@ def _small_fix(t: np.ndarray, closed, series) -> np.ndarray:
     return out
 
 
-def _f_cos(t: np.ndarray) -> np.ndarray:
-    """(1 - cos t) / t."""
-    return _small_fix(t, lambda x: (1.0 - np.cos(x)) / x, _series_f_cos)
-
-
-def _f_sin(t: np.ndarray) -> np.ndarray:
-    """sin t / t."""
-    return _small_fix(t, lambda x: np.sin(x) / x, _series_f_sin)
-
-
-def _df_cos(t: np.ndarray) -> np.ndarray:
-    """d/dt (1 - cos t)/t = (t sin t + cos t - 1) / t^2 (paper 3, eq. (6))."""
-    return _small_fix(t, lambda x: (x * np.sin(x) + np.cos(x) - 1.0) / (x * x), _series_df_cos)
-
-
-def _df_sin(t: np.ndarray) -> np.ndarray:
-    """d/dt sin t / t = (t cos t - sin t) / t^2 (paper 3, eq. (6))."""
-    return _small_fix(t, lambda x: (x * np.cos(x) - np.sin(x)) / (x * x), _series_df_sin)
-
-
-def _half_angle(angle: np.ndarray, one_minus_cos: bool = True) -> tuple[np.ndarray, ...]:
-    """``(sin, cos[, 1 - cos])`` of ``angle`` from ``t = tan(angle / 2)`` (the formulas of
-    ``robomech.spatial.sincos``: numpy's float64 tan is vectorised, its sin and cos are not, ~10x
-    slower).  ``1 - cos = 2 t^2 / (1 + t^2)`` has no cancellation at small angles."""
+def _half_angle(angle: np.ndarray) -> tuple[np.ndarray, ...]:
+    """``(sin, cos, 1 - cos)`` of ``angle``: ``robomech.spatial.sincos``'s half-angle formulas, with
+    ``1 - cos = 2 t^2 / (1 + t^2)`` (no cancellation at small angles) from the same ``t``."""
     t = np.tan(0.5 * angle)
     t2 = t * t
     d = 1.0 / (1.0 + t2)
     s = 2.0 * t * d
     c = (1.0 - t2) * d
-    if not one_minus_cos:
-        return s, c
     t2 *= 2.0
     t2 *= d
     return s, c, t2
@@ -176,16 +138,15 @@ def _flat(a: np.ndarray, shape: tuple) -> np.ndarray:
     return np.broadcast_to(a, shape).reshape(-1)
 
 
-def _split(robot: ContinuumRobot, psi: object, name: str = "psi") -> tuple[np.ndarray, np.ndarray]:
+def _split(
+    robot: ContinuumRobot, psi: object, name: str = "psi", views: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(theta, beta)`` of ``psi``: contiguous copies (numpy's vectorised trigonometry is ~2x faster on
+    contiguous input), or strided ``views`` for the chunked kernels (which copy chunk by chunk)."""
     p = as_array(psi, name, (2 * robot.n_segments,))
-    # contiguous copies: numpy's vectorised trigonometry is ~2x faster on contiguous input
+    if views:
+        return p[..., 0::2], p[..., 1::2]
     return np.ascontiguousarray(p[..., 0::2]), np.ascontiguousarray(p[..., 1::2])
-
-
-def _split_views(robot: ContinuumRobot, psi: object) -> tuple[np.ndarray, np.ndarray]:
-    """Like ``_split`` but strided views, for the chunked kernels (which copy chunk by chunk)."""
-    p = as_array(psi, "psi", (2 * robot.n_segments,))
-    return p[..., 0::2], p[..., 1::2]
 
 
 # ---- one segment --------------------------------------------------------------------------------
@@ -207,7 +168,7 @@ def _segment_planes(theta: np.ndarray, beta: np.ndarray, length: np.ndarray | fl
     for c in slices(th.size, CHUNK):
         t = np.ascontiguousarray(th[c])
         st, ct, omc = _half_angle(t)
-        sb, cb = _half_angle(be[c], one_minus_cos=False)
+        sb, cb = sincos(be[c])
         fc, fs = _bend_scalars(t, st, ct, omc, derivatives=False)
         # R = Rz(beta) Ry(theta) Rz(-beta) = I - (1 - cos theta) [cb^2, cb sb, .; cb sb, sb^2, .; ...] + ...
         # paper 3, eq. (1): printed element (2,1) c(beta)s(beta)c(theta); the product gives
@@ -241,29 +202,14 @@ def _segment_planes(theta: np.ndarray, beta: np.ndarray, length: np.ndarray | fl
 def segment_transform(theta: object, beta: object, length: object) -> np.ndarray:
     """Pose ``T (..., 4, 4)`` of a constant-curvature segment's end frame in its base frame.
 
-    ``theta`` bend angle (rad), ``beta`` bending-plane angle (rad), ``length`` arc length (m); all
-    broadcast.  Rotation ``Rz(beta) Ry(theta) Rz(-beta)``; exact and finite at ``theta = 0`` (series).
+    Rotation ``Rz(beta) Ry(theta) Rz(-beta)``; exact and finite at ``theta = 0`` (series).
 
     Parameters
     ----------
-    theta : array_like, shape (...)
-        Bend angle (rad).
-    beta : array_like, shape (...)
-        Bending-plane angle about the base z axis (rad).
+    theta, beta : array_like, shape (...)
+        Bend angle and bending-plane angle about the base z axis (rad).
     length : array_like, shape (...)
-        Arc length of the segment (m).
-
-    Returns
-    -------
-    ndarray, shape (..., 4, 4)
-        ``T`` of the segment's end frame in its base frame (m).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> T = segment_transform(np.pi / 2, 0.0, 0.09)          # a quarter circle of radius 0.0573 m
-    >>> T[:3, 3].round(4), T[:3, 2].round(12) + 0.0         # end point; the end tangent is +x
-    (array([0.0573, 0.    , 0.0573]), array([1., 0., 0.]))
+        Arc length of the segment (m).  The three arguments broadcast.
     """
     t = as_array(theta, "theta")
     b = as_array(beta, "beta")
@@ -305,12 +251,8 @@ def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
     ----------
     robot : ContinuumRobot
     psi : array_like, shape (..., 2 n)
-        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
-
-    Returns
-    -------
-    ndarray, shape (..., n, 4, 4)
-        ``T_0i`` of each segment's end frame in the base frame (m).
+        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad); the
+        same argument in every function of the package.
 
     Examples
     --------
@@ -322,40 +264,25 @@ def forward_kinematics(robot: ContinuumRobot, psi: object) -> np.ndarray:
     ((1, 4, 4), array([0.057296, 0.      , 0.057296]))
     """
     check_params(robot, ContinuumRobot, "robot")
-    theta, beta = _split_views(robot, psi)
+    theta, beta = _split(robot, psi, views=True)
     return _fk(robot, theta, beta)
 
 
 @carries_failed_rows({"psi": 1})
 def tip_position(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """Tip position ``(..., 3)`` in the base frame (m).
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        Bend and bending-plane angles of the segments (rad).
+    """Tip position ``(..., 3)`` in the base frame (m) at ``psi (..., 2 n)``.
 
     Returns
     -------
     ndarray, shape (..., 3)
-        Tip position in the base frame (m).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> cr.tip_position(cr.ContinuumRobot.paper(), np.zeros(2))     # straight: the segment length on z
-    array([0.  , 0.  , 0.09])
     """
     check_params(robot, ContinuumRobot, "robot")
     return forward_kinematics(robot, psi)[..., -1, :3, 3]
 
 
 def _local_columns(theta: np.ndarray, beta: np.ndarray, length: float) -> np.ndarray:
-    """Every segment's local Jacobian columns as contiguous planes ``(6, 2, ...)`` (paper 3, eq. (6):
-    angular and linear velocity of the segment end in the segment's base frame; verified correct),
-    in chunks of CHUNK samples; inputs of any strides."""
+    """Every segment's local Jacobian columns (paper 3, eq. (6), in the segment's base frame) as
+    contiguous planes ``(6, 2, ...)``, in chunks of CHUNK samples; inputs of any strides."""
     shape = np.broadcast_shapes(np.shape(theta), np.shape(beta))
     P = np.empty((6, 2, *shape))
     Pf = P.reshape(12, -1)
@@ -363,7 +290,7 @@ def _local_columns(theta: np.ndarray, beta: np.ndarray, length: float) -> np.nda
     for c in slices(th.size, CHUNK):
         t = np.ascontiguousarray(th[c])
         st, ct, omc = _half_angle(t)
-        sb, cb = _half_angle(be[c], one_minus_cos=False)
+        sb, cb = sincos(be[c])
         fc, _, g1, g2 = _bend_scalars(t, st, ct, omc, derivatives=True)
         np.negative(sb, out=Pf[0, c])  # row 0: omega_x, columns (theta, beta)
         np.multiply(cb, st, out=Pf[1, c])
@@ -417,51 +344,23 @@ def tip_jacobian(robot: ContinuumRobot, psi: object) -> np.ndarray:
     ``omega`` is the tip frame's angular velocity and ``v_tip`` the velocity of the tip point (paper 3,
     eq. (6): J_xomega stacked on J_xv, angular first as in robomech's twists).
 
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        Bend and bending-plane angles of the segments (rad).
-
     Returns
     -------
     ndarray, shape (..., 6, 2 n)
-        ``[omega; v_tip]`` per unit ``psi_dot`` (rad/s, m/s), base frame.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> J = cr.tip_jacobian(cr.ContinuumRobot.paper(), np.array([np.pi / 2, 0.0]))
-    >>> J.shape, J[:3, 0].round(12) + 0.0          # bending turns the tip about the base y axis
-    ((6, 2), array([0., 1., 0.]))
     """
     check_params(robot, ContinuumRobot, "robot")
-    theta, beta = _split_views(robot, psi)
+    theta, beta = _split(robot, psi, views=True)
     return _tip_jacobian(robot, theta, beta)
 
 
 @carries_failed_rows({"psi": 1})
 def disk_transforms(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """Poses of the base plate and of every disk, ``(..., 1 + n N, 4, 4)``, in the base frame.
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        Bend and bending-plane angles of the segments (rad).
+    """Poses ``(..., 1 + n N, 4, 4)`` of the base plate, then the N disks of each segment, in the base
+    frame (m).
 
     Returns
     -------
     ndarray, shape (..., 1 + n N, 4, 4)
-        The base plate, then the N disks of each segment, in the base frame (m).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> cr.disk_transforms(cr.ContinuumRobot.paper(), np.zeros(2)).shape     # base + 5 disks
-    (6, 4, 4)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -483,7 +382,8 @@ def _disk_T(robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray) -> np.nd
 
 # ---- cable lengths --------------------------------------------------------------------------------
 def _sinc(x: np.ndarray) -> np.ndarray:
-    return _f_sin(x)
+    """sin x / x, finite at 0."""
+    return _small_fix(x, lambda v: np.sin(v) / v, _series_f_sin)
 
 
 def _dsinc_over_x(x: np.ndarray) -> np.ndarray:
@@ -494,16 +394,9 @@ def _dsinc_over_x(x: np.ndarray) -> np.ndarray:
 def _segment_spans(
     robot: ContinuumRobot, theta: np.ndarray, beta: np.ndarray, model: str
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Span length of every cable in every segment, d/dtheta and (d/dbeta)/theta: (..., 3n, n) each.
-
-    d/dbeta is proportional to theta; returning it divided by theta keeps it finite in coordinates
-    (theta cos beta, theta sin beta) that are smooth through the straight pose.
-
-    Arc model (paper 3, eq. (4)): the cable is parallel to the core, span = (l - r theta cos(beta -
-    sigma)) / N.  Chord model: the cable is straight between consecutive holes (paper 3, eq. (21)); both
-    holes lie at distance 1/kappa - d from the centre of curvature, d = r cos(beta - sigma), so the
-    span is 2 (1/kappa - d) sin(theta / 2N) = (l - d theta)/N * sinc(theta / 2N).
-    """
+    """Span length of every cable in every segment, d/dtheta and (d/dbeta)/theta (finite through the
+    straight pose): (..., 3n, n) each.  Arc (paper 3, eq. (4)) and chord spans
+    ``(l - d theta)/N * sinc(theta / 2N)``, ``d = r cos(beta - sigma)`` (docs/mechanisms/continuum.md)."""
     N, L, r = robot.disks_per_segment, robot.segment_length, robot.hole_radius
     sig = robot.hole_angles  # (3n,)
     th = theta[..., None, :]  # (..., 1, n)
@@ -529,29 +422,20 @@ def _active(robot: ContinuumRobot) -> np.ndarray:
     return robot.cable_segment[:, None] >= np.arange(robot.n_segments)[None, :]
 
 
+def _span_active(robot: ContinuumRobot) -> np.ndarray:
+    """(3 n, n N) mask: cable c runs over span (disk interval) j."""
+    N = robot.disks_per_segment
+    return np.arange(robot.n_segments * N)[None, :] < (N * (robot.cable_segment + 1))[:, None]
+
+
 @carries_failed_rows({"psi": 1})
 def span_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "chord") -> np.ndarray:
-    """Length of every cable span ``(..., 3 n, n N)`` (zero beyond the cable's termination disk).
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        Bend and bending-plane angles of the segments (rad).
-    model : {"chord", "arc"}, optional
-        Cable path model.
+    """Length (m) of every cable span between consecutive disks, ``(..., 3 n, n N)`` (zero beyond the
+    cable's termination disk); ``model`` the cable path, as in :func:`cable_lengths`.
 
     Returns
     -------
     ndarray, shape (..., 3 n, n N)
-        Length of each cable's span between consecutive disks (m).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> cr.span_lengths(cr.ContinuumRobot.paper(), np.zeros(2))[0]   # straight: 0.09 m / 5 disks
-    array([0.018, 0.018, 0.018, 0.018, 0.018])
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -561,20 +445,11 @@ def span_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "chord"
 
 @carries_failed_rows({"psi": 1})
 def span_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "chord") -> np.ndarray:
-    """``d span / d psi``: ``(..., 3 n, n N, 2 n)``.
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        Bend and bending-plane angles of the segments (rad).
-    model : {"chord", "arc"}, optional
-        Cable path model.
+    """``d span_lengths / d psi`` (m/rad): ``(..., 3 n, n N, 2 n)``.
 
     Returns
     -------
     ndarray, shape (..., 3 n, n N, 2 n)
-        ``d span / d psi`` (m/rad).
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -598,28 +473,12 @@ def cable_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "arc")
     """Geometric length of every cable from the base plate to its termination disk, ``(..., 3 n)`` (m).
 
     ``model="arc"`` is paper 3, eq. (4) (cable parallel to the core); ``model="chord"`` takes straight
-    cable spans between the holes of consecutive disks (what a real cable does).
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        Bend and bending-plane angles of the segments (rad).
-    model : {"arc", "chord"}, optional
-        Cable path model (see above).
+    cable spans between the holes of consecutive disks (what a real cable does).  Cable ``3 i + j``
+    belongs to segment i.
 
     Returns
     -------
     ndarray, shape (..., 3 n)
-        Cable lengths (m), cable ``3 i + j`` of segment i.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> robot = cr.ContinuumRobot.paper()                    # holes at r = 4 mm, 0 and ±120 deg
-    >>> cr.cable_lengths(robot, np.array([np.pi / 2, 0.0])).round(6)   # L - theta r cos(beta - phi_j)
-    array([0.083717, 0.093142, 0.093142])
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -629,29 +488,11 @@ def cable_lengths(robot: ContinuumRobot, psi: object, model: CableModel = "arc")
 
 @carries_failed_rows({"psi": 1})
 def cable_jacobian(robot: ContinuumRobot, psi: object, model: CableModel = "arc") -> np.ndarray:
-    """``J_qpsi = d cable_lengths / d psi``, ``(..., 3 n, 2 n)`` (paper 3, eq. (5) for one segment).
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        Bend and bending-plane angles of the segments (rad).
-    model : {"arc", "chord"}, optional
-        Cable path model.
+    """``J_qpsi = d cable_lengths / d psi`` (m/rad), ``(..., 3 n, 2 n)`` (paper 3, eq. (5), one segment).
 
     Returns
     -------
     ndarray, shape (..., 3 n, 2 n)
-        ``d l / d psi`` (m/rad).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> cr.cable_jacobian(cr.ContinuumRobot.paper(), np.array([np.pi / 2, 0.0])).round(5)
-    array([[-0.004  ,  0.     ],
-           [ 0.002  , -0.00544],
-           [ 0.002  ,  0.00544]])
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, beta = _split(robot, psi)
@@ -666,16 +507,13 @@ class IKResult:
     Attributes
     ----------
     psi : ndarray, shape (..., 2 n)
-        ``[theta_1, beta_1, ...]`` (rad) with theta >= 0 and beta in (-pi, pi] (beta = 0 where
-        theta = 0); where not ``reachable``, the best least-squares pose found (a local minimum of the
-        tip distance).
+        ``[theta_1, beta_1, ...]`` (rad), theta >= 0, beta in (-pi, pi] (0 where theta = 0); where not
+        ``reachable``, the best least-squares pose found.
     residual : ndarray, shape (...)
         Distance of the pose's tip from the target (m).
-    reachable : ndarray of bool, shape (...)
-        ``residual`` below ``IK_TOLERANCE``.
-    converged : ndarray of bool, shape (...)
-        The solver stopped on its own criterion (target reached, or a step below ``IK_TOLERANCE``: a
-        stationary point) rather than on ``IK_MAX_ITERATIONS``.
+    reachable, converged : ndarray of bool, shape (...)
+        ``residual`` below ``IK_TOLERANCE``; the solver stopped on its own criterion (reached, or a
+        stationary point), not on the iteration cap.
     iterations : ndarray of int, shape (...)
         Iterations of all starts tried for the sample.
     """
@@ -748,14 +586,9 @@ def _lm_step(J: np.ndarray, e: np.ndarray, lam: np.ndarray) -> np.ndarray:
 
 
 def _ik_solve(robot: ContinuumRobot, p: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Levenberg-Marquardt on the tip position in bending-vector coordinates, from ``u (k, n, 2)``.
-
-    Per-sample adaptive damping ``lam = mu l^2``: a step is accepted when it lowers the residual (then mu
-    shrinks by IK_DAMPING_DECREASE), otherwise rejected (mu grows by IK_DAMPING_INCREASE).  A sample stops
-    (``converged``) when its residual is below IK_TOLERANCE or its trial step moves it by less than
-    IK_TOLERANCE (a stationary point: the least-squares pose, or a local minimum).  Every iteration acts on
-    the whole unconverged subset.  Returns ``u, residual, converged, iterations``.
-    """
+    """Levenberg-Marquardt on the tip position in bending-vector coordinates from ``u (k, n, 2)``, with
+    per-sample adaptive damping ``lam = mu l^2``, on the whole unconverged subset at every iteration
+    (docs/mechanisms/continuum.md).  Returns ``u, residual, converged, iterations``."""
     L2 = robot.segment_length**2
     u = u.copy()
     e_all = p - _tip_u(robot, u)
@@ -805,9 +638,8 @@ def _ik_start(robot: ContinuumRobot, p: np.ndarray, shape: tuple) -> np.ndarray:
 
 def _single_arc(robot: ContinuumRobot, p: np.ndarray, theta: np.ndarray, beta: np.ndarray) -> np.ndarray:
     """The single constant-curvature arc through every tip ``p (k, 3)``: writes ``theta, beta (k, n)``
-    (every segment bent by theta = 2 atan2(sqrt(x^2 + y^2), z) / n in the plane beta = atan2(y, x)) and
-    returns the tip residual ``(k,)`` of that pose.  One segment: chunks of CHUNK samples, the residual
-    from the tip of the arc (the formulas of _segment_T); n >= 2: from the composed forward kinematics."""
+    and returns the tip residual ``(k,)`` of that pose (one segment: chunked, with the formulas of
+    _segment_T; n >= 2: from the composed forward kinematics)."""
     n, L = robot.n_segments, robot.segment_length
     res = np.empty(p.shape[0])
     for c in slices(p.shape[0], CHUNK):
@@ -825,7 +657,7 @@ def _single_arc(robot: ContinuumRobot, p: np.ndarray, theta: np.ndarray, beta: n
         if n > 1:
             continue
         st, ct, omc = _half_angle(th)
-        sb, cb = _half_angle(be, one_minus_cos=False)
+        sb, cb = sincos(be)
         fc, fs = _bend_scalars(th, st, ct, omc, derivatives=False)
         fc *= L
         fs *= L
@@ -845,21 +677,10 @@ def _single_arc(robot: ContinuumRobot, p: np.ndarray, theta: np.ndarray, beta: n
 
 @carries_failed_rows({"p_tip": 1})
 def inverse_kinematics(robot: ContinuumRobot, p_tip: object) -> IKResult:
-    """Bend parameters ``psi`` that put the tip at ``p_tip (..., 3)`` (m).
+    """Bend parameters ``psi`` that put the tip at ``p_tip (..., 3)`` (m, base frame): :class:`IKResult`.
 
-    Start: the single constant-curvature arc through all segments (exact for every reachable tip of a
-    one-segment robot: beta = atan2(y, x), theta = 2 atan2(sqrt(x^2 + y^2), z)), refined by
-    Levenberg-Marquardt on the tip position in the bending vectors u_i = theta_i (cos beta_i, sin beta_i)
-    (smooth through the straight pose, where beta is undefined).  For n >= 2, the targets within the
-    robot's reach (|p| <= n l) that are still not reached are restarted from a small fixed set of other
-    shapes (IK_STARTS: segments bent in opposite or crossed planes, different bends); the pose with the
-    smallest residual is kept, with its ``converged`` flag.  Targets beyond the reach get one solve only.
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    p_tip : array_like, shape (..., 3)
-        Tip targets in the base frame (m).
+    The single constant-curvature arc through the tip, refined by Levenberg-Marquardt in the bending
+    vectors, with restarts from ``IK_STARTS`` for n >= 2 (``docs/mechanisms/continuum.md``, Models).
 
     Returns
     -------
@@ -867,9 +688,7 @@ def inverse_kinematics(robot: ContinuumRobot, p_tip: object) -> IKResult:
 
     Examples
     --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> ik = cr.inverse_kinematics(cr.ContinuumRobot.paper(), np.array([0.057296, 0.0, 0.057296]))
+    >>> ik = inverse_kinematics(ContinuumRobot.paper(), np.array([0.057296, 0.0, 0.057296]))
     >>> ik.psi.round(4), bool(ik.converged)
     (array([1.5708, 0.    ]), True)
     """

@@ -16,50 +16,31 @@ CABLES_PER_SEGMENT = 3  # paper 3, Fig. 3: three cables 120 degrees apart drive 
 
 @dataclass(frozen=True)
 class ContinuumRobot:
-    """Parameters of a cable-driven constant-curvature continuum robot.
-
-    Every segment is a NiTi core rod of length ``segment_length`` carrying ``disks_per_segment`` disks
-    evenly spaced along it (the last one at the segment's end, the segment's base disk being the
-    previous segment's end disk or the robot's base plate), and three cables in holes at radius
-    ``hole_radius``, 120 degrees apart.  The cables of segment ``i`` (0-based) terminate at its end disk
-    and run through the holes of all proximal segments; their hole angles are
-    ``(0, 2 pi/3, 4 pi/3) + i * cable_offset``.
+    """Parameters of a cable-driven constant-curvature continuum robot: n segments of ``disks_per_segment``
+    evenly spaced disks on a NiTi core, three cables per segment at hole angles ``(0, 2 pi/3, 4 pi/3) + i *
+    cable_offset`` (layout and the source of every default: ``docs/mechanisms/continuum.md``, Parameters).
 
     Parameters
     ----------
-    n_segments : int
-        Number of segments n (>= 1).
+    n_segments, disks_per_segment : int
+        Number of segments n and of disks N per segment (chord spans, >= 1); paper: 1 and 5.
     segment_length : float
         Arc length of every segment (m); paper: 90 mm.
-    disks_per_segment : int
-        Disks N per segment (chord spans per segment, >= 1); paper: 5 disks.
     hole_radius : float
-        Distance r of the cable holes from the core axis (m); not printed, default 4 mm. Must be well
-        below ``segment_length`` (``n_segments * hole_radius < segment_length``) and clear the core
-        (``hole_radius >= (core_diameter + cable_diameter) / 2``).
+        Distance r of the cable holes from the core axis (m); not printed, default 4 mm; below
+        ``segment_length / n_segments`` and ``>= (core_diameter + cable_diameter) / 2``.
     core_modulus, core_diameter : float
-        Young's modulus (Pa) and diameter (m) of the NiTi core; not printed (60 GPa, 1.0 mm: EI =
-        2.9e-3 N m², chosen for stability, see ``core_diameter`` below and
-        ``docs/mechanisms/continuum_cosserat.md``).
+        Young's modulus (Pa) and diameter (m) of the NiTi core; not printed (60 GPa, 1.0 mm).
     cable_modulus, cable_diameter : float
         Young's modulus (Pa) and diameter (m) of the Dyneema cable; paper: 4.96 GPa, 0.8 mm.
     friction : tuple of float
         Coulomb friction coefficient per cable (3 n entries, >= 0); paper Table 1 (0.26, 0.31, 0.28).
     pretension : float
-        Cable pretension T0 (N, >= 0); not printed, default 10 N (inside Fig. 6's 3-11 N range; with the
-        1.0 mm core a 90 deg bend needs ~13 N of tension difference, so 5 N lets the paid-out cables go slack
-        there).
+        Cable pretension T0 (N, >= 0); not printed, default 10 N (inside Fig. 6's 3-11 N range).
     free_length : float
         Cable length between the actuator and the base plate (m, >= 0); not printed, default 0.1 m.
     cable_offset : float
         Angular offset of the holes of successive segments (rad).
-
-    Raises
-    ------
-    ValueError
-        If a count is not an integer >= 1, a length or modulus is not positive, ``pretension`` or
-        ``free_length`` is negative, ``hole_radius`` is too large or inside the core, or ``friction``
-        does not have 3 n finite non-negative entries.
     """
 
     n_segments: int = 1
@@ -67,12 +48,8 @@ class ContinuumRobot:
     disks_per_segment: int = 5
     hole_radius: float = 0.004
     core_modulus: float = 60e9
-    # paper 3 prints no core diameter.  1.0 mm (EI = 2.9e-3 N m²) because the paper's robot runs stably
-    # at pretensions up to 11 N (Fig. 6; the verification range goes to 15 N): between two disks (h = 18 mm)
-    # the core is a column under the three cables' compression 3 T, so the straight robot buckles at
-    # T_cr = pi² EI / (3 h²) per cable (measured on the disk reference: 12.25 N with the 0.8 mm core
-    # assumed before, inside that range; 29.9 N with 1.0 mm, twice 15 N), and the chord sagitta's
-    # negative bending stiffness 3 T l_d² / 8 stays below EI up to 8 EI / (3 l_d²) = 24 N (10 N before).
+    # paper 3 prints no core diameter: 1.0 mm keeps the column between two disks from buckling below
+    # 29.9 N per cable, twice the 15 N working range (docs/mechanisms/continuum.md, Parameters).
     core_diameter: float = 1.0e-3
     cable_modulus: float = 4.96e9
     cable_diameter: float = 0.8e-3

@@ -43,12 +43,6 @@ class Pulley:
         paper Fig. 9: 0.15 or 0.6; default 0.15.  alpha = 0 is the frictionless pulley.
     n : float, optional
         Exponent of eq. (25), in (0, 1]; paper Fig. 9: 0.67 or 1; default 1.
-
-    Examples
-    --------
-    >>> from robomech.mechanisms import continuum as cr
-    >>> cr.Pulley(radius=0.01, wrap=1.0, alpha=0.6, n=0.67).alpha
-    0.6
     """
 
     radius: float = 0.005
@@ -91,11 +85,8 @@ def pulley_chain(
     robot: ContinuumRobot, pulley: Pulley, t: NDArray[np.float64], d: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Actuator-side tension and the wrap integral int T dphi' (N rad) for base tensions ``t`` (> 0).
-
-    Pulled in (d = +1): the robot side is the output, T_act = kappa(phi; t) t.  Paid out (d = -1): the
-    actuator side is the output, t = kappa(phi; T_act) T_act, solved by fixed point for n < 1.  d = 0
-    (no friction state, only where mu = 0 at the disks): the pulley is taken as stuck, T = t throughout.
-    """
+    The output side: the robot for d = +1, the actuator for d = -1 (fixed point for n < 1); d = 0 (only
+    where mu = 0 at the disks): the pulley taken as stuck, T = t throughout."""
     t = np.maximum(np.asarray(t, dtype=float), np.finfo(float).tiny)
     d = np.broadcast_to(d, t.shape)
     phi = pulley.wrap

@@ -1,4 +1,5 @@
-"""Statics by virtual work: core elastic energy, cable tensions with pretension, coupling moments."""
+"""Statics by virtual work (paper 3, eqs. (7)-(15)): core elastic energy, cable tensions with pretension,
+coupling moments."""
 
 from __future__ import annotations
 
@@ -22,32 +23,17 @@ __all__ = [
     "elastic_gradient",
 ]
 
-# A cable counts as taut when its tension is at least 0 N: a cable cannot push; any positive
-# tension keeps it straight between the holes in this (massless, inextensible-path) model.
+# A cable counts as taut at >= 0 N: it cannot push; any tension keeps it straight (massless cable model).
 TENSION_FLOOR = 0.0
 
 
 @carries_failed_rows({"psi": 1})
 def elastic_energy(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """Bending energy of the cores, U = sum EI theta_i^2 / (2 l) (paper 3, eq. (8)), ``(...)`` in J.
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
+    """Bending energy ``(...)`` (J) of the cores, U = sum EI theta_i^2 / (2 l) (paper 3, eq. (8)).
 
     Returns
     -------
     ndarray, shape (...)
-        Elastic energy U (J) of all cores (``EI = robot.bending_stiffness``, ``l = segment_length``).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> np.round(cr.elastic_energy(cr.ContinuumRobot.paper(), np.array([0.5, 0.0])), 8)
-    np.float64(0.00409062)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
@@ -62,25 +48,11 @@ def _grad_u(robot: ContinuumRobot, theta: np.ndarray) -> np.ndarray:
 
 @carries_failed_rows({"psi": 1})
 def elastic_gradient(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """dU/dpsi ``(..., 2 n)``: (EI theta_i / l, 0) per segment (gradient of paper 3, eq. (8)).
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
+    """dU/dpsi ``(..., 2 n)`` (N m/rad): (EI theta_i / l, 0) per segment (gradient of paper 3, eq. (8)).
 
     Returns
     -------
     ndarray, shape (..., 2 n)
-        ``dU/dpsi`` (N m per rad), ordered like ``psi``; the beta entries are 0.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> cr.elastic_gradient(cr.ContinuumRobot.paper(), np.array([0.5, 0.0])).round(6)
-    array([0.016362, 0.      ])
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
@@ -89,30 +61,13 @@ def elastic_gradient(robot: ContinuumRobot, psi: object) -> np.ndarray:
 
 @carries_failed_rows({"psi": 1})
 def coupling_moments(robot: ContinuumRobot, psi: object) -> np.ndarray:
-    """Paper 3, eq. (12): moment of segment i+1 on segment i, ``(..., n, 2)`` = (-EI theta_i+1 / l, 0).
-
-    The last segment has none.  The full virtual-work model of :func:`cable_tensions` contains this
-    coupling exactly (distal cables run through proximal segments); this function is the paper's
-    one-neighbour form, for comparison.
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
+    """Paper 3, eq. (12): moment (N m) of segment i+1 on segment i, ``(..., n, 2)`` = (-EI theta_i+1 / l, 0)
+    (zero for the last segment): the paper's one-neighbour form, for comparison (the virtual work of
+    :func:`cable_tensions` contains this coupling exactly).
 
     Returns
     -------
     ndarray, shape (..., n, 2)
-        Per segment i, ``(-EI theta_i+1 / l, 0)`` (N m); zero for the last segment.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> robot = cr.ContinuumRobot(n_segments=2, friction=(0.2,) * 6)
-    >>> cr.coupling_moments(robot, np.array([0.5, 0.0, 0.2, 0.0])).shape
-    (2, 2)
     """
     check_params(robot, ContinuumRobot, "robot")
     theta, _ = _split(robot, psi)
@@ -123,7 +78,7 @@ def coupling_moments(robot: ContinuumRobot, psi: object) -> np.ndarray:
 
 @dataclass(frozen=True)
 class TensionResult:
-    """Cable tensions in equilibrium (the result of :func:`cable_tensions`).
+    """Cable tensions in equilibrium (from :func:`cable_tensions`).
 
     Attributes
     ----------
@@ -163,28 +118,13 @@ def cable_tensions(
     pretension: float | None = None,
     model: CableModel = "chord",
 ) -> TensionResult:
-    """Cable tensions holding the robot at ``psi (..., 2 n)`` (paper 3, eqs. (7)-(10), (23)-(24)).
+    """Cable tensions holding the robot at ``psi (..., 2 n)`` (paper 3, eqs. (7)-(10), (23)-(24)):
+    :class:`TensionResult`.
 
-    Virtual work with tension positive: the actuators pull the cables in by -dL, so
-    ``-G^T tau + J_x^T W = grad U`` with ``G = dL/dpsi`` weighted by the friction factors of each span
-    (``direction``, see :func:`friction_factors`), and ``W = [m; f] (..., 6)`` an external wrench at the
-    tip, in the base frame.  Solution: ``tau = -(G^T)^+ (grad U - J_x^T W) + (I - (G^T)^+ G^T) eta`` with
-    ``eta = pretension * 1`` (default ``robot.pretension``).
-
-    Parameters
-    ----------
-    robot : ContinuumRobot
-    psi : array_like, shape (..., 2 n)
-        ``[theta_1, beta_1, ...]``: bend and bending-plane angle of each of the n segments (rad).
-    wrench : array_like, shape (..., 6), optional
-        External wrench ``[m; f]`` (N m, N) at the tip, base frame; ``None``: unloaded.
-    direction : array_like, shape (..., 3 n), optional
-        Sliding direction of each cable (+1 pulled in, -1 paid out, see :func:`friction_factors`);
-        ``None``: frictionless.
-    pretension : float, optional
-        Null-space pretension (N, >= 0); ``None``: ``robot.pretension``.
-    model : {"chord", "arc"}, optional
-        Cable path model of the span Jacobian (straight chords between holes, or arcs).
+    ``-G^T tau + J_x^T W = grad U`` (tension positive), ``G`` the span Jacobians weighted by the friction
+    factors in ``direction``, ``W = [m; f] (..., 6)`` (N m, N) a ``wrench`` at the tip (base frame);
+    ``tau = -(G^T)^+ (grad U - J_x^T W) + (I - (G^T)^+ G^T) pretension * 1`` (``pretension`` N,
+    default ``robot.pretension``).
 
     Returns
     -------
@@ -192,9 +132,7 @@ def cable_tensions(
 
     Examples
     --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import continuum as cr
-    >>> res = cr.cable_tensions(cr.ContinuumRobot.paper(), np.array([0.5, 0.0]))
+    >>> res = cable_tensions(ContinuumRobot.paper(), np.array([0.5, 0.0]))
     >>> res.tension.round(4), bool(res.taut), bool(res.residual < 1e-9)
     (array([12.0483,  9.087 ,  9.087 ]), True, True)
     """

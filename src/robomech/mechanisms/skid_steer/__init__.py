@@ -1,10 +1,5 @@
-"""Paper 4: the six-wheel skid-steer wheel-track exploration robot.
-
-Velocity kinematics from the wheel chains (rear wheels on rockers, road wheels on a parallelogram bogie)
-with instantaneously coincident contact frames, stacked into the 30×11 system ``A0 ṗ = J q̇`` and
-solved per sample by batched Householder QR; skid-steer turning; dead reckoning.
-See ``docs/mechanisms/skid_steer.md``.
-"""
+"""Paper 4: the six-wheel skid-steer exploration robot — the 30×11 velocity system ``A0 ṗ = J q̇``, skid
+steering, ICR kinematics, odometry.  Frames and departures: ``docs/mechanisms/skid_steer.md``."""
 
 from ._chains import CONFIG_SIZE, N_WHEELS, SIDE_JOINTS, WHEEL_SIDE, WHEELS, contact_frames, wheel_jacobians
 from ._icr import (

@@ -1,22 +1,13 @@
-"""Wheel chains of the robot: contact frames (Sheth–Uicker) and their Jacobians, batched.
-
-Configuration ``config (..., 8)`` = ``[θ1, θ01_1, θ02_1, s1, θ2, θ01_2, θ02_2, s2]`` (side 1 right,
-side 2 left): rocker angle θ about body y, bogie angle θ01 relative to the rocker, side-link angle
-θ02 relative to the bogie (both side links of a side share it: parallelogram), rear-wheel slide s
-along the rocker's -z.  Angles are right-handed about +y, so a positive θ lowers the rocker's front.
-
-Each wheel w has a contact frame P_w attached to the link that carries its hub (rocker for the rear
-wheel, side link for a road wheel), with origin at the hub minus the wheel radius along that link's z
-and axes parallel to that link's.  At each instant P_w coincides with a frame P̄_w fixed to the ground
-(Sheth–Uicker); the measured wheel velocity is the velocity of P_w relative to P̄_w, in P_w axes.
-"""
+"""Wheel chains of the robot: contact frames (Sheth–Uicker) and their Jacobians, batched.  Configuration
+``config (..., 8)`` = ``[θ1, θ01_1, θ02_1, s1, θ2, θ01_2, θ02_2, s2]`` (side 1 right, side 2 left; the
+joints and contact frames: ``docs/mechanisms/skid_steer.md``, "Frames and sign conventions")."""
 
 from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from robomech._batching import carries_failed_rows, slices
+from robomech._batching import carries_failed_rows, chunked
 from robomech._validation import as_array, check_params
 
 from ._params import ExplorationRobot
@@ -58,12 +49,8 @@ def _rot_xz(c: np.ndarray, s: np.ndarray, x: np.ndarray | float, z: np.ndarray |
 
 
 def side_points(robot: ExplorationRobot, q: np.ndarray) -> dict[str, np.ndarray]:
-    """Planar (x, z) geometry of one side, ``q (..., 4)`` = ``(θ, θ01, θ02, s)``.
-
-    Returns arrays ``(..., 2)`` of (x, z) for the rocker pivot ``R``, bogie hinge ``H``, side-link
-    hinges ``LF``/``LH``, contacts ``AF``/``AH``/``P``, and the contact-frame angles ``alpha_road``
-    (θ+θ01+θ02) and ``alpha_rear`` (θ), each ``(...,)``.  Kernel: no validation.
-    """
+    """Planar (x, z) geometry ``(..., 2)`` of one side at ``q (..., 4)`` = ``(θ, θ01, θ02, s)``: points ``R``,
+    ``H``, ``LF``, ``LH``, contacts ``AF``, ``AH``, ``P``; the angles ``alpha_road``, ``alpha_rear``."""
     check_params(robot, ExplorationRobot, "robot")
     th, t1, t2, s = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     c0, s0 = np.cos(th), np.sin(th)
@@ -105,36 +92,20 @@ def _check_config(config: ArrayLike) -> np.ndarray:
 
 def _blocked(kernel, q: np.ndarray, tail: tuple[int, ...]) -> np.ndarray:
     """Apply ``kernel (n, 8) -> (n, *tail)`` block by block over the flattened batch of ``q``."""
-    batch = q.shape[:-1]
-    n = int(np.prod(batch))
-    qf = q.reshape(n, CONFIG_SIZE)
-    out = np.empty((n, *tail))
-    for s in slices(n, CHUNK):
-        out[s] = kernel(qf[s])
-    return out.reshape(*batch, *tail)
+    qf = q.reshape(-1, CONFIG_SIZE)
+    return chunked(lambda s: kernel(qf[s]), qf.shape[0], CHUNK).reshape(*q.shape[:-1], *tail)
 
 
 @carries_failed_rows({"config": 1})
 def contact_frames(robot: ExplorationRobot, config: ArrayLike) -> np.ndarray:
-    """Poses ``T_BP`` of the six contact frames in the body frame: ``(..., 6, 4, 4)``, order ``WHEELS``.
+    """Poses ``T_BP (..., 6, 4, 4)`` of the six contact frames in the body frame, order ``WHEELS``.
 
     Parameters
     ----------
     robot : ExplorationRobot
     config : array_like, shape (..., 8)
-        Joint configuration: per side ``SIDE_JOINTS`` (rocker, bogie and slide coordinates; rad, m).
-
-    Returns
-    -------
-    ndarray, shape (..., 6, 4, 4)
-        ``T_BP`` of each wheel's contact frame in the body frame B, wheels in ``WHEELS`` order.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> robot = ExplorationRobot.paper()
-    >>> contact_frames(robot, np.zeros(8)).shape
-    (6, 4, 4)
+        Joint configuration: per side ``SIDE_JOINTS`` (rad, m); the same argument in every function of
+        the package.
     """
     check_params(robot, ExplorationRobot, "robot")
     q = _check_config(config)
@@ -164,11 +135,8 @@ def _contact_frames(robot: ExplorationRobot, q: np.ndarray) -> np.ndarray:
 def _linear_columns(robot: ExplorationRobot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Contact positions ``p (..., 6, 3)``, contact angles ``alpha (..., 6)`` and the chain's (x, z)
     velocity columns ``G (..., 6, 2, 4)``: the velocity of contact w relative to B due to its side's
-    joint rates ``(θ̇, θ̇01, θ̇02, ṡ)`` is ``(G[w, 0] @ q̇, 0, G[w, 1] @ q̇)``.
-
-    A revolute joint about y through ``o`` moves a point ``p`` at
-    ``y × (p - o) = (p_z - o_z, 0, -(p_x - o_x))``.
-    """
+    joint rates ``(θ̇, θ̇01, θ̇02, ṡ)`` is ``(G[w, 0] @ q̇, 0, G[w, 1] @ q̇)`` (a revolute joint about y
+    through ``o`` moves ``p`` at ``y × (p - o) = (p_z - o_z, 0, -(p_x - o_x))``)."""
     batch = q.shape[:-1]
     p = np.zeros((*batch, N_WHEELS, 3))
     alpha = np.zeros((*batch, N_WHEELS))
@@ -202,29 +170,15 @@ def _linear_columns(robot: ExplorationRobot, q: np.ndarray) -> tuple[np.ndarray,
 
 @carries_failed_rows({"config": 1})
 def wheel_jacobians(robot: ExplorationRobot, config: ArrayLike) -> np.ndarray:
-    """Space Jacobians of the contact frames relative to the body: ``(..., 6, 6, 4)``.
+    """Space Jacobians ``(..., 6, 6, 4)`` of the contact frames relative to the body at ``config (..., 8)``.
 
     ``J[..., w, :, j]`` is the twist ``[ω; v]`` (in B, ``v`` the velocity of the point at B's origin)
-    of contact frame ``w`` relative to the body per unit rate of joint ``j`` of its side
-    (``SIDE_JOINTS``); joints outside the wheel's chain give zero columns.  ``ω = (0, Σ rates, 0)``.
-
-    Parameters
-    ----------
-    robot : ExplorationRobot
-    config : array_like, shape (..., 8)
-        Joint configuration (rad, m), ``SIDE_JOINTS`` per side.
+    of contact frame ``w`` (``WHEELS`` order) relative to the body per unit rate of joint ``j`` of its
+    side (``SIDE_JOINTS``); joints outside the wheel's chain give zero columns.
 
     Returns
     -------
     ndarray, shape (..., 6, 6, 4)
-        Per wheel (``WHEELS`` order) the 6 x 4 Jacobian of its contact frame relative to B, columns
-        the four joints of its side; twists ``[ω; v]`` in body axes (rad/s, m/s per unit joint rate).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> wheel_jacobians(ExplorationRobot.paper(), np.zeros((5, 8))).shape   # a batch of 5
-    (5, 6, 6, 4)
     """
     check_params(robot, ExplorationRobot, "robot")
     q = _check_config(config)

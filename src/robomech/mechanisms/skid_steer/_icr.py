@@ -1,19 +1,6 @@
 """ICR kinematics of a skid-steered vehicle (Martínez et al. 2005; Mandow et al. 2007), its identification
-from encoders and a measured body twist by least squares, and per-wheel slip.
-
-Planar body twist ``(v_x, v_y, r)`` in body axes (x forward, y left, r yaw rate).  Each track (side) has
-an instantaneous centre of rotation: the point of the track plane where the belt's ground velocity
-vanishes.  With the track moving backwards relative to the body at its encoder speed ``v_i``, the belt
-point at body ``(x, y)`` moves over the ground at ``(v_x - r y - v_i, v_y + r x)``; it vanishes at
-``y = y_i``, ``x = x_icr = -v_y / r``.  Hence
-
-    v_right = v_x - r y_right,   v_left = v_x - r y_left,   v_y = -r x_icr,
-
-so ``r = (v_right - v_left)/(y_left - y_right)`` and
-``v_x = (v_right y_left - v_left y_right)/(y_left - y_right)``.
-No slip is ``y_left = -y_right = S/2``, ``x_icr = 0``; ``χ = (y_left - y_right)/S >= 1`` is the effective
-track-width factor of the skid.
-"""
+from encoders and a measured planar body twist ``(v_x, v_y, r)`` by least squares, and per-wheel slip.
+The model: ``docs/mechanisms/skid_steer.md``, "ICR kinematics, identification and slip"."""
 
 from __future__ import annotations
 
@@ -58,23 +45,19 @@ SLIP_SPEED_FLOOR = 1e-6
 
 @dataclass(frozen=True)
 class ICRModel:
-    """Lateral ICR positions of the left and right tracks and the longitudinal ICR position (m, body axes).
-
-    ``y_left > y_right`` is required (otherwise the yaw rate has the wrong sign or is undefined).
+    """Lateral ICR positions of the left and right tracks and the longitudinal ICR position of the body.
 
     Parameters
     ----------
-    y_left : float
-        Lateral position of the left track's ICR (m, body y axis, positive to the left).
-    y_right : float
-        Lateral position of the right track's ICR (m, body y axis).
+    y_left, y_right : float
+        Lateral positions of the left and right tracks' ICRs (m, body y, to the left), ``y_left > y_right``.
     x_icr : float, optional
-        Longitudinal position of the body's ICR (m, body x axis).
+        Longitudinal position of the body's ICR (m, body x).
 
     Raises
     ------
     ValueError
-        If a field is not a finite real number or ``y_left <= y_right``.
+        ``y_left <= y_right`` (the yaw rate would have the wrong sign or be undefined).
     """
 
     y_left: float
@@ -101,14 +84,12 @@ class ICRModel:
 
 @dataclass(frozen=True)
 class PlanarVelocity:
-    """Planar body velocity (the result of :func:`icr_velocity`).
+    """Planar body velocity (from :func:`icr_velocity`).
 
     Attributes
     ----------
-    v_x, v_y : ndarray, shape (...)
-        Body velocity (m/s, body axes); NaN where not ``valid``.
-    yaw_rate : ndarray, shape (...)
-        Yaw rate (rad/s, about body z); NaN where not ``valid``.
+    v_x, v_y, yaw_rate : ndarray, shape (...)
+        Body velocity (m/s, body axes) and yaw rate (rad/s, about z); NaN where not ``valid``.
     valid : ndarray of bool, shape (...)
         False where an input track speed was not finite.
     """
@@ -120,15 +101,8 @@ class PlanarVelocity:
 
 
 def icr_velocity(model: ICRModel, v_right: ArrayLike, v_left: ArrayLike) -> PlanarVelocity:
-    """Body velocity predicted by the ICR model from the right and left track (encoder) speeds (m/s).
-
-    Non-finite speeds (encoder drop-outs) are flagged per sample by ``valid``.
-
-    Parameters
-    ----------
-    model : ICRModel
-    v_right, v_left : array_like, shape (...)
-        Track speeds (m/s); broadcast together.
+    """Body velocity predicted by the ICR model from the right and left track (encoder) speeds ``(...)``
+    (m/s, broadcast): :class:`PlanarVelocity`; non-finite speeds (drop-outs) are flagged per sample.
 
     Returns
     -------
@@ -161,21 +135,11 @@ def icr_velocity(model: ICRModel, v_right: ArrayLike, v_left: ArrayLike) -> Plan
 
 
 def wheel_radii(robot: ExplorationRobot) -> np.ndarray:
-    """Rolling radius of each wheel in ``WHEELS`` order (m): road wheels, then the rear wheel, per side.
-
-    Parameters
-    ----------
-    robot : ExplorationRobot
+    """Rolling radius ``(6,)`` of each wheel in ``WHEELS`` order (m).
 
     Returns
     -------
     ndarray, shape (6,)
-        Rolling radii (m), ``WHEELS`` order.
-
-    Examples
-    --------
-    >>> wheel_radii(ExplorationRobot.paper())
-    array([0.05, 0.05, 0.1 , 0.05, 0.05, 0.1 ])
     """
     check_params(robot, ExplorationRobot, "robot")
     return np.array([robot.road_wheel_radius if "road" in w else robot.rear_wheel_radius for w in WHEELS])
@@ -183,7 +147,7 @@ def wheel_radii(robot: ExplorationRobot) -> np.ndarray:
 
 @dataclass(frozen=True)
 class TrackSpeeds:
-    """No-slip track speeds from wheel rates (the result of :func:`encoder_track_speeds`).
+    """No-slip track speeds from wheel rates (from :func:`encoder_track_speeds`).
 
     Attributes
     ----------
@@ -199,26 +163,12 @@ class TrackSpeeds:
 
 
 def encoder_track_speeds(robot: ExplorationRobot, wheel_rate: ArrayLike) -> TrackSpeeds:
-    """No-slip track speeds from the wheel spin rates ``(..., 6)`` (rad/s): the mean rim speed
-    ``r_w φ̇_w`` of each side's three wheels.  A sample with a non-finite wheel rate is flagged.
-
-    Parameters
-    ----------
-    robot : ExplorationRobot
-    wheel_rate : array_like, shape (..., 6)
-        Wheel spin rates (rad/s), ``WHEELS`` order.
+    """No-slip track speeds from the wheel spin rates ``(..., 6)`` (rad/s, ``WHEELS`` order): the mean rim
+    speed ``r_w φ̇_w`` of each side's three wheels, :class:`TrackSpeeds` (non-finite rates flagged).
 
     Returns
     -------
     TrackSpeeds
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> robot = ExplorationRobot.paper()
-    >>> ts = encoder_track_speeds(robot, np.array([10.0, 10.0, 5.0, 8.0, 8.0, 4.0]))   # rad/s
-    >>> round(float(ts.right), 12), round(float(ts.left), 12)          # rim speeds r * rate (m/s)
-    (0.5, 0.4)
     """
     radii = wheel_radii(robot)
     w = as_array(wheel_rate, "wheel_rate", (N_WHEELS,), finite=False)
@@ -232,7 +182,7 @@ def encoder_track_speeds(robot: ExplorationRobot, wheel_rate: ArrayLike) -> Trac
 
 @dataclass(frozen=True)
 class ICRIdentification:
-    """Least-squares ICR parameters and their quality (the result of :func:`identify_icr`).
+    """Least-squares ICR parameters and their quality (from :func:`identify_icr`).
 
     Attributes
     ----------
@@ -241,7 +191,7 @@ class ICRIdentification:
     residual_rms : ndarray, shape (3,)
         RMS misfit of the three equation groups (right track, left track, lateral; m/s).
     used : ndarray of bool, shape (N,)
-        Samples that entered the fit (finite).
+        Samples that entered the fit (finite, weight > 0).
     n_used : int
         Number of samples used.
     cond : float
@@ -261,24 +211,12 @@ class ICRIdentification:
 def identify_icr(
     v_right: ArrayLike, v_left: ArrayLike, body_velocity: ArrayLike, *, weights: ArrayLike | None = None
 ) -> ICRIdentification:
-    """Identify ``(y_right, y_left, x_icr)`` from track speeds ``(N,)`` and measured planar body
-    velocities ``(N, 3)`` = ``(v_x, v_y, r)`` by linear least squares (``analysis.lstsq``).
+    """Identify ``(y_right, y_left, x_icr)`` from track speeds ``v_right, v_left (N,)`` (m/s) and measured
+    planar body velocities ``(N, 3)`` = ``(v_x, v_y, r)`` by linear least squares (``analysis.lstsq``).
 
-    Equations per sample: ``-r y_right = v_right - v_x``, ``-r y_left = v_left - v_x``, ``-r x_icr = v_y``.
-    ``weights (N,)`` (``>= 0``) weight each sample's three equations (e.g. ``1/σ²`` of that sample).
-    Samples with any non-finite value (drop-outs; also magnitudes beyond ``_validation.MAX_MAGNITUDE``,
-    which would overflow the products) and samples of weight 0 are not used and are reported in
-    ``used`` (nothing is dropped silently).  Straight driving carries no information (its rows are
-    zero); a data set without turning is reported ``identifiable = False``.
-
-    Parameters
-    ----------
-    v_right, v_left : array_like, shape (N,)
-        Track (encoder) speeds (m/s).
-    body_velocity : array_like, shape (N, 3)
-        Measured planar body velocities ``(v_x, v_y, r)`` (m/s, m/s, rad/s).
-    weights : array_like, shape (N,), optional
-        Per-sample weights (``>= 0``; a sample of weight 0 is not used).
+    ``weights (N,)`` (``>= 0``) weight each sample's three equations.  Samples with a non-finite value
+    (or beyond ``_validation.MAX_MAGNITUDE``) or of weight 0 are left out and reported in ``used``; data
+    without turning are reported ``identifiable = False``.
 
     Returns
     -------
@@ -286,7 +224,6 @@ def identify_icr(
 
     Examples
     --------
-    >>> import numpy as np
     >>> true = ICRModel(y_left=0.3, y_right=-0.32, x_icr=0.02)
     >>> r = np.array([0.2, -0.4, 0.5, 0.1])                          # yaw rates (rad/s)
     >>> vx = np.array([0.5, 0.3, 0.2, 0.4])
@@ -358,32 +295,13 @@ class WheelSlip:
 def wheel_slip(
     robot: ExplorationRobot, wheel_rate: ArrayLike, body_velocity: ArrayLike, config: ArrayLike | None = None
 ) -> WheelSlip:
-    """Slip of each wheel from its spin rate ``(..., 6)`` (rad/s) and the planar body velocity
-    ``(..., 3)`` = ``(v_x, v_y, r)``; contacts at ``config (..., 8)`` (default: zero joint angles with
-    the nominal slides), planar rigid motion: contact ``(x, y)`` moves at ``(v_x - r y, v_y + r x)``.
-
-    Parameters
-    ----------
-    robot : ExplorationRobot
-    wheel_rate : array_like, shape (..., 6)
-        Wheel spin rates (rad/s), ``WHEELS`` order.
-    body_velocity : array_like, shape (..., 3)
-        Planar body velocity ``(v_x, v_y, r)`` (m/s, m/s, rad/s).
-    config : array_like, shape (..., 8), optional
-        Joint configuration for the contact positions (rad, m).
+    """Slip of each wheel from its spin rate ``(..., 6)`` (rad/s) and the planar body velocity ``(..., 3)``
+    = ``(v_x, v_y, r)``, contacts at ``config (..., 8)`` (default: zero joint angles, nominal slides):
+    :class:`WheelSlip`.  Planar rigid motion: contact ``(x, y)`` moves at ``(v_x - r y, v_y + r x)``.
 
     Returns
     -------
     WheelSlip
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> robot = ExplorationRobot.paper()
-    >>> rate = 0.5 / wheel_radii(robot)                     # every rim at 0.5 m/s
-    >>> s = wheel_slip(robot, rate, np.array([0.5, 0.0, 0.0]))   # straight at 0.5 m/s: no slip
-    >>> np.abs(s.ratio).max() < 1e-12, bool(s.valid.all())
-    (np.True_, True)
     """
     radii = wheel_radii(robot)
     w = as_array(wheel_rate, "wheel_rate", (N_WHEELS,), finite=False)

@@ -1,16 +1,6 @@
 """Sensor models (wheel encoders, IMU) with stated, seeded noise, and an extended Kalman filter for planar
-odometry from encoders and a gyro, with the ICR model as its measurement model.
-
-Encoder: an incremental encoder of ``counts_per_rev`` counts; the rate at sample k is the count
-difference over the last sample interval, so it reads ``floor`` or ``ceil`` of the true count increment:
-with ``δ`` the fractional part of the increment the error has variance ``δ(1-δ) q²/dt²`` (at most
-``q²/(4 dt²)``), ``q = 2π / counts_per_rev``; averaged over rates (δ uniform) the stated standard
-deviation is ``q / (dt √6)`` rad/s.  The
-first sample has no previous count: NaN (a drop-out, flagged downstream, never silently filled).
-
-IMU: gyro and accelerometer with a constant bias plus white noise of the stated density
-(σ = density · √(rate)); the accelerometer measures specific force (acceleration minus gravity) in body axes.
-"""
+odometry from encoders and a gyro, with the ICR model as its measurement model.  The noise models:
+``docs/mechanisms/skid_steer.md``, "Sensors and fusion"."""
 
 from __future__ import annotations
 
@@ -54,7 +44,7 @@ N_STATE = 8
 
 @dataclass(frozen=True)
 class EncoderModel:
-    """Incremental wheel encoder: ``counts_per_rev`` counts per wheel revolution (quantisation only).
+    """Incremental wheel encoder (quantisation only).
 
     Parameters
     ----------
@@ -69,27 +59,21 @@ class EncoderModel:
 
     def rate_sigma(self, dt: float) -> float:
         """Standard deviation of the measured spin rate (rad/s) at sample interval ``dt`` (s), averaged
-        over rates (module docstring); the worst rate gives ``√1.5`` times this."""
+        over rates, ``q / (dt √6)``; the worst rate gives ``√1.5`` times this."""
         return 2.0 * math.pi / self.counts_per_rev / (check_positive(dt, "dt") * math.sqrt(6.0))
 
 
 @dataclass(frozen=True)
 class ImuModel:
-    """Gyro and accelerometer: white-noise densities and constant biases (per axis, SI units).
-
-    Defaults: a MEMS IMU of the ADIS16470 class (gyro 0.008 °/s/√Hz, accelerometer 0.5 mg/√Hz); the
-    biases are of the size left after a start-up calibration.
+    """Gyro and accelerometer: white noise (σ = density · √(rate)) and constant biases, SI units.
+    Defaults: a MEMS IMU of the ADIS16470 class, biases as a start-up calibration leaves.
 
     Parameters
     ----------
-    gyro_noise_density : float, optional
-        Gyro white-noise density (rad/s/√Hz, >= 0).
-    gyro_bias : tuple of float, optional
-        Constant gyro bias per body axis (rad/s).
-    accel_noise_density : float, optional
-        Accelerometer white-noise density (m/s²/√Hz, >= 0).
-    accel_bias : tuple of float, optional
-        Constant accelerometer bias per body axis (m/s²).
+    gyro_noise_density, accel_noise_density : float, optional
+        White-noise densities (rad/s/√Hz, m/s²/√Hz; >= 0).
+    gyro_bias, accel_bias : tuple of float, optional
+        Constant biases per body axis (rad/s, m/s²).
     """
 
     gyro_noise_density: float = math.radians(0.008)  # rad/s/√Hz
@@ -122,7 +106,7 @@ def _rng(seed: object) -> np.random.Generator:
 
 @dataclass(frozen=True)
 class EncoderReadings:
-    """Measured wheel spin rates from quantised encoder counts.
+    """Measured wheel spin rates from quantised encoder counts (from :func:`encoder_rates`).
 
     Attributes
     ----------
@@ -139,21 +123,9 @@ class EncoderReadings:
 def encoder_rates(
     model: EncoderModel, wheel_rate: ArrayLike, dt: float, seed: int | np.random.Generator = 0
 ) -> EncoderReadings:
-    """Measured spin rates from true rates ``(N, 6)`` sampled every ``dt`` s.
-
-    The true angle is integrated by the trapezoidal rule from a random initial phase (``seed``: an int
-    or a ``numpy.random.Generator``), counted, and differenced; the first sample has no reading.
-
-    Parameters
-    ----------
-    model : EncoderModel
-        Encoder resolution.
-    wheel_rate : array_like, shape (N, 6)
-        True wheel spin rates (rad/s).
-    dt : float
-        Sample period (s), ``> 0``.
-    seed : int or numpy.random.Generator, optional
-        Random initial phase of the counters.
+    """Measured spin rates from true rates ``wheel_rate (N, 6)`` (rad/s) sampled every ``dt`` s:
+    :class:`EncoderReadings`.  The trapezoidal angle from a random initial phase (``seed``: an int or a
+    ``numpy.random.Generator``) is counted and differenced; the first sample has no reading.
 
     Returns
     -------
@@ -183,25 +155,12 @@ def imu_measurements(
     dt: float,
     seed: int | np.random.Generator = 0,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Gyro and accelerometer readings ``(N, 3)`` each from true body-axis values ``(N, 3)``.
-
-    Parameters
-    ----------
-    model : ImuModel
-        Noise densities and biases of the gyro and the accelerometer.
-    angular_velocity : array_like, shape (N, 3)
-        True body angular velocity (rad/s, body axes).
-    specific_force : array_like, shape (N, 3)
-        True specific force (m/s², body axes).
-    dt : float
-        Sample period (s), ``> 0``.
-    seed : int or numpy.random.Generator, optional
-        Random state of the noise.
+    """Gyro (rad/s) and accelerometer (m/s²) readings ``(N, 3)`` each from the true body-axis
+    ``angular_velocity`` and ``specific_force`` ``(N, 3)`` sampled every ``dt`` s (noise from ``seed``).
 
     Returns
     -------
     gyro, accel : ndarray, shape (N, 3)
-        Gyro (rad/s) and accelerometer (m/s²) readings.
     """
     check_params(model, ImuModel, "model")
     w = as_array(angular_velocity, "angular_velocity", (3,))
@@ -217,23 +176,12 @@ def imu_measurements(
 
 
 def track_speed_sigma(encoder: EncoderModel, radii: ArrayLike, dt: float) -> float:
-    """Standard deviation of a side's encoder track speed (mean of its wheels' rim speeds, m/s).
-
-    ``radii``: the side's wheel radii (m); the wheels' quantisation errors are independent.
-
-    Parameters
-    ----------
-    encoder : EncoderModel
-        Encoder resolution.
-    radii : array_like, shape (k,)
-        The side's wheel radii (m).
-    dt : float
-        Sample period (s), ``> 0``.
+    """Standard deviation (m/s) of a side's encoder track speed (the mean rim speed of its wheels of
+    ``radii (k,)`` m, independent quantisation errors) at sample period ``dt`` (s).
 
     Returns
     -------
     float
-        Standard deviation of the side's track speed (m/s).
     """
     check_params(encoder, EncoderModel, "encoder")
     r = as_array(radii, "radii", (None,))
@@ -244,7 +192,7 @@ def track_speed_sigma(encoder: EncoderModel, radii: ArrayLike, dt: float) -> flo
 
 @dataclass(frozen=True)
 class EKFResult:
-    """Filtered planar odometry over ``N`` samples (the result of :func:`planar_ekf`).
+    """Filtered planar odometry over ``N`` samples (from :func:`planar_ekf`).
 
     Attributes
     ----------
@@ -253,8 +201,7 @@ class EKFResult:
     covariance : ndarray, shape (N, 8, 8)
         Covariance of ``state`` (in the squared units of its entries).
     encoder_used, gyro_used : ndarray of bool, shape (N,)
-        Whether that sample's measurement updated the filter (false at the drop-outs marked by
-        ``encoder_ok`` / ``gyro_ok``: the filter only predicts there).
+        Whether that sample's measurement updated the filter (false at the marked drop-outs).
     """
 
     state: np.ndarray
@@ -295,37 +242,19 @@ def planar_ekf(
     encoder_ok: ArrayLike | None = None,
     gyro_ok: ArrayLike | None = None,
 ) -> EKFResult:
-    """Extended Kalman filter for planar odometry: encoders through the ICR model, and a gyro.
+    """Extended Kalman filter for planar odometry from encoders (ICR model) and a gyro: :class:`EKFResult`.
 
-    State ``s = [x, y, ψ, v_x, r, b, y_left, y_right]`` (``N_STATE = 8``).  Prediction over ``dt``:
-    ``x += dt (v_x cos ψ - v_y sin ψ)``, ``y += dt (v_x sin ψ + v_y cos ψ)``, ``ψ += dt r`` with
-    ``v_y = -r x_icr`` (the ICR model's lateral slip); ``v_x``, ``r`` and the gyro bias ``b`` are random
-    walks with spectral densities ``accel_psd`` (m²/s³), ``yaw_accel_psd`` (rad²/s³) and ``bias_psd``
-    (rad²/s³).  Measurements: the encoder track speeds ``v_right = v_x - r y_right``,
-    ``v_left = v_x - r y_left`` (the ICR model, noise ``sigma_track² + sigma_model²`` per side, m/s)
-    and the gyro ``z = r + b`` (``sigma_gyro``, rad/s).
-
-    The track ICRs ``y_left``, ``y_right`` start at ``icr``'s; with ``icr_sigma > 0`` (their initial
-    1σ, m) and ``icr_psd`` (random-walk density, m²/s) the filter adapts them online (cf. Pentzer et al.
-    2014), otherwise they stay fixed.  Only their spread ``y_left - y_right`` (the yaw-rate scale
-    ``χ S``) is observable from encoders and a gyro; their mean trades with ``v_x``.  Adapting needs a
-    calibrated gyro bias (``initial_bias_sigma`` of the size left by a start-up calibration): in a
-    steady turn the encoders alone cannot tell a gyro bias from an ICR error.
-
-    All histories ``(N,)`` share the time stamps ``t`` (one sample rate: arrays of another length, or
-    ``t`` with non-uniform steps, raise ``ValueError``).  Drop-outs are explicit: ``encoder_ok`` /
-    ``gyro_ok`` (bool ``(N,)``, default all true) mark the samples with a reading; the values there must
-    be finite (a NaN elsewhere raises: nothing is skipped silently), the others are ignored, and
-    ``encoder_used`` / ``gyro_used`` report what entered.
+    State ``[x, y, ψ, v_x, r, b, y_left, y_right]`` (``N_STATE``); ``v_x``, ``r``, ``b`` and (with
+    ``icr_sigma > 0``) the track ICRs are random walks; measurements ``v_right = v_x - r y_right``,
+    ``v_left = v_x - r y_left``, gyro ``r + b`` (``docs/mechanisms/skid_steer.md``, "Sensors and fusion").
+    Only the ICRs' spread is observable; adapting them needs a calibrated gyro bias.  All histories
+    ``(N,)`` share the uniform time stamps ``t``; drop-outs are marked in ``encoder_ok`` / ``gyro_ok``
+    (a non-finite value elsewhere raises) and reported in ``encoder_used`` / ``gyro_used``.
 
     Parameters
     ----------
-    t : array_like, shape (N,)
-        Uniform sample times (s).
-    v_right, v_left : array_like, shape (N,)
-        Encoder track speeds (m/s).
-    gyro_z : array_like, shape (N,)
-        Gyro yaw-rate readings (rad/s).
+    t, v_right, v_left, gyro_z : array_like, shape (N,)
+        Uniform sample times (s), encoder track speeds (m/s), gyro yaw-rate readings (rad/s).
     icr : ICRModel
     sigma_track, sigma_gyro : float
         Measurement noise of a track speed (m/s) and of the gyro (rad/s).
@@ -341,10 +270,6 @@ def planar_ekf(
         Initial 1σ (m) and random-walk density (m²/s) of the track ICRs (0: fixed).
     encoder_ok, gyro_ok : array_like of bool, shape (N,), optional
         Samples with a reading (default all).
-
-    Returns
-    -------
-    EKFResult
     """
     ta = _check_times(t)
     n = ta.size

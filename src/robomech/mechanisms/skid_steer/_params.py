@@ -1,9 +1,5 @@
-"""Geometry of the six-wheel wheel-track exploration robot (paper 4), in SI units.
-
-Frames (``docs/mechanisms/skid_steer.md``): body frame B at the body centre (the differential D),
-x forward, y left, z up.  Side 1 is the right side (y = -b), side 2 the left side (y = +b), with
-``b = rocker_lateral_offset``.  Every joint of a side turns about an axis parallel to body y.
-"""
+"""Geometry of the six-wheel wheel-track exploration robot (paper 4), in SI units; frames:
+``docs/mechanisms/skid_steer.md``."""
 
 from __future__ import annotations
 
@@ -27,31 +23,19 @@ _PAPER_MM = {
 
 @dataclass(frozen=True)
 class ExplorationRobot:
-    """Kinematic geometry of the robot (metres, radians).
-
-    The paper prints six lengths (``paper()``); the others are documented choices
-    (``docs/mechanisms/skid_steer.md``, "Parameters").
+    """Kinematic geometry of the robot (metres, radians): the paper prints six lengths (``paper()``), the
+    others are documented choices (``docs/mechanisms/skid_steer.md``, "Parameters").
 
     Attributes
     ----------
-    rocker_lateral_offset:
-        ``b``: lateral distance from the body centre to each rocker pivot and wheel plane; the track
-        width is ``S = 2 b``.
-    spring_mount_offset:
-        Rocker pivot to the spring-damper mount Q; recorded for completeness, it enters no kinematics.
-    side_link_hinge_offset:
-        Bogie hinge H to each side-link hinge (front at +x, rear at -x of the bogie frame).
-    road_wheel_radius, rear_wheel_radius:
-        Hub-to-contact distances (the 4 mm track is neglected, as in the paper).
-    rear_wheel_drop:
-        Nominal extension of the rear-wheel slide along the rocker's -z (the joint variable ``s``).
-    rear_arm_length:
-        Rocker pivot to the rear-wheel slide, along the rocker's -x (not printed).
-    bogie_hinge_x, bogie_hinge_drop:
-        Position of the bogie hinge H in the rocker frame: ``(+x, 0, -drop)`` (not printed).
-    side_link_length, side_link_rake:
-        Each side link carries its road wheel ``side_link_length`` from its hinge, raked backwards by
-        ``side_link_rake`` from the downward vertical of the side-link frame (not printed).
+    rocker_lateral_offset, spring_mount_offset, side_link_hinge_offset : float
+        ``b``, body centre to each rocker pivot and wheel plane (track width ``S = 2 b``); rocker pivot to
+        the spring-damper mount (no kinematics); bogie hinge to each side-link hinge (front +x, rear -x).
+    road_wheel_radius, rear_wheel_radius, rear_wheel_drop : float
+        Hub-to-contact distances (track neglected); nominal rear-wheel slide ``s`` along the rocker's -z.
+    rear_arm_length, bogie_hinge_x, bogie_hinge_drop, side_link_length, side_link_rake : float
+        Not printed: rocker pivot to the rear slide (along -x); bogie hinge at ``(+x, 0, -drop)`` in the
+        rocker frame; each road wheel ``side_link_length`` from its hinge, raked back by ``side_link_rake``.
     """
 
     rocker_lateral_offset: float

@@ -35,14 +35,12 @@ LATERAL_SLIP_RTOL = 1e-9
 
 @dataclass(frozen=True)
 class SkidSteerTurn:
-    """Turning of a skid-steered body from its right/left track speeds (batch shape ``...``).
+    """Turning of a skid-steered body from its right/left track speeds (from :func:`skid_steer_turn`).
 
     Attributes
     ----------
-    yaw_rate : ndarray, shape (...)
-        ``(v1 - v2) / S`` (rad/s, about body z; positive: turning left).
-    forward_speed : ndarray, shape (...)
-        ``(v1 + v2) / 2`` of the body centre (m/s).
+    yaw_rate, forward_speed : ndarray, shape (...)
+        ``(v1 - v2) / S`` (rad/s, about body z; positive: turning left), ``(v1 + v2) / 2`` (m/s).
     radius : ndarray, shape (...)
         Signed radius of the body centre's path (m, positive: centre of rotation on the left); ``inf``
         where not ``turning`` (straight or at rest).
@@ -59,18 +57,8 @@ class SkidSteerTurn:
 @carries_failed_rows({"v_right": 0, "v_left": 0})
 def skid_steer_turn(v_right: ArrayLike, v_left: ArrayLike, track_width: float) -> SkidSteerTurn:
     """Yaw rate, speed and turning radius of the body centre from the right (``v1``) and left (``v2``)
-    track speeds (m/s), for tracks ``track_width`` (m) apart, assuming no longitudinal slip.
-
-    paper 4, Sec. 1.2: printed ``R_s = (S/2)(v1+v2)/(v1-v2)`` is called the inner wheel's radius; it is
-    the radius of the body centre (the inner track runs at ``R_s - S/2``).  Printed ``ω = 2 v_X / L``;
-    the yaw rate consistent with the geometry is ``(v1 - v2)/S``.
-
-    Parameters
-    ----------
-    v_right, v_left : array_like, shape (...)
-        Right and left track speeds (m/s); broadcast together.
-    track_width : float
-        Distance between the track centre lines ``S`` (m), ``> 0``.
+    track speeds ``(...)`` (m/s, broadcast), tracks ``track_width`` (m) apart, no longitudinal slip:
+    :class:`SkidSteerTurn` (paper 4, Sec. 1.2, with the departures commented at the lines below).
 
     Returns
     -------
@@ -97,30 +85,12 @@ def skid_steer_turn(v_right: ArrayLike, v_left: ArrayLike, track_width: float) -
 
 @carries_failed_rows({"yaw_rate": 0}, {"wheel_x": 0, "icr_x": 0})
 def wheel_lateral_velocity(yaw_rate: ArrayLike, wheel_x: ArrayLike, icr_x: ArrayLike = 0.0) -> np.ndarray:
-    """Lateral (body y) sliding velocity of a contact at body ``x = wheel_x`` (m) of a body turning at
-    ``yaw_rate`` about a centre of rotation at longitudinal position ``icr_x`` (m): ``r (x_w - x_icr)``.
-
-    Planar rigid motion: the velocity of point ``p`` is ``r z × (p - p_icr)``, whose y part is this.
-
-    Parameters
-    ----------
-    yaw_rate : array_like, shape (...)
-        Body yaw rate ``r`` (rad/s).
-    wheel_x : array_like, shape (...)
-        Longitudinal position of the contact in body axes (m).
-    icr_x : array_like, shape (...), optional
-        Longitudinal position of the centre of rotation (m), default 0.
+    """Lateral (body y) sliding velocity ``r (x_w - x_icr)`` (m/s) of a contact at body ``x = wheel_x`` (m)
+    of a body turning at ``yaw_rate`` (rad/s) about a centre of rotation at ``x = icr_x`` (m); broadcast.
 
     Returns
     -------
     ndarray, shape (...)
-        Lateral sliding velocity (m/s) of the broadcast shape.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> wheel_lateral_velocity(0.5, np.array([0.3, -0.3]))    # front and rear wheels slide opposite ways
-    array([ 0.15, -0.15])
     """
     r = as_array(yaw_rate, "yaw_rate")
     x = as_array(wheel_x, "wheel_x")
@@ -131,15 +101,14 @@ def wheel_lateral_velocity(yaw_rate: ArrayLike, wheel_x: ArrayLike, icr_x: Array
 
 @dataclass(frozen=True)
 class LateralSlip:
-    """Lateral slip speed of the outer wheel (the result of :func:`paper_lateral_slip`, paper 4, Sec. 1.2).
+    """Lateral slip speed of the outer wheel (from :func:`paper_lateral_slip`, paper 4, Sec. 1.2).
 
     Attributes
     ----------
     lateral_speed : ndarray, shape (...)
         Lateral slip speed ``v_Y`` (m/s); NaN exactly where ``valid`` is false.
     valid : ndarray of bool, shape (...)
-        False where the centre of rotation lies within ``LATERAL_SLIP_RTOL`` S of the inner track (or
-        on an overflow).
+        False within ``LATERAL_SLIP_RTOL`` S of the singularity ``2 R + S = 0`` (or on an overflow).
     """
 
     lateral_speed: np.ndarray
@@ -150,33 +119,13 @@ class LateralSlip:
 def paper_lateral_slip(
     v_outer: ArrayLike, wheelbase: float, radius: ArrayLike, track_width: float
 ) -> LateralSlip:
-    """paper 4, Sec. 1.2: ``v_Y = v_X L / (2 R_s + S)``, magnitude of the lateral slip of an outer
-    wheel a distance ``L/2`` ahead of or behind the centre of rotation, with ``R_s`` the radius of the
-    body centre (not of the inner wheel, as printed).
-
-    Samples at the formula's singularity ``2 R + S = 0`` (the centre of rotation on the inner track, which
-    is then at rest) are flagged (``valid`` false, NaN) instead of returned as huge or infinite values.
-
-    Parameters
-    ----------
-    v_outer : array_like, shape (...)
-        Speed of the outer track ``v_X`` (m/s).
-    wheelbase : float
-        Distance ``L`` between the front and rear wheels (m), ``> 0``.
-    radius : array_like, shape (...)
-        Turning radius ``R_s`` of the body centre (m).
-    track_width : float
-        Track width ``S`` (m), ``> 0``.
+    """paper 4, Sec. 1.2: ``v_Y = v_X L / (2 R_s + S)`` (m/s), the lateral slip of an outer wheel ``L/2``
+    from the centre of rotation, from the outer track speed ``v_outer`` (m/s), ``wheelbase`` L (m), the
+    radius ``R_s`` of the body centre (m; not of the inner wheel, as printed) and ``track_width`` S (m).
 
     Returns
     -------
     LateralSlip
-
-    Examples
-    --------
-    >>> s = paper_lateral_slip(1.0, wheelbase=0.6, radius=2.0, track_width=0.6)
-    >>> round(float(s.lateral_speed), 6)                 # 1.0 * 0.6 / (2 * 2.0 + 0.6)
-    0.130435
     """
     v = as_array(v_outer, "v_outer")
     R = as_array(radius, "radius")
@@ -206,30 +155,16 @@ def _check_rigid(T: np.ndarray, name: str) -> np.ndarray:
 
 
 def dead_reckoning(twists: ArrayLike, dt: float, T0: ArrayLike | None = None) -> np.ndarray:
-    """Body poses ``T_GB (..., N, 4, 4)`` from body twists ``[ω; v]`` ``(..., N, 6)`` sampled every ``dt`` s.
-
-    Between samples the twist is taken as the mean of its end values (second order in ``dt``):
-    ``T_{k+1} = T_k exp(dt (V_k + V_{k+1})/2)``.  The running product is evaluated as a parallel prefix
-    scan (``log2 N`` batched matrix products), so there is no Python loop over samples.
-
-    Parameters
-    ----------
-    twists : array_like, shape (..., N, 6)
-        Body twists ``[ω; v]`` in body axes (rad/s, m/s), one per sample, ``N >= 1``.
-    dt : float
-        Sample period (s), ``> 0``.
-    T0 : array_like, shape (..., 4, 4), optional
-        Initial pose ``T_GB`` (default the identity): a rigid transform (rotation part orthonormal
-        with determinant 1 and last row ``(0, 0, 0, 1)``, within ``ROTATION_ATOL``).
+    """Body poses ``T_GB (..., N, 4, 4)`` (the first is ``T0``, default the identity) from body twists
+    ``[ω; v]`` ``(..., N, 6)`` (rad/s, m/s) sampled every ``dt`` s: ``T_{k+1} = T_k exp(dt (V_k +
+    V_{k+1})/2)`` (second order), evaluated as a parallel prefix scan (``log2 N`` batched products).
 
     Returns
     -------
     ndarray, shape (..., N, 4, 4)
-        Poses ``T_GB`` at the sample times (the first is ``T0``).
 
     Examples
     --------
-    >>> import numpy as np
     >>> V = np.tile([0.0, 0.0, 0.5, 1.0, 0.0, 0.0], (3, 1))     # 1 m/s forward turning at 0.5 rad/s
     >>> T = dead_reckoning(V, 0.1)
     >>> T.shape, T[-1, :2, 3].round(4)                          # on the arc of radius 2 m after 0.2 s

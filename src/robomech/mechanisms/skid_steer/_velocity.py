@@ -1,17 +1,6 @@
-"""Composite velocity system ``A0 ṗ = J q̇`` of the six wheels and its batched least-squares solution.
-
-Unknowns ``ṗ (..., 11)`` (paper 4, eq. (5) order):
-``[v_BX, v_BY, v_BZ, ω_BX, ω_BZ, θ̇01_1, θ̇02_1, θ̇01_2, θ̇02_2, ṡ_1, ṡ_2]``.
-
-Measurements ``q̇ (..., 22)``: the contact-frame velocity of each wheel (3 per wheel, in its contact
-frame, wheel order ``WHEELS``), then ``ω1, ω2`` (pitch rate of each rocker relative to the ground),
-``ω`` (body yaw rate ω_BZ) and the body roll rate ω_BX (added to the paper's 21, see the docs).
-
-Rows (5 per wheel, paper order ``[v_X, v_Y, v_Z, ω_X, ω_Z]`` in body axes), for contact ``p`` of wheel w:
-``v_B + ω_B × p + Σ_chain G q̇_chain = R_BP v_P`` and ``ω_BX = roll``, ``ω_BZ = yaw``.  The differential
-makes the rockers turn oppositely relative to the body, so ``ω_BY = (ω1 + ω2)/2`` and
-``θ̇_i = ω_i - ω_BY`` are known; their terms go to the right-hand side.
-"""
+"""Composite velocity system ``A0 ṗ = J q̇`` of the six wheels (paper 4, eq. (5)) and its batched
+least-squares solution.  Unknowns ``ṗ (..., 11)`` in paper order, measurements ``q̇ (..., 22)`` (the
+18 contact-frame velocities, ``ω1, ω2``, yaw and roll rate) and rows: ``docs/mechanisms/skid_steer.md``."""
 
 from __future__ import annotations
 
@@ -21,7 +10,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from robomech._batching import carries_failed_rows, slices
+from robomech._batching import carries_failed_rows, chunked
 from robomech._validation import as_array, broadcast_batch, broadcast_to_batch, check_bool, check_params
 from robomech.analysis import lstsq
 
@@ -58,37 +47,18 @@ _PASSIVE = ((5, 6, 9), (7, 8, 10))
 
 @carries_failed_rows({"config": 1})
 def assemble(robot: ExplorationRobot, config: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-    """``A0 (..., 30, 11)`` and ``J (..., 30, 22)`` of the composite system at ``config (..., 8)``.
-
-    Parameters
-    ----------
-    robot : ExplorationRobot
-    config : array_like, shape (..., 8)
-        Joint configuration (rad, m).
+    """``A0 (..., 30, 11)`` and ``J (..., 30, 22)`` of ``A0 ṗ = J q̇`` at ``config (..., 8)``: the
+    coefficients of the unknowns and of the measured vector (paper order).
 
     Returns
     -------
-    A0 : ndarray, shape (..., 30, 11)
-        Coefficients of the unknowns ``ṗ`` (body twist and passive joint rates, paper order).
-    J : ndarray, shape (..., 30, 22)
-        Coefficients of the measured vector ``q̇`` (wheel spin rates, rocker rates, gyro): ``A0 ṗ = J q̇``.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> A0, J = assemble(ExplorationRobot.paper(), np.zeros(8))
-    >>> A0.shape, J.shape
-    ((30, 11), (30, 22))
+    A0, J : ndarray, shape (..., 30, 11) and (..., 30, 22)
     """
     check_params(robot, ExplorationRobot, "robot")
     q = as_array(config, "config", (CONFIG_SIZE,))
     batch = q.shape[:-1]
-    n = int(np.prod(batch))
-    qf = q.reshape(n, CONFIG_SIZE)
-    A0 = np.empty((n, N_ROWS, UNKNOWN_SIZE))
-    J = np.empty((n, N_ROWS, MEASURED_SIZE))
-    for sl in slices(n, ASSEMBLY_CHUNK):
-        A0[sl], J[sl] = _assemble(robot, qf[sl])
+    qf = q.reshape(-1, CONFIG_SIZE)
+    A0, J = chunked(lambda sl: _assemble(robot, qf[sl]), qf.shape[0], ASSEMBLY_CHUNK)
     return A0.reshape(*batch, N_ROWS, UNKNOWN_SIZE), J.reshape(*batch, N_ROWS, MEASURED_SIZE)
 
 
@@ -145,31 +115,17 @@ def _assemble(robot: ExplorationRobot, q: np.ndarray) -> tuple[np.ndarray, np.nd
 def wheel_measurements(
     robot: ExplorationRobot, config: ArrayLike, twist: ArrayLike, config_rate: ArrayLike
 ) -> np.ndarray:
-    """Exact measurements ``q̇ (..., 22)`` of a known motion (the forward velocity map).
-
-    ``twist (..., 6)`` = ``[ω_B; v_B]`` of the body relative to the ground in body axes (``v_B`` the
-    velocity of the body centre); ``config_rate (..., 8)`` the joint rates.  :func:`body_velocity`
-    recovers everything from these except that it reports ``ω_BY = (ω1 + ω2)/2``, which is the true
-    pitch rate only when the differential holds (``θ̇2 = -θ̇1``).
-
-    Parameters
-    ----------
-    robot : ExplorationRobot
-    config : array_like, shape (..., 8)
-        Joint configuration (rad, m).
-    twist : array_like, shape (..., 6)
-        Body twist ``[ω_B; v_B]`` relative to the ground, body axes (rad/s, m/s).
-    config_rate : array_like, shape (..., 8)
-        Joint rates (rad/s, m/s).
+    """Exact measurements ``q̇ (..., 22)`` of a known motion (the forward velocity map): body ``twist
+    (..., 6)`` ``[ω_B; v_B]`` relative to the ground in body axes (rad/s, m/s), joint rates ``config_rate
+    (..., 8)``.  :func:`body_velocity` recovers them, with ``ω_BY = (ω1 + ω2)/2`` (exact only when the
+    differential holds, ``θ̇2 = -θ̇1``).
 
     Returns
     -------
     ndarray, shape (..., 22)
-        The measured vector (module docstring): wheel spin rates, rocker rates and the gyro.
 
     Examples
     --------
-    >>> import numpy as np
     >>> robot = ExplorationRobot.paper()
     >>> twist = np.array([0.0, 0.0, 0.2, 0.5, 0.0, 0.0])    # 0.5 m/s forward, turning at 0.2 rad/s
     >>> m = wheel_measurements(robot, np.zeros(8), twist, np.zeros(8))
@@ -202,9 +158,7 @@ def wheel_measurements(
 
 @dataclass(frozen=True)
 class BodyVelocity:
-    """Estimated body motion per sample (the result of :func:`body_velocity`).
-
-    NaN entries appear only where ``valid`` is false.
+    """Estimated body motion per sample (from :func:`body_velocity`); NaN only where ``valid`` is false.
 
     Attributes
     ----------
@@ -239,34 +193,13 @@ def body_velocity(
     exact_cond: bool = False,
     measurement_sigma: ArrayLike | None = None,
 ) -> BodyVelocity:
-    """Body twist and passive joint rates from wheel and rocker measurements, per sample.
+    """Body twist and passive joint rates from the joint configuration ``state (..., 8)`` and the measured
+    vector ``measured (..., 22)``, per sample (non-finite samples flagged).
 
-    ``state (..., 8)`` is the joint configuration, ``measured (..., 22)`` the measured vector (module
-    docstring).  ``solver="qr"`` uses Householder QR (``robomech.analysis.lstsq.solve``, paper 4,
-    Sec. 2.1); ``"normal_equations"`` the textbook ``(A0ᵀA0)⁻¹A0ᵀ`` for comparison.  Non-finite
-    samples (sensor drop-outs) are flagged by ``valid`` instead of raising.  ``cond`` is the exact 1-norm
-    condition number of R (within a factor 11 of the 2-norm one); ``exact_cond=True`` gives the 2-norm
-    one from the singular values of R (QR only; slower).
-
-    ``measurement_sigma (..., 22)`` (> 0, the standard deviations of the measured vector, independent
-    errors) makes it weighted least squares (QR only): row i of ``A0 ṗ = J q̇`` gets the weight
-    ``1 / Σ_j J_ij² σ_j²``, the inverse variance of its right-hand side.  The rows' correlations (the
-    gyro appears in all six wheels' angular rows) are neglected: a diagonal weighting, not full GLS.
-    ``residual_norm`` is then the weighted (dimensionless) residual.
-
-    Parameters
-    ----------
-    robot : ExplorationRobot
-    state : array_like, shape (..., 8)
-        Joint configuration (rad, m).
-    measured : array_like, shape (..., 22)
-        Measured vector (rad/s; module docstring); non-finite samples are flagged, not raised.
-    solver : {"qr", "normal_equations"}, optional
-        Householder QR (default) or the normal equations (for comparison).
-    exact_cond : bool, optional
-        Report the 2-norm condition number (QR only).
-    measurement_sigma : array_like, shape (..., 22), optional
-        Standard deviations (> 0) of the measured vector for weighted least squares (QR only).
+    ``solver="qr"``: Householder QR (``analysis.lstsq.solve``, paper 4, Sec. 2.1); ``"normal_equations"``
+    for comparison.  ``cond``: 1-norm condition number of R (within 11x of the 2-norm one, which
+    ``exact_cond=True`` gives).  ``measurement_sigma (..., 22)`` (> 0): weighted least squares with the
+    rows' inverse variances ``1 / Σ_j J_ij² σ_j²`` (diagonal; ``residual_norm`` then dimensionless).
 
     Returns
     -------
@@ -274,7 +207,6 @@ def body_velocity(
 
     Examples
     --------
-    >>> import numpy as np
     >>> robot = ExplorationRobot.paper()
     >>> m = wheel_measurements(robot, np.zeros(8), np.array([0, 0, 0, 0.5, 0, 0]), np.zeros(8))
     >>> m = np.stack([m, np.full(22, np.nan)])                # a drop-out in the second sample
@@ -300,32 +232,27 @@ def body_velocity(
     n = int(np.prod(batch))
     qf = np.broadcast_to(q, (*batch, CONFIG_SIZE)).reshape(n, CONFIG_SIZE)
     mf = np.broadcast_to(m, (*batch, MEASURED_SIZE)).reshape(n, MEASURED_SIZE)
-    x = np.empty((n, UNKNOWN_SIZE))
-    resid = np.empty(n)
-    cond = np.empty(n)
-    valid = np.empty(n, dtype=bool)
-    for sl in slices(n, CHUNK):
-        qc, mc = qf[sl], mf[sl]
+    sf = None if sig is None else np.broadcast_to(sig, (*batch, MEASURED_SIZE)).reshape(n, MEASURED_SIZE)
+
+    def solve(sl: slice) -> tuple[np.ndarray, ...]:
+        qc = qf[sl]
         finite_q = np.all(np.isfinite(qc), axis=-1)
         A0, J = _assemble(robot, np.where(finite_q[:, None], qc, 0.0))
         A0[~finite_q] = np.nan  # flagged by lstsq as not ok
-        b = np.einsum("nij,nj->ni", J, mc)
-        if sig is not None:
-            sc = np.broadcast_to(sig, (*batch, MEASURED_SIZE)).reshape(n, MEASURED_SIZE)[sl]
-            w = 1.0 / np.einsum("nij,nj->ni", J * J, sc * sc)  # inverse variance of each row's b_i
+        b = np.einsum("nij,nj->ni", J, mf[sl])
+        if sf is not None:
+            w = 1.0 / np.einsum("nij,nj->ni", J * J, sf[sl] * sf[sl])  # inverse variance of each row's b_i
             res = lstsq.solve(A0, b, exact_cond=exact_cond, weights=w)
         elif solver == "qr":
             res = lstsq.solve(A0, b, exact_cond=exact_cond)
         else:
             res = lstsq.solve_normal_equations(A0, b)
-        x[sl] = res.x
-        resid[sl] = res.residual_norm
-        # the condition number stays reported for finite rank-deficient samples (huge or inf)
-        cond[sl] = np.where(res.ok, res.cond, np.nan)
-        # A finite but huge sample can overflow the residual (or x) to inf: never valid.
-        valid[sl] = (
-            res.ok & res.full_rank & np.isfinite(res.residual_norm) & np.all(np.isfinite(res.x), axis=-1)
-        )
+        # the condition number stays reported for finite rank-deficient samples (huge or inf); a finite
+        # but huge sample can overflow the residual (or x) to inf: never valid
+        ok = res.ok & res.full_rank & np.isfinite(res.residual_norm) & np.all(np.isfinite(res.x), axis=-1)
+        return res.x, res.residual_norm, np.where(res.ok, res.cond, np.nan), ok
+
+    x, resid, cond, valid = chunked(solve, n, CHUNK)
     x = x.reshape(*batch, UNKNOWN_SIZE)
     # A non-finite rocker reading (inf - inf) only reaches samples that the mask below flags.
     with np.errstate(invalid="ignore", over="ignore"):
