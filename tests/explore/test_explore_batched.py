@@ -1,0 +1,100 @@
+"""The paper studies' design-batched chunks equal the per-design evaluation, design by design.
+
+Each reference below is the study's per-design loop as it was before its kernels took per-design
+arrays: one public mechanism call per design.  The batched chunk must give the same metrics on a few
+dozen Sobol designs, with rejected designs (None parameter objects) among them, for any design block.
+"""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from robomech.explore import Variable, design_matrix, with_variables
+from robomech.explore import _spherical_leg as sls
+from robomech.mechanisms import spherical_leg as sl
+
+
+def _spherical_leg_per_design(study, params):
+    """``_spherical_leg.evaluate`` as one ``workspace_map`` and one ``inverse_dynamics`` per design."""
+    n = len(params)
+    out = {m.name: np.full(n, np.nan) for m in study.metrics}
+    for k in ("has_workspace", "fig5b_ok"):
+        out[k] = np.zeros(n, dtype=bool)
+    a, b = sls._task_grid()
+    q, qd, qdd = sls._fig5b()
+    m = a.size
+    a_all, b_all = np.concatenate([a, q[:, 0]]), np.concatenate([b, q[:, 1]])
+    for i, leg in enumerate(params):
+        if leg is None:
+            continue
+        both = sl.workspace_map(leg, a_all, b_all)
+        reach = both.reachable[:m] & ~both.singular[:m]
+        out["workspace_fraction"][i] = reach.mean()
+        if reach.any():
+            dex = both.sigma_min[:m][reach] / both.sigma_max[:m][reach]
+            out["min_dexterity"][i] = dex.min()
+            out["mean_dexterity"][i] = dex.mean()
+            out["has_workspace"][i] = True
+        sign = np.sign(both.dl3_dalpha[m:])
+        if not (both.reachable[m:].all() and np.all(sign == sign[0]) and sign[0] != 0):
+            continue
+        dyn = sl.inverse_dynamics(leg, q, qd, qdd, driven_legs=sl.PAPER_DRIVEN_LEGS)
+        ok = bool(dyn.valid.all())
+        out["fig5b_ok"][i] = ok
+        if ok:
+            out["peak_force"][i] = np.max(np.abs(dyn.leg_forces))
+    return out
+
+
+def _rows_with_rejected(study, n, bad):
+    """``n`` Sobol designs of ``study`` with ``bad`` (a row the parameter object rejects) at rows 3, 17."""
+    X = design_matrix(study.variables, n, "sobol", 3, n)
+    X[[3, 17]] = bad
+    return X
+
+
+def _assert_same(study, X, reference):
+    got = study.evaluate_rows(X, None)
+    ref = reference(study, study.designs_to_params(X))
+    assert not got["design_ok"].all() and got["design_ok"].any()
+    for k, v in ref.items():
+        assert got[k].tobytes() == v.tobytes(), k
+    return got
+
+
+def test_spherical_leg_batched_chunk_equals_each_design_alone():
+    X = _rows_with_rejected(sls.STUDY, 48, [0.075, -0.03, 0.1])  # r < 0: rejected
+    got = _assert_same(sls.STUDY, X, _spherical_leg_per_design)
+    # the sample holds designs with and without workspace, with a feasible and an infeasible Fig. 5(b)
+    ok = got["design_ok"]
+    assert 0 < got["fig5b_ok"].sum() < ok.sum() and got["has_workspace"][ok].all()
+
+
+def test_spherical_leg_legs_varying_beyond_r_r_h_are_evaluated_in_their_own_groups():
+    # length_max varies per design: every design is its own group; below length_min it is rejected
+    st = with_variables(sls.STUDY, [Variable("length_max", 0.01, 0.2, "m")])
+    X = _rows_with_rejected(st, 24, [0.075, 0.03, 0.1, 0.02])
+    got = _assert_same(st, X, _spherical_leg_per_design)
+    assert np.unique(got["workspace_fraction"][got["design_ok"]]).size > 1
+
+
+@pytest.mark.parametrize("block", [1, 7])
+def test_spherical_leg_design_blocks_change_no_bit(monkeypatch, block):
+    X = _rows_with_rejected(sls.STUDY, 24, [0.075, -0.03, 0.1])
+    whole = sls.STUDY.evaluate_rows(X, None)
+    monkeypatch.setattr(sls, "DESIGN_BLOCK", block)
+    blocked = sls.STUDY.evaluate_rows(X, None)
+    for k, v in whole.items():
+        assert v.tobytes() == blocked[k].tobytes(), k
+
+
+def test_spherical_leg_designs_carry_each_legs_derived_geometry():
+    from robomech.mechanisms.spherical_leg import _designs as sld
+
+    legs = [dataclasses.replace(sl.SphericalLeg.paper(), R=R, r=r) for R, r in [(0.06, 0.03), (0.09, 0.04)]]
+    d = sld.designs(legs)
+    for i, leg in enumerate(legs):
+        for name in ("base_points", "platform_points_home", "cardan_axes"):
+            np.testing.assert_array_equal(getattr(d, name)[i, 0], getattr(leg, name))
+    assert d.platform_mass == legs[0].platform_mass
