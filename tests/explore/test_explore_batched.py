@@ -13,8 +13,10 @@ import pytest
 from robomech.explore import Variable, design_matrix, with_variables
 from robomech.explore import _omnileg as om
 from robomech.explore import _spherical_leg as sls
+from robomech.explore import _vectored_thrust as vts
 from robomech.mechanisms import omnileg as ol
 from robomech.mechanisms import spherical_leg as sl
+from robomech.mechanisms import vectored_thrust as vt
 
 # The OmniLeg's batched dynamics multiplies each body's inertia per sample where a single leg makes one
 # BLAS product: the same three products and two sums per component, possibly in another order (a few
@@ -22,7 +24,7 @@ from robomech.mechanisms import spherical_leg as sl
 OMNILEG_RTOL = 1e-13
 
 
-def _spherical_leg_per_design(study, params):
+def _spherical_leg_per_design(study, params, X):
     """``_spherical_leg.evaluate`` as one ``workspace_map`` and one ``inverse_dynamics`` per design."""
     n = len(params)
     out = {m.name: np.full(n, np.nan) for m in study.metrics}
@@ -54,7 +56,7 @@ def _spherical_leg_per_design(study, params):
     return out
 
 
-def _omnileg_per_design(study, params):
+def _omnileg_per_design(study, params, X):
     """``_omnileg.evaluate`` as one ``jacobian`` and one ``inverse_dynamics`` per design."""
     n = len(params)
     out = {m.name: np.full((n, *m.shape), np.nan) for m in study.metrics}
@@ -73,6 +75,31 @@ def _omnileg_per_design(study, params):
     return out
 
 
+def _thruster_per_design(study, params, X):
+    """``_vectored_thrust.evaluate`` design by design: each as-built thruster (its arc angle in its
+    parameter object) with its other errors, against the nominal axes at the workspace poses."""
+    n = len(params)
+    out = {m.name: np.full(n, np.nan) for m in study.metrics}
+    out["assembles"] = np.zeros(n, dtype=bool)
+    nominal = study.nominal()
+    q = vts.workspace(nominal)
+    nom = vt.forward_kinematics(nominal, q).axis
+    for i, th in enumerate(params):
+        if th is None:  # a thruster that cannot be built assembles nowhere
+            out["assembled_fraction"][i] = 0.0
+            continue
+        errors = {name: X[i, k] for k, name in enumerate(study.variable_names) if name != "arc_angle"}
+        err, ok = vts._pointing_error(th, errors, q, nom)
+        out["assembled_fraction"][i] = ok.mean()
+        out["assembles"][i] = ok.all()
+        if ok.all():
+            out["rms_error"][i] = np.sqrt(np.mean(err * err))
+            out["p50_error"][i] = np.percentile(err, 50)
+            out["p95_error"][i] = np.percentile(err, 95)
+            out["max_error"][i] = err.max()
+    return out
+
+
 def _rows_with_rejected(study, n, bad):
     """``n`` Sobol designs of ``study`` with ``bad`` (a row the parameter object rejects) at rows 3, 17."""
     X = design_matrix(study.variables, n, "sobol", 3, n)
@@ -82,7 +109,7 @@ def _rows_with_rejected(study, n, bad):
 
 def _assert_same(study, X, reference, rtol=0.0):
     got = study.evaluate_rows(X, None)
-    ref = reference(study, study.designs_to_params(X))
+    ref = reference(study, study.designs_to_params(X), X)
     assert not got["design_ok"].all() and got["design_ok"].any()
     for k, v in ref.items():
         if rtol == 0.0:
@@ -142,3 +169,15 @@ def test_omnileg_legs_varying_beyond_their_lengths_are_evaluated_in_their_own_gr
     X = _rows_with_rejected(st, 20, [0.15, -0.09, 0.16, 0.04])  # L4 < 0: rejected
     got = _assert_same(st, X, _omnileg_per_design, OMNILEG_RTOL)
     assert np.unique(got["peak_torque"][got["design_ok"]]).size == got["design_ok"].sum()
+
+
+def test_thruster_batched_chunk_equals_each_design_alone():
+    # wide errors: some designs do not assemble everywhere; an arc angle below 0 is rejected
+    st = with_variables(
+        vts.STUDY, [Variable(v.name, unit="rad", kind="normal", sigma=0.3) for v in vts.STUDY.variables]
+    )
+    X = design_matrix(st.variables, 64, "random", 2, 64)
+    X[[3, 17], st.variable_names.index("arc_angle")] = -1.0
+    got = _assert_same(st, X, _thruster_per_design)
+    ok = got["design_ok"]
+    assert 0 < got["assembles"][ok].sum() < ok.sum()

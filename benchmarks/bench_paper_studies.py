@@ -1,0 +1,150 @@
+"""robomech.explore: the paper studies' chunks, design-batched kernels against an earlier revision.
+
+``python benchmarks/bench_paper_studies.py [--before REV]`` (standalone; ~2 min on a loaded machine)
+evaluates one default-size chunk of each built-in paper study (its default sampler, chunk 0's designs)
+in-process on one core (``WORKER_ENV``: one BLAS/OpenMP/numba thread) and reports designs/s and
+design-poses/s (designs x ``poses_per_design`` / s), best of ``--repeats``.  Each measurement runs in a
+fresh process; with ``--before REV`` the same measurement also runs on ``git archive REV src`` (e.g. the
+revision before the paper studies' kernels took per-design arrays: one mechanism call per design),
+the two trees alternating so that both see the same load, and the table gives the speed-up.
+
+``workloads()`` (for ``run.py``): one default chunk of each study in the current tree.
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tarfile
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+STUDIES = ("spherical-leg-synthesis", "omnileg-synthesis", "vectored-thrust-tolerance")
+REPEATS = 3
+# Rounds of (before, after) measurements, alternating; the median of the rounds' best times is reported.
+ROUNDS = 3
+
+
+def _chunk(name: str):
+    from robomech.explore import design_matrix, get_study
+
+    st = get_study(name)
+    return st, design_matrix(st.variables, st.default_chunk, st.default_sampler, 0, st.default_chunk)
+
+
+def _evaluate(st, X) -> None:
+    from robomech.explore._sampling import chunk_seed
+
+    st.evaluate_rows(X, chunk_seed(0, 0))
+
+
+def workloads():
+    from _harness import Workload
+
+    out = []
+    for name in STUDIES:
+        st, X = _chunk(name)
+        out.append(
+            Workload(
+                name=f"explore: {name}, one design-batched chunk ({st.default_chunk} designs)",
+                group="x",
+                run=functools.partial(_evaluate, st, X),
+                n=st.default_chunk * st.poses_per_design,
+                bytes_moved=0,
+                repeats=2,
+            )
+        )
+    return out
+
+
+def _measure(name: str, repeats: int) -> dict:
+    """Best wall time of one default chunk of ``name`` in this process (after a warm-up chunk)."""
+    st, X = _chunk(name)
+    _evaluate(st, X[:4])
+    best = float("inf")
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        _evaluate(st, X)
+        best = min(best, time.perf_counter() - t0)
+    return {"designs": int(X.shape[0]), "poses_per_design": int(st.poses_per_design), "seconds": best}
+
+
+def _in_fresh_process(src: Path, name: str, repeats: int) -> dict:
+    from robomech.explore._runner import WORKER_ENV
+
+    env = {**os.environ, **WORKER_ENV, "PYTHONPATH": str(src)}
+    code = (
+        f"import sys, json; sys.path.insert(0, {str(ROOT / 'benchmarks')!r}); "
+        "import bench_paper_studies as b; "
+        f"print(json.dumps(b._measure({name!r}, {repeats})))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True, env=env)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _archive(rev: str, into: Path) -> Path:
+    """``git archive REV src`` unpacked under ``into``; returns its ``src``."""
+    tar = into / "src.tar"
+    subprocess.run(["git", "-C", str(ROOT), "archive", "-o", str(tar), rev, "src"], check=True)
+    with tarfile.open(tar) as t:
+        t.extractall(into, filter="data")
+    return into / "src"
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--before", default=None, help="a git revision to compare with (its src/ tree)")
+    p.add_argument("--only", default=None, help="only the studies whose name contains this")
+    p.add_argument("--repeats", type=int, default=REPEATS, help=f"chunks per measurement (default {REPEATS})")
+    p.add_argument("--rounds", type=int, default=ROUNDS, help=f"alternating rounds (default {ROUNDS})")
+    p.add_argument("--json", default=None, help="also write the rows as JSON to this file")
+    a = p.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        trees = {"after": ROOT / "src"}
+        if a.before:
+            trees = {"before": _archive(a.before, Path(tmp)), **trees}
+        rows = []
+        for name in (s for s in STUDIES if a.only is None or a.only in s):
+            runs: dict[str, list[dict]] = {k: [] for k in trees}
+            for _ in range(a.rounds):
+                for k, src in trees.items():
+                    runs[k].append(_in_fresh_process(src, name, a.repeats))
+            row = {"study": name, "load_1min": os.getloadavg()[0]}
+            for k, rs in runs.items():
+                r = rs[0]
+                t = statistics.median(x["seconds"] for x in rs)
+                row[k] = {
+                    "designs": r["designs"],
+                    "seconds": t,
+                    "designs_per_s": r["designs"] / t,
+                    "poses_per_s": r["designs"] * r["poses_per_design"] / t,
+                    "all_seconds": [x["seconds"] for x in rs],
+                }
+            if "before" in row:
+                row["speedup"] = row["before"]["seconds"] / row["after"]["seconds"]
+            rows.append(row)
+            print(_line(row), flush=True)
+    if a.json:
+        Path(a.json).write_text(json.dumps(rows, indent=1))
+
+
+def _line(row: dict) -> str:
+    parts = [f"{row['study']:28s} ({row['after']['designs']} designs, load {row['load_1min']:.1f})"]
+    for k in ("before", "after"):
+        if k in row:
+            r = row[k]
+            parts.append(f"{k}: {r['designs_per_s']:8.1f} designs/s {r['poses_per_s']:10.3g} poses/s")
+    if "speedup" in row:
+        parts.append(f"x{row['speedup']:.2f}")
+    return " | ".join(parts)
+
+
+if __name__ == "__main__":
+    main()
