@@ -32,9 +32,9 @@ TASK_GRID = 41  # per axis: 1681 poses, a 3 deg step
 FIG5B_DURATION = 25.0
 FIG5B_STEP = 0.1
 # Designs evaluated in one kernel call: (DESIGN_BLOCK x 1932 poses x (3, 2)) float64 temporaries of
-# ~1.5 MB, near a core's cache (measured on one core, 512 designs: 200-330 designs/s in blocks of 1,
-# 390-450 in blocks of 16, 350-400 in blocks of 32); the block size changes no bit (every operation is
-# per design and pose; tested).
+# ~1.5 MB, near a core's cache (measured on one core at load 6, 512 designs: 330-350 designs/s in
+# blocks of 1, 520-620 in blocks of 8-16, 460-500 in blocks of 32-64); the block size changes no bit
+# (every operation is per design and pose; tested).
 DESIGN_BLOCK = 16
 
 
