@@ -39,7 +39,8 @@ GAMMA_USABLE_MIN = math.radians(10.0)
 SIMPSON_POINTS = 13
 # eq. (52) motion: one 6 s period, 0.05 s steps.
 EQ52_STEP = 0.05
-# Designs in one dynamics call: 64 x 121 samples, the jets' (3, N, 3) temporaries ~190 kB each.
+# Designs in one dynamics call (64 x 121 samples, the jets' (3, N, 3) temporaries ~0.6 MB each); measured
+# on one core at load 6, 128 designs: 51-62 designs/s in blocks of 1, 89-123 in blocks of 8 to 128.
 DESIGN_BLOCK = 64
 
 
