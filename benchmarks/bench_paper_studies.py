@@ -2,11 +2,14 @@
 
 ``python benchmarks/bench_paper_studies.py [--before REV]`` (standalone; ~2 min on a loaded machine)
 evaluates one default-size chunk of each built-in paper study (its default sampler, chunk 0's designs)
-in-process on one core (``WORKER_ENV``: one BLAS/OpenMP/numba thread) and reports designs/s and
-design-poses/s (designs x ``poses_per_design`` / s), best of ``--repeats``.  Each measurement runs in a
-fresh process; with ``--before REV`` the same measurement also runs on ``git archive REV src`` (e.g. the
-revision before the paper studies' kernels took per-design arrays: one mechanism call per design),
-the two trees alternating so that both see the same load, and the table gives the speed-up.
+in-process on one core as a sweep's worker runs it (``WORKER_ENV``: one BLAS/OpenMP/numba thread;
+``WORKER_MALLOC``: glibc's malloc as Dask's nanny sets it) and reports designs/s and design-poses/s
+(designs x ``poses_per_design`` / s) from the wall time, and designs per CPU-second
+(``time.process_time``, less sensitive to the machine's other load), best of ``--repeats``.  Each
+measurement runs in a fresh process; with ``--before REV`` the same measurement also runs on
+``git archive REV src`` (e.g. the revision before the paper studies' kernels took per-design arrays:
+one mechanism call per design), the two trees alternating so that both see the same load, and the
+table gives the speed-ups.
 
 ``workloads()`` (for ``run.py``): one default chunk of each study in the current tree.
 """
@@ -28,6 +31,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 STUDIES = ("spherical-leg-synthesis", "omnileg-synthesis", "vectored-thrust-tolerance")
 REPEATS = 3
+# glibc's malloc as Dask's nanny starts a worker (distributed's default ``pre-spawn-environ``): above
+# this trim threshold glibc no longer adapts its mmap threshold, so every temporary above 128 kB is
+# mapped and unmapped (page faults on each use): the setting the chunks of a sweep run under.
+WORKER_MALLOC = {"MALLOC_TRIM_THRESHOLD_": "65536"}
 # Rounds of (before, after) measurements, alternating; the median of the rounds' best times is reported.
 ROUNDS = 3
 
@@ -68,18 +75,23 @@ def _measure(name: str, repeats: int) -> dict:
     """Best wall time of one default chunk of ``name`` in this process (after a warm-up chunk)."""
     st, X = _chunk(name)
     _evaluate(st, X[:4])
-    best = float("inf")
+    best, cpu = float("inf"), float("inf")
     for _ in range(repeats):
-        t0 = time.perf_counter()
+        c0, t0 = time.process_time(), time.perf_counter()
         _evaluate(st, X)
-        best = min(best, time.perf_counter() - t0)
-    return {"designs": int(X.shape[0]), "poses_per_design": int(st.poses_per_design), "seconds": best}
+        best, cpu = min(best, time.perf_counter() - t0), min(cpu, time.process_time() - c0)
+    return {
+        "designs": int(X.shape[0]),
+        "poses_per_design": int(st.poses_per_design),
+        "seconds": best,
+        "cpu": cpu,
+    }
 
 
 def _in_fresh_process(src: Path, name: str, repeats: int) -> dict:
     from robomech.explore._runner import WORKER_ENV
 
-    env = {**os.environ, **WORKER_ENV, "PYTHONPATH": str(src)}
+    env = {**os.environ, **WORKER_ENV, **WORKER_MALLOC, "PYTHONPATH": str(src)}
     code = (
         f"import sys, json; sys.path.insert(0, {str(ROOT / 'benchmarks')!r}); "
         "import bench_paper_studies as b; "
@@ -120,15 +132,20 @@ def main() -> None:
             for k, rs in runs.items():
                 r = rs[0]
                 t = statistics.median(x["seconds"] for x in rs)
+                c = statistics.median(x["cpu"] for x in rs)
                 row[k] = {
                     "designs": r["designs"],
                     "seconds": t,
+                    "cpu_seconds": c,
                     "designs_per_s": r["designs"] / t,
+                    "designs_per_cpu_s": r["designs"] / c,
                     "poses_per_s": r["designs"] * r["poses_per_design"] / t,
                     "all_seconds": [x["seconds"] for x in rs],
+                    "all_cpu_seconds": [x["cpu"] for x in rs],
                 }
             if "before" in row:
                 row["speedup"] = row["before"]["seconds"] / row["after"]["seconds"]
+                row["cpu_speedup"] = row["before"]["cpu_seconds"] / row["after"]["cpu_seconds"]
             rows.append(row)
             print(_line(row), flush=True)
     if a.json:
@@ -140,9 +157,12 @@ def _line(row: dict) -> str:
     for k in ("before", "after"):
         if k in row:
             r = row[k]
-            parts.append(f"{k}: {r['designs_per_s']:8.1f} designs/s {r['poses_per_s']:10.3g} poses/s")
+            parts.append(
+                f"{k}: {r['designs_per_s']:7.1f} designs/s {r['poses_per_s']:9.3g} poses/s "
+                f"{r['designs_per_cpu_s']:7.1f} designs/CPU-s"
+            )
     if "speedup" in row:
-        parts.append(f"x{row['speedup']:.2f}")
+        parts.append(f"x{row['speedup']:.2f} (CPU x{row['cpu_speedup']:.2f})")
     return " | ".join(parts)
 
 

@@ -39,9 +39,11 @@ GAMMA_USABLE_MIN = math.radians(10.0)
 SIMPSON_POINTS = 13
 # eq. (52) motion: one 6 s period, 0.05 s steps.
 EQ52_STEP = 0.05
-# Designs in one dynamics call (64 x 121 samples, the jets' (3, N, 3) temporaries ~0.6 MB each); measured
-# on one core at load 6, 128 designs: 51-62 designs/s in blocks of 1, 89-123 in blocks of 8 to 128.
-DESIGN_BLOCK = 64
+# Designs in one dynamics call (16 x 121 samples: the jets' temporaries up to (3, N, 3), 140 kB);
+# measured on one core, 64 designs, as a Dask worker runs them (glibc's MALLOC_TRIM_THRESHOLD_=65536,
+# which Dask's nanny sets: every temporary above 128 kB is mapped and unmapped): 0.50 s of CPU in
+# blocks of 1, 0.27 in blocks of 16-32, 0.37 in one block of 64.
+DESIGN_BLOCK = 16
 
 
 def simpson_weights(lo: float, hi: float, n: int) -> tuple[np.ndarray, np.ndarray]:

@@ -31,11 +31,13 @@ TASK_GRID = 41  # per axis: 1681 poses, a 3 deg step
 # Fig. 5(b): beta pi/3 -> pi/6 in 5 s, then one 20 s sway period about X; sampled as the study's plots.
 FIG5B_DURATION = 25.0
 FIG5B_STEP = 0.1
-# Designs evaluated in one kernel call: (DESIGN_BLOCK x 1932 poses x (3, 2)) float64 temporaries of
-# ~1.5 MB, near a core's cache (measured on one core at load 6, 512 designs: 330-350 designs/s in
-# blocks of 1, 520-620 in blocks of 8-16, 460-500 in blocks of 32-64); the block size changes no bit
-# (every operation is per design and pose; tested).
-DESIGN_BLOCK = 16
+# Designs evaluated in one kernel call: (DESIGN_BLOCK x 1932 poses) float64 temporaries of ~120 kB
+# (x 6 for J); measured on one core, 1024 designs, as a Dask worker runs them (glibc's
+# MALLOC_TRIM_THRESHOLD_=65536, which Dask's nanny sets: every temporary above 128 kB is mapped and
+# unmapped): 1.27 s of CPU in blocks of 1, 0.99 in blocks of 4-8, 1.25-1.27 in blocks of 16-32
+# (0.71 s in blocks of 8 without that setting). The block size changes no bit (every operation is per
+# design and pose; tested).
+DESIGN_BLOCK = 8
 
 
 def _task_grid() -> tuple[np.ndarray, np.ndarray]:
