@@ -11,13 +11,12 @@ measurement runs in a fresh process; with ``--before REV`` the same measurement 
 one mechanism call per design), the two trees alternating so that both see the same load, and the
 table gives the speed-ups.
 
-``workloads()`` (for ``run.py``): one default chunk of each study in the current tree.
+``make bench`` times one chunk of each study through ``bench_explore.workloads()``.
 """
 
 from __future__ import annotations
 
 import argparse
-import functools
 import json
 import os
 import statistics
@@ -46,33 +45,15 @@ def _chunk(name: str):
     return st, design_matrix(st.variables, st.default_chunk, st.default_sampler, 0, st.default_chunk)
 
 
-def _evaluate(st, X) -> None:
-    from robomech.explore._sampling import chunk_seed
-
-    st.evaluate_rows(X, chunk_seed(0, 0))
-
-
-def workloads():
-    from _harness import Workload
-
-    out = []
-    for name in STUDIES:
-        st, X = _chunk(name)
-        out.append(
-            Workload(
-                name=f"explore: {name}, one design-batched chunk ({st.default_chunk} designs)",
-                group="x",
-                run=functools.partial(_evaluate, st, X),
-                n=st.default_chunk * st.poses_per_design,
-                bytes_moved=0,
-                repeats=2,
-            )
-        )
-    return out
+def workloads() -> list:
+    """None for ``run.py``: its in-process chunk of each study is ``bench_explore.workloads()``."""
+    return []
 
 
 def _measure(name: str, repeats: int) -> dict:
-    """Best wall time of one default chunk of ``name`` in this process (after a warm-up chunk)."""
+    """Best wall and CPU time of one default chunk of ``name`` in this process (after a warm-up chunk)."""
+    from bench_explore import _one_chunk as _evaluate
+
     st, X = _chunk(name)
     _evaluate(st, X[:4])
     best, cpu = float("inf"), float("inf")
