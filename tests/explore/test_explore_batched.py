@@ -6,6 +6,7 @@ dozen Sobol designs, with rejected designs (None parameter objects) among them, 
 """
 
 import dataclasses
+import inspect
 
 import numpy as np
 import pytest
@@ -17,6 +18,8 @@ from robomech.explore import _vectored_thrust as vts
 from robomech.mechanisms import omnileg as ol
 from robomech.mechanisms import spherical_leg as sl
 from robomech.mechanisms import vectored_thrust as vt
+from robomech.mechanisms.omnileg import _designs as old
+from robomech.mechanisms.spherical_leg import _designs as sld
 
 # The spherical leg's batched map takes J's singular values in closed form (to a few ulps of each),
 # the per-design map from LAPACK's SVD (to rounding of sigma_max in each): the dexterity
@@ -152,8 +155,6 @@ def test_spherical_leg_design_blocks_change_no_bit(monkeypatch, block):
 
 
 def test_spherical_leg_designs_carry_each_legs_derived_geometry():
-    from robomech.mechanisms.spherical_leg import _designs as sld
-
     legs = [dataclasses.replace(sl.SphericalLeg.paper(), R=R, r=r) for R, r in [(0.06, 0.03), (0.09, 0.04)]]
     d = sld.designs(legs)
     for i, leg in enumerate(legs):
@@ -190,15 +191,13 @@ def test_thruster_batched_chunk_equals_each_design_alone():
 
 
 def test_spherical_leg_closed_form_singular_values_are_lapacks_and_relatively_accurate():
-    from robomech.mechanisms.spherical_leg._designs import _singular_values
-
     rng = np.random.default_rng(5)
     J = rng.normal(size=(4000, 3, 2))
     J[:, :2, 0] = 0.0  # legs 1 and 2 do not move with alpha
     J[:1000, 2, 0] *= 10.0 ** rng.uniform(-12, -2, 1000)  # near the actuation singularity
     J[1000:2000, :2, 1] *= 10.0 ** rng.uniform(-12, -2, (1000, 1))  # beta nearly uncontrolled
     J[2000, 2, 0] = 0.0  # rank 1
-    smax, smin = _singular_values(J)
+    smax, smin = sld._singular_values(J)
     s = np.linalg.svd(J, compute_uv=False)
     np.testing.assert_allclose(smax, s[:, 0], rtol=4e-15)
     assert np.all(np.abs(smin - s[:, 1]) <= 4e-15 * s[:, 0])  # LAPACK: to rounding of sigma_max
@@ -206,3 +205,33 @@ def test_spherical_leg_closed_form_singular_values_are_lapacks_and_relatively_ac
     det = np.abs(J[:, 2, 0]) * np.hypot(J[:, 0, 1], J[:, 1, 1])
     np.testing.assert_allclose(smin * smax, det, rtol=4e-15, atol=0.0)
     assert smin[2000] == 0.0
+
+
+def _omnileg_designs(legs):
+    return old.designs(legs, 1)  # one sample per design: row i is design i
+
+
+def _spherical_leg_designs(legs):
+    return sld.designs(legs)
+
+
+@pytest.mark.parametrize(
+    "make, designs, changed",
+    [
+        (sl.SphericalLeg.paper, _spherical_leg_designs, {"R": 0.06, "r": 0.04, "h": 0.12}),
+        (ol.OmniLeg.paper, _omnileg_designs, {"L1": 0.12, "L4": 0.07, "L5": 0.15}),
+    ],
+)
+def test_every_parameter_property_that_varies_per_design_is_carried_per_design(make, designs, changed):
+    # Designs hands a kernel the first leg's value of any attribute it does not define: a property of
+    # the parameter class that depends on the per-design fields must be defined on Designs instead
+    a, b = make(), dataclasses.replace(make(), **changed)
+    props = [n for n, v in inspect.getmembers(type(a)) if isinstance(v, property)]
+    varying = [n for n in props if not np.array_equal(np.asarray(getattr(a, n)), np.asarray(getattr(b, n)))]
+    assert varying  # the check has something to find
+    d = designs([a, b])
+    assert all(n in type(d).__dict__ for n in varying), varying
+    for n in varying:
+        for i, leg in enumerate((a, b)):
+            want = np.asarray(getattr(leg, n))
+            np.testing.assert_array_equal(np.asarray(getattr(d, n))[i].reshape(want.shape), want)

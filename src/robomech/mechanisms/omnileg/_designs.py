@@ -53,6 +53,11 @@ class Designs:
         # the shared parameters (L3, shank geometry, ranges, gravity): the first leg's
         return getattr(self.legs[0], name)
 
+    @property
+    def foot_drop(self) -> np.ndarray:
+        """:attr:`OmniLeg.foot_drop` per sample, (N, 1) (m)."""
+        return self.L5 - self.legs[0].knee_to_crank
+
 
 def designs(legs: Sequence[OmniLeg], samples: int) -> Designs:
     """The legs as one :class:`Designs` of ``samples`` poses per design."""
