@@ -138,7 +138,7 @@ def _one_sweep(client: Any, name: str, out: Path, n: int) -> dict[str, float]:
     computes = [ss for t in tasks for ss in t["startstops"] if ss["action"] == "compute"]
     durations = [ss["stop"] - ss["start"] for t in tasks for ss in t["startstops"]]
     window = max(ss["stop"] for ss in computes) - min(ss["start"] for ss in computes)
-    stored = open_results(out)
+    stored = open_results(out, as_dict=True)
     work = np.asarray(stored["chunk_seconds"], dtype=float)
     chunks = s.n_chunks
     assert len(computes) == chunks and s.computed_designs == n, "a chunk ran twice or not at all"

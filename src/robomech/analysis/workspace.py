@@ -160,7 +160,12 @@ def singularity_map(J: ArrayLike, *, rtol: float = SINGULAR_RTOL) -> Singularity
     J = as_array(J, "J", (None, None), finite=False, nonempty=True)
     rtol = check_real(rtol, "rtol", low=0.0, high=1.0, low_open=True)
     s, finite = _singular_values(J)
-    smax, smin = s[..., 0], s[..., -1]
+    return _measures(s[..., 0], s[..., -1], finite, rtol)
+
+
+def _measures(smax: np.ndarray, smin: np.ndarray, finite: np.ndarray, rtol: float) -> SingularityMap:
+    """The :class:`SingularityMap` of Jacobians with extreme singular values ``smax``, ``smin`` (0 where
+    ``finite`` is False)."""
     ratio = np.where(smax > 0, smin / np.where(smax > 0, smax, 1.0), 0.0)
     ratio = np.where(finite, ratio, 0.0)
     cond = np.where(ratio > 0, 1.0 / np.where(ratio > 0, ratio, 1.0), np.inf)

@@ -27,10 +27,12 @@ WORKSPACE_GRID = 41
 # Assumed manufacturing tolerance (the paper states none): sigma = 0.1 deg for every angle (a machined
 # bore or arc of ~25 mm radius held to ~0.04 mm), encoder zero offsets sigma = 0.1 deg.
 SIGMA_ANGLE = math.radians(0.1)
-# Designs evaluated at once within a chunk: (DESIGN_BLOCK x 1399 poses x 3) float64 temporaries of ~1 MB,
-# which stay in a core's cache; measured on one core, 1024 designs: 0.84 s at once, 0.59 s in blocks of
-# 16-64 (docs/performance.md), and less memory traffic for two workers to share.
-DESIGN_BLOCK = 32
+# Designs evaluated at once within a chunk: (DESIGN_BLOCK x 1399 poses x 3) float64 temporaries of
+# ~270 kB, which stay in a core's cache; measured on one core, 1024 designs: 0.84 s at once, 0.59 s in
+# blocks of 16-64 (docs/performance.md); 2048 designs as a Dask worker runs them (glibc's
+# MALLOC_TRIM_THRESHOLD_=65536, which Dask's nanny sets: every temporary above 128 kB is mapped and
+# unmapped): 1.21-1.22 s of CPU in blocks of 2-8, 1.45 s in blocks of 32.
+DESIGN_BLOCK = 8
 # The as-built s13 needs 1 - |in-plane part|^2 > 0; below this the platform does not assemble.
 ASSEMBLY_TOL = 1e-12
 

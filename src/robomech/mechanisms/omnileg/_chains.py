@@ -221,7 +221,11 @@ def shank_frames(leg: OmniLeg) -> np.ndarray:
         ``S[i - 1]``: rotation of chain i's frame in the knee-plate frame.
     """
     check_params(leg, OmniLeg, "leg")
-    psi = leg.shank_azimuth + 2.0 * np.pi * np.arange(3) / 3.0
+    return _shank_frames(leg.shank_azimuth)
+
+
+def _shank_frames(azimuth: float) -> np.ndarray:
+    psi = azimuth + 2.0 * np.pi * np.arange(3) / 3.0
     c, s = np.cos(psi), np.sin(psi)
     S = np.zeros((3, 3, 3))
     S[:, 0, 0], S[:, 1, 0] = c, s

@@ -27,7 +27,7 @@ from robomech._validation import as_array, broadcast_batch, check_bool, check_pa
 from robomech.analysis.lstsq import _damped_svd_solve
 
 from . import _jet as jt
-from ._chains import shank_frames
+from ._chains import _shank_frames
 from ._kinematics import jacobian
 from ._params import OmniLeg, RigidBody
 
@@ -157,7 +157,7 @@ def _poses(
     R_drod = (a2, jt.cross(u, a2), u)
     origin = np.zeros(3)
     out += [(Rz, origin), (R_dcross, origin), (R_drod, origin), (R_dcross, knee), (Rz, knee)]
-    S = shank_frames(leg)
+    S = _shank_frames(leg.shank_azimuth)
     crank_dir = jt.stack([zero, -sg, cg])  # Rx(γ) e_z
     Rx_p = (jt.stack([one, zero, zero]), jt.stack([zero, cg, sg]), jt.stack([zero, -sg, cg]))
     Rx_m = (jt.stack([one, zero, zero]), jt.stack([zero, cg, -sg]), jt.stack([zero, sg, cg]))
@@ -166,7 +166,10 @@ def _poses(
         D = C + jt.rotate_const(S[i], crank_dir) * leg.L4
         out.append((_rotate_cols(S[i], Rx_p), C))
         out.append((_rotate_cols(S[i], Rx_m), D))
-    foot_origin = knee + jt.stack([zero, zero, cg * (2.0 * leg.L4) + leg.knee_to_crank])
+    # the foot's z as a vector jet, so that a per-sample L4 (N, 1) broadcasts (omnileg._designs)
+    foot_origin = knee + (
+        jt.stack([zero, zero, cg]) * (2.0 * leg.L4) + np.array([0.0, 0.0, leg.knee_to_crank])
+    )
     out.append((None, foot_origin))
     return out
 
@@ -217,16 +220,17 @@ def _terms(
         if cols is not None:
             by_name[name] = cols
         body: RigidBody = leg.bodies[key]
-        m = body.mass
-        c = body.com_vector
+        m = body.mass  # a float, or (N,) per sample (omnileg._designs)
+        c = body.com_vector  # (3,) or (N, 3)
         # mass centre p = o + R c = o + Σ_j c_j r_j
         p = (
             o + c
             if cols is None
-            else o + sum((cols[j] * c[j] for j in range(3) if c[j] != 0.0), start=0.0 * c)
+            else o
+            + sum((cols[j] * c[..., j, None] for j in range(3) if np.any(c[..., j] != 0.0)), start=0.0 * c)
         )
         if isinstance(p, jt.Jet):
-            tau_m += np.sum(p.g * (m * p.vdd), axis=-1)
+            tau_m += np.sum(p.g * (np.asarray(m)[..., None] * p.vdd), axis=-1)
             tau_g -= m * (p.g @ grav)
             M += m * np.sum(p.g[:, None] * p.g[None, :], axis=-1)
             kin += 0.5 * m * np.sum(p.vd * p.vd, axis=-1)
@@ -234,7 +238,7 @@ def _terms(
             if poses:
                 ps.append(p.v)
         else:  # a mass centre fixed in the hip frame (the hip crosses): potential only
-            pot -= m * float(np.asarray(p) @ grav)
+            pot -= m * (np.asarray(p) @ grav)
             if poses:
                 ps.append(np.broadcast_to(np.asarray(p, dtype=float), (N, 3)))
         if poses:
@@ -268,14 +272,26 @@ def _terms(
         wb = np.stack([np.sum(r.v * w, axis=-1) for r in cols], axis=-1)
         wdb = np.stack([np.sum(r.v * wd, axis=-1) for r in cols], axis=-1)
         Jwb = np.stack([np.sum(r.v * Jw, axis=-1) for r in cols], axis=-1)  # (3 q, N, 3 body)
-        Iwb = wb @ Iner.T
-        hb = wdb @ Iner.T + jt.cross3(wb, Iwb)  # I ω̇ + ω × I ω in body axes
+        Iwb = _inertia_times(Iner, wb)
+        hb = _inertia_times(Iner, wdb) + jt.cross3(wb, Iwb)  # I ω̇ + ω × I ω in body axes
         tau_m += np.sum(Jwb * hb, axis=-1)
-        M += np.sum((Jwb @ Iner.T)[:, None] * Jwb[None, :], axis=-1)
+        M += np.sum(_inertia_times(Iner, Jwb)[:, None] * Jwb[None, :], axis=-1)
         kin += 0.5 * np.sum(wb * Iwb, axis=-1)
     R_all = np.stack(Rs, axis=1) if poses else np.zeros((N, 0, 3, 3))
     p_all = np.stack(ps, axis=1) if poses else np.zeros((N, 0, 3))
     return _Terms(tau_m.T, tau_g.T, np.moveaxis(M, -1, 0), kin, pot, R_all, p_all)
+
+
+def _inertia_times(inertia: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``I x`` for body-axis vectors ``x (..., N, 3)``: one BLAS product for a constant ``I (3, 3)``, per
+    sample for ``I (N, 3, 3)`` (omnileg._designs)."""
+    if inertia.ndim == 2:
+        return x @ inertia.T
+    return (
+        inertia[..., 0] * x[..., 0, None]
+        + inertia[..., 1] * x[..., 1, None]
+        + inertia[..., 2] * x[..., 2, None]
+    )
 
 
 def _terms_chunked(

@@ -139,7 +139,7 @@ def _motion(
     dw = np.einsum("...ij,...j->...i", E, qdd) + Ed_qd
     # paper 1, eq. (21): printed lever arm h_p (the platform thickness); the centre P is at OP = h
     p = leg.h * Rp[..., :, 2]
-    B = np.einsum("...ij,kj->...ki", Rp, leg.platform_points_home)  # (..., 3 legs, 3)
+    B = np.einsum("...ij,...kj->...ki", Rp, leg.platform_points_home)  # (..., 3 legs, 3)
     u = B - leg.base_points
     wl = w[..., None, :]
     ud = np.cross(wl, B)

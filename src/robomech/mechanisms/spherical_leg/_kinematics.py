@@ -487,18 +487,23 @@ def jacobian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
 
 
 def _jacobian_kernel(leg: SphericalLeg, a, b, J) -> None:
+    (sa, ca), (sb, cb) = sincos(a), sincos(b)
+    _jacobian_sincos(leg, sa, ca, sb, cb, J)
+
+
+def _jacobian_sincos(leg, sa, ca, sb, cb, J) -> None:
+    """J from the sines and cosines; ``leg``'s R, r, h may be per-design arrays broadcasting with them."""
     R, r, h = leg.R, leg.r, leg.h
     K = R * R + r * r + h * h
-    (sa, ca), (sb, cb) = sincos(a), sincos(b)
     rcb, hsb, rsb, hcb = r * cb, h * sb, r * sb, h * cb
     # dl/dq = (dq/dq) / (2 l) with q = l^2 (module docstring); R/l below is 2R / (2l)
-    J[:, 0, 0] = 0.0
-    J[:, 1, 0] = 0.0
-    J[:, 0, 1] = (rsb - hcb) * R / np.sqrt(np.maximum(K - 2 * R * (rcb + hsb), LENGTH_FLOOR**2))
-    J[:, 1, 1] = (rsb + hcb) * R / np.sqrt(np.maximum(K - 2 * R * (rcb - hsb), LENGTH_FLOOR**2))
+    J[..., 0, 0] = 0.0
+    J[..., 1, 0] = 0.0
+    J[..., 0, 1] = (rsb - hcb) * R / np.sqrt(np.maximum(K - 2 * R * (rcb + hsb), LENGTH_FLOOR**2))
+    J[..., 1, 1] = (rsb + hcb) * R / np.sqrt(np.maximum(K - 2 * R * (rcb - hsb), LENGTH_FLOOR**2))
     k3 = R / np.sqrt(np.maximum(K - 2 * R * (r * ca - hcb * sa), LENGTH_FLOOR**2))
-    J[:, 2, 0] = (r * sa + hcb * ca) * k3
-    J[:, 2, 1] = -(hsb * sa) * k3
+    J[..., 2, 0] = (r * sa + hcb * ca) * k3
+    J[..., 2, 1] = -(hsb * sa) * k3
 
 
 def _derivatives(leg: SphericalLeg, sa, ca, sb, cb):

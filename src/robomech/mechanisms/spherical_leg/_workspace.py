@@ -13,7 +13,7 @@ import numpy as np
 
 from robomech._batching import carries_failed_rows
 from robomech._validation import check_params
-from robomech.analysis.workspace import singularity_map
+from robomech.analysis.workspace import SingularityMap, singularity_map
 
 from ._kinematics import _angles, inverse_kinematics, jacobian
 from ._params import SphericalLeg
@@ -86,13 +86,16 @@ def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMa
     """
     check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
-    ik = inverse_kinematics(leg, a, b)
-    J = jacobian(leg, a, b)
-    sm = singularity_map(J, rtol=SINGULAR_RTOL)
+    return _map(leg, inverse_kinematics(leg, a, b).lengths, jacobian(leg, a, b))
+
+
+def _map(leg: SphericalLeg, L: np.ndarray, J: np.ndarray, sm: SingularityMap | None = None) -> WorkspaceMap:
+    """The map from the leg lengths ``L (..., 3)`` and Jacobians ``J (..., 3, 2)`` (any batch), and their
+    singularity map ``sm`` if already known."""
+    sm = singularity_map(J, rtol=SINGULAR_RTOL) if sm is None else sm
     # rank <= 1 where sigma_min = 0: then sigma_max is J's Frobenius norm
     frob = np.sqrt(np.einsum("...ij,...ij->...", J, J))
     smax = np.where(sm.dexterity > 0, sm.sigma_min / np.where(sm.dexterity > 0, sm.dexterity, 1.0), frob)
-    L = ik.lengths
     reach = np.all((L >= leg.length_min) & (L <= leg.length_max), axis=-1)
     return WorkspaceMap(
         L, reach, sm.sigma_min, smax, sm.cond, sm.singular, sm.cond > ILL_CONDITIONED, J[..., 2, 0]
