@@ -1,9 +1,5 @@
-"""Reachable workspace and singularity map of the spherical parallel leg over (alpha, beta).
-
-J = dl/d(alpha, beta) has rows (0, dl1/db), (0, dl2/db), (dl3/da, dl3/db): dl1/db and dl2/db never
-vanish together, so J loses rank exactly where dl3/da = 0, i.e. ``h cos b cos a + r sin a = 0``: the
-boundary between the two assembly branches of the l3 equation, where alpha is no longer controlled.
-"""
+"""Reachable workspace and singularity map of the spherical parallel leg over (alpha, beta): J loses rank
+exactly where dl3/dalpha = 0, the boundary of the assembly branches (docs/mechanisms/spherical_leg.md)."""
 
 from __future__ import annotations
 
@@ -63,9 +59,8 @@ class WorkspaceMap:
 
 @carries_failed_rows({"alpha": 0, "beta": 0})
 def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMap:
-    """Workspace and singularity map at poses ``alpha``, ``beta`` (rad, broadcast) in closed form.
-
-    The singular values of the 3x2 J are :func:`robomech.analysis.workspace.singularity_map`'s.
+    """Workspace and singularity map at poses ``alpha``, ``beta`` (singular values of J by
+    :func:`robomech.analysis.workspace.singularity_map`).
 
     Parameters
     ----------
