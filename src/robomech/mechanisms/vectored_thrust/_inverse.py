@@ -1,18 +1,5 @@
-"""Inverse rates and accelerations (paper 5, Section 3.3) and statics of the vectored thruster.
-
-Inverse accelerations: for a commanded platform motion (ω, ω̇) (the propeller shaft's carrier, base
-frame), the input rates solve ``J q̇ = ω`` and the input accelerations ``J q̈ = ω̇ - J̇ q̇``, where
-``J̇ q̇`` is the velocity-product (Lie-bracket) term of :func:`angular_acceleration` (paper 5, eqs.
-(22)-(28) solve the same closure chain by chain; their Klein form drops the velocity products, errata).
-J is 3 x 2: a commanded ω is realisable only in J's range (the platform has two rotational degrees of
-freedom), so q̇ is the least-squares solution and the unrealised part is reported as a residual.
-
-Statics: every joint axis passes through O, so a wrench ``[m_O; f]`` on the platform (moment about O)
-does work only through its moment: ``τ·q̇ + m_O·ω = 0`` for every motion (virtual work), i.e. the motor
-torques holding it are ``τ = -Jᵀ m_O``; the force f is carried by the universal joint at O.  In
-particular the propeller's thrust along its shaft (a line through O) needs no motor torque at all;
-its reaction torque about the shaft does.
-"""
+"""Inverse rates and accelerations (paper 5, Section 3.3: ``J q̇ = ω``, ``J q̈ = ω̇ - J̇ q̇`` in least
+squares, J being 3 x 2) and statics (virtual work, ``τ = -Jᵀ m_O``) of the vectored thruster."""
 
 from __future__ import annotations
 
@@ -101,23 +88,17 @@ def inverse_rates(
 ) -> InverseRatesResult:
     """Input rates ``q̇`` (and accelerations ``q̈``) for the platform's ``omega`` (and ``omega_dot``).
 
-    ``q (..., 2)`` rad; ``omega (..., 3)`` rad/s and ``omega_dot (..., 3)`` rad/s² in the base frame;
-    all broadcast.  paper 5, Section 3.3 (eqs. (22)-(28)): the inverse acceleration model, here with
-    the Lie-bracket velocity products the print drops.  ``damping`` (>= 0, relative to sigma_max)
-    applies to the directions with ``sigma < 1 / INPUT_GAIN_MAX`` (selectively damped least squares).
+    paper 5, eqs. (22)-(28), with the Lie-bracket velocity products the print drops.
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Input angles ``(q1, q2)`` (rad).
-    omega : array_like, shape (..., 3)
-        Commanded platform angular velocity (rad/s, base frame).
-    omega_dot : array_like, shape (..., 3), optional
-        Commanded platform angular acceleration (rad/s², base frame); ``None`` (default) leaves ``qdd``
-        NaN.
+    omega, omega_dot : array_like, shape (..., 3)
+        Commanded platform angular velocity (rad/s) and acceleration (rad/s², optional: without it
+        ``qdd`` is NaN), base frame; broadcast with ``q``.
     damping : float, optional
-        Damping of the weak directions relative to sigma_max (>= 0; default ``DEFAULT_DAMPING``).
+        Damping (>= 0, relative to sigma_max) of the directions with ``sigma < 1 / INPUT_GAIN_MAX``.
 
     Returns
     -------
@@ -211,20 +192,16 @@ class StaticsResult:
 
 @carries_failed_rows({"q": 1}, {"wrench": 1})
 def static_torques(th: VectoredThruster, q: object, wrench: object) -> StaticsResult:
-    """Motor torques ``τ = -Jᵀ m_O`` holding the platform against a wrench ``[m_O; f] (..., 6)``.
-
-    The wrench is applied *to* the platform (propeller and shaft included), base frame, moment about O
-    (conventions: ``[m; f]``); virtual work ``τ·q̇ + m_O·ω = 0``.  The force f passes through the
-    universal joint at O and needs no motor torque.  For a propeller thrust T along the shaft s0 and a
-    reaction torque Q about it, the wrench is ``[Q s0; T s0]`` (the thrust line passes through O).
+    """Motor torques ``τ = -Jᵀ m_O`` holding the platform against a wrench (virtual work
+    ``τ·q̇ + m_O·ω = 0``: the force passes through O and needs no motor torque).
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Input angles ``(q1, q2)`` (rad).
     wrench : array_like, shape (..., 6)
-        Wrench ``[m_O; f]`` applied to the platform (N·m, N; base frame, moment about O).
+        ``[m_O; f]`` applied to the platform (N·m, N; base frame, moment about O); a propeller's
+        thrust T and reaction torque Q about its shaft s0 are ``[Q s0; T s0]``.
 
     Returns
     -------

@@ -1,17 +1,7 @@
 """Position, velocity and acceleration kinematics of the RRR-RR vectored thruster (paper 5, Section 3).
 
-Every joint axis passes through O, so every joint screw is ``[s; 0]`` and the platform only rotates.
-With ``q = (q1, q2)`` (RRR input about X, RR input about Y, as in eqs. (5) and (7)):
-
-* ``s12 = Rx(q1) (cos a, 0, -sin a)``, ``s22 = Ry(q2) (-1, 0, 0)``;
-* closure: ``s13`` is fixed in the platform at 90 deg to ``s22`` and at 90 deg to ``s12`` (the RRR
-  chain's second arc), so ``s13 = s22 x s12 / |s22 x s12|`` in the assembly mode with the propeller
-  along +Z at q = 0 (eq. 8);
-* propeller axis ``s0 = s22 x s13`` (eq. 11).
-
-Equivalently the platform rotation is ``R = Ry(q2) Rx(-theta)``, ``theta`` the RR chain's passive angle,
-``theta = atan2(-sin a sin q1, sin a cos q1 cos q2 - cos a sin q2)``.  The mechanism is singular where
-``s22`` and ``s12`` become parallel (``|s22 x s12| = 0``: at q = (0, a) for the paper's a = pi/4).
+``q = (q1, q2)`` (rad): the RRR input about X and the RR input about Y; axes, closure and the closed form
+``R = Ry(q2) Rx(-theta)``: docs/mechanisms/vectored_thrust.md.  Singular where s22 and s12 are parallel.
 """
 
 from __future__ import annotations
@@ -313,25 +303,16 @@ def _axes(th: VectoredThruster, q: np.ndarray) -> JointAxes:
 
 @carries_failed_rows({"q": 1})
 def joint_axes(th: VectoredThruster, q: object) -> JointAxes:
-    """Unit joint axes at inputs ``q (..., 2)`` (rad).
-
-    Singular samples have NaN s13 and s0 and ``valid`` False.  Paper 5, eqs. (5), (7), (8), (11).
+    """Unit joint axes at inputs ``q`` (paper 5, eqs. (5), (7), (8), (11)).
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
     JointAxes
-
-    Examples
-    --------
-    >>> ax = joint_axes(VectoredThruster.paper(), [0.0, 0.0])
-    >>> ax.s0 + 0.0, bool(ax.valid)
-    (array([0., 0., 1.]), True)
     """
     check_params(th, VectoredThruster, "th")
     return _axes(th, _q(q))
@@ -409,26 +390,16 @@ def _split(v: np.ndarray) -> _V:
 
 @carries_failed_rows({"a1": 1, "b1": 1, "a2": 1, "b2": 1})
 def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
-    """Angular distance (rad) between the minor great-circle arcs (a1 -> b1) and (a2 -> b2) (unit, (..., 3)).
-
-    Zero where they cross; otherwise the closest point is an end of one of them.
+    """Angular distance (rad, in [0, π]) between the minor great-circle arcs (a1 -> b1) and (a2 -> b2).
 
     Parameters
     ----------
-    a1, b1 : array_like, shape (..., 3)
-        Unit start and end points of the first arc.
-    a2, b2 : array_like, shape (..., 3)
-        Unit start and end points of the second arc; all four broadcast.
+    a1, b1, a2, b2 : array_like, shape (..., 3)
+        Unit start and end points of the two arcs; broadcast together.
 
     Returns
     -------
     ndarray, shape (...)
-        Angular distance between the arcs (rad), in [0, π].
-
-    Examples
-    --------
-    >>> round(float(arc_clearance([1, 0, 0], [0, 1, 0], [0, 0, 1], [0, 1, 0])), 12)   # share an end
-    0.0
     """
     arrs = [as_array(v, name, (3,)) for v, name in ((a1, "a1"), (b1, "b1"), (a2, "a2"), (b2, "b2"))]
     broadcast_batch(*((v, 1, name) for v, name in zip(arrs, ("a1", "b1", "a2", "b2"), strict=True)))
@@ -438,11 +409,9 @@ def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
 def _interference(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
     """Clearance (rad) of the 45 deg arc (s11 -> s12) from the fixing device (s22 -> s13); NaN if singular.
 
-    :func:`_arc_clearance` specialised to this mechanism's arcs (identical to rounding; tested against the
-    generic form): with ``(s22, s13, s0)`` orthonormal and right-handed (``s0 = s22 x s13``), the first
-    arc's unit normal is ``n1 = X x s12 / sin a = (0, c1, s1)``, the second's is ``s0``, and the side
-    vectors ``n x a``, ``b x n`` are ``(0, s1, -c1)``, ``(sin a, -cos a s1, cos a c1)``, ``s13`` and
-    ``s22``; about 70 element-wise passes instead of ~250 for the generic 3-vector form.
+    :func:`_arc_clearance` specialised to these arcs (tested against it): normals ``(0, c1, s1)`` and
+    ``s0``, side vectors ``(0, s1, -c1)``, ``(sin a, -cos a s1, cos a c1)``, ``s13``, ``s22``; about 70
+    element-wise passes instead of ~250 for the generic 3-vector form.
     """
     with np.errstate(invalid="ignore"):  # NaN (singular samples) is masked at the end
         return _interference_unmasked(th, q)
@@ -489,29 +458,16 @@ def _interference_unmasked(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
 
 @carries_failed_rows({"q": 1})
 def link_clearance(th: VectoredThruster, q: object) -> LinkClearanceResult:
-    """Angular clearance (rad) between the RRR chain's 45 deg arc and the fixing device at ``q (..., 2)``.
-
-    Section 4.1 (2).  Where the configuration is singular (``|s12 x s22| <= SINGULAR_TOL``, the same
-    samples as ``joint_axes(...).valid`` False) the fixing device's arc does not exist: ``clearance`` is
-    NaN there and ``valid`` False.
+    """Angular clearance (rad) between the RRR chain's 45 deg arc and the fixing device (Section 4.1 (2)).
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
     LinkClearanceResult
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import vectored_thrust as vt
-    >>> r = vt.link_clearance(vt.VectoredThruster.paper(), [[0.0, 0.2], [0.0, np.pi / 4]])
-    >>> r.valid
-    array([ True, False])
     """
     check_params(th, VectoredThruster, "th")
     c = _interference(th, _q(q))
@@ -564,29 +520,17 @@ def _fk(th: VectoredThruster, q: np.ndarray) -> FKResult:
 
 @carries_failed_rows({"q": 1})
 def forward_kinematics(th: VectoredThruster, q: object) -> FKResult:
-    """Propeller axis and tip from the inputs ``q (..., 2)`` = (q1, q2) in rad.
-
-    Paper 5, eqs. (11)-(12), with eq. (12)'s sin(phi1) corrected to sin(phi2).  Singular inputs
-    (``|s22 x s12| <= SINGULAR_TOL``) give NaN outputs with ``valid`` False.  The link-interference
-    limit (Section 4.1 (2)) is evaluated by :func:`link_clearance` and ``workspace_map``.
+    """Propeller axis and tip from the inputs ``q`` (paper 5, eqs. (11)-(12), eq. (12)'s sin(phi1) corrected
+    to sin(phi2)); the link-interference limit is :func:`link_clearance`'s.
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
     FKResult
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import vectored_thrust as vt
-    >>> fk = vt.forward_kinematics(vt.VectoredThruster.paper(), np.array([0.3, 0.2]))
-    >>> fk.axis.round(5), bool(fk.valid)
-    (array([ 0.18442, -0.3719 ,  0.90977]), True)
     """
     check_params(th, VectoredThruster, "th")
     return _chunked(_fk, th, _q(q))
@@ -600,17 +544,10 @@ def platform_rotation(th: VectoredThruster, q: object) -> RotationResult:
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
     RotationResult
-
-    Examples
-    --------
-    >>> r = platform_rotation(VectoredThruster.paper(), [0.3, 0.2])
-    >>> bool(np.allclose(r.R @ r.R.T, np.eye(3))), bool(np.isclose(np.linalg.det(r.R), 1.0))
-    (True, True)
     """
     check_params(th, VectoredThruster, "th")
     ax = _axes(th, _q(q))
@@ -695,17 +632,13 @@ def _ik_unmasked(th: VectoredThruster, s: np.ndarray) -> IKResult:
 
 @carries_failed_rows({"s": 1})
 def inverse_kinematics(th: VectoredThruster, s: object) -> IKResult:
-    """Inputs ``q (..., 2)`` pointing the propeller along ``s (..., 3)`` (any positive multiple: axis or tip).
-
-    Per-sample masks: ``solved`` (an assembly exists: |s| > 0, the closure has a root), ``in_range``,
-    ``tilt_ok`` (universal joint); ``valid`` is all of them.  The link-interference limit is checked
-    on the inputs by :func:`link_clearance` / ``workspace_map``.
+    """Inputs ``q`` pointing the propeller along ``s`` (paper 5, eq. (13), corrected: see the code).
 
     Parameters
     ----------
     th : VectoredThruster
     s : array_like, shape (..., 3)
-        Desired propeller direction (base frame; any positive multiple).
+        Propeller direction (base frame; any positive multiple: the axis or the tip).
 
     Returns
     -------
@@ -752,16 +685,12 @@ def _rates(ax: JointAxes, qd: np.ndarray) -> np.ndarray:
 
 @carries_failed_rows({"q": 1})
 def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
-    """Passive joint angles (..., 3), rad, zero at q = 0, ordered (RR s22, RRR s12, RRR s13).
-
-    Product of exponentials from the home axes: ``R = Ry(q2) exp(s22(0) theta)`` on the RR chain and
-    ``R = Rx(q1) exp(s12(0) rho2) exp(s13(0) rho3)`` on the RRR chain.
+    """Passive joint angles (rad, zero at q = 0) by products of exponentials from the home axes.
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
@@ -790,17 +719,13 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
 
 @carries_failed_rows({"q": 1, "qd": 1})
 def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
-    """Passive joint rates (..., 3), rad/s, ordered (RR s22, RRR s12, RRR s13), from ``q, qd (..., 2)``.
-
-    The velocity closure (paper 5, eq. (16)) solved; eq. (17)'s printed rates violate it.
+    """Passive joint rates (rad/s): the velocity closure (paper 5, eq. (16)) solved; eq. (17)'s violate it.
 
     Parameters
     ----------
     th : VectoredThruster
-    q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
-    qd : array_like, shape (..., 2)
-        Input rates (rad/s).
+    q, qd : array_like, shape (..., 2)
+        Inputs (rad) and their rates (rad/s); broadcast together.
 
     Returns
     -------
@@ -847,29 +772,16 @@ def _jacobian(th: VectoredThruster, q: np.ndarray) -> JacobianResult:
 
 @carries_failed_rows({"q": 1})
 def jacobian(th: VectoredThruster, q: object) -> JacobianResult:
-    """``omega = J qd``: J (..., 3, 2) maps input rates to the platform's angular velocity (base frame).
-
-    ``omega`` is the angular velocity of the platform carrying the propeller shaft (the propeller's
-    own spin about s0 excluded).  NaN with ``valid`` False at singular inputs.
+    """Platform Jacobian ``omega = J qd`` (``omega`` base frame, the propeller's own spin excluded).
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
     JacobianResult
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import vectored_thrust as vt
-    >>> vt.jacobian(vt.VectoredThruster.paper(), np.array([0.3, 0.2])).J.round(4) + 0.0
-    array([[ 1.2266,  0.5366],
-           [ 0.    ,  1.    ],
-           [-0.2486, -0.1088]])
     """
     check_params(th, VectoredThruster, "th")
     return _chunked(_jacobian, th, _q(q))
@@ -893,25 +805,17 @@ class VelocityResult:
 
 @carries_failed_rows({"q": 1, "qd": 1})
 def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityResult:
-    """Platform angular velocity ``omega = J qd`` (..., 3), rad/s, from ``q, qd (..., 2)``.
+    """Platform angular velocity ``omega = J qd`` (rad/s).
 
     Parameters
     ----------
     th : VectoredThruster
-    q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
-    qd : array_like, shape (..., 2)
-        Input rates (rad/s).
+    q, qd : array_like, shape (..., 2)
+        Inputs (rad) and their rates (rad/s); broadcast together.
 
     Returns
     -------
     VelocityResult
-
-    Examples
-    --------
-    >>> w = angular_velocity(VectoredThruster.paper(), [0.0, 0.0], [0.0, 1.0])  # q2 turns about Y
-    >>> w.omega.round(12) + 0.0, bool(w.valid)
-    (array([0., 1., 0.]), True)
     """
     check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
@@ -928,24 +832,17 @@ def _screw(s: np.ndarray) -> np.ndarray:
 
 @carries_failed_rows({"q": 1, "qd": 1, "qdd": 1})
 def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: object) -> AccelerationResult:
-    """Platform angular acceleration from ``q, qd, qdd (..., 2)`` by screw theory with Lie brackets.
+    """Platform angular acceleration by screw theory: each chain's acceleration twist is
+    ``sum_i S_i x_i'' + sum_{i<j} [S_i x_i', S_j x_j']``; equating the chains gives the passive accelerations.
 
-    Each chain is serial, so its platform acceleration twist is
-    ``sum_i S_i x_i'' + sum_{i<j} [S_i x_i', S_j x_j']`` (Lie brackets, :func:`robomech.spatial.lie_bracket`).
-    Equating the RRR and RR expressions gives the passive accelerations, then
-    ``omega' = q2'' Y + theta'' s22 + [q2' S21, theta' S22]``.
     paper 5, eq. (24): printed with the Klein form (a scalar, zero for axes through O) where the Lie
     bracket is needed; eq. (32) therefore lacks the velocity-product terms included here.
 
     Parameters
     ----------
     th : VectoredThruster
-    q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
-    qd : array_like, shape (..., 2)
-        Input rates (rad/s).
-    qdd : array_like, shape (..., 2)
-        Input accelerations (rad/s²).
+    q, qd, qdd : array_like, shape (..., 2)
+        Inputs (rad), their rates and accelerations; broadcast together.
 
     Returns
     -------

@@ -1,14 +1,8 @@
 """Workspace, singularity and dexterity maps of the vectored thruster over its inputs (paper 5, Section 4).
 
-Two kinds of singularity, both from the closed-form Jacobian ``J = [theta_1 s22, Y + theta_2 s22]``:
-
-* passive axes parallel (``s22 || s12``, ``|s22 x s12| = 0``): the platform's rotation about s22 is
-  undetermined and J is unbounded.  Isolated points q = (0, a) and (pi, -a), a the 45 deg arc angle.
-* input 1 idle (``theta_1 = 0``: X, s12, s13 coplanar, the RRR chain at a serial singularity): J
-  loses rank, q1 no longer moves the platform.  The curve ``tan q2 = tan a / cos q1`` (|q2| >= a).
-
-paper 5, eq. (35): the printed "no singularity" tests det of the 3x3 passive-rate map (21), which is
-the wrong matrix; both sets above exist, and (0, pi/4) lies on the edge of the +-pi/4 trajectory box.
+Singular where the passive axes are parallel (:func:`singular_points`) and where input 1 is idle
+(:func:`idle_input_curve`); paper 5, eq. (35)'s "no singularity" tests the wrong matrix
+(docs/mechanisms/vectored_thrust.md, "Departures").
 """
 
 from __future__ import annotations
@@ -105,24 +99,16 @@ def _dexterity(J: np.ndarray, ok: np.ndarray) -> np.ndarray:
 
 @carries_failed_rows({"q": 1})
 def dexterity(th: VectoredThruster, q: object) -> np.ndarray:
-    """Dexterity 1/cond(J) (...,) in [0, 1] at inputs ``q (..., 2)``; 0 at singular inputs.
+    """Dexterity ``1/cond(J) = sigma_min / sigma_max`` of the platform Jacobian, in [0, 1] (0 where singular).
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
     ndarray, shape (...)
-        ``sigma_min / sigma_max`` of the platform Jacobian, in [0, 1].
-
-    Examples
-    --------
-    >>> th = VectoredThruster.paper()
-    >>> float(dexterity(th, singular_points(th)[0]))   # passive axes parallel
-    0.0
     """
     check_params(th, VectoredThruster, "th")
     jr = _jacobian(th, _q(q))
@@ -131,13 +117,13 @@ def dexterity(th: VectoredThruster, q: object) -> np.ndarray:
 
 @carries_failed_rows({"q": 1})
 def workspace_map(th: VectoredThruster, q: object) -> WorkspaceMap:
-    """Section 4 at each input sample ``q (..., 2)`` (rad): tip, limits, singularity, dexterity.
+    """Section 4 at each input sample ``q``: tip, limits, singularity, dexterity.
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad), e.g. :func:`input_grid`.
+        Inputs (rad), e.g. :func:`input_grid`.
 
     Returns
     -------
@@ -178,7 +164,7 @@ def _workspace_map(th: VectoredThruster, q: np.ndarray) -> WorkspaceMap:
 
 
 def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = None) -> np.ndarray:
-    """Regular grid (n1, n2, 2) over ``limits`` ((lo, hi) per input, rad; default the input ranges).
+    """Regular grid of inputs (rad), the ends included.
 
     Parameters
     ----------
@@ -186,17 +172,11 @@ def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = 
     n : int or tuple of int
         Samples per input (each >= 2): one count for both, or ``(n1, n2)``.
     limits : array_like, shape (2, 2), optional
-        ``[[lo1, hi1], [lo2, hi2]]`` (rad), lo < hi; ``None`` (default): ``q1_limits``, ``q2_limits``.
+        ``[[lo1, hi1], [lo2, hi2]]`` (rad), lo < hi; default ``q1_limits``, ``q2_limits``.
 
     Returns
     -------
     ndarray, shape (n1, n2, 2)
-        Input samples ``(q1, q2)`` (rad), the ends included.
-
-    Examples
-    --------
-    >>> input_grid(VectoredThruster.paper(), (3, 5)).shape
-    (3, 5, 2)
     """
     check_params(th, VectoredThruster, "th")
     lim = np.array([th.q1_limits, th.q2_limits]) if limits is None else as_array(limits, "limits", (2, 2))
@@ -206,7 +186,7 @@ def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = 
 
 
 def singular_points(th: VectoredThruster) -> np.ndarray:
-    """Passive-axes-parallel singular inputs (2, 2), q1 in (-pi, pi], |q2| < pi/2: (0, a), (pi, -a).
+    """The passive-axes-parallel singular inputs ``(0, a), (pi, -a)`` (rad), a = ``th.arc_angle``.
 
     Parameters
     ----------
@@ -215,7 +195,6 @@ def singular_points(th: VectoredThruster) -> np.ndarray:
     Returns
     -------
     ndarray, shape (2, 2)
-        The two singular inputs ``(q1, q2)`` (rad), a = ``th.arc_angle``.
     """
     check_params(th, VectoredThruster, "th")
     a = th.arc_angle
@@ -224,9 +203,8 @@ def singular_points(th: VectoredThruster) -> np.ndarray:
 
 @carries_failed_rows({"q1": 0})
 def idle_input_curve(th: VectoredThruster, q1: object) -> np.ndarray:
-    """q2 (...,) on the rank-deficient curve ``tan q2 = tan a / cos q1`` for |q1| < pi/2 (rad).
-
-    On this curve input 1 is idle (X, s12, s13 coplanar): J loses rank (module docstring).
+    """q2 (rad) on the curve ``tan q2 = tan a / cos q1`` where input 1 is idle (X, s12, s13 coplanar) and
+    J loses rank, for |q1| < pi/2.
 
     Parameters
     ----------
@@ -237,7 +215,6 @@ def idle_input_curve(th: VectoredThruster, q1: object) -> np.ndarray:
     Returns
     -------
     ndarray, shape (...)
-        The input 2 angle q2 (rad) on the curve, ``atan2(tan a, cos q1)``.
 
     Examples
     --------
