@@ -1,12 +1,5 @@
-"""Every joint of the leg as a spanning tree plus closures (for multibody engines and animations).
-
-The tree (``TREE_JOINTS``): chain 1's four joints θ11..θ14 carry the knee plate; chains 2 and 3 keep their
-first three joints (their fourth joint closes on the knee plate); the shank drive is the input shaft (γ),
-the two joints of the Cardan cross A4 (φ1 about the shaft's y arm, φ2 about the rod's x arm) and the
-first joint of cross B4 (φ3 = -φ2), closing on the output shaft (turning γ in the knee plate); each shank
-chain is crank (γ about its radial axis) and coupler (-2γ relative to the crank); the foot hangs on
-coupler 1 (+γ) and closes on couplers 2 and 3.
-"""
+"""Every joint of the leg as a spanning tree plus closures (``TREE_JOINTS``, for multibody engines and
+animations; the tree: docs/mechanisms/omnileg.md, "Generic description")."""
 
 from __future__ import annotations
 
@@ -35,16 +28,12 @@ TREE_JOINTS = (
 
 @dataclass(frozen=True)
 class JointMotion:
-    """Angles, rates and accelerations of the tree joints ``TREE_JOINTS`` (..., 22), rad-based units.
+    """Angles, rates and accelerations of the tree joints (the result of :func:`joint_motion`).
 
     Attributes
     ----------
-    q : ndarray, shape (..., 22)
-        Joint angles (rad), in the order of ``TREE_JOINTS``.
-    qd : ndarray, shape (..., 22)
-        Joint rates (rad/s).
-    qdd : ndarray, shape (..., 22)
-        Joint accelerations (rad/s²).
+    q, qd, qdd : ndarray, shape (..., 22)
+        Joint angles (rad), rates (rad/s) and accelerations (rad/s²), in the order of ``TREE_JOINTS``.
     """
 
     q: np.ndarray

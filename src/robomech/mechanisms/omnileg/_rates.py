@@ -1,10 +1,5 @@
-"""Inverse differential kinematics of the OmniLeg: joint rates and accelerations for a foot motion.
-
-``q̇ = J⁻¹ ṗ`` and ``q̈ = J⁻¹ (p̈ - q̇ᵀ H q̇)`` (conventions: ``ÿ = J q̈ + q̇ᵀ H q̇``), solved per sample by
-the SVD of the foot Jacobian with the weak directions damped where J is near singular (γ ≈ 0, the
-fully extended shank, where ∂p/∂γ = (0, 0, -2 L4 sin γ) vanishes: paper 2, eq. (47)'s inverse does
-not exist there).  The flagged samples keep a finite, damped solution and report their residual.
-"""
+"""Inverse differential kinematics of the OmniLeg: ``q̇ = J⁻¹ ṗ``, ``q̈ = J⁻¹ (p̈ - q̇ᵀ H q̇)`` by the SVD of
+the foot Jacobian, the weak directions damped where J is near singular (γ ≈ 0)."""
 
 from __future__ import annotations
 
@@ -71,21 +66,17 @@ def joint_rates(
 ) -> JointRatesResult:
     """Joint rates ``q̇`` (and accelerations ``q̈``) realising the foot velocity ``ṗ`` (and acceleration ``p̈``).
 
-    Paper 2, eq. (47)'s inverse of the foot Jacobian (eq. (14)), regularised at γ = 0: the directions
-    with ``σ < SINGULAR_RCOND σ_max`` get ``c = σ / (σ² + λ²)``, ``λ = damping σ_max``; ``damping = 0``
-    inverts them exactly (unbounded as σ -> 0).  ``valid`` is False there for any damping.
+    Paper 2, eq. (47)'s inverse of the foot Jacobian, regularised at γ = 0: the directions with
+    ``σ < SINGULAR_RCOND σ_max`` get ``c = σ / (σ² + λ²)``, ``λ = damping σ_max`` (0: exact, unbounded).
 
     Parameters
     ----------
     leg : OmniLeg
     q : array_like, shape (..., 3)
-        Joint angles ``(α, β, γ)`` (rad).
-    foot_velocity : array_like, shape (..., 3)
-        Foot velocity ``ṗ`` in the hip frame (m/s).
-    foot_acceleration : array_like, shape (..., 3), optional
-        Foot acceleration ``p̈`` in the hip frame (m/s²); ``None`` (default) leaves ``qdd`` NaN.
+    foot_velocity, foot_acceleration : array_like, shape (..., 3)
+        ``ṗ`` (m/s) and, optionally, ``p̈`` (m/s²; without it ``qdd`` is NaN), hip frame.
     damping : float, optional
-        Damping of the weak directions relative to sigma_max (>= 0; default ``DEFAULT_DAMPING``).
+        Damping of the weak directions relative to sigma_max (>= 0).
 
     Returns
     -------
