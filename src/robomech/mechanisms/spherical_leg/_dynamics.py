@@ -45,21 +45,14 @@ PAPER_DRIVEN_LEGS = (0, 2)
 # this ratio sigma_min/sigma_max the 2x2 solve itself loses all accuracy (same threshold as
 # robomech.analysis.workspace.SINGULAR_RTOL); the forces are NaN there.
 ACTUATION_SINGULAR_RTOL = 1e-8
-# Physical bound of the actuation (m/rad): sigma_min of the leg Jacobian (or of the driven legs' block)
-# is the smallest leg-length change per radian of platform motion, i.e. the lever arm through which the
-# legs hold the platform (leg forces = generalized forces / lever arm).  Below 1 mm/rad (i) every N m of
-# generalized force needs more than 1 kN of leg force, 10x the largest force of any well-conditioned
-# sample of paper 1's Fig. 5 (max 345 N, typical 100 N), and (ii) 10 um of leg-length error (lead-screw
-# backlash) leaves more than 10 mrad (0.6 deg) of platform play: the legs no longer hold the pose.
-# Samples below it are flagged (valid False) with their finite forces kept for inspection; the 1e-8
-# ratio alone would let ~1e8 N through as valid 1e-6 rad from the singular curve.
+# Physical bound of the actuation (m/rad): sigma_min is the lever arm through which the legs hold the
+# platform.  Below 1 mm/rad every N m needs more than 1 kN of leg force (10x the largest well-conditioned
+# force of Fig. 5) and 10 um of leg-length error leaves more than 0.6 deg of platform play; such samples
+# are flagged with their finite forces kept (docs/mechanisms/spherical_leg.md, "Actuation bound").
 ACTUATION_SIGMA_MIN = 1e-3
-# Gimbal lock of a base universal joint: the leg along the joint's fixed axis, 1 - (a . s)^2 = 0, where
-# the spin sigma = (a . s)(a . (s x sdot)) / (1 - (a . s)^2) is unbounded (the joint cannot follow).
-# Below this value of 1 - (a . s)^2 (the leg within 1.8 deg of the axis, spin gain > 1000 rad per rad
-# of swing) a sample of inverse_dynamics is flagged, and the formula's denominator is floored there
-# (finite values, flagged).  The paper's motions stay above 0.036 (Fig. 5(a), leg 3 at alpha = -60 deg;
-# Fig. 5(b) 0.17, 5(c) 0.38): lock needs a leg lying along its joint's horizontal axis.
+# Gimbal lock of a base universal joint (the leg along its fixed axis: 1 - (a . s)^2 = 0, where the spin
+# is unbounded): below this value (the leg within 1.8 deg of the axis, spin gain > 1000) a sample is
+# flagged and the denominator floored.  The paper's motions stay above 0.036 (Fig. 5(a), leg 3).
 CARDAN_LOCK_TOL = 1e-3
 
 

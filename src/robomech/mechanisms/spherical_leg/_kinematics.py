@@ -32,24 +32,20 @@ __all__ = [
     "platform_rotation",
 ]
 
-# Forward kinematics fits beta to (l1, l2) by Newton's method started at the exact closed form.  For
-# consistent lengths the start is already the answer; for noisy lengths the 1-D least-squares problem
-# is smooth and convex near the start, and Newton converges quadratically in about 3-5 steps.  40 is a
-# generous cap that only sub-millimetre-inconsistent inputs far from any pose could approach.
+# FK fits beta to (l1, l2) by Newton's method from the exact closed form: no step for consistent
+# lengths, 3-5 (quadratic) for noisy ones; 40 is a cap only far-inconsistent inputs could approach.
 FK_MAX_ITER = 40
 # Newton stops when the beta step falls below this (rad): 100x the rounding of an O(1) angle, far
 # below the 1e-10 rad accuracy the tests require (used where the Gauss-Newton fallback is active).
 FK_STEP_TOL = 1e-14
-# With Newton's own curvature the convergence is quadratic (f'' is bounded away from zero since
-# dl1/db and dl2/db never vanish together), so after a step below 1e-8 rad the remaining error is
-# of order step^2 ~ 1e-16 rad: the step is applied and the iteration stops, saving one iteration.
+# Newton converges quadratically (dl1/db and dl2/db never vanish together), so after a step below 1e-8
+# rad the remaining error is ~step^2 ~ 1e-16 rad: the step is applied and the iteration stops.
 FK_NEWTON_STEP_TOL = 1e-8
 # |sin(alpha - phi)| may exceed 1 by rounding when l3 sits exactly on the branch boundary (the
 # l3-singularity); up to this excess the value is clipped, beyond it the lengths have no assembly.
 ASSEMBLY_TOL = 1e-12
-# Derivatives divide by the leg length; B_i can only reach A_i in a collided pose far outside any
-# stroke (length_min > 0). The length is floored here so such a pose gives a huge finite derivative
-# (flagged by within_limits) rather than a division-by-zero warning.
+# Derivatives divide by the leg length, zero only in a collided pose far outside any stroke: floored so
+# such a pose gives a huge finite derivative (flagged by within_limits), not a division by zero.
 LENGTH_FLOOR = 1e-12
 # Large batches are evaluated in chunks of this many samples so that a kernel's temporaries (about
 # twenty arrays of 16384 float64 = 128 KiB each) stay in the L2 cache instead of streaming through
@@ -180,7 +176,7 @@ def inverse_kinematics(leg: SphericalLeg, alpha: object, beta: object) -> Invers
 
 def _ik_kernel(leg: SphericalLeg, a, b, L, S, B) -> None:
     """B_i = T b_i written out (paper 1, eq. (3) and its analogues), lengths from the closed form."""
-    R, r, h = leg.R, leg.r, leg.h
+    r, h = leg.r, leg.h
     (sa, ca), (sb, cb) = sincos(a), sincos(b)
     rsb_m_hcb = r * sb - h * cb
     rsb_p_hcb = r * sb + h * cb
@@ -195,10 +191,7 @@ def _ik_kernel(leg: SphericalLeg, a, b, L, S, B) -> None:
     B[:, 2, 1] = r * ca - sa * hcb
     B[:, 2, 2] = r * sa + ca * hcb
     # the closed form keeps full relative accuracy where |B - A| is small
-    K = R * R + r * r + h * h
-    L[:, 0] = K - 2 * R * (r * cb + h * sb)
-    L[:, 1] = K - 2 * R * (r * cb - h * sb)
-    L[:, 2] = K - 2 * R * (r * ca - hcb * sa)
+    L[:, 0], L[:, 1], L[:, 2] = _squared_length_columns(leg, sa, ca, sb, cb)
     np.sqrt(np.maximum(L, 0.0, out=L), out=L)
     np.subtract(B, leg.base_points, out=S)
     S /= np.where(L > 0, L, 1.0)[:, :, None]
@@ -429,15 +422,15 @@ def jacobian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
 
 def _jacobian_kernel(leg: SphericalLeg, a, b, J) -> None:
     R, r, h = leg.R, leg.r, leg.h
-    K = R * R + r * r + h * h
     (sa, ca), (sb, cb) = sincos(a), sincos(b)
-    rcb, hsb, rsb, hcb = r * cb, h * sb, r * sb, h * cb
-    # dl/dq = (dq/dq) / (2 l) with q = l^2 (module docstring); R/l below is 2R / (2l)
+    hsb, rsb, hcb = h * sb, r * sb, h * cb
+    q1, q2, q3 = _squared_length_columns(leg, sa, ca, sb, cb)
+    # dl/dq = (dq/dq) / (2 l) with q = l^2; R/l below is 2R / (2l)
     J[:, 0, 0] = 0.0
     J[:, 1, 0] = 0.0
-    J[:, 0, 1] = (rsb - hcb) * R / np.sqrt(np.maximum(K - 2 * R * (rcb + hsb), LENGTH_FLOOR**2))
-    J[:, 1, 1] = (rsb + hcb) * R / np.sqrt(np.maximum(K - 2 * R * (rcb - hsb), LENGTH_FLOOR**2))
-    k3 = R / np.sqrt(np.maximum(K - 2 * R * (r * ca - hcb * sa), LENGTH_FLOOR**2))
+    J[:, 0, 1] = (rsb - hcb) * R / np.sqrt(np.maximum(q1, LENGTH_FLOOR**2))
+    J[:, 1, 1] = (rsb + hcb) * R / np.sqrt(np.maximum(q2, LENGTH_FLOOR**2))
+    k3 = R / np.sqrt(np.maximum(q3, LENGTH_FLOOR**2))
     J[:, 2, 0] = (r * sa + hcb * ca) * k3
     J[:, 2, 1] = -(hsb * sa) * k3
 

@@ -12,16 +12,11 @@ from __future__ import annotations
 import numpy as np
 
 from robomech.multibody import Builder, Inertial, Mechanism
+from robomech.multibody._model import _quat_from_matrix
 
 from ._params import SphericalLeg
 
 __all__ = ["to_multibody"]
-
-
-def _quat(R: np.ndarray) -> tuple[float, ...]:
-    from robomech.multibody._model import _quat_from_matrix
-
-    return tuple(_quat_from_matrix(R))
 
 
 def to_multibody(leg: SphericalLeg, actuate: str = "legs") -> Mechanism:
@@ -57,7 +52,7 @@ def to_multibody(leg: SphericalLeg, actuate: str = "legs") -> Mechanism:
         b.body(
             f"cardan{k}",
             pos=A[i],
-            quat=_quat(R),
+            quat=_quat_from_matrix(R),
             joints=[b.hinge(f"u{k}a", axis=(0, 1, 0)), b.hinge(f"u{k}b", axis=(0, 0, 1))],
         )
         lower = Inertial(

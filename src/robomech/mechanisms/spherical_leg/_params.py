@@ -83,12 +83,9 @@ class SphericalLeg:
 
     Parameters
     ----------
-    R : float
-        Radius OA_i of the base joint circle (m); paper: 75 mm.
-    r : float
-        Radius PB_i of the platform joint circle (m); paper: 30 mm.
-    h : float
-        Distance OP at the home pose (m); paper: 100 mm.
+    R, r, h : float
+        Radii OA_i, PB_i of the base and platform joint circles and distance OP at the home pose (m);
+        paper: 75, 30, 100 mm.
     platform_side, platform_thickness : float
         Side and thickness of the box-shaped platform (m); paper: 60 mm, 20 mm.
     platform_mass : float

@@ -19,34 +19,24 @@ from ._params import SphericalLeg
 
 __all__ = ["BranchTrack", "track_branches"]
 
-# A local minimum of the branch separation counts as a meeting of the branches (a place where the
-# motion may change branch) when the separation there is at most this many times the motion's step
-# (the largest step per sample within MEET_WINDOW samples, times the gap to the neighbouring valid
-# samples): near the singular curve the separation is 2 |α - α_s| (the two solutions are mirror
-# images about α_s), so a crossing between two samples leaves a separation of at most 2 steps at the
-# nearer one; noise in the lengths moves the samples next to the curve by up to about a step (10-30
-# nm on Fig. 5(a)), hence 4.  A local minimum that is no crossing costs only a fit (it is a touch).
+# A local minimum of the branch separation counts as a meeting of the branches when it is at most this
+# many times the motion's step (per sample, within MEET_WINDOW samples): near the curve the separation
+# is 2 |α - α_s|, so a crossing between two samples leaves at most 2 steps at the nearer one, and noise
+# moves the samples next to the curve by about a step, hence 4 (a local minimum that is no crossing
+# costs only a fit).
 MEET_STEP_FACTOR = 4.0
-# Candidate meetings closer than this many samples are one meeting (noise in the lengths makes the
-# separation wiggle next to the curve and gives several local minima for one passage); two real
-# passages a few samples apart (a dip just beyond the curve on a coarse grid) stay two meetings
-# only if at least one sample separates them, and are then decided together (MEET_CLUSTER_MAX).
+# Candidate meetings closer than this many samples are one meeting (noise makes the separation wiggle
+# next to the curve); two real passages stay two meetings if a sample separates them.
 MEET_MERGE = 1
 # Samples on either side of a meeting that the crossing / touch models are fitted to, and the degree
-# of the polynomial in the sample index they are fitted with: 32 samples average the noise of the
-# samples nearest the curve (with 8, 30 nm of noise left most Fig. 5(a) meetings ambiguous), and a
-# cubic describes σ over that window for a motion sampled finely enough to be tracked (a quadratic
-# misfits the asymmetry of a sway passing the curve near its turning point on a 0.5 s grid and then
-# decides wrongly).  Measured on Fig. 5(a) (grids 0.01-1 s, 10-100 nm of noise) and on random sways:
-# docs/mechanisms/spherical_leg.md.
+# of their polynomial: 32 samples average the noise nearest the curve (with 8, 30 nm of noise left most
+# Fig. 5(a) meetings ambiguous); a quadratic misfits a sway passing the curve near its turning point on
+# a 0.5 s grid, a cubic does not (measured: docs/mechanisms/spherical_leg.md).
 MEET_WINDOW = 16
-# Where MEET_WINDOW leaves a meeting ambiguous, the shorter windows are tried: on a coarse grid (0.25 s
-# or coarser on Fig. 5(a)) 16 samples span several seconds, over which no cubic follows the motion,
-# so both models misfit alike; a window of a few samples is short enough in time for the cubic
-# again.  Their answer is taken only if every shorter window decides (AMBIGUITY_RATIO) and all call
-# the same meetings crossings: noise that leaves the long window undecided (0.1-1 um on a fine grid)
-# makes short windows disagree, where a lone short window could decide wrongly (measured: one in 40
-# runs at 0.1 um on 2001 samples; the measurements per grid: docs/mechanisms/spherical_leg.md).
+# Where MEET_WINDOW leaves a meeting ambiguous, shorter windows are tried (on a coarse grid 16 samples
+# span seconds, over which no cubic follows the motion); their answer is taken only if every one decides
+# and all agree (a lone short window decided wrongly once in 40 runs at 0.1 um of noise on 2001 samples;
+# per grid: docs/mechanisms/spherical_leg.md).
 MEET_WINDOWS = (MEET_WINDOW, 6, 4)
 MEET_FIT_DEGREE = 3
 # The crossing model places the passage through the curve within this many samples of the sample

@@ -71,13 +71,6 @@ def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMa
     Returns
     -------
     :class:`WorkspaceMap`
-
-    Examples
-    --------
-    >>> from robomech.mechanisms import spherical_leg as sl
-    >>> ws = sl.workspace_map(sl.SphericalLeg.paper(), [0.0, 0.1], 0.05)
-    >>> ws.lengths.shape, ws.singular
-    ((2, 3), array([False, False]))
     """
     check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
