@@ -103,13 +103,6 @@ def inverse_rates(
     Returns
     -------
     InverseRatesResult
-
-    Examples
-    --------
-    >>> th = VectoredThruster.paper()
-    >>> r = inverse_rates(th, [[0.1, 0.2]] * 3, [0.0, 0.0, 0.0])
-    >>> r.qd.shape, bool(r.valid.all()), bool(np.allclose(r.qd, 0.0))
-    ((3, 2), True, True)
     """
     check_params(th, VectoredThruster, "th")
     q = _q(q)

@@ -55,11 +55,9 @@ MIN_DIRECTION_NORM = 1e-12
 # Inputs within this of a range limit count as in range: an IK solution on the boundary carries a few
 # ulps of rounding (1e-16 rad), and a limit is never meaningful to better than a micro-radian.
 RANGE_TOL = 1e-12
-# Samples per block in the batched kernels: ~20 float64 temporaries of 8192 samples (~1.3 MB) stay in
-# cache; measured 1.3-2x faster than whole-array evaluation at 10^6 samples (benchmarks/).  Not 16384:
-# its 128 KiB temporaries reach glibc malloc's default mmap threshold (128 KiB), so until a large free
-# raises that threshold every temporary is a fresh mmap with page faults (first 10^6-sample FK in a fresh
-# process: 113 ms at 16384, 66 ms at 8192; equal once warm).
+# Samples per block in the batched kernels: their ~20 temporaries stay in cache (1.3-2x faster at 10^6
+# samples); not 16384, whose 128 KiB temporaries reach glibc's default mmap threshold (every temporary a
+# fresh mmap in a fresh process: docs/mechanisms/vectored_thrust.md, "Numerical constants").
 CHUNK = 1 << 13
 
 if TYPE_CHECKING:

@@ -47,12 +47,6 @@ class VectoredThruster:
         Largest tilt of s0 from +Z allowed by the universal joint (rad), in (0, π/2).
     interference_clearance : float, optional
         Smallest angle between the 45° arc and the fixing device on the platform sphere (rad), in [0, π/2).
-
-    Examples
-    --------
-    >>> th = VectoredThruster.paper()
-    >>> round(th.arc_angle, 6), th.propeller_arm
-    (0.785398, 0.08)
     """
 
     arc_angle: float = math.pi / 4  # paper 5, eq. (7): angle between X and s12 (the 45 deg arc)

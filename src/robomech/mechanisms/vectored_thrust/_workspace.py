@@ -128,13 +128,6 @@ def workspace_map(th: VectoredThruster, q: object) -> WorkspaceMap:
     Returns
     -------
     WorkspaceMap
-
-    Examples
-    --------
-    >>> th = VectoredThruster.paper()
-    >>> w = workspace_map(th, input_grid(th, (5, 4)))
-    >>> w.tip.shape, w.reachable.shape
-    ((5, 4, 3), (5, 4))
     """
     check_params(th, VectoredThruster, "th")
     return _chunked(_workspace_map, th, _q(q))
