@@ -50,14 +50,9 @@ class WorkspaceMap:
         The sample is within Table 2's joint ranges.
     det : ndarray, shape (...)
         Determinant of the foot Jacobian (m³/rad³).
-    cond : ndarray, shape (...)
-        2-norm condition number of the Jacobian (inf where singular).
-    dexterity : ndarray, shape (...)
-        ``1 / cond``, in [0, 1].
-    sigma_min : ndarray, shape (...)
-        Smallest singular value of the Jacobian (m/rad).
-    singular : ndarray of bool, shape (...)
-        ``sigma_min / sigma_max < SINGULAR_RCOND`` (the damped solves' threshold; γ ≈ 0).
+    cond, dexterity, sigma_min, singular : ndarray, shape (...)
+        The foot Jacobian's :class:`robomech.analysis.workspace.SingularityMap` (sigma_min in m/rad),
+        singular below ``SINGULAR_RCOND`` (the damped solves' threshold; γ ≈ 0).
     """
 
     q: np.ndarray

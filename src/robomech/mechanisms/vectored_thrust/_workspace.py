@@ -41,10 +41,8 @@ class WorkspaceMap:
     ----------
     q : ndarray, shape (..., 2)
         The input samples (rad).
-    tip : ndarray, shape (..., 3)
-        Propeller tip (m, base frame); NaN where singular.
-    tilt : ndarray, shape (...)
-        Universal-joint deflection (rad).
+    tip, tilt, in_range, tilt_ok : ndarray
+        As in :class:`FKResult`.
     clearance : ndarray, shape (...)
         Angular clearance of the 45° arc from the fixing device (rad).
     distance : ndarray, shape (...)
@@ -53,10 +51,6 @@ class WorkspaceMap:
         ``1 / cond(J)`` in [0, 1]; 0 where singular.
     singular : ndarray of bool, shape (...)
         ``dexterity < DEXTERITY_TOL`` or passive axes parallel.
-    in_range : ndarray of bool, shape (...)
-        Inputs within ``q1_limits``, ``q2_limits``.
-    tilt_ok : ndarray of bool, shape (...)
-        Not singular and ``tilt <= tilt_limit``.
     clear : ndarray of bool, shape (...)
         ``clearance >= interference_clearance``.
     reachable : ndarray of bool, shape (...)
