@@ -14,7 +14,7 @@ import numpy as np
 
 from robomech._batching import carries_failed_rows, chunked
 from robomech._validation import as_array, broadcast_batch, check_bool, check_params
-from robomech.analysis.lstsq import _damped_svd_solve
+from robomech.analysis.lstsq import _damped_inverse
 
 from . import _jet as jt
 from ._chains import shank_frames
@@ -526,15 +526,13 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     tau = as_array(tau, "tau", (3,))
     batch = broadcast_batch((q, 1, "q"), (tau, 1, "tau"))
     J = jacobian(leg, q)
-    U, s, Vt = np.linalg.svd(J)
+    # Jᵀ = V Σ Uᵀ: only the directions with σ_i < SINGULAR_RCOND σ_max are damped
+    s, solve = _damped_inverse(np.swapaxes(J, -1, -2), rtol=SINGULAR_RCOND, damping=DAMPING_RELATIVE)
     rcond = s[..., -1] / s[..., 0]
     singular = rcond < SINGULAR_RCOND
-    lam = DAMPING_RELATIVE * s[..., :1]
-    # Jᵀ = V Σ Uᵀ, so F = U Σ⁺ Vᵀ τ; only the directions with σ_i < SINGULAR_RCOND σ_max are damped
-    weak = s < SINGULAR_RCOND * s[..., :1]
     # paper 2, eq. (47): F_f = (Jᵀ)⁻¹ τ for the force the foot delivers; the force applied to it is -F_f
-    F = -_damped_svd_solve(np.swapaxes(Vt, -1, -2), s, np.swapaxes(U, -1, -2), tau, lam, weak)
-    resid = np.linalg.norm(-np.einsum("...ij,...i->...j", J, F) - tau, axis=-1)
+    F_f, resid = solve(tau)  # |-Jᵀ F - τ|
+    F = -F_f
     # the per-sample fields have the batch of every argument (q may be one configuration for many tau)
     return FootForceResult(
         force=F,

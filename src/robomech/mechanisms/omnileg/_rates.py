@@ -9,7 +9,7 @@ import numpy as np
 
 from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_batch, check_params, check_real
-from robomech.analysis.lstsq import _damped_svd_solve
+from robomech.analysis.lstsq import _damped_inverse
 
 from ._dynamics import SINGULAR_RCOND
 from ._kinematics import hessian, jacobian
@@ -106,21 +106,16 @@ def joint_rates(
 
 def _joint_rates(leg, q, pd, pdd, damping, batch) -> JointRatesResult:
     J = jacobian(leg, q)
-    U, s, Vt = np.linalg.svd(J)
-    smax = s[..., :1]
-    rcond = s[..., -1] / smax[..., 0]
-    weak = s < SINGULAR_RCOND * smax
-    lam = float(damping) * smax
-    qd = _damped_svd_solve(U, s, Vt, pd, lam, weak)
-    v_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qd) - pd, axis=-1)
+    s, solve = _damped_inverse(J, rtol=SINGULAR_RCOND, damping=damping)
+    rcond = s[..., -1] / s[..., 0]
+    qd, v_res = solve(pd)
     if pdd is None:
         qdd = np.full((*batch, 3), np.nan)
         a_res = np.full(batch, np.nan)
     else:
         pdd = np.broadcast_to(pdd, (*batch, 3))
         bias = np.einsum("...ijk,...j,...k->...i", hessian(leg, q), qd, qd)  # q̇ᵀ H q̇
-        qdd = _damped_svd_solve(U, s, Vt, pdd - bias, lam, weak)
-        a_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qdd) + bias - pdd, axis=-1)
+        qdd, a_res = solve(pdd - bias)  # |J q̈ + q̇ᵀ H q̇ - p̈|
     singular = rcond < SINGULAR_RCOND
     finite = np.all(np.isfinite(qd), -1) & (pdd is None or np.all(np.isfinite(qdd), -1))
     return JointRatesResult(

@@ -9,7 +9,7 @@ import numpy as np
 
 from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_batch, check_params, check_real
-from robomech.analysis.lstsq import _damped_svd_solve
+from robomech.analysis.lstsq import _damped_inverse
 
 from ._kinematics import _chunked, _jacobian, _q, angular_acceleration
 from ._params import VectoredThruster
@@ -122,18 +122,13 @@ def _inverse_rates(th, q, w, wd, lam_rel, batch) -> InverseRatesResult:
     jr = _chunked(_jacobian, th, np.ascontiguousarray(q))
     exists = jr.valid
     J = np.where(exists[..., None, None], jr.J, 0.0)
-    U, s, Vt = np.linalg.svd(J, full_matrices=False)
-    smax = s[..., :1]
     bound = 1.0 / INPUT_GAIN_MAX
-    weak = s < bound
-    lam = lam_rel * smax
-    qd = _damped_svd_solve(U, s, Vt, w, lam, weak)
-    w_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qd) - w, axis=-1)
+    s, solve = _damped_inverse(J, atol=bound, damping=lam_rel)
+    qd, w_res = solve(w)
     sigma_min = np.where(exists, s[..., -1], 0.0)
     singular = ~exists | (sigma_min < bound)
-    nan = np.full((*batch, 2), np.nan)
     if wd is None:
-        qdd = nan
+        qdd = np.full((*batch, 2), np.nan)
         wd_res = np.full(batch, np.nan)
     else:
         wd = np.broadcast_to(wd, (*batch, 3))
@@ -141,8 +136,7 @@ def _inverse_rates(th, q, w, wd, lam_rel, batch) -> InverseRatesResult:
         qd_safe = np.where(exists[..., None], qd, 0.0)
         vp = angular_acceleration(th, q_safe, qd_safe, np.zeros_like(qd_safe)).velocity_product
         vp = np.where(exists[..., None], vp, 0.0)
-        qdd = _damped_svd_solve(U, s, Vt, wd - vp, lam, weak)
-        wd_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qdd) + vp - wd, axis=-1)
+        qdd, wd_res = solve(wd - vp)  # |J q̈ + J̇ q̇ - ω̇|
         qdd = np.where(exists[..., None], qdd, np.nan)
         wd_res = np.where(exists, wd_res, np.nan)
     finite = np.all(np.isfinite(qd), -1) & (wd is None or np.all(np.isfinite(qdd), -1))
