@@ -26,24 +26,17 @@ TRIANGLE_RTOL = 1e-9
 
 @dataclass(frozen=True)
 class RigidBody:
-    """Inertial parameters of one rigid body, in its own body frame (see ``docs/mechanisms/omnileg.md``).
+    """Inertial parameters of one rigid body in its body frame (docs/mechanisms/omnileg.md, "Dynamics model").
 
     Parameters
     ----------
     mass : float
         Mass (kg), > 0.
     com : array_like, shape (3,)
-        Centre of mass in the body frame (m); stored as a tuple of 3 floats.
+        Centre of mass (m); stored as a tuple (``com_vector``: as an array).
     inertia : array_like, shape (3, 3)
-        Inertia about the centre of mass in body axes (kg m²): symmetric, positive semidefinite, its
-        principal moments obeying the triangle inequality; stored as nested tuples.
-
-    Attributes
-    ----------
-    inertia_matrix : ndarray, shape (3, 3)
-        ``inertia`` as an array (kg m²).
-    com_vector : ndarray, shape (3,)
-        ``com`` as an array (m).
+        Inertia about the centre of mass (kg m²): symmetric, positive semidefinite, principal moments
+        obeying the triangle inequality; stored as nested tuples (``inertia_matrix``: as an array).
     """
 
     mass: float
@@ -83,12 +76,7 @@ class RigidBody:
 
 
 def _cylinder(
-    mass: float,
-    radius: float,
-    length: float,
-    com: tuple[float, float, float] = (0, 0, 0),
-    axis: int = 2,
-    inner_radius: float = 0.0,
+    mass: float, radius: float, length: float, com=(0, 0, 0), axis=2, inner_radius=0.0
 ) -> RigidBody:
     """(Hollow) cylinder along body axis ``axis`` about its centre."""
     r2 = radius**2 + inner_radius**2
@@ -101,13 +89,6 @@ def _cylinder(
     )
 
 
-def _box(
-    mass: float, sx: float, sy: float, sz: float, com: tuple[float, float, float] = (0, 0, 0)
-) -> RigidBody:
-    d = (mass * (sy**2 + sz**2) / 12, mass * (sx**2 + sz**2) / 12, mass * (sx**2 + sy**2) / 12)
-    return RigidBody(mass, com, tuple(tuple(d[i] if i == j else 0.0 for j in range(3)) for i in range(3)))
-
-
 def _cross(radius: float, span: float) -> RigidBody:
     """A universal-joint cross: two steel pins of ``radius`` and length ``span`` along body x and y."""
     m_pin = RHO_STEEL * math.pi * radius**2 * span
@@ -118,8 +99,8 @@ def _cross(radius: float, span: float) -> RigidBody:
 
 
 def default_bodies(L1: float, L3: float, L4: float, L5: float, knee_to_crank: float) -> dict[str, RigidBody]:
-    """Plausible inertial parameters from the link geometry (the sizes and materials of every body kind,
-    in body frames with z along the link: docs/mechanisms/omnileg.md, "Dynamics model").
+    """Plausible inertial parameters from the link geometry (sizes, materials and frames of the 11 body kinds
+    of ``BODY_FIELDS``: docs/mechanisms/omnileg.md, "Dynamics model").
 
     Parameters
     ----------
@@ -129,7 +110,6 @@ def default_bodies(L1: float, L3: float, L4: float, L5: float, knee_to_crank: fl
     Returns
     -------
     dict of str to RigidBody
-        The 11 body kinds of ``BODY_FIELDS``.
     """
     L1, L3, L4, L5 = (check_positive(v, n) for v, n in ((L1, "L1"), (L3, "L3"), (L4, "L4"), (L5, "L5")))
     knee_to_crank = check_positive(knee_to_crank, "knee_to_crank", allow_zero=True)
@@ -170,7 +150,8 @@ def default_bodies(L1: float, L3: float, L4: float, L5: float, knee_to_crank: fl
     knee_plate = _cylinder(m_plate + m_extra, plate_r, plate_t, com=(0.0, 0.0, knee_to_crank / 2))
     bar_w, bar_t = 0.012, 0.006
     m_bar = RHO_ALUMINIUM * bar_w * bar_t * L4
-    bar = _box(m_bar, bar_t, bar_w, L4).inertia_matrix
+    box = (bar_w**2 + L4**2, bar_t**2 + L4**2, bar_t**2 + bar_w**2)  # the bar as a box
+    bar = np.diag([m_bar * v / 12 for v in box])
     coupler = RigidBody(m_bar, (0.0, 0.0, L4 / 2), tuple(map(tuple, bar)))
     m_cg = 0.025
     z_cr = m_bar * (L4 / 2) / (m_bar + m_cg)
@@ -206,37 +187,21 @@ def default_bodies(L1: float, L3: float, L4: float, L5: float, knee_to_crank: fl
 
 
 BODY_FIELDS = (
-    "hip_cross",
-    "thigh_rod",
-    "knee_cross",
-    "knee_plate",
-    "drive_shaft_in",
-    "drive_cross",
-    "drive_rod",
-    "drive_shaft_out",
-    "crank",
-    "coupler",
-    "foot",
-)
+    "hip_cross", "thigh_rod", "knee_cross", "knee_plate", "drive_shaft_in", "drive_cross", "drive_rod",
+    "drive_shaft_out", "crank", "coupler", "foot",
+)  # fmt: skip
 
 
 class BodySet(Mapping):
-    """The 11 body parameter sets of an :class:`OmniLeg` (read-only mapping body kind -> RigidBody).
-
-    The entries not ``explicit`` are :func:`default_bodies`, derived again whenever the leg is rebuilt
-    (``dataclasses.replace``).  Two sets compare equal when all 11 bodies are equal.
+    """The 11 body parameter sets of an :class:`OmniLeg`, a read-only mapping body kind -> RigidBody; the
+    kinds not ``explicit`` are :func:`default_bodies` (docs/mechanisms/omnileg.md, "Derived inertias").
 
     Parameters
     ----------
     bodies : Mapping
         Body kind -> :class:`RigidBody` for all 11 kinds.
     explicit : frozenset of str
-        The kinds given explicitly by the user.
-
-    Attributes
-    ----------
-    explicit : frozenset of str
-        Body kinds given explicitly (not derived from the dimensions).
+        The kinds given explicitly by the user (not derived from the dimensions).
     """
 
     __slots__ = ("_bodies", "_explicit")
@@ -276,36 +241,24 @@ _SHANK_RADIUS = 0.025
 class OmniLeg:
     """The OmniLeg: thigh 3-UU double-parallel mechanism + 3-RRR (crank-slider) shank.
 
+    Defaults and their sources: docs/mechanisms/omnileg.md, "Parameters and their justification".
+
     Parameters
     ----------
-    L1 : float
-        Thigh rod length A_iB_i (m), > 0 (Table 2: 0.15 m).
-    L3 : float
-        Distance of the U joints A_i, B_i from the plate centres O0, O0' (m), > 0.
-    L4 : float
-        Shank link length C_iD_i = D_iE_i (m), > 0.
-    L5 : float
-        Knee height (m), > 0: the constant part of the foot depth below O0' (eq. (11)).
+    L1, L3, L4, L5 : float
+        Thigh rod A_iB_i, U-joint offset from O0 and O0', shank link C_iD_i = D_iE_i, knee height (m), > 0.
     alpha_max, beta_max : float, optional
-        Joint range magnitudes of α and β (rad), in (0, π/2); default 65°.
+        Joint range magnitudes of α and β (rad), in (0, π/2).
     gamma_min, gamma_max : float, optional
-        Range of the crank angle γ (rad), ``-π/2 < gamma_min < gamma_max < π/2``; default 0 and 85°.
-    knee_to_crank : float, optional
-        Depth of the C_i joints below O0' (m), in [0, L5) (the foot point lies below); default 0.03 m.
-    shank_radius : float, optional
-        Radius of the C_i and E_i circles (m), > 0; default 0.025 m.
-    shank_azimuth : float, optional
-        Angle of chain C1D1E1 from X0 (rad), the three chains 120° apart; default π/2.
+        Range of the crank angle γ (rad), ``-π/2 < gamma_min < gamma_max < π/2``.
+    knee_to_crank, shank_radius, shank_azimuth : float, optional
+        Depth of the C_i below O0' (m, in [0, L5)), radius of the C_i/E_i circles (m), angle of chain
+        C1D1E1 from X0 (rad).
     gravity : array_like, shape (3,), optional
-        Gravity acceleration in the hip frame (m/s²); default ``(0, 0, 9.80665)`` (Z0 down).
+        Gravity acceleration in the hip frame (m/s²; Z0 points down).
     bodies : Mapping, optional
-        Explicit :class:`RigidBody` overrides by body kind (keys from ``BODY_FIELDS``; a chain's three
-        copies share one); the others are :func:`default_bodies`, stored as a :class:`BodySet`.
-
-    Attributes
-    ----------
-    foot_drop : float
-        Depth of the foot point below the E_i plane, ``L5 - knee_to_crank`` (m).
+        :class:`RigidBody` overrides by body kind (``BODY_FIELDS``); the others are :func:`default_bodies`
+        (stored as a :class:`BodySet`).
     """
 
     L1: float
