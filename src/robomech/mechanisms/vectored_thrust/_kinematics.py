@@ -6,14 +6,12 @@
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
-from robomech._batching import carries_failed_rows, chunked
+from robomech._batching import R, carries_failed_rows, chunked_rows
 from robomech._validation import as_array, broadcast_batch, check_params
 from robomech.spatial import lie_bracket
 
@@ -60,18 +58,9 @@ RANGE_TOL = 1e-12
 # fresh mmap in a fresh process: docs/mechanisms/vectored_thrust.md, "Numerical constants").
 CHUNK = 1 << 13
 
-if TYPE_CHECKING:
-    from _typeshed import DataclassInstance
 
-_R = TypeVar("_R", bound="DataclassInstance")  # a frozen result dataclass of arrays
-
-
-def _chunked(kernel: Callable[..., _R], th: VectoredThruster, x: np.ndarray) -> _R:
-    """``kernel(th, x_block)`` over blocks of CHUNK samples of ``x (..., k)``, reshaped to its batch."""
-    batch, flat = x.shape[:-1], x.reshape(-1, x.shape[-1])
-    r = chunked(lambda s: kernel(th, flat[s]), flat.shape[0], CHUNK)
-    arrays = {f.name: getattr(r, f.name) for f in dataclasses.fields(r)}
-    return dataclasses.replace(r, **{k: a.reshape(batch + a.shape[1:]) for k, a in arrays.items()})
+def _chunked(kernel: Callable[[VectoredThruster, np.ndarray], R], th: VectoredThruster, x: np.ndarray) -> R:
+    return chunked_rows(lambda rows: kernel(th, rows), x, CHUNK)
 
 
 _X = np.array([1.0, 0.0, 0.0])
