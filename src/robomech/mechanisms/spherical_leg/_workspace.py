@@ -9,16 +9,13 @@ import numpy as np
 
 from robomech._batching import carries_failed_rows
 from robomech._validation import check_params
-from robomech.analysis.workspace import singularity_map
+from robomech.analysis.workspace import SINGULAR_RTOL, singularity_map
 
 from ._kinematics import _angles, inverse_kinematics, jacobian
 from ._params import SphericalLeg
 
 __all__ = ["WorkspaceMap", "workspace_map"]
 
-# A pose counts as singular when sigma_min/sigma_max of J falls below this (as
-# robomech.analysis.workspace.SINGULAR_RTOL: a 1e8 amplification has no physical meaning here).
-SINGULAR_RTOL = 1e-8
 # Poses whose J condition number exceeds this are reported as ill-conditioned: the platform's
 # sensitivity to leg-length errors then differs by more than 100x between its two directions (both
 # columns of J are in m/rad, so the ratio is unit-free).

@@ -13,7 +13,7 @@ import numpy as np
 
 from robomech._batching import R, carries_failed_rows, chunked_rows
 from robomech._validation import as_array, broadcast_batch, check_params
-from robomech.spatial import lie_bracket
+from robomech.spatial import lie_bracket, rot_x
 
 # the unvalidated kernel: inputs are validated once at this module's public boundary
 from robomech.spatial._so3 import _sincos as sincos
@@ -73,18 +73,10 @@ class JointAxes:
 
     Attributes
     ----------
-    s11 : ndarray, shape (..., 3)
-        RRR input axis (X).
-    s12 : ndarray, shape (..., 3)
-        RRR passive axis between the 45° and the 90° arcs (eq. (7)).
-    s13 : ndarray, shape (..., 3)
-        RRR passive axis on the platform (eq. (8)); NaN where singular.
-    s21 : ndarray, shape (..., 3)
-        RR input axis (Y).
-    s22 : ndarray, shape (..., 3)
-        RR passive axis on the platform (eq. (5)).
-    s0 : ndarray, shape (..., 3)
-        Propeller shaft ``s22 x s13`` (eq. (11)); NaN where singular.
+    s11, s12, s13, s21, s22, s0 : ndarray, shape (..., 3)
+        RRR input axis X, passive axes between the arcs (eq. (7)) and on the platform (eq. (8)); RR input
+        axis Y, passive axis on the platform (eq. (5)); propeller shaft ``s22 x s13`` (eq. (11)).  s13 and
+        s0 are NaN where singular.
     distance : ndarray, shape (...)
         ``|s22 x s12|``, the distance to the singularity, in [0, 1].
     valid : ndarray of bool, shape (...)
@@ -110,8 +102,7 @@ class LinkClearanceResult:
     clearance : ndarray, shape (...)
         Angular clearance (rad) between the 45 deg arc and the fixing device; NaN where not ``valid``.
     valid : ndarray of bool, shape (...)
-        The configuration is not singular (``|s12 x s22| > SINGULAR_TOL``: the fixing device's arc
-        exists), so the clearance is defined.
+        Not singular (the fixing device's arc exists).
     """
 
     clearance: np.ndarray
@@ -130,14 +121,9 @@ class FKResult:
         Propeller position ``propeller_arm * s0`` (m, base frame).
     tilt : ndarray, shape (...)
         Angle between s0 and Z, the universal joint's deflection (rad).
-    valid : ndarray of bool, shape (...)
-        Assembled and not singular.
-    in_range : ndarray of bool, shape (...)
-        Inputs within ``q1_limits`` and ``q2_limits``.
-    tilt_ok : ndarray of bool, shape (...)
-        Valid and ``tilt <= tilt_limit``.
-    within_limits : ndarray of bool, shape (...)
-        ``in_range & tilt_ok`` (link interference: see :func:`link_clearance`, ``workspace_map``).
+    valid, in_range, tilt_ok, within_limits : ndarray of bool, shape (...)
+        Not singular; inputs within ``q1_limits``, ``q2_limits``; valid and ``tilt <= tilt_limit``;
+        ``in_range & tilt_ok`` (link interference: :func:`link_clearance`).
     """
 
     axis: np.ndarray
@@ -157,14 +143,9 @@ class IKResult:
     ----------
     q : ndarray, shape (..., 2)
         Inputs ``(q1, q2)`` (rad); NaN where not solved.
-    solved : ndarray of bool, shape (...)
-        An assembly with this propeller direction exists (limits ignored).
-    in_range : ndarray of bool, shape (...)
-        Solved and ``q`` within ``q1_limits``, ``q2_limits``.
-    tilt_ok : ndarray of bool, shape (...)
-        Solved and the direction within ``tilt_limit`` of Z.
-    valid : ndarray of bool, shape (...)
-        ``solved & in_range & tilt_ok``.
+    solved, in_range, tilt_ok, valid : ndarray of bool, shape (...)
+        An assembly with this direction exists (limits ignored); solved and ``q`` within ``q1_limits``,
+        ``q2_limits``; solved and the direction within ``tilt_limit`` of Z; ``solved & in_range & tilt_ok``.
     """
 
     q: np.ndarray
@@ -231,14 +212,11 @@ class AccelerationResult:
 
     Attributes
     ----------
-    omega : ndarray, shape (..., 3)
-        Platform angular velocity (rad/s, base frame).
-    omega_dot : ndarray, shape (..., 3)
-        Platform angular acceleration (rad/s², base frame).
-    passive_acc : ndarray, shape (..., 3)
-        Passive accelerations (RR s22, RRR s12, RRR s13), rad/s².
-    velocity_product : ndarray, shape (..., 3)
-        The Lie-bracket part ``J̇ q̇`` of ``omega_dot`` (rad/s²).
+    omega, omega_dot : ndarray, shape (..., 3)
+        Platform angular velocity (rad/s) and acceleration (rad/s²), base frame.
+    passive_acc, velocity_product : ndarray, shape (..., 3)
+        Passive accelerations (RR s22, RRR s12, RRR s13; rad/s²); the Lie-bracket part ``J̇ q̇`` of
+        ``omega_dot`` (rad/s²).
     valid : ndarray of bool, shape (...)
         Not singular.
     """
@@ -305,10 +283,6 @@ def joint_axes(th: VectoredThruster, q: object) -> JointAxes:
     return _axes(th, _q(q))
 
 
-def _in_range(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
-    return _in_range2(th, q[..., 0], q[..., 1])
-
-
 def _in_range2(th: VectoredThruster, q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
     """q1, q2 within their limits (+- RANGE_TOL); False where NaN."""
     (a1, b1), (a2, b2) = th.q1_limits, th.q2_limits
@@ -371,10 +345,6 @@ def _arc_clearance(a1: _V, b1: _V, a2: _V, b2: _V) -> np.ndarray:
     return np.where(crosses, 0.0, ends)
 
 
-def _split(v: np.ndarray) -> _V:
-    return (v[..., 0], v[..., 1], v[..., 2])
-
-
 @carries_failed_rows({"a1": 1, "b1": 1, "a2": 1, "b2": 1})
 def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
     """Angular distance (rad, in [0, π]) between the minor great-circle arcs (a1 -> b1) and (a2 -> b2).
@@ -390,7 +360,7 @@ def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
     """
     arrs = [as_array(v, name, (3,)) for v, name in ((a1, "a1"), (b1, "b1"), (a2, "a2"), (b2, "b2"))]
     broadcast_batch(*((v, 1, name) for v, name in zip(arrs, ("a1", "b1", "a2", "b2"), strict=True)))
-    return _arc_clearance(*(_split(v) for v in arrs))
+    return _arc_clearance(*((v[..., 0], v[..., 1], v[..., 2]) for v in arrs))
 
 
 def _interference(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
@@ -493,7 +463,7 @@ def _fk(th: VectoredThruster, q: np.ndarray) -> FKResult:
     with np.errstate(invalid="ignore"):  # NaN where singular, covered by valid
         tilt_ok = tilt <= th.tilt_limit
     tilt_ok &= valid
-    in_range = _in_range(th, q)
+    in_range = _in_range2(th, q[..., 0], q[..., 1])
     return FKResult(
         axis=axis,
         tip=np.multiply(axis, th.propeller_arm),
@@ -690,14 +660,9 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
     _, _, ct, st, _, _ = _theta_cs(th, q)
     theta = np.arctan2(st, ct)  # full circle: the propeller may pass beyond the horizontal
     R = np.stack([-ax.s22, -ax.s13, ax.s0], axis=-1)
-    c1, s1 = np.cos(q[..., 0]), np.sin(q[..., 0])
     # R_rel = Rx(-q1) R, expressed in the basis P = [s12(0), s13(0), s12(0) x s13(0)] = Rx'(rho2) Ry'(rho3).
     P = np.array([[ca, 0.0, -sa], [0.0, -1.0, 0.0], [-sa, 0.0, -ca]])
-    Rx_inv = np.zeros((*q.shape[:-1], 3, 3))
-    Rx_inv[..., 0, 0] = 1.0
-    Rx_inv[..., 1, 1], Rx_inv[..., 1, 2] = c1, s1
-    Rx_inv[..., 2, 1], Rx_inv[..., 2, 2] = -s1, c1
-    M = np.einsum("ji,...jk,...kl,lm->...im", P, Rx_inv, R, P)
+    M = np.einsum("ji,...jk,...kl,lm->...im", P, rot_x(-q[..., 0]), R, P)
     rho3 = np.arctan2(M[..., 0, 2], M[..., 0, 0])
     rho2 = np.arctan2(M[..., 2, 1], M[..., 1, 1])
     vals = np.stack([theta, rho2, rho3], axis=-1)

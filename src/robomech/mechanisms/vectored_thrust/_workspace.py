@@ -13,7 +13,7 @@ import numpy as np
 
 from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, check_params
-from robomech.analysis.workspace import grid
+from robomech.analysis.workspace import SINGULAR_RTOL, grid
 
 from ._kinematics import _chunked, _fk, _interference, _jacobian, _q
 from ._params import VectoredThruster
@@ -28,9 +28,9 @@ __all__ = [
     "workspace_map",
 ]
 
-# sigma_min / sigma_max of J below which an input configuration counts as singular in the maps: the
-# same threshold as robomech.analysis.workspace.SINGULAR_RTOL (1e-8), applied to the closed form.
-DEXTERITY_TOL = 1e-8
+# sigma_min / sigma_max of J below which an input configuration counts as singular in the maps, applied
+# to the closed form: the shared threshold.
+DEXTERITY_TOL = SINGULAR_RTOL
 
 
 @dataclass(frozen=True)
