@@ -68,14 +68,11 @@ class ThighClosure:
         Joint angles of the three chains (rad), ``theta[..., k, i] = θ_{k+1, i+1}``.
     T_knee : ndarray, shape (..., 4, 4)
         Knee-plate pose ``T_O0 O0'`` (m), chain 1's product of exponentials.
-    residual : ndarray, shape (...)
-        Largest component of the closure twists ``log(T_k T_1^-1)`` (rad or m).
-    converged : ndarray of bool, shape (...)
-        The closure holds: ``residual <= 10 CLOSURE_TOL``.
-    rotation_error : ndarray, shape (...)
-        Rotation angle of the knee plate (rad); zero for an exact closure.
-    translation_only : ndarray of bool, shape (...)
-        ``converged & (rotation_error <= TRANSLATION_ONLY_TOL)``.
+    residual, rotation_error : ndarray, shape (...)
+        Largest component of the closure twists ``log(T_k T_1^-1)`` (rad or m); rotation angle of the knee
+        plate (rad), zero for an exact closure.
+    converged, translation_only : ndarray of bool, shape (...)
+        ``residual <= 10 CLOSURE_TOL``; ``converged & (rotation_error <= TRANSLATION_ONLY_TOL)``.
     iterations : int
         The engine's assembly iterations (largest over the samples).
     knee : ndarray, shape (..., 3)
@@ -175,12 +172,9 @@ class ShankResult:
     ----------
     C, D, E : ndarray, shape (..., 3, 3)
         Joint points of chains i = 1..3 as ``C[..., i - 1, :]`` (m, knee-plate frame).
-    slider : ndarray, shape (...)
-        Depth of the E plane below the C plane (m).
-    coupler_angle : ndarray, shape (...)
-        Coupler angle from Z0' (rad, sign opposite to the crank).
-    delta_L2 : ndarray, shape (...)
-        Shank shortening ``2 L4 - slider`` (m, eq. (10)).
+    slider, coupler_angle, delta_L2 : ndarray, shape (...)
+        Depth of the E plane below the C plane (m); coupler angle from Z0' (rad, opposite to the crank);
+        shank shortening ``2 L4 - slider`` (m, eq. (10)).
     valid : ndarray of bool, shape (...)
         ``|γ| < π/2``; beyond it the chain folds flat and D, E, slider are NaN.
     """

@@ -314,12 +314,9 @@ class DynamicsResult:
         Motor torques (N·m), α, β, γ order.
     M : ndarray, shape (..., 3, 3)
         Joint-space inertia matrix (kg m²).
-    velocity_terms : ndarray, shape (..., 3)
-        Coriolis and centrifugal torques ``V(q, q̇)`` (N·m).
-    gravity_terms : ndarray, shape (..., 3)
-        Gravity torques ``G(q)`` (N·m).
-    foot_terms : ndarray, shape (..., 3)
-        Torques ``-Jᵀ F`` of the foot force (N·m); zero when no foot force was given.
+    velocity_terms, gravity_terms, foot_terms : ndarray, shape (..., 3)
+        Coriolis and centrifugal ``V(q, q̇)``, gravity ``G(q)`` and foot-force ``-Jᵀ F`` torques (N·m; the
+        last zero without a foot force).
     """
 
     tau: np.ndarray
@@ -465,14 +462,6 @@ def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
     Returns
     -------
     ndarray, shape (..., 3)
-
-    Examples
-    --------
-    >>> leg = OmniLeg.paper()
-    >>> tau = static_torques(leg, [0.1, 0.2, 1.0], [0.0, 0.0, -10.0])
-    >>> f = foot_force_from_torques(leg, [0.1, 0.2, 1.0], tau)
-    >>> bool(np.allclose(f.force, [0.0, 0.0, -10.0]))
-    True
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))

@@ -118,10 +118,7 @@ def passive_angles(leg: OmniLeg, alpha: object, beta: object) -> tuple[np.ndarra
 
     Returns
     -------
-    theta12 : ndarray, shape (...)
-        Passive angle of chain 1's second U-joint axis (rad).
-    theta22 : ndarray, shape (...)
-        Passive angle of chain 2's second U-joint axis (rad).
+    theta12, theta22 : ndarray, shape (...)
     """
     check_params(leg, OmniLeg, "leg")
     a = as_array(alpha, "alpha")
@@ -278,12 +275,16 @@ def within_limits(leg: OmniLeg, q: object) -> np.ndarray:
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,), finite=False)
     with np.errstate(invalid="ignore"):
-        return (
-            (np.abs(q[..., 0]) <= leg.alpha_max + LIMIT_SLACK)
-            & (np.abs(q[..., 1]) <= leg.beta_max + LIMIT_SLACK)
-            & (q[..., 2] >= leg.gamma_min - LIMIT_SLACK)
-            & (q[..., 2] <= leg.gamma_max + LIMIT_SLACK)
-        )
+        return _within(leg, q[..., 0], q[..., 1], q[..., 2])
+
+
+def _within(leg: OmniLeg, alpha: np.ndarray, beta: np.ndarray, gamma: np.ndarray) -> np.ndarray:
+    return (
+        (np.abs(alpha) <= leg.alpha_max + LIMIT_SLACK)
+        & (np.abs(beta) <= leg.beta_max + LIMIT_SLACK)
+        & (gamma >= leg.gamma_min - LIMIT_SLACK)
+        & (gamma <= leg.gamma_max + LIMIT_SLACK)
+    )
 
 
 @dataclass(frozen=True)
@@ -294,13 +295,9 @@ class IKResult:
     ----------
     q : ndarray, shape (..., 3)
         Joint angles ``(α, β, γ)`` (rad), branch γ ≥ 0; NaN where no solution exists.
-    exists : ndarray of bool, shape (...)
-        A real solution exists (the foot is not farther than L1 from Z0 horizontally, nor deeper or
-        shallower than the shank can reach).
-    within_limits : ndarray of bool, shape (...)
-        The solution is within the joint ranges.
-    reachable : ndarray of bool, shape (...)
-        ``exists & within_limits``.
+    exists, within_limits, reachable : ndarray of bool, shape (...)
+        A real solution exists (the foot within L1 of Z0 horizontally and within the shank's depths); it is
+        within the joint ranges; ``exists & within_limits``.
     leg : OmniLeg
     p_foot : ndarray, shape (..., 3)
         The requested foot positions (m, hip frame).
@@ -377,13 +374,7 @@ def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
         q[s, 2] = gamma
         if not ok.all():  # NaN exactly where no solution exists
             q[s][~ok] = np.nan
-        lim[s] = (
-            ok
-            & (np.abs(alpha) <= leg.alpha_max + LIMIT_SLACK)
-            & (np.abs(beta) <= leg.beta_max + LIMIT_SLACK)
-            & (gamma >= leg.gamma_min - LIMIT_SLACK)
-            & (gamma <= leg.gamma_max + LIMIT_SLACK)
-        )
+        lim[s] = ok & _within(leg, alpha, beta, gamma)
     batch = p.shape[:-1]
     return IKResult(
         q=q.reshape(p.shape),

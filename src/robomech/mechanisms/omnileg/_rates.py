@@ -29,19 +29,15 @@ class JointRatesResult:
 
     Attributes
     ----------
-    qd : ndarray, shape (..., 3)
-        Joint rates (rad/s).
-    qdd : ndarray, shape (..., 3)
-        Joint accelerations (rad/s²); NaN if no foot acceleration was given.
+    qd, qdd : ndarray, shape (..., 3)
+        Joint rates (rad/s) and accelerations (rad/s²; NaN if no foot acceleration was given).
     rcond : ndarray, shape (...)
         ``sigma_min / sigma_max`` of the foot Jacobian (dimensionless).
     singular : ndarray of bool, shape (...)
         ``rcond < SINGULAR_RCOND`` (γ ≈ 0): the weak direction is damped, so the solution is the damped
         least-squares one and the residuals are no longer zero.
-    velocity_residual : ndarray, shape (...)
-        ``|J q̇ - ṗ|`` (m/s).
-    acceleration_residual : ndarray, shape (...)
-        ``|J q̈ + q̇ᵀ H q̇ - p̈|`` (m/s²); NaN if no foot acceleration was given.
+    velocity_residual, acceleration_residual : ndarray, shape (...)
+        ``|J q̇ - ṗ|`` (m/s) and ``|J q̈ + q̇ᵀ H q̇ - p̈|`` (m/s²; NaN if no foot acceleration was given).
     valid : ndarray of bool, shape (...)
         Not singular and every value finite.
     """

@@ -146,19 +146,14 @@ class FootWorkspace:
 
     Attributes
     ----------
-    volume : float
-        Workspace volume (m³), ``projected_area * stroke``.
-    projected_area : float
-        Area of the workspace's horizontal section (m²): the knee patch seen from above.
-    stroke : float
-        Vertical travel of the shank (m), ``2 L4 (max cos γ - min cos γ)``.
+    volume, projected_area, stroke : float
+        ``projected_area * stroke`` (m³); area of the horizontal section, the knee patch seen from above
+        (m²); vertical travel of the shank ``2 L4 (max cos γ - min cos γ)`` (m).
     boundary : ndarray, shape (M, 2)
         Closed horizontal boundary ``(x, y)`` (m, hip frame), ``M = 4 BOUNDARY_POINTS``: the images
         of the edges ``|α| = α_max``, ``|β| = β_max``.
-    depth_min, depth_max : float
-        Shallowest and deepest foot positions along Z0 (m).
-    radius_max : float
-        Largest horizontal distance of the foot from Z0 (m).
+    depth_min, depth_max, radius_max : float
+        Shallowest and deepest foot positions along Z0, largest horizontal distance from Z0 (m).
     """
 
     volume: float

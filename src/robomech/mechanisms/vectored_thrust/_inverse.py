@@ -50,18 +50,15 @@ class InverseRatesResult:
 
     Attributes
     ----------
-    qd : ndarray, shape (..., 2)
-        Input rates (rad/s); NaN where J does not exist.
-    qdd : ndarray, shape (..., 2)
-        Input accelerations (rad/s²); NaN if no ω̇ was given or J does not exist.
+    qd, qdd : ndarray, shape (..., 2)
+        Input rates (rad/s) and accelerations (rad/s²; NaN if no ω̇ was given); NaN where J does not exist.
     sigma_min : ndarray, shape (...)
         Smallest singular value of J (dimensionless; 0 where J does not exist).
     singular : ndarray of bool, shape (...)
         ``sigma_min < 1 / INPUT_GAIN_MAX`` or J does not exist (the weak direction is damped there).
-    omega_residual : ndarray, shape (...)
-        ``|J q̇ - ω|`` (rad/s): the part of ω not realised (outside J's range, or damped).
-    omega_dot_residual : ndarray, shape (...)
-        ``|J q̈ + J̇ q̇ - ω̇|`` (rad/s²); NaN if no ω̇ was given.
+    omega_residual, omega_dot_residual : ndarray, shape (...)
+        ``|J q̇ - ω|`` (rad/s; the part of ω outside J's range, or damped) and ``|J q̈ + J̇ q̇ - ω̇|`` (rad/s²;
+        NaN if no ω̇ was given).
     valid : ndarray of bool, shape (...)
         Not singular, every value finite and the command realised: ``omega_residual`` (and
         ``omega_dot_residual`` if given) at most ``RATE_RESIDUAL_RTOL`` times the command's norm plus

@@ -43,17 +43,11 @@ class WorkspaceMap:
         The input samples (rad).
     tip, tilt, in_range, tilt_ok : ndarray
         As in :class:`FKResult`.
-    clearance : ndarray, shape (...)
-        Angular clearance of the 45° arc from the fixing device (rad).
-    distance : ndarray, shape (...)
-        ``|s22 x s12|`` (0 at the passive-axes-parallel singularity).
-    dexterity : ndarray, shape (...)
-        ``1 / cond(J)`` in [0, 1]; 0 where singular.
-    singular : ndarray of bool, shape (...)
-        ``dexterity < DEXTERITY_TOL`` or passive axes parallel.
-    clear : ndarray of bool, shape (...)
-        ``clearance >= interference_clearance``.
-    reachable : ndarray of bool, shape (...)
+    clearance, distance, dexterity : ndarray, shape (...)
+        Angular clearance of the 45° arc from the fixing device (rad); ``|s22 x s12|`` (0 where the passive
+        axes are parallel); ``1 / cond(J)`` in [0, 1], 0 where singular.
+    singular, clear, reachable : ndarray of bool, shape (...)
+        ``dexterity < DEXTERITY_TOL`` or passive axes parallel; ``clearance >= interference_clearance``;
         ``in_range & tilt_ok & clear`` and not singular.
     """
 
