@@ -125,10 +125,8 @@ class InverseKinematicsResult:
     ----------
     lengths : ndarray, shape (..., 3)
         Leg lengths l_i (m).
-    unit_vectors : ndarray, shape (..., 3, 3)
-        Rows ``s_i = (B_i - A_i) / l_i``: leg directions (base frame).
-    platform_points : ndarray, shape (..., 3, 3)
-        Rows B_i (m, base frame, relative to O).
+    unit_vectors, platform_points : ndarray, shape (..., 3, 3)
+        Rows ``s_i = (B_i - A_i) / l_i`` (leg directions) and B_i (m, relative to O), base frame.
     base_points : ndarray, shape (3, 3)
         Rows A_i (m, base frame).
     within_limits : ndarray of bool, shape (..., 3)
@@ -208,10 +206,8 @@ class ForwardKinematicsResult:
     residual : ndarray, shape (...)
         Norm of ``l(alpha, beta) - lengths`` (m): how inconsistent the three lengths are (rounding
         level for exact lengths).
-    valid : ndarray of bool, shape (...)
-        Finite positive lengths that assemble (NaN angles only where this is False).
-    converged : ndarray of bool, shape (...)
-        The beta fit converged.
+    valid, converged : ndarray of bool, shape (...)
+        Finite positive lengths that assemble (NaN angles only where this is False); the beta fit converged.
     """
 
     alpha: np.ndarray
@@ -531,7 +527,7 @@ def influence_coefficients(leg: SphericalLeg, alpha: object, beta: object) -> np
 def leg_rates(
     leg: SphericalLeg, q: object, qd: object, qdd: object
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Leg lengths, rates and accelerations ``(l, ldot, lddot)``, each (..., 3), along q = (alpha, beta).
+    """Leg lengths (m), rates (m/s), accelerations (m/s²) ``(l, ldot, lddot)`` along q = (alpha, beta).
 
     ``ldot = J qd``, ``lddot = J qdd + qd^T H qd``, replacing paper 1, eqs. (13)-(17) (see the code).
 
@@ -544,7 +540,6 @@ def leg_rates(
     Returns
     -------
     l, ldot, lddot : ndarray, shape (..., 3)
-        m, m/s, m/s^2.
     """
     check_params(leg, SphericalLeg, "leg")
     qa, qda, qdda = _check_state(q, qd, qdd)

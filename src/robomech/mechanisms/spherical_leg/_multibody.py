@@ -1,11 +1,5 @@
-"""The spherical parallel leg described generically (``robomech.multibody``), from its parameters.
-
-Central chain 0: hinges ``alpha`` (X) and ``beta`` (turned Y) at O (paper 1, eq. (1)); leg i: a
-universal joint at A_i (``u{i}a`` about ``leg.cardan_axes[i]``, then ``u{i}b``), the upper body sliding
-along the leg (qpos of ``l{i}`` = length - home length) and a point closure at B_i; legs 1 and 3 carry
-the lead screw, coupled to the stroke at 2 pi / lead (``screw_spin``).  Inertias as in ``_params.py``.
-The tests compare it with the closed forms of ``_kinematics.py`` to 1e-10.
-"""
+"""The spherical parallel leg described generically (``robomech.multibody``), from its parameters: chains,
+joints and closures in docs/mechanisms/spherical_leg.md, "Generic description"."""
 
 from __future__ import annotations
 

@@ -71,13 +71,10 @@ class BranchTrack:
         Which closed-form solution the motion is on (0 or 1); -1 where not valid.
     separation : ndarray, shape (..., N)
         Angle between the two solutions (rad); 0 on the singular curve.
-    meeting : ndarray of bool, shape (..., N)
-        Samples where the branches meet (within the sampling, see ``MEET_STEP_FACTOR``), i.e. where the
-        tracker had to choose.
-    switched : ndarray of bool, shape (..., N)
-        The meetings where the motion changed branch.
-    ambiguous : ndarray of bool, shape (..., N)
-        The meetings where the samples do not tell a crossing from a touch (see ``AMBIGUITY_RATIO``).
+    meeting, switched, ambiguous : ndarray of bool, shape (..., N)
+        Samples where the branches meet (within the sampling, ``MEET_STEP_FACTOR``) and the tracker had to
+        choose; those where the motion changed branch; those where the samples do not tell a crossing from
+        a touch (``AMBIGUITY_RATIO``).
     """
 
     alpha: np.ndarray
