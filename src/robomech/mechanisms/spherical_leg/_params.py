@@ -31,16 +31,13 @@ class LegBody:
     ----------
     name : str
         Label used in error messages (e.g. ``"screw"``).
-    length : float
-        Length along the leg axis (m, > 0).
-    width : float
-        Outer diameter (round) or side (square) of the section (m, > 0).
-    wall : float
-        Wall thickness of the section (m, > 0; ``>= width / 2``: solid).
+    length, width, wall : float
+        Length along the leg axis, outer diameter (round) or side (square) of the section, and its wall
+        thickness (``>= width / 2``: solid); m, > 0.
     mass : float
         Mass (kg, >= 0).
     shape : {"round", "square"}, optional
-        Section shape: cylinder of outer diameter ``width`` or square section of side ``width``.
+        Section shape.
     """
 
     name: str
@@ -79,27 +76,25 @@ class LegBody:
 
 @dataclass(frozen=True)
 class SphericalLeg:
-    """Frozen parameters of the spherical parallel leg (SI units, radians).
+    """Frozen parameters of the spherical parallel leg (SI units, radians); defaults and their sources (the
+    leg stroke is not printed): docs/mechanisms/spherical_leg.md, "Parameters".
 
     Parameters
     ----------
     R, r, h : float
-        Radii OA_i, PB_i of the base and platform joint circles and distance OP at the home pose (m);
-        paper: 75, 30, 100 mm.
-    platform_side, platform_thickness : float
-        Side and thickness of the box-shaped platform (m); paper: 60 mm, 20 mm.
-    platform_mass : float
-        Platform mass (kg, >= 0); paper: 5 kg.
+        Radii OA_i, PB_i of the base and platform joint circles and distance OP at the home pose (m).
+    platform_side, platform_thickness, platform_mass : float
+        The box-shaped platform's side and thickness (m) and mass (kg, >= 0).
     lower, upper : tuple of LegBody
         The lower (starting at A_i) and upper (ending at B_i) body of legs 1, 2, 3.
     screw_lead : float
-        Lead of the helical joints of legs 1 and 3 (m per turn); paper: 10 mm.
+        Lead of the helical joints of legs 1 and 3 (m per turn).
     screw_spin : bool
         Whether the screw (lower body of legs 1, 3) spins relative to the sleeve at 2 pi ldot / screw_lead.
     length_min, length_max : float
-        Leg stroke limits (m), ``length_max > length_min >= 0``; not printed (30 mm, 170 mm).
+        Leg stroke limits (m), ``length_max > length_min >= 0``.
     gravity : tuple of float
-        Gravitational acceleration in the base frame (m/s^2); paper: (0, 0, -10).
+        Gravitational acceleration in the base frame (m/s^2).
     """
 
     R: float = 75 * _MM
