@@ -43,12 +43,8 @@ class JointMotion:
 
 @carries_failed_rows({"q": 1, "qd": 1, "qdd": 1})
 def joint_motion(leg: OmniLeg, q: object, qd: object, qdd: object) -> JointMotion:
-    """All tree-joint angles, rates and accelerations for the motion ``(q, q̇, q̈)`` of ``(α, β, γ)``.
-
-    Thigh: θ11 = β, θ12 = atan(tan α cos β), θ13 = -θ12, θ14 = -β; θ21 = α, θ22 = -atan(tan β cos α),
-    θ23 = -θ22; θ31 = -β, θ32 = -θ12, θ33 = θ12 (the closure, eqs. (8), (12)).  Drive: with the rod
-    direction u, the shaft arm a1 = Rz(γ) e_y and the rod arm a2 = (a1 × u)/|a1 × u|,
-    φ1 = atan2((Rz(γ) e_x)·(a2 × a1), (Rz(γ) e_x)·a2), φ2 = atan2((a2 × a1)·(u × a2), a1·(u × a2)).
+    """All tree-joint angles, rates and accelerations for the motion ``(q, q̇, q̈)`` of ``(α, β, γ)`` (the
+    formulas: docs/mechanisms/omnileg.md, "Generic description").
 
     Parameters
     ----------

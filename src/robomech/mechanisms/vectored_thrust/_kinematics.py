@@ -614,8 +614,8 @@ def inverse_kinematics(th: VectoredThruster, s: object) -> IKResult:
     return _chunked(_ik, th, as_array(s, "s", (3,)))
 
 
-def _solve3(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Cramer's rule for ``[c0 c1 c2] x = b`` batched over (..., 3) columns; returns x and the determinant."""
+def _solve3(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cramer's rule for ``[c0 c1 c2] x = b`` batched over (..., 3) columns."""
     det = np.sum(c0 * np.cross(c1, c2), axis=-1)
     safe = np.where(det != 0, det, 1.0)
     x = np.stack(
@@ -626,7 +626,7 @@ def _solve3(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray, b: np.ndarray) -> tu
         ],
         axis=-1,
     )
-    return x / safe[..., None], det
+    return x / safe[..., None]
 
 
 def _rates(ax: JointAxes, qd: np.ndarray) -> np.ndarray:
@@ -636,8 +636,7 @@ def _rates(ax: JointAxes, qd: np.ndarray) -> np.ndarray:
     paper 5, eq. (17): the printed rates violate this closure; these satisfy it.
     """
     b = qd[..., 0:1] * ax.s11 - qd[..., 1:2] * ax.s21
-    x, _ = _solve3(ax.s22, -ax.s12, -ax.s13, b)
-    return x
+    return _solve3(ax.s22, -ax.s12, -ax.s13, b)
 
 
 @carries_failed_rows({"q": 1})
@@ -815,12 +814,12 @@ def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: objec
     lie_rrr = lie_bracket(V11, V12) + lie_bracket(V11 + V12, V13)
     lie_rr = lie_bracket(V21, V22)
     b = qdd[..., 0:1] * ax.s11 - qdd[..., 1:2] * ax.s21 + lie_rrr[..., :3] - lie_rr[..., :3]
-    acc, _ = _solve3(ax.s22, -ax.s12, -s13, b)
+    acc = _solve3(ax.s22, -ax.s12, -s13, b)
     omega = qd[..., 1:2] * ax.s21 + r[..., 0:1] * ax.s22
     omega_dot = qdd[..., 1:2] * ax.s21 + acc[..., 0:1] * ax.s22 + lie_rr[..., :3]
     # velocity-product part: omega' with qdd = 0
     b0 = lie_rrr[..., :3] - lie_rr[..., :3]
-    acc0, _ = _solve3(ax.s22, -ax.s12, -s13, b0)
+    acc0 = _solve3(ax.s22, -ax.s12, -s13, b0)
     vp = acc0[..., 0:1] * ax.s22 + lie_rr[..., :3]
     valid = np.broadcast_to(ax.valid, batch)  # the mask has the batch of every argument
     m = valid[..., None]
