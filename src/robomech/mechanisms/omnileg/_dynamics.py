@@ -1,10 +1,6 @@
-"""Rigid-body dynamics of the OmniLeg (paper 2's Lagrange model): M(q) q̈ + V(q, q̇) + G(q) = τ + Jᵀ F,
-and the static force maps.
-
-The 22 bodies are placed by closed-form kinematics of the solved closure, evaluated as jets
-(``_jet.py``); the Newton-Euler equations of every body projected on q give the motor torques.  Model,
-bodies and departures from the print: docs/mechanisms/omnileg.md.
-"""
+"""Rigid-body dynamics of the OmniLeg (paper 2's Lagrange model ``M q̈ + V + G = τ + Jᵀ F``) and the static
+force maps: the 22 bodies placed by the solved closure as jets (``_jet.py``), each body's Newton-Euler
+equations projected on q (docs/mechanisms/omnileg.md, "Dynamics model")."""
 
 from __future__ import annotations
 

@@ -1,9 +1,6 @@
-"""Foot kinematics of the OmniLeg: eq. (11) forward, the corrected eq. (13) inverse, Jacobian, Hessian.
-
-The knee is ``L1 u``, ``u = w / |w|``, ``w = (sin β cos α, -cos β sin α, cos β cos α)`` (eq. (9)/(11)
-multiplied through by cos α cos β: not mirrored beyond 90°, docs/mechanisms/omnileg.md); the shank adds
-``(0, 0, L5 + 2 L4 cos γ)`` (eq. (10)).  ``q = (α, β, γ)`` (rad) throughout.
-"""
+"""Foot kinematics of the OmniLeg: eq. (11) forward (the knee ``L1 w/|w|``, not mirrored beyond 90°), the
+corrected eq. (13) inverse, Jacobian, Hessian; ``q = (α, β, γ)`` (rad) throughout (docs/mechanisms/omnileg.md,
+"Beyond 90°" and "Departures")."""
 
 from __future__ import annotations
 

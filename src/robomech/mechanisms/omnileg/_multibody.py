@@ -1,7 +1,5 @@
-"""The OmniLeg described generically (``robomech.multibody``): the analytic model's 22 bodies and tree
-joints, closures and gear couplings, body by body in docs/mechanisms/omnileg.md, "Generic description";
-the tests compare it with the analytic model.
-"""
+"""The OmniLeg described generically (``robomech.multibody``): the analytic model's 22 bodies, tree joints,
+closures and gear couplings, body by body in docs/mechanisms/omnileg.md, "Generic description"."""
 
 from __future__ import annotations
 

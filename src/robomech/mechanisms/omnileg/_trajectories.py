@@ -1,7 +1,5 @@
-"""The test trajectories of paper 2, eqs. (51)-(53), built from :mod:`robomech.trajectory`; the foot
-displacements are read as X, Y along X0, Y0 and Z a lift from :func:`start_point`
-(docs/mechanisms/omnileg.md, departures 10-12).
-"""
+"""The test trajectories of paper 2, eqs. (51)-(53), built from :mod:`robomech.trajectory`: foot displacements
+X, Y along X0, Y0 and a lift Z from :func:`start_point` (docs/mechanisms/omnileg.md, departures 10-12)."""
 
 from __future__ import annotations
 

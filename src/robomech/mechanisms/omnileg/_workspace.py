@@ -1,8 +1,6 @@
-"""Foot workspace and singularity map of the OmniLeg over the joint ranges of Table 2 (paper 2).
-
-The workspace is the vertical sweep of the knee's sphere patch over the shank's stroke; the Jacobian is
-singular only where γ = 0; Section 1's symmetry claim is tested per sample (docs/mechanisms/omnileg.md).
-"""
+"""Foot workspace and singularity map of the OmniLeg over Table 2's joint ranges (paper 2): the knee's sphere
+patch swept by the shank's stroke, singular only where γ = 0, and Section 1's symmetry claim tested per
+sample (docs/mechanisms/omnileg.md)."""
 
 from __future__ import annotations
 

@@ -1,8 +1,6 @@
-"""Position, velocity and acceleration kinematics of the spherical parallel leg (paper 1, Sections 3-4).
-
-Squared leg lengths ``l_i^2 = K - 2R (...)``, ``K = R^2 + r^2 + h^2``: l1, l2 fix beta alone and l3
-then fixes alpha (docs/mechanisms/spherical_leg.md, "Frames, signs, units" and "Departures").
-"""
+"""Position, velocity and acceleration kinematics of the spherical parallel leg (paper 1, Sections 3-4):
+l1, l2 fix beta alone and l3 then fixes alpha (docs/mechanisms/spherical_leg.md, "Frames, signs, units"
+and "Departures")."""
 
 from __future__ import annotations
 

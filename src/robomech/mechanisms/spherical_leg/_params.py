@@ -1,7 +1,5 @@
-"""Parameters of the 2RUHU-RUPR-RUR spherical parallel leg (paper 1, Tables 1-2), in SI units.
-
-Geometry, inertial model and the justification of every value: docs/mechanisms/spherical_leg.md.
-"""
+"""Parameters of the 2RUHU-RUPR-RUR spherical parallel leg (paper 1, Tables 1-2), in SI units; geometry,
+inertial model and the justification of every value: docs/mechanisms/spherical_leg.md."""
 
 from __future__ import annotations
 

@@ -1,9 +1,6 @@
-"""Forward kinematics along a trajectory of leg lengths that keeps its assembly branch (continuation).
-
-Both closed-form branches are solved per sample; where they meet (on the actuation-singular curve) the
-signed distance from the curve is fitted with a *crossing* (the branch changes) and a *touch* (it is
-kept) and the better fit decides (docs/mechanisms/spherical_leg.md, "Branch tracking").
-"""
+"""Forward kinematics along a trajectory of leg lengths that keeps its assembly branch: where the two
+closed-form branches meet, a crossing and a touch are fitted to the signed distance from the singular
+curve and the better fit decides (docs/mechanisms/spherical_leg.md, "Branch tracking")."""
 
 from __future__ import annotations
 

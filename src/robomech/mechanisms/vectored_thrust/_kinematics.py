@@ -1,8 +1,6 @@
-"""Position, velocity and acceleration kinematics of the RRR-RR vectored thruster (paper 5, Section 3).
-
-``q = (q1, q2)`` (rad): the RRR input about X and the RR input about Y; axes, closure and the closed form
-``R = Ry(q2) Rx(-theta)``: docs/mechanisms/vectored_thrust.md.  Singular where s22 and s12 are parallel.
-"""
+"""Position, velocity and acceleration kinematics of the RRR-RR vectored thruster (paper 5, Section 3):
+``q = (q1, q2)`` (rad), inputs about X (RRR) and Y (RR); axes, closure, ``R = Ry(q2) Rx(-theta)`` and the
+singularity (s22 parallel to s12): docs/mechanisms/vectored_thrust.md."""
 
 from __future__ import annotations
 

@@ -1,9 +1,6 @@
-"""Workspace, singularity and dexterity maps of the vectored thruster over its inputs (paper 5, Section 4).
-
-Singular where the passive axes are parallel (:func:`singular_points`) and where input 1 is idle
-(:func:`idle_input_curve`); paper 5, eq. (35)'s "no singularity" tests the wrong matrix
-(docs/mechanisms/vectored_thrust.md, "Departures").
-"""
+"""Workspace, singularity and dexterity maps of the vectored thruster over its inputs (paper 5, Section 4);
+paper 5, eq. (35)'s "no singularity" tests the wrong matrix (docs/mechanisms/vectored_thrust.md,
+"Departures")."""
 
 from __future__ import annotations
 
