@@ -52,25 +52,10 @@ DYN_CHUNK = 32768
 
 def _body_list() -> list[tuple[str, str]]:
     """(instance name, parameter key) of the 22 bodies, in a fixed order."""
-    out = []
-    for k in range(3):
-        out += [
-            (f"hip_cross_{k + 1}", "hip_cross"),
-            (f"thigh_rod_{k + 1}", "thigh_rod"),
-            (f"knee_cross_{k + 1}", "knee_cross"),
-        ]
-    out += [
-        ("knee_plate", "knee_plate"),
-        ("drive_shaft_in", "drive_shaft_in"),
-        ("drive_cross_a", "drive_cross"),
-        ("drive_rod", "drive_rod"),
-        ("drive_cross_b", "drive_cross"),
-        ("drive_shaft_out", "drive_shaft_out"),
-    ]
-    for i in range(3):
-        out += [(f"crank_{i + 1}", "crank"), (f"coupler_{i + 1}", "coupler")]
-    out.append(("foot", "foot"))
-    return out
+    thigh = [(f"{b}_{k + 1}", b) for k in range(3) for b in ("hip_cross", "thigh_rod", "knee_cross")]
+    drive = ["knee_plate", "drive_shaft_in", "drive_cross_a", "drive_rod", "drive_cross_b", "drive_shaft_out"]
+    shank = [(f"{b}_{i + 1}", b) for i in range(3) for b in ("crank", "coupler")]
+    return [*thigh, *((n, n.removesuffix("_a").removesuffix("_b")) for n in drive), *shank, ("foot", "foot")]
 
 
 BODY_NAMES = tuple(name for name, _ in _body_list())
@@ -100,14 +85,8 @@ def _poses(
 ) -> list[tuple[Cols, jt.Jet | np.ndarray]]:
     """(columns of R_b, o_b) of every body as jets, in the order of BODY_NAMES; ``q, qd, qdd (N, 3)``."""
     alpha, beta, gamma = jt.Jet.variables(q, qd, qdd)
-    ca, sa, cb, sb, cg, sg = (
-        jt.cos(alpha),
-        jt.sin(alpha),
-        jt.cos(beta),
-        jt.sin(beta),
-        jt.cos(gamma),
-        jt.sin(gamma),
-    )
+    ca, sa, cb, sb = jt.cos(alpha), jt.sin(alpha), jt.cos(beta), jt.sin(beta)
+    cg, sg = jt.cos(gamma), jt.sin(gamma)
     # thigh direction, eq. (9) / L1 multiplied through by cos α cos β (not mirrored beyond 90°, _kinematics)
     cbsa, cbca = cb * sa, cb * ca
     inv_n = jt.reciprocal(jt.sqrt(ca * ca + cbsa * cbsa))

@@ -1,8 +1,6 @@
 """Rigid-body inverse dynamics of the spherical parallel leg (Kane's equations on q = (alpha, beta)) and
-its redundant force distribution ``J^T f = tau``, replacing paper 1, eqs. (19)-(28) (errata, assumptions
-and the Cardan spin: docs/mechanisms/spherical_leg.md).  ``paper_as_printed=True`` drops the spin that
-the base universal joints impose on the legs (eq. (23) has none), for comparison only.
-"""
+its redundant force distribution ``J^T f = tau``, replacing paper 1, eqs. (19)-(28) (errata, assumptions,
+the Cardan spin that ``paper_as_printed=True`` drops: docs/mechanisms/spherical_leg.md)."""
 
 from __future__ import annotations
 
