@@ -99,11 +99,7 @@ def _poses(
     x2 = jt.stack([zero, -ca, -sa])  # Rx(α) (-e_y)
     x_axes = [x1, x2, -x1]
     y_axes = [np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 0.0]), np.array([0.0, -1.0, 0.0])]
-    A_pts = [
-        np.array([0.0, leg.L3, 0.0]),
-        np.array([leg.L3, 0.0, 0.0]),
-        np.array([0.0, -leg.L3, 0.0]),
-    ]  # eq. (7)
+    A_pts = [np.array(a) for a in ((0.0, leg.L3, 0.0), (leg.L3, 0.0, 0.0), (0.0, -leg.L3, 0.0))]  # eq. (7)
     out: list[tuple[Cols, jt.Jet | np.ndarray]] = []
     for k in range(3):
         xk = x_axes[k]
