@@ -251,9 +251,7 @@ def mass_matrix(leg: SphericalLeg, q: object, *, paper_as_printed: bool = False)
     zero_g = replace(leg, gravity=(0.0, 0.0, 0.0))
     cols = []
     for j in range(2):
-        e = np.zeros(2)
-        e[j] = 1.0
-        mo = _motion(zero_g, qa, np.zeros_like(qa), np.broadcast_to(e, qa.shape), cardan)
+        mo = _motion(zero_g, qa, np.zeros_like(qa), np.broadcast_to(np.eye(2)[j], qa.shape), cardan)
         cols.append(_generalized(zero_g, mo, None))
     return np.stack(cols, -1)
 
