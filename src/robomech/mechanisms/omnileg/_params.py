@@ -10,6 +10,7 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from robomech._validation import as_array, check_positive, check_real
+from robomech.dynamics import _check_inertia
 
 __all__ = ["BodySet", "OmniLeg", "RigidBody", "default_bodies"]
 
@@ -18,8 +19,6 @@ RHO_ALUMINIUM = 2700.0
 RHO_STEEL = 7850.0
 # Standard gravity, m/s^2.
 STANDARD_GRAVITY = 9.80665
-# Inertia matrices must be symmetric to this relative tolerance (rounding of user input).
-INERTIA_SYMMETRY_RTOL = 1e-9
 # Principal moments may violate the triangle inequality by this relative amount (rounding only).
 TRIANGLE_RTOL = 1e-9
 
@@ -53,14 +52,12 @@ class RigidBody:
             raise ValueError(
                 f"Expected RigidBody.inertia to be a finite 3x3 matrix, got shape {inertia.shape}."
             )
-        scale = max(float(np.abs(inertia).max()), 1e-300)
-        if np.abs(inertia - inertia.T).max() > INERTIA_SYMMETRY_RTOL * scale:
-            raise ValueError("Expected RigidBody.inertia to be symmetric, got an asymmetric matrix.")
+        _check_inertia(inertia, "RigidBody.inertia")  # symmetric, positive semidefinite (to rounding)
         ev = np.linalg.eigvalsh(inertia)
-        if ev[0] < 0 or ev[0] + ev[1] < ev[2] * (1 - TRIANGLE_RTOL):
+        if ev[0] + ev[1] < ev[2] * (1 - TRIANGLE_RTOL):
             raise ValueError(
-                f"Expected RigidBody.inertia positive semidefinite with principal moments obeying the "
-                f"triangle inequality, got principal moments {ev.tolist()}."
+                f"Expected RigidBody.inertia's principal moments to obey the triangle inequality, got "
+                f"{ev.tolist()}."
             )
         object.__setattr__(self, "mass", m)
         object.__setattr__(self, "com", tuple(float(v) for v in c))
