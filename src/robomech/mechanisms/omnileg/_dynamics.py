@@ -209,11 +209,8 @@ def _terms(
             continue
         # bodies turning together (a U-joint's two crosses, the drive's two crosses and two shafts) share
         # one set of columns: their rotational terms are linear in the inertia, so sum the inertias
-        key_cols = id(cols)
-        if key_cols in groups:
-            groups[key_cols] = (cols, groups[key_cols][1] + body.inertia_matrix)
-        else:
-            groups[key_cols] = (cols, body.inertia_matrix)
+        prev = groups.get(id(cols))
+        groups[id(cols)] = (cols, body.inertia_matrix if prev is None else prev[1] + body.inertia_matrix)
     ez = np.array([0.0, 0.0, 1.0])
     rot = [(c, i, False) for c, i in groups.values()] + [(c, i, True) for c, i in spun.values()]
     for cols, Iner, spin in rot:
