@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from robomech._batching import carries_failed_rows, chunked, on_rows, slices
+from robomech._batching import carries_failed_rows, chunked, chunked_rows, on_rows, slices
 from robomech._validation import as_array
 
 
@@ -29,6 +29,16 @@ X = np.random.default_rng(0).normal(size=(23, 3))
 
 def _pair(s: slice) -> _Pair:
     return _Pair(np.sin(X[s]), (X[s, 0] > 0))
+
+
+@pytest.mark.parametrize("chunk", [1, 5, 23, 100])
+@pytest.mark.parametrize("batch", [(24,), (4, 6), (2, 3, 4), (0, 2)])
+def test_chunked_rows_gives_the_whole_batch_result_back_in_the_input_batch_shape(chunk, batch):
+    x = np.random.default_rng(1).normal(size=(*batch, 3))
+    got = chunked_rows(lambda r: _Pair(np.cross(r, [0.0, 0.0, 1.0]), r[:, 0] > 0), x, chunk)
+    assert isinstance(got, _Pair) and got.a.shape == (*batch, 3) and got.b.shape == batch
+    np.testing.assert_array_equal(got.a, np.cross(x, [0.0, 0.0, 1.0]))
+    np.testing.assert_array_equal(got.b, x[..., 0] > 0)
 
 
 @given(n=st.integers(0, 23), chunk=st.integers(1, 30))

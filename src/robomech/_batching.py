@@ -24,9 +24,10 @@ import numpy as np
 
 from robomech._validation import as_array, broadcast_batch
 
-__all__ = ["carries_failed_rows", "chunked", "failed_rows", "on_rows", "slices"]
+__all__ = ["carries_failed_rows", "chunked", "chunked_rows", "failed_rows", "on_rows", "slices"]
 
 F = TypeVar("F", bound=Callable[..., Any])
+R = TypeVar("R")
 
 
 def slices(n: int, chunk: int) -> Iterator[slice]:
@@ -96,6 +97,15 @@ def chunked(fn: Callable[[slice], Any], n: int, chunk: int) -> Any:
         for o, a in zip(outs, _leaves(fn(s)), strict=True):
             o[s] = a
     return _rebuild(first, outs)
+
+
+def chunked_rows(kernel: Callable[[np.ndarray], R], x: np.ndarray, chunk: int) -> R:
+    """:func:`chunked` over the samples of ``x (..., k)``: ``kernel(rows)`` on blocks of at most ``chunk``
+    rows ``(m, k)``, every per-sample array of the result (an array, tuple or dataclass of them) given
+    ``x``'s batch shape back."""
+    batch, flat = x.shape[:-1], x.reshape(-1, x.shape[-1])
+    r = chunked(lambda s: kernel(flat[s]), flat.shape[0], chunk)
+    return _rebuild(r, [a.reshape(batch + a.shape[1:]) for a in _leaves(r)])
 
 
 def failed_rows(a: np.ndarray, n_core: int = 1) -> np.ndarray:

@@ -11,6 +11,7 @@ QR.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -186,6 +187,25 @@ def _damped_svd_solve(
     den = s * s + lam * lam
     coef = np.where(weak, s / np.where(den > 0, den, 1.0), 1.0 / np.where(weak, 1.0, s))
     return np.einsum("...ji,...j->...i", Vt, coef * np.einsum("...ji,...j->...i", U, b))
+
+
+def _damped_inverse(
+    A: np.ndarray, *, rtol: float = 0.0, atol: float = 0.0, damping: float
+) -> tuple[np.ndarray, Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]]:
+    """The mechanisms' damped rate and force inversion: the SVD of each ``A (..., m, n)`` once, and
+    ``solve(b) -> (x, |A x - b|)`` by :func:`_damped_svd_solve` on it, the directions with
+    ``σ < rtol σ_max + atol`` damped by ``λ = damping σ_max``.  Also returns the singular values
+    (descending)."""
+    U, s, Vt = np.linalg.svd(A, full_matrices=False)
+    smax = s[..., :1]
+    weak = s < rtol * smax + atol
+    lam = damping * smax
+
+    def solve(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        x = _damped_svd_solve(U, s, Vt, b, lam, weak)
+        return x, np.linalg.norm(np.einsum("...ij,...j->...i", A, x) - b, axis=-1)
+
+    return s, solve
 
 
 def rank_cond_limit(m: int, n: int) -> float:

@@ -1,9 +1,6 @@
-"""Paper 2: the OmniLeg serial-parallel leg (3-UU double-parallel thigh + 3-RRR crank-slider shank).
-
-Joint coordinates ``q = (α, β, γ)`` (rad): α turns chain 2 about X0, β turns chain 1 about Y0, γ is the
-crank angle of the shank (motor M3).  The hip frame's Z0 points down, toward the foot.  See
-``docs/mechanisms/omnileg.md`` for frames, assumptions and every departure from the printed paper.
-"""
+"""Paper 2: the OmniLeg serial-parallel leg (3-UU double-parallel thigh + 3-RRR crank-slider shank); joints
+``q = (α, β, γ)`` (rad), hip frame with Z0 toward the foot, every assumption and departure from the printed
+paper: ``docs/mechanisms/omnileg.md``."""
 
 from ._chains import ShankResult, ThighClosure, chain_screws, shank_crank_slider, shank_frames, thigh_closure
 from ._dynamics import (

@@ -1,15 +1,5 @@
-"""The thigh as three UU chains closed by the product of exponentials, and the shank crank-slider.
-
-Thigh (paper 2, eqs. (1)-(8)): chain k's joint screws are those of chain 1 rotated by
-``kR = [[cos δ, sin δ, 0], [-sin δ, cos δ, 0], [0, 0, 1]]`` with δ = (k - 1) π/2 (eq. (5); this is
-Rz(-δ), and taken literally it yields the signs of eqs. (9) and (11)).  Chain 1's actuated joint θ11 = β
-(about Y0 through A1), chain 2's θ21 = α (about X0 through A2); the other ten joint angles are passive
-and are found by assembling the thigh's description on the engine (``robomech.multibody``), independently
-of the closed form; the closure ``T1 = T2 = T3`` (eq. (8)) is then checked by the product of exponentials.
-
-Shank (paper 2, eq. (10), Fig. 4e): each chain C_iD_iE_i is a centred crank-slider with crank C_iD_i
-and coupler D_iE_i of equal length L4 and the slider E_i moving along Z0 directly below C_i.
-"""
+"""The thigh as three UU chains (paper 2, eqs. (1)-(8)) assembled on the engine and checked by the
+product of exponentials, and the shank's centred crank-slider (eq. (10), Fig. 4e)."""
 
 from __future__ import annotations
 
@@ -47,9 +37,8 @@ TRANSLATION_ONLY_TOL = 1e-12
 
 
 def chain_screws(leg: OmniLeg) -> tuple[np.ndarray, np.ndarray]:
-    """Space screws of the three UU chains at the home pose, (3, 4, 6), and their home pose M (4, 4).
-
-    Paper 2, eqs. (1)-(7): chain 1's screws rotated by ``kR`` (eq. (5)) for chains 2 and 3.
+    """Space screws of the three UU chains at the home pose and the knee plate's home pose (eqs. (1)-(7):
+    chain 1's screws rotated by ``kR = Rz(-δ)``, δ = (k - 1) π/2, eq. (5) as printed).
 
     Parameters
     ----------
@@ -79,14 +68,11 @@ class ThighClosure:
         Joint angles of the three chains (rad), ``theta[..., k, i] = θ_{k+1, i+1}``.
     T_knee : ndarray, shape (..., 4, 4)
         Knee-plate pose ``T_O0 O0'`` (m), chain 1's product of exponentials.
-    residual : ndarray, shape (...)
-        Largest component of the closure twists ``log(T_k T_1^-1)`` (rad or m).
-    converged : ndarray of bool, shape (...)
-        The closure holds: ``residual <= 10 CLOSURE_TOL``.
-    rotation_error : ndarray, shape (...)
-        Rotation angle of the knee plate (rad); zero for an exact closure.
-    translation_only : ndarray of bool, shape (...)
-        ``converged & (rotation_error <= TRANSLATION_ONLY_TOL)``.
+    residual, rotation_error : ndarray, shape (...)
+        Largest component of the closure twists ``log(T_k T_1^-1)`` (rad or m); rotation angle of the knee
+        plate (rad), zero for an exact closure.
+    converged, translation_only : ndarray of bool, shape (...)
+        ``residual <= 10 CLOSURE_TOL``; ``converged & (rotation_error <= TRANSLATION_ONLY_TOL)``.
     iterations : int
         The engine's assembly iterations (largest over the samples).
     knee : ndarray, shape (..., 3)
@@ -117,15 +103,14 @@ def _closure_residual(S: np.ndarray, M: np.ndarray, theta: np.ndarray) -> tuple[
 def thigh_closure(leg: OmniLeg, alpha: object, beta: object) -> ThighClosure:
     """Solve the closure T1 = T2 = T3 (eq. (8)) for the passive joints, given α = θ21 and β = θ11.
 
-    The thigh's description is assembled by :func:`robomech.multibody.forward_kinematics` from the home
-    pose in ``CLOSURE_STAGES`` stages; the cut joints θ24, θ34 follow from the knee plate's rotation, and
-    the residual is that of the product of exponentials of all three chains.
+    Assembled by :func:`robomech.multibody.forward_kinematics` from the home pose in ``CLOSURE_STAGES``
+    stages; the residual is that of the product of exponentials of all three chains.
 
     Parameters
     ----------
     leg : OmniLeg
     alpha, beta : array_like, shape (...)
-        Active angles α = θ21 and β = θ11 (rad); broadcast together.
+        Active angles (rad); broadcast together.
 
     Returns
     -------
@@ -134,8 +119,8 @@ def thigh_closure(leg: OmniLeg, alpha: object, beta: object) -> ThighClosure:
     Examples
     --------
     >>> c = thigh_closure(OmniLeg.paper(), 0.3, -0.2)
-    >>> bool(c.converged), bool(c.translation_only), c.theta.shape
-    (True, True, (3, 4))
+    >>> bool(c.converged), bool(c.translation_only)
+    (True, True)
     """
     check_params(leg, OmniLeg, "leg")
     a = as_array(alpha, "alpha")
@@ -187,12 +172,9 @@ class ShankResult:
     ----------
     C, D, E : ndarray, shape (..., 3, 3)
         Joint points of chains i = 1..3 as ``C[..., i - 1, :]`` (m, knee-plate frame).
-    slider : ndarray, shape (...)
-        Depth of the E plane below the C plane (m).
-    coupler_angle : ndarray, shape (...)
-        Coupler angle from Z0' (rad, sign opposite to the crank).
-    delta_L2 : ndarray, shape (...)
-        Shank shortening ``2 L4 - slider`` (m, eq. (10)).
+    slider, coupler_angle, delta_L2 : ndarray, shape (...)
+        Depth of the E plane below the C plane (m); coupler angle from Z0' (rad, opposite to the crank);
+        shank shortening ``2 L4 - slider`` (m, eq. (10)).
     valid : ndarray of bool, shape (...)
         ``|γ| < π/2``; beyond it the chain folds flat and D, E, slider are NaN.
     """
@@ -207,9 +189,8 @@ class ShankResult:
 
 
 def shank_frames(leg: OmniLeg) -> np.ndarray:
-    """Rotations S_i (3, 3, 3) of the shank chain frames: x radial outward along the C_i axis, z = Z0'.
-
-    Chain i's frame is turned by ``shank_azimuth + 2π (i - 1)/3`` about Z0'.
+    """Rotations ``S[i - 1]`` of the shank chain frames in the knee-plate frame: x radial along the C_i
+    axis, z = Z0', chain i turned by ``shank_azimuth + 2π (i - 1)/3``.
 
     Parameters
     ----------
@@ -218,7 +199,6 @@ def shank_frames(leg: OmniLeg) -> np.ndarray:
     Returns
     -------
     ndarray, shape (3, 3, 3)
-        ``S[i - 1]``: rotation of chain i's frame in the knee-plate frame.
     """
     check_params(leg, OmniLeg, "leg")
     return _shank_frames(leg.shank_azimuth)
@@ -236,10 +216,8 @@ def _shank_frames(azimuth: float) -> np.ndarray:
 
 @carries_failed_rows({"gamma": 0})
 def shank_crank_slider(leg: OmniLeg, gamma: object) -> ShankResult:
-    """Centred crank-slider of each shank chain for crank angle ``gamma`` (...), rad (valid for |γ| < π/2).
-
-    Crank C_iD_i turns by γ about the radial axis X_Ci; the slider position below C_i is the crank-slider
-    law ``s = r cos γ + sqrt(l² - (r sin γ)²)`` with r = l = L4, i.e. 2 L4 cos γ (eq. (10)).
+    """Centred crank-slider of each shank chain: ``s = r cos γ + sqrt(l² - (r sin γ)²)``, r = l = L4,
+    i.e. 2 L4 cos γ (eq. (10)).
 
     Parameters
     ----------
@@ -250,13 +228,6 @@ def shank_crank_slider(leg: OmniLeg, gamma: object) -> ShankResult:
     Returns
     -------
     :class:`ShankResult`
-
-    Examples
-    --------
-    >>> leg = OmniLeg.paper()
-    >>> r = shank_crank_slider(leg, 0.0)
-    >>> bool(np.isclose(r.slider, 2 * leg.L4)), bool(r.valid)
-    (True, True)
     """
     check_params(leg, OmniLeg, "leg")
     g_in = as_array(gamma, "gamma")

@@ -1,20 +1,6 @@
-"""Rigid-body dynamics of the OmniLeg: M(q) q̈ + V(q, q̇) + G(q) = τ + Jᵀ F, and the static force maps.
-
-Every moving body (22 of them, ``docs/mechanisms/omnileg.md``) is placed by closed-form kinematics of
-the solved closure: U-joint crosses and thigh rods of the three UU chains, the translating knee plate,
-the double-Cardan drive of the shank (input shaft, two crosses, central rod, output shaft with bevel
-gear), the three cranks and three couplers of the crank-slider shank, and the foot.  Each body's
-rotation ``R_b(q)`` and origin ``o_b(q)`` are evaluated as jets (value, first and second time derivative
-along the motion, gradient in q; ``_jet.py``), which yields exact body velocities, accelerations and
-Jacobians; the Newton-Euler equations of every body projected on q (Lagrange's equations in
-matrix form, ``τ = Σ_b J_bᵀ (G_b V̇_b - ad(V_b)ᵀ G_b V_b - gravity)``) then give the motor torques: the
-closure's constraint forces do no work on q = (α, β, γ) and drop out.
-
-Departures from the print (paper 2, Section 3): the central drive rod A4B4 is modelled with its exact
-double-Cardan kinematics instead of neglecting its non-uniform spin (the paper's simplification); the
-cross CS_B1 turns with +β̇ about Y0 (eq. (16) prints -β̇, eq. (27) uses +); potential energy is the
-scalar -m gᵀ p with g along +Z0 (eq. (44) prints m g P).
-"""
+"""Rigid-body dynamics of the OmniLeg (paper 2's Lagrange model ``M q̈ + V + G = τ + Jᵀ F``) and the static
+force maps: the 22 bodies placed by the solved closure as jets (``_jet.py``), each body's Newton-Euler
+equations projected on q (docs/mechanisms/omnileg.md, "Dynamics model")."""
 
 from __future__ import annotations
 
@@ -24,7 +10,7 @@ import numpy as np
 
 from robomech._batching import carries_failed_rows, chunked
 from robomech._validation import as_array, broadcast_batch, check_bool, check_params
-from robomech.analysis.lstsq import _damped_svd_solve
+from robomech.analysis.lstsq import _damped_inverse
 
 from . import _jet as jt
 from ._chains import _shank_frames
@@ -66,25 +52,10 @@ DYN_CHUNK = 32768
 
 def _body_list() -> list[tuple[str, str]]:
     """(instance name, parameter key) of the 22 bodies, in a fixed order."""
-    out = []
-    for k in range(3):
-        out += [
-            (f"hip_cross_{k + 1}", "hip_cross"),
-            (f"thigh_rod_{k + 1}", "thigh_rod"),
-            (f"knee_cross_{k + 1}", "knee_cross"),
-        ]
-    out += [
-        ("knee_plate", "knee_plate"),
-        ("drive_shaft_in", "drive_shaft_in"),
-        ("drive_cross_a", "drive_cross"),
-        ("drive_rod", "drive_rod"),
-        ("drive_cross_b", "drive_cross"),
-        ("drive_shaft_out", "drive_shaft_out"),
-    ]
-    for i in range(3):
-        out += [(f"crank_{i + 1}", "crank"), (f"coupler_{i + 1}", "coupler")]
-    out.append(("foot", "foot"))
-    return out
+    thigh = [(f"{b}_{k + 1}", b) for k in range(3) for b in ("hip_cross", "thigh_rod", "knee_cross")]
+    drive = ["knee_plate", "drive_shaft_in", "drive_cross_a", "drive_rod", "drive_cross_b", "drive_shaft_out"]
+    shank = [(f"{b}_{i + 1}", b) for i in range(3) for b in ("crank", "coupler")]
+    return [*thigh, *((n, n.removesuffix("_a").removesuffix("_b")) for n in drive), *shank, ("foot", "foot")]
 
 
 BODY_NAMES = tuple(name for name, _ in _body_list())
@@ -114,14 +85,8 @@ def _poses(
 ) -> list[tuple[Cols, jt.Jet | np.ndarray]]:
     """(columns of R_b, o_b) of every body as jets, in the order of BODY_NAMES; ``q, qd, qdd (N, 3)``."""
     alpha, beta, gamma = jt.Jet.variables(q, qd, qdd)
-    ca, sa, cb, sb, cg, sg = (
-        jt.cos(alpha),
-        jt.sin(alpha),
-        jt.cos(beta),
-        jt.sin(beta),
-        jt.cos(gamma),
-        jt.sin(gamma),
-    )
+    ca, sa, cb, sb = jt.cos(alpha), jt.sin(alpha), jt.cos(beta), jt.sin(beta)
+    cg, sg = jt.cos(gamma), jt.sin(gamma)
     # thigh direction, eq. (9) / L1 multiplied through by cos α cos β (not mirrored beyond 90°, _kinematics)
     cbsa, cbca = cb * sa, cb * ca
     inv_n = jt.reciprocal(jt.sqrt(ca * ca + cbsa * cbsa))
@@ -134,11 +99,7 @@ def _poses(
     x2 = jt.stack([zero, -ca, -sa])  # Rx(α) (-e_y)
     x_axes = [x1, x2, -x1]
     y_axes = [np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 0.0]), np.array([0.0, -1.0, 0.0])]
-    A_pts = [
-        np.array([0.0, leg.L3, 0.0]),
-        np.array([leg.L3, 0.0, 0.0]),
-        np.array([0.0, -leg.L3, 0.0]),
-    ]  # eq. (7)
+    A_pts = [np.array(a) for a in ((0.0, leg.L3, 0.0), (leg.L3, 0.0, 0.0), (0.0, -leg.L3, 0.0))]  # eq. (7)
     out: list[tuple[Cols, jt.Jet | np.ndarray]] = []
     for k in range(3):
         xk = x_axes[k]
@@ -252,11 +213,8 @@ def _terms(
             continue
         # bodies turning together (a U-joint's two crosses, the drive's two crosses and two shafts) share
         # one set of columns: their rotational terms are linear in the inertia, so sum the inertias
-        key_cols = id(cols)
-        if key_cols in groups:
-            groups[key_cols] = (cols, groups[key_cols][1] + body.inertia_matrix)
-        else:
-            groups[key_cols] = (cols, body.inertia_matrix)
+        prev = groups.get(id(cols))
+        groups[id(cols)] = (cols, body.inertia_matrix if prev is None else prev[1] + body.inertia_matrix)
     ez = np.array([0.0, 0.0, 1.0])
     rot = [(c, i, False) for c, i in groups.values()] + [(c, i, True) for c, i in spun.values()]
     for cols, Iner, spin in rot:
@@ -311,20 +269,16 @@ def _flat(*arrays: np.ndarray) -> tuple[tuple[int, ...], list[np.ndarray]]:
 
 @carries_failed_rows({"q": 1})
 def body_poses(leg: OmniLeg, q: object) -> tuple[np.ndarray, np.ndarray]:
-    """Body rotations ``R_b (..., 22, 3, 3)`` (in the hip frame) and mass centres ``p_b (..., 22, 3)`` (m).
+    """Body rotations and mass centres (m) in the hip frame, in the order of ``BODY_NAMES``.
 
     Parameters
     ----------
     leg : OmniLeg
     q : array_like, shape (..., 3)
-        Joint coordinates ``(α, β, γ)`` (rad).
 
     Returns
     -------
-    R : ndarray, shape (..., 22, 3, 3)
-        Rotation of each body (hip frame), in the order of ``BODY_NAMES``.
-    p : ndarray, shape (..., 22, 3)
-        Mass centre of each body (m, hip frame), in the order of ``BODY_NAMES``.
+    R, p : ndarray, shape (..., 22, 3, 3) and (..., 22, 3)
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -344,12 +298,9 @@ class DynamicsResult:
         Motor torques (N·m), α, β, γ order.
     M : ndarray, shape (..., 3, 3)
         Joint-space inertia matrix (kg m²).
-    velocity_terms : ndarray, shape (..., 3)
-        Coriolis and centrifugal torques ``V(q, q̇)`` (N·m).
-    gravity_terms : ndarray, shape (..., 3)
-        Gravity torques ``G(q)`` (N·m).
-    foot_terms : ndarray, shape (..., 3)
-        Torques ``-Jᵀ F`` of the foot force (N·m); zero when no foot force was given.
+    velocity_terms, gravity_terms, foot_terms : ndarray, shape (..., 3)
+        Coriolis and centrifugal ``V(q, q̇)``, gravity ``G(q)`` and foot-force ``-Jᵀ F`` torques (N·m; the
+        last zero without a foot force).
     """
 
     tau: np.ndarray
@@ -369,16 +320,7 @@ def inverse_dynamics(
     *,
     paper_as_printed: bool = False,
 ) -> DynamicsResult:
-    """Motor torques (α, β, γ order) for the motion (q, q̇, q̈), optionally with a force on the foot.
-
-    ``foot_force`` is ``FOOT_FORCE_CONVENTION``: the force applied *to* the foot; it enters as ``-Jᵀ F``
-    (= :func:`static_torques`).  Paper 2, eqs. (49)-(50) add ``+Jᵀ F_f`` (F_f the force the foot
-    delivers): pass ``-F_f``.
-
-    ``paper_as_printed=True`` replaces the exact double-Cardan drive by paper 2's simplification (eqs.
-    (26)-(31): the crosses CS_A4, CS_B4 and the rod A4B4 turn like chain 1's cross CS_A1, rod A1B1, cross
-    CS_B1 plus an independent spin γ̇ about Z0), for comparison only: the difference is the error the
-    paper's theory carries against its ADAMS model.
+    """Motor torques for the motion (q, q̇, q̈), optionally with a force on the foot.
 
     Parameters
     ----------
@@ -386,9 +328,10 @@ def inverse_dynamics(
     q, qd, qdd : array_like, shape (..., 3)
         Joint coordinates (rad), rates (rad/s) and accelerations (rad/s²); broadcast together.
     foot_force : array_like, shape (..., 3), optional
-        Force applied to the foot (N, hip frame); ``None`` (default) means no external force.
+        Force applied *to* the foot (N, hip frame; ``FOOT_FORCE_CONVENTION``): it enters as ``-Jᵀ F``.
+        Paper 2, eqs. (49)-(50) add ``+Jᵀ F_f``: pass ``-F_f``.
     paper_as_printed : bool, optional
-        Use paper 2's simplified Cardan drive (eqs. (26)-(31)) instead of the exact one (default False).
+        Use paper 2's simplified Cardan drive (eqs. (26)-(31)) instead of the exact one, for comparison.
 
     Returns
     -------
@@ -398,8 +341,6 @@ def inverse_dynamics(
     --------
     >>> leg = OmniLeg.paper()
     >>> r = inverse_dynamics(leg, [[0.1, 0.2, 1.0]] * 4, np.zeros(3), np.zeros(3))
-    >>> r.tau.shape, r.M.shape
-    ((4, 3), (4, 3, 3))
     >>> bool(np.allclose(r.tau, r.gravity_terms))   # at rest only gravity acts
     True
     """
@@ -432,27 +373,16 @@ def inverse_dynamics(
 
 @carries_failed_rows({"q": 1})
 def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
-    """Joint-space inertia matrix ``M(q) (..., 3, 3)`` (kg m²), symmetric positive definite.
-
-    The M(η) of paper 2, eq. (46), from the kinetic energies of eq. (44) (with the exact double-Cardan
-    drive, see the module docstring).
+    """Joint-space inertia matrix ``M(q)`` (kg m²; paper 2, eq. (46) with the exact Cardan drive).
 
     Parameters
     ----------
     leg : OmniLeg
     q : array_like, shape (..., 3)
-        Joint coordinates ``(α, β, γ)`` (rad).
 
     Returns
     -------
     ndarray, shape (..., 3, 3)
-        ``M(q)`` (kg m² on the diagonal; α, β, γ order), the kinetic energy being ``½ q̇ᵀ M q̇``.
-
-    Examples
-    --------
-    >>> M = mass_matrix(OmniLeg.paper(), [0.1, 0.2, 1.0])
-    >>> M.shape, bool(np.allclose(M, M.T)), bool(np.all(np.linalg.eigvalsh(M) > 0))
-    ((3, 3), True, True)
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -462,20 +392,16 @@ def mass_matrix(leg: OmniLeg, q: object) -> np.ndarray:
 
 @carries_failed_rows({"q": 1})
 def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
-    """``G(q) = ∂V/∂q`` (..., 3), N·m: the torques holding the leg still against gravity.
-
-    The G(η) of paper 2, eq. (46), with the potential ``-m gᵀ p`` (eq. (44) prints ``m g P``).
+    """Gravity torques ``G(q) = ∂V/∂q`` (N·m; eq. (46)): ``gravity_terms`` of :func:`inverse_dynamics`.
 
     Parameters
     ----------
     leg : OmniLeg
     q : array_like, shape (..., 3)
-        Joint coordinates ``(α, β, γ)`` (rad).
 
     Returns
     -------
     ndarray, shape (..., 3)
-        Gravity torques (N·m), α, β, γ order (``gravity_terms`` of :func:`inverse_dynamics`).
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -485,23 +411,16 @@ def gravity_torques(leg: OmniLeg, q: object) -> np.ndarray:
 
 @carries_failed_rows({"q": 1, "qd": 1})
 def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]:
-    """Kinetic ``½ q̇ᵀ M q̇`` and potential ``-Σ m_b gᵀ p_b`` energy (J), each (...).
-
-    The potential is the scalar ``-m gᵀ p`` with the hip origin as datum (paper 2, eq. (44) prints
-    ``m g P``).
+    """Kinetic ``½ q̇ᵀ M q̇`` and potential ``-Σ m_b gᵀ p_b`` energy (J), the hip origin as datum.
 
     Parameters
     ----------
     leg : OmniLeg
     q, qd : array_like, shape (..., 3)
-        Joint coordinates (rad) and rates (rad/s); broadcast together.
 
     Returns
     -------
-    kinetic : ndarray, shape (...)
-        Kinetic energy (J).
-    potential : ndarray, shape (...)
-        Potential energy (J).
+    kinetic, potential : ndarray, shape (...)
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -514,32 +433,19 @@ def energy(leg: OmniLeg, q: object, qd: object) -> tuple[np.ndarray, np.ndarray]
 
 @carries_failed_rows({"q": 1}, {"force": 1})
 def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
-    """Motor torques ``τ = -Jᵀ F`` (..., 3), N·m, holding the leg still against a foot force, gravity aside.
-
-    ``force (..., 3)`` (N, hip frame) is ``FOOT_FORCE_CONVENTION``: the force applied *to* the foot,
-    the same as ``inverse_dynamics(foot_force=F)``, whose ``foot_terms`` these torques are.  paper 2,
-    eq. (50): τ = Jᵀ F_f with F_f the force the foot delivers, F_f = -F.
+    """Motor torques ``τ = -Jᵀ F`` (N·m) holding the leg against a foot force, gravity aside: the
+    ``foot_terms`` of :func:`inverse_dynamics` (paper 2, eq. (50): τ = Jᵀ F_f, F_f = -F).
 
     Parameters
     ----------
     leg : OmniLeg
     q : array_like, shape (..., 3)
-        Joint coordinates ``(α, β, γ)`` (rad).
     force : array_like, shape (..., 3)
-        Force applied to the foot (N, hip frame); broadcasts with ``q``.
+        Force applied to the foot (N, hip frame; ``FOOT_FORCE_CONVENTION``); broadcasts with ``q``.
 
     Returns
     -------
     ndarray, shape (..., 3)
-        Motor torques (N·m), α, β, γ order.
-
-    Examples
-    --------
-    >>> leg = OmniLeg.paper()
-    >>> tau = static_torques(leg, [0.1, 0.2, 1.0], [0.0, 0.0, -10.0])
-    >>> f = foot_force_from_torques(leg, [0.1, 0.2, 1.0], tau)
-    >>> bool(np.allclose(f.force, [0.0, 0.0, -10.0]))
-    True
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,))
@@ -550,18 +456,15 @@ def static_torques(leg: OmniLeg, q: object, force: object) -> np.ndarray:
 
 @dataclass(frozen=True)
 class FootForceResult:
-    """Foot force ``(..., 3)`` (N, applied to the foot: ``FOOT_FORCE_CONVENTION``) from motor torques.
-
-    ``singular`` marks samples with ``sigma_min / sigma_max < SINGULAR_RCOND`` (γ ≈ 0): there the force is
-    the damped least-squares estimate (its component along the lost direction is not determined by the
-    torques) and ``residual = |-Jᵀ F - τ|`` is no longer zero.
+    """Foot force from motor torques (the result of :func:`foot_force_from_torques`).
 
     Attributes
     ----------
     force : ndarray, shape (..., 3)
-        Force applied to the foot (N, hip frame).
+        Force applied to the foot (N, hip frame; ``FOOT_FORCE_CONVENTION``).
     singular : ndarray of bool, shape (...)
-        True where the foot Jacobian is near singular (``rcond < SINGULAR_RCOND``).
+        ``rcond < SINGULAR_RCOND`` (γ ≈ 0): the force is the damped least-squares estimate there and
+        ``residual`` is no longer zero.
     rcond : ndarray, shape (...)
         ``sigma_min / sigma_max`` of the foot Jacobian (dimensionless).
     residual : ndarray, shape (...)
@@ -576,23 +479,16 @@ class FootForceResult:
 
 @carries_failed_rows({"q": 1}, {"tau": 1})
 def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceResult:
-    """Solve ``-Jᵀ F = τ`` for the force F applied to the foot (paper 2, eq. (47)), never by a blind inverse.
-
-    The torques are those of :func:`static_torques` (F = ``FOOT_FORCE_CONVENTION``; the paper's F_f, the
-    force the foot delivers, is -F).
-
-    Regular samples: the exact solution by SVD.  Samples with ``rcond < SINGULAR_RCOND`` are flagged and
-    their weak directions damped: ``F = Σ c_i u_i (v_iᵀ τ)`` with ``c_i = 1/σ_i`` where
-    ``σ_i >= SINGULAR_RCOND σ_max`` and ``c_i = σ_i / (σ_i² + λ²)``, ``λ = DAMPING_RELATIVE σ_max``, otherwise
-    (selectively damped least squares: the well-determined components stay exact).
+    """Solve ``-Jᵀ F = τ`` (the torques of :func:`static_torques`) for the force F applied to the foot
+    (paper 2, eq. (47)) by SVD; the weak directions of samples with ``rcond < SINGULAR_RCOND`` are damped
+    (``λ = DAMPING_RELATIVE σ_max``, selectively damped least squares).
 
     Parameters
     ----------
     leg : OmniLeg
     q : array_like, shape (..., 3)
-        Joint coordinates ``(α, β, γ)`` (rad).
     tau : array_like, shape (..., 3)
-        Motor torques (N·m), α, β, γ order; broadcasts with ``q``.
+        Motor torques (N·m); broadcasts with ``q``.
 
     Returns
     -------
@@ -603,15 +499,13 @@ def foot_force_from_torques(leg: OmniLeg, q: object, tau: object) -> FootForceRe
     tau = as_array(tau, "tau", (3,))
     batch = broadcast_batch((q, 1, "q"), (tau, 1, "tau"))
     J = jacobian(leg, q)
-    U, s, Vt = np.linalg.svd(J)
+    # Jᵀ = V Σ Uᵀ: only the directions with σ_i < SINGULAR_RCOND σ_max are damped
+    s, solve = _damped_inverse(np.swapaxes(J, -1, -2), rtol=SINGULAR_RCOND, damping=DAMPING_RELATIVE)
     rcond = s[..., -1] / s[..., 0]
     singular = rcond < SINGULAR_RCOND
-    lam = DAMPING_RELATIVE * s[..., :1]
-    # Jᵀ = V Σ Uᵀ, so F = U Σ⁺ Vᵀ τ; only the directions with σ_i < SINGULAR_RCOND σ_max are damped
-    weak = s < SINGULAR_RCOND * s[..., :1]
     # paper 2, eq. (47): F_f = (Jᵀ)⁻¹ τ for the force the foot delivers; the force applied to it is -F_f
-    F = -_damped_svd_solve(np.swapaxes(Vt, -1, -2), s, np.swapaxes(U, -1, -2), tau, lam, weak)
-    resid = np.linalg.norm(-np.einsum("...ij,...i->...j", J, F) - tau, axis=-1)
+    F_f, resid = solve(tau)  # |-Jᵀ F - τ|
+    F = -F_f
     # the per-sample fields have the batch of every argument (q may be one configuration for many tau)
     return FootForceResult(
         force=F,

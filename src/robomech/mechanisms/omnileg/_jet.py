@@ -1,12 +1,6 @@
-"""Forward differentiation along a motion, batched (private).
-
-A :class:`Jet` carries, for a quantity ``x(q)`` evaluated along a motion ``(q, q̇, q̈)``: its value ``v``,
-its first and second time derivatives ``vd = ẋ`` and ``vdd = ẍ``, and its gradient ``g[k] = ∂x/∂q_k``.
-The derivative axis ``k`` is the *leading* axis of ``g`` (shape ``(n, *S)`` for a value of shape ``S``)
-so that NumPy broadcasting applies the chain and product rules without reshaping.  This gives exact
-(rounding-level) body velocities, accelerations and Jacobians for the dynamics, with no symbolic
-derivation at import.
-"""
+"""Forward differentiation along a motion ``(q, q̇, q̈)``, batched (private): a :class:`Jet` carries a
+quantity's value ``v``, time derivatives ``vd``, ``vdd`` and gradient ``g[k] = ∂x/∂q_k``, the derivative axis
+leading (``(n, *S)`` for a value of shape ``S``) so that broadcasting applies the chain and product rules."""
 
 from __future__ import annotations
 

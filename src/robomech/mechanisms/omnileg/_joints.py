@@ -1,12 +1,5 @@
-"""Every joint of the leg as a spanning tree plus closures (for multibody engines and animations).
-
-The tree (``TREE_JOINTS``): chain 1's four joints θ11..θ14 carry the knee plate; chains 2 and 3 keep their
-first three joints (their fourth joint closes on the knee plate); the shank drive is the input shaft (γ),
-the two joints of the Cardan cross A4 (φ1 about the shaft's y arm, φ2 about the rod's x arm) and the
-first joint of cross B4 (φ3 = -φ2), closing on the output shaft (turning γ in the knee plate); each shank
-chain is crank (γ about its radial axis) and coupler (-2γ relative to the crank); the foot hangs on
-coupler 1 (+γ) and closes on couplers 2 and 3.
-"""
+"""Every joint of the leg as a spanning tree plus closures (``TREE_JOINTS``, for multibody engines and
+animations; the tree: docs/mechanisms/omnileg.md, "Generic description")."""
 
 from __future__ import annotations
 
@@ -35,16 +28,12 @@ TREE_JOINTS = (
 
 @dataclass(frozen=True)
 class JointMotion:
-    """Angles, rates and accelerations of the tree joints ``TREE_JOINTS`` (..., 22), rad-based units.
+    """Angles, rates and accelerations of the tree joints (the result of :func:`joint_motion`).
 
     Attributes
     ----------
-    q : ndarray, shape (..., 22)
-        Joint angles (rad), in the order of ``TREE_JOINTS``.
-    qd : ndarray, shape (..., 22)
-        Joint rates (rad/s).
-    qdd : ndarray, shape (..., 22)
-        Joint accelerations (rad/s²).
+    q, qd, qdd : ndarray, shape (..., 22)
+        Joint angles (rad), rates (rad/s) and accelerations (rad/s²), in the order of ``TREE_JOINTS``.
     """
 
     q: np.ndarray
@@ -54,12 +43,8 @@ class JointMotion:
 
 @carries_failed_rows({"q": 1, "qd": 1, "qdd": 1})
 def joint_motion(leg: OmniLeg, q: object, qd: object, qdd: object) -> JointMotion:
-    """All tree-joint angles, rates and accelerations for the motion ``(q, q̇, q̈)`` of ``(α, β, γ)``.
-
-    Thigh: θ11 = β, θ12 = atan(tan α cos β), θ13 = -θ12, θ14 = -β; θ21 = α, θ22 = -atan(tan β cos α),
-    θ23 = -θ22; θ31 = -β, θ32 = -θ12, θ33 = θ12 (the closure, eqs. (8), (12)).  Drive: with the rod
-    direction u, the shaft arm a1 = Rz(γ) e_y and the rod arm a2 = (a1 × u)/|a1 × u|,
-    φ1 = atan2((Rz(γ) e_x)·(a2 × a1), (Rz(γ) e_x)·a2), φ2 = atan2((a2 × a1)·(u × a2), a1·(u × a2)).
+    """All tree-joint angles, rates and accelerations for the motion ``(q, q̇, q̈)`` of ``(α, β, γ)`` (the
+    formulas: docs/mechanisms/omnileg.md, "Generic description").
 
     Parameters
     ----------

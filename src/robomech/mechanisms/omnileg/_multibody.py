@@ -1,13 +1,5 @@
-"""The OmniLeg described generically (``robomech.multibody``), from its parameters.
-
-Nothing is derived by hand: the 22 bodies and tree joints of the analytic model (``BODY_NAMES``,
-``TREE_JOINTS``, each joint's ``qpos`` that of :func:`joint_motion`), the thigh's UU chains, the exact
-double-Cardan drive and the shank closed by hinge cuts, the 1:1 bevel gears as joint couplings, and the
-analytic inertias rotated into these body frames.  ``q_act = (α, β, γ)`` (actuators ``theta21``,
-``theta11``, ``drive_in``), site ``foot`` at the foot point (eq. (11)), reference γ = 60°.  Body by body:
-``docs/mechanisms/omnileg.md``, "Generic description"; the tests compare it with the analytic model
-(eq. (11) FK, the thigh closure, J, H and the Lagrange inverse dynamics of ``_dynamics.py``).
-"""
+"""The OmniLeg described generically (``robomech.multibody``): the analytic model's 22 bodies, tree joints,
+closures and gear couplings, body by body in docs/mechanisms/omnileg.md, "Generic description"."""
 
 from __future__ import annotations
 
@@ -46,10 +38,6 @@ def _rx(a: float) -> Matrix:
     return np.array([[1.0, 0.0, 0.0], [0.0, np.cos(a), -np.sin(a)], [0.0, np.sin(a), np.cos(a)]])
 
 
-def _quat(R: Matrix) -> tuple[float, ...]:
-    return tuple(float(v) for v in _quat_from_matrix(R))
-
-
 def _frame(name: str) -> Matrix:
     """The analytic model's body frame of ``name`` in this description's body frame (constant).
 
@@ -74,7 +62,7 @@ def _inertial(body: RigidBody, Q: Matrix) -> Inertial:
     return Inertial(
         body.mass,
         pos=tuple(float(v) for v in Q @ body.com_vector),
-        quat=_quat(V),
+        quat=tuple(_quat_from_matrix(V)),
         diaginertia=tuple(float(max(v, 0.0)) for v in d),
     )
 
@@ -122,10 +110,8 @@ def thigh_mechanism(L1: float, L3: float) -> Mechanism:
 
 
 def to_multibody(leg: OmniLeg) -> Mechanism:
-    """The generic description of ``leg`` (an :class:`OmniLeg`), with its inertias; q_act = (α, β, γ).
-
-    Bodies, joints and inertial parameters are those of the analytic model (module docstring); the
-    exported MJCF (``robomech.multibody.to_mjcf``) is the engine model of ``robomech verify omnileg``.
+    """The generic description of ``leg`` with its inertias: q_act = (α, β, γ) (actuators ``theta21``,
+    ``theta11``, ``drive_in``), site ``foot`` at the foot point, reference γ = ``REFERENCE_GAMMA``.
 
     Parameters
     ----------
@@ -134,8 +120,6 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
     Returns
     -------
     Mechanism
-        The spanning tree of ``TREE_JOINTS`` with its bodies and inertials, the loop closures, and the
-        actuated coordinates ``(α, β, γ)``.
     """
     check_params(leg, OmniLeg, "leg")
     L1, L4 = leg.L1, leg.L4
@@ -151,7 +135,7 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
     # at O0', output shaft about Z0' in the knee plate; every frame is Rz(γ) at α = β = 0.
     # paper 2, eqs. (26)-(31): the paper decouples the drive's spin from the thigh motion; here the
     # closure solves the double Cardan exactly (as the analytic model does, docs departure 9).
-    Rg0 = _quat(_rz(g0))
+    Rg0 = _quat_from_matrix(_rz(g0))
     b.body(
         "drive_shaft_in",
         quat=Rg0,
@@ -198,7 +182,7 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
             f"crank_{c}",
             "knee_plate",
             pos=C,
-            quat=_quat(Rc),
+            quat=_quat_from_matrix(Rc),
             joints=[b.hinge(f"crank_{c}", axis=(1, 0, 0), ref=g0)],
             inertial=inertial(f"crank_{c}", "crank"),
         )
@@ -207,7 +191,7 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
             f"coupler_{c}",
             f"crank_{c}",
             pos=(0.0, 0.0, L4),
-            quat=_quat(Rrel),
+            quat=_quat_from_matrix(Rrel),
             joints=[b.hinge(f"coupler_{c}", axis=(1, 0, 0), ref=-2 * g0)],
             inertial=inertial(f"coupler_{c}", "coupler"),
         )
@@ -219,7 +203,7 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
                 "foot",
                 "coupler_1",
                 pos=Rc_world.T @ (foot_origin - (C + Rc @ np.array([0.0, 0.0, L4]))),
-                quat=_quat(Rc_world.T),
+                quat=_quat_from_matrix(Rc_world.T),
                 # the foot turns by γ relative to coupler 1 (qpos = γ, as joint_motion)
                 joints=[b.hinge("foot", axis=tuple(S[:, 0]), pos=tuple(E), ref=g0)],
                 inertial=inertial("foot", "foot"),

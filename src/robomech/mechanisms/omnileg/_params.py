@@ -1,13 +1,5 @@
-"""Parameters of the OmniLeg (paper 2): geometry of Table 2, joint ranges, and inertial assumptions.
-
-Frames (paper 2, Section 2): the hip frame O0 has X0 along Axis2 (the α axis of chain 2), Y0 along
-Axis1 (the β axis of chain 1) and Z0 = X0 × Y0 pointing *down, toward the foot*.  Every length is in
-metres, every angle in radians.
-
-The paper gives no masses or inertias.  Every moving body therefore carries a user-replaceable
-:class:`RigidBody`; the defaults of :meth:`OmniLeg.paper` are computed by :func:`default_bodies` from
-plausible link geometry and materials (aluminium links, steel crosses and shafts), each stated there.
-"""
+"""Parameters of the OmniLeg (paper 2): geometry of Table 2, joint ranges, and inertial assumptions
+(the paper gives none: :func:`default_bodies`); frames and justification: docs/mechanisms/omnileg.md."""
 
 from __future__ import annotations
 
@@ -18,6 +10,7 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from robomech._validation import as_array, check_positive, check_real
+from robomech.dynamics import _check_inertia
 
 __all__ = ["BodySet", "OmniLeg", "RigidBody", "default_bodies"]
 
@@ -26,45 +19,23 @@ RHO_ALUMINIUM = 2700.0
 RHO_STEEL = 7850.0
 # Standard gravity, m/s^2.
 STANDARD_GRAVITY = 9.80665
-# Inertia matrices must be symmetric to this relative tolerance (rounding of user input).
-INERTIA_SYMMETRY_RTOL = 1e-9
 # Principal moments may violate the triangle inequality by this relative amount (rounding only).
 TRIANGLE_RTOL = 1e-9
 
 
-def _real(value: object, name: str) -> float:
-    """A real scalar field as a float: a str, bool, complex or None raises instead of being converted."""
-    return check_real(value, name, finite=False)
-
-
 @dataclass(frozen=True)
 class RigidBody:
-    """Inertial parameters of one rigid body, in its own body frame (see ``docs/mechanisms/omnileg.md``).
-
-    ``mass`` in kg; ``com (3,)`` the centre of mass in the body frame (m); ``inertia (3, 3)`` the
-    rotational inertia about the centre of mass in body axes (kg m^2).
+    """Inertial parameters of one rigid body in its body frame (docs/mechanisms/omnileg.md, "Dynamics model").
 
     Parameters
     ----------
     mass : float
         Mass (kg), > 0.
     com : array_like, shape (3,)
-        Centre of mass in the body frame (m); stored as a tuple of 3 floats.
+        Centre of mass (m); stored as a tuple (``com_vector``: as an array).
     inertia : array_like, shape (3, 3)
-        Inertia about the centre of mass in body axes (kg m²): symmetric, positive semidefinite, its
-        principal moments obeying the triangle inequality; stored as nested tuples.
-
-    Attributes
-    ----------
-    inertia_matrix : ndarray, shape (3, 3)
-        ``inertia`` as an array (kg m²).
-    com_vector : ndarray, shape (3,)
-        ``com`` as an array (m).
-
-    Raises
-    ------
-    ValueError
-        If a field is not finite, the mass is not positive, or the inertia is not a valid inertia matrix.
+        Inertia about the centre of mass (kg m²): symmetric, positive semidefinite, principal moments
+        obeying the triangle inequality; stored as nested tuples (``inertia_matrix``: as an array).
     """
 
     mass: float
@@ -72,9 +43,7 @@ class RigidBody:
     inertia: tuple[tuple[float, ...], ...]  # 3 x 3 floats once validated
 
     def __post_init__(self) -> None:
-        m = _real(self.mass, "RigidBody.mass")
-        if not (math.isfinite(m) and m > 0.0):
-            raise ValueError(f"Expected RigidBody.mass > 0 and finite, got {self.mass!r}.")
+        m = check_positive(self.mass, "RigidBody.mass")
         c = as_array(self.com, "RigidBody.com")
         if c.shape != (3,) or not np.all(np.isfinite(c)):
             raise ValueError(f"Expected RigidBody.com to be 3 finite numbers, got {self.com!r}.")
@@ -83,14 +52,12 @@ class RigidBody:
             raise ValueError(
                 f"Expected RigidBody.inertia to be a finite 3x3 matrix, got shape {inertia.shape}."
             )
-        scale = max(float(np.abs(inertia).max()), 1e-300)
-        if np.abs(inertia - inertia.T).max() > INERTIA_SYMMETRY_RTOL * scale:
-            raise ValueError("Expected RigidBody.inertia to be symmetric, got an asymmetric matrix.")
+        _check_inertia(inertia, "RigidBody.inertia")  # symmetric, positive semidefinite (to rounding)
         ev = np.linalg.eigvalsh(inertia)
-        if ev[0] < 0 or ev[0] + ev[1] < ev[2] * (1 - TRIANGLE_RTOL):
+        if ev[0] + ev[1] < ev[2] * (1 - TRIANGLE_RTOL):
             raise ValueError(
-                f"Expected RigidBody.inertia positive semidefinite with principal moments obeying the "
-                f"triangle inequality, got principal moments {ev.tolist()}."
+                f"Expected RigidBody.inertia's principal moments to obey the triangle inequality, got "
+                f"{ev.tolist()}."
             )
         object.__setattr__(self, "mass", m)
         object.__setattr__(self, "com", tuple(float(v) for v in c))
@@ -106,12 +73,7 @@ class RigidBody:
 
 
 def _cylinder(
-    mass: float,
-    radius: float,
-    length: float,
-    com: tuple[float, float, float] = (0, 0, 0),
-    axis: int = 2,
-    inner_radius: float = 0.0,
+    mass: float, radius: float, length: float, com=(0, 0, 0), axis=2, inner_radius=0.0
 ) -> RigidBody:
     """(Hollow) cylinder along body axis ``axis`` about its centre."""
     r2 = radius**2 + inner_radius**2
@@ -124,13 +86,6 @@ def _cylinder(
     )
 
 
-def _box(
-    mass: float, sx: float, sy: float, sz: float, com: tuple[float, float, float] = (0, 0, 0)
-) -> RigidBody:
-    d = (mass * (sy**2 + sz**2) / 12, mass * (sx**2 + sz**2) / 12, mass * (sx**2 + sy**2) / 12)
-    return RigidBody(mass, com, tuple(tuple(d[i] if i == j else 0.0 for j in range(3)) for i in range(3)))
-
-
 def _cross(radius: float, span: float) -> RigidBody:
     """A universal-joint cross: two steel pins of ``radius`` and length ``span`` along body x and y."""
     m_pin = RHO_STEEL * math.pi * radius**2 * span
@@ -141,42 +96,17 @@ def _cross(radius: float, span: float) -> RigidBody:
 
 
 def default_bodies(L1: float, L3: float, L4: float, L5: float, knee_to_crank: float) -> dict[str, RigidBody]:
-    """Plausible inertial parameters from the link geometry (assumptions, see the docs page).
-
-    Body frames are those of ``docs/mechanisms/omnileg.md``; the z axis of every link frame runs along
-    the link.  Sizes: U-joint crosses of 5 mm steel pins spanning 24 mm; thigh rods aluminium tubes
-    16/12 mm diameter plus 20 g of fittings at each end; the central drive shaft a 6 mm steel rod;
-    input/output drive shafts 6 mm steel, 30 mm long, carrying a 40 g bevel gear (output); knee plate
-    an 8 mm aluminium disk of radius L3 + 15 mm with 150 g of gears and bearings; cranks and couplers
-    aluminium bars 12 x 6 mm of length L4 (the crank also carrying a 25 g bevel gear at C); foot a
-    100 g aluminium pad with a 10 mm aluminium rod from the E plane down to the foot point.
+    """Plausible inertial parameters from the link geometry (sizes, materials and frames of the 11 body kinds
+    of ``BODY_FIELDS``: docs/mechanisms/omnileg.md, "Dynamics model").
 
     Parameters
     ----------
-    L1, L3, L4, L5 : float
-        Thigh rod length, U-joint radius, shank link length and knee height (m), each > 0 (see
-        :class:`OmniLeg`).
-    knee_to_crank : float
-        Depth of the crank joints C_i below the knee point O0' (m), ``0 <= knee_to_crank < L5``.
+    L1, L3, L4, L5, knee_to_crank : float
+        As in :class:`OmniLeg` (m).
 
     Returns
     -------
     dict of str to RigidBody
-        The 11 body kinds (``hip_cross``, ``thigh_rod``, ``knee_cross``, ``knee_plate``,
-        ``drive_shaft_in``, ``drive_cross``, ``drive_rod``, ``drive_shaft_out``, ``crank``, ``coupler``,
-        ``foot``) and their inertial parameters.
-
-    Raises
-    ------
-    ValueError
-        If a length is not a positive finite real number, or ``knee_to_crank`` is negative or not
-        below ``L5``.
-
-    Examples
-    --------
-    >>> b = default_bodies(0.15, 0.075, 0.095, 0.16, 0.03)
-    >>> len(b), bool(b["foot"].mass > 0)
-    (11, True)
     """
     L1, L3, L4, L5 = (check_positive(v, n) for v, n in ((L1, "L1"), (L3, "L3"), (L4, "L4"), (L5, "L5")))
     knee_to_crank = check_positive(knee_to_crank, "knee_to_crank", allow_zero=True)
@@ -217,7 +147,8 @@ def default_bodies(L1: float, L3: float, L4: float, L5: float, knee_to_crank: fl
     knee_plate = _cylinder(m_plate + m_extra, plate_r, plate_t, com=(0.0, 0.0, knee_to_crank / 2))
     bar_w, bar_t = 0.012, 0.006
     m_bar = RHO_ALUMINIUM * bar_w * bar_t * L4
-    bar = _box(m_bar, bar_t, bar_w, L4).inertia_matrix
+    box = (bar_w**2 + L4**2, bar_t**2 + L4**2, bar_t**2 + bar_w**2)  # the bar as a box
+    bar = np.diag([m_bar * v / 12 for v in box])
     coupler = RigidBody(m_bar, (0.0, 0.0, L4 / 2), tuple(map(tuple, bar)))
     m_cg = 0.025
     z_cr = m_bar * (L4 / 2) / (m_bar + m_cg)
@@ -253,39 +184,21 @@ def default_bodies(L1: float, L3: float, L4: float, L5: float, knee_to_crank: fl
 
 
 BODY_FIELDS = (
-    "hip_cross",
-    "thigh_rod",
-    "knee_cross",
-    "knee_plate",
-    "drive_shaft_in",
-    "drive_cross",
-    "drive_rod",
-    "drive_shaft_out",
-    "crank",
-    "coupler",
-    "foot",
-)
+    "hip_cross", "thigh_rod", "knee_cross", "knee_plate", "drive_shaft_in", "drive_cross", "drive_rod",
+    "drive_shaft_out", "crank", "coupler", "foot",
+)  # fmt: skip
 
 
 class BodySet(Mapping):
-    """The 11 body parameter sets of an :class:`OmniLeg` (read-only mapping body kind -> RigidBody).
-
-    Remembers which entries were given explicitly (``explicit``): the others are the defaults
-    :func:`default_bodies` derives from the leg's dimensions, and are derived again whenever the leg is
-    rebuilt (``dataclasses.replace(leg, L1=...)`` passes this mapping back to ``OmniLeg``, which keeps
-    only its explicit entries).  Two sets compare equal when all 11 bodies are equal.
+    """The 11 body parameter sets of an :class:`OmniLeg`, a read-only mapping body kind -> RigidBody; the
+    kinds not ``explicit`` are :func:`default_bodies` (docs/mechanisms/omnileg.md, "Derived inertias").
 
     Parameters
     ----------
     bodies : Mapping
         Body kind -> :class:`RigidBody` for all 11 kinds.
     explicit : frozenset of str
-        The kinds given explicitly by the user.
-
-    Attributes
-    ----------
-    explicit : frozenset of str
-        Body kinds given explicitly (not derived from the dimensions).
+        The kinds given explicitly by the user (not derived from the dimensions).
     """
 
     __slots__ = ("_bodies", "_explicit")
@@ -325,61 +238,24 @@ _SHANK_RADIUS = 0.025
 class OmniLeg:
     """The OmniLeg: thigh 3-UU double-parallel mechanism + 3-RRR (crank-slider) shank.
 
-    Geometry (m): ``L1`` thigh rod length A_iB_i; ``L3`` distance of the U joints A_i, B_i from the
-    plate centres O0, O0'; ``L4`` shank link length C_iD_i = D_iE_i; ``L5`` knee height (the constant
-    part of the foot depth below O0' besides 2 L4 cos γ, eq. (11)).  ``knee_to_crank`` splits L5: the
-    C_i joints lie ``knee_to_crank`` below O0', the foot point ``L5 - knee_to_crank`` below the E_i
-    plane; ``shank_radius`` is the radius of the C_i and E_i circles and ``shank_azimuth`` the angle of
-    chain C1D1E1 from X0 (the three shank chains are 120° apart).  Joint ranges (rad) are Table 2
-    read as magnitudes.  ``gravity`` is the gravity acceleration in the hip frame (Z0 down).  The
-    :class:`RigidBody` fields are the inertial parameters of each body kind (the three copies of a
-    chain's bodies share them, rotated with the chain).  ``bodies`` takes the explicit overrides
-    (a mapping of some body kinds to :class:`RigidBody`); every other body is derived from the
-    dimensions by :func:`default_bodies`, and is derived again when a dimension changes
-    (``dataclasses.replace``).  ``leg.bodies`` is the full :class:`BodySet`; equality compares it.
+    Defaults and their sources: docs/mechanisms/omnileg.md, "Parameters and their justification".
 
     Parameters
     ----------
-    L1 : float
-        Thigh rod length A_iB_i (m), > 0 (Table 2: 0.15 m).
-    L3 : float
-        Distance of the U joints A_i, B_i from the plate centres O0, O0' (m), > 0.
-    L4 : float
-        Shank link length C_iD_i = D_iE_i (m), > 0.
-    L5 : float
-        Knee height (m), > 0: the constant part of the foot depth below O0' (eq. (11)).
+    L1, L3, L4, L5 : float
+        Thigh rod A_iB_i, U-joint offset from O0 and O0', shank link C_iD_i = D_iE_i, knee height (m), > 0.
     alpha_max, beta_max : float, optional
-        Joint range magnitudes of α and β (rad), in (0, π/2); default 65°.
+        Joint range magnitudes of α and β (rad), in (0, π/2).
     gamma_min, gamma_max : float, optional
-        Range of the crank angle γ (rad), ``-π/2 < gamma_min < gamma_max < π/2``; default 0 and 85°.
-    knee_to_crank : float, optional
-        Depth of the C_i joints below O0' (m), in [0, L5) (the foot point lies below); default 0.03 m.
-    shank_radius : float, optional
-        Radius of the C_i and E_i circles (m), > 0; default 0.025 m.
-    shank_azimuth : float, optional
-        Angle of chain C1D1E1 from X0 (rad); default π/2.
+        Range of the crank angle γ (rad), ``-π/2 < gamma_min < gamma_max < π/2``.
+    knee_to_crank, shank_radius, shank_azimuth : float, optional
+        Depth of the C_i below O0' (m, in [0, L5)), radius of the C_i/E_i circles (m), angle of chain
+        C1D1E1 from X0 (rad).
     gravity : array_like, shape (3,), optional
-        Gravity acceleration in the hip frame (m/s²); default ``(0, 0, 9.80665)`` (Z0 down).
+        Gravity acceleration in the hip frame (m/s²; Z0 points down).
     bodies : Mapping, optional
-        Explicit :class:`RigidBody` overrides by body kind (keys from ``BODY_FIELDS``); the others are
-        :func:`default_bodies`.  Stored as a :class:`BodySet` of all 11 kinds.
-
-    Attributes
-    ----------
-    foot_drop : float
-        Depth of the foot point below the E_i plane, ``L5 - knee_to_crank`` (m).
-
-    Raises
-    ------
-    ValueError
-        If a field is out of its range, not finite, or ``bodies`` has an unknown key or a value that is
-        not a :class:`RigidBody`.
-
-    Examples
-    --------
-    >>> leg = OmniLeg.paper()
-    >>> leg.L1, len(leg.bodies), round(leg.foot_drop, 3)
-    (0.15, 11, 0.13)
+        :class:`RigidBody` overrides by body kind (``BODY_FIELDS``); the others are :func:`default_bodies`
+        (stored as a :class:`BodySet`).
     """
 
     L1: float
@@ -400,34 +276,29 @@ class OmniLeg:
 
     def __post_init__(self) -> None:
         for name in ("L1", "L3", "L4", "L5", "shank_radius"):
-            v = _real(getattr(self, name), f"OmniLeg.{name}")
-            if not (math.isfinite(v) and v > 0):
-                raise ValueError(f"Expected OmniLeg.{name} > 0 and finite, got {getattr(self, name)!r}.")
-            object.__setattr__(self, name, v)
-        h = _real(self.knee_to_crank, "OmniLeg.knee_to_crank")
-        if not (math.isfinite(h) and 0 <= h < self.L5):  # the foot rod below the cranks needs a length
+            object.__setattr__(self, name, check_positive(getattr(self, name), f"OmniLeg.{name}"))
+        h = check_positive(self.knee_to_crank, "OmniLeg.knee_to_crank", allow_zero=True)
+        if h >= self.L5:  # the foot rod below the cranks needs a length
             raise ValueError(
                 f"Expected OmniLeg.knee_to_crank in [0, L5 = {self.L5}), got {self.knee_to_crank!r}."
             )
         object.__setattr__(self, "knee_to_crank", h)
         for name in ("alpha_max", "beta_max"):
-            v = _real(getattr(self, name), f"OmniLeg.{name}")
-            # tan(α), tan(β) enter eq. (11): |α|, |β| must stay below 90°.
-            if not (math.isfinite(v) and 0 < v < math.pi / 2):
+            v = check_positive(getattr(self, name), f"OmniLeg.{name}")
+            if v >= math.pi / 2:  # tan(α), tan(β) enter eq. (11): |α|, |β| must stay below 90°.
                 raise ValueError(f"Expected OmniLeg.{name} in (0, pi/2) rad, got {getattr(self, name)!r}.")
             object.__setattr__(self, name, v)
-        gmin, gmax = _real(self.gamma_min, "OmniLeg.gamma_min"), _real(self.gamma_max, "OmniLeg.gamma_max")
+        gmin = check_real(self.gamma_min, "OmniLeg.gamma_min")
+        gmax = check_real(self.gamma_max, "OmniLeg.gamma_max")
         # The crank-slider of the shank folds flat at γ = ±90°: the range must lie strictly inside.
-        if not (math.isfinite(gmin) and math.isfinite(gmax) and -math.pi / 2 < gmin < gmax < math.pi / 2):
+        if not (-math.pi / 2 < gmin < gmax < math.pi / 2):
             raise ValueError(
                 "Expected -pi/2 < OmniLeg.gamma_min < OmniLeg.gamma_max < pi/2, "
                 f"got {self.gamma_min!r}, {self.gamma_max!r}."
             )
         object.__setattr__(self, "gamma_min", gmin)
         object.__setattr__(self, "gamma_max", gmax)
-        if not math.isfinite(_real(self.shank_azimuth, "OmniLeg.shank_azimuth")):
-            raise ValueError(f"Expected OmniLeg.shank_azimuth finite, got {self.shank_azimuth!r}.")
-        object.__setattr__(self, "shank_azimuth", float(self.shank_azimuth))
+        object.__setattr__(self, "shank_azimuth", check_real(self.shank_azimuth, "OmniLeg.shank_azimuth"))
         g = as_array(self.gravity, "OmniLeg.gravity")
         if g.shape != (3,) or not np.all(np.isfinite(g)):
             raise ValueError(f"Expected OmniLeg.gravity to be 3 finite numbers, got {self.gravity!r}.")

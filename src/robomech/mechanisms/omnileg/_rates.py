@@ -1,10 +1,5 @@
-"""Inverse differential kinematics of the OmniLeg: joint rates and accelerations for a foot motion.
-
-``q̇ = J⁻¹ ṗ`` and ``q̈ = J⁻¹ (p̈ - q̇ᵀ H q̇)`` (conventions: ``ÿ = J q̈ + q̇ᵀ H q̇``), solved per sample by
-the SVD of the foot Jacobian with the weak directions damped where J is near singular (γ ≈ 0, the
-fully extended shank, where ∂p/∂γ = (0, 0, -2 L4 sin γ) vanishes: paper 2, eq. (47)'s inverse does
-not exist there).  The flagged samples keep a finite, damped solution and report their residual.
-"""
+"""Inverse differential kinematics of the OmniLeg: ``q̇ = J⁻¹ ṗ``, ``q̈ = J⁻¹ (p̈ - q̇ᵀ H q̇)`` by the SVD of
+the foot Jacobian, the weak directions damped where J is near singular (γ ≈ 0)."""
 
 from __future__ import annotations
 
@@ -14,7 +9,7 @@ import numpy as np
 
 from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_batch, check_params, check_real
-from robomech.analysis.lstsq import _damped_svd_solve
+from robomech.analysis.lstsq import _damped_inverse
 
 from ._dynamics import SINGULAR_RCOND
 from ._kinematics import hessian, jacobian
@@ -34,19 +29,15 @@ class JointRatesResult:
 
     Attributes
     ----------
-    qd : ndarray, shape (..., 3)
-        Joint rates (rad/s).
-    qdd : ndarray, shape (..., 3)
-        Joint accelerations (rad/s²); NaN if no foot acceleration was given.
+    qd, qdd : ndarray, shape (..., 3)
+        Joint rates (rad/s) and accelerations (rad/s²; NaN if no foot acceleration was given).
     rcond : ndarray, shape (...)
         ``sigma_min / sigma_max`` of the foot Jacobian (dimensionless).
     singular : ndarray of bool, shape (...)
         ``rcond < SINGULAR_RCOND`` (γ ≈ 0): the weak direction is damped, so the solution is the damped
         least-squares one and the residuals are no longer zero.
-    velocity_residual : ndarray, shape (...)
-        ``|J q̇ - ṗ|`` (m/s).
-    acceleration_residual : ndarray, shape (...)
-        ``|J q̈ + q̇ᵀ H q̇ - p̈|`` (m/s²); NaN if no foot acceleration was given.
+    velocity_residual, acceleration_residual : ndarray, shape (...)
+        ``|J q̇ - ṗ|`` (m/s) and ``|J q̈ + q̇ᵀ H q̇ - p̈|`` (m/s²; NaN if no foot acceleration was given).
     valid : ndarray of bool, shape (...)
         Not singular and every value finite.
     """
@@ -71,21 +62,17 @@ def joint_rates(
 ) -> JointRatesResult:
     """Joint rates ``q̇`` (and accelerations ``q̈``) realising the foot velocity ``ṗ`` (and acceleration ``p̈``).
 
-    Paper 2, eq. (47)'s inverse of the foot Jacobian (eq. (14)), regularised at γ = 0: the directions
-    with ``σ < SINGULAR_RCOND σ_max`` get ``c = σ / (σ² + λ²)``, ``λ = damping σ_max``; ``damping = 0``
-    inverts them exactly (unbounded as σ -> 0).  ``valid`` is False there for any damping.
+    Paper 2, eq. (47)'s inverse of the foot Jacobian, regularised at γ = 0: the directions with
+    ``σ < SINGULAR_RCOND σ_max`` get ``c = σ / (σ² + λ²)``, ``λ = damping σ_max`` (0: exact, unbounded).
 
     Parameters
     ----------
     leg : OmniLeg
     q : array_like, shape (..., 3)
-        Joint angles ``(α, β, γ)`` (rad).
-    foot_velocity : array_like, shape (..., 3)
-        Foot velocity ``ṗ`` in the hip frame (m/s).
-    foot_acceleration : array_like, shape (..., 3), optional
-        Foot acceleration ``p̈`` in the hip frame (m/s²); ``None`` (default) leaves ``qdd`` NaN.
+    foot_velocity, foot_acceleration : array_like, shape (..., 3)
+        ``ṗ`` (m/s) and, optionally, ``p̈`` (m/s²; without it ``qdd`` is NaN), hip frame.
     damping : float, optional
-        Damping of the weak directions relative to sigma_max (>= 0; default ``DEFAULT_DAMPING``).
+        Damping of the weak directions relative to sigma_max (>= 0).
 
     Returns
     -------
@@ -115,21 +102,16 @@ def joint_rates(
 
 def _joint_rates(leg, q, pd, pdd, damping, batch) -> JointRatesResult:
     J = jacobian(leg, q)
-    U, s, Vt = np.linalg.svd(J)
-    smax = s[..., :1]
-    rcond = s[..., -1] / smax[..., 0]
-    weak = s < SINGULAR_RCOND * smax
-    lam = float(damping) * smax
-    qd = _damped_svd_solve(U, s, Vt, pd, lam, weak)
-    v_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qd) - pd, axis=-1)
+    s, solve = _damped_inverse(J, rtol=SINGULAR_RCOND, damping=damping)
+    rcond = s[..., -1] / s[..., 0]
+    qd, v_res = solve(pd)
     if pdd is None:
         qdd = np.full((*batch, 3), np.nan)
         a_res = np.full(batch, np.nan)
     else:
         pdd = np.broadcast_to(pdd, (*batch, 3))
         bias = np.einsum("...ijk,...j,...k->...i", hessian(leg, q), qd, qd)  # q̇ᵀ H q̇
-        qdd = _damped_svd_solve(U, s, Vt, pdd - bias, lam, weak)
-        a_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qdd) + bias - pdd, axis=-1)
+        qdd, a_res = solve(pdd - bias)  # |J q̈ + q̇ᵀ H q̇ - p̈|
     singular = rcond < SINGULAR_RCOND
     finite = np.all(np.isfinite(qd), -1) & (pdd is None or np.all(np.isfinite(qdd), -1))
     return JointRatesResult(

@@ -1,11 +1,5 @@
-"""The test trajectories of paper 2: eq. (51) (foot, IK test), eq. (52) (joints, FK and dynamics tests)
-and eq. (53) (foot, gait of the single-leg platform), built from :mod:`robomech.trajectory`.
-
-The paper gives eqs. (51) and (53) as foot *displacements* without their start point or the direction of
-Z; robomech's reading (``docs/mechanisms/omnileg.md``): X, Y along X0, Y0, Z a lift (against Z0, toward
-the hip), added to the start point ``FK(0, 0, START_GAMMA)`` (the leg vertical with the shank half
-folded).
-"""
+"""The test trajectories of paper 2, eqs. (51)-(53), built from :mod:`robomech.trajectory`: foot displacements
+X, Y along X0, Y0 and a lift Z from :func:`start_point` (docs/mechanisms/omnileg.md, departures 10-12)."""
 
 from __future__ import annotations
 
@@ -46,9 +40,7 @@ GAIT_STRIDE, GAIT_HEIGHT, GAIT_LATERAL, GAIT_PERIOD = 0.1, 0.05, 0.0, 1.0
 
 
 def start_point(leg: OmniLeg) -> np.ndarray:
-    """Foot start point ``FK(0, 0, START_GAMMA)`` (3,), m.
-
-    The start of the foot trajectories of eqs. (51) and (53) (the paper gives none; module docstring).
+    """Foot start point ``FK(0, 0, START_GAMMA)`` (m) of eqs. (51) and (53) (the paper gives none).
 
     Parameters
     ----------
@@ -57,7 +49,6 @@ def start_point(leg: OmniLeg) -> np.ndarray:
     Returns
     -------
     ndarray, shape (3,)
-        Foot position in the hip frame (m).
     """
     check_params(leg, OmniLeg, "leg")
     return forward_kinematics(leg, np.array([0.0, 0.0, START_GAMMA]))
@@ -70,10 +61,8 @@ def _lift(p0: np.ndarray, x: Profile, y: Profile, z: Profile) -> Profile:
 
 
 def foot_trajectory_eq51(leg: OmniLeg, t: object) -> Profile:
-    """Foot position, velocity, acceleration (..., 3) of eq. (51) at times ``t`` (...), 0 <= t <= 5 s.
-
-    Paper 2, eq. (51): X rises by 0.1 m over T/2 and returns, Y rises by 0.1 m over T, Z lifts 0.05 m
-    and returns, T = ``EQ51_PERIOD``; added to :func:`start_point`, Z against Z0.
+    """Foot position, velocity, acceleration (m, hip frame) of eq. (51): X rises by 0.1 m over T/2 and
+    returns, Y rises by 0.1 m over T, Z lifts 0.05 m and returns, T = ``EQ51_PERIOD``.
 
     Parameters
     ----------
@@ -84,13 +73,6 @@ def foot_trajectory_eq51(leg: OmniLeg, t: object) -> Profile:
     Returns
     -------
     Profile
-
-    Examples
-    --------
-    >>> leg = OmniLeg.paper()
-    >>> f = foot_trajectory_eq51(leg, np.linspace(0.0, 5.0, 11))
-    >>> f.q.shape, bool(np.allclose(f.q[0], start_point(leg)))
-    ((11, 3), True)
     """
     check_params(leg, OmniLeg, "leg")
     t = as_array(t, "t")
@@ -106,10 +88,8 @@ def foot_trajectory_eq51(leg: OmniLeg, t: object) -> Profile:
 
 
 def joint_trajectory_eq52(t: object) -> Profile:
-    """Joint angles, rates, accelerations (..., 3) of eq. (52): (α, β, γ) = (π/6, π/6, 25π/180) sin(πt/3).
-
-    Note: γ < 0 for 3 s < t < 6 s, outside Table 2's γ range [0°, 85°]; the model is valid there
-    (|γ| < 90°) and the foot retraces its path since eq. (11) is even in γ.
+    """Joint angles, rates, accelerations of eq. (52): (α, β, γ) = (π/6, π/6, 25π/180) sin(πt/3) (γ < 0
+    for 3 s < t < 6 s, outside Table 2's range: the model is valid there, eq. (11) is even in γ).
 
     Parameters
     ----------
@@ -119,13 +99,6 @@ def joint_trajectory_eq52(t: object) -> Profile:
     Returns
     -------
     Profile
-
-    Examples
-    --------
-    >>> p = joint_trajectory_eq52([0.0, 1.5])
-    >>> np.round(np.degrees(p.q), 6)
-    array([[ 0.,  0.,  0.],
-           [30., 30., 25.]])
     """
     t = as_array(t, "t")
     return sinusoid(t[..., None], EQ52_AMPLITUDE, EQ52_FREQUENCY)
@@ -133,7 +106,7 @@ def joint_trajectory_eq52(t: object) -> Profile:
 
 @dataclass(frozen=True)
 class GaitProfile:
-    """Foot profile (position, velocity, acceleration (..., 3)) and ``stance (...)`` mask of eq. (53).
+    """Foot profile and stance mask of eq. (53) (the result of :func:`gait_eq53`).
 
     Attributes
     ----------
@@ -149,12 +122,8 @@ class GaitProfile:
 
 
 def gait_eq53(leg: OmniLeg, t: object, periods: int = 6) -> GaitProfile:
-    """Gait of the single-leg platform, eq. (53): alternating swing and stance periods of T = 1 s.
-
-    Swing: the foot moves from Y = -L/2 to +L/2 (quintic) while lifting H (sextic); stance: it returns
-    from +L/2 to -L/2 on the ground (H = 0), as the body moves forward.  The paper writes only the swing
-    form (Y from 0 to L); centring the stride under the hip and reversing it in stance is robomech's
-    reading (a foot fixed relative to the ground moves backward relative to the hip).
+    """Gait of the single-leg platform, eq. (53): swing (Y from -L/2 to +L/2, lifting H) and stance (back
+    on the ground) periods of T = 1 s; the paper writes only the swing (docs/mechanisms/omnileg.md).
 
     Parameters
     ----------
@@ -167,12 +136,6 @@ def gait_eq53(leg: OmniLeg, t: object, periods: int = 6) -> GaitProfile:
     Returns
     -------
     :class:`GaitProfile`
-
-    Examples
-    --------
-    >>> g = gait_eq53(OmniLeg.paper(), [0.5, 1.5])
-    >>> g.foot.q.shape, g.stance
-    ((2, 3), array([False,  True]))
     """
     check_params(leg, OmniLeg, "leg")
     t = as_array(t, "t")

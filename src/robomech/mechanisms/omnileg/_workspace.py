@@ -1,19 +1,6 @@
-"""Foot workspace and singularity map of the OmniLeg over the joint ranges of Table 2 (paper 2).
-
-The foot is the knee point ``L1 u(α, β)`` (a patch of the sphere of radius L1 about O0) shifted down by
-the shank, ``L5 + 2 L4 cos γ`` (eq. (11)).  For |α|, |β| < 90° the patch projects one-to-one onto the
-horizontal plane, so the workspace is the vertical sweep of the patch over the shank's stroke and its
-volume is exactly ``area(projected patch) x stroke``, with the area a smooth double integral over (α, β)
-(Gauss-Legendre quadrature).  The foot Jacobian is singular only where γ = 0 (∂p/∂γ = 0): with
-Table 2's γ range starting at 0 the whole bottom surface of the workspace (the leg fully extended) is
-singular.
-
-Paper 2, Section 1 claims "the foot workspace is completely symmetric" (足端运动区域呈现出完全的对称).
-Written out: the reflections x -> -x (β -> -β) and y -> -y (α -> -α) map the workspace onto itself for
-any ranges read as magnitudes, and the swap x <-> y (with a sign: (x, y) -> (-y, -x), i.e. α <-> β) does
-too when α_max = β_max, as in Table 2: the symmetry group of a square (D4) about Z0.
-:func:`workspace_symmetry` tests each of these per sample.
-"""
+"""Foot workspace and singularity map of the OmniLeg over Table 2's joint ranges (paper 2): the knee's sphere
+patch swept by the shank's stroke, singular only where γ = 0, and Section 1's symmetry claim tested per
+sample (docs/mechanisms/omnileg.md)."""
 
 from __future__ import annotations
 
@@ -61,14 +48,9 @@ class WorkspaceMap:
         The sample is within Table 2's joint ranges.
     det : ndarray, shape (...)
         Determinant of the foot Jacobian (m³/rad³).
-    cond : ndarray, shape (...)
-        2-norm condition number of the Jacobian (inf where singular).
-    dexterity : ndarray, shape (...)
-        ``1 / cond``, in [0, 1].
-    sigma_min : ndarray, shape (...)
-        Smallest singular value of the Jacobian (m/rad).
-    singular : ndarray of bool, shape (...)
-        ``sigma_min / sigma_max < SINGULAR_RCOND`` (the damped solves' threshold; γ ≈ 0).
+    cond, dexterity, sigma_min, singular : ndarray, shape (...)
+        The foot Jacobian's :class:`robomech.analysis.workspace.SingularityMap` (sigma_min in m/rad),
+        singular below ``SINGULAR_RCOND`` (the damped solves' threshold; γ ≈ 0).
     """
 
     q: np.ndarray
@@ -82,8 +64,7 @@ class WorkspaceMap:
 
 
 def joint_grid(leg: OmniLeg, n: int | tuple[int, int, int]) -> np.ndarray:
-    """Regular grid ``(n_α, n_β, n_γ, 3)`` over Table 2's joint ranges (|α| <= α_max, |β| <= β_max,
-    γ_min <= γ <= γ_max), rad.
+    """Regular grid of joint samples (rad) over Table 2's joint ranges, the range ends included.
 
     Parameters
     ----------
@@ -94,35 +75,21 @@ def joint_grid(leg: OmniLeg, n: int | tuple[int, int, int]) -> np.ndarray:
     Returns
     -------
     ndarray, shape (n_α, n_β, n_γ, 3)
-        Joint samples ``(α, β, γ)`` (rad), the range ends included.
-
-    Examples
-    --------
-    >>> joint_grid(OmniLeg.paper(), (3, 4, 5)).shape
-    (3, 4, 5, 3)
     """
     check_params(leg, OmniLeg, "leg")
-    if isinstance(n, tuple | list):
-        if len(n) != 3:
-            raise ValueError(f"Expected n to be an int >= 2 or three of them, got {n!r}.")
-        counts = tuple(check_int(c, "n", low=2) for c in n)
-    else:
-        counts = (check_int(n, "n", low=2),) * 3
     ranges = [(-leg.alpha_max, leg.alpha_max), (-leg.beta_max, leg.beta_max), (leg.gamma_min, leg.gamma_max)]
-    return grid(ranges, list(counts))
+    return grid(ranges, n)
 
 
 @carries_failed_rows({"q": 1})
 def workspace_map(leg: OmniLeg, q: object) -> WorkspaceMap:
-    """Foot position and Jacobian conditioning at joint samples ``q (..., 3)`` (e.g. :func:`joint_grid`).
-
-    Paper 2, eqs. (11) and (14) evaluated per sample.
+    """Foot position and Jacobian conditioning (paper 2, eqs. (11), (14)) at joint samples ``q``.
 
     Parameters
     ----------
     leg : OmniLeg
     q : array_like, shape (..., 3)
-        Joint samples ``(α, β, γ)`` (rad).
+        Joint samples (rad), e.g. :func:`joint_grid`.
 
     Returns
     -------
@@ -152,7 +119,7 @@ def workspace_map(leg: OmniLeg, q: object) -> WorkspaceMap:
 
 
 def singular_surface(leg: OmniLeg, alpha: object, beta: object) -> np.ndarray:
-    """Foot positions (..., 3) m on the singular surface γ = 0 (the fully extended shank) at (α, β) rad.
+    """Foot positions ``FK(α, β, 0)`` (m) on the singular surface γ = 0 (the fully extended shank).
 
     Parameters
     ----------
@@ -163,7 +130,6 @@ def singular_surface(leg: OmniLeg, alpha: object, beta: object) -> np.ndarray:
     Returns
     -------
     ndarray, shape (..., 3)
-        Foot positions ``FK(α, β, 0)`` in the hip frame (m).
     """
     check_params(leg, OmniLeg, "leg")
     a = as_array(alpha, "alpha")
@@ -178,19 +144,14 @@ class FootWorkspace:
 
     Attributes
     ----------
-    volume : float
-        Workspace volume (m³), ``projected_area * stroke``.
-    projected_area : float
-        Area of the workspace's horizontal section (m²): the knee patch seen from above.
-    stroke : float
-        Vertical travel of the shank (m), ``2 L4 (max cos γ - min cos γ)``.
+    volume, projected_area, stroke : float
+        ``projected_area * stroke`` (m³); area of the horizontal section, the knee patch seen from above
+        (m²); vertical travel of the shank ``2 L4 (max cos γ - min cos γ)`` (m).
     boundary : ndarray, shape (M, 2)
         Closed horizontal boundary ``(x, y)`` (m, hip frame), ``M = 4 BOUNDARY_POINTS``: the images
         of the edges ``|α| = α_max``, ``|β| = β_max``.
-    depth_min, depth_max : float
-        Shallowest and deepest foot positions along Z0 (m).
-    radius_max : float
-        Largest horizontal distance of the foot from Z0 (m).
+    depth_min, depth_max, radius_max : float
+        Shallowest and deepest foot positions along Z0, largest horizontal distance from Z0 (m).
     """
 
     volume: float
@@ -209,26 +170,18 @@ def _projected_jacobian_det(leg: OmniLeg, a: np.ndarray, b: np.ndarray) -> np.nd
 
 
 def foot_workspace(leg: OmniLeg, *, nodes: int = AREA_NODES) -> FootWorkspace:
-    """Volume, horizontal section, boundary and extent of the foot workspace over Table 2's ranges.
-
-    The area is a Gauss-Legendre double integral over (α, β) of the knee's projected Jacobian
-    determinant (module docstring).
+    """Volume, horizontal section, boundary and extent of the foot workspace over Table 2's ranges (the
+    area: a Gauss-Legendre double integral over (α, β) of the knee's projected Jacobian determinant).
 
     Parameters
     ----------
     leg : OmniLeg
     nodes : int, optional
-        Gauss-Legendre nodes per joint coordinate (>= 2; default ``AREA_NODES``).
+        Gauss-Legendre nodes per joint coordinate (>= 2).
 
     Returns
     -------
     :class:`FootWorkspace`
-
-    Examples
-    --------
-    >>> ws = foot_workspace(OmniLeg.paper())
-    >>> bool(np.isclose(ws.volume, ws.projected_area * ws.stroke)), ws.boundary.shape
-    (True, (800, 2))
     """
     check_params(leg, OmniLeg, "leg")
     nodes = check_int(nodes, "nodes", low=2)
@@ -287,27 +240,18 @@ class SymmetryResult:
 
 
 def workspace_symmetry(leg: OmniLeg, p_foot: object) -> SymmetryResult:
-    """Test paper 2's claim that the foot workspace is symmetric at foot positions ``p_foot (..., 3)`` m.
-
-    Non-finite samples are unreachable, as are their images (they agree).
+    """Test paper 2's claim that the foot workspace is symmetric (the reflections x -> -x, y -> -y and,
+    for α_max = β_max, the swap (x, y) -> (-y, -x): a square's symmetry about Z0) at foot positions.
 
     Parameters
     ----------
     leg : OmniLeg
     p_foot : array_like, shape (..., 3)
-        Foot positions in the hip frame (m); non-finite samples allowed.
+        Foot positions in the hip frame (m); non-finite samples are unreachable, as are their images.
 
     Returns
     -------
     :class:`SymmetryResult`
-
-    Examples
-    --------
-    >>> leg = OmniLeg.paper()
-    >>> p = forward_kinematics(leg, [0.3, -0.2, 0.7])
-    >>> r = workspace_symmetry(leg, p)
-    >>> bool(r.reachable), bool(r.holds)
-    (True, True)
     """
     check_params(leg, OmniLeg, "leg")
     p = as_array(p_foot, "p_foot", (3,), finite=False)

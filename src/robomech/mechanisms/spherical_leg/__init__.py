@@ -1,10 +1,5 @@
-"""Paper 1: the 2RUHU-RUPR-RUR spherical parallel leg of a wheel-leg robot.
-
-Chen, He, Jiang, Sang, Ning, "Dynamic model of spherical parallel mechanism for wheel-leg hybrid mobile
-robot", Optics and Precision Engineering 27(8), 2019.  Exact closed-form inverse and forward position,
-first- and second-order influence coefficients, rigid-body inverse dynamics with a selectable
-redundant-actuation force distribution, and workspace/singularity maps.  See
-``docs/mechanisms/spherical_leg.md`` for every assumption and departure from the print.
+"""Paper 1: the 2RUHU-RUPR-RUR spherical parallel leg of a wheel-leg robot (Chen et al., Optics and
+Precision Engineering 27(8), 2019); every assumption and departure: ``docs/mechanisms/spherical_leg.md``.
 """
 
 from ._dynamics import (

@@ -1,29 +1,11 @@
-"""Paper 1's forward solution exactly as printed (eqs. (6)-(7)): for showing why its numbers differ.
-
-Nothing here is a model robomech uses: it re-runs the printed pipeline, misprints included, so that a
-report can put its output beside the exact solution.  As printed (paper 1, Section 3.2), in mm:
-
-* β = arcsin((l2² - l1²) / (4 R h)) (eq. (6); right);
-* the half-angle tangent a = tan(α/2) solves a⁴ + k1 a³ + k2 a² + k3 a + k4 = 0 with A = cos β,
-  D = r² + R² + h² + 2Rr - l3², k1 = k3 = 4RhA / D, k4 = (r² + R² + h² - 2Rr - l3²) / D and
-  k2 = [(l2² - l1²) / (8R²) + 2r² + 2R² + 2h²A² - 2l3²] / D.  Correct is (l2² - l1²)² / (8R²) (the
-  square is lost; with it k2 = 1 + k4 and the quartic is (a² + 1)(a² + k1 a + k4): the exact quadratic);
-  the lost square makes the printed k2 depend on the unit, so it is evaluated in mm, the paper's unit;
-* Ferrari's method with the resolvent Q = (2k2³ - 9 k2 k3 k4 + 27k3² + 27k1²k4 - 72k2k4) / 54 (correct:
-  9 k1 k2 k3), D = sqrt(Q² - P³), P = (k2² - 3k1k3 + 12k4)/9, G = cbrt(Q + D) + P / cbrt(Q + D),
-  M = sqrt(k1²/4 - 2k2/3 + G), S = k1²/2 - 4k2/3 - G, T = (-k1³ + 4k1k2 - 8k3) / (4M),
-  a = -k1/4 ± M/2 ± sqrt(S ± T)/2 (the sign of T paired with that of M), in complex arithmetic as
-  MATLAB evaluates it;
-* α = arctan(2a) (correct: 2 arctan(a)), "discarding the solutions outside (-π/2, π/2)".
-
-The print does not say which of the remaining roots it keeps; here: the real one (|Im| below
-``REAL_ROOT_TOL``) in (-π/2, π/2) whose α reproduces l3 best.  With all three misprints corrected this
-pipeline returns the exact pose (tests), so the misprints alone are what it shows.
-"""
+"""Paper 1's forward solution exactly as printed (eqs. (6)-(7), misprints included, in mm), for a report to
+put beside the exact solution; the printed formulas: docs/mechanisms/spherical_leg.md, "Findings"."""
 
 from __future__ import annotations
 
 import numpy as np
+
+from ._kinematics import _squared_length_columns
 
 # A root of the printed quartic counts as real when its imaginary part is below this (relative to
 # 1 + |a|): the complex Ferrari arithmetic leaves ~1e-16 imaginary parts on real roots, while the
@@ -77,22 +59,8 @@ def forward_as_printed(leg, L: np.ndarray, *, fix_square=False, fix_resolvent=Fa
         pick = np.argmin(miss, axis=-1)
         alpha = np.take_along_axis(alpha, pick[:, None], -1)[:, 0]
         valid = ok_in & ok_b & np.any(admissible, -1)
-        sa, ca, sbt, cbt = np.sin(alpha), np.cos(alpha), np.sin(beta), np.cos(beta)
-        Lr, rr, hr = leg.R, leg.r, leg.h
-        Kr = Lr * Lr + rr * rr + hr * hr
-        fit = np.sqrt(
-            np.maximum(
-                np.stack(
-                    [
-                        Kr - 2 * Lr * (rr * cbt + hr * sbt),
-                        Kr - 2 * Lr * (rr * cbt - hr * sbt),
-                        Kr - 2 * Lr * (rr * ca - hr * cbt * sa),
-                    ],
-                    -1,
-                ),
-                0.0,
-            )
-        )
+        sq = _squared_length_columns(leg, np.sin(alpha), np.cos(alpha), np.sin(beta), np.cos(beta))
+        fit = np.sqrt(np.maximum(np.stack(sq, -1), 0.0))
         resid = np.linalg.norm(fit - np.where(ok_in[:, None], L, 0.0), axis=-1)
     nan = np.nan
     return (

@@ -23,13 +23,13 @@ from typing import Any
 import numpy as np
 
 from robomech._validation import finite_samples
-from robomech.analysis.workspace import _measures
+from robomech.analysis.workspace import SINGULAR_RTOL, _measures
 from robomech.spatial._so3 import _sincos as sincos
 
 from ._dynamics import InverseDynamicsResult, _generalized, _motion, distribute_forces
 from ._kinematics import _jacobian_sincos, _squared_length_columns
 from ._params import SphericalLeg
-from ._workspace import SINGULAR_RTOL, WorkspaceMap, _map
+from ._workspace import WorkspaceMap, _map
 
 __all__ = ["Designs", "designs", "group_legs", "inverse_dynamics_designs", "workspace_designs"]
 

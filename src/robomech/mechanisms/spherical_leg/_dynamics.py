@@ -1,18 +1,6 @@
-"""Rigid-body inverse dynamics of the spherical parallel leg and its redundant force distribution.
-
-Replaces paper 1, eqs. (19)-(28), which cannot be reproduced as printed (errata): the generalized
-coordinates are the platform angles q = (alpha, beta) (the print uses the three leg lengths of a 2-DOF
-platform), the platform lever arm is OP = h (the print uses the thickness h_p), and every body's kinetic
-energy is complete (eq. (25)'s dE/dqdot lost its squares).  Kane's equations, exact once the closure is
-solved, over the platform and each leg's lower and upper body:
-
-    tau = sum_b Pv_b^T m_b (a_b - g) + Pw_b^T (I_b dw_b + w_b x I_b w_b) - E^T m_ext.
-
-The base universal joints make both bodies of a leg spin about its axis (``_cardan_spin``), the lead
-screws of legs 1 and 3 spin more when ``leg.screw_spin`` is set; ``paper_as_printed=True`` drops the
-Cardan spin (eq. (23) has none).  Leg forces f (positive extending) satisfy ``J^T f = tau``: three legs
-drive two coordinates, so a rule picks f.  Assumptions, one by one: ``docs/mechanisms/spherical_leg.md``.
-"""
+"""Rigid-body inverse dynamics of the spherical parallel leg (Kane's equations on q = (alpha, beta)) and
+its redundant force distribution ``J^T f = tau``, replacing paper 1, eqs. (19)-(28) (errata, assumptions,
+the Cardan spin that ``paper_as_printed=True`` drops: docs/mechanisms/spherical_leg.md)."""
 
 from __future__ import annotations
 
@@ -55,21 +43,14 @@ PAPER_DRIVEN_LEGS = (0, 2)
 # this ratio sigma_min/sigma_max the 2x2 solve itself loses all accuracy (same threshold as
 # robomech.analysis.workspace.SINGULAR_RTOL); the forces are NaN there.
 ACTUATION_SINGULAR_RTOL = 1e-8
-# Physical bound of the actuation (m/rad): sigma_min of the leg Jacobian (or of the driven legs' block)
-# is the smallest leg-length change per radian of platform motion, i.e. the lever arm through which the
-# legs hold the platform (leg forces = generalized forces / lever arm).  Below 1 mm/rad (i) every N m of
-# generalized force needs more than 1 kN of leg force, 10x the largest force of any well-conditioned
-# sample of paper 1's Fig. 5 (max 345 N, typical 100 N), and (ii) 10 um of leg-length error (lead-screw
-# backlash) leaves more than 10 mrad (0.6 deg) of platform play: the legs no longer hold the pose.
-# Samples below it are flagged (valid False) with their finite forces kept for inspection; the 1e-8
-# ratio alone would let ~1e8 N through as valid 1e-6 rad from the singular curve.
+# Physical bound of the actuation (m/rad): sigma_min is the lever arm through which the legs hold the
+# platform.  Below 1 mm/rad every N m needs more than 1 kN of leg force (10x the largest well-conditioned
+# force of Fig. 5) and 10 um of leg-length error leaves more than 0.6 deg of platform play; such samples
+# are flagged with their finite forces kept (docs/mechanisms/spherical_leg.md, "Actuation bound").
 ACTUATION_SIGMA_MIN = 1e-3
-# Gimbal lock of a base universal joint: the leg along the joint's fixed axis, 1 - (a . s)^2 = 0, where
-# the spin sigma = (a . s)(a . (s x sdot)) / (1 - (a . s)^2) is unbounded (the joint cannot follow).
-# Below this value of 1 - (a . s)^2 (the leg within 1.8 deg of the axis, spin gain > 1000 rad per rad
-# of swing) a sample of inverse_dynamics is flagged, and the formula's denominator is floored there
-# (finite values, flagged).  The paper's motions stay above 0.036 (Fig. 5(a), leg 3 at alpha = -60 deg;
-# Fig. 5(b) 0.17, 5(c) 0.38): lock needs a leg lying along its joint's horizontal axis.
+# Gimbal lock of a base universal joint (the leg along its fixed axis: 1 - (a . s)^2 = 0, where the spin
+# is unbounded): below this value (the leg within 1.8 deg of the axis, spin gain > 1000) a sample is
+# flagged and the denominator floored.  The paper's motions stay above 0.036 (Fig. 5(a), leg 3).
 CARDAN_LOCK_TOL = 1e-3
 
 
@@ -99,15 +80,10 @@ class _Motion:
 def _cardan_spin(
     a: np.ndarray, s: np.ndarray, sd: np.ndarray, sdd: np.ndarray, Ps: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Spin ``w . s`` of a body on a universal joint with fixed first axis ``a (3 legs, 3)``.
-
-    Derivation (independent of the multibody layer): in a frame with ``a`` as its y axis the leg is
-    ``s = Ry(u_a) (cos u_b, sin u_b, 0)`` and ``w = du_a a + du_b b`` with ``b`` perpendicular to
-    ``a`` and to ``s``, so ``w . s = du_a (a . s) = du_a sin u_b``.  With ``c = a . s = sin u_b`` and
-    ``du_a = (a . (s x sdot)) / (1 - c^2)`` (the rate of ``u_a = atan2(-s_z, s_x)``):
-    ``sigma = kappa . sdot``, ``kappa = f(c) (a x s)``, ``f(c) = c / (1 - c^2)``.  Returns sigma,
-    its time derivative ``kappa . sddot + kappa_dot . sdot``, its partial velocities ``kappa . Ps``
-    and the gimbal-lock mask (``1 - c^2 < CARDAN_LOCK_TOL``, denominator floored there)."""
+    """Spin ``w . s`` of a body on a universal joint with fixed first axis ``a (3 legs, 3)``
+    (docs/mechanisms/spherical_leg.md, assumption 3): ``sigma = kappa . sdot``, ``kappa = f(c) (a x s)``,
+    ``f(c) = c / (1 - c^2)``, ``c = a . s``.  Returns sigma, its time derivative, its partial velocities
+    ``kappa . Ps`` and the gimbal-lock mask (``1 - c^2 < CARDAN_LOCK_TOL``, denominator floored there)."""
     c = np.sum(a * s, -1)
     den = 1.0 - c * c
     lock = den < CARDAN_LOCK_TOL
@@ -234,116 +210,68 @@ def generalized_forces(
     platform_wrench: object | None = None,
     paper_as_printed: bool = False,
 ) -> NDArray[np.float64]:
-    """Generalized forces on q = (alpha, beta) (N m) for the motion (q, qd, qdd), each (..., 2).
+    """Generalized forces ``tau`` (..., 2) on (alpha, beta) (N m) the actuators supply for (q, qd, qdd).
 
-    ``platform_wrench (..., 6)``: external wrench ``[m_O; f]`` on the platform, base frame, moment
-    about O (conventions); tau is what the actuators must supply.  ``paper_as_printed``: see
-    :func:`inverse_dynamics`.  Near a gimbal lock of a base universal joint (``CARDAN_LOCK_TOL``, far
-    outside the paper's motions) the values are finite but meaningless: :func:`inverse_dynamics` flags
-    them. Replaces paper 1, eqs. (19)-(28) (see the module docstring).
+    Near a gimbal lock of a base universal joint the values are finite but meaningless:
+    :func:`inverse_dynamics` flags them (``CARDAN_LOCK_TOL``).
 
     Parameters
     ----------
     leg : SphericalLeg
-    q : array_like, shape (..., 2)
-        Platform angles ``(alpha, beta)`` (rad).
-    qd : array_like, shape (..., 2)
-        Their rates (rad/s).
-    qdd : array_like, shape (..., 2)
-        Their accelerations (rad/s^2). ``q``, ``qd`` and ``qdd`` broadcast together.
+    q, qd, qdd : array_like, shape (..., 2)
+        Platform angles ``(alpha, beta)`` (rad), their rates and accelerations; broadcast together.
     platform_wrench : array_like, shape (..., 6), optional
-        External wrench ``[m_O; f]`` (N m, N) on the platform, base frame, moment about O; ``None``:
-        no external load.
+        External wrench ``[m_O; f]`` (N m, N) on the platform, base frame, moment about O.
     paper_as_printed : bool, optional
-        Drop the Cardan spin of the legs (paper 1, eq. (23)), for comparison only.
 
     Returns
     -------
     ndarray, shape (..., 2)
-        Generalized forces ``tau`` on (alpha, beta) (N m).
-
-    Examples
-    --------
-    >>> from robomech.mechanisms import spherical_leg as sl
-    >>> sl.generalized_forces(sl.SphericalLeg.paper(), [0.1, 0.05], [0.0, 0.0], [0.0, 0.0]).shape
-    (2,)
     """
     return _generalized(leg, *_driven_motion(leg, q, qd, qdd, platform_wrench, paper_as_printed))
 
 
 @carries_failed_rows({"q": 1})
 def mass_matrix(leg: SphericalLeg, q: object, *, paper_as_printed: bool = False) -> NDArray[np.float64]:
-    """Mass matrix M(q) (..., 2, 2) of the coordinates (alpha, beta): tau = M qdd + c(q, qd) + g(q).
-
-    Built column by column from :func:`generalized_forces` with zero gravity and rates.
+    """Mass matrix M(q) (kg m^2, symmetric positive definite): tau = M qdd + c(q, qd) + g(q).
 
     Parameters
     ----------
     leg : SphericalLeg
     q : array_like, shape (..., 2)
-        Platform angles ``(alpha, beta)`` (rad).
     paper_as_printed : bool, optional
-        Drop the Cardan spin of the legs (see :func:`inverse_dynamics`), for comparison only.
 
     Returns
     -------
     ndarray, shape (..., 2, 2)
-        ``M(q)`` (kg m^2), symmetric positive definite.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import spherical_leg as sl
-    >>> M = sl.mass_matrix(sl.SphericalLeg.paper(), [0.1, 0.05])
-    >>> M.shape, bool(np.allclose(M, M.T))
-    ((2, 2), True)
     """
     check_params(leg, SphericalLeg, "leg")
     qa = as_array(q, "q", (2,))
     cardan = not check_bool(paper_as_printed, "paper_as_printed")
-    zero_g = _replace_gravity(leg)
+    zero_g = replace(leg, gravity=(0.0, 0.0, 0.0))
     cols = []
     for j in range(2):
-        e = np.zeros(2)
-        e[j] = 1.0
-        mo = _motion(zero_g, qa, np.zeros_like(qa), np.broadcast_to(e, qa.shape), cardan)
+        mo = _motion(zero_g, qa, np.zeros_like(qa), np.broadcast_to(np.eye(2)[j], qa.shape), cardan)
         cols.append(_generalized(zero_g, mo, None))
     return np.stack(cols, -1)
-
-
-def _replace_gravity(leg: SphericalLeg) -> SphericalLeg:
-    return replace(leg, gravity=(0.0, 0.0, 0.0))
 
 
 @carries_failed_rows({"q": 1, "qd": 1})
 def mechanical_energy(
     leg: SphericalLeg, q: object, qd: object, *, paper_as_printed: bool = False
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Kinetic and potential energy (J) of platform and legs, each (...); potential zero at O.
+    """Kinetic and potential energy of platform and legs.
 
     Parameters
     ----------
     leg : SphericalLeg
-    q : array_like, shape (..., 2)
-        Platform angles ``(alpha, beta)`` (rad).
-    qd : array_like, shape (..., 2)
-        Their rates (rad/s); broadcast with ``q``.
+    q, qd : array_like, shape (..., 2)
     paper_as_printed : bool, optional
-        Drop the Cardan spin of the legs (see :func:`inverse_dynamics`), for comparison only.
 
     Returns
     -------
-    T : ndarray, shape (...)
-        Kinetic energy (J).
-    V : ndarray, shape (...)
-        Gravitational potential energy (J), zero with every centre of mass at O.
-
-    Examples
-    --------
-    >>> from robomech.mechanisms import spherical_leg as sl
-    >>> T, V = sl.mechanical_energy(sl.SphericalLeg.paper(), [0.1, 0.05], [0.0, 0.0])
-    >>> float(T)
-    0.0
+    T, V : ndarray, shape (...)
+        Kinetic and gravitational potential energy (J), V zero with every centre of mass at O.
     """
     check_params(leg, SphericalLeg, "leg")
     qa, qda = _check_state(q, qd)
@@ -410,37 +338,25 @@ def distribute_forces(
     *,
     sigma_min_bound: float = ACTUATION_SIGMA_MIN,
 ) -> ForceDistribution:
-    """Leg forces balancing the generalized forces ``tau (..., 2)`` through ``J (..., 3, 2)``.
+    """Leg forces balancing the generalized forces ``tau`` through ``J``: ``J^T f = tau``.
 
-    ``driven_legs=None``: minimum-norm forces ``f = J (J^T J)^-1 tau`` (all three legs share the load,
-    no internal preload). ``driven_legs=(i, j)``: only those two legs act (paper 1's choice is
-    ``PAPER_DRIVEN_LEGS``, legs 1 and 3), the third carries no force.  ``sigma_min_bound`` (m/rad,
-    >= 0): the lever arm below which a sample is flagged (see ``ACTUATION_SIGMA_MIN``).
+    ``driven_legs=None``: minimum-norm forces ``f = J (J^T J)^-1 tau`` (no internal preload);
+    ``driven_legs=(i, j)``: only those two legs act (paper 1: ``PAPER_DRIVEN_LEGS``), the third carries none.
 
     Parameters
     ----------
     J : array_like, shape (..., 3, 2)
-        Leg Jacobian ``d l_i / d(alpha, beta)_j`` (m/rad), e.g. from :func:`jacobian`. Non-finite
-        samples are flagged, not raised.
+        Leg Jacobian (m/rad), e.g. from :func:`jacobian`; non-finite samples are flagged, not raised.
     tau : array_like, shape (..., 2)
-        Generalized forces on (alpha, beta) (N m); broadcast with ``J``. Non-finite samples are flagged.
+        Generalized forces (N m); broadcast with ``J``; non-finite samples are flagged.
     driven_legs : tuple of int, optional
-        Two different leg indices in 0..2 that carry the load; ``None``: minimum-norm over all three.
+        Two different leg indices in 0..2.
     sigma_min_bound : float, optional
-        Smallest acceptable lever arm (m/rad, >= 0); default ``ACTUATION_SIGMA_MIN``.
+        Smallest acceptable lever arm (m/rad, >= 0) of a ``valid`` sample.
 
     Returns
     -------
     :class:`ForceDistribution`
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import spherical_leg as sl
-    >>> J = sl.jacobian(sl.SphericalLeg.paper(), 0.1, 0.05)
-    >>> fd = sl.distribute_forces(J, [1.0, 0.0], driven_legs=sl.PAPER_DRIVEN_LEGS)
-    >>> fd.forces[1], bool(fd.valid), bool(fd.residual < 1e-9)
-    (np.float64(0.0), True, True)
     """
     J = as_array(J, "J", (3, 2), finite=False)
     t = as_array(tau, "tau", (2,), finite=False)
@@ -517,17 +433,10 @@ class InverseDynamicsResult:
     ----------
     generalized_forces : ndarray, shape (..., 2)
         ``tau`` on (alpha, beta) (N m).
-    leg_forces : ndarray, shape (..., 3)
-        Leg actuator forces (N, positive extends the leg); NaN where the solve is numerically singular.
-    residual : ndarray, shape (...)
-        ``|J^T f - tau|`` (N m).
+    leg_forces, residual, sigma_min, rcond : ndarray
+        As ``forces``, ``residual``, ``sigma_min``, ``rcond`` of :class:`ForceDistribution`.
     valid : ndarray of bool, shape (...)
-        False at or near an actuation singularity (``sigma_min < ACTUATION_SIGMA_MIN``) or a gimbal
-        lock of a base universal joint (``CARDAN_LOCK_TOL``).
-    sigma_min : ndarray, shape (...)
-        The per-sample lever arm (m/rad), as in :class:`ForceDistribution`.
-    rcond : ndarray, shape (...)
-        Its ratio to the largest singular value (unit-free).
+        As in :class:`ForceDistribution`, and False near a gimbal lock (``CARDAN_LOCK_TOL``).
     """
 
     generalized_forces: np.ndarray
@@ -549,33 +458,21 @@ def inverse_dynamics(
     driven_legs: tuple[int, int] | None = None,
     paper_as_printed: bool = False,
 ) -> InverseDynamicsResult:
-    """Generalized forces and leg actuator forces for the platform motion (q, qd, qdd), each (..., 2).
+    """Generalized forces and leg actuator forces for the platform motion (q, qd, qdd).
 
-    q = (alpha, beta) rad; ``platform_wrench (..., 6)`` ``[m_O; f]`` on the platform (base frame, moment
-    about O); ``driven_legs`` selects the force distribution (see :func:`distribute_forces`).
-    ``valid`` is also False where a base universal joint is at or near gimbal lock
-    (``CARDAN_LOCK_TOL``).  ``paper_as_printed=True``: without the spin of the legs about their own
-    axes that the base universal joints impose (paper 1, eq. (23)),
-    for comparison only; the lead-screw spin still follows ``leg.screw_spin``. Replaces paper 1,
-    eqs. (19)-(28) (see the module docstring).
+    :func:`generalized_forces` distributed by :func:`distribute_forces`; ``valid`` is also False near a
+    gimbal lock of a base universal joint (``CARDAN_LOCK_TOL``).  With ``paper_as_printed`` the
+    lead-screw spin still follows ``leg.screw_spin``.
 
     Parameters
     ----------
     leg : SphericalLeg
-    q : array_like, shape (..., 2)
-        Platform angles ``(alpha, beta)`` (rad).
-    qd : array_like, shape (..., 2)
-        Their rates (rad/s).
-    qdd : array_like, shape (..., 2)
-        Their accelerations (rad/s^2). ``q``, ``qd`` and ``qdd`` broadcast together.
+    q, qd, qdd : array_like, shape (..., 2)
+        As in :func:`generalized_forces`.
     platform_wrench : array_like, shape (..., 6), optional
-        External wrench ``[m_O; f]`` (N m, N) on the platform, base frame, moment about O; ``None``:
-        no external load.
     driven_legs : tuple of int, optional
-        Two leg indices that carry the load (e.g. ``PAPER_DRIVEN_LEGS``); ``None``: minimum-norm forces
-        over all three legs.
+        As in :func:`distribute_forces`.
     paper_as_printed : bool, optional
-        Drop the Cardan spin of the legs, for comparison only.
 
     Returns
     -------

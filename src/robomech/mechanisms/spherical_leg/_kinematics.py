@@ -1,15 +1,6 @@
-"""Position, velocity and acceleration kinematics of the spherical parallel leg (paper 1, Sections 3-4).
-
-The platform rotates about O by ``T = Rx(alpha) Ry(beta)`` (paper 1, eq. (1)); leg i joins
-``A_i`` (base) to ``B_i = T b_i`` (``b_i`` = B_i at the home pose). Squared leg lengths in closed form,
-with ``K = R^2 + r^2 + h^2``:
-
-    l1^2 = K - 2R (r cos b + h sin b)
-    l2^2 = K - 2R (r cos b - h sin b)
-    l3^2 = K - 2R (r cos a - h cos b sin a)
-
-so l1, l2 fix beta alone and l3 then fixes alpha: the three lengths over-determine the two angles.
-"""
+"""Position, velocity and acceleration kinematics of the spherical parallel leg (paper 1, Sections 3-4):
+l1, l2 fix beta alone and l3 then fixes alpha (docs/mechanisms/spherical_leg.md, "Frames, signs, units"
+and "Departures")."""
 
 from __future__ import annotations
 
@@ -39,24 +30,20 @@ __all__ = [
     "platform_rotation",
 ]
 
-# Forward kinematics fits beta to (l1, l2) by Newton's method started at the exact closed form.  For
-# consistent lengths the start is already the answer; for noisy lengths the 1-D least-squares problem
-# is smooth and convex near the start, and Newton converges quadratically in about 3-5 steps.  40 is a
-# generous cap that only sub-millimetre-inconsistent inputs far from any pose could approach.
+# FK fits beta to (l1, l2) by Newton's method from the exact closed form: no step for consistent
+# lengths, 3-5 (quadratic) for noisy ones; 40 is a cap only far-inconsistent inputs could approach.
 FK_MAX_ITER = 40
 # Newton stops when the beta step falls below this (rad): 100x the rounding of an O(1) angle, far
 # below the 1e-10 rad accuracy the tests require (used where the Gauss-Newton fallback is active).
 FK_STEP_TOL = 1e-14
-# With Newton's own curvature the convergence is quadratic (f'' is bounded away from zero since
-# dl1/db and dl2/db never vanish together), so after a step below 1e-8 rad the remaining error is
-# of order step^2 ~ 1e-16 rad: the step is applied and the iteration stops, saving one iteration.
+# Newton converges quadratically (dl1/db and dl2/db never vanish together), so after a step below 1e-8
+# rad the remaining error is ~step^2 ~ 1e-16 rad: the step is applied and the iteration stops.
 FK_NEWTON_STEP_TOL = 1e-8
 # |sin(alpha - phi)| may exceed 1 by rounding when l3 sits exactly on the branch boundary (the
 # l3-singularity); up to this excess the value is clipped, beyond it the lengths have no assembly.
 ASSEMBLY_TOL = 1e-12
-# Derivatives divide by the leg length; B_i can only reach A_i in a collided pose far outside any
-# stroke (length_min > 0). The length is floored here so such a pose gives a huge finite derivative
-# (flagged by within_limits) rather than a division-by-zero warning.
+# Derivatives divide by the leg length, zero only in a collided pose far outside any stroke: floored so
+# such a pose gives a huge finite derivative (flagged by within_limits), not a division by zero.
 LENGTH_FLOOR = 1e-12
 # Large batches are evaluated in chunks of this many samples so that a kernel's temporaries (about
 # twenty arrays of 16384 float64 = 128 KiB each) stay in the L2 cache instead of streaming through
@@ -88,7 +75,7 @@ def _check_state(q: object, qd: object, qdd: object = _NO_QDD) -> tuple[np.ndarr
 
 @carries_failed_rows({"alpha": 0, "beta": 0})
 def platform_rotation(alpha: object, beta: object) -> np.ndarray:
-    """Platform rotation ``T = Rx(alpha) Ry(beta)`` (paper 1, eq. (1)).
+    """Platform rotation ``R_base_platform = Rx(alpha) Ry(beta)`` (paper 1, eq. (1)).
 
     Parameters
     ----------
@@ -98,13 +85,6 @@ def platform_rotation(alpha: object, beta: object) -> np.ndarray:
     Returns
     -------
     ndarray, shape (..., 3, 3)
-        The rotation of the platform frame relative to the base frame (``R_base_platform``).
-
-    Examples
-    --------
-    >>> from robomech.mechanisms import spherical_leg as sl
-    >>> sl.platform_rotation([0.0, 0.1], 0.2).shape
-    (2, 3, 3)
     """
     a, b = _angles(alpha, beta)
     return _rotation(np.sin(a), np.cos(a), np.sin(b), np.cos(b))
@@ -137,16 +117,14 @@ def _squared_lengths(leg: SphericalLeg, sa, ca, sb, cb) -> np.ndarray:
 
 @dataclass(frozen=True)
 class InverseKinematicsResult:
-    """Leg lengths and geometry for platform angles (alpha, beta) (the result of :func:`inverse_kinematics`).
+    """Leg lengths and geometry (the result of :func:`inverse_kinematics`).
 
     Attributes
     ----------
     lengths : ndarray, shape (..., 3)
         Leg lengths l_i (m).
-    unit_vectors : ndarray, shape (..., 3, 3)
-        Rows ``s_i = (B_i - A_i) / l_i``: leg directions (base frame).
-    platform_points : ndarray, shape (..., 3, 3)
-        Rows B_i (m, base frame, relative to O).
+    unit_vectors, platform_points : ndarray, shape (..., 3, 3)
+        Rows ``s_i = (B_i - A_i) / l_i`` (leg directions) and B_i (m, relative to O), base frame.
     base_points : ndarray, shape (3, 3)
         Rows A_i (m, base frame).
     within_limits : ndarray of bool, shape (..., 3)
@@ -164,24 +142,14 @@ class InverseKinematicsResult:
 def inverse_kinematics(leg: SphericalLeg, alpha: object, beta: object) -> InverseKinematicsResult:
     """Leg lengths (paper 1, eq. (4)) for platform angles ``alpha``, ``beta`` (rad, broadcast).
 
-    Every finite (alpha, beta) has a solution; a NaN angle marks a failed sample (NaN lengths, False
-    ``within_limits`` there), ±inf raises ``ValueError``.
-
     Parameters
     ----------
     leg : SphericalLeg
     alpha, beta : array_like, shape (...)
-        Platform angles (rad); broadcast together.
 
     Returns
     -------
     :class:`InverseKinematicsResult`
-
-    Examples
-    --------
-    >>> from robomech.mechanisms import spherical_leg as sl
-    >>> sl.inverse_kinematics(sl.SphericalLeg.paper(), 0.1, 0.05).lengths.round(5)   # m
-    array([0.10621, 0.11305, 0.11637])
     """
     check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
@@ -204,7 +172,7 @@ def inverse_kinematics(leg: SphericalLeg, alpha: object, beta: object) -> Invers
 
 def _ik_kernel(leg: SphericalLeg, a, b, L, S, B) -> None:
     """B_i = T b_i written out (paper 1, eq. (3) and its analogues), lengths from the closed form."""
-    R, r, h = leg.R, leg.r, leg.h
+    r, h = leg.r, leg.h
     (sa, ca), (sb, cb) = sincos(a), sincos(b)
     rsb_m_hcb = r * sb - h * cb
     rsb_p_hcb = r * sb + h * cb
@@ -219,10 +187,7 @@ def _ik_kernel(leg: SphericalLeg, a, b, L, S, B) -> None:
     B[:, 2, 1] = r * ca - sa * hcb
     B[:, 2, 2] = r * sa + ca * hcb
     # the closed form keeps full relative accuracy where |B - A| is small
-    K = R * R + r * r + h * h
-    L[:, 0] = K - 2 * R * (r * cb + h * sb)
-    L[:, 1] = K - 2 * R * (r * cb - h * sb)
-    L[:, 2] = K - 2 * R * (r * ca - hcb * sa)
+    L[:, 0], L[:, 1], L[:, 2] = _squared_length_columns(leg, sa, ca, sb, cb)
     np.sqrt(np.maximum(L, 0.0, out=L), out=L)
     np.subtract(B, leg.base_points, out=S)
     S /= np.where(L > 0, L, 1.0)[:, :, None]
@@ -239,10 +204,8 @@ class ForwardKinematicsResult:
     residual : ndarray, shape (...)
         Norm of ``l(alpha, beta) - lengths`` (m): how inconsistent the three lengths are (rounding
         level for exact lengths).
-    valid : ndarray of bool, shape (...)
-        Finite positive lengths that assemble (NaN angles only where this is False).
-    converged : ndarray of bool, shape (...)
-        The beta fit converged.
+    valid, converged : ndarray of bool, shape (...)
+        Finite positive lengths that assemble (NaN angles only where this is False); the beta fit converged.
     """
 
     alpha: np.ndarray
@@ -257,26 +220,18 @@ def forward_kinematics(
 ) -> ForwardKinematicsResult:
     """Platform angles from leg lengths ``(..., 3)`` (m): exact closed form, least squares if noisy.
 
-    beta is the least-squares fit of (l1, l2) (which depend on beta only), started from the exact
-    ``atan2`` form built from l2^2 - l1^2 and l1^2 + l2^2; alpha then matches l3 exactly:
-    ``h cos b sin a - r cos a = (l3^2 - K) / (2R)``, i.e. ``sin(a - phi) = s`` with
-    ``phi = atan2(r, h cos b)``. ``branch=0`` is the assembly ``a = phi + asin(s)`` that contains
-    alpha = 0; ``branch=1`` is ``a = phi + pi - asin(s)``.
-
-    ``paper_as_printed=True`` runs paper 1's printed pipeline instead (eq. (6), the quartic of eq. (7)
-    with its lost square, Ferrari with the misprinted resolvent, α = arctan(2a); ``_as_printed.py``),
-    for comparison only: its ``residual`` shows how far the printed α is from assembling the lengths
-    (``branch`` is then ignored: the print keeps the real root in (-π/2, π/2) that fits l3 best).
+    beta fits (l1, l2) (Newton from the exact ``atan2`` form), then alpha matches l3 exactly on the
+    assembly ``branch``: ``sin(alpha - phi) = s``, branch 0 ``alpha = phi + asin(s)`` contains alpha = 0,
+    branch 1 is ``phi + pi - asin(s)`` (docs/mechanisms/spherical_leg.md, "Departures").
 
     Parameters
     ----------
     leg : SphericalLeg
     lengths : array_like, shape (..., 3)
-        Leg lengths ``(l1, l2, l3)`` (m).
     branch : {0, 1}, optional
-        Assembly branch of alpha (0: the one containing alpha = 0).
     paper_as_printed : bool, optional
-        Run paper 1's printed pipeline instead (for comparison only).
+        Run paper 1's printed eqs. (6)-(7) instead (``_as_printed.py``), for comparison only:
+        ``residual`` then shows how far the printed alpha is from assembling; ``branch`` is ignored.
 
     Returns
     -------
@@ -314,12 +269,9 @@ def forward_kinematics(
 def _fk_kernel_compiled(
     leg: SphericalLeg, branch: int, L, alpha_out, beta_out, resid_out, valid_out, conv_out
 ) -> None:
-    """Forward kinematics of a flat batch: the Newton fit of beta and the closed form of alpha in two
-    compiled per-sample kernels (``fit`` and ``close``, below); the three transcendental calls
-    stay in numpy, whose SIMD atan2/tan are several times faster than the scalar libm calls numba makes.
-    Runs on the whole batch: each compiled kernel is one parallel region (one per cache-sized chunk cost
-    ~8 ms each when another process held the second core: the region waits for a scheduler slice).
-    """
+    """FK of a flat batch: compiled ``fit`` (Newton on beta) and ``close`` (alpha, residual) over the
+    whole batch (a parallel region per chunk cost ~8 ms each under load); the transcendental calls stay
+    in numpy, whose SIMD atan2/tan are several times faster than numba's scalar libm calls."""
     fit, close = _fk_numba_kernels()
     R, r, h = leg.R, leg.r, leg.h
     n = L.shape[0]
@@ -331,22 +283,8 @@ def _fk_kernel_compiled(
         np.arctan2(sb[c], cb[c], out=beta_out[c])
         sb[c], cb[c] = sincos(beta_out[c])
     sa, ca = np.empty(n), np.empty(n)
-    close(
-        M,
-        R,
-        r,
-        h,
-        -1.0 if branch == 1 else 1.0,
-        ASSEMBLY_TOL,
-        sb,
-        cb,
-        sa,
-        ca,
-        beta_out,
-        resid_out,
-        valid_out,
-        conv_out,
-    )
+    sign = -1.0 if branch == 1 else 1.0
+    close(M, R, r, h, sign, ASSEMBLY_TOL, sb, cb, sa, ca, beta_out, resid_out, valid_out, conv_out)
     np.arctan2(sa, ca, out=alpha_out)
 
 
@@ -457,26 +395,16 @@ def _fk_numba_kernels():
 
 @carries_failed_rows({"alpha": 0, "beta": 0})
 def jacobian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
-    """``J[..., i, j] = d l_i / d (alpha, beta)_j`` -> (..., 3, 2) in m/rad.
+    """Leg Jacobian ``J[..., i, j] = d l_i / d (alpha, beta)_j`` (m/rad).
 
     Parameters
     ----------
     leg : SphericalLeg
     alpha, beta : array_like, shape (...)
-        Platform angles (rad); broadcast together.
 
     Returns
     -------
     ndarray, shape (..., 3, 2)
-        ``d l_i / d(alpha, beta)_j`` (m/rad).
-
-    Examples
-    --------
-    >>> from robomech.mechanisms import spherical_leg as sl
-    >>> sl.jacobian(sl.SphericalLeg.paper(), 0.1, 0.05).round(4)
-    array([[ 0.    , -0.0695],
-           [ 0.    ,  0.0673],
-           [ 0.066 , -0.0003]])
     """
     check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
@@ -494,14 +422,14 @@ def _jacobian_kernel(leg: SphericalLeg, a, b, J) -> None:
 def _jacobian_sincos(leg, sa, ca, sb, cb, J) -> None:
     """J from the sines and cosines; ``leg``'s R, r, h may be per-design arrays broadcasting with them."""
     R, r, h = leg.R, leg.r, leg.h
-    K = R * R + r * r + h * h
-    rcb, hsb, rsb, hcb = r * cb, h * sb, r * sb, h * cb
-    # dl/dq = (dq/dq) / (2 l) with q = l^2 (module docstring); R/l below is 2R / (2l)
+    hsb, rsb, hcb = h * sb, r * sb, h * cb
+    q1, q2, q3 = _squared_length_columns(leg, sa, ca, sb, cb)
+    # dl/dq = (dq/dq) / (2 l) with q = l^2; R/l below is 2R / (2l)
     J[..., 0, 0] = 0.0
     J[..., 1, 0] = 0.0
-    J[..., 0, 1] = (rsb - hcb) * R / np.sqrt(np.maximum(K - 2 * R * (rcb + hsb), LENGTH_FLOOR**2))
-    J[..., 1, 1] = (rsb + hcb) * R / np.sqrt(np.maximum(K - 2 * R * (rcb - hsb), LENGTH_FLOOR**2))
-    k3 = R / np.sqrt(np.maximum(K - 2 * R * (r * ca - hcb * sa), LENGTH_FLOOR**2))
+    J[..., 0, 1] = (rsb - hcb) * R / np.sqrt(np.maximum(q1, LENGTH_FLOOR**2))
+    J[..., 1, 1] = (rsb + hcb) * R / np.sqrt(np.maximum(q2, LENGTH_FLOOR**2))
+    k3 = R / np.sqrt(np.maximum(q3, LENGTH_FLOOR**2))
     J[..., 2, 0] = (r * sa + hcb * ca) * k3
     J[..., 2, 1] = -(hsb * sa) * k3
 
@@ -509,86 +437,61 @@ def _jacobian_sincos(leg, sa, ca, sb, cb, J) -> None:
 def _derivatives(leg: SphericalLeg, sa, ca, sb, cb):
     """Squared lengths q (..., 3), dq (..., 3, 2) and d2q (..., 3, 2, 2) w.r.t. (alpha, beta)."""
     R, r, h = leg.R, leg.r, leg.h
-    z = np.zeros_like(sa)
     q = _squared_lengths(leg, sa, ca, sb, cb)
-    dq = np.stack(
-        [
-            np.stack([z, 2 * R * (r * sb - h * cb)], -1),
-            np.stack([z, 2 * R * (r * sb + h * cb)], -1),
-            np.stack([2 * R * (r * sa + h * cb * ca), -2 * R * h * sb * sa], -1),
-        ],
-        -2,
-    )
-    d2q = np.stack(
-        [
-            np.stack([np.stack([z, z], -1), np.stack([z, 2 * R * (r * cb + h * sb)], -1)], -2),
-            np.stack([np.stack([z, z], -1), np.stack([z, 2 * R * (r * cb - h * sb)], -1)], -2),
-            np.stack(
-                [
-                    np.stack([2 * R * (r * ca - h * cb * sa), -2 * R * h * sb * ca], -1),
-                    np.stack([-2 * R * h * sb * ca, -2 * R * h * cb * sa], -1),
-                ],
-                -2,
-            ),
-        ],
-        -3,
-    )
+    dq = np.zeros((*sa.shape, 3, 2))
+    dq[..., 0, 1] = 2 * R * (r * sb - h * cb)
+    dq[..., 1, 1] = 2 * R * (r * sb + h * cb)
+    dq[..., 2, 0] = 2 * R * (r * sa + h * cb * ca)
+    dq[..., 2, 1] = -2 * R * h * sb * sa
+    d2q = np.zeros((*sa.shape, 3, 2, 2))
+    d2q[..., 0, 1, 1] = 2 * R * (r * cb + h * sb)
+    d2q[..., 1, 1, 1] = 2 * R * (r * cb - h * sb)
+    d2q[..., 2, 0, 0] = 2 * R * (r * ca - h * cb * sa)
+    d2q[..., 2, 0, 1] = d2q[..., 2, 1, 0] = -2 * R * h * sb * ca
+    d2q[..., 2, 1, 1] = -2 * R * h * cb * sa
     return q, dq, d2q
 
 
 @carries_failed_rows({"alpha": 0, "beta": 0})
 def hessian(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
-    """Second derivatives of the leg lengths, ``H[..., i, j, k] = d^2 l_i / dq_j dq_k``, q = (alpha, beta).
+    """``H[..., i, j, k] = d^2 l_i / dq_j dq_k`` (m/rad^2), q = (alpha, beta): d :func:`jacobian` / dq.
 
     Parameters
     ----------
     leg : SphericalLeg
     alpha, beta : array_like, shape (...)
-        Platform angles (rad); broadcast together.
 
     Returns
     -------
     ndarray, shape (..., 3, 2, 2)
-        ``d^2 l_i / dq_j dq_k`` (m/rad^2), symmetric in (j, k); the derivative of :func:`jacobian`.
-
-    Examples
-    --------
-    >>> from robomech.mechanisms import spherical_leg as sl
-    >>> sl.hessian(sl.SphericalLeg.paper(), [0.0, 0.1], 0.05).shape
-    (2, 3, 2, 2)
     """
     check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)
+    return _lengths_jh(leg, a, b)[2]
+
+
+def _lengths_jh(leg: SphericalLeg, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Leg lengths l, J = dl/dq and H = d2l/dq2 at q = (a, b), from the squared lengths' derivatives."""
     q, dq, d2q = _derivatives(leg, np.sin(a), np.cos(a), np.sin(b), np.cos(b))
-    l = np.sqrt(np.maximum(q, LENGTH_FLOOR**2))[..., None, None]
-    # l = sqrt(q): l'' = q''/(2l) - q' q'^T / (4 l^3)
-    return d2q / (2 * l) - np.einsum("...ij,...ik->...ijk", dq, dq) / (4 * l**3)
+    l = np.sqrt(np.maximum(q, LENGTH_FLOOR**2))
+    ln = l[..., None, None]
+    # l = sqrt(q): l' = q'/(2l), l'' = q''/(2l) - q' q'^T / (4 l^3)
+    H = d2q / (2 * ln) - np.einsum("...ij,...ik->...ijk", dq, dq) / (4 * ln**3)
+    return l, dq / (2 * l[..., None]), H
 
 
 @carries_failed_rows({"alpha": 0})
 def angular_velocity_jacobian(alpha: object) -> np.ndarray:
-    """``E`` with platform angular velocity ``omega = E (alpha_dot, beta_dot)`` (base frame), (..., 3, 2).
-
-    For T = Rx(alpha) Ry(beta): omega = alpha_dot x + beta_dot Rx(alpha) y.
+    """``E = [x, Rx(alpha) y]``: platform angular velocity ``omega = E (alpha_dot, beta_dot)`` (base frame).
 
     Parameters
     ----------
     alpha : array_like, shape (...)
-        Platform angle alpha (rad); ``E`` does not depend on beta.
+        ``E`` does not depend on beta.
 
     Returns
     -------
     ndarray, shape (..., 3, 2)
-        ``E`` (rad/s of omega, base frame, per rad/s of (alpha_dot, beta_dot)): columns ``x`` and
-        ``Rx(alpha) y``.
-
-    Examples
-    --------
-    >>> from robomech.mechanisms import spherical_leg as sl
-    >>> sl.angular_velocity_jacobian(0.0)
-    array([[1., 0.],
-           [0., 1.],
-           [0., 0.]])
     """
     a = as_array(alpha, "alpha")
     E = np.zeros((*a.shape, 3, 2))
@@ -600,30 +503,20 @@ def angular_velocity_jacobian(alpha: object) -> np.ndarray:
 
 @carries_failed_rows({"alpha": 0, "beta": 0})
 def influence_coefficients(leg: SphericalLeg, alpha: object, beta: object) -> np.ndarray:
-    """First-order influence coefficients: ``ldot = G [omega; v_O]`` -> G (..., 3, 6).
+    """First-order influence coefficients ``G``: ``ldot = G [omega; v_O]`` (base frame, about O).
 
-    Row i is the Pluecker line of leg i, ``[(B_i - O) x s_i; s_i]``, acting on the platform twist
-    ``[omega; v_O]`` (base frame, reference point O; for this leg v_O = 0 since O is fixed). This is
-    paper 1, eqs. (8)-(12) with the reference point moved from P to O; eq. (12)'s first row lacks a
-    factor sin(alpha) on its ``R r`` term (errata). ``jacobian = G[..., :3] @ angular_velocity_jacobian``.
+    Row i is the Plücker line of leg i, ``[(B_i - O) x s_i; s_i]``: paper 1, eqs. (8)-(12) about O
+    instead of P, eq. (12)'s first row with its missing sin(alpha) restored (errata).
+    ``jacobian = G[..., :3] @ angular_velocity_jacobian``.
 
     Parameters
     ----------
     leg : SphericalLeg
     alpha, beta : array_like, shape (...)
-        Platform angles (rad); broadcast together.
 
     Returns
     -------
     ndarray, shape (..., 3, 6)
-        ``G``: row i is ``[(B_i - O) x s_i; s_i]`` (first three columns in m, last three unit-free),
-        base frame, so that ``ldot = G @ [omega; v_O]`` (m/s).
-
-    Examples
-    --------
-    >>> from robomech.mechanisms import spherical_leg as sl
-    >>> sl.influence_coefficients(sl.SphericalLeg.paper(), 0.1, 0.05).shape
-    (3, 6)
     """
     check_params(leg, SphericalLeg, "leg")
     ik = inverse_kinematics(leg, alpha, beta)
@@ -637,47 +530,23 @@ def influence_coefficients(leg: SphericalLeg, alpha: object, beta: object) -> np
 def leg_rates(
     leg: SphericalLeg, q: object, qd: object, qdd: object
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Leg lengths, rates and accelerations ``(l, ldot, lddot)`` (each (..., 3)) along q = (alpha, beta).
+    """Leg lengths (m), rates (m/s), accelerations (m/s²) ``(l, ldot, lddot)`` along q = (alpha, beta).
 
-    ``ldot = J qd``, ``lddot = J qdd + qd^T H qd`` (conventions: H[..., i, j, k] = dJ_ij/dq_k). This
-    replaces paper 1, eqs. (13)-(17), whose printed acceleration is wrong (see the comment in the code).
+    ``ldot = J qd``, ``lddot = J qdd + qd^T H qd``, replacing paper 1, eqs. (13)-(17) (see the code).
 
     Parameters
     ----------
     leg : SphericalLeg
-    q : array_like, shape (..., 2)
-        Platform angles ``(alpha, beta)`` (rad).
-    qd : array_like, shape (..., 2)
-        Their rates (rad/s).
-    qdd : array_like, shape (..., 2)
-        Their accelerations (rad/s^2). ``q``, ``qd`` and ``qdd`` broadcast together.
+    q, qd, qdd : array_like, shape (..., 2)
+        Platform angles ``(alpha, beta)`` (rad), their rates and accelerations; broadcast together.
 
     Returns
     -------
-    l : ndarray, shape (..., 3)
-        Leg lengths (m).
-    ldot : ndarray, shape (..., 3)
-        Leg extension rates (m/s).
-    lddot : ndarray, shape (..., 3)
-        Leg extension accelerations (m/s^2).
-
-    Examples
-    --------
-    >>> from robomech.mechanisms import spherical_leg as sl
-    >>> l, ld, ldd = sl.leg_rates(sl.SphericalLeg.paper(), [0.1, 0.05], [0.0, 0.0], [0.0, 0.0])
-    >>> l.round(5), ld
-    (array([0.10621, 0.11305, 0.11637]), array([0., 0., 0.]))
+    l, ldot, lddot : ndarray, shape (..., 3)
     """
     check_params(leg, SphericalLeg, "leg")
     qa, qda, qdda = _check_state(q, qd, qdd)
-    a, b = qa[..., 0], qa[..., 1]
-    sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
-    qq, dq, d2q = _derivatives(leg, sa, ca, sb, cb)
-    l = np.sqrt(np.maximum(qq, LENGTH_FLOOR**2))
-    J = dq / (2 * l[..., None])
-    H = d2q / (2 * l[..., None, None]) - np.einsum("...ij,...ik->...ijk", dq, dq) / (
-        4 * l[..., None, None] ** 3
-    )
+    l, J, H = _lengths_jh(leg, qa[..., 0], qa[..., 1])
     ld = np.einsum("...ij,...j->...i", J, qda)
     # paper 1, eqs. (13)-(17): printed l*lddot = L.V (for l*ldot) and a scalar (1 - S^2)/l; correct is
     # lddot = s.a_B + v_B^T (I - s s^T) v_B / l = s.a_B + (|v_B|^2 - ldot^2)/l, which J qdd + qd^T H qd

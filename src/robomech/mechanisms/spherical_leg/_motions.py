@@ -17,35 +17,20 @@ FIG5B_TRANSITION = 5.0
 
 
 def sway(t: object, about: str, beta0: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Section 6.1 sway ``A sin(2 pi f t)`` about X (alpha; beta held at ``beta0``) or Y (beta; alpha = 0).
-
-    ``A = AMPLITUDE`` (pi/3 rad) and ``f = FREQUENCY`` (0.05 Hz), as paper 1, Section 6.1 states.
+    """Section 6.1 sway ``AMPLITUDE sin(2 pi FREQUENCY t)`` about X (alpha; beta = ``beta0``) or Y (beta).
 
     Parameters
     ----------
     t : array_like, shape (...)
         Times (s).
     about : {"x", "y"}
-        The sway axis: ``"x"`` sways alpha, ``"y"`` sways beta.
     beta0 : float, optional
-        The constant beta (rad) held during a sway about X (ignored for ``"y"``).
+        The constant beta (rad) of a sway about X.
 
     Returns
     -------
-    q : ndarray, shape (..., 2)
-        Platform angles ``(alpha, beta)`` (rad).
-    qd : ndarray, shape (..., 2)
-        Their rates (rad/s).
-    qdd : ndarray, shape (..., 2)
-        Their accelerations (rad/s^2).
-
-    Examples
-    --------
-    >>> from robomech.mechanisms import spherical_leg as sl
-    >>> q, qd, qdd = sl.sway([0.0, 5.0], "x", beta0=0.5)
-    >>> q.round(6)
-    array([[0.      , 0.5     ],
-           [1.047198, 0.5     ]])
+    q, qd, qdd : ndarray, shape (..., 2)
+        Platform angles ``(alpha, beta)`` (rad), their rates and accelerations.
     """
     check_choice(about, "about", ("x", "y"))
     beta0 = check_real(beta0, "beta0")
@@ -58,28 +43,21 @@ def sway(t: object, about: str, beta0: float = 0.0) -> tuple[np.ndarray, np.ndar
 
 
 def fig5_motion(case: str, t: object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The motions of Fig. 5, each returned as q, qd, qdd (..., 2).
+    """The motions of Fig. 5 (docs/mechanisms/spherical_leg.md, assumption 7).
 
-    ``"a"``: sway about X at beta = pi/3. ``"b"``: beta pi/3 -> pi/6 in 5 s, then sway about X from
-    alpha = 0 (one period = 20 s); as printed the sine starts from rest, so alpha_dot steps by
-    A 2 pi f = 0.33 rad/s at t = 5 s (an impulse the forces cannot show). ``"c"``: sway about X at
-    beta = 0 (the print does not state beta for case (c): an assumption).
+    ``"a"``: sway about X at beta = pi/3; ``"b"``: beta pi/3 -> pi/6 in 5 s, then a sway about X from
+    alpha = 0; ``"c"``: sway about X at beta = 0 (assumed: the print does not state beta).
 
     Parameters
     ----------
     case : {"a", "b", "c"}
-        The panel of paper 1, Fig. 5.
     t : array_like, shape (...)
         Times (s).
 
     Returns
     -------
-    q : ndarray, shape (..., 2)
-        Platform angles ``(alpha, beta)`` (rad).
-    qd : ndarray, shape (..., 2)
-        Their rates (rad/s).
-    qdd : ndarray, shape (..., 2)
-        Their accelerations (rad/s^2).
+    q, qd, qdd : ndarray, shape (..., 2)
+        As :func:`sway`.
 
     Examples
     --------
@@ -95,8 +73,6 @@ def fig5_motion(case: str, t: object) -> tuple[np.ndarray, np.ndarray, np.ndarra
         return sway(t, "x", np.pi / 3)
     if case == "c":
         return sway(t, "x", 0.0)
-    if case != "b":
-        raise ValueError(f"Expected case to be 'a', 'b' or 'c', got {case!r}.")
     tr = quintic(t, FIG5B_TRANSITION, np.pi / 3, np.pi / 6)
     sw = sinusoid(np.clip(t - FIG5B_TRANSITION, 0.0, None), AMPLITUDE, FREQUENCY)
     on = t >= FIG5B_TRANSITION

@@ -1,43 +1,24 @@
-"""The spherical parallel leg described generically (``robomech.multibody``), from its parameters.
-
-Nothing here is derived by hand: the generic layer assembles, differentiates and analyses this
-description, and the tests compare it with the closed forms of ``_kinematics.py`` (lengths, FK from
-three lengths, J, H) to 1e-10.
-
-* central chain 0 (RUR): two hinges at O, ``alpha`` about X then ``beta`` about the turned Y, so the
-  platform turns by ``Rx(alpha) Ry(beta)`` about O (paper 1, eq. (1));
-* leg i: a universal joint at A_i (two hinges across the leg: ``u{i}a`` about ``leg.cardan_axes[i]``,
-  fixed in the base, then ``u{i}b`` about the turned axis; the analytic dynamics carries the spin of
-  the leg about its axis that this joint imposes), then the upper body sliding along the
-  leg (qpos of ``l{i}`` = length - home length), and a point closure (the upper spherical joint) at
-  B_i; legs 1 and 3 also carry the lead screw, spinning about the leg axis at 2 pi / lead per metre of
-  stroke (a joint coupling, ``screw_spin``), as the analytic dynamics assumes.
-* inertias as in ``_params.py`` (lower body from A_i, upper body ending at B_i, platform box about P);
-  the cardan and the central chain are massless there and have no ``Inertial`` here.
-
-``actuate="legs"`` (the robot: three legs on a 2-DOF platform, redundantly actuated) or
-``"platform"`` (alpha, beta as inputs: then ``G``'s leg rows are the analytic Jacobian dl/d(alpha, beta)).
-"""
+"""The spherical parallel leg described generically (``robomech.multibody``), from its parameters: chains,
+joints and closures in docs/mechanisms/spherical_leg.md, "Generic description"."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from robomech.multibody import Builder, Inertial, Mechanism
+from robomech.multibody._model import _quat_from_matrix
 
 from ._params import SphericalLeg
 
 __all__ = ["to_multibody"]
 
 
-def _quat(R: np.ndarray) -> tuple[float, ...]:
-    from robomech.multibody._model import _quat_from_matrix
-
-    return tuple(_quat_from_matrix(R))
-
-
 def to_multibody(leg: SphericalLeg, actuate: str = "legs") -> Mechanism:
-    """The generic description of ``leg``; q_act = the leg extensions, or (alpha, beta)."""
+    """The generic description of ``leg``; q_act = the leg extensions, or (alpha, beta).
+
+    ``actuate="legs"``: the robot, three legs on a 2-DOF platform (redundantly actuated);
+    ``"platform"``: alpha, beta as inputs (then ``G``'s leg rows are the analytic J).
+    """
     if not isinstance(leg, SphericalLeg):
         raise ValueError(f"Expected leg to be a SphericalLeg, got {type(leg).__name__}.")
     if actuate not in ("legs", "platform"):
@@ -65,7 +46,7 @@ def to_multibody(leg: SphericalLeg, actuate: str = "legs") -> Mechanism:
         b.body(
             f"cardan{k}",
             pos=A[i],
-            quat=_quat(R),
+            quat=_quat_from_matrix(R),
             joints=[b.hinge(f"u{k}a", axis=(0, 1, 0)), b.hinge(f"u{k}b", axis=(0, 0, 1))],
         )
         lower = Inertial(

@@ -1,17 +1,5 @@
-"""Parameters of the 2RUHU-RUPR-RUR spherical parallel leg (paper 1), in SI units.
-
-Geometry (paper 1, Section 3.1): base joints A1 = (R, 0, 0), A2 = (-R, 0, 0), A3 = (0, R, 0); platform
-joints at the home pose B1 = (r, 0, h), B2 = (-r, 0, h), B3 = (0, r, h); platform centre P = (0, 0, h).
-Table 1 is reproduced exactly by R = 75 mm, r = 30 mm, h = 100 mm (errata; h is Table 2's H).
-
-Inertial model (assumptions, see ``docs/mechanisms/spherical_leg.md``): each leg is two bodies of
-Table 2. The *lower* body is joined to the base at A_i, its near end at A_i (centre of mass at half its
-length from A_i); the *upper* body is joined to the platform at B_i, its far end at B_i. Legs 1 and 3
-(RUHU): lower = lead screw (solid cylinder 110 x 30 mm, 2 kg, 10 mm lead), upper = sleeve (70 mm,
-20 mm outer diameter, 10 mm wall, 1.5 kg). Leg 2 (RUPR): lower = cylinder (square tube 70 x 40 mm,
-10 mm wall, 1 kg), upper = piston (solid bar 110 x 30 x 30 mm, 1 kg). Platform: uniform box
-60 x 60 x 20 mm, 5 kg, centred at P. The central passive chain 0 (RUR) is massless (no data given).
-"""
+"""Parameters of the 2RUHU-RUPR-RUR spherical parallel leg (paper 1, Tables 1-2), in SI units; geometry,
+inertial model and the justification of every value: docs/mechanisms/spherical_leg.md."""
 
 from __future__ import annotations
 
@@ -37,30 +25,17 @@ def _positive(obj: object, field_name: str, label: str, *, allow_zero: bool = Fa
 class LegBody:
     """One rigid body of a leg, modelled as a uniform prism along the leg axis.
 
-    ``shape`` is ``"round"`` (cylinder of outer diameter ``width``) or ``"square"`` (square section of
-    side ``width``); ``wall`` is the wall thickness of a hollow section (``wall >= width / 2`` means
-    solid). Lengths in metres, mass in kg.
-
     Parameters
     ----------
     name : str
         Label used in error messages (e.g. ``"screw"``).
-    length : float
-        Length along the leg axis (m, > 0).
-    width : float
-        Outer diameter (round) or side (square) of the section (m, > 0).
-    wall : float
-        Wall thickness of the section (m, > 0; ``>= width / 2``: solid).
+    length, width, wall : float
+        Length along the leg axis, outer diameter (round) or side (square) of the section, and its wall
+        thickness (``>= width / 2``: solid); m, > 0.
     mass : float
         Mass (kg, >= 0).
     shape : {"round", "square"}, optional
         Section shape.
-
-    Raises
-    ------
-    ValueError
-        If ``name`` is not a str, a dimension is not positive, ``mass`` is negative or ``shape`` is not
-        ``"round"`` or ``"square"``.
     """
 
     name: str
@@ -92,54 +67,32 @@ class LegBody:
 
     @property
     def transverse_inertia(self) -> float:
-        """Moment of inertia about a transverse axis through the centre of mass (kg m^2).
-
-        Both section shapes have equal second moments about every transverse axis (a square's
-        section is isotropic), so the body is inertially axisymmetric.
-        """
+        """Moment of inertia about a transverse axis through the centre of mass (kg m^2); both section
+        shapes are isotropic, so the body is inertially axisymmetric."""
         return 0.5 * self.axial_inertia + self.mass * self.length**2 / 12.0
 
 
 @dataclass(frozen=True)
 class SphericalLeg:
-    """Frozen parameters of the spherical parallel leg (SI units, radians).
-
-    ``R``, ``r``: radii of the base and platform joint circles (OA_i, PB_i); ``h``: distance OP at the
-    home pose. ``lower``/``upper``: the two bodies of each leg (index 0, 1, 2 = legs 1, 2, 3).
-    ``screw_lead``: lead of the helical joints of legs 1 and 3; the lower body of those legs (the
-    screw) spins about the leg axis at ``2 pi ldot / screw_lead`` relative to the upper body when
-    ``screw_spin`` is true. ``length_min``/``length_max``: leg stroke limits (the paper gives none).
-    ``gravity``: acceleration vector in the base frame (paper: (0, 0, -10) m/s^2).
+    """Frozen parameters of the spherical parallel leg (SI units, radians); defaults and their sources (the
+    leg stroke is not printed): docs/mechanisms/spherical_leg.md, "Parameters".
 
     Parameters
     ----------
-    R : float
-        Radius OA_i of the base joint circle (m); paper: 75 mm.
-    r : float
-        Radius PB_i of the platform joint circle (m); paper: 30 mm.
-    h : float
-        Distance OP at the home pose (m); paper: 100 mm.
-    platform_side, platform_thickness : float
-        Side and thickness of the box-shaped platform (m); paper: 60 mm, 20 mm.
-    platform_mass : float
-        Platform mass (kg, >= 0); paper: 5 kg.
+    R, r, h : float
+        Radii OA_i, PB_i of the base and platform joint circles and distance OP at the home pose (m).
+    platform_side, platform_thickness, platform_mass : float
+        The box-shaped platform's side and thickness (m) and mass (kg, >= 0).
     lower, upper : tuple of LegBody
-        The lower (at A_i) and upper (at B_i) body of each of the three legs.
+        The lower (starting at A_i) and upper (ending at B_i) body of legs 1, 2, 3.
     screw_lead : float
-        Lead of the helical joints of legs 1 and 3 (m per turn); paper: 10 mm.
+        Lead of the helical joints of legs 1 and 3 (m per turn).
     screw_spin : bool
-        Whether the screw spins relative to the sleeve at ``2 pi ldot / screw_lead`` (the dynamics).
+        Whether the screw (lower body of legs 1, 3) spins relative to the sleeve at 2 pi ldot / screw_lead.
     length_min, length_max : float
-        Leg stroke limits (m), ``length_max > length_min >= 0``; not printed (30 mm, 170 mm).
+        Leg stroke limits (m), ``length_max > length_min >= 0``.
     gravity : tuple of float
         Gravitational acceleration in the base frame (m/s^2).
-
-    Raises
-    ------
-    ValueError
-        If a length or ``screw_lead`` is not positive, a mass is negative, ``length_max <=
-        length_min``, ``lower``/``upper`` is not three :class:`LegBody`, or ``gravity`` is not three
-        finite numbers.
     """
 
     R: float = 75 * _MM
@@ -197,7 +150,7 @@ class SphericalLeg:
 
     @classmethod
     def paper(cls) -> SphericalLeg:
-        """The paper's values (Tables 1-2, Section 6.1) converted to SI; see the module docstring."""
+        """The paper's values (Tables 1-2, Section 6.1) converted to SI."""
         return cls()
 
     # --- derived geometry (cheap properties, no state) -------------------------------------------------
@@ -219,15 +172,8 @@ class SphericalLeg:
 
     @property
     def cardan_axes(self) -> np.ndarray:
-        """First (base-fixed) axis ``a_i`` of the universal joint at A_i, (3, 3) rows = legs 1..3.
-
-        The paper gives no U-joint axis directions (assumption, docs/mechanisms/spherical_leg.md): the
-        first axis is horizontal and perpendicular to the leg at the home pose, ``a_i = Z x s_i(0)``
-        normalised, i.e. tangent to the base circle (for a leg within ~6 deg of vertical at home,
-        ``R`` close to ``r``: ``Y`` made perpendicular to the leg); the second axis turns with it and
-        is perpendicular to both ``a_i`` and the leg.  This fixes the spin of each leg about its own
-        axis, ``w . s = sin(u_b) du_a/dt`` (the dynamics).
-        """
+        """First (base-fixed) axis ``a_i = Z x s_i(0)`` (normalised) of the universal joint at A_i, (3, 3)
+        rows = legs 1..3: an assumption (docs/mechanisms/spherical_leg.md, assumption 3)."""
         u = self.platform_points_home - self.base_points
         x = u / np.linalg.norm(u, axis=-1, keepdims=True)
         out = np.empty((3, 3))

@@ -1,28 +1,6 @@
-"""Forward kinematics along a trajectory of leg lengths that keeps its assembly branch (continuation).
-
-The l3 equation ``sin(α - φ) = s`` has two solutions per sample, ``α0 = φ + asin s`` (branch 0, which
-contains α = 0) and ``α1 = φ + π - asin s`` (branch 1).  They meet where ``|s| = 1``, i.e. on the
-actuation-singular curve ``∂l3/∂α = 0`` (``h cos β cos α + r sin α = 0``).  A motion that crosses that
-curve (paper 1's Fig. 5(a) does, twice per period) passes from one branch to the other: a
-forward kinematics that keeps branch 0 then returns the mirror image of the pose about the curve with a
-residual of 0, indistinguishable from the right pose by the lengths alone.
-
-Both solutions give the same length residual (they are exact mirror images), so the residual cannot tell
-the branches apart; what tells them apart is the motion around the place where they meet.
-:func:`track_branches` solves both branches for every sample and follows the motion: between the
-places where the branches meet the branch cannot change (the two solutions are separated), and at
-each meeting it asks which of two models explains the samples around it better: the signed distance
-from the curve ``σ = ±separation / 2`` passes through zero (a *crossing*: α moves on through the curve,
-the branch changes) or stays on one side (a *touch*: α turns back, the branch is kept).  Each model is
-a cubic least-squares fit of σ over ``MEET_WINDOW`` samples on either side, weighted by the
-distance from the curve (near it, noise in the lengths is amplified: the closed form loses half the
-digits); meetings closer than a window (a dip just beyond the curve on a coarse grid) are decided
-together, every combination of crossing and touch fitted.  A fit over a window, not an
-extrapolation of the last few samples, keeps the choice right on measured lengths: 10 nm of noise
-moves α by up to 2e-3 rad next to the curve, about two sampling steps of Fig. 5(a).  A meeting
-where neither model fits clearly better (``AMBIGUITY_RATIO``) is reported as ``ambiguous``, and
-every later sample of that trajectory is flagged not valid: its branch is not known.
-"""
+"""Forward kinematics along a trajectory of leg lengths that keeps its assembly branch: where the two
+closed-form branches meet, a crossing and a touch are fitted to the signed distance from the singular
+curve and the better fit decides (docs/mechanisms/spherical_leg.md, "Branch tracking")."""
 
 from __future__ import annotations
 
@@ -38,37 +16,24 @@ from ._params import SphericalLeg
 
 __all__ = ["BranchTrack", "track_branches"]
 
-# A local minimum of the branch separation counts as a meeting of the branches (a place where the
-# motion may change branch) when the separation there is at most this many times the motion's step
-# (the largest step per sample within MEET_WINDOW samples, times the gap to the neighbouring valid
-# samples): near the singular curve the separation is 2 |α - α_s| (the two solutions are mirror
-# images about α_s), so a crossing between two samples leaves a separation of at most 2 steps at the
-# nearer one; noise in the lengths moves the samples next to the curve by up to about a step (10-30
-# nm on Fig. 5(a)), hence 4.  A local minimum that is no crossing costs only a fit (it is a touch).
+# A local minimum of the branch separation counts as a meeting of the branches when it is at most this
+# many times the motion's step (per sample, within MEET_WINDOW samples): near the curve the separation
+# is 2 |α - α_s|, so a crossing between two samples leaves at most 2 steps at the nearer one, and noise
+# moves the samples next to the curve by about a step, hence 4 (a local minimum that is no crossing
+# costs only a fit).
 MEET_STEP_FACTOR = 4.0
-# Candidate meetings closer than this many samples are one meeting (noise in the lengths makes the
-# separation wiggle next to the curve and gives several local minima for one passage); two real
-# passages a few samples apart (a dip just beyond the curve on a coarse grid) stay two meetings
-# only if at least one sample separates them, and are then decided together (MEET_CLUSTER_MAX).
+# Candidate meetings closer than this many samples are one meeting (noise makes the separation wiggle
+# next to the curve); two real passages stay two meetings if a sample separates them.
 MEET_MERGE = 1
 # Samples on either side of a meeting that the crossing / touch models are fitted to, and the degree
-# of the polynomial in the sample index they are fitted with: 32 samples average the noise of the
-# samples nearest the curve (with 8, 30 nm of noise left most Fig. 5(a) meetings ambiguous), and a
-# cubic describes σ over that window for a motion sampled finely enough to be tracked (a quadratic
-# misfits the asymmetry of a sway passing the curve near its turning point on a 0.5 s grid and then
-# decides wrongly).  Measured on Fig. 5(a) (grids 0.01-1 s, 10-100 nm of noise) and on random sways:
-# docs/mechanisms/spherical_leg.md.
+# of their polynomial: 32 samples average the noise nearest the curve (with 8, 30 nm of noise left most
+# Fig. 5(a) meetings ambiguous); a quadratic misfits a sway passing the curve near its turning point on
+# a 0.5 s grid, a cubic does not (measured: docs/mechanisms/spherical_leg.md).
 MEET_WINDOW = 16
-# Where MEET_WINDOW leaves a meeting ambiguous, the shorter windows are tried: on a coarse grid (0.25 s
-# or coarser on Fig. 5(a)) 16 samples span several seconds, over which no cubic follows the motion,
-# so both models misfit alike; a window of a few samples is short enough in time for the cubic
-# again.  Their answer is taken only if every shorter window decides (AMBIGUITY_RATIO) and all call
-# the same meetings crossings: noise that leaves the long window undecided (0.1-1 um on a fine grid)
-# makes short windows disagree, where a lone short window could decide wrongly (measured: one in 40
-# runs at 0.1 um on 2001 samples).  Measured on Fig. 5(a) (10 seeds per case): grids of 0.25-0.4 s
-# are then decided, all right, at up to 0.1 um of noise (most 1 um runs stay ambiguous); at 0.5 s and
-# coarser the dip beyond the curve is one or two samples and stays ambiguous; fine grids (1001-3001
-# samples, 40 seeds, 1 nm-1 um) never put a valid sample on the wrong branch.
+# Where MEET_WINDOW leaves a meeting ambiguous, shorter windows are tried (on a coarse grid 16 samples
+# span seconds, over which no cubic follows the motion); their answer is taken only if every one decides
+# and all agree (a lone short window decided wrongly once in 40 runs at 0.1 um of noise on 2001 samples;
+# per grid: docs/mechanisms/spherical_leg.md).
 MEET_WINDOWS = (MEET_WINDOW, 6, 4)
 MEET_FIT_DEGREE = 3
 # The crossing model places the passage through the curve within this many samples of the sample
@@ -103,13 +68,10 @@ class BranchTrack:
         Which closed-form solution the motion is on (0 or 1); -1 where not valid.
     separation : ndarray, shape (..., N)
         Angle between the two solutions (rad); 0 on the singular curve.
-    meeting : ndarray of bool, shape (..., N)
-        Samples where the branches meet (within the sampling, see ``MEET_STEP_FACTOR``), i.e. where the
-        tracker had to choose.
-    switched : ndarray of bool, shape (..., N)
-        The meetings where the motion changed branch.
-    ambiguous : ndarray of bool, shape (..., N)
-        The meetings where the samples do not tell a crossing from a touch (see ``AMBIGUITY_RATIO``).
+    meeting, switched, ambiguous : ndarray of bool, shape (..., N)
+        Samples where the branches meet (within the sampling, ``MEET_STEP_FACTOR``) and the tracker had to
+        choose; those where the motion changed branch; those where the samples do not tell a crossing from
+        a touch (``AMBIGUITY_RATIO``).
     """
 
     alpha: np.ndarray
@@ -134,16 +96,12 @@ def _fit_residual(t: np.ndarray, y: np.ndarray, w: np.ndarray) -> float:
 
 
 def _decide(t: np.ndarray, d: np.ndarray, ks: list[int]) -> tuple[list[int | None], bool]:
-    """Crossing or touch at each meeting of a cluster: ``(splits, ambiguous)``.
+    """Crossing or touch at each meeting ``ks`` of a cluster: ``(splits, ambiguous)``.
 
-    ``t`` are the window's sample indices, ``d`` the distances from the curve (half the separation,
-    rad) and ``ks`` the positions in the window of the meetings (the samples nearest the curve).
-    ``splits[j]`` is the first sample on the far side of meeting j if the motion crosses there,
-    ``None`` for a touch.  Every combination is fitted at once (the sign of σ flips at each crossing),
-    so two meetings closer than a window (a motion that dips just beyond the curve and back) are
-    decided together; a crossing is placed just before or after a sample next to the meeting (noise
-    moves the sample nearest the curve by about a step).  The decision is ambiguous when the best
-    fit with the other parity (the other branch after the cluster) fits almost as well.
+    ``t``: the window's sample indices, ``d``: distances from the curve (rad).  ``splits[j]`` is the
+    first sample beyond meeting j if the motion crosses there, ``None`` for a touch.  Every combination
+    is fitted (the sign of σ flips at each crossing); ambiguous when the best fit with the other parity
+    (the other branch after the cluster) fits almost as well.
     """
     n = t.size
     bounds = [0, *ks[1:], n]  # meeting j may place its crossing in (ks[j-1], ks[j+1]]
@@ -194,35 +152,24 @@ def _short_windows_agree(tries: list[tuple[list[int | None], bool, int]]) -> boo
 
 
 def track_branches(leg: SphericalLeg, lengths: object, *, branch: int = 0) -> BranchTrack:
-    """Platform angles along a trajectory of leg lengths ``(..., N, 3)`` (m), starting on ``branch``.
+    """Platform angles along trajectories of leg lengths, starting on ``branch``.
 
-    The time axis is the second-to-last axis of ``lengths`` (N >= 1 samples in order); leading axes are
-    independent trajectories.  Samples that do not assemble are flagged (``valid`` False) and bridged:
-    the branch carries across them.  Where the two closed-form solutions of :func:`forward_kinematics`
-    meet, the tracker fits the samples around the meeting with a crossing and with a touch of the
-    singular curve and keeps the branch the better fit implies; a meeting neither fit explains clearly
-    better is flagged ``ambiguous`` and the samples after it not ``valid``.
+    Samples that do not assemble are flagged (``valid`` False) and bridged: the branch carries across
+    them.  A meeting of the branches neither fit explains clearly better is flagged ``ambiguous`` and
+    the samples after it not ``valid``.
 
     Parameters
     ----------
     leg : SphericalLeg
-        The leg's geometry (m).
     lengths : array_like, shape (..., N, 3)
-        Leg lengths ``(l1, l2, l3)`` (m) at N >= 1 consecutive samples of each trajectory; non-finite or
-        non-positive samples are flagged, not raised.
+        Leg lengths (m) at N >= 1 consecutive samples (axis -2 is time; leading axes are independent
+        trajectories); non-finite or non-positive samples are flagged, not raised.
     branch : {0, 1}, optional
         The assembly branch at the first sample (0: the one containing alpha = 0).
 
     Returns
     -------
     :class:`BranchTrack`
-        The assembly followed along each path, with branch diagnostics.
-
-    Raises
-    ------
-    ValueError
-        If ``leg`` is not a :class:`SphericalLeg`, ``lengths`` does not end in a sample axis and an axis
-        of 3 or has a non-real dtype, or ``branch`` is not 0 or 1.
 
     Examples
     --------

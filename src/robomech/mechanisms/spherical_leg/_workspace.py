@@ -1,9 +1,5 @@
-"""Reachable workspace and singularity map of the spherical parallel leg over (alpha, beta).
-
-J = dl/d(alpha, beta) has rows (0, dl1/db), (0, dl2/db), (dl3/da, dl3/db): dl1/db and dl2/db never
-vanish together, so J loses rank exactly where dl3/da = 0, i.e. ``h cos b cos a + r sin a = 0``: the
-boundary between the two assembly branches of the l3 equation, where alpha is no longer controlled.
-"""
+"""Reachable workspace and singularity map of the spherical parallel leg over (alpha, beta): J loses rank
+exactly where dl3/dalpha = 0, the boundary of the assembly branches (docs/mechanisms/spherical_leg.md)."""
 
 from __future__ import annotations
 
@@ -13,16 +9,13 @@ import numpy as np
 
 from robomech._batching import carries_failed_rows
 from robomech._validation import check_params
-from robomech.analysis.workspace import SingularityMap, singularity_map
+from robomech.analysis.workspace import SINGULAR_RTOL, SingularityMap, singularity_map
 
 from ._kinematics import _angles, inverse_kinematics, jacobian
 from ._params import SphericalLeg
 
 __all__ = ["WorkspaceMap", "workspace_map"]
 
-# A pose counts as singular when sigma_min/sigma_max of J falls below this (as
-# robomech.analysis.workspace.SINGULAR_RTOL: a 1e8 amplification has no physical meaning here).
-SINGULAR_RTOL = 1e-8
 # Poses whose J condition number exceeds this are reported as ill-conditioned: the platform's
 # sensitivity to leg-length errors then differs by more than 100x between its two directions (both
 # columns of J are in m/rad, so the ratio is unit-free).
@@ -63,9 +56,8 @@ class WorkspaceMap:
 
 @carries_failed_rows({"alpha": 0, "beta": 0})
 def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMap:
-    """Workspace and singularity map at poses ``alpha``, ``beta`` (rad, broadcast) in closed form.
-
-    The singular values of the 3x2 J are :func:`robomech.analysis.workspace.singularity_map`'s.
+    """Workspace and singularity map at poses ``alpha``, ``beta`` (singular values of J by
+    :func:`robomech.analysis.workspace.singularity_map`).
 
     Parameters
     ----------
@@ -76,13 +68,6 @@ def workspace_map(leg: SphericalLeg, alpha: object, beta: object) -> WorkspaceMa
     Returns
     -------
     :class:`WorkspaceMap`
-
-    Examples
-    --------
-    >>> from robomech.mechanisms import spherical_leg as sl
-    >>> ws = sl.workspace_map(sl.SphericalLeg.paper(), [0.0, 0.1], 0.05)
-    >>> ws.lengths.shape, ws.singular
-    ((2, 3), array([False, False]))
     """
     check_params(leg, SphericalLeg, "leg")
     a, b = _angles(alpha, beta)

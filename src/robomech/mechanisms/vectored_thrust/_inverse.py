@@ -1,18 +1,5 @@
-"""Inverse rates and accelerations (paper 5, Section 3.3) and statics of the vectored thruster.
-
-Inverse accelerations: for a commanded platform motion (ω, ω̇) (the propeller shaft's carrier, base
-frame), the input rates solve ``J q̇ = ω`` and the input accelerations ``J q̈ = ω̇ - J̇ q̇``, where
-``J̇ q̇`` is the velocity-product (Lie-bracket) term of :func:`angular_acceleration` (paper 5, eqs.
-(22)-(28) solve the same closure chain by chain; their Klein form drops the velocity products, errata).
-J is 3 x 2: a commanded ω is realisable only in J's range (the platform has two rotational degrees of
-freedom), so q̇ is the least-squares solution and the unrealised part is reported as a residual.
-
-Statics: every joint axis passes through O, so a wrench ``[m_O; f]`` on the platform (moment about O)
-does work only through its moment: ``τ·q̇ + m_O·ω = 0`` for every motion (virtual work), i.e. the motor
-torques holding it are ``τ = -Jᵀ m_O``; the force f is carried by the universal joint at O.  In
-particular the propeller's thrust along its shaft (a line through O) needs no motor torque at all;
-its reaction torque about the shaft does.
-"""
+"""Inverse rates and accelerations (paper 5, Section 3.3: ``J q̇ = ω``, ``J q̈ = ω̇ - J̇ q̇`` in least
+squares, J being 3 x 2) and statics (virtual work, ``τ = -Jᵀ m_O``) of the vectored thruster."""
 
 from __future__ import annotations
 
@@ -22,7 +9,7 @@ import numpy as np
 
 from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_batch, check_params, check_real
-from robomech.analysis.lstsq import _damped_svd_solve
+from robomech.analysis.lstsq import _damped_inverse
 
 from ._kinematics import _chunked, _jacobian, _q, angular_acceleration
 from ._params import VectoredThruster
@@ -63,18 +50,15 @@ class InverseRatesResult:
 
     Attributes
     ----------
-    qd : ndarray, shape (..., 2)
-        Input rates (rad/s); NaN where J does not exist.
-    qdd : ndarray, shape (..., 2)
-        Input accelerations (rad/s²); NaN if no ω̇ was given or J does not exist.
+    qd, qdd : ndarray, shape (..., 2)
+        Input rates (rad/s) and accelerations (rad/s²; NaN if no ω̇ was given); NaN where J does not exist.
     sigma_min : ndarray, shape (...)
         Smallest singular value of J (dimensionless; 0 where J does not exist).
     singular : ndarray of bool, shape (...)
         ``sigma_min < 1 / INPUT_GAIN_MAX`` or J does not exist (the weak direction is damped there).
-    omega_residual : ndarray, shape (...)
-        ``|J q̇ - ω|`` (rad/s): the part of ω not realised (outside J's range, or damped).
-    omega_dot_residual : ndarray, shape (...)
-        ``|J q̈ + J̇ q̇ - ω̇|`` (rad/s²); NaN if no ω̇ was given.
+    omega_residual, omega_dot_residual : ndarray, shape (...)
+        ``|J q̇ - ω|`` (rad/s; the part of ω outside J's range, or damped) and ``|J q̈ + J̇ q̇ - ω̇|`` (rad/s²;
+        NaN if no ω̇ was given).
     valid : ndarray of bool, shape (...)
         Not singular, every value finite and the command realised: ``omega_residual`` (and
         ``omega_dot_residual`` if given) at most ``RATE_RESIDUAL_RTOL`` times the command's norm plus
@@ -101,34 +85,21 @@ def inverse_rates(
 ) -> InverseRatesResult:
     """Input rates ``q̇`` (and accelerations ``q̈``) for the platform's ``omega`` (and ``omega_dot``).
 
-    ``q (..., 2)`` rad; ``omega (..., 3)`` rad/s and ``omega_dot (..., 3)`` rad/s² in the base frame;
-    all broadcast.  paper 5, Section 3.3 (eqs. (22)-(28)): the inverse acceleration model, here with
-    the Lie-bracket velocity products the print drops.  ``damping`` (>= 0, relative to sigma_max)
-    applies to the directions with ``sigma < 1 / INPUT_GAIN_MAX`` (selectively damped least squares).
+    paper 5, eqs. (22)-(28), with the Lie-bracket velocity products the print drops.
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Input angles ``(q1, q2)`` (rad).
-    omega : array_like, shape (..., 3)
-        Commanded platform angular velocity (rad/s, base frame).
-    omega_dot : array_like, shape (..., 3), optional
-        Commanded platform angular acceleration (rad/s², base frame); ``None`` (default) leaves ``qdd``
-        NaN.
+    omega, omega_dot : array_like, shape (..., 3)
+        Commanded platform angular velocity (rad/s) and acceleration (rad/s², optional: without it
+        ``qdd`` is NaN), base frame; broadcast with ``q``.
     damping : float, optional
-        Damping of the weak directions relative to sigma_max (>= 0; default ``DEFAULT_DAMPING``).
+        Damping (>= 0, relative to sigma_max) of the directions with ``sigma < 1 / INPUT_GAIN_MAX``.
 
     Returns
     -------
     InverseRatesResult
-
-    Examples
-    --------
-    >>> th = VectoredThruster.paper()
-    >>> r = inverse_rates(th, [[0.1, 0.2]] * 3, [0.0, 0.0, 0.0])
-    >>> r.qd.shape, bool(r.valid.all()), bool(np.allclose(r.qd, 0.0))
-    ((3, 2), True, True)
     """
     check_params(th, VectoredThruster, "th")
     q = _q(q)
@@ -148,18 +119,13 @@ def _inverse_rates(th, q, w, wd, lam_rel, batch) -> InverseRatesResult:
     jr = _chunked(_jacobian, th, np.ascontiguousarray(q))
     exists = jr.valid
     J = np.where(exists[..., None, None], jr.J, 0.0)
-    U, s, Vt = np.linalg.svd(J, full_matrices=False)
-    smax = s[..., :1]
     bound = 1.0 / INPUT_GAIN_MAX
-    weak = s < bound
-    lam = lam_rel * smax
-    qd = _damped_svd_solve(U, s, Vt, w, lam, weak)
-    w_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qd) - w, axis=-1)
+    s, solve = _damped_inverse(J, atol=bound, damping=lam_rel)
+    qd, w_res = solve(w)
     sigma_min = np.where(exists, s[..., -1], 0.0)
     singular = ~exists | (sigma_min < bound)
-    nan = np.full((*batch, 2), np.nan)
     if wd is None:
-        qdd = nan
+        qdd = np.full((*batch, 2), np.nan)
         wd_res = np.full(batch, np.nan)
     else:
         wd = np.broadcast_to(wd, (*batch, 3))
@@ -167,8 +133,7 @@ def _inverse_rates(th, q, w, wd, lam_rel, batch) -> InverseRatesResult:
         qd_safe = np.where(exists[..., None], qd, 0.0)
         vp = angular_acceleration(th, q_safe, qd_safe, np.zeros_like(qd_safe)).velocity_product
         vp = np.where(exists[..., None], vp, 0.0)
-        qdd = _damped_svd_solve(U, s, Vt, wd - vp, lam, weak)
-        wd_res = np.linalg.norm(np.einsum("...ij,...j->...i", J, qdd) + vp - wd, axis=-1)
+        qdd, wd_res = solve(wd - vp)  # |J q̈ + J̇ q̇ - ω̇|
         qdd = np.where(exists[..., None], qdd, np.nan)
         wd_res = np.where(exists, wd_res, np.nan)
     finite = np.all(np.isfinite(qd), -1) & (wd is None or np.all(np.isfinite(qdd), -1))
@@ -211,20 +176,16 @@ class StaticsResult:
 
 @carries_failed_rows({"q": 1}, {"wrench": 1})
 def static_torques(th: VectoredThruster, q: object, wrench: object) -> StaticsResult:
-    """Motor torques ``τ = -Jᵀ m_O`` holding the platform against a wrench ``[m_O; f] (..., 6)``.
-
-    The wrench is applied *to* the platform (propeller and shaft included), base frame, moment about O
-    (conventions: ``[m; f]``); virtual work ``τ·q̇ + m_O·ω = 0``.  The force f passes through the
-    universal joint at O and needs no motor torque.  For a propeller thrust T along the shaft s0 and a
-    reaction torque Q about it, the wrench is ``[Q s0; T s0]`` (the thrust line passes through O).
+    """Motor torques ``τ = -Jᵀ m_O`` holding the platform against a wrench (virtual work
+    ``τ·q̇ + m_O·ω = 0``: the force passes through O and needs no motor torque).
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Input angles ``(q1, q2)`` (rad).
     wrench : array_like, shape (..., 6)
-        Wrench ``[m_O; f]`` applied to the platform (N·m, N; base frame, moment about O).
+        ``[m_O; f]`` applied to the platform (N·m, N; base frame, moment about O); a propeller's
+        thrust T and reaction torque Q about its shaft s0 are ``[Q s0; T s0]``.
 
     Returns
     -------

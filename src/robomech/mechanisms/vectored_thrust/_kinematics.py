@@ -1,31 +1,17 @@
-"""Position, velocity and acceleration kinematics of the RRR-RR vectored thruster (paper 5, Section 3).
-
-Every joint axis passes through O, so every joint screw is ``[s; 0]`` and the platform only rotates.
-With ``q = (q1, q2)`` (RRR input about X, RR input about Y, as in eqs. (5) and (7)):
-
-* ``s12 = Rx(q1) (cos a, 0, -sin a)``, ``s22 = Ry(q2) (-1, 0, 0)``;
-* closure: ``s13`` is fixed in the platform at 90 deg to ``s22`` and at 90 deg to ``s12`` (the RRR
-  chain's second arc), so ``s13 = s22 x s12 / |s22 x s12|`` in the assembly mode with the propeller
-  along +Z at q = 0 (eq. 8);
-* propeller axis ``s0 = s22 x s13`` (eq. 11).
-
-Equivalently the platform rotation is ``R = Ry(q2) Rx(-theta)``, ``theta`` the RR chain's passive angle,
-``theta = atan2(-sin a sin q1, sin a cos q1 cos q2 - cos a sin q2)``.  The mechanism is singular where
-``s22`` and ``s12`` become parallel (``|s22 x s12| = 0``: at q = (0, a) for the paper's a = pi/4).
-"""
+"""Position, velocity and acceleration kinematics of the RRR-RR vectored thruster (paper 5, Section 3):
+``q = (q1, q2)`` (rad), inputs about X (RRR) and Y (RR); axes, closure, ``R = Ry(q2) Rx(-theta)`` and the
+singularity (s22 parallel to s12): docs/mechanisms/vectored_thrust.md."""
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
-from robomech._batching import carries_failed_rows, chunked
+from robomech._batching import R, carries_failed_rows, chunked_rows
 from robomech._validation import as_array, broadcast_batch, check_params
-from robomech.spatial import lie_bracket
+from robomech.spatial import lie_bracket, rot_x
 
 # the unvalidated kernel: inputs are validated once at this module's public boundary
 from robomech.spatial._so3 import _sincos as sincos
@@ -65,25 +51,14 @@ MIN_DIRECTION_NORM = 1e-12
 # Inputs within this of a range limit count as in range: an IK solution on the boundary carries a few
 # ulps of rounding (1e-16 rad), and a limit is never meaningful to better than a micro-radian.
 RANGE_TOL = 1e-12
-# Samples per block in the batched kernels: ~20 float64 temporaries of 8192 samples (~1.3 MB) stay in
-# cache; measured 1.3-2x faster than whole-array evaluation at 10^6 samples (benchmarks/).  Not 16384:
-# its 128 KiB temporaries reach glibc malloc's default mmap threshold (128 KiB), so until a large free
-# raises that threshold every temporary is a fresh mmap with page faults (first 10^6-sample FK in a fresh
-# process: 113 ms at 16384, 66 ms at 8192; equal once warm).
+# Samples per block in the batched kernels: their ~20 temporaries stay in cache (1.3-2x faster at 10^6
+# samples); not 16384, whose 128 KiB temporaries reach glibc's default mmap threshold (every temporary a
+# fresh mmap in a fresh process: docs/mechanisms/vectored_thrust.md, "Numerical constants").
 CHUNK = 1 << 13
 
-if TYPE_CHECKING:
-    from _typeshed import DataclassInstance
 
-_R = TypeVar("_R", bound="DataclassInstance")  # a frozen result dataclass of arrays
-
-
-def _chunked(kernel: Callable[..., _R], th: VectoredThruster, x: np.ndarray) -> _R:
-    """``kernel(th, x_block)`` over blocks of CHUNK samples of ``x (..., k)``, reshaped to its batch."""
-    batch, flat = x.shape[:-1], x.reshape(-1, x.shape[-1])
-    r = chunked(lambda s: kernel(th, flat[s]), flat.shape[0], CHUNK)
-    arrays = {f.name: getattr(r, f.name) for f in dataclasses.fields(r)}
-    return dataclasses.replace(r, **{k: a.reshape(batch + a.shape[1:]) for k, a in arrays.items()})
+def _chunked(kernel: Callable[[VectoredThruster, np.ndarray], R], th: VectoredThruster, x: np.ndarray) -> R:
+    return chunked_rows(lambda rows: kernel(th, rows), x, CHUNK)
 
 
 _X = np.array([1.0, 0.0, 0.0])
@@ -96,18 +71,10 @@ class JointAxes:
 
     Attributes
     ----------
-    s11 : ndarray, shape (..., 3)
-        RRR input axis (X).
-    s12 : ndarray, shape (..., 3)
-        RRR passive axis between the 45° and the 90° arcs (eq. (7)).
-    s13 : ndarray, shape (..., 3)
-        RRR passive axis on the platform (eq. (8)); NaN where singular.
-    s21 : ndarray, shape (..., 3)
-        RR input axis (Y).
-    s22 : ndarray, shape (..., 3)
-        RR passive axis on the platform (eq. (5)).
-    s0 : ndarray, shape (..., 3)
-        Propeller shaft ``s22 x s13`` (eq. (11)); NaN where singular.
+    s11, s12, s13, s21, s22, s0 : ndarray, shape (..., 3)
+        RRR input axis X, passive axes between the arcs (eq. (7)) and on the platform (eq. (8)); RR input
+        axis Y, passive axis on the platform (eq. (5)); propeller shaft ``s22 x s13`` (eq. (11)).  s13 and
+        s0 are NaN where singular.
     distance : ndarray, shape (...)
         ``|s22 x s12|``, the distance to the singularity, in [0, 1].
     valid : ndarray of bool, shape (...)
@@ -133,8 +100,7 @@ class LinkClearanceResult:
     clearance : ndarray, shape (...)
         Angular clearance (rad) between the 45 deg arc and the fixing device; NaN where not ``valid``.
     valid : ndarray of bool, shape (...)
-        The configuration is not singular (``|s12 x s22| > SINGULAR_TOL``: the fixing device's arc
-        exists), so the clearance is defined.
+        Not singular (the fixing device's arc exists).
     """
 
     clearance: np.ndarray
@@ -153,14 +119,9 @@ class FKResult:
         Propeller position ``propeller_arm * s0`` (m, base frame).
     tilt : ndarray, shape (...)
         Angle between s0 and Z, the universal joint's deflection (rad).
-    valid : ndarray of bool, shape (...)
-        Assembled and not singular.
-    in_range : ndarray of bool, shape (...)
-        Inputs within ``q1_limits`` and ``q2_limits``.
-    tilt_ok : ndarray of bool, shape (...)
-        Valid and ``tilt <= tilt_limit``.
-    within_limits : ndarray of bool, shape (...)
-        ``in_range & tilt_ok`` (link interference: see :func:`link_clearance`, ``workspace_map``).
+    valid, in_range, tilt_ok, within_limits : ndarray of bool, shape (...)
+        Not singular; inputs within ``q1_limits``, ``q2_limits``; valid and ``tilt <= tilt_limit``;
+        ``in_range & tilt_ok`` (link interference: :func:`link_clearance`).
     """
 
     axis: np.ndarray
@@ -180,14 +141,9 @@ class IKResult:
     ----------
     q : ndarray, shape (..., 2)
         Inputs ``(q1, q2)`` (rad); NaN where not solved.
-    solved : ndarray of bool, shape (...)
-        An assembly with this propeller direction exists (limits ignored).
-    in_range : ndarray of bool, shape (...)
-        Solved and ``q`` within ``q1_limits``, ``q2_limits``.
-    tilt_ok : ndarray of bool, shape (...)
-        Solved and the direction within ``tilt_limit`` of Z.
-    valid : ndarray of bool, shape (...)
-        ``solved & in_range & tilt_ok``.
+    solved, in_range, tilt_ok, valid : ndarray of bool, shape (...)
+        An assembly with this direction exists (limits ignored); solved and ``q`` within ``q1_limits``,
+        ``q2_limits``; solved and the direction within ``tilt_limit`` of Z; ``solved & in_range & tilt_ok``.
     """
 
     q: np.ndarray
@@ -254,14 +210,11 @@ class AccelerationResult:
 
     Attributes
     ----------
-    omega : ndarray, shape (..., 3)
-        Platform angular velocity (rad/s, base frame).
-    omega_dot : ndarray, shape (..., 3)
-        Platform angular acceleration (rad/s², base frame).
-    passive_acc : ndarray, shape (..., 3)
-        Passive accelerations (RR s22, RRR s12, RRR s13), rad/s².
-    velocity_product : ndarray, shape (..., 3)
-        The Lie-bracket part ``J̇ q̇`` of ``omega_dot`` (rad/s²).
+    omega, omega_dot : ndarray, shape (..., 3)
+        Platform angular velocity (rad/s) and acceleration (rad/s²), base frame.
+    passive_acc, velocity_product : ndarray, shape (..., 3)
+        Passive accelerations (RR s22, RRR s12, RRR s13; rad/s²); the Lie-bracket part ``J̇ q̇`` of
+        ``omega_dot`` (rad/s²).
     valid : ndarray of bool, shape (...)
         Not singular.
     """
@@ -313,32 +266,19 @@ def _axes(th: VectoredThruster, q: np.ndarray) -> JointAxes:
 
 @carries_failed_rows({"q": 1})
 def joint_axes(th: VectoredThruster, q: object) -> JointAxes:
-    """Unit joint axes at inputs ``q (..., 2)`` (rad).
-
-    Singular samples have NaN s13 and s0 and ``valid`` False.  Paper 5, eqs. (5), (7), (8), (11).
+    """Unit joint axes at inputs ``q`` (paper 5, eqs. (5), (7), (8), (11)).
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
     JointAxes
-
-    Examples
-    --------
-    >>> ax = joint_axes(VectoredThruster.paper(), [0.0, 0.0])
-    >>> ax.s0 + 0.0, bool(ax.valid)
-    (array([0., 0., 1.]), True)
     """
     check_params(th, VectoredThruster, "th")
     return _axes(th, _q(q))
-
-
-def _in_range(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
-    return _in_range2(th, q[..., 0], q[..., 1])
 
 
 def _in_range2(th: VectoredThruster, q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
@@ -403,46 +343,30 @@ def _arc_clearance(a1: _V, b1: _V, a2: _V, b2: _V) -> np.ndarray:
     return np.where(crosses, 0.0, ends)
 
 
-def _split(v: np.ndarray) -> _V:
-    return (v[..., 0], v[..., 1], v[..., 2])
-
-
 @carries_failed_rows({"a1": 1, "b1": 1, "a2": 1, "b2": 1})
 def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
-    """Angular distance (rad) between the minor great-circle arcs (a1 -> b1) and (a2 -> b2) (unit, (..., 3)).
-
-    Zero where they cross; otherwise the closest point is an end of one of them.
+    """Angular distance (rad, in [0, π]) between the minor great-circle arcs (a1 -> b1) and (a2 -> b2).
 
     Parameters
     ----------
-    a1, b1 : array_like, shape (..., 3)
-        Unit start and end points of the first arc.
-    a2, b2 : array_like, shape (..., 3)
-        Unit start and end points of the second arc; all four broadcast.
+    a1, b1, a2, b2 : array_like, shape (..., 3)
+        Unit start and end points of the two arcs; broadcast together.
 
     Returns
     -------
     ndarray, shape (...)
-        Angular distance between the arcs (rad), in [0, π].
-
-    Examples
-    --------
-    >>> round(float(arc_clearance([1, 0, 0], [0, 1, 0], [0, 0, 1], [0, 1, 0])), 12)   # share an end
-    0.0
     """
     arrs = [as_array(v, name, (3,)) for v, name in ((a1, "a1"), (b1, "b1"), (a2, "a2"), (b2, "b2"))]
     broadcast_batch(*((v, 1, name) for v, name in zip(arrs, ("a1", "b1", "a2", "b2"), strict=True)))
-    return _arc_clearance(*(_split(v) for v in arrs))
+    return _arc_clearance(*((v[..., 0], v[..., 1], v[..., 2]) for v in arrs))
 
 
 def _interference(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
     """Clearance (rad) of the 45 deg arc (s11 -> s12) from the fixing device (s22 -> s13); NaN if singular.
 
-    :func:`_arc_clearance` specialised to this mechanism's arcs (identical to rounding; tested against the
-    generic form): with ``(s22, s13, s0)`` orthonormal and right-handed (``s0 = s22 x s13``), the first
-    arc's unit normal is ``n1 = X x s12 / sin a = (0, c1, s1)``, the second's is ``s0``, and the side
-    vectors ``n x a``, ``b x n`` are ``(0, s1, -c1)``, ``(sin a, -cos a s1, cos a c1)``, ``s13`` and
-    ``s22``; about 70 element-wise passes instead of ~250 for the generic 3-vector form.
+    :func:`_arc_clearance` specialised to these arcs (tested against it): normals ``(0, c1, s1)`` and
+    ``s0``, side vectors ``(0, s1, -c1)``, ``(sin a, -cos a s1, cos a c1)``, ``s13``, ``s22``; about 70
+    element-wise passes instead of ~250 for the generic 3-vector form.
     """
     with np.errstate(invalid="ignore"):  # NaN (singular samples) is masked at the end
         return _interference_unmasked(th, q)
@@ -489,29 +413,16 @@ def _interference_unmasked(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
 
 @carries_failed_rows({"q": 1})
 def link_clearance(th: VectoredThruster, q: object) -> LinkClearanceResult:
-    """Angular clearance (rad) between the RRR chain's 45 deg arc and the fixing device at ``q (..., 2)``.
-
-    Section 4.1 (2).  Where the configuration is singular (``|s12 x s22| <= SINGULAR_TOL``, the same
-    samples as ``joint_axes(...).valid`` False) the fixing device's arc does not exist: ``clearance`` is
-    NaN there and ``valid`` False.
+    """Angular clearance (rad) between the RRR chain's 45 deg arc and the fixing device (Section 4.1 (2)).
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
     LinkClearanceResult
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import vectored_thrust as vt
-    >>> r = vt.link_clearance(vt.VectoredThruster.paper(), [[0.0, 0.2], [0.0, np.pi / 4]])
-    >>> r.valid
-    array([ True, False])
     """
     check_params(th, VectoredThruster, "th")
     c = _interference(th, _q(q))
@@ -550,7 +461,7 @@ def _fk(th: VectoredThruster, q: np.ndarray) -> FKResult:
     with np.errstate(invalid="ignore"):  # NaN where singular, covered by valid
         tilt_ok = tilt <= th.tilt_limit
     tilt_ok &= valid
-    in_range = _in_range(th, q)
+    in_range = _in_range2(th, q[..., 0], q[..., 1])
     return FKResult(
         axis=axis,
         tip=np.multiply(axis, th.propeller_arm),
@@ -564,29 +475,17 @@ def _fk(th: VectoredThruster, q: np.ndarray) -> FKResult:
 
 @carries_failed_rows({"q": 1})
 def forward_kinematics(th: VectoredThruster, q: object) -> FKResult:
-    """Propeller axis and tip from the inputs ``q (..., 2)`` = (q1, q2) in rad.
-
-    Paper 5, eqs. (11)-(12), with eq. (12)'s sin(phi1) corrected to sin(phi2).  Singular inputs
-    (``|s22 x s12| <= SINGULAR_TOL``) give NaN outputs with ``valid`` False.  The link-interference
-    limit (Section 4.1 (2)) is evaluated by :func:`link_clearance` and ``workspace_map``.
+    """Propeller axis and tip from the inputs ``q`` (paper 5, eqs. (11)-(12), eq. (12)'s sin(phi1) corrected
+    to sin(phi2)); the link-interference limit is :func:`link_clearance`'s.
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
     FKResult
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import vectored_thrust as vt
-    >>> fk = vt.forward_kinematics(vt.VectoredThruster.paper(), np.array([0.3, 0.2]))
-    >>> fk.axis.round(5), bool(fk.valid)
-    (array([ 0.18442, -0.3719 ,  0.90977]), True)
     """
     check_params(th, VectoredThruster, "th")
     return _chunked(_fk, th, _q(q))
@@ -600,17 +499,10 @@ def platform_rotation(th: VectoredThruster, q: object) -> RotationResult:
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
     RotationResult
-
-    Examples
-    --------
-    >>> r = platform_rotation(VectoredThruster.paper(), [0.3, 0.2])
-    >>> bool(np.allclose(r.R @ r.R.T, np.eye(3))), bool(np.isclose(np.linalg.det(r.R), 1.0))
-    (True, True)
     """
     check_params(th, VectoredThruster, "th")
     ax = _axes(th, _q(q))
@@ -695,17 +587,13 @@ def _ik_unmasked(th: VectoredThruster, s: np.ndarray) -> IKResult:
 
 @carries_failed_rows({"s": 1})
 def inverse_kinematics(th: VectoredThruster, s: object) -> IKResult:
-    """Inputs ``q (..., 2)`` pointing the propeller along ``s (..., 3)`` (any positive multiple: axis or tip).
-
-    Per-sample masks: ``solved`` (an assembly exists: |s| > 0, the closure has a root), ``in_range``,
-    ``tilt_ok`` (universal joint); ``valid`` is all of them.  The link-interference limit is checked
-    on the inputs by :func:`link_clearance` / ``workspace_map``.
+    """Inputs ``q`` pointing the propeller along ``s`` (paper 5, eq. (13), corrected: see the code).
 
     Parameters
     ----------
     th : VectoredThruster
     s : array_like, shape (..., 3)
-        Desired propeller direction (base frame; any positive multiple).
+        Propeller direction (base frame; any positive multiple: the axis or the tip).
 
     Returns
     -------
@@ -724,8 +612,8 @@ def inverse_kinematics(th: VectoredThruster, s: object) -> IKResult:
     return _chunked(_ik, th, as_array(s, "s", (3,)))
 
 
-def _solve3(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Cramer's rule for ``[c0 c1 c2] x = b`` batched over (..., 3) columns; returns x and the determinant."""
+def _solve3(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cramer's rule for ``[c0 c1 c2] x = b`` batched over (..., 3) columns."""
     det = np.sum(c0 * np.cross(c1, c2), axis=-1)
     safe = np.where(det != 0, det, 1.0)
     x = np.stack(
@@ -736,7 +624,7 @@ def _solve3(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray, b: np.ndarray) -> tu
         ],
         axis=-1,
     )
-    return x / safe[..., None], det
+    return x / safe[..., None]
 
 
 def _rates(ax: JointAxes, qd: np.ndarray) -> np.ndarray:
@@ -746,22 +634,17 @@ def _rates(ax: JointAxes, qd: np.ndarray) -> np.ndarray:
     paper 5, eq. (17): the printed rates violate this closure; these satisfy it.
     """
     b = qd[..., 0:1] * ax.s11 - qd[..., 1:2] * ax.s21
-    x, _ = _solve3(ax.s22, -ax.s12, -ax.s13, b)
-    return x
+    return _solve3(ax.s22, -ax.s12, -ax.s13, b)
 
 
 @carries_failed_rows({"q": 1})
 def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
-    """Passive joint angles (..., 3), rad, zero at q = 0, ordered (RR s22, RRR s12, RRR s13).
-
-    Product of exponentials from the home axes: ``R = Ry(q2) exp(s22(0) theta)`` on the RR chain and
-    ``R = Rx(q1) exp(s12(0) rho2) exp(s13(0) rho3)`` on the RRR chain.
+    """Passive joint angles (rad, zero at q = 0) by products of exponentials from the home axes.
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
@@ -774,14 +657,9 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
     _, _, ct, st, _, _ = _theta_cs(th, q)
     theta = np.arctan2(st, ct)  # full circle: the propeller may pass beyond the horizontal
     R = np.stack([-ax.s22, -ax.s13, ax.s0], axis=-1)
-    c1, s1 = np.cos(q[..., 0]), np.sin(q[..., 0])
     # R_rel = Rx(-q1) R, expressed in the basis P = [s12(0), s13(0), s12(0) x s13(0)] = Rx'(rho2) Ry'(rho3).
     P = np.array([[ca, 0.0, -sa], [0.0, -1.0, 0.0], [-sa, 0.0, -ca]])
-    Rx_inv = np.zeros((*q.shape[:-1], 3, 3))
-    Rx_inv[..., 0, 0] = 1.0
-    Rx_inv[..., 1, 1], Rx_inv[..., 1, 2] = c1, s1
-    Rx_inv[..., 2, 1], Rx_inv[..., 2, 2] = -s1, c1
-    M = np.einsum("ji,...jk,...kl,lm->...im", P, Rx_inv, R, P)
+    M = np.einsum("ji,...jk,...kl,lm->...im", P, rot_x(-q[..., 0]), R, P)
     rho3 = np.arctan2(M[..., 0, 2], M[..., 0, 0])
     rho2 = np.arctan2(M[..., 2, 1], M[..., 1, 1])
     vals = np.stack([theta, rho2, rho3], axis=-1)
@@ -790,17 +668,13 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
 
 @carries_failed_rows({"q": 1, "qd": 1})
 def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
-    """Passive joint rates (..., 3), rad/s, ordered (RR s22, RRR s12, RRR s13), from ``q, qd (..., 2)``.
-
-    The velocity closure (paper 5, eq. (16)) solved; eq. (17)'s printed rates violate it.
+    """Passive joint rates (rad/s): the velocity closure (paper 5, eq. (16)) solved; eq. (17)'s violate it.
 
     Parameters
     ----------
     th : VectoredThruster
-    q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
-    qd : array_like, shape (..., 2)
-        Input rates (rad/s).
+    q, qd : array_like, shape (..., 2)
+        Inputs (rad) and their rates (rad/s); broadcast together.
 
     Returns
     -------
@@ -847,29 +721,16 @@ def _jacobian(th: VectoredThruster, q: np.ndarray) -> JacobianResult:
 
 @carries_failed_rows({"q": 1})
 def jacobian(th: VectoredThruster, q: object) -> JacobianResult:
-    """``omega = J qd``: J (..., 3, 2) maps input rates to the platform's angular velocity (base frame).
-
-    ``omega`` is the angular velocity of the platform carrying the propeller shaft (the propeller's
-    own spin about s0 excluded).  NaN with ``valid`` False at singular inputs.
+    """Platform Jacobian ``omega = J qd`` (``omega`` base frame, the propeller's own spin excluded).
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
     JacobianResult
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from robomech.mechanisms import vectored_thrust as vt
-    >>> vt.jacobian(vt.VectoredThruster.paper(), np.array([0.3, 0.2])).J.round(4) + 0.0
-    array([[ 1.2266,  0.5366],
-           [ 0.    ,  1.    ],
-           [-0.2486, -0.1088]])
     """
     check_params(th, VectoredThruster, "th")
     return _chunked(_jacobian, th, _q(q))
@@ -893,25 +754,17 @@ class VelocityResult:
 
 @carries_failed_rows({"q": 1, "qd": 1})
 def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityResult:
-    """Platform angular velocity ``omega = J qd`` (..., 3), rad/s, from ``q, qd (..., 2)``.
+    """Platform angular velocity ``omega = J qd`` (rad/s).
 
     Parameters
     ----------
     th : VectoredThruster
-    q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
-    qd : array_like, shape (..., 2)
-        Input rates (rad/s).
+    q, qd : array_like, shape (..., 2)
+        Inputs (rad) and their rates (rad/s); broadcast together.
 
     Returns
     -------
     VelocityResult
-
-    Examples
-    --------
-    >>> w = angular_velocity(VectoredThruster.paper(), [0.0, 0.0], [0.0, 1.0])  # q2 turns about Y
-    >>> w.omega.round(12) + 0.0, bool(w.valid)
-    (array([0., 1., 0.]), True)
     """
     check_params(th, VectoredThruster, "th")
     q, qd = _q(q), as_array(qd, "qd", (2,))
@@ -928,24 +781,17 @@ def _screw(s: np.ndarray) -> np.ndarray:
 
 @carries_failed_rows({"q": 1, "qd": 1, "qdd": 1})
 def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: object) -> AccelerationResult:
-    """Platform angular acceleration from ``q, qd, qdd (..., 2)`` by screw theory with Lie brackets.
+    """Platform angular acceleration by screw theory: each chain's acceleration twist is
+    ``sum_i S_i x_i'' + sum_{i<j} [S_i x_i', S_j x_j']``; equating the chains gives the passive accelerations.
 
-    Each chain is serial, so its platform acceleration twist is
-    ``sum_i S_i x_i'' + sum_{i<j} [S_i x_i', S_j x_j']`` (Lie brackets, :func:`robomech.spatial.lie_bracket`).
-    Equating the RRR and RR expressions gives the passive accelerations, then
-    ``omega' = q2'' Y + theta'' s22 + [q2' S21, theta' S22]``.
     paper 5, eq. (24): printed with the Klein form (a scalar, zero for axes through O) where the Lie
     bracket is needed; eq. (32) therefore lacks the velocity-product terms included here.
 
     Parameters
     ----------
     th : VectoredThruster
-    q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
-    qd : array_like, shape (..., 2)
-        Input rates (rad/s).
-    qdd : array_like, shape (..., 2)
-        Input accelerations (rad/s²).
+    q, qd, qdd : array_like, shape (..., 2)
+        Inputs (rad), their rates and accelerations; broadcast together.
 
     Returns
     -------
@@ -966,12 +812,12 @@ def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: objec
     lie_rrr = lie_bracket(V11, V12) + lie_bracket(V11 + V12, V13)
     lie_rr = lie_bracket(V21, V22)
     b = qdd[..., 0:1] * ax.s11 - qdd[..., 1:2] * ax.s21 + lie_rrr[..., :3] - lie_rr[..., :3]
-    acc, _ = _solve3(ax.s22, -ax.s12, -s13, b)
+    acc = _solve3(ax.s22, -ax.s12, -s13, b)
     omega = qd[..., 1:2] * ax.s21 + r[..., 0:1] * ax.s22
     omega_dot = qdd[..., 1:2] * ax.s21 + acc[..., 0:1] * ax.s22 + lie_rr[..., :3]
     # velocity-product part: omega' with qdd = 0
     b0 = lie_rrr[..., :3] - lie_rr[..., :3]
-    acc0, _ = _solve3(ax.s22, -ax.s12, -s13, b0)
+    acc0 = _solve3(ax.s22, -ax.s12, -s13, b0)
     vp = acc0[..., 0:1] * ax.s22 + lie_rr[..., :3]
     valid = np.broadcast_to(ax.valid, batch)  # the mask has the batch of every argument
     m = valid[..., None]

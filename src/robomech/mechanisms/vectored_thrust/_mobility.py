@@ -1,10 +1,5 @@
-"""Screw-theory mobility of the vectored thruster (paper 5, Section 2), from the joint screws.
-
-Nothing is hard-coded: each chain's joint screws are built from the joint axes at a configuration
-(optionally with an axis moved off the common centre) and passed to
-:func:`robomech.analysis.mobility.analyze`, which forms the chains' constraint systems, their union and
-the platform's reciprocal twist system.
-"""
+"""Screw-theory mobility of the vectored thruster (paper 5, Section 2): the chains' joint screws at a
+configuration, analysed by :func:`robomech.analysis.mobility.analyze`."""
 
 from __future__ import annotations
 
@@ -30,37 +25,25 @@ _JOINTS = ("s11", "s12", "s13", "s21", "s22")
 def chain_screws(
     th: VectoredThruster, q: object, offsets: dict[str, object] | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Unit joint screws ``[s; r x s]`` of the RRR chain (3, 6) and the RR chain (2, 6) at ``q (2,)``.
-
-    The paper's axes all pass through O (eqs. (5) and (7)); ``offsets`` moves some off it (a design
-    perturbation).
+    """Unit joint screws ``[s; r x s]`` (m) of the RRR chain (s11, s12, s13) and the RR chain (s21, s22).
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (2,)
-        One input configuration ``(q1, q2)`` (rad), away from the singularity.
+        One input configuration (rad).
     offsets : dict of str to array_like, optional
         Axis name (``"s11"``, ``"s12"``, ``"s13"``, ``"s21"``, ``"s22"``) -> point (3,) (m, base frame)
         the axis is moved to pass through; ``None`` (default): every axis through O.
 
     Returns
     -------
-    rrr : ndarray, shape (3, 6)
-        Screws ``[s; r x s]`` (moment part in m) of s11, s12, s13.
-    rr : ndarray, shape (2, 6)
-        Screws of s21, s22.
+    rrr, rr : ndarray, shape (3, 6) and (2, 6)
 
     Raises
     ------
     ValueError
         A singular ``q``.
-
-    Examples
-    --------
-    >>> rrr, rr = chain_screws(VectoredThruster.paper(), [0.1, 0.2])
-    >>> rrr.shape, rr.shape, bool(np.allclose(rrr[:, 3:], 0.0))   # axes through O: no moment part
-    ((3, 6), (2, 6), True)
     """
     check_params(th, VectoredThruster, "th")
     qa = as_array(q, "q", (2,))
@@ -85,28 +68,19 @@ def platform_mobility(
 ) -> mobility.MobilityResult:
     """Mobility of the RRR-RR platform (the fixing device) at ``q``: paper 5, eqs. (4)-(10).
 
-    Screws are in metres with ``length_scale = 1``: offsets of millimetres give moment parts ~1e-3,
-    far above the SVD rank tolerance (1e-9).  The returned ``constraint_wrenches`` are wrenches
-    ``[m; f]`` that do no work on any joint screw S: ``virtual_power(W, S) = 0``.
+    Screws in metres (``length_scale = 1``): offsets of millimetres give moment parts ~1e-3, far above
+    the SVD rank tolerance (1e-9).
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (2,), optional
-        Input configuration (rad); default ``(0, 0)``.
     offsets : dict of str to array_like, optional
-        Axis name (``"s11"``, ``"s12"``, ``"s13"``, ``"s21"``, ``"s22"``) -> point (3,) (m, base frame)
-        the axis is moved to pass through; ``None`` (default): every axis through O.
+        As in :func:`chain_screws`.
 
     Returns
     -------
     MobilityResult
-
-    Examples
-    --------
-    >>> m = platform_mobility(VectoredThruster.paper())
-    >>> m.dof, m.rotational_dof, m.translational_dof
-    (2, 2, 0)
     """
     check_params(th, VectoredThruster, "th")
     rrr, rr = chain_screws(th, q, offsets)
@@ -137,19 +111,15 @@ def mechanism_mobility(
 ) -> MechanismMobility:
     """Mobility of the whole vectored thruster with the central universal-joint chain (Section 2, Fig. 2).
 
-    The propeller body is reached by two paths: the central chain (motor R about Z, universal joint with
-    axes X and Y at ``ujoint_centre``) and the platform (its twist system from :func:`platform_mobility`,
-    taken as an equivalent chain) followed by the shaft bearing R about s0 through O.  The propeller has
-    3 rotational DOF (platform 2R + spin) when the universal-joint centre coincides with O.
+    The propeller body is reached by the central chain (motor about Z, universal joint at
+    ``ujoint_centre``) and by the platform's twist system followed by the shaft bearing about s0.
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (2,), optional
-        Input configuration (rad); default ``(0, 0)``.
     offsets : dict of str to array_like, optional
-        Axis name (``"s11"``, ``"s12"``, ``"s13"``, ``"s21"``, ``"s22"``) -> point (3,) (m, base frame)
-        the axis is moved to pass through; ``None`` (default): every axis through O.
+        As in :func:`chain_screws`.
     ujoint_centre : array_like, shape (3,), optional
         Centre of the central universal joint (m, base frame); default O.
 

@@ -1,18 +1,5 @@
-"""The RRR-RR vectored thruster described generically (``robomech.multibody``), from its parameters.
-
-Every joint axis passes through O (paper 5, Section 2).  With every body frame equal to the base frame
-at q = 0 (the assembly mode with the propeller along +Z):
-
-* RR chain: ``q2`` about Y (``rr_arc``), then the platform on the passive hinge ``s22(0) = -X``;
-* RRR chain: ``q1`` about X (``rrr_arc1``), the passive hinge ``s12(0) = (cos a, 0, -sin a)`` (eq. (7);
-  ``rrr_arc2``), and the cut: the hinge ``s13(0) = s22(0) x s12(0) / |.| = -Y`` (eq. (8)) joining
-  ``rrr_arc2`` to the platform (a ``revolute`` closure);
-* site ``propeller`` at the tip ``propeller_arm * s0`` with the platform's orientation ``R_OP``
-  (columns ``-s22, -s13, s0``).
-
-The tests compare FK (axis, tip, R_OP), IK, the Jacobian ω = J q̇ and the angular acceleration of the
-generic layer with the analytic model to 1e-10.  No inertias are attached (the paper gives none).
-"""
+"""The RRR-RR vectored thruster described generically (``robomech.multibody``), from its parameters: bodies,
+hinges and the cut joint in docs/mechanisms/vectored_thrust.md, "Generic description"."""
 
 from __future__ import annotations
 

@@ -30,55 +30,23 @@ def _check_pos(name: str, value: float, upper: float = math.inf) -> float:
 class VectoredThruster:
     """Geometry of the vectored thruster, SI units (metres, radians).
 
-    All joint axes pass through the universal-joint centre O (Section 2), so the kinematics depend
-    only on ``arc_angle``; the radii and the propeller arm give points (tip, drawings, engine model),
-    and the limits define the workspace.
-
-    Chains, as in eqs. (5) and (7) (the paper's subscript 1 is the RRR chain, 2 the RR chain):
-
-    * RRR chain: input ``q1`` about X; a ``arc_angle`` (45 deg) arc of radius ``rrr_arc1_radius`` to the
-      passive axis ``s12 = Rx(q1) (cos a, 0, -sin a)``; a 90 deg arc of radius ``rrr_arc2_radius`` to the
-      passive axis ``s13`` fixed in the platform.
-    * RR chain: input ``q2`` about Y; a 90 deg arc of radius ``rr_arc_radius`` to the passive axis
-      ``s22 = Ry(q2) (-1, 0, 0)`` fixed in the platform.
-    * Platform (the "arc-link fixing device", radius ``platform_radius``) carries ``s22``, ``s13`` (at
-      90 deg to each other) and the propeller shaft ``s0 = s22 x s13`` (eq. 11), along +Z at q = 0.
+    Every joint axis passes through O, so the kinematics depend only on ``arc_angle``; the radii and
+    the propeller arm give points, the limits the workspace (chains: docs/mechanisms/vectored_thrust.md).
 
     Parameters
     ----------
     arc_angle : float, optional
-        Angle between X and the passive axis s12, the RRR chain's first arc (rad), in (0, π/2);
-        default π/4 (eq. (7)).
-    platform_radius : float, optional
-        Radius of the arc-link fixing device (m), > 0; default 0.020 (Table 1).
-    rr_arc_radius : float, optional
-        Radius of the RR chain's 90° arc (m), > 0; default 0.0225.
-    rrr_arc1_radius : float, optional
-        Radius of the RRR chain's 45° arc (m), > 0; default 0.025.
-    rrr_arc2_radius : float, optional
-        Radius of the RRR chain's 90° arc (m), > 0; default 0.0225.
+        Angle between X and the passive axis s12, the RRR chain's first arc (rad), in (0, π/2).
+    platform_radius, rr_arc_radius, rrr_arc1_radius, rrr_arc2_radius : float, optional
+        Radii (m) of the arc-link fixing device, the RR chain's 90° arc, the RRR chain's 45° and 90° arcs.
     propeller_arm : float, optional
-        Distance of the propeller from O along s0 (m), larger than every radius; default 0.080.
-    q1_limits : tuple of float, optional
-        ``(lo, hi)`` range of q1 (rad), within [-π, π]; default ±π/4.
-    q2_limits : tuple of float, optional
-        ``(lo, hi)`` range of q2 (rad), within [-π/2, π/2]; default ±π/6.
+        Distance of the propeller from O along s0 (m), larger than every radius.
+    q1_limits, q2_limits : tuple of float, optional
+        ``(lo, hi)`` ranges of q1 (within [-π, π]) and q2 (within [-π/2, π/2]) (rad).
     tilt_limit : float, optional
-        Largest tilt of s0 from +Z allowed by the universal joint (rad), in (0, π/2); default π/4.
+        Largest tilt of s0 from +Z allowed by the universal joint (rad), in (0, π/2).
     interference_clearance : float, optional
-        Smallest angle between the 45° arc and the fixing device on the platform sphere (rad), in
-        [0, π/2); default 0.3 (assumed; the paper gives none).
-
-    Raises
-    ------
-    ValueError
-        If a field is out of its range or not finite, or ``propeller_arm`` does not exceed every radius.
-
-    Examples
-    --------
-    >>> th = VectoredThruster.paper()
-    >>> round(th.arc_angle, 6), th.propeller_arm
-    (0.785398, 0.08)
+        Smallest angle between the 45° arc and the fixing device on the platform sphere (rad), in [0, π/2).
     """
 
     arc_angle: float = math.pi / 4  # paper 5, eq. (7): angle between X and s12 (the 45 deg arc)

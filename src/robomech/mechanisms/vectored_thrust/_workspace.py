@@ -1,15 +1,6 @@
-"""Workspace, singularity and dexterity maps of the vectored thruster over its inputs (paper 5, Section 4).
-
-Two kinds of singularity, both from the closed-form Jacobian ``J = [theta_1 s22, Y + theta_2 s22]``:
-
-* passive axes parallel (``s22 || s12``, ``|s22 x s12| = 0``): the platform's rotation about s22 is
-  undetermined and J is unbounded.  Isolated points q = (0, a) and (pi, -a), a the 45 deg arc angle.
-* input 1 idle (``theta_1 = 0``: X, s12, s13 coplanar, the RRR chain at a serial singularity): J
-  loses rank, q1 no longer moves the platform.  The curve ``tan q2 = tan a / cos q1`` (|q2| >= a).
-
-paper 5, eq. (35): the printed "no singularity" tests det of the 3x3 passive-rate map (21), which is
-the wrong matrix; both sets above exist, and (0, pi/4) lies on the edge of the +-pi/4 trajectory box.
-"""
+"""Workspace, singularity and dexterity maps of the vectored thruster over its inputs (paper 5, Section 4);
+paper 5, eq. (35)'s "no singularity" tests the wrong matrix (docs/mechanisms/vectored_thrust.md,
+"Departures")."""
 
 from __future__ import annotations
 
@@ -19,7 +10,7 @@ import numpy as np
 
 from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, check_params
-from robomech.analysis.workspace import grid
+from robomech.analysis.workspace import SINGULAR_RTOL, grid
 
 from ._kinematics import _chunked, _fk, _interference, _jacobian, _q
 from ._params import VectoredThruster
@@ -34,9 +25,9 @@ __all__ = [
     "workspace_map",
 ]
 
-# sigma_min / sigma_max of J below which an input configuration counts as singular in the maps: the
-# same threshold as robomech.analysis.workspace.SINGULAR_RTOL (1e-8), applied to the closed form.
-DEXTERITY_TOL = 1e-8
+# sigma_min / sigma_max of J below which an input configuration counts as singular in the maps, applied
+# to the closed form: the shared threshold.
+DEXTERITY_TOL = SINGULAR_RTOL
 
 
 @dataclass(frozen=True)
@@ -47,25 +38,13 @@ class WorkspaceMap:
     ----------
     q : ndarray, shape (..., 2)
         The input samples (rad).
-    tip : ndarray, shape (..., 3)
-        Propeller tip (m, base frame); NaN where singular.
-    tilt : ndarray, shape (...)
-        Universal-joint deflection (rad).
-    clearance : ndarray, shape (...)
-        Angular clearance of the 45° arc from the fixing device (rad).
-    distance : ndarray, shape (...)
-        ``|s22 x s12|`` (0 at the passive-axes-parallel singularity).
-    dexterity : ndarray, shape (...)
-        ``1 / cond(J)`` in [0, 1]; 0 where singular.
-    singular : ndarray of bool, shape (...)
-        ``dexterity < DEXTERITY_TOL`` or passive axes parallel.
-    in_range : ndarray of bool, shape (...)
-        Inputs within ``q1_limits``, ``q2_limits``.
-    tilt_ok : ndarray of bool, shape (...)
-        Not singular and ``tilt <= tilt_limit``.
-    clear : ndarray of bool, shape (...)
-        ``clearance >= interference_clearance``.
-    reachable : ndarray of bool, shape (...)
+    tip, tilt, in_range, tilt_ok : ndarray
+        As in :class:`FKResult`.
+    clearance, distance, dexterity : ndarray, shape (...)
+        Angular clearance of the 45° arc from the fixing device (rad); ``|s22 x s12|`` (0 where the passive
+        axes are parallel); ``1 / cond(J)`` in [0, 1], 0 where singular.
+    singular, clear, reachable : ndarray of bool, shape (...)
+        ``dexterity < DEXTERITY_TOL`` or passive axes parallel; ``clearance >= interference_clearance``;
         ``in_range & tilt_ok & clear`` and not singular.
     """
 
@@ -105,24 +84,16 @@ def _dexterity(J: np.ndarray, ok: np.ndarray) -> np.ndarray:
 
 @carries_failed_rows({"q": 1})
 def dexterity(th: VectoredThruster, q: object) -> np.ndarray:
-    """Dexterity 1/cond(J) (...,) in [0, 1] at inputs ``q (..., 2)``; 0 at singular inputs.
+    """Dexterity ``1/cond(J) = sigma_min / sigma_max`` of the platform Jacobian, in [0, 1] (0 where singular).
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad).
 
     Returns
     -------
     ndarray, shape (...)
-        ``sigma_min / sigma_max`` of the platform Jacobian, in [0, 1].
-
-    Examples
-    --------
-    >>> th = VectoredThruster.paper()
-    >>> float(dexterity(th, singular_points(th)[0]))   # passive axes parallel
-    0.0
     """
     check_params(th, VectoredThruster, "th")
     jr = _jacobian(th, _q(q))
@@ -131,24 +102,17 @@ def dexterity(th: VectoredThruster, q: object) -> np.ndarray:
 
 @carries_failed_rows({"q": 1})
 def workspace_map(th: VectoredThruster, q: object) -> WorkspaceMap:
-    """Section 4 at each input sample ``q (..., 2)`` (rad): tip, limits, singularity, dexterity.
+    """Section 4 at each input sample ``q``: tip, limits, singularity, dexterity.
 
     Parameters
     ----------
     th : VectoredThruster
     q : array_like, shape (..., 2)
-        Inputs ``(q1, q2)`` (rad), e.g. :func:`input_grid`.
+        Inputs (rad), e.g. :func:`input_grid`.
 
     Returns
     -------
     WorkspaceMap
-
-    Examples
-    --------
-    >>> th = VectoredThruster.paper()
-    >>> w = workspace_map(th, input_grid(th, (5, 4)))
-    >>> w.tip.shape, w.reachable.shape
-    ((5, 4, 3), (5, 4))
     """
     check_params(th, VectoredThruster, "th")
     return _chunked(_workspace_map, th, _q(q))
@@ -178,7 +142,7 @@ def _workspace_map(th: VectoredThruster, q: np.ndarray) -> WorkspaceMap:
 
 
 def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = None) -> np.ndarray:
-    """Regular grid (n1, n2, 2) over ``limits`` ((lo, hi) per input, rad; default the input ranges).
+    """Regular grid of inputs (rad), the ends included.
 
     Parameters
     ----------
@@ -186,17 +150,11 @@ def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = 
     n : int or tuple of int
         Samples per input (each >= 2): one count for both, or ``(n1, n2)``.
     limits : array_like, shape (2, 2), optional
-        ``[[lo1, hi1], [lo2, hi2]]`` (rad), lo < hi; ``None`` (default): ``q1_limits``, ``q2_limits``.
+        ``[[lo1, hi1], [lo2, hi2]]`` (rad), lo < hi; default ``q1_limits``, ``q2_limits``.
 
     Returns
     -------
     ndarray, shape (n1, n2, 2)
-        Input samples ``(q1, q2)`` (rad), the ends included.
-
-    Examples
-    --------
-    >>> input_grid(VectoredThruster.paper(), (3, 5)).shape
-    (3, 5, 2)
     """
     check_params(th, VectoredThruster, "th")
     lim = np.array([th.q1_limits, th.q2_limits]) if limits is None else as_array(limits, "limits", (2, 2))
@@ -206,7 +164,7 @@ def input_grid(th: VectoredThruster, n: int | tuple[int, int], limits: object = 
 
 
 def singular_points(th: VectoredThruster) -> np.ndarray:
-    """Passive-axes-parallel singular inputs (2, 2), q1 in (-pi, pi], |q2| < pi/2: (0, a), (pi, -a).
+    """The passive-axes-parallel singular inputs ``(0, a), (pi, -a)`` (rad), a = ``th.arc_angle``.
 
     Parameters
     ----------
@@ -215,7 +173,6 @@ def singular_points(th: VectoredThruster) -> np.ndarray:
     Returns
     -------
     ndarray, shape (2, 2)
-        The two singular inputs ``(q1, q2)`` (rad), a = ``th.arc_angle``.
     """
     check_params(th, VectoredThruster, "th")
     a = th.arc_angle
@@ -224,9 +181,8 @@ def singular_points(th: VectoredThruster) -> np.ndarray:
 
 @carries_failed_rows({"q1": 0})
 def idle_input_curve(th: VectoredThruster, q1: object) -> np.ndarray:
-    """q2 (...,) on the rank-deficient curve ``tan q2 = tan a / cos q1`` for |q1| < pi/2 (rad).
-
-    On this curve input 1 is idle (X, s12, s13 coplanar): J loses rank (module docstring).
+    """q2 (rad) on the curve ``tan q2 = tan a / cos q1`` where input 1 is idle (X, s12, s13 coplanar) and
+    J loses rank, for |q1| < pi/2.
 
     Parameters
     ----------
@@ -237,7 +193,6 @@ def idle_input_curve(th: VectoredThruster, q1: object) -> np.ndarray:
     Returns
     -------
     ndarray, shape (...)
-        The input 2 angle q2 (rad) on the curve, ``atan2(tan a, cos q1)``.
 
     Examples
     --------
