@@ -18,13 +18,13 @@ from robomech._numba import import_numba
 
 from ._compiled import (
     BLOCK,
-    _all_finite,
     _amax_abs,
     _inertia_apply,
     chol_solve,
     entry,
     inertia_world,
     kin_into,
+    pinv_rank,
     prepare_one,
     rates_kdot,
     resjac,
@@ -158,22 +158,9 @@ def solve_constrained(M, f, K, kdq, rank, P, Pn, Mc, H, x, qdd):  # pragma: no c
                 H[i, j] = M[i, j]
         chol_solve(H, f, qdd)
         return cond
-    if not _all_finite(K):  # LAPACK refuses it: no acceleration (the sample is flagged)
+    if not pinv_rank(K, rank, P):  # non-finite K or no LAPACK convergence: the sample is flagged
         qdd[:] = np.nan
         return np.inf
-    try:
-        U, s, Vt = np.linalg.svd(K, full_matrices=False)
-    except Exception:  # no convergence (LAPACK): no acceleration, the sample is flagged
-        qdd[:] = np.nan
-        return np.inf
-    ok = s[rank - 1] > 0
-    P[:, :] = 0.0
-    for c in range(rank):
-        inv = 1.0 / s[c] if ok else 1.0
-        for i in range(nv):
-            g = Vt[c, i] * inv
-            for j in range(m):
-                P[i, j] += g * U[j, c]
     for i in range(nv):  # qdd_p = -K^+ kdq, Pn = I - K^+ K
         acc = 0.0
         for j in range(m):
