@@ -18,6 +18,10 @@
 
 * the Delta's closed-chain ``mb.forward_dynamics`` (actuated-rates form) at batch 1 and 10^4 samples.
 
+* ``--moved`` (:func:`moved_rows`): the Delta's ``mb.influence``, ``mb.site_hessian``,
+  ``mb.site_wrench``, full-rate ``mb.inverse_dynamics`` and a short ``mb.simulate`` at batch 1 and 10^4
+  samples (run on two source trees in turn for a before / after comparison).
+
 The compared measurements are taken in interleaved rounds (:func:`_interleaved`: in each round
 robomech and every alternative in turn) and reported as the minimum and the median over the rounds,
 so that the shared machine's background load hits both sides alike; the load average is printed.

@@ -23,6 +23,7 @@ from ._compiled import (
     chol_solve,
     entry,
     inertia_world,
+    influence_G,
     kin_into,
     pinv_rank,
     prepare_one,
@@ -30,7 +31,6 @@ from ._compiled import (
     resjac,
     rnea_block,
     site_forces,
-    svd_pinv,
     writable,
 )
 
@@ -232,8 +232,8 @@ def fd_block(
     """Forward dynamics of any mechanism, samples ``lo:hi``, the closure a constraint on the tree
     accelerations (:func:`solve_constrained`), with site wrenches ``W (N, ns, 6)`` on bodies ``wsb``
     at frames ``wT``, the applied generalized forces ``F (N, nv)`` and gravity ``gv``.  ``R`` the
-    rates: ``(N, n_act)`` actuated rates (``act_mode``: ``qd = G qd_act``, the passive block's SVD
-    pseudo-inverse, ``reg_o`` its rank and conditioning check) or ``(N, nv)`` every rate.  Outputs per
+    rates: ``(N, n_act)`` actuated rates (``act_mode``: ``qd = G qd_act``, ``G`` by ``_compiled.influence_G``,
+    ``reg_o`` its rank and conditioning check) or ``(N, nv)`` every rate.  Outputs per
     sample: ``qd_o``, ``qdd_o (N, nv)``, ``cond_o`` (of the constrained mass matrix, or of the
     singular passive block against the generic rank if larger), ``adm_o`` (``|K qd|`` and
     ``|K qdd + Kdot qd|``, relative), ``clo_o`` (max closure row of ``q``) and ``reg_o``.  ``t``,
@@ -252,6 +252,7 @@ def fd_block(
     K = np.empty((m, nv))
     Kp = np.empty((m, npas))
     Pp = np.empty((npas, m))
+    Gq = np.empty((nv, na))
     qd = np.empty((1, nv))
     Sd = np.empty((nv, 6))
     V = np.empty((nb, 6))
@@ -276,25 +277,14 @@ def fd_block(
         clo_o[n] = _amax_abs(r)
         reg = True
         e1 = 0.0
-        if act_mode:  # qd = G qd_act, G = [I; -K_p^+ K_a]
-            rank, cK = 0, 1.0
-            Pp[:, :] = 0.0
-            if m > 0 and npas > 0:
-                for i in range(m):
-                    for j in range(npas):
-                        Kp[i, j] = K[i, pas[j]]
-                rank, _, cK = svd_pinv(Kp, d.pinv_rtol, Pp)
+        if act_mode:  # qd = G qd_act, G = [I; -K_p^+ K_a] (_compiled.influence_G)
+            rank, _, cK = influence_G(K, act, pas, d.pinv_rtol, L, Kp, Pp, Gq)
             reg = rank >= d.rank0 and cK <= d.singular_cond
-            for j in range(na):
-                qd[0, act[j]] = R[n, j]
-            for i in range(npas):
+            for k in range(nv):
                 acc = 0.0
-                for c in range(m):
-                    kr = 0.0
-                    for j in range(na):
-                        kr += K[c, act[j]] * R[n, j]
-                    acc += Pp[i, c] * kr
-                qd[0, pas[i]] = -acc
+                for j in range(na):
+                    acc += Gq[k, j] * R[n, j]
+                qd[0, k] = acc
         else:
             for i in range(nv):
                 qd[0, i] = R[n, i]
