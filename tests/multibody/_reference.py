@@ -405,6 +405,11 @@ _SWAPS = {
     "closure_terms": numpy_closure_terms,
     "compiled_project": numpy_project,
 }
+_SWAPS_DYNAMICS = {
+    "_inverse_compiled": lambda *a, **k: _inverse_flat(*a, **k),
+    "_forward_compiled": lambda *a, **k: numpy_forward(*a, **k),
+    "_inverse_full_flat": lambda *a, **k: numpy_inverse_full(*a, **k),
+}
 
 
 @contextlib.contextmanager
@@ -412,17 +417,18 @@ def numpy_reference():
     """Inside the block, FK, site Jacobians, influence coefficients, site Hessians, the closure terms,
     the velocity projection, inverse and forward dynamics run the numpy formulation."""
     saved = {k: getattr(_compiled, k) for k in _SWAPS}
-    saved_d = (_dynamics._inverse_compiled, _dynamics._forward_compiled)
+    saved_d = {k: getattr(_dynamics, k) for k in _SWAPS_DYNAMICS}
     for k, fn in _SWAPS.items():
         setattr(_compiled, k, fn)
-    _dynamics._inverse_compiled = _inverse_flat
-    _dynamics._forward_compiled = numpy_forward
+    for k, fn in _SWAPS_DYNAMICS.items():
+        setattr(_dynamics, k, fn)
     try:
         yield
     finally:
         for k, fn in saved.items():
             setattr(_compiled, k, fn)
-        _dynamics._inverse_compiled, _dynamics._forward_compiled = saved_d
+        for k, fn in saved_d.items():
+            setattr(_dynamics, k, fn)
 
 
 # ----------------------------------------------------------------------------- the tree's RNEA and CRBA
@@ -678,6 +684,93 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
         admissibility=adm,
         valid=valid,
         closure=D._closure_error(mech, state, q),
+    )
+
+
+# ----------------------------------------------------------------------------- full-rate inverse dynamics
+# The numpy formulation of _rnea_kernels.inv_full_block (batched over samples).
+def null_basis(mech: Mechanism, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Orthonormal basis ``(N, nv, d)`` of the admissible velocities ``null(K)`` at the mechanism's
+    generic rank of ``K``, and ``s_1 / s_r`` of ``K`` (N,): 1 for a tree (the identity basis)."""
+    N, m, nv = K.shape
+    r = D._rank_K(mech) if m else 0
+    if r == 0:
+        return np.broadcast_to(np.eye(nv), (N, nv, nv)), np.ones(N)
+    _, s, Vt = np.linalg.svd(K, full_matrices=True)
+    sr = s[:, r - 1]
+    cond = np.where(sr > 0, s[:, 0] / np.where(sr > 0, sr, 1.0), np.inf)
+    return Vt[:, r:].swapaxes(-1, -2), cond
+
+
+def numpy_inverse_full(mech, q, qd, qdd, wr, weights, gravity=True):
+    """``_dynamics._inverse_full_flat`` (the compiled ``_rnea_kernels.inv_full_block``) in batched numpy:
+    the derivation of that docstring, from numpy_crba, numpy_rnea and numpy_closure_terms."""
+    model = D.compile_model(mech)
+    tree = model.tree
+    N, nv = q.shape[0], tree.nv
+    act = tree.act_dof
+    na = len(act)
+    L = tree.length
+    z = np.zeros_like(qd)
+    gv = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
+    M = numpy_crba(mech, q)
+    K, kdq, ext, closure = numpy_closure_terms(model, q, qd, *D._wrench_arrays(tree, wr, N))
+    parts = (
+        D._mv(M, qdd),
+        numpy_rnea(mech, q, qd, z, np.zeros(3)),
+        numpy_rnea(mech, q, z, z, gv),
+        ext,
+    )
+    f = parts[0] + parts[1] + parts[2] + parts[3]
+    Nb, condK = null_basis(mech, K)
+    NbT = Nb.swapaxes(-1, -2)
+    Na = Nb[:, act]  # (N, na, d): the actuated rows of the admissible motions
+    ws = np.ones(na) if weights is None else np.sqrt(weights)
+    A = NbT[:, :, act] * ws  # (N, d, na)
+    d = Nb.shape[-1]
+    if na and d:
+        sA = np.linalg.svd(A, compute_uv=False)
+        smin = sA[:, -1]
+        cond_a = np.where(smin > RANK_RTOL * sA[:, 0], sA[:, 0] / np.where(smin > 0, smin, 1.0), np.inf)
+        B = ws[:, None] * (np.linalg.pinv(A, rcond=RANK_RTOL) @ NbT)  # (N, na, nv)
+    else:
+        smin, cond_a = np.ones(N), np.ones(N)
+        B = np.zeros((N, na, nv))
+    tau_parts = [D._mv(B, x) for x in parts]
+    tau = tau_parts[0] + tau_parts[1] + tau_parts[2] + tau_parts[3]
+    b = D._mv(NbT, f)
+    unact = D._mv(Nb, b - D._mv(Na.swapaxes(-1, -2), tau))
+    # relative to the largest of the inertial, velocity, gravity and external terms (their sum is ~0 on a
+    # free motion, whose rounding must not count as a force the actuators cannot give)
+    scale = np.max(np.abs(np.stack(parts)), axis=(0, -1)) if nv else np.zeros(N)
+    e_force = np.max(np.abs(unact), axis=-1) / np.maximum(scale, 1e-300) if nv else np.zeros(N)
+    sv = np.max(np.abs(qd), axis=-1) if nv else np.zeros(N)
+    sa = np.max(np.abs(qdd), axis=-1) + sv * sv if nv else np.zeros(N)
+    if K.shape[1]:
+        e1 = np.max(np.abs(D._mv(K, qd)), axis=-1) / (L * np.maximum(sv, RATE_FLOOR))
+        e2 = np.max(np.abs(D._mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
+        adm = np.maximum(np.maximum(e1, e2), e_force)
+    else:
+        adm = e_force
+    M_a = B @ M @ B.swapaxes(-1, -2)
+    cond = np.maximum(condK, cond_a)
+    fin = np.all(np.isfinite(tau), axis=-1) & np.all(np.isfinite(M_a), axis=(-1, -2))
+    computed = fin & (cond <= SINGULAR_COND)
+    return dict(
+        _computed=computed,
+        tau=tau,
+        M_a=M_a,
+        velocity_terms=tau_parts[1],
+        gravity_terms=tau_parts[2],
+        external_terms=tau_parts[3],
+        qd=np.array(qd),
+        qdd=np.array(qdd),
+        cond=cond,
+        sigma_min=L * smin,
+        admissibility=adm,
+        unactuated=unact,
+        closure=closure,
+        valid=computed & (adm <= ADMISSIBLE_RTOL),
     )
 
 

@@ -1,6 +1,6 @@
 """Influence coefficients, site Hessians, site wrenches, the full-rate inverse dynamics and the simulation's
-projection: the compiled kernels (``_compiled.influence_block``, ``closure_terms_block``,
-``project_block``) against their numpy formulation (tests/multibody/_reference.py) on closed chains
+projection: the compiled kernels (``_compiled.influence_block``, ``_rnea_kernels.inv_full_block``,
+``_compiled.project_block``) against their numpy formulation (tests/multibody/_reference.py) on closed chains
 (Delta, a five-bar typed unassembled, Sarrus, Tsai 3-UPU, the agile eye), an open chain, an
 under-actuated floating-base tree, a passive pendulum and a cart, at batch 1 and at batches below and
 above the kernels' block size (``_compiled.BLOCK`` samples run in one block in the calling thread, more
@@ -142,9 +142,10 @@ def test_site_wrench_equals_numpy(name):
     _close(one.wrench, fast.wrench[7], BATCH_RTOL, "wrench at batch 1")
 
 
-# The full-rate inverse dynamics: the compiled closure rows, Kdot qd and site forces against numpy;
-# the least squares on top is the same numpy code, so forces agree to rounding times the conditioning
-# of the admissible-motion basis (cond <= 1e4 here).
+# The full-rate inverse dynamics: the compiled kernel (_rnea_kernels.inv_full_block) against its numpy
+# formulation (_reference.numpy_inverse_full): the same SVDs of K and of the actuated rows, another
+# operation order, so forces agree to rounding times the conditioning of the admissible-motion basis
+# (cond <= 1e4 here).
 FULL_RTOL = 1e-10
 
 

@@ -1866,7 +1866,8 @@ def warm() -> None:
         compiled_site_jacobian(mech, qf, site)
         compiled_influence(model, qf, True, site)  # influence coefficients and site Hessians
         zv = np.zeros((n, mech.nv))
-        closure_terms(model, qf, zv, *_dynamics._wrench_arrays(model.tree, {}, n))  # full-rate dynamics
+        closure_terms(model, qf, zv, *_dynamics._wrench_arrays(model.tree, {}, n))
+        _dynamics.inverse_dynamics(mech, qf, qd=zv, qdd=zv)  # the full-rate inverse dynamics kernel
         if n == 1:
             compiled_project(model, qf, zv)  # simulate's projection (one sample per call)
         z = np.zeros((n, len(model.act)))

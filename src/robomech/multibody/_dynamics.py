@@ -56,7 +56,6 @@ from ._options import (
     ADMISSIBLE_RTOL,
     CLOSURE_RTOL,
     RANK_RTOL,
-    RATE_FLOOR,
     SINGULAR_COND,
 )
 from ._tree import (
@@ -285,6 +284,26 @@ class InverseDynamicsResult:
     valid: np.ndarray
 
 
+def _id_outputs(N: int, na: int, nv: int, extra: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """Empty output arrays of an inverse-dynamics kernel: the forces and measures of
+    ``InverseDynamicsResult`` (N samples, ``na`` actuators, ``nv`` coordinates), then ``extra`` in the
+    kernel's argument order."""
+    shapes = {"qd": (N, nv), "qdd": (N, nv), "unactuated": (N, nv), "closure": (N,)}
+    out = dict(
+        tau=np.empty((N, na)),
+        M_a=np.empty((N, na, na)),
+        velocity_terms=np.empty((N, na)),
+        gravity_terms=np.empty((N, na)),
+        external_terms=np.empty((N, na)),
+    )
+    out.update({k: np.empty(shapes[k]) for k in extra if k in ("qd", "qdd")})
+    out.update(cond=np.empty(N), sigma_min=np.empty(N), admissibility=np.empty(N))
+    for k in extra:
+        if k not in ("qd", "qdd"):
+            out[k] = np.empty(N, dtype=np.bool_) if k in ("valid", "_computed") else np.empty(shapes[k])
+    return out
+
+
 def _inverse_compiled(mech, q, qd_a, qdd_a, wr, weights, gravity=True) -> dict[str, np.ndarray]:
     """The closed-chain inverse dynamics in actuator space (the derivation of the module docstring) by
     the compiled per-sample kernel (``_compiled.inv_dyn``), the one implementation at every batch size;
@@ -297,20 +316,7 @@ def _inverse_compiled(mech, q, qd_a, qdd_a, wr, weights, gravity=True) -> dict[s
     W, wsb, wT = _wrench_arrays(tree, wr, N)
     gv = np.asarray(mech.gravity, dtype=float) if gravity else np.zeros(3)
     wts = np.zeros(0) if weights is None else np.ascontiguousarray(weights, dtype=float)
-    out = dict(
-        tau=np.empty((N, na)),
-        M_a=np.empty((N, na, na)),
-        velocity_terms=np.empty((N, na)),
-        gravity_terms=np.empty((N, na)),
-        external_terms=np.empty((N, na)),
-        qd=np.empty((N, nv)),
-        qdd=np.empty((N, nv)),
-        cond=np.empty(N),
-        sigma_min=np.empty(N),
-        admissibility=np.empty(N),
-        valid=np.empty(N, dtype=np.bool_),
-        closure=np.empty(N),
-    )
+    out = _id_outputs(N, na, nv, ("qd", "qdd", "valid", "closure"))
     f = np.ascontiguousarray
     inv_dyn(
         f(q, dtype=float),
@@ -479,19 +485,6 @@ def _shape(d: dict, batch, ok: np.ndarray, nan_keys) -> dict:
 _FORCE_KEYS = ("tau", "M_a", "velocity_terms", "gravity_terms", "external_terms")
 
 
-def _null_basis(mech: Mechanism, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Orthonormal basis ``(N, nv, d)`` of the admissible velocities ``null(K)`` at the mechanism's
-    generic rank of ``K``, and ``s_1 / s_r`` of ``K`` (N,): 1 for a tree (the identity basis)."""
-    N, m, nv = K.shape
-    r = _rank_K(mech) if m else 0
-    if r == 0:
-        return np.broadcast_to(np.eye(nv), (N, nv, nv)), np.ones(N)
-    _, s, Vt = np.linalg.svd(K, full_matrices=True)
-    sr = s[:, r - 1]
-    cond = np.where(sr > 0, s[:, 0] / np.where(sr > 0, sr, 1.0), np.inf)
-    return Vt[:, r:].swapaxes(-1, -2), cond
-
-
 def _inverse_full_flat(mech, q, qd, qdd, wr, weights, gravity=True):
     """Inverse dynamics from every coordinate's rates and accelerations (any kinematic class).
 
@@ -500,78 +493,16 @@ def _inverse_full_flat(mech, q, qd, qdd, wr, weights, gravity=True):
     ``Nb^T E tau = Nb^T f``; ``tau = B f`` is its least-squares solution (minimum norm, or minimum
     ``sum tau_i^2 / w_i``), and what no actuator force can do, ``Nb (Nb^T f - Nb^T E tau)``, is the
     force the unactuated coordinates would need.  Where the actuators determine the motion this is
-    ``G^T f`` of :func:`_inverse_compiled`."""
-    from ._compiled import closure_terms
-    from ._rnea import _crba_flat, _rnea_flat
+    ``G^T f`` of :func:`_inverse_compiled`.  Computed per sample by the compiled kernel
+    (``_rnea_kernels.inv_full_block``), the one implementation at every batch size; its numpy
+    formulation is the tests' reference (tests/multibody/_reference.py)."""
+    from ._rnea_kernels import inverse_full
 
     model = compile_model(mech)
-    tree = model.tree
-    N, nv = q.shape[0], tree.nv
-    act = tree.act_dof
-    na = len(act)
-    L = tree.length
-    z = np.zeros_like(qd)
+    N = q.shape[0]
     gv = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
-    M = _crba_flat(mech, q)
-    # the closure rows, their velocity-product accelerations and the site wrenches' forces (compiled)
-    K, kdq, ext, closure = closure_terms(model, q, qd, *_wrench_arrays(tree, wr, N))
-    parts = (
-        _mv(M, qdd),
-        _rnea_flat(mech, q, qd, z, np.zeros(3)),
-        _rnea_flat(mech, q, z, z, gv),
-        ext,
-    )
-    f = parts[0] + parts[1] + parts[2] + parts[3]
-    Nb, condK = _null_basis(mech, K)
-    NbT = Nb.swapaxes(-1, -2)
-    Na = Nb[:, act]  # (N, na, d): the actuated rows of the admissible motions
-    ws = np.ones(na) if weights is None else np.sqrt(weights)
-    A = NbT[:, :, act] * ws  # (N, d, na)
-    d = Nb.shape[-1]
-    if na and d:
-        sA = np.linalg.svd(A, compute_uv=False)
-        smin = sA[:, -1]
-        cond_a = np.where(smin > RANK_RTOL * sA[:, 0], sA[:, 0] / np.where(smin > 0, smin, 1.0), np.inf)
-        B = ws[:, None] * (np.linalg.pinv(A, rcond=RANK_RTOL) @ NbT)  # (N, na, nv)
-    else:
-        smin, cond_a = np.ones(N), np.ones(N)
-        B = np.zeros((N, na, nv))
-    tau_parts = [_mv(B, x) for x in parts]
-    tau = tau_parts[0] + tau_parts[1] + tau_parts[2] + tau_parts[3]
-    b = _mv(NbT, f)
-    unact = _mv(Nb, b - _mv(Na.swapaxes(-1, -2), tau))
-    # relative to the largest of the inertial, velocity, gravity and external terms (their sum is ~0 on a
-    # free motion, whose rounding must not count as a force the actuators cannot give)
-    scale = np.max(np.abs(np.stack(parts)), axis=(0, -1)) if nv else np.zeros(N)
-    e_force = np.max(np.abs(unact), axis=-1) / np.maximum(scale, 1e-300) if nv else np.zeros(N)
-    sv = np.max(np.abs(qd), axis=-1) if nv else np.zeros(N)
-    sa = np.max(np.abs(qdd), axis=-1) + sv * sv if nv else np.zeros(N)
-    if K.shape[1]:
-        e1 = np.max(np.abs(_mv(K, qd)), axis=-1) / (L * np.maximum(sv, RATE_FLOOR))
-        e2 = np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
-        adm = np.maximum(np.maximum(e1, e2), e_force)
-    else:
-        adm = e_force
-    M_a = B @ M @ B.swapaxes(-1, -2)
-    cond = np.maximum(condK, cond_a)
-    fin = np.all(np.isfinite(tau), axis=-1) & np.all(np.isfinite(M_a), axis=(-1, -2))
-    computed = fin & (cond <= SINGULAR_COND)
-    return dict(
-        _computed=computed,
-        tau=tau,
-        M_a=M_a,
-        velocity_terms=tau_parts[1],
-        gravity_terms=tau_parts[2],
-        external_terms=tau_parts[3],
-        qd=np.array(qd),
-        qdd=np.array(qdd),
-        cond=cond,
-        sigma_min=L * smin,
-        admissibility=adm,
-        unactuated=unact,
-        closure=closure,
-        valid=computed & (adm <= ADMISSIBLE_RTOL),
-    )
+    out = _id_outputs(N, len(model.act), model.tree.nv, ("unactuated", "closure", "_computed", "valid"))
+    return inverse_full(model, q, qd, qdd, *_wrench_arrays(model.tree, wr, N), gv, weights, out)
 
 
 def _finish_inverse(mech: Mechanism, q: np.ndarray, d: dict, actuated_mode: bool) -> dict:
