@@ -14,7 +14,7 @@ from collections.abc import Callable
 import numpy as np
 
 from robomech.dynamics import _com_terms
-from robomech.multibody import _compiled, _dynamics, _rnea
+from robomech.multibody import _compiled, _dynamics, _rnea, _rnea_kernels
 from robomech.multibody import _dynamics as D
 from robomech.multibody._constraints import jacobian, jacobian_rate, residual
 from robomech.multibody._model import Mechanism
@@ -375,8 +375,29 @@ def numpy_compiled_influence(model, q, second, site=-1):
     return G, dG, H, rank, cons, smin, cond
 
 
+def rank_measures(Kp: np.ndarray, rank0: int, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(sigma_min, cond)`` of ``Kp (N, m, n)`` against the mechanism's generic passive rank ``rank0``:
+    the ``rank0``-th singular value and ``s_1`` over it (inf where it is zero).  A truncated
+    pseudo-inverse keeps only the non-zero values, so its own ratio is 1 at a rank drop (a type II
+    singularity); this is the measure reported wherever a sample is not valid.  An empty block or a
+    generic rank 0: ``(length, 1)`` as in ``_influence._pinv``."""
+    N, m, n = Kp.shape
+    if m == 0 or n == 0 or rank0 == 0:
+        return np.full(N, float(length)), np.ones(N)
+    s = np.linalg.svd(np.where(np.isfinite(Kp), Kp, 0.0), compute_uv=False)
+    sr = s[:, rank0 - 1] if s.shape[1] >= rank0 else np.zeros(N)
+    cond = np.where(sr > 0, s[:, 0] / np.where(sr > 0, sr, 1.0), np.inf)
+    return sr, cond
+
+
+def numpy_passive_rank_measures(model, q):
+    """``_rnea_kernels.passive_rank_measures``: :func:`rank_measures` of ``K_p`` at ``q (N, nq)``."""
+    K = constraint_matrix(model, kinematics(model.tree, q), q)
+    return rank_measures(K[..., model.pas], model.rank0, model.tree.length)
+
+
 def numpy_closure_terms(model, q, qd, W, wsb, wT):
-    """``_compiled.closure_terms`` by the numpy formulation: ``(K, Kdot qd, -sum_s J_s^T W_s, closure)``."""
+    """The closure terms of the full-rate inverse dynamics: ``(K, Kdot qd, -sum_s J_s^T W_s, closure)``."""
     tree = model.tree
     state = kinematics(tree, q)
     K = constraint_matrix(model, state, q)
@@ -402,7 +423,6 @@ _SWAPS = {
     "compiled_fk": numpy_fk,
     "compiled_site_jacobian": numpy_site_jacobian,
     "compiled_influence": numpy_compiled_influence,
-    "closure_terms": numpy_closure_terms,
     "compiled_project": numpy_project,
 }
 _SWAPS_DYNAMICS = {
@@ -417,6 +437,8 @@ def numpy_reference():
     """Inside the block, FK, site Jacobians, influence coefficients, site Hessians, the closure terms,
     the velocity projection, inverse and forward dynamics run the numpy formulation."""
     saved = {k: getattr(_compiled, k) for k in _SWAPS}
+    saved_rank = _rnea_kernels.passive_rank_measures
+    _rnea_kernels.passive_rank_measures = numpy_passive_rank_measures
     saved_d = {k: getattr(_dynamics, k) for k in _SWAPS_DYNAMICS}
     for k, fn in _SWAPS.items():
         setattr(_compiled, k, fn)
@@ -429,6 +451,7 @@ def numpy_reference():
             setattr(_compiled, k, fn)
         for k, fn in saved_d.items():
             setattr(_dynamics, k, fn)
+        _rnea_kernels.passive_rank_measures = saved_rank
 
 
 # ----------------------------------------------------------------------------- the tree's RNEA and CRBA
@@ -839,5 +862,5 @@ def numpy_forward(mech, q, rates, tau_a, wr, gravity, act_mode):
     closure = np.max(np.abs(residual(mech.constraints, tree, state, q)), axis=-1, initial=0.0)
     if act_mode and np.any(~reg):  # a singular passive block: its measure against the generic rank
         bad = np.flatnonzero(~reg)
-        cond[bad] = np.maximum(cond[bad], D._rank_measures(K[bad][..., pas], rank0, L)[1])
+        cond[bad] = np.maximum(cond[bad], rank_measures(K[bad][..., pas], rank0, L)[1])
     return qd, qdd, cond, adm, closure, reg

@@ -6,14 +6,13 @@ kinematics, closure residual and velocity constraint matrix (the formulas of ``_
 ``_constraints``, written per sample), the Levenberg–Marquardt assembly (damping, step cap and stopping
 rules of ``_options``), ``G = [I; -K_p^+ K_a]`` by the SVD pseudo-inverse (:func:`influence_G`) with the
 site's ``[ω; ṗ]`` Jacobian, the second-order coefficients ``∂G/∂q_act`` and site Hessians
-(:func:`influence_block`, from ``(dK/dt along u) v``, :func:`kdot_uv`), the closure terms of the full-rate
-inverse dynamics (:func:`closure_terms_block`), the velocity projection of ``simulate``
-(:func:`project_block`), and the closed-chain inverse dynamics (:func:`inv_dyn`: passive pseudo-inverse,
-screw rates, ``K̇ q̇``, the bodies' Newton–Euler terms through ``G``, site wrenches, the redundant-
-actuation rule and the validity flags). Every sample stays in cache; large batches run in parallel over
-the cores (``numba.prange``). The mechanism is passed packed, as the named tuples ``_compile.Tables`` and
-``_compile.DynTables`` of its compiled model. The numpy formulation stays in the tests as the reference
-(tests/multibody/_reference.py).
+(:func:`influence_block`, from ``(dK/dt along u) v``, :func:`kdot_uv`), the velocity projection of
+``simulate`` (:func:`project_block`), and the closed-chain inverse dynamics (:func:`inv_dyn`: passive
+pseudo-inverse, screw rates, ``K̇ q̇``, the bodies' Newton–Euler terms through ``G``, site wrenches, the
+redundant-actuation rule and the validity flags). Every sample stays in cache; large batches run in
+parallel over the cores (``numba.prange``). The mechanism is passed packed, as the named tuples
+``_compile.Tables`` and ``_compile.DynTables`` of its compiled model. The numpy formulation stays in the
+tests as the reference (tests/multibody/_reference.py).
 """
 
 from __future__ import annotations
@@ -27,7 +26,6 @@ from . import _options as opt
 from ._compile import compile_model
 
 __all__ = [
-    "closure_terms",
     "compiled_fk",
     "compiled_influence",
     "compiled_project",
@@ -1080,57 +1078,6 @@ def site_forces(T, S, A, Wn, wsb, wT, ps, ext):  # pragma: no cover - compiled
 
 
 @_nj
-def closure_terms_block(Q, QD, W, wsb, wT, lo, hi, t, K_o, kdq_o, ext_o, clo_o):  # pragma: no cover
-    """Per sample ``lo:hi``: the constraint matrix ``K_o (N, m, nv)``, the velocity-product accelerations
-    ``kdq_o = Kdot qd (N, m)`` along ``QD (N, nv)`` (:func:`rates_kdot`), the site wrenches' generalized
-    forces ``ext_o = -sum_s J_s^T W_s (N, nv)`` (:func:`site_forces`) and the largest closure row
-    ``clo_o`` (m): what the full-rate inverse dynamics needs from the kinematics."""
-    nb = t.parent.shape[0]
-    m = t.m
-    nv = t.A.shape[1]
-    T = np.empty((nb, 4, 4))
-    S = np.zeros((nv, 6))
-    r = np.empty(m)
-    Sd = np.empty((nv, 6))
-    V = np.empty((nb, 6))
-    Vd = np.empty((nb, 6))
-    ps = np.empty(3)
-    for n in range(lo, hi):
-        q = Q[n]
-        kin(q, t, T, S)
-        resjac(q, t, T, S, r, K_o[n], True)
-        clo_o[n] = _amax_abs(r)
-        if m > 0:
-            rates_kdot(q, t, T, S, QD[n], Sd, V, Vd, kdq_o[n])
-        site_forces(T, S, t.A, W[n], wsb, wT, ps, ext_o[n])
-
-
-@numba.njit(cache=True, error_model="numpy", parallel=True)
-def closure_terms_par(Q, QD, W, wsb, wT, t, K_o, kdq_o, ext_o, clo_o):  # pragma: no cover - compiled
-    """:func:`closure_terms_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
-    N = Q.shape[0]
-    for k in numba.prange((N + BLOCK - 1) // BLOCK):
-        closure_terms_block(
-            Q, QD, W, wsb, wT, k * BLOCK, min(N, (k + 1) * BLOCK), t, K_o, kdq_o, ext_o, clo_o
-        )
-
-
-def closure_terms(model, q: np.ndarray, qd: np.ndarray, W, wsb, wT) -> tuple:
-    """``(K (N, m, nv), Kdot qd (N, m), -sum_s J_s^T W_s (N, nv), closure (N,))`` by
-    :func:`closure_terms_block` (``W (N, ns, 6)`` on the site bodies ``wsb`` at frames ``wT``)."""
-    Q, QD, WW = writable(q), writable(qd), writable(W)
-    N, m, nv = Q.shape[0], model.tables.m, model.tree.nv
-    outs = (np.zeros((N, m, nv)), np.zeros((N, m)), np.empty((N, nv)), np.empty(N))
-    if N <= BLOCK:
-        entry(
-            model, closure_terms_block, "closure_terms_block", (Q, QD, WW, wsb, wT, 0, N, model.tables, *outs)
-        )
-    else:
-        closure_terms_par(Q, QD, WW, wsb, wT, model.tables, *outs)
-    return outs
-
-
-@_nj
 def inv_dyn_block(
     lo,
     hi,
@@ -1866,7 +1813,6 @@ def warm() -> None:
         compiled_site_jacobian(mech, qf, site)
         compiled_influence(model, qf, True, site)  # influence coefficients and site Hessians
         zv = np.zeros((n, mech.nv))
-        closure_terms(model, qf, zv, *_dynamics._wrench_arrays(model.tree, {}, n))
         _dynamics.inverse_dynamics(mech, qf, qd=zv, qdd=zv)  # the full-rate inverse dynamics kernel
         if n == 1:
             compiled_project(model, qf, zv)  # simulate's projection (one sample per call)

@@ -116,21 +116,6 @@ def _rank_K(mech: Mechanism) -> int:
     return _reference3(mech)[2]
 
 
-def _rank_measures(Kp: np.ndarray, rank0: int, length: float) -> tuple[np.ndarray, np.ndarray]:
-    """``(sigma_min, cond)`` of ``Kp (N, m, n)`` against the mechanism's generic passive rank ``rank0``:
-    the ``rank0``-th singular value and ``s_1`` over it (inf where it is zero).  A truncated
-    pseudo-inverse keeps only the non-zero values, so its own ratio is 1 at a rank drop (a type II
-    singularity); this is the measure reported wherever a sample is not valid.  An empty block or a
-    generic rank 0: ``(length, 1)`` as in ``_influence._pinv``."""
-    N, m, n = Kp.shape
-    if m == 0 or n == 0 or rank0 == 0:
-        return np.full(N, float(length)), np.ones(N)
-    s = np.linalg.svd(np.where(np.isfinite(Kp), Kp, 0.0), compute_uv=False)
-    sr = s[:, rank0 - 1] if s.shape[1] >= rank0 else np.zeros(N)
-    cond = np.where(sr > 0, s[:, 0] / np.where(sr > 0, sr, 1.0), np.inf)
-    return sr, cond
-
-
 def _closure_error(mech: Mechanism, state, q: np.ndarray) -> np.ndarray:
     """Largest closure row ``max |phi(q)|`` (m) per sample; 0 for a tree."""
     from ._constraints import residual
@@ -509,7 +494,8 @@ def _finish_inverse(mech: Mechanism, q: np.ndarray, d: dict, actuated_mode: bool
     """The checks common to both inverse-dynamics forms (actuated and full rates): the closure of the
     input ``q`` (reported by the kernels); in actuator mode a zero
     ``unactuated`` force, the empty passive block's measures and, where a sample is not valid, the
-    rank measures against the generic rank (``_rank_measures``: a type II singularity has cond inf)."""
+    rank measures against the generic rank (``_rnea_kernels.rank_measures``: a type II singularity has
+    cond inf)."""
     tree = mech.tree
     N = q.shape[0]
     if actuated_mode:
@@ -520,13 +506,9 @@ def _finish_inverse(mech: Mechanism, q: np.ndarray, d: dict, actuated_mode: bool
         else:
             bad = np.flatnonzero(~d["valid"])
             if bad.size:
-                from ._compiled import closure_terms
+                from ._rnea_kernels import passive_rank_measures
 
-                zb = np.zeros((bad.size, tree.nv))
-                K = closure_terms(compile_model(mech), q[bad], zb, *_wrench_arrays(tree, {}, bad.size))[0]
-                d["sigma_min"][bad], d["cond"][bad] = _rank_measures(
-                    K[..., pas], _reference(mech)[0], tree.length
-                )
+                d["sigma_min"][bad], d["cond"][bad] = passive_rank_measures(compile_model(mech), q[bad])
     assembled = d["closure"] <= CLOSURE_RTOL * tree.length
     d["valid"] = d["valid"] & assembled
     if "_computed" in d:

@@ -568,12 +568,15 @@ def inverse_full(model, q, qd, qdd, W, wsb, wT, gv, weights, out: dict) -> dict:
 
 
 @_nj
-def rank_cond(Kp, rank0):  # pragma: no cover - compiled
-    """``s_1 / s_rank0`` of ``Kp (m, n)`` (non-finite entries read as 0; inf where ``s_rank0`` is 0; 1
-    for an empty block or a generic rank 0): ``_dynamics._rank_measures``' conditioning."""
+def rank_measures(Kp, rank0, L):  # pragma: no cover - compiled
+    """``(s_rank0, s_1 / s_rank0)`` of ``Kp (m, n)`` against the mechanism's generic passive rank
+    ``rank0`` (non-finite entries read as 0; cond inf where ``s_rank0`` is 0, or where LAPACK does not
+    converge).  A truncated pseudo-inverse keeps only the non-zero values, so its own ratio is 1 at a
+    rank drop (a type II singularity); this is the measure reported wherever a sample is not valid.  An
+    empty block or a generic rank 0: ``(L, 1)``, as ``_compiled.influence_G`` has it."""
     m, n = Kp.shape
     if m == 0 or n == 0 or rank0 == 0:
-        return 1.0
+        return L, 1.0
     H = np.empty((m, n))
     for i in range(m):
         for j in range(n):
@@ -582,9 +585,52 @@ def rank_cond(Kp, rank0):  # pragma: no cover - compiled
     try:
         s = np.linalg.svd(H)[1]
     except Exception:  # no convergence (LAPACK): no measure
-        return np.inf
+        return 0.0, np.inf
     sr = s[rank0 - 1] if s.shape[0] >= rank0 else 0.0
-    return s[0] / sr if sr > 0 else np.inf
+    return sr, (s[0] / sr if sr > 0 else np.inf)
+
+
+@_nj
+def rank_cond(Kp, rank0):  # pragma: no cover - compiled
+    """The conditioning of :func:`rank_measures` (1 for an empty block or a generic rank 0)."""
+    return rank_measures(Kp, rank0, 1.0)[1]
+
+
+@_nj
+def rank_measures_block(Q, lo, hi, pas, rank0, t, smin_o, cond_o):  # pragma: no cover - compiled
+    """:func:`rank_measures` of the passive block ``K_p`` at each configuration ``Q[lo:hi]``."""
+    nb = t.parent.shape[0]
+    m = t.m
+    nv = t.A.shape[1]
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    Rj = np.empty((3, 3))
+    Rn = np.empty((3, 3))
+    anchor = np.empty(3)
+    r = np.empty(m)
+    K = np.empty((m, nv))
+    Kp = np.empty((m, pas.shape[0]))
+    for n in range(lo, hi):
+        kin_into(Q[n], t, T, S, Rj, Rn, anchor)
+        resjac(Q[n], t, T, S, r, K, True)
+        for i in range(m):
+            for j in range(pas.shape[0]):
+                Kp[i, j] = K[i, pas[j]]
+        smin_o[n], cond_o[n] = rank_measures(Kp, rank0, t.L)
+
+
+def passive_rank_measures(model, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(sigma_min, cond)`` of :func:`rank_measures` at ``q (N, nq)`` (the samples that are not valid)."""
+    Q = writable(q)
+    N = Q.shape[0]
+    smin, cond = np.empty(N), np.empty(N)
+    entry(
+        model,
+        rank_measures_block,
+        "rank_measures_block",
+        (Q, 0, N, model.pas, model.rank0, model.tables, smin, cond),
+    )
+    return smin, cond
 
 
 @numba.njit(cache=True, error_model="numpy", parallel=True)
