@@ -18,6 +18,10 @@
 
 * the Delta's closed-chain ``mb.forward_dynamics`` (actuated-rates form) at batch 1 and 10^4 samples.
 
+* ``--moved`` (:func:`moved_rows`): the Delta's ``mb.influence``, ``mb.site_hessian``,
+  ``mb.site_wrench``, full-rate ``mb.inverse_dynamics`` and a short ``mb.simulate`` at batch 1 and 10^4
+  samples (run on two source trees in turn for a before / after comparison).
+
 The compared measurements are taken in interleaved rounds (:func:`_interleaved`: in each round
 robomech and every alternative in turn) and reported as the minimum and the median over the rounds,
 so that the shared machine's background load hits both sides alike; the load average is printed.
@@ -323,5 +327,50 @@ def main() -> None:
         print(row)
 
 
+N_MOVED = 10_000  # samples of the large-batch rows of :func:`moved_rows`
+N_SIM = 20  # simulate: initial conditions of the batch row (each integrated on its own)
+
+
+def moved_rows() -> list[str]:
+    """The Delta's ``influence``, ``site_hessian``, ``site_wrench``, full-rate ``inverse_dynamics``
+    (``qd=``, ``qdd=``) and a short ``simulate`` (0.05 s, 6 output times): per call at batch 1 and per
+    sample at 10^4 (``simulate``: ``N_SIM`` initial conditions), min / median over interleaved rounds."""
+    mech = mb.gallery.load("delta")
+    q, qd, qdd = _states(mech, N_MOVED)
+    r = mb.inverse_dynamics(mech, q, qd, qdd)
+    tau, fq, fqd = r.tau, r.qd, r.qdd
+    t = np.linspace(0.0, 0.05, 6)
+    calls = {
+        "influence": lambda s: mb.influence(mech, q[s]),
+        "site_hessian": lambda s: mb.site_hessian(mech, q[s], "tcp"),
+        "site_wrench": lambda s: mb.site_wrench(mech, q[s], "tcp", tau[s]),
+        "inverse_dynamics (qd=, qdd=)": lambda s: mb.inverse_dynamics(mech, q[s], qd=fq[s], qdd=fqd[s]),
+        "simulate (0.05 s)": lambda s: mb.simulate(mech, q[s], qd[s], t),
+    }
+    for fn in calls.values():  # compile / load every kernel outside the timing
+        fn(0), fn(slice(0, 100))
+    fns = {}
+    for name, fn in calls.items():
+        n1 = 20 if name.startswith("simulate") else 200
+        nN = N_SIM if name.startswith("simulate") else N_MOVED
+        fns[name + " 1"] = lambda fn=fn, n1=n1: _per(fn, n1)
+        fns[name + " N"] = _large(lambda fn=fn, nN=nN: fn(slice(0, nN)), nN, 2)
+    res = _interleaved(fns, rounds=3)
+    rows = [
+        "| Delta function | batch 1 (per call, min / median) | 10^4 (per sample, min / median) |",
+        "|---|---|---|",
+    ]
+    for name in calls:
+        big = f"{N_SIM} samples" if name.startswith("simulate") else "10^4"
+        rows.append(f"| {name} | {_mm(res[name + ' 1'])} | {big}: {_mm(res[name + ' N'])} |")
+    return rows
+
+
 if __name__ == "__main__":
-    main()
+    import sys
+
+    if sys.argv[1:] == ["--moved"]:
+        for row in moved_rows():
+            print(row)
+    else:
+        main()

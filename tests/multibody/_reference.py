@@ -14,10 +14,9 @@ from collections.abc import Callable
 import numpy as np
 
 from robomech.dynamics import _com_terms
-from robomech.multibody import _compiled, _dynamics, _rnea
+from robomech.multibody import _compiled, _dynamics, _rnea, _rnea_kernels
 from robomech.multibody import _dynamics as D
-from robomech.multibody._constraints import jacobian, residual
-from robomech.multibody._influence import _influence_flat, _pinv
+from robomech.multibody._constraints import jacobian, jacobian_rate, residual
 from robomech.multibody._model import Mechanism
 from robomech.multibody._options import (
     ADMISSIBLE_RTOL,
@@ -30,12 +29,209 @@ from robomech.multibody._options import (
     MU_MAX,
     MU_MIN,
     MU_START,
+    PASSIVE_RANK_RTOL,
     RANK_RTOL,
     RATE_FLOOR,
     SINGULAR_COND,
     STOP_RTOL,
 )
-from robomech.multibody._tree import TreeState, frame_jacobian, integrate, kinematics
+from robomech.multibody._tree import (
+    TreeState,
+    frame_jacobian,
+    frame_jacobian_rate,
+    integrate,
+    kinematics,
+    screw_rates,
+)
+
+
+# ----------------------------------------------------------------------------- influence coefficients
+# The numpy formulation of _compiled.influence_block (batched over samples): G = [I; -K_p^+ K_a] by the
+# SVD pseudo-inverse, dG along the unit input motions, the site Hessian (_influence's module docstring).
+# An empty passive block (an open chain or tree: no closure rows, or no passive coordinate) cannot lose
+# rank: its measures are those of the best-conditioned block, cond 1 and sigma_min = the characteristic
+# length (the singular value of a unit passive column at distance L), finite like every other sample's.
+def _pinv(Kp: np.ndarray, length: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Batched pseudo-inverse of ``Kp (N, m, n)`` with its rank, smallest kept singular value, cond."""
+    N, m, n = Kp.shape
+    if m == 0 or n == 0:
+        return np.zeros((N, n, m)), np.zeros(N, dtype=int), np.full(N, float(length)), np.ones(N)
+    U, s, Vt = np.linalg.svd(Kp, full_matrices=False)
+    cut = PASSIVE_RANK_RTOL * s[:, :1]
+    keep = s > cut
+    sinv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
+    P = np.einsum("nji,nj,nkj->nik", Vt, sinv, U)
+    rank = np.sum(keep, axis=-1)
+    smin = np.min(np.where(keep, s, np.inf), axis=-1)
+    cond = np.where(rank > 0, s[:, 0] / np.where(np.isfinite(smin), smin, 1.0), np.inf)
+    return P, rank, smin, cond
+
+
+def _influence_flat(mech: Mechanism, q: np.ndarray, second: bool):
+    """``(state, K, G, dG, Sd, (rank, n_passive, consistency, sigma_min, cond))`` at ``q (N, nq)``."""
+    tree, cs = mech.tree, mech.constraints
+    state = kinematics(tree, q)
+    K = jacobian(cs, tree, state, q)
+    N = q.shape[0]
+    na = len(tree.act_dof)
+    act = tree.act_dof
+    pas = np.setdiff1d(np.arange(tree.nv), act)
+    P, rank, smin, cond = _pinv(K[..., pas], tree.length)
+    G = np.zeros((N, tree.nv, na))
+    G[:, act, np.arange(na)] = 1.0
+    G[:, pas] = -P @ K[..., act]
+    cons = np.max(np.abs(K @ G), axis=(-1, -2)) / tree.length if K.shape[1] and na else np.zeros(N)
+    dG = None
+    Sd = None
+    if second and na:
+        qd = G.swapaxes(-1, -2)  # (N, na, nv): the motion of unit rate of input k
+        Sd = screw_rates(tree, state, qd)
+        Kd = jacobian_rate(cs, tree, state, Sd, q, qd)  # (N, na, m, nv)
+        dGk = np.zeros((N, na, tree.nv, na))
+        dGk[:, :, pas] = -np.einsum("nim,nkmj->nkij", P, Kd @ G[:, None])
+        dG = dGk.transpose(0, 2, 3, 1)
+    return state, K, G, dG, Sd, (rank, len(pas), cons, smin, cond)
+
+
+def numpy_influence(mech: Mechanism, q: np.ndarray, second: bool = True) -> tuple:
+    """``(G, dG, rank, consistency, sigma_min, cond)`` of ``_compiled.compiled_influence``."""
+    _, _, G, dG, _, (rank, _, cons, smin, cond) = _influence_flat(mech, q, second)
+    return G, dG, rank, cons, smin, cond
+
+
+def numpy_site_hessian(mech: Mechanism, q: np.ndarray, site: int) -> np.ndarray:
+    """``H (N, 6, na, na)``: ``(dJ_f/dt along G e_k) G e_j + J_f dG[:, j, k]`` (``mb.site_hessian``)."""
+    tree = mech.tree
+    state, _, G, dG, Sd, _ = _influence_flat(mech, q, True)
+    b = tree.site_body[site]
+    p = (state.T[:, b] @ tree.T_site[site])[:, :3, 3]
+    Jf = frame_jacobian(tree, state, b, p)
+    Jfd = frame_jacobian_rate(tree, state, Sd, b, p, G.swapaxes(-1, -2))  # (N, na_k, 6, nv)
+    Hk = Jfd @ G[:, None] + Jf[:, None] @ dG.transpose(0, 3, 1, 2)  # (N, k, 6, j)
+    return Hk.transpose(0, 2, 3, 1)
+
+
+# ----------------------------------------------------------------------------- closure rows, batched
+# The numpy formulation of the kernels' closure terms (_compiled.resjac, rates_kdot, site_forces,
+# pinv_rank): K with the point rows' cross products in component arithmetic, Kdot qd without forming
+# Kdot, the site wrenches' generalized forces, the pseudo-inverse truncated to the generic rank.
+def pinv_rank(K: np.ndarray, r: int) -> tuple[np.ndarray, np.ndarray]:
+    """Pseudo-inverse of ``K (N, m, n)`` truncated to the mechanism's generic rank ``r``, and the ratio
+    ``s_1 / s_r`` (N,).  A fixed rank rather than a tolerance: between two projections a simulated state
+    is ~1e-12 off the manifold, which lifts the zero singular values of an over-constrained closure
+    (Bennett, planar loops in 3-D) to ~1e-12 — a tolerance would then invert them."""
+    N, m, n = K.shape
+    if r == 0 or m == 0:
+        return np.zeros((N, n, m)), np.ones(N)
+    U, s, Vt = np.linalg.svd(K, full_matrices=False)
+    sr = s[:, r - 1]
+    ok = sr > 0
+    sinv = np.zeros_like(s)
+    sinv[:, :r] = 1.0 / np.where(ok[:, None], s[:, :r], 1.0)
+    P = np.einsum("nji,nj,nkj->nik", Vt, sinv, U)
+    return P, np.where(ok, s[:, 0] / np.where(ok, sr, 1.0), np.inf)
+
+
+def screw_rates_flat(tree, state, qd: np.ndarray) -> np.ndarray:
+    """``_tree.screw_rates`` for flat ``qd (N, nv)`` with the carrier twists by matmul (the 3-operand
+    einsum there runs as a naive loop): ``dS_k = [w_c x w_k; w_c x v_k - w_k x v_c]``."""
+    S = state.S
+    Vc = tree.C @ (S * qd[..., None])
+    wc, vc = Vc[..., :3], Vc[..., 3:]
+    ws, vs = S[..., :3], S[..., 3:]
+    return np.concatenate([np.cross(wc, ws), np.cross(wc, vs) - np.cross(ws, vc)], axis=-1)
+
+
+def _path(tree, b: int) -> np.ndarray:
+    """Indices of the velocity coordinates that move body ``b`` (``Tree.dof_paths``, compiled once)."""
+    return tree.dof_paths[b]
+
+
+def constraint_matrix(mech: Mechanism, state, q: np.ndarray) -> np.ndarray:
+    """``K (N, m, nv)`` as ``_constraints.jacobian`` builds it (same rows, same order), with the point
+    rows' cross products in component arithmetic (the dynamics' hot path; tested equal)."""
+    from robomech.multibody._constraints import _poly
+
+    tree, cs = mech.tree, mech.constraints
+    N, nv = q.shape[0], tree.nv
+    S = state.S
+    w = S[..., :3]
+    w0, w1, w2 = w[..., 0], w[..., 1], w[..., 2]
+    v = S[..., 3:]
+    L = tree.length
+    out = []
+    for kind, d in cs.blocks:
+        if kind == "point":
+            b1, x1, b2, x2 = d
+            rows = np.zeros((N, 3, nv))
+            for b, x, sign in ((b1, x1, 1.0), (b2, x2, -1.0)):
+                if b == 0:
+                    continue
+                p = (state.T[:, b] @ x)[:, :3]
+                c = _path(tree, b)  # only the coordinates that move body b (a loop touches few)
+                p0, p1, p2 = p[:, 0, None], p[:, 1, None], p[:, 2, None]
+                a0, a1, a2 = w0[:, c], w1[:, c], w2[:, c]
+                rows[:, 0, c] += sign * (v[:, c, 0] + a1 * p2 - a2 * p1)
+                rows[:, 1, c] += sign * (v[:, c, 1] + a2 * p0 - a0 * p2)
+                rows[:, 2, c] += sign * (v[:, c, 2] + a0 * p1 - a1 * p0)
+            out.append(rows)
+        elif kind == "rot":
+            b1, _, b2 = d
+            out.append(L * w.swapaxes(-1, -2) * (tree.A[b2] - tree.A[b1]))
+        else:
+            d1, _, _, d2, q2, ref2, c, sc = d
+            row = np.zeros((N, 1, nv))
+            row[:, 0, d1] = sc
+            if d2 >= 0:
+                row[:, 0, d2] -= sc * _poly(c, q[:, q2] - ref2)[1]
+            out.append(row)
+    return np.concatenate(out, axis=-2) if out else np.zeros((N, 0, nv))
+
+
+def kdot_qd(mech: Mechanism, state, q: np.ndarray, qd: np.ndarray, Sd: np.ndarray) -> np.ndarray:
+    """``Kdot qd (N, m)`` directly (the closure rows' velocity-product accelerations), block by block as
+    ``_constraints.jacobian_rate`` builds ``Kdot``, without forming the (N, m, nv) matrix: a point row is
+    the difference of the two anchors' ``dVd_v + dVd_w x p + w x pdot`` (``Vd = sum_k A Sd_k qd_k``), a
+    rotation row ``L (Vd_w2 - Vd_w1)``, a coupling row ``-s poly''(x) qd2^2``."""
+    from robomech.multibody._constraints import _poly
+
+    tree, cs = mech.tree, mech.constraints
+    V = tree.A @ (state.S * qd[..., None])
+    Vd = tree.A @ (Sd * qd[..., None])
+    L = tree.length
+    out = []
+    for kind, d in cs.blocks:
+        if kind == "point":
+            b1, x1, b2, x2 = d
+            acc = []
+            for b, x in ((b1, x1), (b2, x2)):
+                pt = (state.T[:, b] @ x)[:, :3]
+                w = V[:, b, :3]
+                pd = V[:, b, 3:] + np.cross(w, pt)
+                acc.append(Vd[:, b, 3:] + np.cross(Vd[:, b, :3], pt) + np.cross(w, pd))
+            out.append(acc[0] - acc[1])
+        elif kind == "rot":
+            b1, _, b2 = d
+            out.append(L * (Vd[:, b2, :3] - Vd[:, b1, :3]))
+        else:
+            _d1, _, _, d2, q2, ref2, c, sc = d
+            row = np.zeros((q.shape[0], 1))
+            if d2 >= 0:
+                row[:, 0] = -sc * _poly(c, q[:, q2] - ref2)[2] * qd[:, d2] ** 2
+            out.append(row)
+    return np.concatenate(out, axis=-1) if out else np.zeros((q.shape[0], 0))
+
+
+def site_terms(mech: Mechanism, state, wrenches: dict[int, np.ndarray]) -> np.ndarray:
+    """``-sum_s J_s^T W_s`` (N, nv) for wrenches ``W_s (N, 6)`` applied to the mechanism at sites."""
+    tree = mech.tree
+    out = np.zeros((state.T.shape[0], tree.nv))
+    for si, W in wrenches.items():
+        b = tree.site_body[si]
+        p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
+        Js = frame_jacobian(tree, state, b, p)
+        out -= np.einsum("nik,ni->nk", Js, W)
+    return out
 
 
 # ----------------------------------------------------------------------------- Levenberg–Marquardt
@@ -172,28 +368,90 @@ def numpy_site_jacobian(mech, q, site):
     return frame_jacobian(tree, state, b, p) @ G
 
 
+def numpy_compiled_influence(model, q, second, site=-1):
+    """``_compiled.compiled_influence`` by the numpy formulation (``model`` carries the tree and rows)."""
+    G, dG, rank, cons, smin, cond = numpy_influence(model, q, second)
+    H = numpy_site_hessian(model, q, site) if second and site >= 0 else None
+    return G, dG, H, rank, cons, smin, cond
+
+
+def rank_measures(Kp: np.ndarray, rank0: int, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(sigma_min, cond)`` of ``Kp (N, m, n)`` against the mechanism's generic passive rank ``rank0``:
+    the ``rank0``-th singular value and ``s_1`` over it (inf where it is zero).  A truncated
+    pseudo-inverse keeps only the non-zero values, so its own ratio is 1 at a rank drop (a type II
+    singularity); this is the measure reported wherever a sample is not valid.  An empty block or a
+    generic rank 0: ``(length, 1)`` as in ``_influence._pinv``."""
+    N, m, n = Kp.shape
+    if m == 0 or n == 0 or rank0 == 0:
+        return np.full(N, float(length)), np.ones(N)
+    s = np.linalg.svd(np.where(np.isfinite(Kp), Kp, 0.0), compute_uv=False)
+    sr = s[:, rank0 - 1] if s.shape[1] >= rank0 else np.zeros(N)
+    cond = np.where(sr > 0, s[:, 0] / np.where(sr > 0, sr, 1.0), np.inf)
+    return sr, cond
+
+
+def numpy_passive_rank_measures(model, q):
+    """``_rnea_kernels.passive_rank_measures``: :func:`rank_measures` of ``K_p`` at ``q (N, nq)``."""
+    K = constraint_matrix(model, kinematics(model.tree, q), q)
+    return rank_measures(K[..., model.pas], model.rank0, model.tree.length)
+
+
+def numpy_closure_terms(model, q, qd, W, wsb, wT):
+    """The closure terms of the full-rate inverse dynamics: ``(K, Kdot qd, -sum_s J_s^T W_s, closure)``."""
+    tree = model.tree
+    state = kinematics(tree, q)
+    K = constraint_matrix(model, state, q)
+    kdq = kdot_qd(model, state, q, qd, screw_rates_flat(tree, state, qd))
+    ext = np.zeros((q.shape[0], tree.nv))
+    for s, b in enumerate(wsb):
+        p = (state.T[:, b] @ wT[s])[:, :3, 3]
+        ext -= np.einsum("nik,ni->nk", frame_jacobian(tree, state, b, p), W[:, s])
+    return K, kdq, ext, D._closure_error(model, state, q)
+
+
+def numpy_project(model, q, qd):
+    """``_compiled.compiled_project``: ``qd - K^+ K qd``, ``K^+`` truncated to the generic rank of K."""
+    tree = model.tree
+    K = jacobian(model.constraints, tree, kinematics(tree, q), q)
+    if not K.shape[1] or not model.rank_K:
+        return np.array(qd, dtype=float)
+    Kp, _ = pinv_rank(K, model.rank_K)
+    return qd - np.einsum("nij,njk,nk->ni", Kp, K, qd)
+
+
+_SWAPS = {
+    "compiled_fk": numpy_fk,
+    "compiled_site_jacobian": numpy_site_jacobian,
+    "compiled_influence": numpy_compiled_influence,
+    "compiled_project": numpy_project,
+}
+_SWAPS_DYNAMICS = {
+    "_inverse_compiled": lambda *a, **k: _inverse_flat(*a, **k),
+    "_forward_compiled": lambda *a, **k: numpy_forward(*a, **k),
+    "_inverse_full_flat": lambda *a, **k: numpy_inverse_full(*a, **k),
+}
+
+
 @contextlib.contextmanager
 def numpy_reference():
-    """Inside the block, FK, site Jacobians, inverse and forward dynamics run the numpy formulation."""
-    saved = (
-        _compiled.compiled_fk,
-        _compiled.compiled_site_jacobian,
-        _dynamics._inverse_compiled,
-        _dynamics._forward_compiled,
-    )
-    _compiled.compiled_fk = numpy_fk
-    _compiled.compiled_site_jacobian = numpy_site_jacobian
-    _dynamics._inverse_compiled = _inverse_flat
-    _dynamics._forward_compiled = numpy_forward
+    """Inside the block, FK, site Jacobians, influence coefficients, site Hessians, the closure terms,
+    the velocity projection, inverse and forward dynamics run the numpy formulation."""
+    saved = {k: getattr(_compiled, k) for k in _SWAPS}
+    saved_rank = _rnea_kernels.passive_rank_measures
+    _rnea_kernels.passive_rank_measures = numpy_passive_rank_measures
+    saved_d = {k: getattr(_dynamics, k) for k in _SWAPS_DYNAMICS}
+    for k, fn in _SWAPS.items():
+        setattr(_compiled, k, fn)
+    for k, fn in _SWAPS_DYNAMICS.items():
+        setattr(_dynamics, k, fn)
     try:
         yield
     finally:
-        (
-            _compiled.compiled_fk,
-            _compiled.compiled_site_jacobian,
-            _dynamics._inverse_compiled,
-            _dynamics._forward_compiled,
-        ) = saved
+        for k, fn in saved.items():
+            setattr(_compiled, k, fn)
+        for k, fn in saved_d.items():
+            setattr(_dynamics, k, fn)
+        _rnea_kernels.passive_rank_measures = saved_rank
 
 
 # ----------------------------------------------------------------------------- the tree's RNEA and CRBA
@@ -347,7 +605,7 @@ def _com_projected(tree, state, bd, qd, Sd, G, extra_qdd):
     SG = np.empty((S.shape[0], len(bd.idx), 6, G.shape[-1]))  # (N, B, 6, na): sum over b's path of S_k G_k
     St = S.swapaxes(-1, -2)
     for i, b in enumerate(bd.idx):
-        c = D._path(tree, b)
+        c = _path(tree, b)
         SG[:, i] = St[:, :, c] @ G[:, c]
     JG = np.concatenate([SG[..., :3, :], SG[..., 3:, :] + _cross_rows(SG[..., :3, :], p)], axis=-2)
     V = A @ (S * qd[..., None])
@@ -394,14 +652,14 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
     pas = np.setdiff1d(np.arange(tree.nv), act)
     N = q.shape[0]
     state = kinematics(tree, q)
-    K = D._constraint_matrix(mech, state, q)
+    K = constraint_matrix(mech, state, q)
     P, rank, smin, cond = _passive_inverse(K[..., pas], rank0, tree.length)
     G = np.zeros((N, tree.nv, na))
     G[:, act, np.arange(na)] = 1.0
     G[:, pas] = -P @ K[..., act]
     qd = D._mv(G, qd_a)
-    Sd = D._screw_rates(tree, state, qd)
-    kdq = D._kdot_qd(mech, state, q, qd, Sd)
+    Sd = screw_rates_flat(tree, state, qd)
+    kdq = kdot_qd(mech, state, q, qd, Sd)
     qdd = D._mv(G, qdd_a)
     qdd[:, pas] -= D._mv(P, kdq)
     # Project each body's Jacobian through G first (6 x n_act instead of 6 x nv): the tree mass matrix is
@@ -413,7 +671,7 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
     JG, a0 = _com_projected(tree, state, bd, qd, Sd, G, conv)
     gv = np.asarray(mech.gravity) if gravity else np.zeros(3)
     terms = _com_terms(np.broadcast_to(bd.mass, (N, len(bd.mass))), Iw, JG, a0, qd_a, qdd_a, gv[None])
-    ext = D._site_terms(mech, state, wr)
+    ext = site_terms(mech, state, wr)
     GT = G.swapaxes(-1, -2)
     M_a = terms.M
     vel = terms.velocity_terms
@@ -448,6 +706,94 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
         sigma_min=smin,
         admissibility=adm,
         valid=valid,
+        closure=D._closure_error(mech, state, q),
+    )
+
+
+# ----------------------------------------------------------------------------- full-rate inverse dynamics
+# The numpy formulation of _rnea_kernels.inv_full_block (batched over samples).
+def null_basis(mech: Mechanism, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Orthonormal basis ``(N, nv, d)`` of the admissible velocities ``null(K)`` at the mechanism's
+    generic rank of ``K``, and ``s_1 / s_r`` of ``K`` (N,): 1 for a tree (the identity basis)."""
+    N, m, nv = K.shape
+    r = D._rank_K(mech) if m else 0
+    if r == 0:
+        return np.broadcast_to(np.eye(nv), (N, nv, nv)), np.ones(N)
+    _, s, Vt = np.linalg.svd(K, full_matrices=True)
+    sr = s[:, r - 1]
+    cond = np.where(sr > 0, s[:, 0] / np.where(sr > 0, sr, 1.0), np.inf)
+    return Vt[:, r:].swapaxes(-1, -2), cond
+
+
+def numpy_inverse_full(mech, q, qd, qdd, wr, weights, gravity=True):
+    """``_dynamics._inverse_full_flat`` (the compiled ``_rnea_kernels.inv_full_block``) in batched numpy:
+    the derivation of that docstring, from numpy_crba, numpy_rnea and numpy_closure_terms."""
+    model = D.compile_model(mech)
+    tree = model.tree
+    N, nv = q.shape[0], tree.nv
+    act = tree.act_dof
+    na = len(act)
+    L = tree.length
+    z = np.zeros_like(qd)
+    gv = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
+    M = numpy_crba(mech, q)
+    K, kdq, ext, closure = numpy_closure_terms(model, q, qd, *D._wrench_arrays(tree, wr, N))
+    parts = (
+        D._mv(M, qdd),
+        numpy_rnea(mech, q, qd, z, np.zeros(3)),
+        numpy_rnea(mech, q, z, z, gv),
+        ext,
+    )
+    f = parts[0] + parts[1] + parts[2] + parts[3]
+    Nb, condK = null_basis(mech, K)
+    NbT = Nb.swapaxes(-1, -2)
+    Na = Nb[:, act]  # (N, na, d): the actuated rows of the admissible motions
+    ws = np.ones(na) if weights is None else np.sqrt(weights)
+    A = NbT[:, :, act] * ws  # (N, d, na)
+    d = Nb.shape[-1]
+    if na and d:
+        sA = np.linalg.svd(A, compute_uv=False)
+        smin = sA[:, -1]
+        cond_a = np.where(smin > RANK_RTOL * sA[:, 0], sA[:, 0] / np.where(smin > 0, smin, 1.0), np.inf)
+        B = ws[:, None] * (np.linalg.pinv(A, rcond=RANK_RTOL) @ NbT)  # (N, na, nv)
+    else:
+        smin, cond_a = np.ones(N), np.ones(N)
+        B = np.zeros((N, na, nv))
+    tau_parts = [D._mv(B, x) for x in parts]
+    tau = tau_parts[0] + tau_parts[1] + tau_parts[2] + tau_parts[3]
+    b = D._mv(NbT, f)
+    unact = D._mv(Nb, b - D._mv(Na.swapaxes(-1, -2), tau))
+    # relative to the largest of the inertial, velocity, gravity and external terms (their sum is ~0 on a
+    # free motion, whose rounding must not count as a force the actuators cannot give)
+    scale = np.max(np.abs(np.stack(parts)), axis=(0, -1)) if nv else np.zeros(N)
+    e_force = np.max(np.abs(unact), axis=-1) / np.maximum(scale, 1e-300) if nv else np.zeros(N)
+    sv = np.max(np.abs(qd), axis=-1) if nv else np.zeros(N)
+    sa = np.max(np.abs(qdd), axis=-1) + sv * sv if nv else np.zeros(N)
+    if K.shape[1]:
+        e1 = np.max(np.abs(D._mv(K, qd)), axis=-1) / (L * np.maximum(sv, RATE_FLOOR))
+        e2 = np.max(np.abs(D._mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
+        adm = np.maximum(np.maximum(e1, e2), e_force)
+    else:
+        adm = e_force
+    M_a = B @ M @ B.swapaxes(-1, -2)
+    cond = np.maximum(condK, cond_a)
+    fin = np.all(np.isfinite(tau), axis=-1) & np.all(np.isfinite(M_a), axis=(-1, -2))
+    computed = fin & (cond <= SINGULAR_COND)
+    return dict(
+        _computed=computed,
+        tau=tau,
+        M_a=M_a,
+        velocity_terms=tau_parts[1],
+        gravity_terms=tau_parts[2],
+        external_terms=tau_parts[3],
+        qd=np.array(qd),
+        qdd=np.array(qdd),
+        cond=cond,
+        sigma_min=L * smin,
+        admissibility=adm,
+        unactuated=unact,
+        closure=closure,
+        valid=computed & (adm <= ADMISSIBLE_RTOL),
     )
 
 
@@ -480,7 +826,7 @@ def numpy_forward(mech, q, rates, tau_a, wr, gravity, act_mode):
     pas = np.setdiff1d(np.arange(nv), act)
     rank0 = D._reference(mech)[0]
     state = kinematics(tree, q)
-    K = D._constraint_matrix(mech, state, q)
+    K = constraint_matrix(mech, state, q)
     if act_mode:
         P, rank, _, cK = _pinv(K[..., pas], L)
         qd = np.zeros((N, nv))
@@ -493,13 +839,13 @@ def numpy_forward(mech, q, rates, tau_a, wr, gravity, act_mode):
         reg = np.ones(N, dtype=bool)
         sv = np.max(np.abs(qd), axis=-1)
         e1 = np.max(np.abs(D._mv(K, qd)), axis=-1, initial=0.0) / (L * np.maximum(sv, RATE_FLOOR))
-    kdq = D._kdot_qd(mech, state, q, qd, D._screw_rates(tree, state, qd))
+    kdq = kdot_qd(mech, state, q, qd, screw_rates_flat(tree, state, qd))
     g = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
     M = numpy_crba(mech, q)
-    f = -numpy_rnea(mech, q, qd, np.zeros_like(qd), g) - D._site_terms(mech, state, wr)
+    f = -numpy_rnea(mech, q, qd, np.zeros_like(qd), g) - site_terms(mech, state, wr)
     f[:, act] += tau_a
     if K.shape[1]:
-        Kp, _ = D._pinv_rank(K, D._rank_K(mech))  # (N, nv, m)
+        Kp, _ = pinv_rank(K, D._rank_K(mech))  # (N, nv, m)
         qdd_p = -D._mv(Kp, kdq)
         Pn = np.eye(nv) - Kp @ K
     else:
@@ -516,5 +862,5 @@ def numpy_forward(mech, q, rates, tau_a, wr, gravity, act_mode):
     closure = np.max(np.abs(residual(mech.constraints, tree, state, q)), axis=-1, initial=0.0)
     if act_mode and np.any(~reg):  # a singular passive block: its measure against the generic rank
         bad = np.flatnonzero(~reg)
-        cond[bad] = np.maximum(cond[bad], D._rank_measures(K[bad][..., pas], rank0, L)[1])
+        cond[bad] = np.maximum(cond[bad], rank_measures(K[bad][..., pas], rank0, L)[1])
     return qd, qdd, cond, adm, closure, reg

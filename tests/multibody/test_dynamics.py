@@ -19,6 +19,8 @@ from hypothesis import strategies as st
 from robomech import dynamics
 from robomech import multibody as mb
 
+from . import _reference as R
+
 # Exact identities of O(1) quantities evaluated in double precision.
 IDENTITY_TOL = 1e-10
 # Central difference (step 1e-5 s) of the energy along a trajectory: truncation ~h^2 E''' ~ 1e-9.
@@ -191,39 +193,39 @@ def test_com_inverse_dynamics_matches_spatial_form():
 
 @pytest.mark.parametrize("name", ["bennett", "delta", "stewart"])
 def test_kdot_qd_equals_constraint_jacobian_rate(name):
-    """The direct velocity-product closure accelerations against the multibody layer's dK/dt."""
-    from robomech.multibody import _dynamics as D
+    """The reference's direct velocity-product closure accelerations against the multibody layer's dK/dt
+    (the kernels' are checked against the reference: test_compiled_influence.py)."""
     from robomech.multibody._tree import kinematics, screw_rates
 
     mech = mb.gallery.load(name)
     q, qd_a, _ = _motion(mech, n=3, seed=6, amp=0.02)
     qd = np.einsum("nij,nj->ni", mb.influence(mech, q, second_order=False).G, qd_a)
     st = kinematics(mech.tree, q)
-    got = D._kdot_qd(mech, st, q, qd, screw_rates(mech.tree, st, qd))
     ref = np.einsum("nij,nj->ni", mb.constraint_jacobian_rate(mech, q, qd), qd)
+    got = R.kdot_qd(mech, st, q, qd, screw_rates(mech.tree, st, qd))
     assert np.max(np.abs(got - ref)) < IDENTITY_TOL * max(1.0, np.max(np.abs(ref)))
 
 
 @pytest.mark.parametrize("name", ["four_bar", "bennett", "delta", "stewart"])
 def test_constraint_matrix_equals_multibody_layer(name):
-    from robomech.multibody import _dynamics as D
     from robomech.multibody._tree import kinematics
 
     mech = mb.gallery.load(name)
     q, _, _ = _motion(mech, n=3, seed=7, amp=0.02)
-    got = D._constraint_matrix(mech, kinematics(mech.tree, q), q)
-    assert np.max(np.abs(got - mb.constraint_jacobian(mech, q))) < IDENTITY_TOL
+    K = mb.constraint_jacobian(mech, q)
+    assert np.max(np.abs(R.constraint_matrix(mech, kinematics(mech.tree, q), q) - K)) < IDENTITY_TOL
 
 
 def test_screw_rates_equal_multibody_layer():
-    from robomech.multibody import _dynamics as D
     from robomech.multibody._tree import kinematics, screw_rates
 
     mech = mb.gallery.load("stewart")
     q, _, _ = _motion(mech, n=3, seed=8, amp=0.02)
     qd = np.random.default_rng(0).normal(size=(3, mech.nv))
     st = kinematics(mech.tree, q)
-    assert np.max(np.abs(D._screw_rates(mech.tree, st, qd) - screw_rates(mech.tree, st, qd))) < IDENTITY_TOL
+    assert (
+        np.max(np.abs(R.screw_rates_flat(mech.tree, st, qd) - screw_rates(mech.tree, st, qd))) < IDENTITY_TOL
+    )
 
 
 @settings(max_examples=25, deadline=None)

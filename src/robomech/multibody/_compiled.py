@@ -1,15 +1,18 @@
-"""The compiled (numba) per-sample kernels: assembly (FK), site Jacobians, inverse dynamics.
+"""The compiled (numba) per-sample kernels: assembly (FK), influence coefficients, site Jacobians and
+Hessians, inverse dynamics.
 
 The one implementation of each of these algorithms, for every batch size (batch 1 included): tree
 kinematics, closure residual and velocity constraint matrix (the formulas of ``_tree`` and
-``_constraints``, written per sample), the Levenberg–Marquardt assembly (damping, step cap and
-stopping rules of ``_options``), ``G = [I; -K_p^+ K_a]`` by the SVD pseudo-inverse with the site's
-``[ω; ṗ]`` Jacobian, and the closed-chain inverse dynamics (:func:`inv_dyn`: passive pseudo-inverse,
-screw rates, ``K̇ q̇``, the bodies' Newton–Euler terms through ``G``, site wrenches, the
-redundant-actuation rule and the validity flags).  Every sample stays in cache; large batches run in
-parallel over the cores (``numba.prange``).  The mechanism is passed packed, as the named tuples
-``_compile.Tables`` and ``_compile.DynTables`` of its compiled model.  The numpy formulation stays in
-the tests as the reference (tests/multibody/_reference.py).
+``_constraints``, written per sample), the Levenberg–Marquardt assembly (damping, step cap and stopping
+rules of ``_options``), ``G = [I; -K_p^+ K_a]`` by the SVD pseudo-inverse (:func:`influence_G`) with the
+site's ``[ω; ṗ]`` Jacobian, the second-order coefficients ``∂G/∂q_act`` and site Hessians
+(:func:`influence_block`, from ``(dK/dt along u) v``, :func:`kdot_uv`), the velocity projection of
+``simulate`` (:func:`project_block`), and the closed-chain inverse dynamics (:func:`inv_dyn`: passive
+pseudo-inverse, screw rates, ``K̇ q̇``, the bodies' Newton–Euler terms through ``G``, site wrenches, the
+redundant-actuation rule and the validity flags). Every sample stays in cache; large batches run in
+parallel over the cores (``numba.prange``). The mechanism is passed packed, as the named tuples
+``_compile.Tables`` and ``_compile.DynTables`` of its compiled model. The numpy formulation stays in the
+tests as the reference (tests/multibody/_reference.py).
 """
 
 from __future__ import annotations
@@ -22,7 +25,13 @@ from robomech._validation import MAX_MAGNITUDE
 from . import _options as opt
 from ._compile import compile_model
 
-__all__ = ["compiled_fk", "compiled_site_jacobian", "inv_dyn"]
+__all__ = [
+    "compiled_fk",
+    "compiled_influence",
+    "compiled_project",
+    "compiled_site_jacobian",
+    "inv_dyn",
+]
 
 numba = import_numba()
 
@@ -471,36 +480,62 @@ def fk_par(
 
 
 @_nj
+def influence_G(K, act, pas, rtol, L, Kp, P, G):  # pragma: no cover - compiled
+    """The first-order influence coefficients ``G (nv, na) = [I; -K_p^+ K_a]`` of one sample from its
+    constraint matrix ``K (m, nv)``, with the SVD pseudo-inverse ``P (npas, m)`` of ``K_p`` (:func:`svd_pinv`,
+    singular values below ``rtol`` times the largest dropped): the minimum-norm passive rates.  Returns
+    (rank, smallest kept singular value, cond) of ``K_p``; an empty block (an open chain or tree)
+    cannot lose rank: (0, ``L``, 1).  ``Kp (m, npas)`` scratch."""
+    m = K.shape[0]
+    na, npas = act.shape[0], pas.shape[0]
+    G[:, :] = 0.0
+    for j in range(na):
+        G[act[j], j] = 1.0
+    if m == 0 or npas == 0:
+        P[:, :] = 0.0
+        return 0, L, 1.0
+    for i in range(m):
+        for j in range(npas):
+            Kp[i, j] = K[i, pas[j]]
+    rank, smin, cond = svd_pinv(Kp, rtol, P)
+    for j in range(na):
+        aj = act[j]
+        for i in range(npas):
+            acc = 0.0
+            for c in range(m):
+                acc += P[i, c] * K[c, aj]
+            G[pas[i], j] = -acc
+    return rank, smin, cond
+
+
+@_nj
+def site_point(T, sb, Tsite):  # pragma: no cover - compiled
+    """World position of the site at ``Tsite`` in body ``sb``."""
+    p0 = T[sb, 0, 3] + T[sb, 0, 0] * Tsite[0, 3] + T[sb, 0, 1] * Tsite[1, 3] + T[sb, 0, 2] * Tsite[2, 3]
+    p1 = T[sb, 1, 3] + T[sb, 1, 0] * Tsite[0, 3] + T[sb, 1, 1] * Tsite[1, 3] + T[sb, 1, 2] * Tsite[2, 3]
+    p2 = T[sb, 2, 3] + T[sb, 2, 0] * Tsite[0, 3] + T[sb, 2, 1] * Tsite[1, 3] + T[sb, 2, 2] * Tsite[2, 3]
+    return p0, p1, p2
+
+
+@_nj
 def site_jac_one(q, act, pas, sb, Tsite, t, rtol, T, S, r, K, G, Kp, P, J):  # pragma: no cover
     """``J (6, na) = J_f G`` of the site (body ``sb``, pose ``Tsite`` in it) at one ``q``; leaves the
     tree state in ``T``, ``S`` and the constraint matrix in ``K`` (scratch ``r``, ``G``, ``Kp``, ``P``).
 
-    ``G = [I; -K_p^+ K_a]`` with the SVD pseudo-inverse of ``K_p`` (:func:`svd_pinv`, singular values
-    below ``rtol`` times the largest dropped): the minimum-norm passive rates, as :func:`influence`."""
-    A, m = t.A, t.m
-    nv = A.shape[1]
-    na, npas = act.shape[0], pas.shape[0]
+    ``G`` by :func:`influence_G`, as :func:`influence` has it."""
     kin(q, t, T, S)
     resjac(q, t, T, S, r, K, True)
-    G[:, :] = 0.0
-    for j in range(na):
-        G[act[j], j] = 1.0
-    if m > 0 and npas > 0:
-        for i in range(m):
-            for j in range(npas):
-                Kp[i, j] = K[i, pas[j]]
-        svd_pinv(Kp, rtol, P)
-        for j in range(na):
-            aj = act[j]
-            for i in range(npas):
-                acc = 0.0
-                for c in range(m):
-                    acc += P[i, c] * K[c, aj]
-                G[pas[i], j] = -acc
-    p0 = T[sb, 0, 3] + T[sb, 0, 0] * Tsite[0, 3] + T[sb, 0, 1] * Tsite[1, 3] + T[sb, 0, 2] * Tsite[2, 3]
-    p1 = T[sb, 1, 3] + T[sb, 1, 0] * Tsite[0, 3] + T[sb, 1, 1] * Tsite[1, 3] + T[sb, 1, 2] * Tsite[2, 3]
-    p2 = T[sb, 2, 3] + T[sb, 2, 0] * Tsite[0, 3] + T[sb, 2, 1] * Tsite[1, 3] + T[sb, 2, 2] * Tsite[2, 3]
-    for j in range(na):
+    influence_G(K, act, pas, rtol, t.L, Kp, P, G)
+    site_apply(T, S, t.A, sb, Tsite, G, J)
+
+
+@_nj
+def site_apply(T, S, A, sb, Tsite, X, J):  # pragma: no cover - compiled
+    """``J (6, nc) = J_f X``: the site's ``[ω; ṗ]`` frame Jacobian over every velocity coordinate (body
+    ``sb``, pose ``Tsite`` in it) applied to the columns of ``X (nv, nc)``."""
+    nv, nc = X.shape
+    p0, p1, p2 = site_point(T, sb, Tsite)
+    for j in range(nc):
         for i in range(6):
             J[i, j] = 0.0
     for k in range(nv):
@@ -510,8 +545,8 @@ def site_jac_one(q, act, pas, sb, Tsite, t, rtol, T, S, r, K, G, Kp, P, J):  # p
         c3 = S[k, 3] + w1 * p2 - w2 * p1
         c4 = S[k, 4] + w2 * p0 - w0 * p2
         c5 = S[k, 5] + w0 * p1 - w1 * p0
-        for j in range(na):
-            g = G[k, j]
+        for j in range(nc):
+            g = X[k, j]
             if g != 0.0:
                 J[0, j] += w0 * g
                 J[1, j] += w1 * g
@@ -519,6 +554,119 @@ def site_jac_one(q, act, pas, sb, Tsite, t, rtol, T, S, r, K, G, Kp, P, J):  # p
                 J[3, j] += c3 * g
                 J[4, j] += c4 * g
                 J[5, j] += c5 * g
+
+
+@_nj
+def influence_block(
+    Q, lo, hi, act, pas, sb, Tsite, t, rtol, second, G_o, dG_o, H_o, rank_o, cons_o, smin_o, cond_o
+):  # pragma: no cover - compiled
+    """The influence coefficients of samples ``lo:hi``: ``G_o (N, nv, na)`` (:func:`influence_G`), the
+    passive block's rank, smallest kept singular value and cond, ``cons_o = max |K G| / L``; with
+    ``second`` the second-order coefficients ``dG_o[n, :, j, k] = [0; -K_p^+ (dK/dt along G e_k) G e_j]``
+    (:func:`kdot_uv`) and, for a site body ``sb >= 0``, the site Hessian ``H_o[n, :, j, k] =
+    (dJ_f/dt along G e_k) G e_j + J_f dG[:, j, k]`` (``_influence``' module docstring).  ``dG_o`` and
+    ``H_o`` may have no samples where they are not asked for."""
+    nb = t.parent.shape[0]
+    m, L = t.m, t.L
+    nv = t.A.shape[1]
+    na, npas = act.shape[0], pas.shape[0]
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    r = np.empty(m)
+    K = np.empty((m, nv))
+    Kp = np.empty((m, npas))
+    P = np.empty((npas, m))
+    G = np.empty((nv, na))
+    dG = np.zeros((nv, na, na))
+    Sd = np.empty((nv, 6))
+    Vu = np.empty((nb, 6))
+    Vv = np.empty((nb, 6))
+    Vd = np.empty((nb, 6))
+    kd = np.empty(m)
+    u = np.empty(nv)
+    v = np.empty(nv)
+    Jd = np.empty((6, na))
+    KG = np.empty((m, na))
+    p0 = p1 = p2 = 0.0
+    for n in range(lo, hi):
+        q = Q[n]
+        kin(q, t, T, S)
+        resjac(q, t, T, S, r, K, True)
+        rank, smin, cond = influence_G(K, act, pas, rtol, L, Kp, P, G)
+        cons = 0.0
+        if m > 0 and na > 0:
+            for i in range(m):
+                for j in range(na):
+                    acc = 0.0
+                    for k in range(nv):
+                        acc += K[i, k] * G[k, j]
+                    KG[i, j] = acc
+            cons = _amax_abs(KG.ravel()) / L
+        G_o[n] = G
+        rank_o[n] = rank
+        cons_o[n] = cons
+        smin_o[n] = smin
+        cond_o[n] = cond
+        if not second:
+            continue
+        if sb >= 0:
+            p0, p1, p2 = site_point(T, sb, Tsite)
+        for k in range(na):
+            for i in range(nv):
+                u[i] = G[i, k]
+            screw_rates_into(t, S, u, Sd)
+            for j in range(na):
+                for i in range(nv):
+                    v[i] = G[i, j]
+                kdot_uv(q, t, T, S, Sd, u, v, Vu, Vv, Vd, kd)
+                for i in range(npas):
+                    acc = 0.0
+                    for c in range(m):
+                        acc += P[i, c] * kd[c]
+                    dG[pas[i], j, k] = -acc
+                if sb >= 0:
+                    a0, a1, a2 = point_rate(Vu, Vv, Vd, sb, p0, p1, p2)
+                    H_o[n, 0, j, k] = Vd[sb, 0]
+                    H_o[n, 1, j, k] = Vd[sb, 1]
+                    H_o[n, 2, j, k] = Vd[sb, 2]
+                    H_o[n, 3, j, k] = a0
+                    H_o[n, 4, j, k] = a1
+                    H_o[n, 5, j, k] = a2
+        dG_o[n] = dG
+        if sb >= 0:
+            for k in range(na):
+                site_apply(T, S, t.A, sb, Tsite, dG[:, :, k], Jd)
+                for i in range(6):
+                    for j in range(na):
+                        H_o[n, i, j, k] += Jd[i, j]
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def influence_par(
+    Q, act, pas, sb, Tsite, t, rtol, second, G_o, dG_o, H_o, rank_o, cons_o, smin_o, cond_o
+):  # pragma: no cover - compiled
+    """:func:`influence_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        influence_block(
+            Q,
+            k * BLOCK,
+            min(N, (k + 1) * BLOCK),
+            act,
+            pas,
+            sb,
+            Tsite,
+            t,
+            rtol,
+            second,
+            G_o,
+            dG_o,
+            H_o,
+            rank_o,
+            cons_o,
+            smin_o,
+            cond_o,
+        )
 
 
 @_nj
@@ -603,6 +751,75 @@ def svd_pinv(Kp, rtol, P):  # pragma: no cover - compiled
                     P[i, j] += f * U[j, c]
     cond = s[0] / (smin if np.isfinite(smin) else 1.0) if rank > 0 else np.inf
     return rank, smin, cond
+
+
+@_nj
+def pinv_rank(K, rank, P):  # pragma: no cover - compiled
+    """``P (n, m)``: the pseudo-inverse of ``K (m, n)`` truncated to its ``rank`` largest singular values
+    (the mechanism's generic rank rather than a tolerance: a state ~1e-12 off the manifold lifts the
+    zero singular values of an over-constrained closure to ~1e-12, which a tolerance would invert; a
+    zero ``s_rank`` leaves the kept values unscaled).  False (``P`` untouched) where ``K`` is not
+    finite or LAPACK does not converge."""
+    m, n = K.shape
+    if not _all_finite(K):
+        return False
+    try:
+        U, s, Vt = np.linalg.svd(np.ascontiguousarray(K), full_matrices=False)
+    except Exception:  # no convergence (LAPACK)
+        return False
+    ok = s[rank - 1] > 0
+    P[:, :] = 0.0
+    for c in range(rank):
+        inv = 1.0 / s[c] if ok else 1.0
+        for i in range(n):
+            g = Vt[c, i] * inv
+            for j in range(m):
+                P[i, j] += g * U[j, c]
+    return True
+
+
+@_nj
+def project_block(Q, QD, lo, hi, t, rank_K, QD_o):  # pragma: no cover - compiled
+    """Velocities onto the admissible ones, samples ``lo:hi``: ``qd - K^+ K qd`` (minimum-norm
+    correction, ``K^+`` by :func:`pinv_rank` at the generic rank ``rank_K``) at the configurations ``Q``;
+    NaN where the pseudo-inverse fails."""
+    nb = t.parent.shape[0]
+    m = t.m
+    nv = t.A.shape[1]
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    r = np.empty(m)
+    K = np.empty((m, nv))
+    P = np.empty((nv, m))
+    x = np.empty(m)
+    for n in range(lo, hi):
+        qd = QD[n]
+        if m == 0 or rank_K == 0:
+            QD_o[n] = qd
+            continue
+        kin(Q[n], t, T, S)
+        resjac(Q[n], t, T, S, r, K, True)
+        if not pinv_rank(K, rank_K, P):
+            QD_o[n] = np.nan
+            continue
+        for i in range(m):
+            acc = 0.0
+            for k in range(nv):
+                acc += K[i, k] * qd[k]
+            x[i] = acc
+        for i in range(nv):
+            acc = 0.0
+            for j in range(m):
+                acc += P[i, j] * x[j]
+            QD_o[n, i] = qd[i] - acc
+
+
+def compiled_project(model, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """:func:`project_block` on ``q (N, nq)``, ``qd (N, nv)`` (one sample per call in ``simulate``)."""
+    Q, QD = writable(q), writable(qd)
+    out = np.empty_like(QD)
+    entry(model, project_block, "project_block", (Q, QD, 0, Q.shape[0], model.tables, model.rank_K, out))
+    return out
 
 
 @_nj
@@ -731,18 +948,16 @@ def passive_solve(Kp, Gi, P, mode, nref, b, x, res, dx, tmp):  # pragma: no cove
 
 
 @_nj
-def rates_kdot(q, t, T, S, qd, Sd, V, Vd, kdq):  # pragma: no cover - compiled
-    """At the kinematics ``T``, ``S`` and rates ``qd (nv,)``: the screw rates ``Sd (nv, 6)``, the body
-    twists ``V (nb, 6)`` (space, ``[w; v at the origin]``), ``Vd = sum_k A Sd_k qd_k (nb, 6)`` and the
-    closure rows' velocity-product accelerations ``Kdot qd (m,)``."""
-    A, C, L = t.A, t.C, t.L
-    nb, nv = A.shape
-    # screw rates dS_k = [w_c x w_k; w_c x v_k - w_k x v_c], V_c the carrier twist of coordinate k
+def screw_rates_into(t, S, u, Sd):  # pragma: no cover - compiled
+    """The screw rates ``Sd (nv, 6)`` along the motion ``u (nv,)``: ``dS_k = [w_c x w_k; w_c x v_k -
+    w_k x v_c]``, ``V_c`` the carrier twist of coordinate ``k`` (``_tree.screw_rates``)."""
+    C = t.C
+    nv = S.shape[0]
     for k in range(nv):
         c0 = c1 = c2 = c3 = c4 = c5 = 0.0
         for j in range(nv):
             if C[k, j] != 0.0:
-                f = C[k, j] * qd[j]
+                f = C[k, j] * u[j]
                 c0 += f * S[j, 0]
                 c1 += f * S[j, 1]
                 c2 += f * S[j, 2]
@@ -756,21 +971,52 @@ def rates_kdot(q, t, T, S, qd, Sd, V, Vd, kdq):  # pragma: no cover - compiled
         Sd[k, 3] = (c1 * v2 - c2 * v1) - (w1 * c5 - w2 * c4)
         Sd[k, 4] = (c2 * v0 - c0 * v2) - (w2 * c3 - w0 * c5)
         Sd[k, 5] = (c0 * v1 - c1 * v0) - (w0 * c4 - w1 * c3)
+
+
+@_nj
+def point_rate(Vu, Vv, Vd, b, p0, p1, p2):  # pragma: no cover - compiled
+    """``(dJ_p/dt along u) v`` of the world point ``p`` fixed in body ``b``, from the body twists ``Vu``
+    (of ``u``), ``Vv`` (of ``v``) and ``Vd = sum_k A Sd_k(u) v_k``: ``dVd_v + dVd_w x p + w_v x pdot_u``
+    with ``pdot_u = v_u + w_u x p`` (``_tree.frame_jacobian_rate`` applied to ``v``)."""
+    w0, w1, w2 = Vu[b, 0], Vu[b, 1], Vu[b, 2]
+    pd0 = Vu[b, 3] + w1 * p2 - w2 * p1
+    pd1 = Vu[b, 4] + w2 * p0 - w0 * p2
+    pd2 = Vu[b, 5] + w0 * p1 - w1 * p0
+    x0, x1, x2 = Vv[b, 0], Vv[b, 1], Vv[b, 2]
+    e0, e1, e2 = Vd[b, 0], Vd[b, 1], Vd[b, 2]
+    return (
+        Vd[b, 3] + (e1 * p2 - e2 * p1) + (x1 * pd2 - x2 * pd1),
+        Vd[b, 4] + (e2 * p0 - e0 * p2) + (x2 * pd0 - x0 * pd2),
+        Vd[b, 5] + (e0 * p1 - e1 * p0) + (x0 * pd1 - x1 * pd0),
+    )
+
+
+@_nj
+def kdot_uv(q, t, T, S, Sd, u, v, Vu, Vv, Vd, kd):  # pragma: no cover - compiled
+    """``kd = (dK/dt along u) v (m,)`` with ``Sd`` the screw rates along ``u`` (:func:`screw_rates_into`),
+    block by block as ``_constraints.jacobian_rate`` builds ``dK/dt``: a point row is the difference
+    of the two anchors' :func:`point_rate`, a rotation row ``L (Vd_w2 - Vd_w1)``, a coupling row
+    ``-s poly''(x) u_2 v_2``.  Also fills the body twists ``Vu = A S u``, ``Vv = A S v`` and ``Vd =
+    sum_k A Sd_k v_k`` (nb, 6); ``Vu`` and ``Vv`` may be one array where ``u`` is ``v``."""
+    A, L = t.A, t.L
+    nb, nv = A.shape
     for b in range(nb):
         for i in range(6):
             acc = 0.0
+            acc1 = 0.0
             acc2 = 0.0
             for k in range(nv):
                 if A[b, k] != 0.0:
-                    acc += A[b, k] * S[k, i] * qd[k]
-                    acc2 += A[b, k] * Sd[k, i] * qd[k]
-            V[b, i] = acc
+                    acc += A[b, k] * S[k, i] * u[k]
+                    acc1 += A[b, k] * S[k, i] * v[k]
+                    acc2 += A[b, k] * Sd[k, i] * v[k]
+            Vu[b, i] = acc
+            Vv[b, i] = acc1
             Vd[b, i] = acc2
-    # Kdot qd, block by block (_dynamics._kdot_qd)
     for i in range(t.pp.shape[0]):
         row = t.pp[i, 2]
         for c in range(3):
-            kdq[row + c] = 0.0
+            kd[row + c] = 0.0
         for side in range(2):
             b = t.pp[i, side]
             x = t.px[i, side]
@@ -778,26 +1024,31 @@ def rates_kdot(q, t, T, S, qd, Sd, V, Vd, kdq):  # pragma: no cover - compiled
             p0 = T[b, 0, 3] + T[b, 0, 0] * x[0] + T[b, 0, 1] * x[1] + T[b, 0, 2] * x[2]
             p1 = T[b, 1, 3] + T[b, 1, 0] * x[0] + T[b, 1, 1] * x[1] + T[b, 1, 2] * x[2]
             p2 = T[b, 2, 3] + T[b, 2, 0] * x[0] + T[b, 2, 1] * x[1] + T[b, 2, 2] * x[2]
-            w0, w1, w2 = V[b, 0], V[b, 1], V[b, 2]
-            pd0 = V[b, 3] + w1 * p2 - w2 * p1
-            pd1 = V[b, 4] + w2 * p0 - w0 * p2
-            pd2 = V[b, 5] + w0 * p1 - w1 * p0
-            e0, e1, e2 = Vd[b, 0], Vd[b, 1], Vd[b, 2]
-            kdq[row] += sign * (Vd[b, 3] + (e1 * p2 - e2 * p1) + (w1 * pd2 - w2 * pd1))
-            kdq[row + 1] += sign * (Vd[b, 4] + (e2 * p0 - e0 * p2) + (w2 * pd0 - w0 * pd2))
-            kdq[row + 2] += sign * (Vd[b, 5] + (e0 * p1 - e1 * p0) + (w0 * pd1 - w1 * pd0))
+            a0, a1, a2 = point_rate(Vu, Vv, Vd, b, p0, p1, p2)
+            kd[row] += sign * a0
+            kd[row + 1] += sign * a1
+            kd[row + 2] += sign * a2
     for i in range(t.rr.shape[0]):
         b1, b2, row = t.rr[i, 0], t.rr[i, 1], t.rr[i, 2]
         for c in range(3):
-            kdq[row + c] = L * (Vd[b2, c] - Vd[b1, c])
+            kd[row + c] = L * (Vd[b2, c] - Vd[b1, c])
     for i in range(t.cc.shape[0]):
         d2, q2, row = t.cc[i, 2], t.cc[i, 3], t.cc[i, 4]
         if d2 >= 0:
             x = q[q2] - t.cf[i, 1]
             dd = 2 * t.cf[i, 4] + x * (6 * t.cf[i, 5] + x * 12 * t.cf[i, 6])
-            kdq[row] = -t.cf[i, 7] * dd * qd[d2] ** 2
+            kd[row] = -t.cf[i, 7] * dd * u[d2] * v[d2]
         else:
-            kdq[row] = 0.0
+            kd[row] = 0.0
+
+
+@_nj
+def rates_kdot(q, t, T, S, qd, Sd, V, Vd, kdq):  # pragma: no cover - compiled
+    """At the kinematics ``T``, ``S`` and rates ``qd (nv,)``: the screw rates ``Sd (nv, 6)``, the body
+    twists ``V (nb, 6)`` (space, ``[w; v at the origin]``), ``Vd = sum_k A Sd_k qd_k (nb, 6)`` and the
+    closure rows' velocity-product accelerations ``Kdot qd (m,)`` (:func:`kdot_uv` with ``u = v = qd``)."""
+    screw_rates_into(t, S, qd, Sd)
+    kdot_uv(q, t, T, S, Sd, qd, qd, V, V, Vd, kdq)
 
 
 @_nj
@@ -1295,6 +1546,29 @@ def compiled_site_jacobian(mech, q: np.ndarray, site: int) -> np.ndarray:
     return J
 
 
+def compiled_influence(model, q: np.ndarray, second: bool, site: int = -1) -> tuple:
+    """``(G, dG, H, rank, consistency, sigma_min, cond)`` at ``q (N, nq)`` (:func:`influence_block`):
+    ``G (N, nv, na)``; with ``second`` also ``dG (N, nv, na, na)`` and, for a site index ``site >= 0``,
+    the site Hessian ``H (N, 6, na, na)`` (else None)."""
+    tree = model.tree
+    Q = writable(q)
+    N, nv, na = Q.shape[0], tree.nv, len(model.act)
+    sb = int(tree.site_body[site]) if site >= 0 else -1
+    Tsite = np.ascontiguousarray(tree.T_site[site], dtype=float) if site >= 0 else np.eye(4)
+    G = np.empty((N, nv, na))
+    dG = np.empty((N if second else 0, nv, na, na))
+    H = np.empty((N if second and site >= 0 else 0, 6, na, na))
+    rank, cons, smin, cond = np.empty(N, dtype=np.int64), np.empty(N), np.empty(N), np.empty(N)
+    args = (model.act, model.pas, sb, Tsite, model.tables, opt.PASSIVE_RANK_RTOL, bool(second))
+    outs = (G, dG, H, rank, cons, smin, cond)
+    if N <= BLOCK:
+        entry(model, influence_block, f"influence_block_{second}", (Q, 0, N, *args, *outs))
+    else:
+        influence_par(Q, *args, *outs)
+    second = second and na > 0  # no input: no second-order coefficients (None, as without second)
+    return G, (dG if second else None), (H if second and site >= 0 else None), rank, cons, smin, cond
+
+
 # ----------------------------------------------------------------------------- tree inverse dynamics (RNEA)
 @_nj
 def _mcross(w0, w1, w2, v0, v1, v2, S, k, out, f):  # pragma: no cover - compiled
@@ -1537,6 +1811,11 @@ def warm() -> None:
         q = np.tile(mech.q0, (n, 1))
         qf, _, _, _ = compiled_fk(mech, q, model.pas)
         compiled_site_jacobian(mech, qf, site)
+        compiled_influence(model, qf, True, site)  # influence coefficients and site Hessians
+        zv = np.zeros((n, mech.nv))
+        _dynamics.inverse_dynamics(mech, qf, qd=zv, qdd=zv)  # the full-rate inverse dynamics kernel
+        if n == 1:
+            compiled_project(model, qf, zv)  # simulate's projection (one sample per call)
         z = np.zeros((n, len(model.act)))
         _dynamics._inverse_compiled(mech, qf, z, z, {}, None, True)
         _dynamics.forward_dynamics(mech, qf, z, tau=z)  # the closed-chain forward dynamics kernel

@@ -51,17 +51,14 @@ from robomech._validation import MAX_MAGNITUDE, as_array, broadcast_batch, check
 
 from ._assembly import check_mechanism, check_q
 from ._compile import Bodies, compile_model
-from ._constraints import jacobian
 from ._model import Mechanism
 from ._options import (
     ADMISSIBLE_RTOL,
     CLOSURE_RTOL,
     RANK_RTOL,
-    RATE_FLOOR,
     SINGULAR_COND,
 )
 from ._tree import (
-    frame_jacobian,
     kinematics,
     normalize_quaternions,
     quat_mul,
@@ -119,38 +116,6 @@ def _rank_K(mech: Mechanism) -> int:
     return _reference3(mech)[2]
 
 
-def _pinv_rank(K: np.ndarray, r: int) -> tuple[np.ndarray, np.ndarray]:
-    """Pseudo-inverse of ``K (N, m, n)`` truncated to the mechanism's generic rank ``r``, and the ratio
-    ``s_1 / s_r`` (N,).  A fixed rank rather than a tolerance: between two projections a simulated state
-    is ~1e-12 off the manifold, which lifts the zero singular values of an over-constrained closure
-    (Bennett, planar loops in 3-D) to ~1e-12 — a tolerance would then invert them."""
-    N, m, n = K.shape
-    if r == 0 or m == 0:
-        return np.zeros((N, n, m)), np.ones(N)
-    U, s, Vt = np.linalg.svd(K, full_matrices=False)
-    sr = s[:, r - 1]
-    ok = sr > 0
-    sinv = np.zeros_like(s)
-    sinv[:, :r] = 1.0 / np.where(ok[:, None], s[:, :r], 1.0)
-    P = np.einsum("nji,nj,nkj->nik", Vt, sinv, U)
-    return P, np.where(ok, s[:, 0] / np.where(ok, sr, 1.0), np.inf)
-
-
-def _rank_measures(Kp: np.ndarray, rank0: int, length: float) -> tuple[np.ndarray, np.ndarray]:
-    """``(sigma_min, cond)`` of ``Kp (N, m, n)`` against the mechanism's generic passive rank ``rank0``:
-    the ``rank0``-th singular value and ``s_1`` over it (inf where it is zero).  A truncated
-    pseudo-inverse keeps only the non-zero values, so its own ratio is 1 at a rank drop (a type II
-    singularity); this is the measure reported wherever a sample is not valid.  An empty block or a
-    generic rank 0: ``(length, 1)`` as in ``_influence._pinv``."""
-    N, m, n = Kp.shape
-    if m == 0 or n == 0 or rank0 == 0:
-        return np.full(N, float(length)), np.ones(N)
-    s = np.linalg.svd(np.where(np.isfinite(Kp), Kp, 0.0), compute_uv=False)
-    sr = s[:, rank0 - 1] if s.shape[1] >= rank0 else np.zeros(N)
-    cond = np.where(sr > 0, s[:, 0] / np.where(sr > 0, sr, 1.0), np.inf)
-    return sr, cond
-
-
 def _closure_error(mech: Mechanism, state, q: np.ndarray) -> np.ndarray:
     """Largest closure row ``max |phi(q)|`` (m) per sample; 0 for a tree."""
     from ._constraints import residual
@@ -187,96 +152,6 @@ def _com_jacobians(tree, state, bd: Bodies, qd: np.ndarray | None, Sd: np.ndarra
     return p, J, a0
 
 
-def _screw_rates(tree, state, qd: np.ndarray) -> np.ndarray:
-    """``_tree.screw_rates`` for flat ``qd (N, nv)`` with the carrier twists by matmul (the 3-operand
-    einsum there runs as a naive loop): ``dS_k = [w_c x w_k; w_c x v_k - w_k x v_c]``."""
-    S = state.S
-    Vc = tree.C @ (S * qd[..., None])
-    wc, vc = Vc[..., :3], Vc[..., 3:]
-    ws, vs = S[..., :3], S[..., 3:]
-    return np.concatenate([np.cross(wc, ws), np.cross(wc, vs) - np.cross(ws, vc)], axis=-1)
-
-
-def _path(tree, b: int) -> np.ndarray:
-    """Indices of the velocity coordinates that move body ``b`` (``Tree.dof_paths``, compiled once)."""
-    return tree.dof_paths[b]
-
-
-def _constraint_matrix(mech: Mechanism, state, q: np.ndarray) -> np.ndarray:
-    """``K (N, m, nv)`` as ``_constraints.jacobian`` builds it (same rows, same order), with the point
-    rows' cross products in component arithmetic (the dynamics' hot path; tested equal)."""
-    from ._constraints import _poly
-
-    tree, cs = mech.tree, mech.constraints
-    N, nv = q.shape[0], tree.nv
-    S = state.S
-    w = S[..., :3]
-    w0, w1, w2 = w[..., 0], w[..., 1], w[..., 2]
-    v = S[..., 3:]
-    L = tree.length
-    out = []
-    for kind, d in cs.blocks:
-        if kind == "point":
-            b1, x1, b2, x2 = d
-            rows = np.zeros((N, 3, nv))
-            for b, x, sign in ((b1, x1, 1.0), (b2, x2, -1.0)):
-                if b == 0:
-                    continue
-                p = (state.T[:, b] @ x)[:, :3]
-                c = _path(tree, b)  # only the coordinates that move body b (a loop touches few)
-                p0, p1, p2 = p[:, 0, None], p[:, 1, None], p[:, 2, None]
-                a0, a1, a2 = w0[:, c], w1[:, c], w2[:, c]
-                rows[:, 0, c] += sign * (v[:, c, 0] + a1 * p2 - a2 * p1)
-                rows[:, 1, c] += sign * (v[:, c, 1] + a2 * p0 - a0 * p2)
-                rows[:, 2, c] += sign * (v[:, c, 2] + a0 * p1 - a1 * p0)
-            out.append(rows)
-        elif kind == "rot":
-            b1, _, b2 = d
-            out.append(L * w.swapaxes(-1, -2) * (tree.A[b2] - tree.A[b1]))
-        else:
-            d1, _, _, d2, q2, ref2, c, sc = d
-            row = np.zeros((N, 1, nv))
-            row[:, 0, d1] = sc
-            if d2 >= 0:
-                row[:, 0, d2] -= sc * _poly(c, q[:, q2] - ref2)[1]
-            out.append(row)
-    return np.concatenate(out, axis=-2) if out else np.zeros((N, 0, nv))
-
-
-def _kdot_qd(mech: Mechanism, state, q: np.ndarray, qd: np.ndarray, Sd: np.ndarray) -> np.ndarray:
-    """``Kdot qd (N, m)`` directly (the closure rows' velocity-product accelerations), block by block as
-    ``_constraints.jacobian_rate`` builds ``Kdot``, without forming the (N, m, nv) matrix: a point row is
-    the difference of the two anchors' ``dVd_v + dVd_w x p + w x pdot`` (``Vd = sum_k A Sd_k qd_k``), a
-    rotation row ``L (Vd_w2 - Vd_w1)``, a coupling row ``-s poly''(x) qd2^2``."""
-    from ._constraints import _poly
-
-    tree, cs = mech.tree, mech.constraints
-    V = tree.A @ (state.S * qd[..., None])
-    Vd = tree.A @ (Sd * qd[..., None])
-    L = tree.length
-    out = []
-    for kind, d in cs.blocks:
-        if kind == "point":
-            b1, x1, b2, x2 = d
-            acc = []
-            for b, x in ((b1, x1), (b2, x2)):
-                pt = (state.T[:, b] @ x)[:, :3]
-                w = V[:, b, :3]
-                pd = V[:, b, 3:] + np.cross(w, pt)
-                acc.append(Vd[:, b, 3:] + np.cross(Vd[:, b, :3], pt) + np.cross(w, pd))
-            out.append(acc[0] - acc[1])
-        elif kind == "rot":
-            b1, _, b2 = d
-            out.append(L * (Vd[:, b2, :3] - Vd[:, b1, :3]))
-        else:
-            _d1, _, _, d2, q2, ref2, c, sc = d
-            row = np.zeros((q.shape[0], 1))
-            if d2 >= 0:
-                row[:, 0] = -sc * _poly(c, q[:, q2] - ref2)[2] * qd[:, d2] ** 2
-            out.append(row)
-    return np.concatenate(out, axis=-1) if out else np.zeros((q.shape[0], 0))
-
-
 def _energy_flat(mech: Mechanism, q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     tree = mech.tree
     bd = _bodies(mech)
@@ -289,18 +164,6 @@ def _energy_flat(mech: Mechanism, q: np.ndarray, qd: np.ndarray) -> tuple[np.nda
     T = 0.5 * (np.einsum("nbi,nbij,nbj->n", w, Iw, w) + np.einsum("b,nbi,nbi->n", bd.mass, v, v))
     U = -np.einsum("b,nbi,i->n", bd.mass, p, np.asarray(mech.gravity))
     return T, U
-
-
-def _site_terms(mech: Mechanism, state, wrenches: dict[int, np.ndarray]) -> np.ndarray:
-    """``-sum_s J_s^T W_s`` (N, nv) for wrenches ``W_s (N, 6)`` applied to the mechanism at sites."""
-    tree = mech.tree
-    out = np.zeros((state.T.shape[0], tree.nv))
-    for si, W in wrenches.items():
-        b = tree.site_body[si]
-        p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
-        Js = frame_jacobian(tree, state, b, p)
-        out -= np.einsum("nik,ni->nk", Js, W)
-    return out
 
 
 # ----------------------------------------------------------------------------- validation helpers
@@ -406,6 +269,26 @@ class InverseDynamicsResult:
     valid: np.ndarray
 
 
+def _id_outputs(N: int, na: int, nv: int, extra: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """Empty output arrays of an inverse-dynamics kernel: the forces and measures of
+    ``InverseDynamicsResult`` (N samples, ``na`` actuators, ``nv`` coordinates), then ``extra`` in the
+    kernel's argument order."""
+    shapes = {"qd": (N, nv), "qdd": (N, nv), "unactuated": (N, nv), "closure": (N,)}
+    out = dict(
+        tau=np.empty((N, na)),
+        M_a=np.empty((N, na, na)),
+        velocity_terms=np.empty((N, na)),
+        gravity_terms=np.empty((N, na)),
+        external_terms=np.empty((N, na)),
+    )
+    out.update({k: np.empty(shapes[k]) for k in extra if k in ("qd", "qdd")})
+    out.update(cond=np.empty(N), sigma_min=np.empty(N), admissibility=np.empty(N))
+    for k in extra:
+        if k not in ("qd", "qdd"):
+            out[k] = np.empty(N, dtype=np.bool_) if k in ("valid", "_computed") else np.empty(shapes[k])
+    return out
+
+
 def _inverse_compiled(mech, q, qd_a, qdd_a, wr, weights, gravity=True) -> dict[str, np.ndarray]:
     """The closed-chain inverse dynamics in actuator space (the derivation of the module docstring) by
     the compiled per-sample kernel (``_compiled.inv_dyn``), the one implementation at every batch size;
@@ -418,20 +301,7 @@ def _inverse_compiled(mech, q, qd_a, qdd_a, wr, weights, gravity=True) -> dict[s
     W, wsb, wT = _wrench_arrays(tree, wr, N)
     gv = np.asarray(mech.gravity, dtype=float) if gravity else np.zeros(3)
     wts = np.zeros(0) if weights is None else np.ascontiguousarray(weights, dtype=float)
-    out = dict(
-        tau=np.empty((N, na)),
-        M_a=np.empty((N, na, na)),
-        velocity_terms=np.empty((N, na)),
-        gravity_terms=np.empty((N, na)),
-        external_terms=np.empty((N, na)),
-        qd=np.empty((N, nv)),
-        qdd=np.empty((N, nv)),
-        cond=np.empty(N),
-        sigma_min=np.empty(N),
-        admissibility=np.empty(N),
-        valid=np.empty(N, dtype=np.bool_),
-        closure=np.empty(N),
-    )
+    out = _id_outputs(N, na, nv, ("qd", "qdd", "valid", "closure"))
     f = np.ascontiguousarray
     inv_dyn(
         f(q, dtype=float),
@@ -600,19 +470,6 @@ def _shape(d: dict, batch, ok: np.ndarray, nan_keys) -> dict:
 _FORCE_KEYS = ("tau", "M_a", "velocity_terms", "gravity_terms", "external_terms")
 
 
-def _null_basis(mech: Mechanism, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Orthonormal basis ``(N, nv, d)`` of the admissible velocities ``null(K)`` at the mechanism's
-    generic rank of ``K``, and ``s_1 / s_r`` of ``K`` (N,): 1 for a tree (the identity basis)."""
-    N, m, nv = K.shape
-    r = _rank_K(mech) if m else 0
-    if r == 0:
-        return np.broadcast_to(np.eye(nv), (N, nv, nv)), np.ones(N)
-    _, s, Vt = np.linalg.svd(K, full_matrices=True)
-    sr = s[:, r - 1]
-    cond = np.where(sr > 0, s[:, 0] / np.where(sr > 0, sr, 1.0), np.inf)
-    return Vt[:, r:].swapaxes(-1, -2), cond
-
-
 def _inverse_full_flat(mech, q, qd, qdd, wr, weights, gravity=True):
     """Inverse dynamics from every coordinate's rates and accelerations (any kinematic class).
 
@@ -621,95 +478,26 @@ def _inverse_full_flat(mech, q, qd, qdd, wr, weights, gravity=True):
     ``Nb^T E tau = Nb^T f``; ``tau = B f`` is its least-squares solution (minimum norm, or minimum
     ``sum tau_i^2 / w_i``), and what no actuator force can do, ``Nb (Nb^T f - Nb^T E tau)``, is the
     force the unactuated coordinates would need.  Where the actuators determine the motion this is
-    ``G^T f`` of :func:`_inverse_compiled`."""
-    from ._rnea import _crba_flat, _rnea_flat
+    ``G^T f`` of :func:`_inverse_compiled`.  Computed per sample by the compiled kernel
+    (``_rnea_kernels.inv_full_block``), the one implementation at every batch size; its numpy
+    formulation is the tests' reference (tests/multibody/_reference.py)."""
+    from ._rnea_kernels import inverse_full
 
-    tree = mech.tree
-    N, nv = q.shape[0], tree.nv
-    act = tree.act_dof
-    na = len(act)
-    L = tree.length
-    closed = mech.constraints.m > 0
-    # a tree without site wrenches needs no kinematics here: the kernels compute their own
-    state = kinematics(tree, q) if closed or wr else None
-    z = np.zeros_like(qd)
+    model = compile_model(mech)
+    N = q.shape[0]
     gv = np.asarray(mech.gravity, float) if gravity else np.zeros(3)
-    M = _crba_flat(mech, q)
-    parts = (
-        _mv(M, qdd),
-        _rnea_flat(mech, q, qd, z, np.zeros(3)),
-        _rnea_flat(mech, q, z, z, gv),
-        _site_terms(mech, state, wr) if wr else np.zeros((N, nv)),
-    )
-    f = parts[0] + parts[1] + parts[2] + parts[3]
-    K = _constraint_matrix(mech, state, q) if closed else np.zeros((N, 0, nv))
-    Nb, condK = _null_basis(mech, K)
-    NbT = Nb.swapaxes(-1, -2)
-    Na = Nb[:, act]  # (N, na, d): the actuated rows of the admissible motions
-    ws = np.ones(na) if weights is None else np.sqrt(weights)
-    A = NbT[:, :, act] * ws  # (N, d, na)
-    d = Nb.shape[-1]
-    if na and d:
-        sA = np.linalg.svd(A, compute_uv=False)
-        smin = sA[:, -1]
-        cond_a = np.where(smin > RANK_RTOL * sA[:, 0], sA[:, 0] / np.where(smin > 0, smin, 1.0), np.inf)
-        B = ws[:, None] * (np.linalg.pinv(A, rcond=RANK_RTOL) @ NbT)  # (N, na, nv)
-    else:
-        smin, cond_a = np.ones(N), np.ones(N)
-        B = np.zeros((N, na, nv))
-    tau_parts = [_mv(B, x) for x in parts]
-    tau = tau_parts[0] + tau_parts[1] + tau_parts[2] + tau_parts[3]
-    b = _mv(NbT, f)
-    unact = _mv(Nb, b - _mv(Na.swapaxes(-1, -2), tau))
-    # relative to the largest of the inertial, velocity, gravity and external terms (their sum is ~0 on a
-    # free motion, whose rounding must not count as a force the actuators cannot give)
-    scale = np.max(np.abs(np.stack(parts)), axis=(0, -1)) if nv else np.zeros(N)
-    e_force = np.max(np.abs(unact), axis=-1) / np.maximum(scale, 1e-300) if nv else np.zeros(N)
-    if closed:
-        Sd = _screw_rates(tree, state, qd)
-        kdq = _kdot_qd(mech, state, q, qd, Sd)
-    sv = np.max(np.abs(qd), axis=-1) if nv else np.zeros(N)
-    sa = np.max(np.abs(qdd), axis=-1) + sv * sv if nv else np.zeros(N)
-    if K.shape[1]:
-        e1 = np.max(np.abs(_mv(K, qd)), axis=-1) / (L * np.maximum(sv, RATE_FLOOR))
-        e2 = np.max(np.abs(_mv(K, qdd) + kdq), axis=-1) / (L * np.maximum(sa, RATE_FLOOR))
-        adm = np.maximum(np.maximum(e1, e2), e_force)
-    else:
-        adm = e_force
-    M_a = B @ M @ B.swapaxes(-1, -2)
-    cond = np.maximum(condK, cond_a)
-    fin = np.all(np.isfinite(tau), axis=-1) & np.all(np.isfinite(M_a), axis=(-1, -2))
-    computed = fin & (cond <= SINGULAR_COND)
-    return dict(
-        _computed=computed,
-        tau=tau,
-        M_a=M_a,
-        velocity_terms=tau_parts[1],
-        gravity_terms=tau_parts[2],
-        external_terms=tau_parts[3],
-        qd=np.array(qd),
-        qdd=np.array(qdd),
-        cond=cond,
-        sigma_min=L * smin,
-        admissibility=adm,
-        unactuated=unact,
-        valid=computed & (adm <= ADMISSIBLE_RTOL),
-    )
+    out = _id_outputs(N, len(model.act), model.tree.nv, ("unactuated", "closure", "_computed", "valid"))
+    return inverse_full(model, q, qd, qdd, *_wrench_arrays(model.tree, wr, N), gv, weights, out)
 
 
 def _finish_inverse(mech: Mechanism, q: np.ndarray, d: dict, actuated_mode: bool) -> dict:
-    """The checks common to both inverse-dynamics paths (numpy and compiled, so that a sample's flags do
-    not depend on the batch size): the closure of the input ``q``; in actuator mode a zero
+    """The checks common to both inverse-dynamics forms (actuated and full rates): the closure of the
+    input ``q`` (reported by the kernels); in actuator mode a zero
     ``unactuated`` force, the empty passive block's measures and, where a sample is not valid, the
-    rank measures against the generic rank (``_rank_measures``: a type II singularity has cond inf)."""
-    from ._tree import TreeState
-
+    rank measures against the generic rank (``_rnea_kernels.rank_measures``: a type II singularity has
+    cond inf)."""
     tree = mech.tree
     N = q.shape[0]
-    state = None
-    if "closure" not in d:  # the compiled kernel reports it (the same max |phi(q)|)
-        state = kinematics(tree, q) if mech.constraints.m else None  # a tree has no closure to check
-        d["closure"] = _closure_error(mech, state, q)
     if actuated_mode:
         d["unactuated"] = np.zeros((N, tree.nv))
         pas = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
@@ -718,12 +506,9 @@ def _finish_inverse(mech: Mechanism, q: np.ndarray, d: dict, actuated_mode: bool
         else:
             bad = np.flatnonzero(~d["valid"])
             if bad.size:
-                state = kinematics(tree, q) if state is None else state
-                sub = TreeState(T=state.T[bad], S=state.S[bad])
-                K = _constraint_matrix(mech, sub, q[bad])
-                d["sigma_min"][bad], d["cond"][bad] = _rank_measures(
-                    K[..., pas], _reference(mech)[0], tree.length
-                )
+                from ._rnea_kernels import passive_rank_measures
+
+                d["sigma_min"][bad], d["cond"][bad] = passive_rank_measures(compile_model(mech), q[bad])
     assembled = d["closure"] <= CLOSURE_RTOL * tree.length
     d["valid"] = d["valid"] & assembled
     if "_computed" in d:
@@ -1048,7 +833,7 @@ def site_wrench(
     >>> w.wrench.shape, bool(np.abs(w.wrench).max() < 1e-12)
     ((6,), True)
     """
-    from ._influence import _influence_flat
+    from ._compiled import compiled_site_jacobian  # numba loads on the first kernel call
 
     mech = check_mechanism(mech)
     if not isinstance(site, str):
@@ -1073,10 +858,7 @@ def site_wrench(
             n = qc.shape[0]
             z = np.zeros((n, na))
             st = _inverse_compiled(mech, qc, z, z, {}, None, gravity)
-            state, _, G, _, _, _ = _influence_flat(mech, qc, False)
-            b = tree.site_body[si]
-            p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
-            J = frame_jacobian(tree, state, b, p) @ G  # (n, 6, na)
+            J = compiled_site_jacobian(mech, qc, si)  # (n, 6, na)
             Js = np.concatenate([J[:, :3] * L, J[:, 3:]], axis=1)
             U, s, Vt = np.linalg.svd(Js, full_matrices=False)
             smax = s[:, :1]
@@ -1088,7 +870,7 @@ def site_wrench(
             res = np.linalg.norm(np.einsum("nik,ni->nk", J, W) - rhs, axis=-1)
             smin = s[:, -1] if na <= 6 else s[:, 5]
             cond = smax[:, 0] / np.maximum(smin, 1e-300)
-            assembled = _closure_error(mech, state, qc) <= CLOSURE_RTOL * L
+            assembled = st["closure"] <= CLOSURE_RTOL * L
             valid = st["valid"] & assembled & (cond <= SINGULAR_COND) & np.all(np.isfinite(W), axis=-1)
             for k, v in zip(out, (W, res, smin, cond, valid), strict=True):
                 out[k].append(v)
@@ -1540,17 +1322,11 @@ class SimulationResult:
 
 def _project(mech, q, qd):
     """Back onto the manifold: positions by the closure Newton iteration (all coordinates), velocities
-    onto ``null(K)`` (minimum-norm correction)."""
-    tree = mech.tree
-    from ._compiled import compiled_fk  # numba loads on the first kernel call, not at import
+    onto ``null(K)`` (minimum-norm correction), both by the compiled kernels."""
+    from ._compiled import compiled_fk, compiled_project  # numba loads on the first kernel call
 
-    q, rc, _, _ = compiled_fk(mech, q, np.arange(tree.nv))
-    st = kinematics(tree, q)
-    K = jacobian(mech.constraints, tree, st, q)
-    if K.shape[1]:
-        Kp, _ = _pinv_rank(K, _rank_K(mech))
-        qd = qd - np.einsum("nij,njk,nk->ni", Kp, K, qd)
-    return q, qd, rc
+    q, rc, _, _ = compiled_fk(mech, q, np.arange(mech.tree.nv))
+    return q, compiled_project(compile_model(mech), q, qd), rc
 
 
 class _SampleFailed(Exception):
@@ -1720,10 +1496,9 @@ def simulate(
     q0f = normalize_quaternions(tree, q0f)
     N = q0f.shape[0]
     if act_mode:  # the initial rates of every coordinate: qd = G qd_act0 (idle motions at rest)
-        from ._influence import _influence_flat
+        from ._compiled import compiled_influence  # numba loads on the first kernel call
 
-        _, _, G, _, _, _ = _influence_flat(mech, q0f, False)
-        qd0f = _mv(G, r0)
+        qd0f = _mv(compiled_influence(compile_model(mech), q0f, False)[0], r0)
     else:
         qd0f = np.array(r0)
     nt = len(t)

@@ -12,7 +12,10 @@ along the motion ``qd = G e_k``:
     ∂G/∂q_a,k = [0; -K_p^+ (dK/dt|_{qd = G e_k}) G]        (the papers' second-order coefficients),
 
 and for a site with ``[ω; ṗ] = J_f qd``: ``J = J_f G`` and ``∂J/∂q_a,k = (dJ_f/dt) G + J_f ∂G/∂q_a,k``.
-Nothing here is a finite difference; the tests compare with ``robomech.testing``.
+Nothing here is a finite difference; the tests compare with ``robomech.testing``.  ``G``, ``∂G/∂q_a``
+and the site Hessian are computed per sample by the compiled kernels (``_compiled.influence_block``,
+the same ``G`` as the site Jacobian's and the dynamics'); their numpy formulation is the tests'
+reference (tests/multibody/_reference.py).
 """
 
 from __future__ import annotations
@@ -25,10 +28,11 @@ from robomech._batching import failed_rows, on_rows
 from robomech._validation import as_array, broadcast_batch, check_bool
 
 from ._assembly import check_mechanism, check_q
+from ._compile import compile_model
 from ._constraints import jacobian, jacobian_rate
 from ._model import Mechanism
 from ._options import PASSIVE_RANK_RTOL
-from ._tree import frame_jacobian, frame_jacobian_rate, kinematics, screw_rates
+from ._tree import kinematics, screw_rates
 
 __all__ = [
     "PASSIVE_RANK_RTOL",
@@ -78,50 +82,6 @@ class Influence:
     consistency: np.ndarray
     sigma_min: np.ndarray
     cond: np.ndarray
-
-
-# An empty passive block (an open chain or tree: no closure rows, or no passive coordinate) cannot lose
-# rank: its measures are those of the best-conditioned block, cond 1 and sigma_min = the characteristic
-# length (the singular value of a unit passive column at distance L), finite like every other sample's.
-def _pinv(Kp: np.ndarray, length: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Batched pseudo-inverse of ``Kp (N, m, n)`` with its rank, smallest kept singular value, cond."""
-    N, m, n = Kp.shape
-    if m == 0 or n == 0:
-        return np.zeros((N, n, m)), np.zeros(N, dtype=int), np.full(N, float(length)), np.ones(N)
-    U, s, Vt = np.linalg.svd(Kp, full_matrices=False)
-    cut = PASSIVE_RANK_RTOL * s[:, :1]
-    keep = s > cut
-    sinv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
-    P = np.einsum("nji,nj,nkj->nik", Vt, sinv, U)
-    rank = np.sum(keep, axis=-1)
-    smin = np.min(np.where(keep, s, np.inf), axis=-1)
-    cond = np.where(rank > 0, s[:, 0] / np.where(np.isfinite(smin), smin, 1.0), np.inf)
-    return P, rank, smin, cond
-
-
-def _influence_flat(mech: Mechanism, q: np.ndarray, second: bool):
-    tree, cs = mech.tree, mech.constraints
-    state = kinematics(tree, q)
-    K = jacobian(cs, tree, state, q)
-    N = q.shape[0]
-    na = len(tree.act_dof)
-    act = tree.act_dof
-    pas = np.setdiff1d(np.arange(tree.nv), act)
-    P, rank, smin, cond = _pinv(K[..., pas], tree.length)
-    G = np.zeros((N, tree.nv, na))
-    G[:, act, np.arange(na)] = 1.0
-    G[:, pas] = -P @ K[..., act]
-    cons = np.max(np.abs(K @ G), axis=(-1, -2)) / tree.length if K.shape[1] and na else np.zeros(N)
-    dG = None
-    Sd = None
-    if second and na:
-        qd = G.swapaxes(-1, -2)  # (N, na, nv): the motion of unit rate of input k
-        Sd = screw_rates(tree, state, qd)
-        Kd = jacobian_rate(cs, tree, state, Sd, q, qd)  # (N, na, m, nv)
-        dGk = np.zeros((N, na, tree.nv, na))
-        dGk[:, :, pas] = -np.einsum("nim,nkmj->nkij", P, Kd @ G[:, None])
-        dG = dGk.transpose(0, 2, 3, 1)
-    return state, K, G, dG, Sd, (rank, len(pas), cons, smin, cond)
 
 
 def _site_index(mech: Mechanism, site: object) -> int:
@@ -179,8 +139,12 @@ def influence(mech: Mechanism, q: object, *, second_order: bool = True) -> Influ
     qf, batch = _flat(mech, q)
     npas = mech.tree.nv - len(mech.tree.act_dof)
 
+    from ._compiled import compiled_influence  # numba loads on the first kernel call
+
+    model = compile_model(mech)
+
     def run(qs: np.ndarray) -> tuple:
-        _, _, G, dG, _, (rank, _, cons, smin, cond) = _influence_flat(mech, qs, second_order)
+        G, dG, _, rank, cons, smin, cond = compiled_influence(model, qs, second_order)
         return (G, rank, cons, smin, cond) + (() if dG is None else (dG,))
 
     res = on_rows(failed_rows(qf), run, qf, probe=(mech.tree.q0[None],))
@@ -330,21 +294,19 @@ def site_hessian(mech: Mechanism, q: object, site: str) -> np.ndarray:
     mech = check_mechanism(mech)
     si = _site_index(mech, site)
     qf, batch = _flat(mech, q)
-    tree = mech.tree
-    na = len(tree.act_dof)
+    na = len(mech.tree.act_dof)
     if na == 0:
         return np.zeros((*batch, 6, 0, 0))
 
-    def run(qs: np.ndarray) -> tuple:
-        state, _, G, dG, Sd, _ = _influence_flat(mech, qs, True)
-        b = tree.site_body[si]
-        p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
-        Jf = frame_jacobian(tree, state, b, p)
-        Jfd = frame_jacobian_rate(tree, state, Sd, b, p, G.swapaxes(-1, -2))  # (N, na_k, 6, nv)
-        return (Jfd @ G[:, None] + Jf[:, None] @ dG.transpose(0, 3, 1, 2),)  # (N, k, 6, j)
+    from ._compiled import compiled_influence  # numba loads on the first kernel call
 
-    (Hk,) = on_rows(failed_rows(qf), run, qf, probe=(mech.tree.q0[None],))
-    return Hk.transpose(0, 2, 3, 1).reshape(*batch, 6, na, na)
+    model = compile_model(mech)
+
+    def run(qs: np.ndarray) -> tuple:
+        return (compiled_influence(model, qs, True, si)[2],)
+
+    (H,) = on_rows(failed_rows(qf), run, qf, probe=(mech.tree.q0[None],))
+    return H.reshape(*batch, 6, na, na)
 
 
 def constraint_residual(mech: Mechanism, q: object) -> np.ndarray:

@@ -24,17 +24,18 @@ from ._compiled import (
     chol_solve,
     entry,
     inertia_world,
+    influence_G,
     kin_into,
+    pinv_rank,
     prepare_one,
     rates_kdot,
     resjac,
     rnea_block,
     site_forces,
-    svd_pinv,
     writable,
 )
 
-__all__ = ["crba_batch", "forward"]
+__all__ = ["crba_batch", "forward", "inverse_full"]
 
 numba = import_numba()
 _nj = numba.njit(cache=True, error_model="numpy")
@@ -158,22 +159,9 @@ def solve_constrained(M, f, K, kdq, rank, P, Pn, Mc, H, x, qdd):  # pragma: no c
                 H[i, j] = M[i, j]
         chol_solve(H, f, qdd)
         return cond
-    if not _all_finite(K):  # LAPACK refuses it: no acceleration (the sample is flagged)
+    if not pinv_rank(K, rank, P):  # non-finite K or no LAPACK convergence: the sample is flagged
         qdd[:] = np.nan
         return np.inf
-    try:
-        U, s, Vt = np.linalg.svd(K, full_matrices=False)
-    except Exception:  # no convergence (LAPACK): no acceleration, the sample is flagged
-        qdd[:] = np.nan
-        return np.inf
-    ok = s[rank - 1] > 0
-    P[:, :] = 0.0
-    for c in range(rank):
-        inv = 1.0 / s[c] if ok else 1.0
-        for i in range(nv):
-            g = Vt[c, i] * inv
-            for j in range(m):
-                P[i, j] += g * U[j, c]
     for i in range(nv):  # qdd_p = -K^+ kdq, Pn = I - K^+ K
         acc = 0.0
         for j in range(m):
@@ -245,8 +233,8 @@ def fd_block(
     """Forward dynamics of any mechanism, samples ``lo:hi``, the closure a constraint on the tree
     accelerations (:func:`solve_constrained`), with site wrenches ``W (N, ns, 6)`` on bodies ``wsb``
     at frames ``wT``, the applied generalized forces ``F (N, nv)`` and gravity ``gv``.  ``R`` the
-    rates: ``(N, n_act)`` actuated rates (``act_mode``: ``qd = G qd_act``, the passive block's SVD
-    pseudo-inverse, ``reg_o`` its rank and conditioning check) or ``(N, nv)`` every rate.  Outputs per
+    rates: ``(N, n_act)`` actuated rates (``act_mode``: ``qd = G qd_act``, ``G`` by ``_compiled.influence_G``,
+    ``reg_o`` its rank and conditioning check) or ``(N, nv)`` every rate.  Outputs per
     sample: ``qd_o``, ``qdd_o (N, nv)``, ``cond_o`` (of the constrained mass matrix, or of the
     singular passive block against the generic rank if larger), ``adm_o`` (``|K qd|`` and
     ``|K qdd + Kdot qd|``, relative), ``clo_o`` (max closure row of ``q``) and ``reg_o``.  ``t``,
@@ -265,6 +253,7 @@ def fd_block(
     K = np.empty((m, nv))
     Kp = np.empty((m, npas))
     Pp = np.empty((npas, m))
+    Gq = np.empty((nv, na))
     qd = np.empty((1, nv))
     Sd = np.empty((nv, 6))
     V = np.empty((nb, 6))
@@ -289,25 +278,14 @@ def fd_block(
         clo_o[n] = _amax_abs(r)
         reg = True
         e1 = 0.0
-        if act_mode:  # qd = G qd_act, G = [I; -K_p^+ K_a]
-            rank, cK = 0, 1.0
-            Pp[:, :] = 0.0
-            if m > 0 and npas > 0:
-                for i in range(m):
-                    for j in range(npas):
-                        Kp[i, j] = K[i, pas[j]]
-                rank, _, cK = svd_pinv(Kp, d.pinv_rtol, Pp)
+        if act_mode:  # qd = G qd_act, G = [I; -K_p^+ K_a] (_compiled.influence_G)
+            rank, _, cK = influence_G(K, act, pas, d.pinv_rtol, L, Kp, Pp, Gq)
             reg = rank >= d.rank0 and cK <= d.singular_cond
-            for j in range(na):
-                qd[0, act[j]] = R[n, j]
-            for i in range(npas):
+            for k in range(nv):
                 acc = 0.0
-                for c in range(m):
-                    kr = 0.0
-                    for j in range(na):
-                        kr += K[c, act[j]] * R[n, j]
-                    acc += Pp[i, c] * kr
-                qd[0, pas[i]] = -acc
+                for j in range(na):
+                    acc += Gq[k, j] * R[n, j]
+                qd[0, k] = acc
         else:
             for i in range(nv):
                 qd[0, i] = R[n, i]
@@ -348,12 +326,257 @@ def fd_block(
 
 
 @_nj
-def rank_cond(Kp, rank0):  # pragma: no cover - compiled
-    """``s_1 / s_rank0`` of ``Kp (m, n)`` (non-finite entries read as 0; inf where ``s_rank0`` is 0; 1
-    for an empty block or a generic rank 0): ``_dynamics._rank_measures``' conditioning."""
+def _nanmax(a, b):  # pragma: no cover - compiled
+    """max(a, b) with NaN propagated (numpy's ``maximum``)."""
+    if a != a or b != b:
+        return np.nan
+    return a if a > b else b
+
+
+@_nj
+def null_basis(K, r, Nb):  # pragma: no cover - compiled
+    """An orthonormal basis ``Nb (nv, nv - r)`` of ``null(K)`` at the rank ``r`` (the trailing right
+    singular vectors of ``K (m, nv)``); returns ``s_1 / s_r`` (inf where ``s_r`` is 0), or -1 where
+    ``K`` is not finite or LAPACK does not converge."""
+    if not _all_finite(K):
+        return -1.0
+    try:
+        _, sK, Vt = np.linalg.svd(K, full_matrices=True)
+    except Exception:  # no convergence (LAPACK)
+        return -1.0
+    nv, dd = Nb.shape
+    for i in range(nv):
+        for j in range(dd):
+            Nb[i, j] = Vt[r + j, i]
+    sr = sK[r - 1]
+    return sK[0] / sr if sr > 0 else np.inf
+
+
+@_nj
+def inv_full_block(
+    lo, hi, Q, QD, QDD, W, wsb, wT, gv, ws, rank_K, t, rt, d,
+    tau_o, Ma_o, vel_o, grav_o, ext_o, cond_o, smin_o, adm_o, unact_o, clo_o, comp_o, valid_o,
+):  # pragma: no cover - compiled  # fmt: skip
+    """Inverse dynamics from every coordinate's rates and accelerations, samples ``lo:hi`` (``_dynamics``'
+    module docstring, "Every kinematic class"): the tree's generalized forces ``f = M qdd + c + g -
+    J_s^T W`` in parts (CRBA, RNEA, :func:`site_forces`), an orthonormal basis ``Nb`` of ``null(K)`` at the
+    generic rank ``rank_K`` (SVD), ``tau = B f`` with ``B = ws pinv(Nb_a^T ws) Nb^T`` (``ws`` the square
+    roots of the weights, ones for minimum norm), ``unact = Nb (Nb^T f - Nb_a^T tau)``, the admissibility
+    (``|K qd|``, ``|K qdd + Kdot qd|``, the size of ``unact`` against the largest part), ``M_a = B M B^T``
+    and ``cond = max(cond K, cond of Nb_a^T ws)``; ``comp_o``: forces finite and not singular."""
+    nb = t.parent.shape[0]
+    A, m, L = t.A, t.m, t.L
+    nv = A.shape[1]
+    act = d.act
+    na = act.shape[0]
+    r_ = rank_K if m > 0 else 0
+    dd = nv - r_
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    Rj = np.empty((3, 3))
+    Rn = np.empty((3, 3))
+    anchor = np.empty(3)
+    r = np.empty(m)
+    K = np.empty((m, nv))
+    Sd = np.empty((nv, 6))
+    V = np.empty((nb, 6))
+    Vd = np.empty((nb, 6))
+    kdq = np.zeros(m)
+    M = np.empty((1, nv, nv))
+    fv = np.empty((1, nv))
+    fg = np.empty((1, nv))
+    zero = np.zeros((1, nv))
+    z3 = np.zeros(3)
+    ext = np.empty(nv)
+    ps = np.empty(3)
+    parts = np.empty((4, nv))
+    f = np.empty(nv)
+    Nb = np.empty((nv, dd))
+    Aw = np.empty((dd, na))
+    B = np.zeros((na, nv))
+    tp = np.empty((4, na))
+    tau = np.empty(na)
+    bb = np.empty(dd)
+    un = np.empty(nv)
+    BM = np.empty((na, nv))
+    res = np.empty(m)
+    for n in range(lo, hi):
+        q = Q[n]
+        qd = QD[n]
+        qdd = QDD[n]
+        kin_into(q, t, T, S, Rj, Rn, anchor)
+        resjac(q, t, T, S, r, K, True)
+        clo_o[n] = _amax_abs(r)
+        if m > 0:
+            rates_kdot(q, t, T, S, qd, Sd, V, Vd, kdq)
+        q1 = Q[n : n + 1]
+        crba_block(q1, 0, 1, rt, M)
+        rnea_block(0, 1, q1, QD[n : n + 1], zero, z3, rt, fv)
+        rnea_block(0, 1, q1, zero, zero, gv, rt, fg)
+        site_forces(T, S, A, W[n], wsb, wT, ps, ext)
+        scale = 0.0
+        for i in range(nv):
+            acc = 0.0
+            for j in range(nv):
+                acc += M[0, i, j] * qdd[j]
+            parts[0, i] = acc
+            parts[1, i] = fv[0, i]
+            parts[2, i] = fg[0, i]
+            parts[3, i] = ext[i]
+            f[i] = parts[0, i] + parts[1, i] + parts[2, i] + parts[3, i]
+            for c in range(4):
+                scale = _nanmax(scale, abs(parts[c, i]))
+        # the admissible motions: an orthonormal basis of null(K) at the generic rank
+        condK = 1.0
+        if r_ == 0:
+            for i in range(nv):
+                for j in range(dd):
+                    Nb[i, j] = 1.0 if i == j else 0.0
+        else:
+            condK = null_basis(K, r_, Nb)
+            if condK < 0.0:  # non-finite K or no LAPACK convergence: the sample is flagged
+                tau_o[n] = np.nan
+                Ma_o[n] = np.nan
+                vel_o[n] = np.nan
+                grav_o[n] = np.nan
+                ext_o[n] = np.nan
+                unact_o[n] = np.nan
+                cond_o[n] = np.inf
+                smin_o[n] = np.nan
+                adm_o[n] = np.nan
+                comp_o[n] = False
+                valid_o[n] = False
+                continue
+        # the least-squares rule on the actuated rows of the admissible motions
+        smin, cond_a = 1.0, 1.0
+        B[:, :] = 0.0
+        if na > 0 and dd > 0:
+            for i in range(dd):
+                for j in range(na):
+                    Aw[i, j] = Nb[act[j], i] * ws[j]
+            if _all_finite(Aw):
+                sA = np.linalg.svd(Aw)[1]
+                smin = sA[sA.shape[0] - 1]
+                cond_a = sA[0] / (smin if smin > 0 else 1.0) if smin > d.rank_rtol * sA[0] else np.inf
+                Ap = np.linalg.pinv(Aw, d.rank_rtol)  # (na, dd)
+                for j in range(na):
+                    for k in range(nv):
+                        acc = 0.0
+                        for i in range(dd):
+                            acc += Ap[j, i] * Nb[k, i]
+                        B[j, k] = ws[j] * acc
+            else:
+                smin, cond_a = np.nan, np.nan
+                B[:, :] = np.nan
+        for c in range(4):
+            for j in range(na):
+                acc = 0.0
+                for k in range(nv):
+                    acc += B[j, k] * parts[c, k]
+                tp[c, j] = acc
+        for j in range(na):
+            tau[j] = tp[0, j] + tp[1, j] + tp[2, j] + tp[3, j]
+        for i in range(dd):
+            acc = 0.0
+            for k in range(nv):
+                acc += Nb[k, i] * f[k]
+            for j in range(na):
+                acc -= Nb[act[j], i] * tau[j]
+            bb[i] = acc
+        for k in range(nv):
+            acc = 0.0
+            for i in range(dd):
+                acc += Nb[k, i] * bb[i]
+            un[k] = acc
+        e_force = _amax_abs(un) / max(scale, 1e-300) if nv > 0 else 0.0
+        adm = e_force
+        if m > 0:
+            sv = _amax_abs(qd)
+            sa = _amax_abs(qdd) + sv * sv
+            for i in range(m):
+                acc = 0.0
+                for k in range(nv):
+                    acc += K[i, k] * qd[k]
+                r[i] = acc
+            e1 = _amax_abs(r) / (L * max(sv, d.rate_floor))
+            for i in range(m):
+                acc = kdq[i]
+                for k in range(nv):
+                    acc += K[i, k] * qdd[k]
+                res[i] = acc
+            e2 = _amax_abs(res) / (L * max(sa, d.rate_floor))
+            adm = _nanmax(_nanmax(e1, e2), e_force)
+        for j in range(na):
+            for k in range(nv):
+                acc = 0.0
+                for i in range(nv):
+                    acc += B[j, i] * M[0, i, k]
+                BM[j, k] = acc
+        for j in range(na):
+            for c in range(na):
+                acc = 0.0
+                for k in range(nv):
+                    acc += BM[j, k] * B[c, k]
+                Ma_o[n, j, c] = acc
+        cond = _nanmax(condK, cond_a)
+        fin = _all_finite(tau) and _all_finite(Ma_o[n])
+        comp = fin and cond <= d.singular_cond
+        for j in range(na):
+            tau_o[n, j] = tau[j]
+            vel_o[n, j] = tp[1, j]
+            grav_o[n, j] = tp[2, j]
+            ext_o[n, j] = tp[3, j]
+        for k in range(nv):
+            unact_o[n, k] = un[k]
+        cond_o[n] = cond
+        smin_o[n] = L * smin
+        adm_o[n] = adm
+        comp_o[n] = comp
+        valid_o[n] = comp and adm <= d.admissible_rtol
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def inv_full_par(
+    Q, QD, QDD, W, wsb, wT, gv, ws, rank_K, t, rt, d,
+    tau_o, Ma_o, vel_o, grav_o, ext_o, cond_o, smin_o, adm_o, unact_o, clo_o, comp_o, valid_o,
+):  # pragma: no cover - compiled  # fmt: skip
+    """:func:`inv_full_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        inv_full_block(
+            k * BLOCK, min(N, (k + 1) * BLOCK), Q, QD, QDD, W, wsb, wT, gv, ws, rank_K, t, rt, d,
+            tau_o, Ma_o, vel_o, grav_o, ext_o, cond_o, smin_o, adm_o, unact_o, clo_o, comp_o, valid_o,
+        )  # fmt: skip
+
+
+def inverse_full(model, q, qd, qdd, W, wsb, wT, gv, weights, out: dict) -> dict:
+    """:func:`inv_full_block` on every sample (normalised ``q (N, nq)``, ``qd``, ``qdd (N, nv)``, site
+    wrenches packed as ``_dynamics._wrench_arrays``, ``weights (n_act,)`` or None) into ``out`` (the
+    kernel's outputs in its argument order, ``_dynamics._id_outputs``), returned with ``qd`` and ``qdd``
+    copied; one block in this thread for a small batch, parallel blocks for a large one (the same
+    per-sample code either way)."""
+    Q, QD, QDD, WW = writable(q), writable(qd), writable(qdd), writable(W)
+    N, na = Q.shape[0], len(model.act)
+    ws = np.ones(na) if weights is None else np.sqrt(np.asarray(weights, dtype=float))
+    args = (Q, QD, QDD, WW, wsb, wT, writable(gv), ws, model.rank_K, model.tables, model.rnea, model.dyn)
+    if N <= BLOCK:
+        entry(model, inv_full_block, "inv_full_block", (0, N, *args, *out.values()))
+    else:
+        inv_full_par(*args, *out.values())
+    out["qd"], out["qdd"] = QD.copy(), QDD.copy()
+    return out
+
+
+@_nj
+def rank_measures(Kp, rank0, L):  # pragma: no cover - compiled
+    """``(s_rank0, s_1 / s_rank0)`` of ``Kp (m, n)`` against the mechanism's generic passive rank
+    ``rank0`` (non-finite entries read as 0; cond inf where ``s_rank0`` is 0, or where LAPACK does not
+    converge).  A truncated pseudo-inverse keeps only the non-zero values, so its own ratio is 1 at a
+    rank drop (a type II singularity); this is the measure reported wherever a sample is not valid.  An
+    empty block or a generic rank 0: ``(L, 1)``, as ``_compiled.influence_G`` has it."""
     m, n = Kp.shape
     if m == 0 or n == 0 or rank0 == 0:
-        return 1.0
+        return L, 1.0
     H = np.empty((m, n))
     for i in range(m):
         for j in range(n):
@@ -362,9 +585,52 @@ def rank_cond(Kp, rank0):  # pragma: no cover - compiled
     try:
         s = np.linalg.svd(H)[1]
     except Exception:  # no convergence (LAPACK): no measure
-        return np.inf
+        return 0.0, np.inf
     sr = s[rank0 - 1] if s.shape[0] >= rank0 else 0.0
-    return s[0] / sr if sr > 0 else np.inf
+    return sr, (s[0] / sr if sr > 0 else np.inf)
+
+
+@_nj
+def rank_cond(Kp, rank0):  # pragma: no cover - compiled
+    """The conditioning of :func:`rank_measures` (1 for an empty block or a generic rank 0)."""
+    return rank_measures(Kp, rank0, 1.0)[1]
+
+
+@_nj
+def rank_measures_block(Q, lo, hi, pas, rank0, t, smin_o, cond_o):  # pragma: no cover - compiled
+    """:func:`rank_measures` of the passive block ``K_p`` at each configuration ``Q[lo:hi]``."""
+    nb = t.parent.shape[0]
+    m = t.m
+    nv = t.A.shape[1]
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    Rj = np.empty((3, 3))
+    Rn = np.empty((3, 3))
+    anchor = np.empty(3)
+    r = np.empty(m)
+    K = np.empty((m, nv))
+    Kp = np.empty((m, pas.shape[0]))
+    for n in range(lo, hi):
+        kin_into(Q[n], t, T, S, Rj, Rn, anchor)
+        resjac(Q[n], t, T, S, r, K, True)
+        for i in range(m):
+            for j in range(pas.shape[0]):
+                Kp[i, j] = K[i, pas[j]]
+        smin_o[n], cond_o[n] = rank_measures(Kp, rank0, t.L)
+
+
+def passive_rank_measures(model, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(sigma_min, cond)`` of :func:`rank_measures` at ``q (N, nq)`` (the samples that are not valid)."""
+    Q = writable(q)
+    N = Q.shape[0]
+    smin, cond = np.empty(N), np.empty(N)
+    entry(
+        model,
+        rank_measures_block,
+        "rank_measures_block",
+        (Q, 0, N, model.pas, model.rank0, model.tables, smin, cond),
+    )
+    return smin, cond
 
 
 @numba.njit(cache=True, error_model="numpy", parallel=True)

@@ -43,10 +43,10 @@ from ._assembly import (
     inverse_kinematics,
 )
 from ._compile import compile_model
-from ._influence import _influence_flat
+from ._constraints import jacobian
 from ._mobility import mobility
 from ._model import Mechanism
-from ._tree import frame_jacobian
+from ._tree import kinematics
 
 __all__ = ["SingularityMapResult", "SingularityResult", "singularities", "singularity_map"]
 
@@ -135,15 +135,15 @@ def _rows(output: object) -> tuple[int, ...]:
 
 
 def _scaled_output_jacobian(mech: Mechanism, qf: np.ndarray, si: int, L: float, rows: tuple[int, ...]):
+    from ._compiled import compiled_site_jacobian  # numba loads on the first kernel call
+
     tree = mech.tree
-    state, K, G, _, _, _ = _influence_flat(mech, qf, False)
+    state = kinematics(tree, qf)
+    K = jacobian(mech.constraints, tree, state, qf)
     col = np.where(tree.dof_translational, 1.0, L)
     scale = np.array([L, L, L, 1.0, 1.0, 1.0])
-    b = tree.site_body[si]
-    p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
-    Jf = frame_jacobian(tree, state, b, p)
-    J = (scale[:, None] * (Jf @ G) / col[tree.act_dof])[:, list(rows)]
-    return state, K, G, col, J
+    J = (scale[:, None] * compiled_site_jacobian(mech, qf, si) / col[tree.act_dof])[:, list(rows)]
+    return state, K, col, J
 
 
 def _generic_output_rank(
@@ -166,7 +166,7 @@ def _generic_output_rank(
         fk = forward_kinematics(mech, qa, q_ref)
         if np.any(fk.converged):
             qs.append(fk.q[fk.converged])
-    J = _scaled_output_jacobian(mech, np.concatenate(qs), si, L, rows)[4]
+    J = _scaled_output_jacobian(mech, np.concatenate(qs), si, L, rows)[3]
     r = 0
     if J.shape[-1] and J.shape[-2]:
         s = np.linalg.svd(J, compute_uv=False)
@@ -240,7 +240,7 @@ def singularities(
 
     def run(qf: np.ndarray) -> tuple:
         # input-output Jacobian per scaled input rate: G maps unscaled rates; hinge inputs are per rad
-        state, K, _, col, J = _scaled_output_jacobian(mech, qf, si, L, out_rows)
+        state, K, col, J = _scaled_output_jacobian(mech, qf, si, L, out_rows)
         act = tree.act_dof
         pas = np.setdiff1d(np.arange(tree.nv), act)
         Ks = K * col  # K rows are already lengths
@@ -407,12 +407,11 @@ def singularity_map(
     tree = mech.tree
     L = s.length
     qf = q.reshape(-1, mech.nq)
-    state, _, G, _, _, _ = _influence_flat(mech, qf, False)
+    from ._compiled import compiled_site_jacobian  # numba loads on the first kernel call
+
     si = tree.site_index(site)
-    b = tree.site_body[si]
-    p = (state.T[:, b] @ tree.T_site[si])[:, :3, 3]
     col = np.where(tree.dof_translational, 1.0, L)
-    J = np.array([L, L, L, 1, 1, 1])[:, None] * (frame_jacobian(tree, state, b, p) @ G) / col[tree.act_dof]
+    J = np.array([L, L, L, 1, 1, 1])[:, None] * compiled_site_jacobian(mech, qf, si) / col[tree.act_dof]
     # keep the rows the output actually uses (rank of the reference), so that a 3-DOF site is not
     # judged singular for the 3 directions it never moves in
     U = np.linalg.svd(J, full_matrices=False)[0]
