@@ -744,12 +744,18 @@ class Builder:
             self.gravity,
             self.name,
         )
-        from ._tree import body_poses
+        # Its tree and assembled reference only (the compile step's q_ref), not its whole compiled model:
+        # the mechanism is compiled once, below.
+        from ._constraints import compile_constraints
+        from ._reference import assembled_reference
+        from ._tree import body_poses, compile_tree
 
-        T0 = body_poses(tree_only.tree, tree_only.q0[None])[0]
+        tree0 = compile_tree(tree_only)
+        q_ref0 = assembled_reference(tree_only, tree0, compile_constraints(tree_only, tree0))
+        T0 = body_poses(tree0, q_ref0[None])[0]
 
         def pose(body: str) -> np.ndarray:
-            return T0[tree_only.tree.body_index(body)]
+            return T0[tree0.body_index(body)]
 
         closures = []
         for kind, name, b1, b2, a, other, axis in self._closures:
