@@ -528,19 +528,18 @@ IK_RETRY_STEPS = 4
 # (MINPACK's gtol test; a point out of reach, which would otherwise spend the iteration limit).  On
 # 8 random five-bar designs x 32 x 32 points it lost none of 3,498 reached points and cut the mean
 # iterations 39.5 -> 28.5 (3e-3 lost one); a reachable point it stops early is re-solved from a
-# reached neighbour (IK_RETRIES; reach_grid's last round).
+# reached neighbour (IK_RETRIES; reach_grid's wavefront).
 IK_GTOL = 1e-3
 
 
 # Seeds of a task grid: every GRID_SEED_STRIDE-th cell per axis (the middle one of each block) is solved
 # from the reference configuration; the rest of the grid is reached from them (reach_grid).
 GRID_SEED_STRIDE = 4
-# Continuation stages of reach_grid's last round (each missed cell next to the reached region re-solved
-# from a reached neighbour).  Measured on 64 Sobol five-bar designs x 32 x 32 cells: with 2 (and with
-# 4) every cell the annuli closed form puts inside (27,452, boundary cells within 1e-6 m excluded) is
-# reached and none outside; without this round 5 were missed.  2 stages cost 0.5 s of 1.6 s there, 4
-# stages 1.2 s of 2.3 s.
-GRID_LAST_STEPS = 2
+# A seed missed from the reference is left to the wavefront (solved from a reached neighbour like any
+# other cell), and no round follows the wavefront: a round re-solving each missed cell next to the
+# reached region from its first reached neighbour in 2 continuation stages recovered, on 256 Sobol
+# five-bar designs x 32 x 32 cells, only such seeds (27 cells); with the seeds left to the wavefront it
+# recovered none of 24,950 re-solves on 1,024 designs, at 14 % of the IK iterations.
 
 
 def _grid_neighbours(n: int, k: int) -> np.ndarray:
@@ -568,12 +567,12 @@ def reach_grid(batch: Any, pts: np.ndarray, n: int, outputs: str) -> tuple[np.nd
     reference configuration (one batched IK); then, round after round, every cell not yet tried that
     has a reached neighbour (within ``RETRY_CELLS`` cells) is solved from that neighbour's configuration
     (the first such neighbour in a fixed order), all designs' cells of a round in one batched IK, until
-    no untried cell has a reached neighbour; a last round re-solves every missed cell next to the reached
-    region from its first reached neighbour in ``GRID_LAST_STEPS`` continuation stages.  A cell is
-    reached if it is connected through reached cells to a seed reached from the reference (the IK is a
-    local solver: a region of the grid not so connected is missed).  A cell out of reach costs one or
-    two IK solves only if it borders the reached region (a solve from the reference of every cell, as
-    :func:`reach_designs`, spends most of its iterations on the cells out of reach).
+    no untried cell has a reached neighbour.  A seed missed from the reference counts as untried (it
+    is solved from a neighbour like any other cell).  A cell is reached if it is connected through
+    reached cells to a seed reached from the reference (the IK is a local solver: a region of the grid
+    not so connected is missed).  A cell out of reach costs an IK solve only if it borders the reached
+    region (a solve from the reference of every cell, as :func:`reach_designs`, spends most of its
+    iterations on the cells out of reach).
     """
     from robomech.multibody._designs import ik_designs
 
@@ -583,37 +582,28 @@ def reach_grid(batch: Any, pts: np.ndarray, n: int, outputs: str) -> tuple[np.nd
     T = _targets(pts.reshape(-1, 3)).reshape(D, P, 4, 4)
     q = np.full((D, P, batch.q_ref.shape[1]), np.nan)
     ok = np.zeros((D, P), bool)
-    tried = np.zeros((D, P), bool)
     cells = np.indices((n,) * k).reshape(k, -1).T
     seed = np.flatnonzero(np.all(cells % GRID_SEED_STRIDE == GRID_SEED_STRIDE // 2, axis=1))
     if seed.size == 0:  # a grid smaller than one stride: its middle cell
         seed = np.array([int(np.ravel_multi_index((n // 2,) * k, (n,) * k))])
     d, p = np.repeat(np.arange(D), seed.size), np.tile(seed, D)
-    guess = batch.q_ref[d]
-    steps = 1
+    qj, cj, _, _, _ = ik_designs(batch, d, T[d, p], batch.q_ref[d], w, gtol=IK_GTOL)
+    ok[d, p] = cj
+    q[d[cj], p[cj]] = qj[cj]
+    tried = ok.copy()  # a seed missed from the reference is solved from a neighbour below
     nb = _grid_neighbours(n, k)
-    last = False
     while True:
-        qj, cj, _, _, _ = ik_designs(batch, d, T[d, p], guess, w, steps=steps, gtol=IK_GTOL)
-        tried[d, p] = True
-        ok[d, p] = cj
-        q[d[cj], p[cj]] = qj[cj]
-        if last:
-            break
         src = np.full((D, P), -1)
         for j in nb:  # the first reached neighbour of each untried cell, in the offsets' order
             has = (j >= 0)[None, :] & ok[:, np.maximum(j, 0)] & ~tried & (src < 0)
             src[has] = np.broadcast_to(j, (D, P))[has]
-        steps = 1
-        if not np.any(src >= 0):  # the last round: each missed cell next to the reached region once more
-            last, steps = True, GRID_LAST_STEPS
-            for j in nb:
-                has = (j >= 0)[None, :] & ok[:, np.maximum(j, 0)] & ~ok & (src < 0)
-                src[has] = np.broadcast_to(j, (D, P))[has]
         d, p = np.nonzero(src >= 0)
         if d.size == 0:
             break
-        guess = q[d, src[d, p]]
+        qj, cj, _, _, _ = ik_designs(batch, d, T[d, p], q[d, src[d, p]], w, gtol=IK_GTOL)
+        tried[d, p] = True
+        ok[d, p] = cj
+        q[d[cj], p[cj]] = qj[cj]
     return q, ok
 
 
