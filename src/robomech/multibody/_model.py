@@ -792,7 +792,11 @@ class Builder:
             self.gravity,
             self.name,
         )
-        mech.q0  # noqa: B018 - assemble the reference now: a description that cannot assemble raises here
+        from ._compile import compile_model
+
+        # assemble the reference now (a description that cannot assemble raises here), on the tree
+        # compiled above: the closures are not part of the tree
+        compile_model(mech, _tree=tree0)
         return mech
 
 
