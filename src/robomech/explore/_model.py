@@ -558,6 +558,81 @@ def _grid_neighbours(n: int, k: int) -> np.ndarray:
     return np.array(out)
 
 
+# Slack of the reach bound's test (relative to the bound plus L): the rounding of the kinematics and of
+# the bound's own sums, far below any task cell.
+REACH_BOUND_RTOL = 1e-9
+
+
+def _chain_bound(batch: Any, body: int, point: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A sphere ``(centre (D, 3), radius (D,))`` that holds ``point (D, 3)`` (fixed in ``body``) at every
+    configuration: from ``body`` up to the world, each body has at most one joint, a hinge or a ball,
+    which rotates everything below it about its anchor (fixed in the parent's frame), so the point's
+    distance from the topmost anchor is at most the sum of the (rigid) distances from the point to its
+    body's anchor and from each anchor to the next one up (triangle inequality).  A slide, a free
+    joint or a body with several joints on the path: radius inf."""
+    t, g = batch.tables, batch.geometry
+    D = batch.n
+    P = point.copy()  # the current point, in the current body's frame
+    radius = np.zeros(D)
+    b = body
+    while b > 0:
+        js = range(int(t.j0[b]), int(t.j0[b + 1]))
+        if len(js) > 1 or (len(js) == 1 and t.jtype[js[0]] not in (0, 2)):  # hinge 0, ball 2
+            return np.zeros((D, 3)), np.full(D, np.inf)
+        if len(js) == 1:
+            a = g.jpos[:, js[0]]
+            radius += np.linalg.norm(P - a, axis=1)
+            P = a
+        P = np.einsum("dij,dj->di", g.T_off[:, b, :3, :3], P) + g.T_off[:, b, :3, 3]
+        b = int(t.parent[b])
+    return P, radius
+
+
+def reach_bound(batch: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Spheres ``(centres (D, S, 3), radii (D, S))`` per design (m), each holding the batch's site at
+    every configuration the IK can call converged (radius inf: no bound): the site's own chain
+    (:func:`_chain_bound`), and for each closure point pair with one point on the site's body, the other
+    point's chain plus the (rigid) distance from the site to this point and the closure tolerance
+    (a converged configuration closes each pair to ``CONVERGED_RTOL * L`` per row)."""
+    from robomech.multibody._options import CONVERGED_RTOL
+
+    t, g = batch.tables, batch.geometry
+    sb = batch.site_body
+    site = batch.T_site[:, :3, 3]
+    centres, radii = [], []
+    c, r = _chain_bound(batch, sb, site)
+    centres.append(c)
+    radii.append(r)
+    for i in range(t.pp.shape[0]):
+        for this, other in ((0, 1), (1, 0)):
+            if int(t.pp[i, this]) != sb:
+                continue
+            c, r = _chain_bound(batch, int(t.pp[i, other]), g.px[:, i, other])
+            r = (
+                r
+                + np.linalg.norm(site - g.px[:, i, this], axis=1)
+                + np.sqrt(3) * CONVERGED_RTOL * batch.length
+            )
+            centres.append(c)
+            radii.append(r)
+    return np.stack(centres, 1), np.stack(radii, 1)
+
+
+def _out_of_reach(
+    batch: Any, bound: tuple[np.ndarray, np.ndarray], d: np.ndarray, pts: np.ndarray, outputs: str
+) -> np.ndarray:
+    """Which targets ``pts (N, 3)`` (design ``d``) are farther along ``outputs`` from one of the design's
+    :func:`reach_bound` spheres than the IK's convergence tolerance: no configuration converges there."""
+    from robomech.multibody._options import CONVERGED_RTOL
+
+    centres, radii = bound
+    ax = [AXES.index(a) for a in outputs]
+    dist = np.linalg.norm((pts[:, None, :] - centres[d])[..., ax], axis=-1)  # (N, S)
+    L = batch.length[d][:, None]
+    slack = np.sqrt(len(ax)) * CONVERGED_RTOL * L + REACH_BOUND_RTOL * (radii[d] + L)
+    return np.any(dist > radii[d] + slack, axis=1)
+
+
 def reach_grid(batch: Any, pts: np.ndarray, n: int, outputs: str) -> tuple[np.ndarray, np.ndarray]:
     """Configurations ``q (D, n**k, nq)`` placing the batch's site at each design's task-grid points
     ``pts (D, n**k, 3)`` (``task_grid`` order, ``n`` cells per axis) along ``outputs``, and which
@@ -586,7 +661,11 @@ def reach_grid(batch: Any, pts: np.ndarray, n: int, outputs: str) -> tuple[np.nd
     seed = np.flatnonzero(np.all(cells % GRID_SEED_STRIDE == GRID_SEED_STRIDE // 2, axis=1))
     if seed.size == 0:  # a grid smaller than one stride: its middle cell
         seed = np.array([int(np.ravel_multi_index((n // 2,) * k, (n,) * k))])
+    bound = reach_bound(batch)
+    # targets no configuration reaches: missed without a solve
+    far = _out_of_reach(batch, bound, np.repeat(np.arange(D), P), pts.reshape(-1, 3), outputs).reshape(D, P)
     d, p = np.repeat(np.arange(D), seed.size), np.tile(seed, D)
+    d, p = d[~far[d, p]], p[~far[d, p]]
     qj, cj, _, _, _ = ik_designs(batch, d, T[d, p], batch.q_ref[d], w, gtol=IK_GTOL)
     ok[d, p] = cj
     q[d[cj], p[cj]] = qj[cj]
@@ -600,8 +679,11 @@ def reach_grid(batch: Any, pts: np.ndarray, n: int, outputs: str) -> tuple[np.nd
         d, p = np.nonzero(src >= 0)
         if d.size == 0:
             break
-        qj, cj, _, _, _ = ik_designs(batch, d, T[d, p], q[d, src[d, p]], w, gtol=IK_GTOL)
         tried[d, p] = True
+        d, p = d[~far[d, p]], p[~far[d, p]]
+        if d.size == 0:
+            continue
+        qj, cj, _, _, _ = ik_designs(batch, d, T[d, p], q[d, src[d, p]], w, gtol=IK_GTOL)
         ok[d, p] = cj
         q[d[cj], p[cj]] = qj[cj]
     return q, ok
