@@ -618,19 +618,23 @@ def reach_bound(batch: Any) -> tuple[np.ndarray, np.ndarray]:
     return np.stack(centres, 1), np.stack(radii, 1)
 
 
-def _out_of_reach(
-    batch: Any, bound: tuple[np.ndarray, np.ndarray], d: np.ndarray, pts: np.ndarray, outputs: str
-) -> np.ndarray:
-    """Which targets ``pts (N, 3)`` (design ``d``) are farther along ``outputs`` from one of the design's
-    :func:`reach_bound` spheres than the IK's convergence tolerance: no configuration converges there."""
+def _out_of_reach(batch: Any, pts: np.ndarray, outputs: str) -> np.ndarray:
+    """Which targets ``pts (D, P, 3)`` (design ``d`` of the batch in row ``d``) are farther along
+    ``outputs`` from one of the design's :func:`reach_bound` spheres than the IK's convergence
+    tolerance: no configuration converges there ``(D, P)``."""
     from robomech.multibody._options import CONVERGED_RTOL
 
-    centres, radii = bound
+    centres, radii = reach_bound(batch)
     ax = [AXES.index(a) for a in outputs]
-    dist = np.linalg.norm((pts[:, None, :] - centres[d])[..., ax], axis=-1)  # (N, S)
-    L = batch.length[d][:, None]
-    slack = np.sqrt(len(ax)) * CONVERGED_RTOL * L + REACH_BOUND_RTOL * (radii[d] + L)
-    return np.any(dist > radii[d] + slack, axis=1)
+    L = batch.length[:, None]
+    reach = radii + np.sqrt(len(ax)) * CONVERGED_RTOL * L + REACH_BOUND_RTOL * (radii + L)  # (D, S)
+    far = np.zeros(pts.shape[:2], bool)
+    for s in range(radii.shape[1]):
+        d2 = np.zeros(pts.shape[:2])
+        for a in ax:
+            d2 += (pts[:, :, a] - centres[:, s, a][:, None]) ** 2
+        far |= np.sqrt(d2) > reach[:, s][:, None]
+    return far
 
 
 def reach_grid(batch: Any, pts: np.ndarray, n: int, outputs: str) -> tuple[np.ndarray, np.ndarray]:
@@ -661,9 +665,7 @@ def reach_grid(batch: Any, pts: np.ndarray, n: int, outputs: str) -> tuple[np.nd
     seed = np.flatnonzero(np.all(cells % GRID_SEED_STRIDE == GRID_SEED_STRIDE // 2, axis=1))
     if seed.size == 0:  # a grid smaller than one stride: its middle cell
         seed = np.array([int(np.ravel_multi_index((n // 2,) * k, (n,) * k))])
-    bound = reach_bound(batch)
-    # targets no configuration reaches: missed without a solve
-    far = _out_of_reach(batch, bound, np.repeat(np.arange(D), P), pts.reshape(-1, 3), outputs).reshape(D, P)
+    far = _out_of_reach(batch, pts, outputs)  # targets no configuration reaches: missed without a solve
     d, p = np.repeat(np.arange(D), seed.size), np.tile(seed, D)
     d, p = d[~far[d, p]], p[~far[d, p]]
     qj, cj, _, _, _ = ik_designs(batch, d, T[d, p], batch.q_ref[d], w, gtol=IK_GTOL)
