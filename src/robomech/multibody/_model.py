@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from robomech._validation import as_array, check_real
+from robomech._validation import MAX_MAGNITUDE, as_array, check_real
 
 from ._options import ASSEMBLED_RTOL, MIN_NORM, ROTATION_TOL  # noqa: F401 (ASSEMBLED_RTOL re-exported)
 
@@ -40,6 +40,17 @@ Vector = Sequence[float] | NDArray[np.float64]
 
 
 def _vec(x: object, n: int, name: str) -> tuple[float, ...]:
+    # the common case without an array: n real numbers (not bool), finite, |v| <= MAX_MAGNITUDE (what
+    # as_array accepts); anything else takes as_array's path and its errors
+    if (
+        type(x) in (tuple, list)
+        and len(x) == n  # type: ignore[arg-type]
+        and all(
+            isinstance(v, float | int) and not isinstance(v, bool) and abs(v) <= MAX_MAGNITUDE
+            for v in x  # type: ignore[attr-defined]
+        )
+    ):
+        return tuple(float(v) for v in x)  # type: ignore[attr-defined]
     a = as_array(x, name)
     if a.shape != (n,) or not np.all(np.isfinite(a)):
         raise ValueError(f"Expected {name} to be {n} finite real numbers, got {x!r}.")
