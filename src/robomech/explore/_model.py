@@ -535,11 +535,15 @@ IK_GTOL = 1e-3
 # Seeds of a task grid: every GRID_SEED_STRIDE-th cell per axis (the middle one of each block) is solved
 # from the reference configuration; the rest of the grid is reached from them (reach_grid).
 GRID_SEED_STRIDE = 4
-# A seed missed from the reference is left to the wavefront (solved from a reached neighbour like any
-# other cell), and no round follows the wavefront: a round re-solving each missed cell next to the
-# reached region from its first reached neighbour in 2 continuation stages recovered, on 256 Sobol
-# five-bar designs x 32 x 32 cells, only such seeds (27 cells); with the seeds left to the wavefront it
-# recovered none of 24,950 re-solves on 1,024 designs, at 14 % of the IK iterations.
+# Continuation stages of reach_grid's last round (each seed missed from the reference, next to the
+# reached region, re-solved from its first reached neighbour).  Measured on 64 Sobol five-bar designs x
+# 32 x 32 cells: with 2 (and with 4) every cell the annuli closed form puts inside (27,452, boundary cells
+# within 1e-6 m excluded) is reached and none outside; without this round 5 were missed.  The round
+# re-solves seeds only: on 256 designs every cell it recovered (27) was a seed, and re-solving the other
+# missed cells next to the reached region too recovered none of 24,950 on 1,024 designs, at 14 % of the
+# IK iterations.  A seed it recovers is no source for other cells (solved from a neighbour in the
+# wavefront instead, it would hand its assembly branch on: other dexterities in 2 of 1,024 designs).
+GRID_LAST_STEPS = 2
 
 
 def _grid_neighbours(n: int, k: int) -> np.ndarray:
@@ -646,12 +650,14 @@ def reach_grid(batch: Any, pts: np.ndarray, n: int, outputs: str) -> tuple[np.nd
     reference configuration (one batched IK); then, round after round, every cell not yet tried that
     has a reached neighbour (within ``RETRY_CELLS`` cells) is solved from that neighbour's configuration
     (the first such neighbour in a fixed order), all designs' cells of a round in one batched IK, until
-    no untried cell has a reached neighbour.  A seed missed from the reference counts as untried (it
-    is solved from a neighbour like any other cell).  A cell is reached if it is connected through
-    reached cells to a seed reached from the reference (the IK is a local solver: a region of the grid
-    not so connected is missed).  A cell out of reach costs an IK solve only if it borders the reached
-    region (a solve from the reference of every cell, as :func:`reach_designs`, spends most of its
-    iterations on the cells out of reach).
+    no untried cell has a reached neighbour; a last round re-solves each seed missed from the
+    reference that borders the reached region from its first reached neighbour in ``GRID_LAST_STEPS``
+    continuation stages.  A cell is reached if it is connected through reached cells to a seed reached
+    from the reference (the IK is a local solver: a region of the grid not so connected is missed).  A
+    cell out of reach costs an IK solve only if it borders the reached region (a solve from the
+    reference of every cell, as :func:`reach_designs`, spends most of its iterations on the cells out
+    of reach), and none if it lies outside one of the design's :func:`reach_bound` spheres (no
+    configuration the IK calls converged does).
     """
     from robomech.multibody._designs import ik_designs
 
@@ -671,7 +677,8 @@ def reach_grid(batch: Any, pts: np.ndarray, n: int, outputs: str) -> tuple[np.nd
     qj, cj, _, _, _ = ik_designs(batch, d, T[d, p], batch.q_ref[d], w, gtol=IK_GTOL)
     ok[d, p] = cj
     q[d[cj], p[cj]] = qj[cj]
-    tried = ok.copy()  # a seed missed from the reference is solved from a neighbour below
+    tried = np.zeros((D, P), bool)
+    tried[:, seed] = True
     nb = _grid_neighbours(n, k)
     while True:
         src = np.full((D, P), -1)
@@ -686,6 +693,21 @@ def reach_grid(batch: Any, pts: np.ndarray, n: int, outputs: str) -> tuple[np.nd
         if d.size == 0:
             continue
         qj, cj, _, _, _ = ik_designs(batch, d, T[d, p], q[d, src[d, p]], w, gtol=IK_GTOL)
+        ok[d, p] = cj
+        q[d[cj], p[cj]] = qj[cj]
+    # the last round: each seed missed from the reference, next to the reached region, once more from
+    # its first reached neighbour in GRID_LAST_STEPS continuation stages (not a source for others)
+    missed = np.zeros((D, P), bool)
+    missed[:, seed] = ~ok[:, seed] & ~far[:, seed]
+    src = np.full((D, P), -1)
+    for j in nb:
+        has = (j >= 0)[None, :] & ok[:, np.maximum(j, 0)] & missed & (src < 0)
+        src[has] = np.broadcast_to(j, (D, P))[has]
+    d, p = np.nonzero(src >= 0)
+    if d.size:
+        qj, cj, _, _, _ = ik_designs(
+            batch, d, T[d, p], q[d, src[d, p]], w, steps=GRID_LAST_STEPS, gtol=IK_GTOL
+        )
         ok[d, p] = cj
         q[d[cj], p[cj]] = qj[cj]
     return q, ok
