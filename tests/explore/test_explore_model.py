@@ -23,7 +23,7 @@ from robomech.explore import (
     optimize_nsga2,
     run_sweep,
 )
-from robomech.explore._model import dexterity, reach, task_grid
+from robomech.explore._model import dexterity, reach, reach_bound, task_grid
 
 MODEL = Path(__file__).resolve().parents[2] / "examples" / "models" / "five_bar.py"
 BOX = [[-0.5, 0.5], [-0.5, 0.5]]
@@ -480,3 +480,48 @@ def test_workspace_area_of_64_sobol_designs_equals_the_annuli_count(build):
         inside, margin = _in_annuli(pts[:, :2], L1, L2, B)
         n_edge = int(np.sum(margin <= EDGE))
         assert abs(round(area / h2) - inside.sum()) <= n_edge
+
+
+def test_reach_bound_is_each_legs_outer_circle_and_holds_every_configuration(build):
+    """The five-bar's reach spheres: the site's own chain gives the left leg's outer circle (centre
+    A_left, radius L1 + L2, closed form) and the closure the right leg's; random configurations (loops
+    open) stay inside the site's own sphere, closed ones (reached task points) inside every sphere."""
+    from robomech.multibody._designs import design_batch, site_poses_designs
+
+    rows = [(0.2, 0.15, 0.1), (0.15, 0.25, 0.05), (0.25, 0.2, 0.15)]
+    mechs = [build(L1=a, L2=b, B=c) for a, b, c in rows]
+    batch = design_batch(mechs, "tip")
+    centres, radii = reach_bound(batch)
+    rng = np.random.default_rng(3)
+    for i, (L1, L2, B) in enumerate(rows):
+        for side in (-1.0, 1.0):
+            hit = np.linalg.norm(centres[i] - [side * B / 2, 0.0, 0.0], axis=1) < 1e-12
+            assert np.any(hit & (np.abs(radii[i] - (L1 + L2)) < 1e-9))
+        q = rng.uniform(-np.pi, np.pi, (500, batch.q_ref.shape[1]))
+        p = site_poses_designs(batch, np.full(500, i), q)[:, :3, 3]
+        assert np.all(np.linalg.norm(p - centres[i, 0], axis=1) <= radii[i, 0] * (1 + 1e-12))
+        c = np.linspace(-0.5, 0.5, 12)
+        pts = np.stack(np.meshgrid(c, c, indexing="ij"), -1).reshape(-1, 2)
+        qc, ok = reach(mechs[i], "tip", np.column_stack([pts, np.zeros(len(pts))]), "xy")
+        assert ok.sum() > 10
+        p = site_poses_designs(batch, np.full(ok.sum(), i), qc[ok])[:, :3, 3]
+        assert np.all(np.linalg.norm(p[:, None, :] - centres[i][None], axis=-1) <= radii[i] * (1 + 1e-9))
+
+
+def test_reach_bound_of_a_free_base_chain_is_infinite_and_of_its_closures_finite():
+    """The Delta's platform (the site's body) is a free body: no bound from its own chain; each rod's
+    closure to it bounds it through the rod's ball, the arm's hinge and the base."""
+    import sys
+
+    from robomech.multibody._designs import design_batch
+
+    sys.path.insert(0, str(MODEL.parent))
+    import delta
+
+    centres, radii = reach_bound(design_batch([delta.build(arm=0.25, forearm=0.6, R=0.2, r=0.05)], "tcp"))
+    assert np.isinf(radii[0, 0]) and radii.shape[1] == 7  # the platform's chain; six rods' closures
+    # centre: the arm's hinge anchor at the base radius R; radius: hinge -> ball (arm, +-w), the rod,
+    # closure point -> tcp (r, +-w), closed form
+    w = delta.HALF_WIDTH
+    np.testing.assert_allclose(np.linalg.norm(centres[0, 1:], axis=1), 0.2, rtol=1e-12)
+    np.testing.assert_allclose(radii[0, 1:], np.hypot(0.25, w) + 0.6 + np.hypot(0.05, w), rtol=1e-9)

@@ -374,3 +374,14 @@ def test_quat_from_matrix_refuses_a_frame_that_is_not_a_rotation():
         _quat_from_matrix(skewed)
     with pytest.raises(ValueError, match="proper rotation"):
         _quat_from_matrix(np.diag([1.0, 1.0, -1.0]))
+
+
+@settings(max_examples=50, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 40), scale=st.floats(-30.0, 30.0))
+def test_tree_cross_product_equals_numpy_bit_for_bit(seed, n, scale):
+    """The kinematics' cross product (_tree._cross3) is np.cross's arithmetic: equal bit for bit."""
+    from robomech.multibody._tree import _cross3
+
+    rng = np.random.default_rng(seed)
+    a, b = rng.standard_normal((2, n, 3)) * 10.0**scale
+    assert np.array_equal(_cross3(a, b), np.cross(a, b))

@@ -528,18 +528,21 @@ IK_RETRY_STEPS = 4
 # (MINPACK's gtol test; a point out of reach, which would otherwise spend the iteration limit).  On
 # 8 random five-bar designs x 32 x 32 points it lost none of 3,498 reached points and cut the mean
 # iterations 39.5 -> 28.5 (3e-3 lost one); a reachable point it stops early is re-solved from a
-# reached neighbour (IK_RETRIES; reach_grid's last round).
+# reached neighbour (IK_RETRIES; reach_grid's wavefront).
 IK_GTOL = 1e-3
 
 
 # Seeds of a task grid: every GRID_SEED_STRIDE-th cell per axis (the middle one of each block) is solved
 # from the reference configuration; the rest of the grid is reached from them (reach_grid).
 GRID_SEED_STRIDE = 4
-# Continuation stages of reach_grid's last round (each missed cell next to the reached region re-solved
-# from a reached neighbour).  Measured on 64 Sobol five-bar designs x 32 x 32 cells: with 2 (and with
-# 4) every cell the annuli closed form puts inside (27,452, boundary cells within 1e-6 m excluded) is
-# reached and none outside; without this round 5 were missed.  2 stages cost 0.5 s of 1.6 s there, 4
-# stages 1.2 s of 2.3 s.
+# Continuation stages of reach_grid's last round (each seed missed from the reference, next to the
+# reached region, re-solved from its first reached neighbour).  Measured on 64 Sobol five-bar designs x
+# 32 x 32 cells: with 2 (and with 4) every cell the annuli closed form puts inside (27,452, boundary cells
+# within 1e-6 m excluded) is reached and none outside; without this round 5 were missed.  The round
+# re-solves seeds only: on 256 designs every cell it recovered (27) was a seed, and re-solving the other
+# missed cells next to the reached region too recovered none of 24,950 on 1,024 designs, at 14 % of the
+# IK iterations.  A seed it recovers is no source for other cells (solved from a neighbour in the
+# wavefront instead, it would hand its assembly branch on: other dexterities in 2 of 1,024 designs).
 GRID_LAST_STEPS = 2
 
 
@@ -559,6 +562,85 @@ def _grid_neighbours(n: int, k: int) -> np.ndarray:
     return np.array(out)
 
 
+# Slack of the reach bound's test (relative to the bound plus L): the rounding of the kinematics and of
+# the bound's own sums, far below any task cell.
+REACH_BOUND_RTOL = 1e-9
+
+
+def _chain_bound(batch: Any, body: int, point: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A sphere ``(centre (D, 3), radius (D,))`` that holds ``point (D, 3)`` (fixed in ``body``) at every
+    configuration: from ``body`` up to the world, each body has at most one joint, a hinge or a ball,
+    which rotates everything below it about its anchor (fixed in the parent's frame), so the point's
+    distance from the topmost anchor is at most the sum of the (rigid) distances from the point to its
+    body's anchor and from each anchor to the next one up (triangle inequality).  A slide, a free
+    joint or a body with several joints on the path: radius inf."""
+    t, g = batch.tables, batch.geometry
+    D = batch.n
+    P = point.copy()  # the current point, in the current body's frame
+    radius = np.zeros(D)
+    b = body
+    while b > 0:
+        js = range(int(t.j0[b]), int(t.j0[b + 1]))
+        if len(js) > 1 or (len(js) == 1 and t.jtype[js[0]] not in (0, 2)):  # hinge 0, ball 2
+            return np.zeros((D, 3)), np.full(D, np.inf)
+        if len(js) == 1:
+            a = g.jpos[:, js[0]]
+            radius += np.linalg.norm(P - a, axis=1)
+            P = a
+        P = np.einsum("dij,dj->di", g.T_off[:, b, :3, :3], P) + g.T_off[:, b, :3, 3]
+        b = int(t.parent[b])
+    return P, radius
+
+
+def reach_bound(batch: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Spheres ``(centres (D, S, 3), radii (D, S))`` per design (m), each holding the batch's site at
+    every configuration the IK can call converged (radius inf: no bound): the site's own chain
+    (:func:`_chain_bound`), and for each closure point pair with one point on the site's body, the other
+    point's chain plus the (rigid) distance from the site to this point and the closure tolerance
+    (a converged configuration closes each pair to ``CONVERGED_RTOL * L`` per row)."""
+    from robomech.multibody._options import CONVERGED_RTOL
+
+    t, g = batch.tables, batch.geometry
+    sb = batch.site_body
+    site = batch.T_site[:, :3, 3]
+    centres, radii = [], []
+    c, r = _chain_bound(batch, sb, site)
+    centres.append(c)
+    radii.append(r)
+    for i in range(t.pp.shape[0]):
+        for this, other in ((0, 1), (1, 0)):
+            if int(t.pp[i, this]) != sb:
+                continue
+            c, r = _chain_bound(batch, int(t.pp[i, other]), g.px[:, i, other])
+            r = (
+                r
+                + np.linalg.norm(site - g.px[:, i, this], axis=1)
+                + np.sqrt(3) * CONVERGED_RTOL * batch.length
+            )
+            centres.append(c)
+            radii.append(r)
+    return np.stack(centres, 1), np.stack(radii, 1)
+
+
+def _out_of_reach(batch: Any, pts: np.ndarray, outputs: str) -> np.ndarray:
+    """Which targets ``pts (D, P, 3)`` (design ``d`` of the batch in row ``d``) are farther along
+    ``outputs`` from one of the design's :func:`reach_bound` spheres than the IK's convergence
+    tolerance: no configuration converges there ``(D, P)``."""
+    from robomech.multibody._options import CONVERGED_RTOL
+
+    centres, radii = reach_bound(batch)
+    ax = [AXES.index(a) for a in outputs]
+    L = batch.length[:, None]
+    reach = radii + np.sqrt(len(ax)) * CONVERGED_RTOL * L + REACH_BOUND_RTOL * (radii + L)  # (D, S)
+    far = np.zeros(pts.shape[:2], bool)
+    for s in range(radii.shape[1]):
+        d2 = np.zeros(pts.shape[:2])
+        for a in ax:
+            d2 += (pts[:, :, a] - centres[:, s, a][:, None]) ** 2
+        far |= np.sqrt(d2) > reach[:, s][:, None]
+    return far
+
+
 def reach_grid(batch: Any, pts: np.ndarray, n: int, outputs: str) -> tuple[np.ndarray, np.ndarray]:
     """Configurations ``q (D, n**k, nq)`` placing the batch's site at each design's task-grid points
     ``pts (D, n**k, 3)`` (``task_grid`` order, ``n`` cells per axis) along ``outputs``, and which
@@ -568,12 +650,14 @@ def reach_grid(batch: Any, pts: np.ndarray, n: int, outputs: str) -> tuple[np.nd
     reference configuration (one batched IK); then, round after round, every cell not yet tried that
     has a reached neighbour (within ``RETRY_CELLS`` cells) is solved from that neighbour's configuration
     (the first such neighbour in a fixed order), all designs' cells of a round in one batched IK, until
-    no untried cell has a reached neighbour; a last round re-solves every missed cell next to the reached
-    region from its first reached neighbour in ``GRID_LAST_STEPS`` continuation stages.  A cell is
-    reached if it is connected through reached cells to a seed reached from the reference (the IK is a
-    local solver: a region of the grid not so connected is missed).  A cell out of reach costs one or
-    two IK solves only if it borders the reached region (a solve from the reference of every cell, as
-    :func:`reach_designs`, spends most of its iterations on the cells out of reach).
+    no untried cell has a reached neighbour; a last round re-solves each seed missed from the
+    reference that borders the reached region from its first reached neighbour in ``GRID_LAST_STEPS``
+    continuation stages.  A cell is reached if it is connected through reached cells to a seed reached
+    from the reference (the IK is a local solver: a region of the grid not so connected is missed).  A
+    cell out of reach costs an IK solve only if it borders the reached region (a solve from the
+    reference of every cell, as :func:`reach_designs`, spends most of its iterations on the cells out
+    of reach), and none if it lies outside one of the design's :func:`reach_bound` spheres (no
+    configuration the IK calls converged does).
     """
     from robomech.multibody._designs import ik_designs
 
@@ -583,37 +667,49 @@ def reach_grid(batch: Any, pts: np.ndarray, n: int, outputs: str) -> tuple[np.nd
     T = _targets(pts.reshape(-1, 3)).reshape(D, P, 4, 4)
     q = np.full((D, P, batch.q_ref.shape[1]), np.nan)
     ok = np.zeros((D, P), bool)
-    tried = np.zeros((D, P), bool)
     cells = np.indices((n,) * k).reshape(k, -1).T
     seed = np.flatnonzero(np.all(cells % GRID_SEED_STRIDE == GRID_SEED_STRIDE // 2, axis=1))
     if seed.size == 0:  # a grid smaller than one stride: its middle cell
         seed = np.array([int(np.ravel_multi_index((n // 2,) * k, (n,) * k))])
+    far = _out_of_reach(batch, pts, outputs)  # targets no configuration reaches: missed without a solve
     d, p = np.repeat(np.arange(D), seed.size), np.tile(seed, D)
-    guess = batch.q_ref[d]
-    steps = 1
+    d, p = d[~far[d, p]], p[~far[d, p]]
+    qj, cj, _, _, _ = ik_designs(batch, d, T[d, p], batch.q_ref[d], w, gtol=IK_GTOL)
+    ok[d, p] = cj
+    q[d[cj], p[cj]] = qj[cj]
+    tried = np.zeros((D, P), bool)
+    tried[:, seed] = True
     nb = _grid_neighbours(n, k)
-    last = False
     while True:
-        qj, cj, _, _, _ = ik_designs(batch, d, T[d, p], guess, w, steps=steps, gtol=IK_GTOL)
-        tried[d, p] = True
-        ok[d, p] = cj
-        q[d[cj], p[cj]] = qj[cj]
-        if last:
-            break
         src = np.full((D, P), -1)
         for j in nb:  # the first reached neighbour of each untried cell, in the offsets' order
             has = (j >= 0)[None, :] & ok[:, np.maximum(j, 0)] & ~tried & (src < 0)
             src[has] = np.broadcast_to(j, (D, P))[has]
-        steps = 1
-        if not np.any(src >= 0):  # the last round: each missed cell next to the reached region once more
-            last, steps = True, GRID_LAST_STEPS
-            for j in nb:
-                has = (j >= 0)[None, :] & ok[:, np.maximum(j, 0)] & ~ok & (src < 0)
-                src[has] = np.broadcast_to(j, (D, P))[has]
         d, p = np.nonzero(src >= 0)
         if d.size == 0:
             break
-        guess = q[d, src[d, p]]
+        tried[d, p] = True
+        d, p = d[~far[d, p]], p[~far[d, p]]
+        if d.size == 0:
+            continue
+        qj, cj, _, _, _ = ik_designs(batch, d, T[d, p], q[d, src[d, p]], w, gtol=IK_GTOL)
+        ok[d, p] = cj
+        q[d[cj], p[cj]] = qj[cj]
+    # the last round: each seed missed from the reference, next to the reached region, once more from
+    # its first reached neighbour in GRID_LAST_STEPS continuation stages (not a source for others)
+    missed = np.zeros((D, P), bool)
+    missed[:, seed] = ~ok[:, seed] & ~far[:, seed]
+    src = np.full((D, P), -1)
+    for j in nb:
+        has = (j >= 0)[None, :] & ok[:, np.maximum(j, 0)] & missed & (src < 0)
+        src[has] = np.broadcast_to(j, (D, P))[has]
+    d, p = np.nonzero(src >= 0)
+    if d.size:
+        qj, cj, _, _, _ = ik_designs(
+            batch, d, T[d, p], q[d, src[d, p]], w, steps=GRID_LAST_STEPS, gtol=IK_GTOL
+        )
+        ok[d, p] = cj
+        q[d[cj], p[cj]] = qj[cj]
     return q, ok
 
 

@@ -266,8 +266,8 @@ def _tables(tree: Tree, cs: Constraints) -> Tables:
     )
 
 
-def _compile(mech: Mechanism) -> Model:
-    tree = compile_tree(mech)
+def _compile(mech: Mechanism, tree: Tree | None = None) -> Model:
+    tree = compile_tree(mech) if tree is None else tree
     cs = compile_constraints(mech, tree)
     act = tree.act_dof.astype(np.int64)
     pas = np.setdiff1d(np.arange(tree.nv), act).astype(np.int64)
@@ -351,8 +351,10 @@ def _drop(key: int) -> None:
     _MODELS.pop(key, None)
 
 
-def compile_model(mech: Mechanism) -> Model:
-    """The compiled model of ``mech`` (built on first use, then returned from the table)."""
+def compile_model(mech: Mechanism, *, _tree: Tree | None = None) -> Model:
+    """The compiled model of ``mech`` (built on first use, then returned from the table).  ``_tree``:
+    its already compiled tree (``compile_tree`` of a description with the same bodies, sites, actuation
+    and characteristic length: the tree depends on nothing else), which the first use then reuses."""
     hit = _MODELS.get(id(mech))
     if hit is not None and hit[0]() is mech:
         return hit[1]
@@ -360,7 +362,7 @@ def compile_model(mech: Mechanism) -> Model:
         hit = _MODELS.get(id(mech))
         if hit is not None and hit[0]() is mech:
             return hit[1]
-        model = _compile(mech)
+        model = _compile(mech, _tree)
         key = id(mech)
         def _release(_ref: object, key: int = key) -> None:
             _drop(key)

@@ -339,8 +339,12 @@ def measures_block(
                 Jr[i, j] = J[rows[i], j] * colscale[d, j]
         dex = np.nan
         if want & 1 and nr > 0 and na > 0 and np.all(np.isfinite(Jr)):
-            s = np.linalg.svd(Jr, full_matrices=False)[1]
-            dex = s[s.shape[0] - 1] / s[0] if s[0] > 0 else 0.0
+            if min(nr, na) <= 2:
+                smax, smin = _sv_small(Jr)
+                dex = smin / smax if smax > 0 else 0.0
+            else:
+                s = np.linalg.svd(Jr, full_matrices=False)[1]
+                dex = s[s.shape[0] - 1] / s[0] if s[0] > 0 else 0.0
         out[n, 0] = dex
         for i in range(m):
             for j in range(nv):
@@ -361,8 +365,80 @@ def _kth(X, k, L):  # pragma: no cover - compiled
         return 0.0
     if not np.all(np.isfinite(X)):
         return np.nan
+    if min(X.shape[0], X.shape[1]) <= 2:
+        if k > min(X.shape[0], X.shape[1]):
+            return 0.0
+        smax, smin = _sv_small(X)
+        return smax if k == 1 else smin
     s = np.linalg.svd(np.ascontiguousarray(X), full_matrices=False)[1]
     return s[k - 1] if s.shape[0] >= k else 0.0
+
+
+@_nj
+def _sv_small(X):  # pragma: no cover - compiled
+    """``(sigma_max, sigma_min)`` of a finite matrix ``X`` with at most two columns or two rows (one of
+    them: ``sigma_min`` is its only singular value), without LAPACK's allocations: the two columns
+    (or rows) reduced to the triangle ``[[a, b], [0, c]]`` (``a`` the first's norm, ``b`` and ``c`` the
+    second's components along and across it, re-orthogonalized once), whose singular values
+    :func:`_sv_triangle` takes.  The reduction is orthogonal to rounding, so the values differ from an
+    SVD's by a few ulps of ``sigma_max`` (as LAPACK's own backward error)."""
+    rows = X.shape[1] > 2  # two rows: the singular values of the transpose
+    n = X.shape[1] if rows else X.shape[0]
+    k = X.shape[0] if rows else X.shape[1]
+    a = 0.0
+    for i in range(n):
+        x = X[0, i] if rows else X[i, 0]
+        a += x * x
+    a = np.sqrt(a)
+    if k == 1:
+        return a, a
+    u = np.empty(n)
+    for i in range(n):
+        u[i] = X[1, i] if rows else X[i, 1]
+    if a == 0.0:
+        c = 0.0
+        for i in range(n):
+            c += u[i] * u[i]
+        return np.sqrt(c), 0.0
+    b = 0.0
+    for _ in range(2):  # Gram-Schmidt twice: orthogonal to rounding
+        p = 0.0
+        for i in range(n):
+            p += (X[0, i] if rows else X[i, 0]) * u[i]
+        p /= a
+        for i in range(n):
+            u[i] -= p * (X[0, i] if rows else X[i, 0]) / a
+        b += p
+    c = 0.0
+    for i in range(n):
+        c += u[i] * u[i]
+    return _sv_triangle(a, b, np.sqrt(c))
+
+
+@_nj
+def _sv_triangle(f, g, h):  # pragma: no cover - compiled
+    """``(sigma_max, sigma_min)`` of the triangle ``[[f, g], [0, h]]`` to high relative accuracy
+    (LAPACK's ``dlas2``)."""
+    fa, ga, ha = abs(f), abs(g), abs(h)
+    fhmn, fhmx = min(fa, ha), max(fa, ha)
+    if fhmn == 0.0:
+        if fhmx == 0.0:
+            return ga, 0.0
+        big, small = max(fhmx, ga), min(fhmx, ga)
+        return big * np.sqrt(1.0 + (small / big) ** 2), 0.0
+    if ga < fhmx:
+        as_ = 1.0 + fhmn / fhmx
+        at = (fhmx - fhmn) / fhmx
+        au = (ga / fhmx) ** 2
+        c = 2.0 / (np.sqrt(as_ * as_ + au) + np.sqrt(at * at + au))
+        return fhmx / c, fhmn * c
+    au = fhmx / ga
+    if au == 0.0:
+        return ga, (fhmn * fhmx) / ga
+    as_ = 1.0 + fhmn / fhmx
+    at = (fhmx - fhmn) / fhmx
+    c = 1.0 / (np.sqrt(1.0 + (as_ * au) ** 2) + np.sqrt(1.0 + (at * au) ** 2))
+    return ga / (c + c), 2.0 * (fhmn * c) * au
 
 
 @numba.njit(cache=True, error_model="numpy", parallel=True)

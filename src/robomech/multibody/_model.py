@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from robomech._validation import as_array, check_real
+from robomech._validation import MAX_MAGNITUDE, as_array, check_real
 
 from ._options import ASSEMBLED_RTOL, MIN_NORM, ROTATION_TOL  # noqa: F401 (ASSEMBLED_RTOL re-exported)
 
@@ -40,6 +40,17 @@ Vector = Sequence[float] | NDArray[np.float64]
 
 
 def _vec(x: object, n: int, name: str) -> tuple[float, ...]:
+    # the common case without an array: n real numbers (not bool), finite, |v| <= MAX_MAGNITUDE (what
+    # as_array accepts); anything else takes as_array's path and its errors
+    if (
+        type(x) in (tuple, list)
+        and len(x) == n  # type: ignore[arg-type]
+        and all(
+            isinstance(v, float | int) and not isinstance(v, bool) and abs(v) <= MAX_MAGNITUDE
+            for v in x  # type: ignore[attr-defined]
+        )
+    ):
+        return tuple(float(v) for v in x)  # type: ignore[attr-defined]
     a = as_array(x, name)
     if a.shape != (n,) or not np.all(np.isfinite(a)):
         raise ValueError(f"Expected {name} to be {n} finite real numbers, got {x!r}.")
@@ -744,12 +755,18 @@ class Builder:
             self.gravity,
             self.name,
         )
-        from ._tree import body_poses
+        # Its tree and assembled reference only (the compile step's q_ref), not its whole compiled model:
+        # the mechanism is compiled once, below.
+        from ._constraints import compile_constraints
+        from ._reference import assembled_reference
+        from ._tree import body_poses, compile_tree
 
-        T0 = body_poses(tree_only.tree, tree_only.q0[None])[0]
+        tree0 = compile_tree(tree_only)
+        q_ref0 = assembled_reference(tree_only, tree0, compile_constraints(tree_only, tree0))
+        T0 = body_poses(tree0, q_ref0[None])[0]
 
         def pose(body: str) -> np.ndarray:
-            return T0[tree_only.tree.body_index(body)]
+            return T0[tree0.body_index(body)]
 
         closures = []
         for kind, name, b1, b2, a, other, axis in self._closures:
@@ -786,7 +803,11 @@ class Builder:
             self.gravity,
             self.name,
         )
-        mech.q0  # noqa: B018 - assemble the reference now: a description that cannot assemble raises here
+        from ._compile import compile_model
+
+        # assemble the reference now (a description that cannot assemble raises here), on the tree
+        # compiled above: the closures are not part of the tree
+        compile_model(mech, _tree=tree0)
         return mech
 
 

@@ -299,6 +299,16 @@ class TreeState:
     S: np.ndarray
 
 
+def _cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.cross`` of ``(N, 3)`` arrays, the same products and differences in the same order (so the
+    same bits) without its axis handling, which dominated the kinematics of a single configuration."""
+    out = np.empty(a.shape)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
+
+
 def _kin(tree: Tree, q: np.ndarray, screws: bool) -> TreeState:
     N = q.shape[0]
     nb = len(tree.body_names)
@@ -327,12 +337,12 @@ def _kin(tree: Tree, q: np.ndarray, screws: bool) -> TreeState:
                     if typ == 0:
                         w = R @ axis
                         S[:, da, :3] = w
-                        S[:, da, 3:] = np.cross(anchor, w)
+                        S[:, da, 3:] = _cross3(anchor, w)
                     else:
                         for c in range(3):
                             w = Rn[:, :, c]
                             S[:, da + c, :3] = w
-                            S[:, da + c, 3:] = np.cross(anchor, w)
+                            S[:, da + c, 3:] = _cross3(anchor, w)
             elif typ == 1:
                 w = R @ axis
                 Tb = Tb.copy()
@@ -349,7 +359,7 @@ def _kin(tree: Tree, q: np.ndarray, screws: bool) -> TreeState:
                         S[:, da + c, 3 + c] = 1.0
                         w = Rn[:, :, c]
                         S[:, da + 3 + c, :3] = w
-                        S[:, da + 3 + c, 3:] = np.cross(q[:, qa : qa + 3], w)
+                        S[:, da + 3 + c, 3:] = _cross3(q[:, qa : qa + 3], w)
         T[:, b] = Tb
     return TreeState(T=T, S=S)
 
