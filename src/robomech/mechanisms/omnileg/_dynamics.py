@@ -326,10 +326,8 @@ def inverse_dynamics(
     ----------
     leg : OmniLeg
     q, qd, qdd : array_like, shape (..., 3)
-        Joint coordinates (rad), rates (rad/s) and accelerations (rad/s²); broadcast together.
     foot_force : array_like, shape (..., 3), optional
-        Force applied *to* the foot (N, hip frame; ``FOOT_FORCE_CONVENTION``): it enters as ``-Jᵀ F``.
-        Paper 2, eqs. (49)-(50) add ``+Jᵀ F_f``: pass ``-F_f``.
+        Force applied *to* the foot (N, hip frame; ``FOOT_FORCE_CONVENTION``: paper 2's ``F_f`` is -F).
     paper_as_printed : bool, optional
         Use paper 2's simplified Cardan drive (eqs. (26)-(31)) instead of the exact one, for comparison.
 
