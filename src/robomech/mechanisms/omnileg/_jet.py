@@ -46,25 +46,10 @@ class Jet:
     def __neg__(self) -> Jet:
         return Jet(-self.v, -self.vd, -self.vdd, -self.g)
 
-    def __sub__(self, o: Jet | Array | float) -> Jet:
-        return self + (-o)
-
-    def __rsub__(self, o: Array | float) -> Jet:
-        return (-self) + o
-
     def __mul__(self, o: Jet | Array | float) -> Jet:
         return bilinear(self, o, np.multiply)
 
     __rmul__ = __mul__
-
-    def __truediv__(self, o: Jet | Array | float) -> Jet:
-        if isinstance(o, Jet):
-            return self * reciprocal(o)
-        return self * (1.0 / np.asarray(o, dtype=float))
-
-    def __getitem__(self, idx: int) -> Jet:
-        """Component ``idx`` of the last value axis."""
-        return Jet(self.v[..., idx], self.vd[..., idx], self.vdd[..., idx], self.g[..., idx])
 
     def expand(self) -> Jet:
         """Add a trailing value axis (a per-sample scalar that multiplies a vector)."""

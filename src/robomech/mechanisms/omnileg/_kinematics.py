@@ -259,12 +259,11 @@ def within_limits(leg: OmniLeg, q: object) -> np.ndarray:
     ----------
     leg : OmniLeg
     q : array_like, shape (..., 3)
-        Non-finite samples give False.
 
     Returns
     -------
     ndarray of bool, shape (...)
-        Inclusive, up to ``LIMIT_SLACK``.
+        Inclusive, up to ``LIMIT_SLACK``; False for non-finite samples.
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,), finite=False)

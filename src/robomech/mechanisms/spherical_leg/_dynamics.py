@@ -493,8 +493,7 @@ def inverse_dynamics(
 def _forces(
     leg: SphericalLeg, m: _Motion, w: np.ndarray | None, driven_legs: tuple[int, int] | None
 ) -> InverseDynamicsResult:
-    """:func:`inverse_dynamics` of the motion ``m`` (unvalidated; ``leg`` may carry per-design arrays that
-    broadcast against the motion, as :func:`_motion` takes them)."""
+    """:func:`inverse_dynamics` of the motion ``m`` (unvalidated; ``leg`` as :func:`_motion` takes it)."""
     tau = _generalized(leg, m, w)
     dist = distribute_forces(m.Jl, tau, driven_legs)
     valid = dist.valid & ~m.lock

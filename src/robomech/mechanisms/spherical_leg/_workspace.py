@@ -89,9 +89,8 @@ def _map(leg: SphericalLeg, L: np.ndarray, J: np.ndarray, sm: SingularityMap | N
 
 
 def _map_closed_form(leg: SphericalLeg, alpha: np.ndarray, beta: np.ndarray) -> WorkspaceMap:
-    """:func:`workspace_map` at the poses ``alpha``, ``beta`` (rad, unvalidated) with J's singular values
-    in closed form (:func:`_singular_values`); ``leg`` may carry per-design arrays that broadcast against
-    the poses (a design study's legs: fields ``(D, P, ...)``)."""
+    """:func:`workspace_map` at poses ``alpha``, ``beta`` (rad, unvalidated) by :func:`_singular_values`;
+    ``leg`` may carry per-design arrays broadcasting against the poses (a design study's legs)."""
     (sa, ca), (sb, cb) = sincos(alpha), sincos(beta)
     L = np.stack(_squared_length_columns(leg, sa, ca, sb, cb), -1)
     np.sqrt(np.maximum(L, 0.0, out=L), out=L)
@@ -103,15 +102,12 @@ def _map_closed_form(leg: SphericalLeg, alpha: np.ndarray, beta: np.ndarray) -> 
 
 
 def _singular_values(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(sigma_max, sigma_min) of leg Jacobians ``J (..., 3, 2)`` in closed form, to a few ulps each.
-
-    Legs 1 and 2 do not move with alpha (``J[..., 0:2, 0] = 0``), so turning rows 0 and 1 into
-    ``(0, hypot(J01, J11))`` and ``(0, 0)`` (an orthogonal transform: the same singular values) leaves
-    the upper triangular ``[[f, g], [0, h]] = [[J20, J21], [0, hypot(J01, J11)]]``, whose singular values
-    are LAPACK's ``dlas2`` (Demmel and Kahan's formula, high relative accuracy for both; LAPACK's SVD of
-    J, in :func:`~robomech.analysis.workspace.singularity_map`, is accurate to rounding of sigma_max in
-    each).  ~25x faster than that SVD on 3x2 matrices, the study's dominant cost.
-    """
+    """(sigma_max, sigma_min) of leg Jacobians ``J (..., 3, 2)`` in closed form, to a few ulps each: legs 1
+    and 2 do not move with alpha (``J[..., 0:2, 0] = 0``), so an orthogonal transform of rows 0, 1 leaves
+    ``[[f, g], [0, h]] = [[J20, J21], [0, hypot(J01, J11)]]`` with the same singular values, LAPACK's
+    ``dlas2``'s (Demmel and Kahan's formula, high relative accuracy for both; the SVD of
+    :func:`~robomech.analysis.workspace.singularity_map` is accurate to rounding of sigma_max in each).
+    ~25x faster than that SVD on 3x2 matrices, the study's dominant cost."""
     fa, ga, ha = np.abs(J[..., 2, 0]), np.abs(J[..., 2, 1]), np.hypot(J[..., 0, 1], J[..., 1, 1])
     fhmn, fhmx = np.minimum(fa, ha), np.maximum(fa, ha)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
