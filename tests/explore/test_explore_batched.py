@@ -18,8 +18,7 @@ from robomech.explore import _vectored_thrust as vts
 from robomech.mechanisms import omnileg as ol
 from robomech.mechanisms import spherical_leg as sl
 from robomech.mechanisms import vectored_thrust as vt
-from robomech.mechanisms.omnileg import _designs as old
-from robomech.mechanisms.spherical_leg import _designs as sld
+from robomech.mechanisms.spherical_leg._workspace import _singular_values
 
 # The spherical leg's batched map takes J's singular values in closed form (to a few ulps of each),
 # the per-design map from LAPACK's SVD (to rounding of sigma_max in each): the dexterity
@@ -156,7 +155,7 @@ def test_spherical_leg_design_blocks_change_no_bit(monkeypatch, block):
 
 def test_spherical_leg_designs_carry_each_legs_derived_geometry():
     legs = [dataclasses.replace(sl.SphericalLeg.paper(), R=R, r=r) for R, r in [(0.06, 0.03), (0.09, 0.04)]]
-    d = sld.designs(legs)
+    d = sls.Legs.of(legs)
     for i, leg in enumerate(legs):
         for name in ("base_points", "platform_points_home", "cardan_axes"):
             np.testing.assert_array_equal(getattr(d, name)[i, 0], getattr(leg, name))
@@ -197,7 +196,7 @@ def test_spherical_leg_closed_form_singular_values_are_lapacks_and_relatively_ac
     J[:1000, 2, 0] *= 10.0 ** rng.uniform(-12, -2, 1000)  # near the actuation singularity
     J[1000:2000, :2, 1] *= 10.0 ** rng.uniform(-12, -2, (1000, 1))  # beta nearly uncontrolled
     J[2000, 2, 0] = 0.0  # rank 1
-    smax, smin = sld._singular_values(J)
+    smax, smin = _singular_values(J)
     s = np.linalg.svd(J, compute_uv=False)
     np.testing.assert_allclose(smax, s[:, 0], rtol=4e-15)
     assert np.all(np.abs(smin - s[:, 1]) <= 4e-15 * s[:, 0])  # LAPACK: to rounding of sigma_max
@@ -208,17 +207,13 @@ def test_spherical_leg_closed_form_singular_values_are_lapacks_and_relatively_ac
 
 
 def _omnileg_designs(legs):
-    return old.designs(legs, 1)  # one sample per design: row i is design i
-
-
-def _spherical_leg_designs(legs):
-    return sld.designs(legs)
+    return om.Legs.of(legs, 1)  # one sample per design: row i is design i
 
 
 @pytest.mark.parametrize(
     "make, designs, changed",
     [
-        (sl.SphericalLeg.paper, _spherical_leg_designs, {"R": 0.06, "r": 0.04, "h": 0.12}),
+        (sl.SphericalLeg.paper, sls.Legs.of, {"R": 0.06, "r": 0.04, "h": 0.12}),
         (ol.OmniLeg.paper, _omnileg_designs, {"L1": 0.12, "L4": 0.07, "L5": 0.15}),
     ],
 )

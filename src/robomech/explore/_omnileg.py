@@ -22,13 +22,15 @@ parameter object): the torques use each design's own link inertias
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from robomech.mechanisms import omnileg as ol
-from robomech.mechanisms.omnileg import _designs as old
+from robomech.mechanisms.omnileg._dynamics import _terms
 
-from ._study import DesignStudy, Metric, Objective, Variable
+from ._study import DesignArrays, DesignStudy, Metric, Objective, Variable, design_blocks
 
 __all__ = ["STUDY", "simpson_weights"]
 
@@ -44,6 +46,46 @@ EQ52_STEP = 0.05
 # which Dask's nanny sets: every temporary above 128 kB is mapped and unmapped): 0.50 s of CPU in
 # blocks of 1, 0.27 in blocks of 16-32, 0.37 in one block of 64.
 DESIGN_BLOCK = 16
+# The fields a dynamics call takes per design; legs that differ in any other field are grouped apart.
+DESIGN_FIELDS = ("L1", "L4", "L5", "bodies")
+
+
+class _Bodies(NamedTuple):
+    """One body kind per sample."""
+
+    mass: np.ndarray  # (N,)
+    com_vector: np.ndarray  # (N, 3)
+    inertia_matrix: np.ndarray  # (N, 3, 3)
+
+
+@dataclass(frozen=True)
+class Legs(DesignArrays):
+    """Legs equal but for :data:`DESIGN_FIELDS` on ``samples`` poses each, those fields per sample
+    (design-major, N = designs x samples: lengths ``(N, 1)``, masses ``(N,)``, centres of mass ``(N, 3)``,
+    inertias ``(N, 3, 3)``).  ``_dynamics._terms`` multiplies the inertias per sample here (one BLAS
+    product for a single leg): the same products, possibly summed in another order."""
+
+    L1: np.ndarray
+    L4: np.ndarray
+    L5: np.ndarray
+    bodies: dict[str, _Bodies]
+
+    @classmethod
+    def of(cls, legs: list[ol.OmniLeg], samples: int) -> Legs:
+        def rep(values: list[Any]) -> np.ndarray:
+            return np.repeat(np.asarray(values, dtype=float), samples, axis=0)
+
+        bodies = {
+            k: _Bodies(*(rep([getattr(g.bodies[k], a) for g in legs]) for a in _Bodies._fields))
+            for k in legs[0].bodies
+        }
+        L1, L4, L5 = (rep([getattr(g, f) for g in legs])[:, None] for f in DESIGN_FIELDS[:3])
+        return cls(tuple(legs), L1, L4, L5, bodies)
+
+    @property
+    def foot_drop(self) -> np.ndarray:
+        """:attr:`OmniLeg.foot_drop` per sample, (N, 1) (m)."""
+        return self.L5 - self.designs[0].knee_to_crank
 
 
 def simpson_weights(lo: float, hi: float, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -71,20 +113,20 @@ def evaluate(study: DesignStudy, params: list, rows: np.ndarray, seed) -> dict[s
     out = {m.name: np.full((n, *m.shape), np.nan) for m in study.metrics}
     t = np.arange(0.0, 6.0 + 1e-9, EQ52_STEP)
     motion = ol.joint_trajectory_eq52(t)
-    good = np.flatnonzero([p is not None for p in params])
     # legs that differ only in L1, L4, L5 (and the bodies derived from them) share one dynamics call
-    for grp in old.group_legs([params[i] for i in good]):
-        for s in range(0, grp.size, DESIGN_BLOCK):
-            idx = good[grp[s : s + DESIGN_BLOCK]]
-            legs = [params[i] for i in idx]
-            for i, leg in zip(idx, legs, strict=True):
-                q, w = _grid(leg)
-                det = np.abs(np.linalg.det(ol.jacobian(leg, q)))
-                out["workspace_volume"][i] = np.dot(w, det)
-                out["min_abs_det_j"][i] = det.min()
-            peaks = np.abs(old.inverse_dynamics_designs(legs, motion.q, motion.qd, motion.qdd)).max(axis=1)
-            out["peak_torque_joint"][idx] = peaks
-            out["peak_torque"][idx] = peaks.max(axis=1)
+    for idx in design_blocks(params, DESIGN_FIELDS, DESIGN_BLOCK):
+        legs = [params[i] for i in idx]
+        for i, leg in zip(idx, legs, strict=True):
+            q, w = _grid(leg)
+            det = np.abs(np.linalg.det(ol.jacobian(leg, q)))
+            out["workspace_volume"][i] = np.dot(w, det)
+            out["min_abs_det_j"][i] = det.min()
+        D, T = len(legs), motion.q.shape[0]
+        qs = (np.tile(x, (D, 1)) for x in (motion.q, motion.qd, motion.qdd))
+        terms = _terms(Legs.of(legs, T), *qs)  # type: ignore[arg-type]
+        peaks = np.abs((terms.tau_motion + terms.tau_gravity).reshape(D, T, 3)).max(axis=1)
+        out["peak_torque_joint"][idx] = peaks
+        out["peak_torque"][idx] = peaks.max(axis=1)
     return out
 
 

@@ -13,14 +13,17 @@ Metrics per design (defined in ``docs/explore.md``):
 
 from __future__ import annotations
 
+import functools
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from robomech.mechanisms import spherical_leg as sl
-from robomech.mechanisms.spherical_leg import _designs as sld
+from robomech.mechanisms.spherical_leg._dynamics import _forces, _motion
+from robomech.mechanisms.spherical_leg._workspace import _map_closed_form
 
-from ._study import DesignStudy, Metric, Objective, Variable
+from ._study import DesignArrays, DesignStudy, Metric, Objective, Variable, design_blocks
 
 __all__ = ["STUDY"]
 
@@ -38,6 +41,39 @@ FIG5B_STEP = 0.1
 # (0.71 s in blocks of 8 without that setting). The block size changes no bit (every operation is per
 # design and pose; tested).
 DESIGN_BLOCK = 8
+# The fields a kernel call takes per design; legs that differ in any other field are grouped apart.
+DESIGN_FIELDS = ("R", "r", "h")
+
+
+@dataclass(frozen=True)
+class Legs(DesignArrays):
+    """Legs equal but for R, r, h: those three as arrays ``(D, 1)`` (m; ``h`` ``(D, 1, 1)`` for the
+    dynamics, whose platform centre ``h Rp e_z`` is ``(D, T, 3)``), the points and axes derived from them
+    ``(D, 1, 3, 3)`` (computed when a kernel first reads them)."""
+
+    R: np.ndarray
+    r: np.ndarray
+    h: np.ndarray
+
+    @classmethod
+    def of(cls, legs: list[sl.SphericalLeg], h_axes: int = 1) -> Legs:
+        R, r, h = (np.array([getattr(g, f) for g in legs], dtype=float) for f in DESIGN_FIELDS)
+        return cls(tuple(legs), R[:, None], r[:, None], h.reshape(-1, *(1,) * h_axes))
+
+    def _per_design(self, name: str) -> np.ndarray:
+        return np.stack([getattr(g, name) for g in self.designs])[:, None]
+
+    @functools.cached_property
+    def base_points(self) -> np.ndarray:
+        return self._per_design("base_points")
+
+    @functools.cached_property
+    def platform_points_home(self) -> np.ndarray:
+        return self._per_design("platform_points_home")
+
+    @functools.cached_property
+    def cardan_axes(self) -> np.ndarray:
+        return self._per_design("cardan_axes")
 
 
 def _task_grid() -> tuple[np.ndarray, np.ndarray]:
@@ -56,12 +92,9 @@ def evaluate(study: DesignStudy, params: list, rows: np.ndarray, seed) -> dict[s
     out = {m.name: np.full(n, np.nan) for m in study.metrics}
     for k in ("has_workspace", "fig5b_ok"):
         out[k] = np.zeros(n, dtype=bool)
-    good = np.flatnonzero([p is not None for p in params])
     # legs that differ only in R, r, h share one kernel call (any other varied field: one group each)
-    for grp in sld.group_legs([params[i] for i in good]):
-        for s in range(0, grp.size, DESIGN_BLOCK):
-            idx = good[grp[s : s + DESIGN_BLOCK]]
-            _block(out, [params[i] for i in idx], idx)
+    for idx in design_blocks(params, DESIGN_FIELDS, DESIGN_BLOCK):
+        _block(out, [params[i] for i in idx], idx)
     return out
 
 
@@ -71,9 +104,8 @@ def _block(out: dict[str, np.ndarray], legs: list[sl.SphericalLeg], idx: np.ndar
     q, qd, qdd = _fig5b()
     # the task grid and the Fig. 5(b) path in one map (the map is per pose, so this changes no bit)
     m = a.size
-    both = sld.workspace_designs(
-        sld.designs(legs), np.concatenate([a, q[:, 0]]), np.concatenate([b, q[:, 1]])
-    )
+    pa, pb = np.concatenate([a, q[:, 0]]), np.concatenate([b, q[:, 1]])
+    both = _map_closed_form(Legs.of(legs), pa, pb)  # type: ignore[arg-type]
     reach = both.reachable[:, :m] & ~both.singular[:, :m]  # (designs, task poses)
     dex = both.sigma_min[:, :m] / both.sigma_max[:, :m]
     out["workspace_fraction"][idx] = reach.mean(axis=1)
@@ -89,9 +121,8 @@ def _block(out: dict[str, np.ndarray], legs: list[sl.SphericalLeg], idx: np.ndar
     # kinematically feasible (a quarter of the default box): the others' force is NaN anyway
     f = np.flatnonzero(feasible)
     if f.size:
-        dyn = sld.inverse_dynamics_designs(
-            sld.designs([legs[k] for k in f]), q, qd, qdd, sl.PAPER_DRIVEN_LEGS
-        )
+        fl = Legs.of([legs[k] for k in f], h_axes=2)
+        dyn = _forces(fl, _motion(fl, q, qd, qdd), None, sl.PAPER_DRIVEN_LEGS)  # type: ignore[arg-type]
         valid = dyn.valid.all(axis=1)
         out["fig5b_ok"][idx[f]] = valid
         out["peak_force"][idx[f[valid]]] = np.max(np.abs(dyn.leg_forces[valid]), axis=(1, 2))

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -478,3 +478,30 @@ def with_variables(study: DesignStudy, variables: Sequence[Variable]) -> DesignS
             )
         current[ov.name] = ov
     return dataclasses.replace(study, variables=tuple(current.values()))
+
+
+def design_blocks(params: Sequence[Any], varied: Collection[str], size: int) -> Iterator[np.ndarray]:
+    """Indices into ``params`` (parameter dataclasses; None, a rejected design, is skipped) in blocks of
+    at most ``size`` designs equal in every field but ``varied``: the designs one broadcasting kernel call
+    takes as per-design arrays (:class:`DesignArrays`).  Groups in first-seen order, indices ascending."""
+    groups: dict[tuple[Any, ...], list[int]] = {}
+    for i, p in enumerate(params):
+        if p is not None:
+            key = tuple(getattr(p, f.name) for f in dataclasses.fields(p) if f.name not in varied)
+            groups.setdefault(key, []).append(i)
+    for g in groups.values():
+        for s in range(0, len(g), size):
+            yield np.array(g[s : s + size], dtype=np.int64)
+
+
+@dataclass(frozen=True)
+class DesignArrays:
+    """Designs of one parameter class from one :func:`design_blocks` block, in place of one parameter
+    object for a mechanism's broadcasting kernels: a subclass defines the varied fields (and every
+    property derived from them) as arrays with a leading design axis; any other attribute is the first
+    design's."""
+
+    designs: tuple[Any, ...]
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.designs[0], name)

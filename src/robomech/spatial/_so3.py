@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from robomech._validation import as_array
 
@@ -227,7 +228,7 @@ def _sincos(angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return 2.0 * t * d, (1.0 - t2) * d
 
 
-def _rot(angle: np.ndarray, i: int, j: int) -> np.ndarray:
+def _rot(angle: ArrayLike, i: int, j: int) -> np.ndarray:
     a = as_array(angle, "angle")
     s, c = _sincos(a)
     R = np.zeros((*a.shape, 3, 3))
@@ -240,7 +241,7 @@ def _rot(angle: np.ndarray, i: int, j: int) -> np.ndarray:
     return R
 
 
-def rot_x(angle: np.ndarray) -> np.ndarray:
+def rot_x(angle: ArrayLike) -> np.ndarray:
     """Active right-handed rotation about x.
 
     Parameters
@@ -261,7 +262,7 @@ def rot_x(angle: np.ndarray) -> np.ndarray:
     return _rot(angle, 1, 2)
 
 
-def rot_y(angle: np.ndarray) -> np.ndarray:
+def rot_y(angle: ArrayLike) -> np.ndarray:
     """Active right-handed rotation about y.
 
     Parameters
@@ -282,7 +283,7 @@ def rot_y(angle: np.ndarray) -> np.ndarray:
     return _rot(angle, 2, 0)
 
 
-def rot_z(angle: np.ndarray) -> np.ndarray:
+def rot_z(angle: ArrayLike) -> np.ndarray:
     """Active right-handed rotation about z.
 
     Parameters

@@ -103,14 +103,12 @@ def _closure_residual(S: np.ndarray, M: np.ndarray, theta: np.ndarray) -> tuple[
 def thigh_closure(leg: OmniLeg, alpha: object, beta: object) -> ThighClosure:
     """Solve the closure T1 = T2 = T3 (eq. (8)) for the passive joints, given α = θ21 and β = θ11.
 
-    Assembled by :func:`robomech.multibody.forward_kinematics` from the home pose in ``CLOSURE_STAGES``
-    stages; the residual is that of the product of exponentials of all three chains.
+    Assembled by :func:`robomech.multibody.forward_kinematics` from home in ``CLOSURE_STAGES`` stages.
 
     Parameters
     ----------
     leg : OmniLeg
     alpha, beta : array_like, shape (...)
-        Active angles (rad); broadcast together.
 
     Returns
     -------

@@ -127,7 +127,7 @@ def _poses(
         D = C + jt.rotate_const(S[i], crank_dir) * leg.L4
         out.append((_rotate_cols(S[i], Rx_p), C))
         out.append((_rotate_cols(S[i], Rx_m), D))
-    # the foot's z as a vector jet, so that a per-sample L4 (N, 1) broadcasts (omnileg._designs)
+    # the foot's z as a vector jet, so that a per-sample L4 (N, 1) broadcasts (a design study's legs)
     foot_origin = knee + (
         jt.stack([zero, zero, cg]) * (2.0 * leg.L4) + np.array([0.0, 0.0, leg.knee_to_crank])
     )
@@ -181,7 +181,7 @@ def _terms(
         if cols is not None:
             by_name[name] = cols
         body: RigidBody = leg.bodies[key]
-        m = body.mass  # a float, or (N,) per sample (omnileg._designs)
+        m = body.mass  # a float, or (N,) per sample (a design study's legs)
         c = body.com_vector  # (3,) or (N, 3)
         # mass centre p = o + R c = o + Σ_j c_j r_j
         p = (
@@ -242,7 +242,7 @@ def _terms(
 
 def _inertia_times(inertia: np.ndarray, x: np.ndarray) -> np.ndarray:
     """``I x`` for body-axis vectors ``x (..., N, 3)``: one BLAS product for a constant ``I (3, 3)``, per
-    sample for ``I (N, 3, 3)`` (omnileg._designs)."""
+    sample for ``I (N, 3, 3)`` (a design study's legs)."""
     if inertia.ndim == 2:
         return x @ inertia.T
     return (
@@ -326,10 +326,8 @@ def inverse_dynamics(
     ----------
     leg : OmniLeg
     q, qd, qdd : array_like, shape (..., 3)
-        Joint coordinates (rad), rates (rad/s) and accelerations (rad/s²); broadcast together.
     foot_force : array_like, shape (..., 3), optional
-        Force applied *to* the foot (N, hip frame; ``FOOT_FORCE_CONVENTION``): it enters as ``-Jᵀ F``.
-        Paper 2, eqs. (49)-(50) add ``+Jᵀ F_f``: pass ``-F_f``.
+        Force applied *to* the foot (N, hip frame; ``FOOT_FORCE_CONVENTION``: paper 2's ``F_f`` is -F).
     paper_as_printed : bool, optional
         Use paper 2's simplified Cardan drive (eqs. (26)-(31)) instead of the exact one, for comparison.
 

@@ -46,37 +46,18 @@ class Jet:
     def __neg__(self) -> Jet:
         return Jet(-self.v, -self.vd, -self.vdd, -self.g)
 
-    def __sub__(self, o: Jet | Array | float) -> Jet:
-        return self + (-o)
-
-    def __rsub__(self, o: Array | float) -> Jet:
-        return (-self) + o
-
     def __mul__(self, o: Jet | Array | float) -> Jet:
         return bilinear(self, o, np.multiply)
 
     __rmul__ = __mul__
 
-    def __truediv__(self, o: Jet | Array | float) -> Jet:
-        if isinstance(o, Jet):
-            return self * reciprocal(o)
-        return self * (1.0 / np.asarray(o, dtype=float))
-
-    def __getitem__(self, idx: int) -> Jet:
-        """Component ``idx`` of the last value axis."""
-        return Jet(self.v[..., idx], self.vd[..., idx], self.vdd[..., idx], self.g[..., idx])
-
     def expand(self) -> Jet:
         """Add a trailing value axis (a per-sample scalar that multiplies a vector)."""
         return Jet(self.v[..., None], self.vd[..., None], self.vdd[..., None], self.g[..., None])
 
-    @property
-    def T(self) -> Jet:
-        return Jet(*(np.swapaxes(a, -1, -2) for a in (self.v, self.vd, self.vdd, self.g)))
-
 
 def bilinear(a: Jet | Array | float, b: Jet | Array | float, op: Callable[[Array, Array], Array]) -> Jet:
-    """Product rule for any bilinear ``op`` (multiply, matmul, cross) of jets or constants."""
+    """Product rule for any bilinear ``op`` (multiply, cross, dot) of jets or constants."""
     if not isinstance(a, Jet):
         if not isinstance(b, Jet):
             raise TypeError("bilinear: expected at least one Jet operand")
@@ -147,18 +128,6 @@ def stack(items: list[Jet | Array]) -> Jet:
     return Jet(*(np.stack([p[k] for p in ps], axis=-1) for k in range(4)))
 
 
-def matmul(a: Jet | Array, b: Jet | Array) -> Jet:
-    return bilinear(a, b, np.matmul)
-
-
-def _matvec(x: Array, y: Array) -> Array:
-    return (x @ y[..., None])[..., 0]
-
-
-def matvec(a: Jet | Array, b: Jet | Array) -> Jet:
-    return bilinear(a, b, _matvec)
-
-
 def cross3(x: Array, y: Array) -> Array:
     """Cross product over the last axis (broadcasting), without np.cross's axis shuffling."""
     x0, x1, x2 = x[..., 0], x[..., 1], x[..., 2]
@@ -172,11 +141,6 @@ def cross(a: Jet | Array, b: Jet | Array) -> Jet:
 
 def dot(a: Jet, b: Jet | Array) -> Jet:
     return bilinear(a, b, lambda x, y: np.sum(x * y, axis=-1))
-
-
-def columns(*cols: Jet) -> Jet:
-    """A 3x3 matrix jet with the given column vectors (each value (..., 3))."""
-    return Jet(*(np.stack([getattr(c, k) for c in cols], axis=-1) for k in ("v", "vd", "vdd", "g")))
 
 
 def atan2(y: Jet, x: Jet) -> Jet:

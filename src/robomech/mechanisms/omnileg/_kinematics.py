@@ -111,7 +111,6 @@ def passive_angles(leg: OmniLeg, alpha: object, beta: object) -> tuple[np.ndarra
     ----------
     leg : OmniLeg
     alpha, beta : array_like, shape (...)
-        Active thigh angles (rad); broadcast together.
 
     Returns
     -------
@@ -220,7 +219,6 @@ def foot_velocity(leg: OmniLeg, q: object, qd: object) -> np.ndarray:
     ----------
     leg : OmniLeg
     q, qd : array_like, shape (..., 3)
-        Joint angles (rad) and rates (rad/s); broadcast together.
 
     Returns
     -------
@@ -240,7 +238,6 @@ def foot_acceleration(leg: OmniLeg, q: object, qd: object, qdd: object) -> np.nd
     ----------
     leg : OmniLeg
     q, qd, qdd : array_like, shape (..., 3)
-        Joint angles, rates and accelerations; broadcast together.
 
     Returns
     -------
@@ -262,12 +259,11 @@ def within_limits(leg: OmniLeg, q: object) -> np.ndarray:
     ----------
     leg : OmniLeg
     q : array_like, shape (..., 3)
-        Non-finite samples give False.
 
     Returns
     -------
     ndarray of bool, shape (...)
-        Inclusive, up to ``LIMIT_SLACK``.
+        Inclusive, up to ``LIMIT_SLACK``; False for non-finite samples.
     """
     check_params(leg, OmniLeg, "leg")
     q = as_array(q, "q", (3,), finite=False)
@@ -321,9 +317,8 @@ class IKResult:
 def inverse_kinematics(leg: OmniLeg, p_foot: object) -> IKResult:
     """Joint angles ``(α, β, γ)`` for foot positions ``p_foot (..., 3)`` (m), branch γ ≥ 0.
 
-    paper 2, eq. (13) corrected: α = arctan(-P_y / s) (printed without the minus, inconsistent with
-    eq. (11)); γ = arccos((P_z - L5 - s) / (2 L4)) (printed with only s divided by 2 L4), where
-    ``s = sqrt(L1² - P_x² - P_y²)`` is the depth of the knee below O0.  Non-finite samples are flagged.
+    Paper 2, eq. (13), two misprints corrected (at the lines), with the knee's depth below O0
+    ``s = sqrt(L1² - P_x² - P_y²)``.  Non-finite samples are flagged.
 
     Parameters
     ----------

@@ -13,6 +13,7 @@ from numpy.typing import NDArray
 from robomech._validation import check_params
 from robomech.multibody import Builder, Inertial, Mechanism
 from robomech.multibody._model import _quat_from_matrix
+from robomech.spatial import rot_x, rot_z
 
 from ._params import OmniLeg, RigidBody
 
@@ -28,14 +29,6 @@ def _kR(k: int) -> Matrix:
     d = 0.5 * np.pi * k
     c, s = np.cos(d), np.sin(d)
     return np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # paper 2, eq. (5): Rz(-δ), as printed
-
-
-def _rz(a: float) -> Matrix:
-    return np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
-
-
-def _rx(a: float) -> Matrix:
-    return np.array([[1.0, 0.0, 0.0], [0.0, np.cos(a), -np.sin(a)], [0.0, np.sin(a), np.cos(a)]])
 
 
 def _frame(name: str) -> Matrix:
@@ -135,7 +128,7 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
     # at O0', output shaft about Z0' in the knee plate; every frame is Rz(γ) at α = β = 0.
     # paper 2, eqs. (26)-(31): the paper decouples the drive's spin from the thigh motion; here the
     # closure solves the double Cardan exactly (as the analytic model does, docs departure 9).
-    Rg0 = _quat_from_matrix(_rz(g0))
+    Rg0 = _quat_from_matrix(rot_z(g0))
     b.body(
         "drive_shaft_in",
         quat=Rg0,
@@ -174,9 +167,9 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
     e_plane = leg.knee_to_crank + 2.0 * L4 * np.cos(g0)  # depth of the E plane below O0' (eq. (10))
     for i in range(3):
         c = i + 1
-        S = _rz(float(psi[i]))
+        S = rot_z(float(psi[i]))
         C = S @ np.array([leg.shank_radius, 0.0, leg.knee_to_crank])
-        Rc = S @ _rx(g0)
+        Rc = S @ rot_x(g0)
         # crank: z along C_iD_i; coupler: z along D_iE_i at angle -γ, i.e. Rx(-2γ) relative to the crank
         b.body(
             f"crank_{c}",
@@ -186,7 +179,7 @@ def to_multibody(leg: OmniLeg) -> Mechanism:
             joints=[b.hinge(f"crank_{c}", axis=(1, 0, 0), ref=g0)],
             inertial=inertial(f"crank_{c}", "crank"),
         )
-        Rrel = _rx(-2.0 * g0)
+        Rrel = rot_x(-2.0 * g0)
         b.body(
             f"coupler_{c}",
             f"crank_{c}",

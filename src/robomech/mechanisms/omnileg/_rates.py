@@ -11,16 +11,15 @@ from robomech._batching import carries_failed_rows
 from robomech._validation import as_array, broadcast_batch, check_params, check_real
 from robomech.analysis.lstsq import _damped_inverse
 
-from ._dynamics import SINGULAR_RCOND
+from ._dynamics import DAMPING_RELATIVE, SINGULAR_RCOND
 from ._kinematics import hessian, jacobian
 from ._params import OmniLeg
 
 __all__ = ["JointRatesResult", "joint_rates"]
 
-# Default damping of the weak singular directions, relative to sigma_max: equal to the singular flag's
-# threshold SINGULAR_RCOND (as foot_force_from_torques), so no direction is amplified by more than
-# 1 / (2 SINGULAR_RCOND) = 500 (a rate of 1 m/s maps to at most ~500 / sigma_max rad/s).
-DEFAULT_DAMPING = SINGULAR_RCOND
+# Default damping of the weak directions: foot_force_from_torques' (no direction amplified by more than
+# 1 / (2 SINGULAR_RCOND) = 500: a rate of 1 m/s maps to at most ~500 / sigma_max rad/s).
+DEFAULT_DAMPING = DAMPING_RELATIVE
 
 
 @dataclass(frozen=True)
@@ -63,7 +62,7 @@ def joint_rates(
     """Joint rates ``q̇`` (and accelerations ``q̈``) realising the foot velocity ``ṗ`` (and acceleration ``p̈``).
 
     Paper 2, eq. (47)'s inverse of the foot Jacobian, regularised at γ = 0: the directions with
-    ``σ < SINGULAR_RCOND σ_max`` get ``c = σ / (σ² + λ²)``, ``λ = damping σ_max`` (0: exact, unbounded).
+    ``σ < SINGULAR_RCOND σ_max`` get ``c = σ / (σ² + λ²)``, ``λ = damping σ_max`` (>= 0; 0: exact, unbounded).
 
     Parameters
     ----------
@@ -72,7 +71,6 @@ def joint_rates(
     foot_velocity, foot_acceleration : array_like, shape (..., 3)
         ``ṗ`` (m/s) and, optionally, ``p̈`` (m/s²; without it ``qdd`` is NaN), hip frame.
     damping : float, optional
-        Damping of the weak directions relative to sigma_max (>= 0).
 
     Returns
     -------

@@ -125,7 +125,6 @@ def singular_surface(leg: OmniLeg, alpha: object, beta: object) -> np.ndarray:
     ----------
     leg : OmniLeg
     alpha, beta : array_like, shape (...)
-        Thigh angles (rad); broadcast together.
 
     Returns
     -------

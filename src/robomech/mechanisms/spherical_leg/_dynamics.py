@@ -487,6 +487,13 @@ def inverse_dynamics(
     ((2, 3), array([ True,  True]))
     """
     m, w = _driven_motion(leg, q, qd, qdd, platform_wrench, paper_as_printed)
+    return _forces(leg, m, w, driven_legs)
+
+
+def _forces(
+    leg: SphericalLeg, m: _Motion, w: np.ndarray | None, driven_legs: tuple[int, int] | None
+) -> InverseDynamicsResult:
+    """:func:`inverse_dynamics` of the motion ``m`` (unvalidated; ``leg`` as :func:`_motion` takes it)."""
     tau = _generalized(leg, m, w)
     dist = distribute_forces(m.Jl, tau, driven_legs)
     valid = dist.valid & ~m.lock

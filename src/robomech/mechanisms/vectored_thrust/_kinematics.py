@@ -362,8 +362,7 @@ def arc_clearance(a1: object, b1: object, a2: object, b2: object) -> np.ndarray:
 
 
 def _interference(th: VectoredThruster, q: np.ndarray) -> np.ndarray:
-    """Clearance (rad) of the 45 deg arc (s11 -> s12) from the fixing device (s22 -> s13); NaN if singular.
-
+    """Clearance (rad) of the 45 deg arc (s11 -> s12) from the fixing device (s22 -> s13); NaN if singular:
     :func:`_arc_clearance` specialised to these arcs (tested against it): normals ``(0, c1, s1)`` and
     ``s0``, side vectors ``(0, s1, -c1)``, ``(sin a, -cos a s1, cos a c1)``, ``s13``, ``s22``; about 70
     element-wise passes instead of ~250 for the generic 3-vector form.
@@ -628,11 +627,8 @@ def _solve3(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray, b: np.ndarray) -> np
 
 
 def _rates(ax: JointAxes, qd: np.ndarray) -> np.ndarray:
-    """Passive rates (RR s22, RRR s12, RRR s13) from the velocity closure (paper 5, eq. (16), solved).
-
-    q1' X + rho2' s12 + rho3' s13 = q2' Y + theta' s22  ->  [s22, -s12, -s13] x = q1' X - q2' Y.
-    paper 5, eq. (17): the printed rates violate this closure; these satisfy it.
-    """
+    """:func:`passive_rates`' kernel: ``q1' X + rho2' s12 + rho3' s13 = q2' Y + theta' s22`` (eq. (16)),
+    i.e. ``[s22, -s12, -s13] x = q1' X - q2' Y``; paper 5, eq. (17)'s printed rates violate it."""
     b = qd[..., 0:1] * ax.s11 - qd[..., 1:2] * ax.s21
     return _solve3(ax.s22, -ax.s12, -ax.s13, b)
 
@@ -668,13 +664,12 @@ def passive_angles(th: VectoredThruster, q: object) -> PassiveResult:
 
 @carries_failed_rows({"q": 1, "qd": 1})
 def passive_rates(th: VectoredThruster, q: object, qd: object) -> PassiveResult:
-    """Passive joint rates (rad/s): the velocity closure (paper 5, eq. (16)) solved; eq. (17)'s violate it.
+    """Passive joint rates (rad/s): the velocity closure (paper 5, eq. (16)) solved.
 
     Parameters
     ----------
     th : VectoredThruster
     q, qd : array_like, shape (..., 2)
-        Inputs (rad) and their rates (rad/s); broadcast together.
 
     Returns
     -------
@@ -760,7 +755,6 @@ def angular_velocity(th: VectoredThruster, q: object, qd: object) -> VelocityRes
     ----------
     th : VectoredThruster
     q, qd : array_like, shape (..., 2)
-        Inputs (rad) and their rates (rad/s); broadcast together.
 
     Returns
     -------
@@ -791,7 +785,6 @@ def angular_acceleration(th: VectoredThruster, q: object, qd: object, qdd: objec
     ----------
     th : VectoredThruster
     q, qd, qdd : array_like, shape (..., 2)
-        Inputs (rad), their rates and accelerations; broadcast together.
 
     Returns
     -------

@@ -16,7 +16,7 @@ from ._params import VectoredThruster
 
 __all__ = ["MechanismMobility", "chain_screws", "mechanism_mobility", "platform_mobility"]
 
-# Screws are passed in metres (see platform_mobility).
+# Screws in metres: offsets of millimetres give moment parts ~1e-3, far above the SVD rank tolerance (1e-9).
 CORE_LENGTH_SCALE = 1.0
 
 _JOINTS = ("s11", "s12", "s13", "s21", "s22")
@@ -68,9 +68,6 @@ def platform_mobility(
 ) -> mobility.MobilityResult:
     """Mobility of the RRR-RR platform (the fixing device) at ``q``: paper 5, eqs. (4)-(10).
 
-    Screws in metres (``length_scale = 1``): offsets of millimetres give moment parts ~1e-3, far above
-    the SVD rank tolerance (1e-9).
-
     Parameters
     ----------
     th : VectoredThruster
@@ -96,7 +93,8 @@ class MechanismMobility:
     platform : MobilityResult
         The RRR-RR platform (2R expected).
     propeller : MobilityResult
-        The propeller body: the central RU chain closed with the platform's twists and the shaft s0.
+        The propeller body: the central chain (motor about Z, universal joint at ``ujoint_centre``)
+        closed with the platform's twists and the shaft bearing about s0.
     """
 
     platform: mobility.MobilityResult
@@ -110,9 +108,6 @@ def mechanism_mobility(
     ujoint_centre: object = (0.0, 0.0, 0.0),
 ) -> MechanismMobility:
     """Mobility of the whole vectored thruster with the central universal-joint chain (Section 2, Fig. 2).
-
-    The propeller body is reached by the central chain (motor about Z, universal joint at
-    ``ujoint_centre``) and by the platform's twist system followed by the shaft bearing about s0.
 
     Parameters
     ----------

@@ -62,10 +62,8 @@ class WorkspaceMap:
 
 
 def _dexterity(J: np.ndarray, ok: np.ndarray) -> np.ndarray:
-    """1/cond of each (..., 3, 2) J from the eigenvalues of the 2x2 J^T J (closed form, no SVD).
-
-    Component-wise sums (no (..., 3, 2) temporaries); J is NaN where not ``ok``, masked at the end.
-    """
+    """1/cond of each (..., 3, 2) J from the eigenvalues of the 2x2 J^T J in closed form by component-wise
+    sums (no SVD, no (..., 3, 2) temporaries); J is NaN where not ``ok``, masked at the end."""
     with np.errstate(invalid="ignore", divide="ignore"):
         j00, j10, j20 = J[..., 0, 0], J[..., 1, 0], J[..., 2, 0]
         j01, j11, j21 = J[..., 0, 1], J[..., 1, 1], J[..., 2, 1]
