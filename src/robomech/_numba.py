@@ -4,9 +4,13 @@ numba's ``cache=True`` writes compiled kernels next to the source (``__pycache__
 package) unless a cache directory is configured: that is read-only or shared in a system-wide
 install, and a cache inside ``site-packages`` outlives the package version.  :func:`import_numba`
 points the cache (when the user has not set ``NUMBA_CACHE_DIR``) at ``$XDG_CACHE_HOME/robomech/numba``
-(default ``~/.cache/robomech/numba``): through the environment variable before numba's first import,
-and through ``numba.config.CACHE_DIR`` when the application imported numba first (numba reads the
-variable once, at import, but looks the setting up again whenever a kernel's cache is opened).
+(default ``~/.cache/robomech/numba``), in a sub-folder named by a fingerprint of the kernels' source
+files (:data:`KERNEL_SOURCES`): numba checks a cached kernel against its own file's time stamp only,
+not against the files of the kernels it calls, so an edited or upgraded callee would otherwise leave
+its callers' stale machine code in use.  The folder is set through the environment variable before
+numba's first import, and through ``numba.config.CACHE_DIR`` when the application imported numba
+first (numba reads the variable once, at import, but looks the setting up again whenever a kernel's
+cache is opened).
 
 Every compilation (a kernel's first use with empty caches) is announced on the ``robomech`` logger
 (``logging.getLogger("robomech")``) at INFO: ``compiling kernel X (first use; cached in DIR)``, then
@@ -16,6 +20,7 @@ is not compiled and says nothing.
 
 from __future__ import annotations
 
+import hashlib
 import logging
 import os
 import sys
@@ -24,18 +29,40 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-__all__ = ["cache_dir", "import_numba"]
+__all__ = ["KERNEL_SOURCES", "cache_dir", "import_numba"]
+
+# Every module of the package that defines numba kernels (relative to the package; a test checks the list
+# is complete): their contents name the cache folder, so no kernel is ever loaded compiled against an older
+# version of a kernel it calls.
+KERNEL_SOURCES = (
+    "analysis/_householder.py",
+    "mechanisms/spherical_leg/_kinematics.py",
+    "multibody/_compiled.py",
+    "multibody/_designs.py",
+    "multibody/_rnea_kernels.py",
+)
 
 _LOG = logging.getLogger("robomech")
 _LISTENING = False
 
 
+def _fingerprint() -> str:
+    """The first 16 hex digits of the SHA-256 of the kernel sources (:data:`KERNEL_SOURCES`)."""
+    h = hashlib.sha256()
+    root = Path(__file__).parent
+    for name in KERNEL_SOURCES:
+        h.update(name.encode())
+        h.update((root / name).read_bytes())
+    return h.hexdigest()[:16]
+
+
 def cache_dir() -> Path:
-    """Where robomech's compiled kernels are cached (``NUMBA_CACHE_DIR`` if set)."""
+    """Where robomech's compiled kernels are cached (``NUMBA_CACHE_DIR`` if set; otherwise a folder per
+    version of the kernel sources, module docstring)."""
     if os.environ.get("NUMBA_CACHE_DIR"):
         return Path(os.environ["NUMBA_CACHE_DIR"])
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "robomech" / "numba"
+    return Path(base) / "robomech" / "numba" / _fingerprint()
 
 
 def _listen(numba: ModuleType) -> None:

@@ -45,7 +45,7 @@ def test_numba_cache_is_not_written_into_the_package(tmp_path):
     env.pop("NUMBA_CACHE_DIR", None)
     code = "from robomech._numba import import_numba; print(import_numba().config.CACHE_DIR)"
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == str(tmp_path / "robomech" / "numba")
+    assert Path(out.stdout.strip()).parent == tmp_path / "robomech" / "numba"  # then the sources' folder
     pkg = Path(robomech.__file__).parent
     direct = [
         str(p.relative_to(pkg))
