@@ -130,6 +130,44 @@ def test_a_spatial_mechanism_with_masses_batches_too():
         )
 
 
+def test_batched_inverse_dynamics_equals_each_designs_public_inverse_dynamics():
+    """32 Sobol Delta designs along the pick-and-place path, with random actuator rates, the samples
+    shuffled across designs, and failures: a non-finite and a huge configuration, an unassembled one,
+    a huge rate.  Each design's samples equal ``mb.inverse_dynamics`` of that design (the same
+    per-sample kernel with the same numbers: bit for bit), its flags included; at any batch size."""
+    from robomech.explore import design_matrix
+
+    X = design_matrix(delta.study().variables, 32, "sobol", 0, 32)
+    mechs = [delta.build(*r) for r in X]
+    b = D.design_batch(mechs, "tcp")
+    t, pts = delta.pick_and_place()
+    di = np.repeat(np.arange(b.n), len(t))
+    w = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 1.0])
+    q, conv, *_ = D.ik_designs(b, di, _targets(np.tile(pts, (b.n, 1))), b.q_ref[di], w, steps=4)
+    assert conv.all()
+    rng = np.random.default_rng(3)
+    qd, qdd = rng.normal(size=(2, q.shape[0], 3))
+    q[5] = np.nan
+    q[40, 0] = 1e301
+    q[100, 0] += 0.05  # the closure opened: not assembled
+    qdd[200, 1] = 1e305
+    perm = rng.permutation(q.shape[0])
+    di, q, qd, qdd = di[perm], q[perm], qd[perm], qdd[perm]
+    res = D.inverse_dynamics_designs(b, di, q, qd, qdd)
+    assert 0 < np.count_nonzero(~res["valid"]) < 8
+    few = D.inverse_dynamics_designs(b, di[:50], q[:50], qd[:50], qdd[:50])  # one serial call
+    for k in ("tau", "valid", "closure"):
+        np.testing.assert_array_equal(few[k], res[k][:50])
+    for d, mech in enumerate(mechs):
+        s = di == d
+        pub = mb.inverse_dynamics(mech, q[s], qd[s], qdd[s])
+        np.testing.assert_array_equal(res["valid"][s], pub.valid)
+        for k in ("tau", "M_a", "velocity_terms", "gravity_terms", "external_terms", "closure", "qd", "qdd"):
+            np.testing.assert_array_equal(res[k][s], getattr(pub, k), err_msg=k)
+        for k in ("cond", "sigma_min", "admissibility"):
+            np.testing.assert_array_equal(res[k][s][pub.valid], getattr(pub, k)[pub.valid], err_msg=k)
+
+
 def _two_link_arm():
     """An open 2R arm with a site "tip": another structure than the five-bar."""
     b = mb.Builder("arm")

@@ -6,7 +6,9 @@ whose numbers are named parameters (``{L1}`` or ``$L1``, :func:`template_builder
 call of ``build``; the generic metrics are computed by the engine's public API
 (:func:`~robomech.multibody.inverse_kinematics`, :func:`~robomech.multibody.site_jacobian`,
 :func:`~robomech.multibody.singularities`, :func:`~robomech.multibody.forward_kinematics`,
-:func:`~robomech.multibody.inverse_dynamics`) on the study's task, one batched call per design.
+:func:`~robomech.multibody.inverse_dynamics`) on the study's task, evaluated for every design of a
+chunk in one kernel call per step by the design-batched drivers of ``multibody._designs`` (the same
+per-sample kernels as the public functions).
 A design whose ``build`` raises, or whose mechanism the engine refuses, is a failed design
 (``design_ok`` False, metrics NaN), never an exception.  Definitions: :data:`GENERIC_METRICS` and
 ``docs/explore.md``.
@@ -816,10 +818,10 @@ def task_forces_designs(
     """Peak and RMS actuator force ``(D,)`` of each design along ``trajectory = (t, points)``: IK of
     every design at each time with its previous solution as the guess (one batched call per time),
     actuator rates by second-order finite differences in time (``numpy.gradient``), then inverse
-    dynamics with gravity per design; NaN for a design where any sample fails (not reached, singular,
-    not valid)."""
-    from robomech import multibody as mb
-    from robomech.multibody._designs import ik_designs
+    dynamics with gravity of every design x time in one design-batched kernel call
+    (``multibody._designs.inverse_dynamics_designs``: :func:`~robomech.multibody.inverse_dynamics` per
+    sample); NaN for a design where any sample fails (not reached, singular, not valid)."""
+    from robomech.multibody._designs import ik_designs, inverse_dynamics_designs
 
     t, pts = trajectory
     D = batch.n
@@ -838,15 +840,22 @@ def task_forces_designs(
         qs[i, di] = qi
         guess[di] = qi
     peak, rms = np.full(D, math.nan), np.full(D, math.nan)
-    for d in np.flatnonzero(alive).tolist():
-        mech = mechs[d]
-        q = qs[:, d]
-        qa = q[:, [mech.qpos_address(j) for j in mech.actuated]]
-        qd = np.gradient(qa, t, axis=0, edge_order=2)
-        qdd = np.gradient(qd, t, axis=0, edge_order=2)
-        res = mb.inverse_dynamics(mech, q, qd, qdd)
-        if np.all(res.valid):
-            tau = np.asarray(res.tau)
+    live = np.flatnonzero(alive)
+    if live.size == 0:
+        return peak, rms
+    q = qs[:, live].transpose(1, 0, 2)  # (designs, times, nq)
+    qa = q[:, :, [mechs[0].qpos_address(j) for j in mechs[0].actuated]]
+    qd = np.gradient(qa, t, axis=1, edge_order=2)
+    qdd = np.gradient(qd, t, axis=1, edge_order=2)
+    na = qa.shape[2]
+    res = inverse_dynamics_designs(
+        batch, np.repeat(live, t.size), q.reshape(-1, q.shape[2]), qd.reshape(-1, na), qdd.reshape(-1, na)
+    )
+    valid = res["valid"].reshape(live.size, t.size)
+    taus = res["tau"].reshape(live.size, t.size, na)
+    for j, d in enumerate(live.tolist()):
+        if np.all(valid[j]):
+            tau = taus[j]
             peak[d], rms[d] = float(np.max(np.abs(tau))), float(np.sqrt(np.mean(tau**2)))
     return peak, rms
 

@@ -16,6 +16,12 @@ of many equals the design evaluated alone (bit for bit on one machine).
 Designs whose structure differs (a ``build`` that changes topology with its parameters) cannot share
 a batch: :func:`design_batch` refuses them (:class:`StructureMismatch`) and :func:`group_designs`
 splits a list of designs into batches of one structure each.
+
+The inverse dynamics is batched the same way: the bodies' masses, centres of mass and inertias are
+numbers per design (:class:`Inertias`, the numbers of :class:`~robomech.multibody._compile.DynTables`;
+which bodies carry mass is structure), and :func:`inverse_dynamics_designs` runs the compiled
+inverse-dynamics kernel :func:`~robomech.multibody._compiled.inv_dyn_block` on each run of
+consecutive samples of one design with that design's tables (:func:`design_dyn`).
 """
 
 from __future__ import annotations
@@ -28,16 +34,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import _options as opt
-from ._compile import Model, Tables, compile_model
-from ._compiled import BLOCK, _nj, kin, lm_solve, numba, site_jac_one, writable
+from ._compile import DynTables, Model, Tables, compile_model
+from ._compiled import BLOCK, _nj, inv_dyn_block, kin, lm_solve, numba, site_jac_one, writable
 
 __all__ = [
     "DesignBatch",
     "Geometry",
+    "Inertias",
     "StructureMismatch",
     "design_batch",
     "group_designs",
     "ik_designs",
+    "inverse_dynamics_designs",
     "single_design",
     "site_measures_designs",
     "site_poses_designs",
@@ -57,8 +65,18 @@ class Geometry(NamedTuple):
     L: NDArray[np.float64]  # (D,)
 
 
+class Inertias(NamedTuple):
+    """The numbers of :class:`DynTables` per design (leading axis D): the massive bodies' inertias."""
+
+    mass: NDArray[np.float64]  # (D, B) kg
+    com: NDArray[np.float64]  # (D, B, 3) m, body frame
+    inertia: NDArray[np.float64]  # (D, B, 3, 3) kg m^2 about the com, body axes
+
+
 # The fields of Tables that are structure (equal for every design of a batch); the others are Geometry's.
 STRUCTURE_FIELDS = tuple(f for f in Tables._fields if f not in Geometry._fields)
+# The same for DynTables and Inertias.
+DYN_STRUCTURE_FIELDS = tuple(f for f in DynTables._fields if f not in Inertias._fields)
 
 
 class StructureMismatch(ValueError):
@@ -93,13 +111,36 @@ def design_tables(t, g, d):  # pragma: no cover - compiled
     )
 
 
+@_nj
+def design_dyn(dt, g, d):  # pragma: no cover - compiled
+    """The :class:`DynTables` of design ``d``: the structure of ``dt``, the inertias of row ``d`` of ``g``."""
+    return DynTables(
+        dt.bidx,
+        g.mass[d],
+        g.com[d],
+        g.inertia[d],
+        dt.act,
+        dt.pas,
+        dt.rank0,
+        dt.dof,
+        dt.gram_cond_max,
+        dt.gram_refine_cond,
+        dt.gram_refine2_cond,
+        dt.pinv_rtol,
+        dt.rank_rtol,
+        dt.singular_cond,
+        dt.admissible_rtol,
+        dt.rate_floor,
+    )
+
+
 def _structure(model: Model, site_body: int) -> tuple[Any, ...]:
-    t = model.tables
     key: list[Any] = [site_body, model.tree.nq, model.tree.nv, model.rank_K, model.idle_dof, model.locked_dof]
     key += [model.act.tobytes(), model.pas.tobytes()]
-    for f in STRUCTURE_FIELDS:
-        v = getattr(t, f)
-        key.append((v.shape, v.dtype.str, v.tobytes()) if isinstance(v, np.ndarray) else v)
+    for tables, fields in ((model.tables, STRUCTURE_FIELDS), (model.dyn, DYN_STRUCTURE_FIELDS)):
+        for f in fields:
+            v = getattr(tables, f)
+            key.append((v.shape, v.dtype.str, v.tobytes()) if isinstance(v, np.ndarray) else v)
     return tuple(key)
 
 
@@ -109,10 +150,17 @@ class DesignBatch:
 
     ``tables`` holds the first design's tables (its structure fields are every design's);
     ``geometry`` the numbers per design; ``T_site (D, 4, 4)`` the site's pose in its body,
-    ``q_ref (D, nq)`` the assembled references, ``length (D,)`` the characteristic lengths (m)."""
+    ``q_ref (D, nq)`` the assembled references, ``length (D,)`` the characteristic lengths (m);
+    ``dyn`` the first design's :class:`DynTables` (structure), ``inertias`` the numbers per design,
+    ``gravity (D, 3)`` each design's gravity (m/s^2), ``tree`` the first design's compiled tree (its
+    structure: the quaternion addresses)."""
 
     tables: Tables
     geometry: Geometry
+    dyn: DynTables
+    inertias: Inertias
+    gravity: np.ndarray
+    tree: Any
     act: np.ndarray
     pas: np.ndarray
     site_body: int
@@ -162,6 +210,15 @@ def design_batch(mechs: Sequence[Any], site: str) -> DesignBatch:
     return DesignBatch(
         tables=m0.tables,
         geometry=geom,
+        dyn=m0.dyn,
+        inertias=Inertias(
+            *(
+                np.ascontiguousarray(np.stack([getattr(m.dyn, f) for m in models]), dtype=float)
+                for f in Inertias._fields
+            )
+        ),
+        gravity=np.array([np.asarray(m.gravity, dtype=float) for m in mechs]).reshape(-1, 3),
+        tree=m0.tree,
         act=m0.act,
         pas=m0.pas,
         site_body=int(m0.tree.site_body[sites[0]]),
@@ -622,3 +679,98 @@ def site_measures_designs(
     else:
         measures_par(Q, *args)
     return out[:, 0].copy(), out[:, 1].copy(), out[:, 2].copy()
+
+
+# ----------------------------------------------------------------------------- inverse dynamics
+@_nj
+def inv_dyn_runs(lo, hi, starts, rd, Q, QD, QDD, W, wsb, wT, gv, wts, t, g, dt, dg, outs):  # pragma: no cover
+    """The inverse dynamics (:func:`~robomech.multibody._compiled.inv_dyn_block`, the one
+    implementation) of the runs ``lo:hi``: run ``k`` is samples ``starts[k]:starts[k + 1]``, all of
+    design ``rd[k]``, with that design's tables and gravity ``gv[rd[k]]``; ``outs`` the kernel's
+    output arrays, in its order."""
+    for k in range(lo, hi):
+        d = rd[k]
+        td, dd = design_tables(t, g, d), design_dyn(dt, dg, d)
+        inv_dyn_block(starts[k], starts[k + 1], Q, QD, QDD, W, wsb, wT, gv[d], wts, td, dd, *outs)
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def inv_dyn_runs_par(starts, rd, Q, QD, QDD, W, wsb, wT, gv, wts, t, g, dt, dg, outs):  # pragma: no cover
+    """:func:`inv_dyn_runs` over every run, in parallel (a run holds at most ``BLOCK`` samples)."""
+    for k in numba.prange(rd.shape[0]):
+        inv_dyn_runs(k, k + 1, starts, rd, Q, QD, QDD, W, wsb, wT, gv, wts, t, g, dt, dg, outs)
+
+
+def _runs(di: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(starts (R + 1,), design of each run (R,))``: the samples cut where the design changes and
+    every ``BLOCK`` samples within a design."""
+    N = di.shape[0]
+    cut = np.flatnonzero(np.diff(di)) + 1
+    starts = np.unique(np.concatenate([[0], cut, np.arange(0, N, BLOCK), [N]]).astype(np.int64))
+    return starts, di[starts[:-1]].copy()
+
+
+def inverse_dynamics_designs(
+    batch: DesignBatch,
+    didx: np.ndarray,
+    q: np.ndarray,
+    qd_act: np.ndarray,
+    qdd_act: np.ndarray,
+    gravity: bool = True,
+) -> dict[str, np.ndarray]:
+    """Actuator forces for the motions ``(q (N, nq), qd_act, qdd_act (N, n_act))``, sample n on design
+    ``didx[n]``: :func:`~robomech.multibody.inverse_dynamics` (actuated-rates form, no site wrench,
+    minimum-norm rule; each design's own gravity unless ``gravity=False``) of every design in one
+    kernel call, the same per-sample kernel and the same validity rule (the kernel's flags, the input's
+    closure within ``CLOSURE_RTOL * L`` of its design, finite inputs and outputs; forces NaN where not
+    valid).  Returns the public result's fields as flat arrays (``tau``, ``M_a``, ``velocity_terms``,
+    ``gravity_terms``, ``external_terms``, ``qd``, ``qdd``, ``cond``, ``sigma_min``,
+    ``admissibility``, ``closure``, ``valid``); ``cond`` and ``sigma_min`` of a sample that is not
+    valid are the kernel's (the public function re-measures them against the generic rank)."""
+    from robomech._validation import MAX_MAGNITUDE
+
+    from ._dynamics import _FORCE_KEYS, _id_outputs, _shape
+    from ._options import CLOSURE_RTOL
+    from ._tree import normalize_quaternions
+
+    di = _index(didx)
+    N = di.shape[0]
+    na, nv = batch.act.shape[0], batch.tables.A.shape[1]
+    flat = [np.array(a, dtype=float).reshape(N, -1) for a in (q, qd_act, qdd_act)]
+    ok = np.ones(N, bool)
+    for a in flat:
+        ok &= np.all(np.isfinite(a) & (np.abs(np.where(np.isfinite(a), a, 0.0)) <= MAX_MAGNITUDE), axis=-1)
+    flat[0][~ok] = batch.q_ref[di[~ok]]
+    flat[1][~ok] = 0.0
+    flat[2][~ok] = 0.0
+    Q = writable(normalize_quaternions(batch.tree, flat[0]))
+    out = _id_outputs(N, na, nv, ("qd", "qdd", "valid", "closure"))
+    starts, rd = _runs(di)
+    gv = writable(batch.gravity if gravity else np.zeros_like(batch.gravity))
+    args = (
+        starts,
+        rd,
+        Q,
+        writable(flat[1]),
+        writable(flat[2]),
+        np.zeros((N, 0, 6)),
+        np.zeros(0, dtype=np.int64),
+        np.zeros((0, 4, 4)),
+        gv,
+        np.zeros(0),
+        batch.tables,
+        batch.geometry,
+        batch.dyn,
+        batch.inertias,
+        tuple(out.values()),
+    )
+    with np.errstate(all="ignore"):
+        if N <= BLOCK:
+            inv_dyn_runs(0, rd.shape[0], *args)
+        else:
+            inv_dyn_runs_par(*args)
+        L = batch.length[di]
+        if batch.tables.m == 0 or batch.pas.shape[0] == 0:  # the empty passive block's measures
+            out["sigma_min"], out["cond"] = L.copy(), np.ones(N)
+        out["valid"] &= out["closure"] <= CLOSURE_RTOL * L
+        return _shape(out, (N,), ok, _FORCE_KEYS)
