@@ -525,3 +525,36 @@ def test_reach_bound_of_a_free_base_chain_is_infinite_and_of_its_closures_finite
     w = delta.HALF_WIDTH
     np.testing.assert_allclose(np.linalg.norm(centres[0, 1:], axis=1), 0.2, rtol=1e-12)
     np.testing.assert_allclose(radii[0, 1:], np.hypot(0.25, w) + 0.6 + np.hypot(0.05, w), rtol=1e-9)
+
+
+def test_batched_assembly_failure_equals_each_designs_forward_kinematics():
+    """The assembly failure of a chunk of designs (one design-batched closure solve) equals, design by
+    design, ``1 - mean(mb.forward_kinematics(mech, grid).converged)``, the metric's definition: 16
+    Sobol five-bars over an input box where part of the grid does not assemble, and Deltas."""
+    import sys
+
+    from robomech.explore import design_matrix
+    from robomech.explore._model import assembly_failure_designs
+    from robomech.multibody._designs import design_batch
+
+    sys.path.insert(0, str(MODEL.parent))
+    import delta
+    import five_bar
+
+    X = design_matrix(VARS, 16, "sobol", 0, 16)
+    cases = [
+        ([five_bar.build(*r) for r in X], "tip", [[-0.5, 2.5], [0.5, 3.5]], 9),
+        (
+            [delta.build(a, f, 0.2, 0.05) for a, f in [(0.25, 0.6), (0.2, 0.5), (0.3, 0.7)]],
+            "tcp",
+            [[-1.2, 1.5]] * 3,
+            4,
+        ),
+    ]
+    for mechs, site, box, grid in cases:
+        got = assembly_failure_designs(mechs, design_batch(mechs, site), box, grid)
+        axes = [np.linspace(lo, hi, grid) for lo, hi in box]
+        qa = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, len(box))
+        want = [1.0 - np.mean(mb.forward_kinematics(m, qa).converged) for m in mechs]
+        assert 0.0 < np.min(want) and np.max(want) < 1.0
+        np.testing.assert_array_equal(got, want)

@@ -895,24 +895,51 @@ def _batch_metrics(study: ModelStudy, mechs: Sequence[Any]) -> dict[str, np.ndar
         out["peak_force"], out["rms_force"] = task_forces_designs(
             mechs, batch, study.site, study.outputs, study.trajectory
         )
+    if "assembly_failure" in gen:
+        out["assembly_failure"] = assembly_failure_designs(mechs, batch, study.input_box, study.input_grid)
+    return out
+
+
+def assembly_failure_designs(mechs: Sequence[Any], batch: Any, input_box: Any, grid: int) -> np.ndarray:
+    """Fraction ``(D,)`` of the ``grid``-per-axis actuator grid over ``input_box`` where each design
+    does not assemble: :func:`~robomech.multibody.forward_kinematics` from the design's reference (its
+    closure solve for every design x grid point in one kernel call, ``multibody._designs.closure_designs``;
+    then its convergence rule per design: closure within ``CONVERGED_RTOL * L``, the same assembly mode
+    as the reference)."""
+    from robomech._validation import MAX_MAGNITUDE
+    from robomech.multibody._assembly import assembly_mode_sign, floating_base_dofs
+    from robomech.multibody._designs import closure_designs
+    from robomech.multibody._options import CONVERGED_RTOL
+
+    m0 = mechs[0]
+    box = np.asarray(input_box)
+    if box.shape[0] != len(m0.actuated):
+        raise ValueError(f"input_box has {box.shape[0]} rows, the mechanism {len(m0.actuated)} actuators")
+    axes = [np.linspace(lo, hi, grid) for lo, hi in box]
+    qa = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, box.shape[0])
+    G = qa.shape[0]
+    tree = m0.tree
+    ok = np.all(np.isfinite(qa) & (np.abs(qa) <= MAX_MAGNITUDE), axis=-1)  # as the public function
+    start = np.stack([np.asarray(m.q0, dtype=float) for m in mechs])  # (D, nq) the assembled references
+    di = np.repeat(np.arange(len(mechs)), G)
+    q = start[di]
+    a0 = q[:, tree.act_qadr]
+    target = np.where(np.tile(ok, len(mechs))[:, None], np.tile(qa, (len(mechs), 1)), a0)
+    q[:, tree.act_qadr] = a0 + (target - a0) * 1.0  # the public function's one continuation stage
+    free = np.setdiff1d(np.arange(tree.nv), np.concatenate([tree.act_dof, floating_base_dofs(m0)]))
+    q, rc, _ = closure_designs(batch, di, q, free)
+    out = np.empty(len(mechs))
+    for d, mech in enumerate(mechs):
+        s = slice(d * G, (d + 1) * G)
+        flipped = (assembly_mode_sign(mech, np.broadcast_to(start[d], (G, start.shape[1])), q[s]) < 0) & ok
+        conv = ok & (rc[s] <= CONVERGED_RTOL * mech.tree.length) & ~flipped
+        out[d] = float(1.0 - np.mean(conv))
     return out
 
 
 def _design_metrics(study: ModelStudy, mech: Any, params: dict[str, float]) -> dict[str, float]:
-    """The metrics evaluated one design at a time: the assembly failure and the user metrics."""
-    from robomech import multibody as mb
-
+    """The metrics evaluated one design at a time: the user metrics."""
     out: dict[str, float] = {}
-    if "assembly_failure" in study.generic:
-        box = np.asarray(study.input_box)
-        if box.shape[0] != len(mech.actuated):
-            raise ValueError(
-                f"input_box has {box.shape[0]} rows, the mechanism {len(mech.actuated)} actuators"
-            )
-        axes = [np.linspace(lo, hi, study.input_grid) for lo, hi in box]
-        qa = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, box.shape[0])
-        fk = mb.forward_kinematics(mech, qa)
-        out["assembly_failure"] = float(1.0 - np.mean(np.asarray(fk.converged, bool)))
     for u in study.user_metrics:
         try:
             out[u.name] = float(u.fn(mech, dict(params)))

@@ -42,6 +42,7 @@ __all__ = [
     "Geometry",
     "Inertias",
     "StructureMismatch",
+    "closure_designs",
     "design_batch",
     "group_designs",
     "ik_designs",
@@ -774,3 +775,46 @@ def inverse_dynamics_designs(
             out["sigma_min"], out["cond"] = L.copy(), np.ones(N)
         out["valid"] &= out["closure"] <= CLOSURE_RTOL * L
         return _shape(out, (N,), ok, _FORCE_KEYS)
+
+
+# ----------------------------------------------------------------------------- assembly
+def closure_designs(
+    batch: DesignBatch, didx: np.ndarray, q: np.ndarray, free: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The closure solve of :func:`~robomech.multibody.forward_kinematics` (one stage), sample n on
+    design ``didx[n]``: the coordinates ``free`` move from ``q (N, nq)`` (finite) until the loops
+    close (:func:`ik_block` without site rows: the arguments of ``_compiled.fk_block``'s
+    :func:`~robomech.multibody._compiled.lm_solve`).  Returns ``q``, the largest closure row (m) and
+    the iterations."""
+    di = _index(didx)
+    Q = writable(np.array(q, dtype=float))
+    N = Q.shape[0]
+    fr = np.ascontiguousarray(free, dtype=np.int64)
+    eye = np.broadcast_to(np.eye(4), (max(N, batch.n), 4, 4))
+    rc, it, pe = np.empty(N), np.zeros(N, dtype=np.int64), np.empty(N)
+    args = (
+        di,
+        writable(eye[:N]),
+        np.zeros(6),
+        fr,
+        writable(np.where(batch.dof_translational, 1.0 / batch.length[:, None], 1.0)[:, fr]),
+        batch.tables,
+        batch.geometry,
+        -1,
+        writable(eye[: batch.n]),
+        writable((opt.STOP_RTOL * batch.geometry.L) ** 2),
+        int(opt.MAX_ITER),
+        opt.MU_START,
+        opt.MU_MIN,
+        opt.MU_MAX,
+        opt.MAX_STEP,
+        0.0,
+        rc,
+        it,
+        pe,
+    )
+    if N <= BLOCK:
+        ik_block(Q, 0, N, *args)
+    else:
+        ik_par(Q, *args)
+    return Q, rc, it
