@@ -406,7 +406,7 @@ def numpy_closure_terms(model, q, qd, W, wsb, wT):
     for s, b in enumerate(wsb):
         p = (state.T[:, b] @ wT[s])[:, :3, 3]
         ext -= np.einsum("nik,ni->nk", frame_jacobian(tree, state, b, p), W[:, s])
-    return K, kdq, ext, D._closure_error(model, state, q)
+    return K, kdq, ext, _closure_error(model, state, q)
 
 
 def numpy_project(model, q, qd):
@@ -419,11 +419,33 @@ def numpy_project(model, q, qd):
     return qd - np.einsum("nij,njk,nk->ni", Kp, K, qd)
 
 
+def _closure_error(mech, state, q: np.ndarray) -> np.ndarray:
+    """Largest closure row ``max |phi(q)|`` (m) per sample; 0 for a tree."""
+    if mech.constraints.m == 0:
+        return np.zeros(q.shape[0])
+    return np.max(np.abs(residual(mech.constraints, mech.tree, state, q)), axis=-1)
+
+
+def numpy_resjac(model, q: np.ndarray, with_jac: bool) -> tuple:
+    """The numpy formulation of ``_compiled.compiled_resjac``: the closure residual and K."""
+    st = kinematics(model.tree, q)
+    r = residual(model.constraints, model.tree, st, q)
+    return r, (jacobian(model.constraints, model.tree, st, q) if with_jac else None)
+
+
+def numpy_jacobian_rate(model, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """The numpy formulation of ``_compiled.compiled_jacobian_rate``: dK/dt along ``qd``."""
+    st = kinematics(model.tree, q)
+    return jacobian_rate(model.constraints, model.tree, st, screw_rates(model.tree, st, qd), q, qd)
+
+
 _SWAPS = {
     "compiled_fk": numpy_fk,
     "compiled_site_jacobian": numpy_site_jacobian,
     "compiled_influence": numpy_compiled_influence,
     "compiled_project": numpy_project,
+    "compiled_resjac": numpy_resjac,
+    "compiled_jacobian_rate": numpy_jacobian_rate,
 }
 _SWAPS_DYNAMICS = {
     "_inverse_compiled": lambda *a, **k: _inverse_flat(*a, **k),
@@ -434,8 +456,9 @@ _SWAPS_DYNAMICS = {
 
 @contextlib.contextmanager
 def numpy_reference():
-    """Inside the block, FK, site Jacobians, influence coefficients, site Hessians, the closure terms,
-    the velocity projection, inverse and forward dynamics run the numpy formulation."""
+    """Inside the block, FK, the closure residual, K and dK/dt, site Jacobians, influence coefficients,
+    site Hessians, the closure terms, the velocity projection, inverse and forward dynamics run the numpy
+    formulation."""
     saved = {k: getattr(_compiled, k) for k in _SWAPS}
     saved_rank = _rnea_kernels.passive_rank_measures
     _rnea_kernels.passive_rank_measures = numpy_passive_rank_measures
@@ -706,7 +729,7 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
         sigma_min=smin,
         admissibility=adm,
         valid=valid,
-        closure=D._closure_error(mech, state, q),
+        closure=_closure_error(mech, state, q),
     )
 
 

@@ -3,7 +3,8 @@ Hessians, inverse dynamics.
 
 The one implementation of each of these algorithms, for every batch size (batch 1 included): tree
 kinematics, closure residual and velocity constraint matrix (the formulas of ``_tree`` and
-``_constraints``, written per sample), the Levenberg–Marquardt assembly (damping, step cap and stopping
+``_constraints``, written per sample; :func:`resjac_block` for ``constraint_residual``,
+``constraint_jacobian`` and ``singularities``, :func:`kdot_block` for ``dK/dt``), the Levenberg–Marquardt assembly (damping, step cap and stopping
 rules of ``_options``), ``G = [I; -K_p^+ K_a]`` by the SVD pseudo-inverse (:func:`influence_G`) with the
 site's ``[ω; ṗ]`` Jacobian, the second-order coefficients ``∂G/∂q_act`` and site Hessians
 (:func:`influence_block`, from ``(dK/dt along u) v``, :func:`kdot_uv`), the velocity projection of
@@ -28,7 +29,9 @@ from ._compile import compile_model
 __all__ = [
     "compiled_fk",
     "compiled_influence",
+    "compiled_jacobian_rate",
     "compiled_project",
+    "compiled_resjac",
     "compiled_site_jacobian",
     "inv_dyn",
 ]
@@ -693,6 +696,61 @@ def site_jac_par(Q, act, pas, sb, Tsite, t, rtol, J_out):  # pragma: no cover
     N = Q.shape[0]
     for k in numba.prange((N + BLOCK - 1) // BLOCK):
         site_jac_block(Q, k * BLOCK, min(N, (k + 1) * BLOCK), act, pas, sb, Tsite, t, rtol, J_out)
+
+
+@_nj
+def resjac_block(Q, lo, hi, t, with_jac, R_o, K_o):  # pragma: no cover - compiled
+    """The closure residual ``R_o (N, m)`` and, with ``with_jac``, the velocity constraint matrix
+    ``K_o (N, m, nv)`` (:func:`resjac`) of samples ``lo:hi`` of ``Q (N, nq)``."""
+    nb = t.parent.shape[0]
+    nv = t.A.shape[1]
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    K = np.empty((t.m, nv))
+    for n in range(lo, hi):
+        kin(Q[n], t, T, S)
+        resjac(Q[n], t, T, S, R_o[n], K_o[n] if with_jac else K, with_jac)
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def resjac_par(Q, t, with_jac, R_o, K_o):  # pragma: no cover - compiled
+    """:func:`resjac_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        resjac_block(Q, k * BLOCK, min(N, (k + 1) * BLOCK), t, with_jac, R_o, K_o)
+
+
+@_nj
+def kdot_block(Q, QD, lo, hi, t, KD_o):  # pragma: no cover - compiled
+    """``dK/dt`` along ``QD (N, nv)`` into ``KD_o (N, m, nv)`` for samples ``lo:hi``: column ``k`` is
+    :func:`kdot_uv` with ``u = qd`` and ``v`` the ``k``-th unit vector."""
+    nb = t.parent.shape[0]
+    nv = t.A.shape[1]
+    m = t.m
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    Sd = np.empty((nv, 6))
+    e = np.zeros(nv)
+    Vu, Vv, Vd = np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nb, 6))
+    kd = np.empty(m)
+    for n in range(lo, hi):
+        q, qd = Q[n], QD[n]
+        kin(q, t, T, S)
+        screw_rates_into(t, S, qd, Sd)
+        for k in range(nv):
+            e[k] = 1.0
+            kdot_uv(q, t, T, S, Sd, qd, e, Vu, Vv, Vd, kd)
+            e[k] = 0.0
+            for i in range(m):
+                KD_o[n, i, k] = kd[i]
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def kdot_par(Q, QD, t, KD_o):  # pragma: no cover - compiled
+    """:func:`kdot_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        kdot_block(Q, QD, k * BLOCK, min(N, (k + 1) * BLOCK), t, KD_o)
 
 
 # ----------------------------------------------------------------------------- inverse dynamics
@@ -1567,6 +1625,32 @@ def compiled_influence(model, q: np.ndarray, second: bool, site: int = -1) -> tu
         influence_par(Q, *args, *outs)
     second = second and na > 0  # no input: no second-order coefficients (None, as without second)
     return G, (dG if second else None), (H if second and site >= 0 else None), rank, cons, smin, cond
+
+
+def compiled_resjac(model, q: np.ndarray, with_jac: bool) -> tuple[np.ndarray, np.ndarray | None]:
+    """The closure residual ``(N, m)`` and, with ``with_jac``, the velocity constraint matrix
+    ``K (N, m, nv)`` (else None) at ``q (N, nq)`` (:func:`resjac_block`)."""
+    Q = writable(q)
+    N, m, nv = Q.shape[0], model.tables.m, model.tree.nv
+    R = np.empty((N, m))
+    K = np.empty((N if with_jac else 0, m, nv))
+    if N <= BLOCK:
+        entry(model, resjac_block, "resjac_block", (Q, 0, N, model.tables, bool(with_jac), R, K))
+    else:
+        resjac_par(Q, model.tables, bool(with_jac), R, K)
+    return R, (K if with_jac else None)
+
+
+def compiled_jacobian_rate(model, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """``dK/dt (N, m, nv)`` along ``qd (N, nv)`` at ``q (N, nq)`` (:func:`kdot_block`)."""
+    Q, QD = writable(q), writable(qd)
+    N = Q.shape[0]
+    KD = np.empty((N, model.tables.m, model.tree.nv))
+    if N <= BLOCK:
+        entry(model, kdot_block, "kdot_block", (Q, QD, 0, N, model.tables, KD))
+    else:
+        kdot_par(Q, QD, model.tables, KD)
+    return KD
 
 
 # ----------------------------------------------------------------------------- tree inverse dynamics (RNEA)

@@ -116,15 +116,6 @@ def _rank_K(mech: Mechanism) -> int:
     return _reference3(mech)[2]
 
 
-def _closure_error(mech: Mechanism, state, q: np.ndarray) -> np.ndarray:
-    """Largest closure row ``max |phi(q)|`` (m) per sample; 0 for a tree."""
-    from ._constraints import residual
-
-    if mech.constraints.m == 0:
-        return np.zeros(q.shape[0])
-    return np.max(np.abs(residual(mech.constraints, mech.tree, state, q)), axis=-1)
-
-
 def _reference3(mech: Mechanism) -> tuple[int, int, int]:
     """(generic passive rank, mobility DOF, generic rank of K): the compiled model's reference rank."""
     m = compile_model(mech)
