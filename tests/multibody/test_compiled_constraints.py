@@ -1,9 +1,9 @@
-"""The closure residual, the velocity constraint matrix K, its rate dK/dt and the singularity measures:
-the compiled kernels (``_compiled.resjac_block``, ``_compiled.kdot_block``) against their numpy formulation
-(``_constraints``, through tests/multibody/_reference.py) on closed chains (Delta, a five-bar typed
-unassembled, Sarrus, Tsai 3-UPU, Bennett's weld), a polynomial coupling, an open chain and a floating-base
-tree, at batch 1 and at batches below and above the kernels' block size (``_compiled.BLOCK`` samples run
-in one block in the calling thread, more in parallel blocks).
+"""The closure residual, the velocity constraint matrix K, its rate dK/dt, the singularity measures, site
+poses and energies: the compiled kernels (``_compiled.resjac_block``, ``kdot_block``, ``site_pose_block``,
+``energy_block``) against their numpy formulation (tests/multibody/_reference.py) on closed chains (Delta,
+a five-bar typed unassembled, Sarrus, Tsai 3-UPU, Bennett's weld), a polynomial coupling, an open chain
+and a floating-base tree, at batch 1 and at batches below and above the kernels' block size
+(``_compiled.BLOCK`` samples run in one block in the calling thread, more in parallel blocks).
 """
 
 from __future__ import annotations
@@ -127,3 +127,28 @@ def test_coupling_rate_equals_finite_differences():
     ) / (2 * h)
     # central differences: truncation h^2 |K'''| ~ 1e-12 plus rounding eps / h ~ 1e-10
     assert np.max(np.abs(mb.constraint_jacobian_rate(mech, q, qd) - fd)) <= 1e-8
+
+
+# Poses: products of a few 4x4 matrices in another order, a few ulps.  Energies: sums over the bodies of
+# products of O(1) rates and O(1-10) masses and inertias, a few ulps of the largest term.
+POSE_RTOL = 1e-13
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_site_pose_and_energy_equal_numpy_at_every_batch_size(name):
+    mech = _get(name)
+    rng = np.random.default_rng(5)
+    q = _configurations(mech, N, seed=5)
+    qd = rng.normal(size=(N, mech.nv))
+    site = mech.sites[0].name
+    got = (mb.site_pose(mech, q, site), *mb.energy(mech, q, qd))
+    with numpy_reference():
+        ref = (mb.site_pose(mech, q, site), *mb.energy(mech, q, qd))
+    for a, b, what in zip(got, ref, ("site_pose", "kinetic", "potential"), strict=True):
+        _close(a, b, POSE_RTOL, what)
+    assert np.all(got[1] > 0.0)  # every sample moves: a kinetic energy that is not zero by construction
+    for n in SIZES[:-1]:
+        qs, qds = (q[:n], qd[:n]) if n > 1 else (q[0], qd[0])
+        part = (mb.site_pose(mech, qs, site), *mb.energy(mech, qs, qds))
+        for a, b, what in zip(part, got, ("site_pose", "kinetic", "potential"), strict=True):
+            _close(a if n > 1 else a[None], b[:n], BATCH_RTOL, f"{what} at batch {n}")

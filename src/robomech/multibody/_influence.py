@@ -195,11 +195,12 @@ def site_pose(mech: Mechanism, q: object, site: str) -> np.ndarray:
     mech = check_mechanism(mech)
     si = _site_index(mech, site)
     qf, batch = _flat(mech, q)
-    from ._tree import body_poses
+    from ._compiled import compiled_site_pose  # numba loads on the first kernel call
 
+    model = compile_model(mech)
     (T,) = on_rows(
         failed_rows(qf),
-        lambda qs: (body_poses(mech.tree, qs)[:, mech.tree.site_body[si]] @ mech.tree.T_site[si],),
+        lambda qs: (compiled_site_pose(model, qs, si),),
         qf,
         probe=(mech.tree.q0[None],),
     )
