@@ -144,6 +144,15 @@ def _scaled_output_jacobian(mech: Mechanism, qf: np.ndarray, si: int, L: float, 
     return r, K, col, J
 
 
+def _reference_mobility(mech: Mechanism, ref_q: np.ndarray | None):
+    """``mobility(mech, ref_q)``, cached per mechanism and reference (a frozen result)."""
+    cache = compile_model(mech).cache.setdefault("_sing_mobility", {})
+    key = None if ref_q is None else ref_q.tobytes()
+    if key not in cache:
+        cache[key] = mobility(mech, ref_q)
+    return cache[key]
+
+
 def _generic_output_rank(
     mech: Mechanism, si: int, L: float, rows: tuple[int, ...], ref_q, rtol: float
 ) -> int:
@@ -233,7 +242,7 @@ def singularities(
         if reference.ndim != 1:
             raise ValueError(f"Expected reference to have shape ({mech.nq},), got {reference.shape}.")
     out_rows = _rows(output)
-    ref = mobility(mech, reference)
+    ref = _reference_mobility(mech, reference)
     batch = q.shape[:-1]
 
     def run(qf: np.ndarray) -> tuple:
@@ -414,7 +423,7 @@ def singularity_map(
     # keep the rows the output actually uses (rank of the reference), so that a 3-DOF site is not
     # judged singular for the 3 directions it never moves in
     U = np.linalg.svd(J, full_matrices=False)[0]
-    J = np.einsum("nij,nik->njk", U, J)[:, : max(1, mobility(mech).dof)]
+    J = np.einsum("nij,nik->njk", U, J)[:, : max(1, _reference_mobility(mech, None).dof)]
     wm = workspace.singularity_map(J)
     nan = np.nan
 
