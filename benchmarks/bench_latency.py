@@ -19,8 +19,10 @@
 * the Delta's closed-chain ``mb.forward_dynamics`` (actuated-rates form) at batch 1 and 10^4 samples.
 
 * ``--moved`` (:func:`moved_rows`): the Delta's ``mb.influence``, ``mb.site_hessian``,
-  ``mb.site_wrench``, full-rate ``mb.inverse_dynamics`` and a short ``mb.simulate`` at batch 1 and 10^4
-  samples (run on two source trees in turn for a before / after comparison).
+  ``mb.site_wrench``, full-rate ``mb.inverse_dynamics``, a short ``mb.simulate``, the closure functions
+  (``constraint_residual``, ``constraint_jacobian``, ``constraint_jacobian_rate``), ``singularities``,
+  ``site_pose`` and ``energy`` at batch 1 and 10^4 samples (run on two source trees in turn for a
+  before / after comparison).
 
 The compared measurements are taken in interleaved rounds (:func:`_interleaved`: in each round
 robomech and every alternative in turn) and reported as the minimum and the median over the rounds,
@@ -333,7 +335,8 @@ N_SIM = 20  # simulate: initial conditions of the batch row (each integrated on 
 
 def moved_rows() -> list[str]:
     """The Delta's ``influence``, ``site_hessian``, ``site_wrench``, full-rate ``inverse_dynamics``
-    (``qd=``, ``qdd=``) and a short ``simulate`` (0.05 s, 6 output times): per call at batch 1 and per
+    (``qd=``, ``qdd=``), a short ``simulate`` (0.05 s, 6 output times), the closure functions,
+    ``singularities``, ``site_pose`` and ``energy``: per call at batch 1 and per
     sample at 10^4 (``simulate``: ``N_SIM`` initial conditions), min / median over interleaved rounds."""
     mech = mb.gallery.load("delta")
     q, qd, qdd = _states(mech, N_MOVED)
@@ -346,6 +349,12 @@ def moved_rows() -> list[str]:
         "site_wrench": lambda s: mb.site_wrench(mech, q[s], "tcp", tau[s]),
         "inverse_dynamics (qd=, qdd=)": lambda s: mb.inverse_dynamics(mech, q[s], qd=fq[s], qdd=fqd[s]),
         "simulate (0.05 s)": lambda s: mb.simulate(mech, q[s], qd[s], t),
+        "constraint_residual": lambda s: mb.constraint_residual(mech, q[s]),
+        "constraint_jacobian": lambda s: mb.constraint_jacobian(mech, q[s]),
+        "constraint_jacobian_rate": lambda s: mb.constraint_jacobian_rate(mech, q[s], fq[s]),
+        "singularities": lambda s: mb.singularities(mech, q[s], "tcp"),
+        "site_pose": lambda s: mb.site_pose(mech, q[s], "tcp"),
+        "energy": lambda s: mb.energy(mech, q[s], fq[s]),
     }
     for fn in calls.values():  # compile / load every kernel outside the timing
         fn(0), fn(slice(0, 100))

@@ -16,7 +16,7 @@ import numpy as np
 from robomech.dynamics import _com_terms
 from robomech.multibody import _compiled, _dynamics, _rnea, _rnea_kernels
 from robomech.multibody import _dynamics as D
-from robomech.multibody._constraints import jacobian, jacobian_rate, residual
+from robomech.multibody._constraints import Constraints, _points, _poly, jacobian, residual
 from robomech.multibody._model import Mechanism
 from robomech.multibody._options import (
     ADMISSIBLE_RTOL,
@@ -36,13 +36,71 @@ from robomech.multibody._options import (
     STOP_RTOL,
 )
 from robomech.multibody._tree import (
+    Tree,
     TreeState,
     frame_jacobian,
-    frame_jacobian_rate,
     integrate,
     kinematics,
-    screw_rates,
 )
+
+
+# ----------------------------------------------------------------------------- dK/dt
+# The numpy formulation of _compiled.screw_rates_into, point_rate and kdot_block (batched over samples).
+def screw_rates(tree: Tree, state: TreeState, qd: np.ndarray) -> np.ndarray:
+    """``dS/dt (N, ..., nv, 6)`` along ``qd (N, ..., nv)``: ``[V_c, S_k]`` with V_c the carrier twist."""
+    S = state.S.reshape(state.S.shape[0], *(1,) * (qd.ndim - 2), *state.S.shape[1:])
+    Vc = np.einsum("kj,...jx,...j->...kx", tree.C, S, qd)
+    wc, vc = Vc[..., :3], Vc[..., 3:]
+    ws, vs = S[..., :3], S[..., 3:]
+    return np.concatenate([np.cross(wc, ws), np.cross(wc, vs) - np.cross(ws, vc)], axis=-1)
+
+
+def frame_jacobian_rate(
+    tree: Tree, state: TreeState, Sd: np.ndarray, body: int, point: np.ndarray, qd: np.ndarray
+) -> np.ndarray:
+    """Time derivative of :func:`frame_jacobian` along ``qd (N, ..., nv)`` with ``Sd = screw_rates(...)``.
+
+    Column k: ``[dω_k; dv_k + dω_k × p + ω_k × ṗ]`` with ``ṗ = v_b + ω_b × p``; (N, ..., 6, nv).
+    """
+    extra = qd.ndim - 2
+    S = state.S.reshape(state.S.shape[0], *(1,) * extra, *state.S.shape[1:])
+    p = point.reshape(point.shape[0], *(1,) * extra, 3)
+    mask = tree.A[body][:, None]
+    V = np.einsum("k,...kx,...k->...x", tree.A[body], S, qd)
+    pd = V[..., 3:] + np.cross(V[..., :3], p)
+    dw = Sd[..., :3] * mask
+    dv = (
+        Sd[..., 3:] + np.cross(Sd[..., :3], p[..., None, :]) + np.cross(S[..., :3], pd[..., None, :])
+    ) * mask
+    return np.concatenate([dw, dv], axis=-1).swapaxes(-1, -2)
+
+
+def jacobian_rate(
+    cs: Constraints, tree: Tree, state: TreeState, Sd: np.ndarray, q: np.ndarray, qd: np.ndarray
+) -> np.ndarray:
+    """``dK/dt (N, ..., m, nv)`` along ``qd (N, ..., nv)`` (``Sd = screw_rates(tree, state, qd)``)."""
+    L = tree.length
+    extra = qd.ndim - 2
+    out = []
+    for k, d in cs.blocks:
+        if k == "point":
+            b1, _x1, b2, _x2 = d
+            p1, p2 = _points(state, *d)
+            out.append(
+                frame_jacobian_rate(tree, state, Sd, b1, p1, qd)[..., 3:, :]
+                - frame_jacobian_rate(tree, state, Sd, b2, p2, qd)[..., 3:, :]
+            )
+        elif k == "rot":
+            b1, _, b2 = d
+            out.append(L * Sd[..., :3].swapaxes(-1, -2) * (tree.A[b2] - tree.A[b1]))
+        else:
+            _d1, _, _, d2, q2, ref2, c, s = d
+            row = np.zeros((*qd.shape[:-1], 1, tree.nv))
+            if d2 >= 0:
+                x = (q[:, q2] - ref2).reshape(-1, *(1,) * extra)
+                row[..., 0, d2] = -s * _poly(c, x)[2] * qd[..., d2]
+            out.append(row)
+    return np.concatenate(out, axis=-2) if out else np.zeros((*qd.shape[:-1], 0, tree.nv))
 
 
 # ----------------------------------------------------------------------------- influence coefficients
@@ -150,7 +208,6 @@ def _path(tree, b: int) -> np.ndarray:
 def constraint_matrix(mech: Mechanism, state, q: np.ndarray) -> np.ndarray:
     """``K (N, m, nv)`` as ``_constraints.jacobian`` builds it (same rows, same order), with the point
     rows' cross products in component arithmetic (the dynamics' hot path; tested equal)."""
-    from robomech.multibody._constraints import _poly
 
     tree, cs = mech.tree, mech.constraints
     N, nv = q.shape[0], tree.nv
@@ -193,7 +250,6 @@ def kdot_qd(mech: Mechanism, state, q: np.ndarray, qd: np.ndarray, Sd: np.ndarra
     ``_constraints.jacobian_rate`` builds ``Kdot``, without forming the (N, m, nv) matrix: a point row is
     the difference of the two anchors' ``dVd_v + dVd_w x p + w x pdot`` (``Vd = sum_k A Sd_k qd_k``), a
     rotation row ``L (Vd_w2 - Vd_w1)``, a coupling row ``-s poly''(x) qd2^2``."""
-    from robomech.multibody._constraints import _poly
 
     tree, cs = mech.tree, mech.constraints
     V = tree.A @ (state.S * qd[..., None])
@@ -406,7 +462,7 @@ def numpy_closure_terms(model, q, qd, W, wsb, wT):
     for s, b in enumerate(wsb):
         p = (state.T[:, b] @ wT[s])[:, :3, 3]
         ext -= np.einsum("nik,ni->nk", frame_jacobian(tree, state, b, p), W[:, s])
-    return K, kdq, ext, D._closure_error(model, state, q)
+    return K, kdq, ext, _closure_error(model, state, q)
 
 
 def numpy_project(model, q, qd):
@@ -419,11 +475,78 @@ def numpy_project(model, q, qd):
     return qd - np.einsum("nij,njk,nk->ni", Kp, K, qd)
 
 
+def _closure_error(mech, state, q: np.ndarray) -> np.ndarray:
+    """Largest closure row ``max |phi(q)|`` (m) per sample; 0 for a tree."""
+    if mech.constraints.m == 0:
+        return np.zeros(q.shape[0])
+    return np.max(np.abs(residual(mech.constraints, mech.tree, state, q)), axis=-1)
+
+
+def numpy_resjac(model, q: np.ndarray, with_jac: bool) -> tuple:
+    """The numpy formulation of ``_compiled.compiled_resjac``: the closure residual and K."""
+    st = kinematics(model.tree, q)
+    r = residual(model.constraints, model.tree, st, q)
+    return r, (jacobian(model.constraints, model.tree, st, q) if with_jac else None)
+
+
+def numpy_jacobian_rate(model, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """The numpy formulation of ``_compiled.compiled_jacobian_rate``: dK/dt along ``qd``."""
+    st = kinematics(model.tree, q)
+    return jacobian_rate(model.constraints, model.tree, st, screw_rates(model.tree, st, qd), q, qd)
+
+
+# ----------------------------------------------------------------------------- site pose and energy
+# The numpy formulation of _compiled.site_pose_block and energy_block.
+def _com_jacobians(tree, state, bd, qd: np.ndarray | None, Sd: np.ndarray | None):
+    """Centre-of-mass points (N, B, 3), Jacobians (N, B, 6, nv) and ``Jdot qd`` (N, B, 6)."""
+    T = state.T[:, bd.idx]
+    p = (T[..., :3, :3] @ bd.com[:, :, None])[..., 0] + T[..., :3, 3]
+    S = state.S
+    A = tree.A[bd.idx]  # (B, nv)
+    Sw, Sv = S[..., :3], S[..., 3:]
+    Jw = Sw[:, None] * A[None, :, :, None]  # (N, B, nv, 3)
+    Jv = (Sv[:, None] + np.cross(Sw[:, None], p[:, :, None])) * A[None, :, :, None]
+    J = np.concatenate([Jw, Jv], axis=-1).swapaxes(-1, -2)
+    a0 = None
+    if qd is not None:
+        V = A @ (S * qd[..., None])
+        Vd = A @ (Sd * qd[..., None])
+        w = V[..., :3]
+        pd = V[..., 3:] + np.cross(w, p)
+        a0 = np.concatenate([Vd[..., :3], Vd[..., 3:] + np.cross(Vd[..., :3], p) + np.cross(w, pd)], axis=-1)
+    return p, J, a0
+
+
+def numpy_energy(model, q: np.ndarray, qd: np.ndarray, gv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Kinetic and potential energy (N,) each: the numpy formulation of ``_compiled.compiled_energy``."""
+    tree = model.tree
+    bd = model.bodies
+    st = kinematics(tree, q)
+    p, J, _ = _com_jacobians(tree, st, bd, None, None)
+    V = np.einsum("nbik,nk->nbi", J, qd)
+    R = st.T[:, bd.idx, :3, :3]
+    Iw = R @ bd.inertia @ R.swapaxes(-1, -2)
+    w, v = V[..., :3], V[..., 3:]
+    T = 0.5 * (np.einsum("nbi,nbij,nbj->n", w, Iw, w) + np.einsum("b,nbi,nbi->n", bd.mass, v, v))
+    U = -np.einsum("b,nbi,i->n", bd.mass, p, gv)
+    return T, U
+
+
+def numpy_site_pose(model, q: np.ndarray, site: int) -> np.ndarray:
+    """The numpy formulation of ``_compiled.compiled_site_pose``: the body pose times the site's."""
+    tree = model.tree
+    return kinematics(tree, q).T[:, tree.site_body[site]] @ tree.T_site[site]
+
+
 _SWAPS = {
     "compiled_fk": numpy_fk,
     "compiled_site_jacobian": numpy_site_jacobian,
     "compiled_influence": numpy_compiled_influence,
     "compiled_project": numpy_project,
+    "compiled_resjac": numpy_resjac,
+    "compiled_jacobian_rate": numpy_jacobian_rate,
+    "compiled_site_pose": numpy_site_pose,
+    "compiled_energy": numpy_energy,
 }
 _SWAPS_DYNAMICS = {
     "_inverse_compiled": lambda *a, **k: _inverse_flat(*a, **k),
@@ -434,8 +557,9 @@ _SWAPS_DYNAMICS = {
 
 @contextlib.contextmanager
 def numpy_reference():
-    """Inside the block, FK, site Jacobians, influence coefficients, site Hessians, the closure terms,
-    the velocity projection, inverse and forward dynamics run the numpy formulation."""
+    """Inside the block, FK, the closure residual, K and dK/dt, site poses, energies, site Jacobians,
+    influence coefficients, site Hessians, the closure terms, the velocity projection, inverse and
+    forward dynamics run the numpy formulation."""
     saved = {k: getattr(_compiled, k) for k in _SWAPS}
     saved_rank = _rnea_kernels.passive_rank_measures
     _rnea_kernels.passive_rank_measures = numpy_passive_rank_measures
@@ -706,7 +830,7 @@ def _inverse_flat(mech, q, qd_a, qdd_a, wr, weights, gravity=True):
         sigma_min=smin,
         admissibility=adm,
         valid=valid,
-        closure=D._closure_error(mech, state, q),
+        closure=_closure_error(mech, state, q),
     )
 
 

@@ -3,9 +3,11 @@ Hessians, inverse dynamics.
 
 The one implementation of each of these algorithms, for every batch size (batch 1 included): tree
 kinematics, closure residual and velocity constraint matrix (the formulas of ``_tree`` and
-``_constraints``, written per sample), the Levenberg–Marquardt assembly (damping, step cap and stopping
-rules of ``_options``), ``G = [I; -K_p^+ K_a]`` by the SVD pseudo-inverse (:func:`influence_G`) with the
-site's ``[ω; ṗ]`` Jacobian, the second-order coefficients ``∂G/∂q_act`` and site Hessians
+``_constraints``, written per sample; :func:`resjac_block` for ``constraint_residual``,
+``constraint_jacobian`` and ``singularities``, :func:`kdot_block` for ``dK/dt``), the
+Levenberg–Marquardt assembly (damping, step cap and stopping rules of ``_options``),
+``G = [I; -K_p^+ K_a]`` by the SVD pseudo-inverse (:func:`influence_G`) with the site's ``[ω; ṗ]``
+Jacobian, the second-order coefficients ``∂G/∂q_act`` and site Hessians
 (:func:`influence_block`, from ``(dK/dt along u) v``, :func:`kdot_uv`), the velocity projection of
 ``simulate`` (:func:`project_block`), and the closed-chain inverse dynamics (:func:`inv_dyn`: passive
 pseudo-inverse, screw rates, ``K̇ q̇``, the bodies' Newton–Euler terms through ``G``, site wrenches, the
@@ -26,10 +28,14 @@ from . import _options as opt
 from ._compile import compile_model
 
 __all__ = [
+    "compiled_energy",
     "compiled_fk",
     "compiled_influence",
+    "compiled_jacobian_rate",
     "compiled_project",
+    "compiled_resjac",
     "compiled_site_jacobian",
+    "compiled_site_pose",
     "inv_dyn",
 ]
 
@@ -695,6 +701,61 @@ def site_jac_par(Q, act, pas, sb, Tsite, t, rtol, J_out):  # pragma: no cover
         site_jac_block(Q, k * BLOCK, min(N, (k + 1) * BLOCK), act, pas, sb, Tsite, t, rtol, J_out)
 
 
+@_nj
+def resjac_block(Q, lo, hi, t, with_jac, R_o, K_o):  # pragma: no cover - compiled
+    """The closure residual ``R_o (N, m)`` and, with ``with_jac``, the velocity constraint matrix
+    ``K_o (N, m, nv)`` (:func:`resjac`) of samples ``lo:hi`` of ``Q (N, nq)``."""
+    nb = t.parent.shape[0]
+    nv = t.A.shape[1]
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    K = np.empty((t.m, nv))
+    for n in range(lo, hi):
+        kin(Q[n], t, T, S)
+        resjac(Q[n], t, T, S, R_o[n], K_o[n] if with_jac else K, with_jac)
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def resjac_par(Q, t, with_jac, R_o, K_o):  # pragma: no cover - compiled
+    """:func:`resjac_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        resjac_block(Q, k * BLOCK, min(N, (k + 1) * BLOCK), t, with_jac, R_o, K_o)
+
+
+@_nj
+def kdot_block(Q, QD, lo, hi, t, KD_o):  # pragma: no cover - compiled
+    """``dK/dt`` along ``QD (N, nv)`` into ``KD_o (N, m, nv)`` for samples ``lo:hi``: column ``k`` is
+    :func:`kdot_uv` with ``u = qd`` and ``v`` the ``k``-th unit vector."""
+    nb = t.parent.shape[0]
+    nv = t.A.shape[1]
+    m = t.m
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    Sd = np.empty((nv, 6))
+    e = np.zeros(nv)
+    Vu, Vv, Vd = np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nb, 6))
+    kd = np.empty(m)
+    for n in range(lo, hi):
+        q, qd = Q[n], QD[n]
+        kin(q, t, T, S)
+        screw_rates_into(t, S, qd, Sd)
+        for k in range(nv):
+            e[k] = 1.0
+            kdot_uv(q, t, T, S, Sd, qd, e, Vu, Vv, Vd, kd)
+            e[k] = 0.0
+            for i in range(m):
+                KD_o[n, i, k] = kd[i]
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def kdot_par(Q, QD, t, KD_o):  # pragma: no cover - compiled
+    """:func:`kdot_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        kdot_block(Q, QD, k * BLOCK, min(N, (k + 1) * BLOCK), t, KD_o)
+
+
 # ----------------------------------------------------------------------------- inverse dynamics
 @_nj
 def _cross_into(a0, a1, a2, b0, b1, b2, out, o):  # pragma: no cover - compiled
@@ -948,22 +1009,31 @@ def passive_solve(Kp, Gi, P, mode, nref, b, x, res, dx, tmp):  # pragma: no cove
 
 
 @_nj
+def row_twist(a, S, u):  # pragma: no cover - compiled
+    """The twist ``sum_j a_j u_j S_j`` (6 floats) of the screws ``S (nv, 6)`` at rates ``u`` over the row
+    ``a (nv,)`` of a 0/1 ancestry matrix (``A[b]``: body b's twist; ``C[k]``: coordinate k's carrier)."""
+    c0 = c1 = c2 = c3 = c4 = c5 = 0.0
+    for j in range(S.shape[0]):
+        if a[j] != 0.0:
+            f = a[j] * u[j]
+            c0 += f * S[j, 0]
+            c1 += f * S[j, 1]
+            c2 += f * S[j, 2]
+            c3 += f * S[j, 3]
+            c4 += f * S[j, 4]
+            c5 += f * S[j, 5]
+    return c0, c1, c2, c3, c4, c5
+
+
+@_nj
 def screw_rates_into(t, S, u, Sd):  # pragma: no cover - compiled
     """The screw rates ``Sd (nv, 6)`` along the motion ``u (nv,)``: ``dS_k = [w_c x w_k; w_c x v_k -
-    w_k x v_c]``, ``V_c`` the carrier twist of coordinate ``k`` (``_tree.screw_rates``)."""
+    w_k x v_c]``, ``V_c`` the carrier twist of coordinate ``k`` (``screw_rates`` of the tests' numpy
+    reference)."""
     C = t.C
     nv = S.shape[0]
     for k in range(nv):
-        c0 = c1 = c2 = c3 = c4 = c5 = 0.0
-        for j in range(nv):
-            if C[k, j] != 0.0:
-                f = C[k, j] * u[j]
-                c0 += f * S[j, 0]
-                c1 += f * S[j, 1]
-                c2 += f * S[j, 2]
-                c3 += f * S[j, 3]
-                c4 += f * S[j, 4]
-                c5 += f * S[j, 5]
+        c0, c1, c2, c3, c4, c5 = row_twist(C[k], S, u)
         w0, w1, w2, v0, v1, v2 = S[k, 0], S[k, 1], S[k, 2], S[k, 3], S[k, 4], S[k, 5]
         Sd[k, 0] = c1 * w2 - c2 * w1
         Sd[k, 1] = c2 * w0 - c0 * w2
@@ -977,7 +1047,7 @@ def screw_rates_into(t, S, u, Sd):  # pragma: no cover - compiled
 def point_rate(Vu, Vv, Vd, b, p0, p1, p2):  # pragma: no cover - compiled
     """``(dJ_p/dt along u) v`` of the world point ``p`` fixed in body ``b``, from the body twists ``Vu``
     (of ``u``), ``Vv`` (of ``v``) and ``Vd = sum_k A Sd_k(u) v_k``: ``dVd_v + dVd_w x p + w_v x pdot_u``
-    with ``pdot_u = v_u + w_u x p`` (``_tree.frame_jacobian_rate`` applied to ``v``)."""
+    with ``pdot_u = v_u + w_u x p`` (the tests' numpy ``frame_jacobian_rate`` applied to ``v``)."""
     w0, w1, w2 = Vu[b, 0], Vu[b, 1], Vu[b, 2]
     pd0 = Vu[b, 3] + w1 * p2 - w2 * p1
     pd1 = Vu[b, 4] + w2 * p0 - w0 * p2
@@ -994,7 +1064,7 @@ def point_rate(Vu, Vv, Vd, b, p0, p1, p2):  # pragma: no cover - compiled
 @_nj
 def kdot_uv(q, t, T, S, Sd, u, v, Vu, Vv, Vd, kd):  # pragma: no cover - compiled
     """``kd = (dK/dt along u) v (m,)`` with ``Sd`` the screw rates along ``u`` (:func:`screw_rates_into`),
-    block by block as ``_constraints.jacobian_rate`` builds ``dK/dt``: a point row is the difference
+    block by block as the tests' numpy ``jacobian_rate`` builds ``dK/dt``: a point row is the difference
     of the two anchors' :func:`point_rate`, a rotation row ``L (Vd_w2 - Vd_w1)``, a coupling row
     ``-s poly''(x) u_2 v_2``.  Also fills the body twists ``Vu = A S u``, ``Vv = A S v`` and ``Vd =
     sum_k A Sd_k v_k`` (nb, 6); ``Vu`` and ``Vv`` may be one array where ``u`` is ``v``."""
@@ -1569,6 +1639,32 @@ def compiled_influence(model, q: np.ndarray, second: bool, site: int = -1) -> tu
     return G, (dG if second else None), (H if second and site >= 0 else None), rank, cons, smin, cond
 
 
+def compiled_resjac(model, q: np.ndarray, with_jac: bool) -> tuple[np.ndarray, np.ndarray | None]:
+    """The closure residual ``(N, m)`` and, with ``with_jac``, the velocity constraint matrix
+    ``K (N, m, nv)`` (else None) at ``q (N, nq)`` (:func:`resjac_block`)."""
+    Q = writable(q)
+    N, m, nv = Q.shape[0], model.tables.m, model.tree.nv
+    R = np.empty((N, m))
+    K = np.empty((N if with_jac else 0, m, nv))
+    if N <= BLOCK:
+        entry(model, resjac_block, "resjac_block", (Q, 0, N, model.tables, bool(with_jac), R, K))
+    else:
+        resjac_par(Q, model.tables, bool(with_jac), R, K)
+    return R, (K if with_jac else None)
+
+
+def compiled_jacobian_rate(model, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """``dK/dt (N, m, nv)`` along ``qd (N, nv)`` at ``q (N, nq)`` (:func:`kdot_block`)."""
+    Q, QD = writable(q), writable(qd)
+    N = Q.shape[0]
+    KD = np.empty((N, model.tables.m, model.tree.nv))
+    if N <= BLOCK:
+        entry(model, kdot_block, "kdot_block", (Q, QD, 0, N, model.tables, KD))
+    else:
+        kdot_par(Q, QD, model.tables, KD)
+    return KD
+
+
 # ----------------------------------------------------------------------------- tree inverse dynamics (RNEA)
 @_nj
 def _mcross(w0, w1, w2, v0, v1, v2, S, k, out, f):  # pragma: no cover - compiled
@@ -1789,6 +1885,102 @@ def compiled_rnea(model, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray, gv: np.
     else:
         rnea_par(Q, QD, QDD, gv, model.rnea, tau)
     return tau
+
+
+# ----------------------------------------------------------------------------- site pose and energy
+@_nj
+def site_pose_block(Q, lo, hi, t, sb, Tsite, T_o):  # pragma: no cover - compiled
+    """World pose ``T_o (N, 4, 4)`` of the site at ``Tsite`` in body ``sb`` for samples ``lo:hi``."""
+    nb = t.parent.shape[0]
+    nv = t.A.shape[1]
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    for n in range(lo, hi):
+        kin(Q[n], t, T, S)
+        for i in range(4):
+            for j in range(4):
+                T_o[n, i, j] = (
+                    T[sb, i, 0] * Tsite[0, j]
+                    + T[sb, i, 1] * Tsite[1, j]
+                    + T[sb, i, 2] * Tsite[2, j]
+                    + T[sb, i, 3] * Tsite[3, j]
+                )
+
+
+@_nj
+def energy_block(Q, QD, lo, hi, t, d, gv, K_o, U_o):  # pragma: no cover - compiled
+    """Kinetic ``K_o (N,)`` and potential ``U_o (N,)`` energy of the massive bodies (``d`` the dynamics
+    tables) for samples ``lo:hi``: ``1/2 (w . I_c w + m |v_c|^2)`` with the centre of mass velocity
+    ``v_c = v + w x c`` of the body twist ``[w; v] = sum_k A S_k qd_k``, and ``-m g . c``."""
+    nb = t.parent.shape[0]
+    nv = t.A.shape[1]
+    A = t.A
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    c, Ic, RI = np.empty(3), np.empty((3, 3)), np.empty((3, 3))
+    for n in range(lo, hi):
+        qd = QD[n]
+        kin(Q[n], t, T, S)
+        kin_e = 0.0
+        pot = 0.0
+        for ib in range(d.bidx.shape[0]):
+            b = d.bidx[ib]
+            m = d.mass[ib]
+            inertia_world(T, d, ib, c, Ic, RI)
+            w0, w1, w2, v0, v1, v2 = row_twist(A[b], S, qd)
+            c0 = v0 + w1 * c[2] - w2 * c[1]
+            c1 = v1 + w2 * c[0] - w0 * c[2]
+            c2 = v2 + w0 * c[1] - w1 * c[0]
+            Iw0 = Ic[0, 0] * w0 + Ic[0, 1] * w1 + Ic[0, 2] * w2
+            Iw1 = Ic[1, 0] * w0 + Ic[1, 1] * w1 + Ic[1, 2] * w2
+            Iw2 = Ic[2, 0] * w0 + Ic[2, 1] * w1 + Ic[2, 2] * w2
+            kin_e += 0.5 * (w0 * Iw0 + w1 * Iw1 + w2 * Iw2 + m * (c0 * c0 + c1 * c1 + c2 * c2))
+            pot -= m * (gv[0] * c[0] + gv[1] * c[1] + gv[2] * c[2])
+        K_o[n] = kin_e
+        U_o[n] = pot
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def energy_par(Q, QD, t, d, gv, K_o, U_o):  # pragma: no cover - compiled
+    """:func:`energy_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        energy_block(Q, QD, k * BLOCK, min(N, (k + 1) * BLOCK), t, d, gv, K_o, U_o)
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def site_pose_par(Q, t, sb, Tsite, T_o):  # pragma: no cover - compiled
+    """:func:`site_pose_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        site_pose_block(Q, k * BLOCK, min(N, (k + 1) * BLOCK), t, sb, Tsite, T_o)
+
+
+def compiled_site_pose(model, q: np.ndarray, site: int) -> np.ndarray:
+    """World pose ``(N, 4, 4)`` of site index ``site`` at ``q (N, nq)`` (:func:`site_pose_block`)."""
+    tree = model.tree
+    Q = writable(q)
+    N = Q.shape[0]
+    T = np.empty((N, 4, 4))
+    sb, Tsite = int(tree.site_body[site]), np.ascontiguousarray(tree.T_site[site], dtype=float)
+    if N <= BLOCK:
+        entry(model, site_pose_block, "site_pose_block", (Q, 0, N, model.tables, sb, Tsite, T))
+    else:
+        site_pose_par(Q, model.tables, sb, Tsite, T)
+    return T
+
+
+def compiled_energy(model, q: np.ndarray, qd: np.ndarray, gv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Kinetic and potential energy ``(N,)`` each at ``q (N, nq)``, ``qd (N, nv)`` under gravity ``gv``
+    (:func:`energy_block`)."""
+    Q, QD, gv = writable(q), writable(qd), writable(gv)
+    N = Q.shape[0]
+    Kin, U = np.empty(N), np.empty(N)
+    if N <= BLOCK:
+        entry(model, energy_block, "energy_block", (Q, QD, 0, N, model.tables, model.dyn, gv, Kin, U))
+    else:
+        energy_par(Q, QD, model.tables, model.dyn, gv, Kin, U)
+    return Kin, U
 
 
 def warm() -> None:

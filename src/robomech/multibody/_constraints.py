@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._tree import Tree, TreeState, frame_jacobian, frame_jacobian_rate, quat_to_matrix
+from ._tree import Tree, TreeState, frame_jacobian, quat_to_matrix
 
-__all__ = ["Constraints", "compile_constraints", "jacobian", "jacobian_rate", "residual"]
+__all__ = ["Constraints", "compile_constraints", "jacobian", "residual"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -144,31 +144,3 @@ def jacobian(cs: Constraints, tree: Tree, state: TreeState, q: np.ndarray) -> np
                 row[:, 0, d2] -= s * _poly(c, q[:, q2] - ref2)[1]
             out.append(row)
     return np.concatenate(out, axis=-2) if out else np.zeros((N, 0, tree.nv))
-
-
-def jacobian_rate(
-    cs: Constraints, tree: Tree, state: TreeState, Sd: np.ndarray, q: np.ndarray, qd: np.ndarray
-) -> np.ndarray:
-    """``dK/dt (N, ..., m, nv)`` along ``qd (N, ..., nv)`` (``Sd = screw_rates(tree, state, qd)``)."""
-    L = tree.length
-    extra = qd.ndim - 2
-    out = []
-    for k, d in cs.blocks:
-        if k == "point":
-            b1, _x1, b2, _x2 = d
-            p1, p2 = _points(state, *d)
-            out.append(
-                frame_jacobian_rate(tree, state, Sd, b1, p1, qd)[..., 3:, :]
-                - frame_jacobian_rate(tree, state, Sd, b2, p2, qd)[..., 3:, :]
-            )
-        elif k == "rot":
-            b1, _, b2 = d
-            out.append(L * Sd[..., :3].swapaxes(-1, -2) * (tree.A[b2] - tree.A[b1]))
-        else:
-            _d1, _, _, d2, q2, ref2, c, s = d
-            row = np.zeros((*qd.shape[:-1], 1, tree.nv))
-            if d2 >= 0:
-                x = (q[:, q2] - ref2).reshape(-1, *(1,) * extra)
-                row[..., 0, d2] = -s * _poly(c, x)[2] * qd[..., d2]
-            out.append(row)
-    return np.concatenate(out, axis=-2) if out else np.zeros((*qd.shape[:-1], 0, tree.nv))

@@ -59,7 +59,6 @@ from ._options import (
     SINGULAR_COND,
 )
 from ._tree import (
-    kinematics,
     normalize_quaternions,
     quat_mul,
 )
@@ -116,54 +115,10 @@ def _rank_K(mech: Mechanism) -> int:
     return _reference3(mech)[2]
 
 
-def _closure_error(mech: Mechanism, state, q: np.ndarray) -> np.ndarray:
-    """Largest closure row ``max |phi(q)|`` (m) per sample; 0 for a tree."""
-    from ._constraints import residual
-
-    if mech.constraints.m == 0:
-        return np.zeros(q.shape[0])
-    return np.max(np.abs(residual(mech.constraints, mech.tree, state, q)), axis=-1)
-
-
 def _reference3(mech: Mechanism) -> tuple[int, int, int]:
     """(generic passive rank, mobility DOF, generic rank of K): the compiled model's reference rank."""
     m = compile_model(mech)
     return m.rank0, m.dof, m.rank_K
-
-
-# ----------------------------------------------------------------------------- tree kernels
-def _com_jacobians(tree, state, bd: Bodies, qd: np.ndarray | None, Sd: np.ndarray | None):
-    """Centre-of-mass points (N, B, 3), Jacobians (N, B, 6, nv) and ``Jdot qd`` (N, B, 6)."""
-    T = state.T[:, bd.idx]
-    p = (T[..., :3, :3] @ bd.com[:, :, None])[..., 0] + T[..., :3, 3]
-    S = state.S
-    A = tree.A[bd.idx]  # (B, nv)
-    Sw, Sv = S[..., :3], S[..., 3:]
-    Jw = Sw[:, None] * A[None, :, :, None]  # (N, B, nv, 3)
-    Jv = (Sv[:, None] + np.cross(Sw[:, None], p[:, :, None])) * A[None, :, :, None]
-    J = np.concatenate([Jw, Jv], axis=-1).swapaxes(-1, -2)
-    a0 = None
-    if qd is not None:
-        V = A @ (S * qd[..., None])
-        Vd = A @ (Sd * qd[..., None])
-        w = V[..., :3]
-        pd = V[..., 3:] + np.cross(w, p)
-        a0 = np.concatenate([Vd[..., :3], Vd[..., 3:] + np.cross(Vd[..., :3], p) + np.cross(w, pd)], axis=-1)
-    return p, J, a0
-
-
-def _energy_flat(mech: Mechanism, q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    tree = mech.tree
-    bd = _bodies(mech)
-    st = kinematics(tree, q)
-    p, J, _ = _com_jacobians(tree, st, bd, None, None)
-    V = np.einsum("nbik,nk->nbi", J, qd)
-    R = st.T[:, bd.idx, :3, :3]
-    Iw = R @ bd.inertia @ R.swapaxes(-1, -2)
-    w, v = V[..., :3], V[..., 3:]
-    T = 0.5 * (np.einsum("nbi,nbij,nbj->n", w, Iw, w) + np.einsum("b,nbi,nbi->n", bd.mass, v, v))
-    U = -np.einsum("b,nbi,i->n", bd.mass, p, np.asarray(mech.gravity))
-    return T, U
 
 
 # ----------------------------------------------------------------------------- validation helpers
@@ -1237,8 +1192,13 @@ def energy(mech: Mechanism, q: object, qd: object) -> tuple[np.ndarray, np.ndarr
     qf = np.broadcast_to(q, (*batch, mech.nq)).reshape(-1, mech.nq)
     qdf = np.broadcast_to(qd, (*batch, mech.nv)).reshape(-1, mech.nv)
 
+    from ._compiled import compiled_energy  # numba loads on the first kernel call
+
+    model = compile_model(mech)
+    gv = np.asarray(mech.gravity, dtype=float)
+
     def energies(qs: np.ndarray, qds: np.ndarray) -> tuple:
-        return _energy_flat(mech, qs, qds)
+        return compiled_energy(model, qs, qds, gv)
 
     (T, U) = on_rows(failed_rows(qf), energies, qf, qdf, probe=(mech.tree.q0[None], qdf[:1]))
     return np.reshape(T, batch), np.reshape(U, batch)
@@ -1516,8 +1476,14 @@ def simulate(
             fn_i = lambda tt, q, qd: _callback_forces(tau, tt, q, qd, na)  # noqa: E731
         Q[i], QD[i], W[i], RC[i], success[i] = _simulate_one(mech, q0f[i], qd0f[i], t, fn_i, gravity)
     from ._assembly import CONVERGED_RTOL
+    from ._compiled import compiled_energy
 
-    Tk, U = _energy_flat(mech, np.nan_to_num(Q.reshape(-1, tree.nq)), np.nan_to_num(QD.reshape(-1, tree.nv)))
+    Tk, U = compiled_energy(
+        compile_model(mech),
+        np.nan_to_num(Q.reshape(-1, tree.nq)),
+        np.nan_to_num(QD.reshape(-1, tree.nv)),
+        np.asarray(mech.gravity, dtype=float),
+    )
     Tk, U = Tk.reshape(N, nt), U.reshape(N, nt)
     E = Tk + U - W
     with np.errstate(all="ignore"):

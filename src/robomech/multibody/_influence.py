@@ -29,10 +29,8 @@ from robomech._validation import as_array, broadcast_batch, check_bool
 
 from ._assembly import check_mechanism, check_q
 from ._compile import compile_model
-from ._constraints import jacobian, jacobian_rate
 from ._model import Mechanism
 from ._options import PASSIVE_RANK_RTOL
-from ._tree import kinematics, screw_rates
 
 __all__ = [
     "PASSIVE_RANK_RTOL",
@@ -197,11 +195,12 @@ def site_pose(mech: Mechanism, q: object, site: str) -> np.ndarray:
     mech = check_mechanism(mech)
     si = _site_index(mech, site)
     qf, batch = _flat(mech, q)
-    from ._tree import body_poses
+    from ._compiled import compiled_site_pose  # numba loads on the first kernel call
 
+    model = compile_model(mech)
     (T,) = on_rows(
         failed_rows(qf),
-        lambda qs: (body_poses(mech.tree, qs)[:, mech.tree.site_body[si]] @ mech.tree.T_site[si],),
+        lambda qs: (compiled_site_pose(model, qs, si),),
         qf,
         probe=(mech.tree.q0[None],),
     )
@@ -339,13 +338,14 @@ def constraint_residual(mech: Mechanism, q: object) -> np.ndarray:
     >>> bool(np.max(np.abs(mb.constraint_residual(mech, q))) < 1e-9)
     True
     """
-    from ._constraints import residual
+    from ._compiled import compiled_resjac  # numba loads on the first kernel call
 
     mech = check_mechanism(mech)
     qf, batch = _flat(mech, q)
+    model = compile_model(mech)
     (r,) = on_rows(
         failed_rows(qf),
-        lambda qs: (residual(mech.constraints, mech.tree, kinematics(mech.tree, qs), qs),),
+        lambda qs: (compiled_resjac(model, qs, False)[0],),
         qf,
         probe=(mech.tree.q0[None],),
     )
@@ -383,11 +383,14 @@ def constraint_jacobian(mech: Mechanism, q: object) -> np.ndarray:
     >>> K.shape, bool(np.allclose(K @ mb.influence(mech, q).G, 0.0))
     ((3, 3), True)
     """
+    from ._compiled import compiled_resjac  # numba loads on the first kernel call
+
     mech = check_mechanism(mech)
     qf, batch = _flat(mech, q)
+    model = compile_model(mech)
     (K,) = on_rows(
         failed_rows(qf),
-        lambda qs: (jacobian(mech.constraints, mech.tree, kinematics(mech.tree, qs), qs),),
+        lambda qs: (compiled_resjac(model, qs, True)[1],),
         qf,
         probe=(mech.tree.q0[None],),
     )
@@ -434,9 +437,12 @@ def constraint_jacobian_rate(mech: Mechanism, q: object, qd: object) -> np.ndarr
     qf = np.broadcast_to(q, (*batch, mech.nq)).reshape(-1, mech.nq)
     qdf = np.broadcast_to(qd, (*batch, mech.nv)).reshape(-1, mech.nv)
 
+    from ._compiled import compiled_jacobian_rate  # numba loads on the first kernel call
+
+    model = compile_model(mech)
+
     def run(qs: np.ndarray, qds: np.ndarray) -> tuple:
-        st = kinematics(mech.tree, qs)
-        return (jacobian_rate(mech.constraints, mech.tree, st, screw_rates(mech.tree, st, qds), qs, qds),)
+        return (compiled_jacobian_rate(model, qs, qds),)
 
     (Kd,) = on_rows(failed_rows(qf), run, qf, qdf, probe=(mech.tree.q0[None], qdf[:1]))
     return Kd.reshape(*batch, *Kd.shape[1:])

@@ -43,10 +43,8 @@ from ._assembly import (
     inverse_kinematics,
 )
 from ._compile import compile_model
-from ._constraints import jacobian
 from ._mobility import mobility
 from ._model import Mechanism
-from ._tree import kinematics
 
 __all__ = ["SingularityMapResult", "SingularityResult", "singularities", "singularity_map"]
 
@@ -135,15 +133,24 @@ def _rows(output: object) -> tuple[int, ...]:
 
 
 def _scaled_output_jacobian(mech: Mechanism, qf: np.ndarray, si: int, L: float, rows: tuple[int, ...]):
-    from ._compiled import compiled_site_jacobian  # numba loads on the first kernel call
+    """(closure residual (N, m), K (N, m, nv), column scales (nv,), the scaled site Jacobian's ``rows``)."""
+    from ._compiled import compiled_resjac, compiled_site_jacobian  # numba loads on the first kernel call
 
     tree = mech.tree
-    state = kinematics(tree, qf)
-    K = jacobian(mech.constraints, tree, state, qf)
+    r, K = compiled_resjac(compile_model(mech), qf, True)
     col = np.where(tree.dof_translational, 1.0, L)
     scale = np.array([L, L, L, 1.0, 1.0, 1.0])
     J = (scale[:, None] * compiled_site_jacobian(mech, qf, si) / col[tree.act_dof])[:, list(rows)]
-    return state, K, col, J
+    return r, K, col, J
+
+
+def _reference_mobility(mech: Mechanism, ref_q: np.ndarray | None):
+    """``mobility(mech, ref_q)``, cached per mechanism and reference (a frozen result)."""
+    cache = compile_model(mech).cache.setdefault("_sing_mobility", {})
+    key = None if ref_q is None else ref_q.tobytes()
+    if key not in cache:
+        cache[key] = mobility(mech, ref_q)
+    return cache[key]
 
 
 def _generic_output_rank(
@@ -235,12 +242,12 @@ def singularities(
         if reference.ndim != 1:
             raise ValueError(f"Expected reference to have shape ({mech.nq},), got {reference.shape}.")
     out_rows = _rows(output)
-    ref = mobility(mech, reference)
+    ref = _reference_mobility(mech, reference)
     batch = q.shape[:-1]
 
     def run(qf: np.ndarray) -> tuple:
         # input-output Jacobian per scaled input rate: G maps unscaled rates; hinge inputs are per rad
-        state, K, col, J = _scaled_output_jacobian(mech, qf, si, L, out_rows)
+        res, K, col, J = _scaled_output_jacobian(mech, qf, si, L, out_rows)
         act = tree.act_dof
         pas = np.setdiff1d(np.arange(tree.nv), act)
         Ks = K * col  # K rows are already lengths
@@ -270,9 +277,10 @@ def singularities(
         sigma_I, cI = cond(sigma_I, sJ[:, 0] if sJ.shape[1] else np.ones(len(qf)))
         sigma_II, cII = cond(sigma_II, sP[:, 0] if sP.shape[1] else np.ones(len(qf)))
         sigma_C, cC = cond(sigma_C, sK[:, 0] if sK.shape[1] else np.ones(len(qf)))
-        return sigma_I, sigma_II, sigma_C, cI, cII, cC, _closure_error(mech, state, qf)
+        closure = np.max(np.abs(res), axis=-1, initial=0.0)  # the largest closure row (m); 0 for a tree
+        return sigma_I, sigma_II, sigma_C, cI, cII, cC, closure
 
-    from ._dynamics import CLOSURE_RTOL, _closure_error
+    from ._dynamics import CLOSURE_RTOL
 
     qf = q.reshape(-1, mech.nq)
     sigma_I, sigma_II, sigma_C, cI, cII, cC, closure = on_rows(
@@ -415,7 +423,7 @@ def singularity_map(
     # keep the rows the output actually uses (rank of the reference), so that a 3-DOF site is not
     # judged singular for the 3 directions it never moves in
     U = np.linalg.svd(J, full_matrices=False)[0]
-    J = np.einsum("nij,nik->njk", U, J)[:, : max(1, mobility(mech).dof)]
+    J = np.einsum("nij,nik->njk", U, J)[:, : max(1, _reference_mobility(mech, None).dof)]
     wm = workspace.singularity_map(J)
     nan = np.nan
 

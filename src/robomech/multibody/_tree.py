@@ -6,10 +6,8 @@ quantities:
 * :func:`kinematics` -> :class:`TreeState`: every body's pose ``T (N, nb, 4, 4)`` (index 0 is the
   world), every velocity coordinate's space screw ``S (N, nv, 6)`` (``[ω; v]``, v of the point at the
   world origin), so that body b's space twist is ``V_b = sum_k A[b, k] S_k qd_k``;
-* :func:`screw_rates` -> ``dS/dt (N, ..., nv, 6)`` along ``qd``: ``dS_k/dt = ad(V_carrier(k)) S_k``
-  where the carrier of coordinate k is the frame in which ``S_k`` is constant;
-* :func:`frame_jacobian` / :func:`frame_jacobian_rate` -> the ``[ω; ṗ]`` Jacobian ``(N, 6, nv)`` of
-  a point fixed in a body (MuJoCo's ``mj_jacSite`` quantities) and its time derivative along ``qd``.
+* :func:`frame_jacobian` -> the ``[ω; ṗ]`` Jacobian ``(N, 6, nv)`` of a point fixed in a body
+  (MuJoCo's ``mj_jacSite`` quantities);
 * :func:`integrate` -> ``q ⊕ δ``: hinge/slide add, ball/free rotate by ``exp`` of the *local*
   angular increment (MuJoCo's ``mj_integratePos``).
 """
@@ -29,12 +27,10 @@ __all__ = [
     "body_twists",
     "compile_tree",
     "frame_jacobian",
-    "frame_jacobian_rate",
     "integrate",
     "kinematics",
     "normalize_quaternions",
     "quat_to_matrix",
-    "screw_rates",
     "space_jacobian",
 ]
 
@@ -400,15 +396,6 @@ def body_twists(tree: Tree, state: TreeState, qd: np.ndarray) -> np.ndarray:
     return np.einsum("bk,...kx,...k->...bx", tree.A, S, qd)
 
 
-def screw_rates(tree: Tree, state: TreeState, qd: np.ndarray) -> np.ndarray:
-    """``dS/dt (N, ..., nv, 6)`` along ``qd (N, ..., nv)``: ``[V_c, S_k]`` with V_c the carrier twist."""
-    S = state.S.reshape(state.S.shape[0], *(1,) * (qd.ndim - 2), *state.S.shape[1:])
-    Vc = np.einsum("kj,...jx,...j->...kx", tree.C, S, qd)
-    wc, vc = Vc[..., :3], Vc[..., 3:]
-    ws, vs = S[..., :3], S[..., 3:]
-    return np.concatenate([np.cross(wc, ws), np.cross(wc, vs) - np.cross(ws, vc)], axis=-1)
-
-
 def frame_jacobian(tree: Tree, state: TreeState, body: int, point: np.ndarray) -> np.ndarray:
     """``[ω; ṗ] = J qd`` for the point ``point (N, 3)`` (world) fixed in ``body``: (N, 6, nv)."""
     S = state.S
@@ -416,23 +403,3 @@ def frame_jacobian(tree: Tree, state: TreeState, body: int, point: np.ndarray) -
     w = S[..., :3] * mask
     v = (S[..., 3:] + np.cross(S[..., :3], point[:, None, :])) * mask
     return np.concatenate([w, v], axis=-1).swapaxes(-1, -2)
-
-
-def frame_jacobian_rate(
-    tree: Tree, state: TreeState, Sd: np.ndarray, body: int, point: np.ndarray, qd: np.ndarray
-) -> np.ndarray:
-    """Time derivative of :func:`frame_jacobian` along ``qd (N, ..., nv)`` with ``Sd = screw_rates(...)``.
-
-    Column k: ``[dω_k; dv_k + dω_k × p + ω_k × ṗ]`` with ``ṗ = v_b + ω_b × p``; (N, ..., 6, nv).
-    """
-    extra = qd.ndim - 2
-    S = state.S.reshape(state.S.shape[0], *(1,) * extra, *state.S.shape[1:])
-    p = point.reshape(point.shape[0], *(1,) * extra, 3)
-    mask = tree.A[body][:, None]
-    V = np.einsum("k,...kx,...k->...x", tree.A[body], S, qd)
-    pd = V[..., 3:] + np.cross(V[..., :3], p)
-    dw = Sd[..., :3] * mask
-    dv = (
-        Sd[..., 3:] + np.cross(Sd[..., :3], p[..., None, :]) + np.cross(S[..., :3], pd[..., None, :])
-    ) * mask
-    return np.concatenate([dw, dv], axis=-1).swapaxes(-1, -2)

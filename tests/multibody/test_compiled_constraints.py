@@ -1,0 +1,154 @@
+"""The closure residual, the velocity constraint matrix K, its rate dK/dt, the singularity measures, site
+poses and energies: the compiled kernels (``_compiled.resjac_block``, ``kdot_block``, ``site_pose_block``,
+``energy_block``) against their numpy formulation (tests/multibody/_reference.py) on closed chains (Delta,
+a five-bar typed unassembled, Sarrus, Tsai 3-UPU, Bennett's weld), a polynomial coupling, an open chain
+and a floating-base tree, at batch 1 and at batches below and above the kernels' block size
+(``_compiled.BLOCK`` samples run in one block in the calling thread, more in parallel blocks).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from robomech import multibody as mb
+from robomech.multibody import Builder, Inertial
+
+from ._reference import numpy_reference
+from .test_compiled_influence import BATCH_RTOL, SIZES, _close, _configurations, _mech
+
+N = max(SIZES)
+# The same formulas per row in another operation order (sums of products of O(1) poses and screws):
+# a few ulps of the largest entry (8.9e-16 measured, the Delta's dK/dt).
+CONSTRAINT_RTOL = 1e-13
+# Singular values of the scaled K, K_p and J from the same SVD of matrices equal to a few ulps: the
+# measures agree to the ulps times the conditioning (4.5e-15 relative measured on the Delta).
+SINGULAR_RTOL = 1e-11
+
+
+def _coupled():
+    """Two hinges and a slide in series, the second hinge a cubic of the first and the slide a linear
+    function of it: coupling rows with a non-zero second derivative and with none."""
+    b = Builder("coupled", gravity=(0.0, 0.0, -9.81))
+    rod = Inertial(mass=1.0, pos=(0.1, 0, 0), diaginertia=(1e-3, 1e-3, 1e-3))
+    b.body("a", joints=[b.hinge("h1", axis=(0, 0, 1))], inertial=rod)
+    b.body("b", "a", joints=[b.hinge("h2", pos=(0.2, 0, 0), axis=(0, 1, 0))], inertial=rod)
+    b.body("c", "b", joints=[b.slide("s", pos=(0.4, 0, 0), axis=(1, 0, 0))], inertial=rod)
+    b.site("tip", "c", pos=(0.5, 0, 0))
+    b.couple("cubic", "h2", "h1", (0.1, 0.5, -0.7, 0.3, 0.2))
+    b.couple("lin", "s", "h1", (0.0, 0.05))
+    b.actuate("h1")
+    return b.build()
+
+
+NAMES = ("delta", "five_bar", "sarrus", "tsai", "bennett", "coupled", "arm6", "quadruped")
+
+
+def _get(name):
+    if name == "bennett":
+        return mb.gallery.load("bennett")
+    if name == "coupled":
+        return _coupled()
+    return _mech(name)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_residual_jacobian_and_rate_equal_numpy_at_every_batch_size(name):
+    mech = _get(name)
+    rng = np.random.default_rng(1)
+    q = _configurations(mech, N)
+    # unassembled samples too: the residual where it is not zero (the tree's coordinates moved)
+    from robomech.multibody._tree import integrate
+
+    q_off = integrate(mech.tree, q, 0.05 * rng.uniform(-1, 1, (N, mech.nv)))
+    qd = rng.normal(size=(N, mech.nv))
+    got = (
+        mb.constraint_residual(mech, q_off),
+        mb.constraint_jacobian(mech, q_off),
+        mb.constraint_jacobian_rate(mech, q_off, qd),
+        mb.constraint_residual(mech, q),
+    )
+    with numpy_reference():
+        ref = (
+            mb.constraint_residual(mech, q_off),
+            mb.constraint_jacobian(mech, q_off),
+            mb.constraint_jacobian_rate(mech, q_off, qd),
+            mb.constraint_residual(mech, q),
+        )
+    for a, b, what in zip(got, ref, ("residual", "K", "dK/dt", "assembled residual"), strict=True):
+        _close(a, b, CONSTRAINT_RTOL, what)
+    if mech.constraints.m:
+        assert np.max(np.abs(ref[0])) > 1e-3  # the unassembled residual is not zero
+    for n in SIZES[:-1]:  # the same samples in a smaller batch (batch 1 as a vector too)
+        qs, qds = (q_off[:n], qd[:n]) if n > 1 else (q_off[0], qd[0])
+        part = (
+            mb.constraint_residual(mech, qs),
+            mb.constraint_jacobian(mech, qs),
+            mb.constraint_jacobian_rate(mech, qs, qds),
+        )
+        for a, b, what in zip(part, got[:3], ("residual", "K", "dK/dt"), strict=True):
+            _close(a if n > 1 else a[None], b[:n], BATCH_RTOL, f"{what} at batch {n}")
+
+
+@pytest.mark.parametrize("name", ("delta", "five_bar", "sarrus", "tsai", "arm6", "quadruped"))
+def test_singularities_equal_numpy_at_every_batch_size(name):
+    mech = _get(name)
+    q = _configurations(mech, N, seed=2)
+    site = mech.sites[0].name
+    s = mb.singularities(mech, q, site)
+    with numpy_reference():
+        r = mb.singularities(mech, q, site)
+    for f in ("type_I", "type_II", "constraint", "singular", "assembled"):
+        assert np.array_equal(getattr(s, f), getattr(r, f)), f
+    for f in ("sigma_I", "sigma_II", "sigma_C", "cond_I", "cond_II", "cond_C", "closure"):
+        a, b = getattr(s, f), getattr(r, f)
+        assert np.array_equal(np.isfinite(a), np.isfinite(b)), f
+        fin = np.isfinite(b)
+        assert np.all(np.abs(a[fin] - b[fin]) <= SINGULAR_RTOL * np.maximum(1.0, np.abs(b[fin]))), f
+    for n in SIZES[:-1]:
+        part = mb.singularities(mech, q[:n] if n > 1 else q[0], site)
+        for f in ("sigma_I", "sigma_II", "sigma_C", "closure"):
+            a = np.atleast_1d(getattr(part, f))
+            _close(np.nan_to_num(a), np.nan_to_num(getattr(s, f)[:n]), BATCH_RTOL, f"{f} at batch {n}")
+
+
+def test_coupling_rate_equals_finite_differences():
+    """dK/dt of the cubic coupling row (the only row here whose K depends on q) against central
+    differences of K along qd: an independent check of the kernel's second derivative of the polynomial."""
+    mech = _coupled()
+    q = _configurations(mech, 4, seed=3)
+    qd = np.random.default_rng(4).normal(size=(4, mech.nv))
+    h = 1e-6
+    from robomech.multibody._tree import integrate
+
+    fd = (
+        mb.constraint_jacobian(mech, integrate(mech.tree, q, h * qd))
+        - mb.constraint_jacobian(mech, integrate(mech.tree, q, -h * qd))
+    ) / (2 * h)
+    # central differences: truncation h^2 |K'''| ~ 1e-12 plus rounding eps / h ~ 1e-10
+    assert np.max(np.abs(mb.constraint_jacobian_rate(mech, q, qd) - fd)) <= 1e-8
+
+
+# Poses: products of a few 4x4 matrices in another order, a few ulps.  Energies: sums over the bodies of
+# products of O(1) rates and O(1-10) masses and inertias, a few ulps of the largest term.
+POSE_RTOL = 1e-13
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_site_pose_and_energy_equal_numpy_at_every_batch_size(name):
+    mech = _get(name)
+    rng = np.random.default_rng(5)
+    q = _configurations(mech, N, seed=5)
+    qd = rng.normal(size=(N, mech.nv))
+    site = mech.sites[0].name
+    got = (mb.site_pose(mech, q, site), *mb.energy(mech, q, qd))
+    with numpy_reference():
+        ref = (mb.site_pose(mech, q, site), *mb.energy(mech, q, qd))
+    for a, b, what in zip(got, ref, ("site_pose", "kinetic", "potential"), strict=True):
+        _close(a, b, POSE_RTOL, what)
+    assert np.all(got[1] > 0.0)  # every sample moves: a kinetic energy that is not zero by construction
+    for n in SIZES[:-1]:
+        qs, qds = (q[:n], qd[:n]) if n > 1 else (q[0], qd[0])
+        part = (mb.site_pose(mech, qs, site), *mb.energy(mech, qs, qds))
+        for a, b, what in zip(part, got, ("site_pose", "kinetic", "potential"), strict=True):
+            _close(a if n > 1 else a[None], b[:n], BATCH_RTOL, f"{what} at batch {n}")
