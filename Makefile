@@ -19,8 +19,10 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e ".[verify,explore,test]"
-	# compile the multibody kernels into the on-disk cache now, not at the user's first call
-	$(BIN)/python -c "from robomech.multibody._compiled import warm; warm()"
+	# compile the multibody kernels into the on-disk cache now, not at the user's first call: two halves
+	# in two processes at once (numba compiles on one thread)
+	$(BIN)/python -c "from robomech.multibody._compiled import warm; warm(0)" & pid=$$!; \
+	  $(BIN)/python -c "from robomech.multibody._compiled import warm; warm(1)" && wait $$pid
 	touch $(STAMP)
 
 $(DOCS_STAMP): $(STAMP)

@@ -1983,11 +1983,19 @@ def compiled_energy(model, q: np.ndarray, qd: np.ndarray, gv: np.ndarray) -> tup
     return Kin, U
 
 
-def warm() -> None:
+WARM_PARTS = 2  # warm(part) for part in range(WARM_PARTS) covers every kernel; each fits one process
+
+
+def warm(part: int | None = None) -> None:
     """Compile (or load) every kernel of this module on a small mechanism, so that a user's first
     call finds them in the on-disk cache (``make install`` runs it).  The kernels' argument types do
     not depend on the mechanism (packed tables of fixed array types), so one specialization per kernel
-    serves every mechanism."""
+    serves every mechanism.
+
+    ``part`` (0 or 1) compiles one half: the closed-chain kernels, or the single-sample, design-batched
+    and tree-dynamics kernels, so that ``make install`` compiles the halves in two processes at once
+    (numba compiles on one thread; the cache's files are written atomically).  ``None``: both.
+    """
     import logging
 
     from . import _dynamics
@@ -1996,10 +2004,12 @@ def warm() -> None:
     if not logging.getLogger("robomech").handlers and not logging.getLogger().handlers:
         logging.basicConfig(level=logging.INFO, format="%(name)s: %(message)s")
         logging.getLogger("robomech").setLevel(logging.INFO)
+    if part not in (None, *range(WARM_PARTS)):
+        raise ValueError(f"Expected part to be None or one of {list(range(WARM_PARTS))}, got {part!r}.")
     mech = load("four_bar")
     model = compile_model(mech)
     site = mech.tree.site_index(mech.sites[0].name)
-    for n in (1, 2 * BLOCK + 1):  # one block in this thread, then parallel blocks
+    for n in (1, 2 * BLOCK + 1) if part in (None, 0) else ():  # one block in this thread, then parallel
         q = np.tile(mech.q0, (n, 1))
         qf, _, _, _ = compiled_fk(mech, q, model.pas)
         compiled_site_jacobian(mech, qf, site)
@@ -2011,6 +2021,8 @@ def warm() -> None:
         z = np.zeros((n, len(model.act)))
         _dynamics._inverse_compiled(mech, qf, z, z, {}, None, True)
         _dynamics.forward_dynamics(mech, qf, z, tau=z)  # the closed-chain forward dynamics kernel
+    if part == 0:
+        return
     inv_dyn_one(model, mech.q0, np.zeros(1), np.zeros(1), mech.gravity, True)
     from ._designs import design_batch, ik_designs, site_measures_designs
 
@@ -2035,6 +2047,25 @@ def warm() -> None:
     mass_matrix(mech, np.array(mech.q0, dtype=float))
     z = np.zeros(tree_mech.nv)
     _dynamics.forward_dynamics(tree_mech, z, tau=z, qd=z)
+    from ._designs import closure_designs, inverse_dynamics_designs
+    from ._influence import constraint_jacobian, constraint_jacobian_rate, constraint_residual, site_pose
+    from ._rnea_kernels import passive_rank_measures
+    from ._singularity import singularities
+
+    name = mech.sites[0].name
+    for n in (1, 2 * BLOCK + 1):  # closure rows, site poses, energies, singularities, rank measures
+        q = np.tile(mech.q0, (n, 1))
+        zv, za = np.zeros((n, mech.nv)), np.zeros((n, len(model.act)))
+        constraint_residual(mech, q)
+        constraint_jacobian(mech, q)
+        constraint_jacobian_rate(mech, q, zv)
+        site_pose(mech, q, name)
+        _dynamics.energy(mech, q, zv)
+        singularities(mech, q, name)
+        passive_rank_measures(model, q)
+        di = np.arange(n) % 2  # the design-batched inverse dynamics and closure solve
+        inverse_dynamics_designs(batch, di, q, za, za)
+        closure_designs(batch, di, q.copy(), model.pas)
 
 
 def _open_chain():
