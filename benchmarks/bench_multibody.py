@@ -20,8 +20,8 @@ from __future__ import annotations
 import numpy as np
 
 from robomech import multibody as mb
-from robomech.multibody._constraints import jacobian, residual
-from robomech.multibody._tree import integrate, kinematics
+from robomech.multibody._compile import compile_model
+from robomech.multibody._compiled import compiled_integrate
 
 from _harness import Workload
 
@@ -52,7 +52,7 @@ def scipy_loop(mech: mb.Mechanism, qa: np.ndarray, site: str) -> list[np.ndarray
     """Per sample: least_squares on the closure residual over the passive coordinates, then J."""
     from scipy.optimize import least_squares
 
-    tree, cs = mech.tree, mech.constraints
+    tree, model = mech.tree, compile_model(mech)
     free = np.setdiff1d(np.arange(tree.nv), tree.act_dof)
     out = []
     for x in qa:
@@ -62,15 +62,15 @@ def scipy_loop(mech: mb.Mechanism, qa: np.ndarray, site: str) -> list[np.ndarray
         def q_of(dx, q0=q0):
             dv = np.zeros((1, tree.nv))
             dv[0, free] = dx
-            return integrate(tree, q0[None], dv)
+            return compiled_integrate(model, q0[None], dv)
 
         def fun(dx, q_of=q_of):
             q = q_of(dx)
-            return residual(cs, tree, kinematics(tree, q), q)[0]
+            return mb.constraint_residual(mech, q)[0]
 
         def jac(dx, q_of=q_of):
             q = q_of(dx)
-            return jacobian(cs, tree, kinematics(tree, q), q)[0][:, free]
+            return mb.constraint_jacobian(mech, q)[0][:, free]
 
         sol = least_squares(
             fun, np.zeros(len(free)), jac=jac, method="trf", xtol=1e-12, ftol=1e-12, gtol=1e-12

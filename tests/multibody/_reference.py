@@ -1,22 +1,26 @@
 """The numpy formulation of the compiled kernels, kept here as the tests' reference.
 
 The library runs one implementation per algorithm (the compiled kernels of
-``robomech/multibody/_compiled.py``, at every batch size).  The same algorithms written batched in
-numpy, from the layer's own tree and closure functions, are the independent formulation the kernels
-are checked against: :func:`numpy_reference` swaps them in for the kernels inside a ``with`` block.
+``robomech/multibody/_compiled.py``, at every batch size, the compile step's reference assembly and
+rank included).  The same algorithms written batched in numpy on the compiled tree and closure rows
+(``_tree.Tree``, ``_constraints.Constraints``): tree kinematics, body Jacobians, integration, the
+closure residual, K and dK/dt, ... are the independent formulation the kernels are checked against:
+:func:`numpy_reference` swaps them in for the kernels inside a ``with`` block.
 """
 
 from __future__ import annotations
 
 import contextlib
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
 from robomech.dynamics import _com_terms
 from robomech.multibody import _compiled, _dynamics, _rnea, _rnea_kernels
 from robomech.multibody import _dynamics as D
-from robomech.multibody._constraints import Constraints, _points, _poly, jacobian, residual
+from robomech.multibody._compile import Tables
+from robomech.multibody._constraints import Constraints
 from robomech.multibody._model import Mechanism
 from robomech.multibody._options import (
     ADMISSIBLE_RTOL,
@@ -35,13 +39,207 @@ from robomech.multibody._options import (
     SINGULAR_COND,
     STOP_RTOL,
 )
-from robomech.multibody._tree import (
-    Tree,
-    TreeState,
-    frame_jacobian,
-    integrate,
-    kinematics,
-)
+from robomech.multibody._tree import Tree, normalize_quaternions, quat_mul, quat_to_matrix
+
+
+# ----------------------------------------------------------------------------- tree kinematics
+# The numpy formulation of _compiled.kin / kin_block (compiled_kinematics, compiled_body_poses),
+# batched over samples with Python loops over bodies and joints.
+@dataclass(frozen=True, eq=False)
+class TreeState:
+    """World poses ``T (N, nb, 4, 4)`` of all bodies and space screws ``S (N, nv, 6)`` of all coordinates."""
+
+    T: np.ndarray
+    S: np.ndarray
+
+
+def _cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.cross`` of ``(N, 3)`` arrays, the same products and differences in the same order (so the
+    same bits) without its axis handling."""
+    out = np.empty(a.shape)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
+
+
+def quat_exp(w: np.ndarray) -> np.ndarray:
+    """Unit quaternion of the rotation vector ``w`` (..., 3)."""
+    th = np.linalg.norm(w, axis=-1)
+    half = 0.5 * th
+    # sin(th/2)/th, with its series below 1e-4 rad (error < th^4/3840 ~ 1e-19)
+    small = th < 1e-4
+    k = np.where(small, 0.5 - th * th / 48.0, np.sin(half) / np.where(small, 1.0, th))
+    return np.concatenate([np.cos(half)[..., None], k[..., None] * w], axis=-1)
+
+
+def axis_angle_matrix(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """Rotation (..., 3, 3) by ``angle (...)`` about the unit ``axis (3,)`` (Rodrigues)."""
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    s, c = np.sin(angle)[..., None, None], np.cos(angle)[..., None, None]
+    return np.eye(3) + s * K + (1 - c) * (K @ K)
+
+
+def _kin(tree: Tree, q: np.ndarray, screws: bool) -> TreeState:
+    N = q.shape[0]
+    nb = len(tree.body_names)
+    T = np.empty((N, nb, 4, 4))
+    T[:, 0] = np.eye(4)
+    # Without screws S is an empty (N, 0, 6) placeholder that is never written (only poses wanted).
+    S = np.zeros((N, tree.nv if screws else 0, 6))
+    for b in range(1, nb):
+        Tb = T[:, tree.parent[b]] @ tree.T_off[b]
+        for k in tree.body_jnts[b]:
+            typ, qa, da = tree.jnt_type[k], tree.jnt_qadr[k], tree.jnt_dadr[k]
+            pos, axis = tree.jnt_pos[k], tree.jnt_axis[k]
+            R, p = Tb[:, :3, :3], Tb[:, :3, 3]
+            if typ == 0 or typ == 2:
+                anchor = p + R @ pos
+                Rj = (
+                    axis_angle_matrix(axis, q[:, qa] - tree.jnt_ref[k])
+                    if typ == 0
+                    else quat_to_matrix(q[:, qa : qa + 4])
+                )
+                Rn = R @ Rj
+                Tb = Tb.copy()
+                Tb[:, :3, :3] = Rn
+                Tb[:, :3, 3] = anchor - Rn @ pos
+                if screws:
+                    if typ == 0:
+                        w = R @ axis
+                        S[:, da, :3] = w
+                        S[:, da, 3:] = _cross3(anchor, w)
+                    else:
+                        for c in range(3):
+                            w = Rn[:, :, c]
+                            S[:, da + c, :3] = w
+                            S[:, da + c, 3:] = _cross3(anchor, w)
+            elif typ == 1:
+                w = R @ axis
+                Tb = Tb.copy()
+                Tb[:, :3, 3] = p + w * (q[:, qa] - tree.jnt_ref[k])[:, None]
+                if screws:
+                    S[:, da, 3:] = w
+            else:
+                Tb = np.tile(np.eye(4), (N, 1, 1))
+                Rn = quat_to_matrix(q[:, qa + 3 : qa + 7])
+                Tb[:, :3, :3] = Rn
+                Tb[:, :3, 3] = q[:, qa : qa + 3]
+                if screws:
+                    for c in range(3):
+                        S[:, da + c, 3 + c] = 1.0
+                        w = Rn[:, :, c]
+                        S[:, da + 3 + c, :3] = w
+                        S[:, da + 3 + c, 3:] = _cross3(q[:, qa : qa + 3], w)
+        T[:, b] = Tb
+    return TreeState(T=T, S=S)
+
+
+def body_poses(tree: Tree, q: np.ndarray) -> np.ndarray:
+    """World pose of every body, ``(N, nb, 4, 4)`` (body 0 is the world).  ``q`` normalised quaternions."""
+    return _kin(tree, q, screws=False).T
+
+
+def kinematics(tree: Tree, q: np.ndarray) -> TreeState:
+    """Body poses and coordinate space screws at ``q (N, nq)`` (quaternions already normalised)."""
+    return _kin(tree, q, screws=True)
+
+
+def integrate(tree: Tree, q: np.ndarray, dv: np.ndarray) -> np.ndarray:
+    """``q ⊕ dv``: the configuration reached from ``q`` by the velocity increment ``dv (N, nv)``
+    (the numpy formulation of _compiled.integrate / compiled_integrate)."""
+    out = np.array(q, copy=True)
+    for k in range(len(tree.jnt_names)):
+        typ, qa, da = tree.jnt_type[k], tree.jnt_qadr[k], tree.jnt_dadr[k]
+        if typ <= 1:
+            out[:, qa] += dv[:, da]
+        elif typ == 2:
+            out[:, qa : qa + 4] = quat_mul(q[:, qa : qa + 4], quat_exp(dv[:, da : da + 3]))
+        else:
+            out[:, qa : qa + 3] += dv[:, da : da + 3]
+            out[:, qa + 3 : qa + 7] = quat_mul(q[:, qa + 3 : qa + 7], quat_exp(dv[:, da + 3 : da + 6]))
+    return normalize_quaternions(tree, out) if tree.quat_adr else out
+
+
+def space_jacobian(tree: Tree, state: TreeState, body: int) -> np.ndarray:
+    """Space-twist Jacobian of ``body`` (N, 6, nv): ``V_b = J qd`` (``[ω; v]``, v at the world origin)."""
+    return (state.S * tree.A[body][:, None]).swapaxes(-1, -2)
+
+
+def body_twists(tree: Tree, state: TreeState, qd: np.ndarray) -> np.ndarray:
+    """Space twists of all bodies (N, ..., nb, 6) for ``qd (N, ..., nv)``."""
+    S = state.S.reshape(state.S.shape[0], *(1,) * (qd.ndim - 2), *state.S.shape[1:])
+    return np.einsum("bk,...kx,...k->...bx", tree.A, S, qd)
+
+
+def frame_jacobian(tree: Tree, state: TreeState, body: int, point: np.ndarray) -> np.ndarray:
+    """``[ω; ṗ] = J qd`` for the point ``point (N, 3)`` (world) fixed in ``body``: (N, 6, nv)."""
+    S = state.S
+    mask = tree.A[body][None, :, None]
+    w = S[..., :3] * mask
+    v = (S[..., 3:] + np.cross(S[..., :3], point[:, None, :])) * mask
+    return np.concatenate([w, v], axis=-1).swapaxes(-1, -2)
+
+
+# ----------------------------------------------------------------------------- closure rows and K
+# The numpy formulation of _compiled.resjac / resjac_block (compiled_resjac), row block by row block.
+def _poly(c: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    f = c[0] + x * (c[1] + x * (c[2] + x * (c[3] + x * c[4])))
+    d1 = c[1] + x * (2 * c[2] + x * (3 * c[3] + x * 4 * c[4]))
+    d2 = 2 * c[2] + x * (6 * c[3] + x * 12 * c[4])
+    return f, d1, d2
+
+
+def _points(
+    state: TreeState, b1: int, x1: np.ndarray, b2: int, x2: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    return (state.T[:, b1] @ x1)[:, :3], (state.T[:, b2] @ x2)[:, :3]
+
+
+def residual(cs: Constraints, tree: Tree, state: TreeState, q: np.ndarray) -> np.ndarray:
+    """Closure residual ``(N, m)`` in length units."""
+    out = []
+    L = tree.length
+    for k, d in cs.blocks:
+        if k == "point":
+            p1, p2 = _points(state, *d)
+            out.append(p1 - p2)
+        elif k == "rot":
+            b1, Rrel, b2 = d
+            Rt = state.T[:, b1, :3, :3] @ Rrel
+            R2 = state.T[:, b2, :3, :3]
+            out.append(0.5 * L * np.sum(np.cross(Rt, R2, axis=-2), axis=-1))
+        else:
+            _d1, q1, ref1, _, q2, ref2, c, s = d
+            x = q[:, q2] - ref2 if q2 >= 0 else np.zeros(q.shape[0])
+            out.append((s * ((q[:, q1] - ref1) - _poly(c, x)[0]))[:, None])
+    return np.concatenate(out, axis=-1) if out else np.zeros((q.shape[0], 0))
+
+
+def jacobian(cs: Constraints, tree: Tree, state: TreeState, q: np.ndarray) -> np.ndarray:
+    """Velocity constraint matrix ``K (N, m, nv)``."""
+    N = state.T.shape[0]
+    L = tree.length
+    out = []
+    for k, d in cs.blocks:
+        if k == "point":
+            b1, _x1, b2, _x2 = d
+            p1, p2 = _points(state, *d)
+            out.append(
+                frame_jacobian(tree, state, b1, p1)[:, 3:] - frame_jacobian(tree, state, b2, p2)[:, 3:]
+            )
+        elif k == "rot":
+            b1, _, b2 = d
+            w = state.S[..., :3].swapaxes(-1, -2)
+            out.append(L * w * (tree.A[b2] - tree.A[b1]))
+        else:
+            d1, _, _, d2, q2, ref2, c, s = d
+            row = np.zeros((N, 1, tree.nv))
+            row[:, 0, d1] = s
+            if d2 >= 0:
+                row[:, 0, d2] -= s * _poly(c, q[:, q2] - ref2)[1]
+            out.append(row)
+    return np.concatenate(out, axis=-2) if out else np.zeros((N, 0, tree.nv))
 
 
 # ----------------------------------------------------------------------------- dK/dt
@@ -484,6 +682,8 @@ def _closure_error(mech, state, q: np.ndarray) -> np.ndarray:
 
 def numpy_resjac(model, q: np.ndarray, with_jac: bool) -> tuple:
     """The numpy formulation of ``_compiled.compiled_resjac``: the closure residual and K."""
+    if isinstance(model, Tables):  # the compile step of a mechanism compiled inside the block
+        return _KERNELS["compiled_resjac"](model, q, with_jac)
     st = kinematics(model.tree, q)
     r = residual(model.constraints, model.tree, st, q)
     return r, (jacobian(model.constraints, model.tree, st, q) if with_jac else None)
@@ -532,6 +732,21 @@ def numpy_energy(model, q: np.ndarray, qd: np.ndarray, gv: np.ndarray) -> tuple[
     return T, U
 
 
+def numpy_kinematics(model, q: np.ndarray, screws: bool = True) -> tuple:
+    """The numpy formulation of ``_compiled.compiled_kinematics``: body poses and coordinate screws."""
+    if isinstance(model, Tables):  # the compile step of a mechanism compiled inside the block
+        return _KERNELS["compiled_kinematics"](model, q, screws)
+    st = _kin(model.tree, np.asarray(q, float), screws)
+    return st.T, (st.S if screws else None)
+
+
+def numpy_integrate(model, q: np.ndarray, dv: np.ndarray) -> np.ndarray:
+    """The numpy formulation of ``_compiled.compiled_integrate``."""
+    if isinstance(model, Tables):  # the compile step of a mechanism compiled inside the block
+        return _KERNELS["compiled_integrate"](model, q, dv)
+    return integrate(model.tree, np.asarray(q, float), np.asarray(dv, float))
+
+
 def numpy_site_pose(model, q: np.ndarray, site: int) -> np.ndarray:
     """The numpy formulation of ``_compiled.compiled_site_pose``: the body pose times the site's."""
     tree = model.tree
@@ -547,7 +762,10 @@ _SWAPS = {
     "compiled_jacobian_rate": numpy_jacobian_rate,
     "compiled_site_pose": numpy_site_pose,
     "compiled_energy": numpy_energy,
+    "compiled_kinematics": numpy_kinematics,
+    "compiled_integrate": numpy_integrate,
 }
+_KERNELS = {k: getattr(_compiled, k) for k in _SWAPS}  # the kernels' wrappers, whatever is swapped in
 _SWAPS_DYNAMICS = {
     "_inverse_compiled": lambda *a, **k: _inverse_flat(*a, **k),
     "_forward_compiled": lambda *a, **k: numpy_forward(*a, **k),
@@ -557,7 +775,8 @@ _SWAPS_DYNAMICS = {
 
 @contextlib.contextmanager
 def numpy_reference():
-    """Inside the block, FK, the closure residual, K and dK/dt, site poses, energies, site Jacobians,
+    """Inside the block, tree kinematics (body poses and screws), integration, FK, the closure
+    residual, K and dK/dt, site poses, energies, site Jacobians,
     influence coefficients, site Hessians, the closure terms, the velocity projection, inverse and
     forward dynamics run the numpy formulation."""
     saved = {k: getattr(_compiled, k) for k in _SWAPS}
@@ -941,8 +1160,6 @@ def _solve_each(A: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def numpy_forward(mech, q, rates, tau_a, wr, gravity, act_mode):
     """``(qd, qdd, cond, admissibility, closure, regular)`` of ``_dynamics._forward_compiled``."""
-    from robomech.multibody._constraints import residual
-
     tree = mech.tree
     N, nv = q.shape[0], tree.nv
     L = tree.length

@@ -385,9 +385,8 @@ ASSEMBLY_NORMAL_RTOL = 1.0
 def test_reference_assembly_equals_numpy():
     from robomech.multibody import _reference as R
     from robomech.multibody._compile import _tables
-    from robomech.multibody._tree import integrate
 
-    from ._reference import numpy_lm
+    from ._reference import integrate, numpy_lm
     from .test_kinematic_classes import _five_bar_by_lengths
 
     mech = _five_bar_by_lengths(0.5).build()

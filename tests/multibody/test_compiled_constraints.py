@@ -58,7 +58,7 @@ def test_residual_jacobian_and_rate_equal_numpy_at_every_batch_size(name):
     rng = np.random.default_rng(1)
     q = _configurations(mech, N)
     # unassembled samples too: the residual where it is not zero (the tree's coordinates moved)
-    from robomech.multibody._tree import integrate
+    from ._reference import integrate
 
     q_off = integrate(mech.tree, q, 0.05 * rng.uniform(-1, 1, (N, mech.nv)))
     qd = rng.normal(size=(N, mech.nv))
@@ -119,7 +119,7 @@ def test_coupling_rate_equals_finite_differences():
     q = _configurations(mech, 4, seed=3)
     qd = np.random.default_rng(4).normal(size=(4, mech.nv))
     h = 1e-6
-    from robomech.multibody._tree import integrate
+    from ._reference import integrate
 
     fd = (
         mb.constraint_jacobian(mech, integrate(mech.tree, q, h * qd))
@@ -152,3 +152,79 @@ def test_site_pose_and_energy_equal_numpy_at_every_batch_size(name):
         part = (mb.site_pose(mech, qs, site), *mb.energy(mech, qs, qds))
         for a, b, what in zip(part, got, ("site_pose", "kinetic", "potential"), strict=True):
             _close(a if n > 1 else a[None], b[:n], BATCH_RTOL, f"{what} at batch {n}")
+
+
+# Integration: the same quaternion products and normalisation in another operation order, a few ulps.
+INTEGRATE_RTOL = 1e-13
+# Central differences of the body poses along q ⊕ (±h qd): truncation h^2 |T'''| ~ 1e-12 plus rounding
+# eps / h ~ 1e-10 (O(1) poses); 1e-8 leaves a 100x margin and is far below a wrong screw (O(|qd|)).
+TWIST_FD_TOL = 1e-8
+TWIST_FD_STEP = 1e-6
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_body_poses_jacobians_and_integration_equal_numpy_at_every_batch_size(name):
+    """Every body's pose, every coordinate's space screw and every body's space Jacobian
+    (``_compiled.compiled_kinematics``, ``space_jacobians``) and ``q ⊕ dv`` (``compiled_integrate``)
+    against the numpy formulation, at batch 1, below and above the block size; the poses-only call
+    and the compile step's call on the packed tables give the same bits."""
+    from robomech.multibody import _compiled
+    from robomech.multibody._compile import compile_model
+
+    from . import _reference as R
+
+    mech = _get(name)
+    model, tree = compile_model(mech), mech.tree
+    nb = len(tree.body_names)
+    rng = np.random.default_rng(7)
+    q = _configurations(mech, N, seed=7)
+    dv = 0.3 * rng.uniform(-1, 1, (N, mech.nv))
+    T, S = _compiled.compiled_kinematics(model, q)
+    J = _compiled.space_jacobians(tree.A, S, range(nb))
+    qi = _compiled.compiled_integrate(model, q, dv)
+    st = R.kinematics(tree, q)
+    _close(T, st.T, POSE_RTOL, "body poses")
+    _close(S, st.S, POSE_RTOL, "coordinate screws")
+    _close(J, np.stack([R.space_jacobian(tree, st, b) for b in range(nb)], axis=1), POSE_RTOL, "J")
+    _close(qi, R.integrate(tree, q, dv), INTEGRATE_RTOL, "integrate")
+    assert np.max(np.abs(qi - q)) > 1e-2  # the increment moves every mechanism
+    assert np.array_equal(_compiled.compiled_body_poses(model, q), T)
+    for n in SIZES[:-1]:
+        Tn, Sn = _compiled.compiled_kinematics(model, q[:n])
+        _close(Tn, T[:n], BATCH_RTOL, f"poses at batch {n}")
+        _close(Sn, S[:n], BATCH_RTOL, f"screws at batch {n}")
+        assert np.array_equal(_compiled.compiled_kinematics(model.tables, q[:n])[0], Tn)
+        assert np.array_equal(_compiled.compiled_body_poses(model.tables, q[:n]), Tn)
+        _close(_compiled.compiled_integrate(model.tables, q[:n], dv[:n]), qi[:n], BATCH_RTOL, f"q+ at {n}")
+    # the twist V_b = J_b qd is the rate of the pose along q ⊕ t qd: [ω]x = Ṙ Rᵀ, v = ṗ - ω × p
+    qd = rng.normal(size=(4, mech.nv))
+    h = TWIST_FD_STEP
+    Tp = _compiled.compiled_body_poses(model, _compiled.compiled_integrate(model, q[:4], h * qd))
+    Tm = _compiled.compiled_body_poses(model, _compiled.compiled_integrate(model, q[:4], -h * qd))
+    Td = (Tp - Tm) / (2 * h)
+    W = Td[..., :3, :3] @ T[:4, :, :3, :3].swapaxes(-1, -2)
+    w = np.stack([W[..., 2, 1], W[..., 0, 2], W[..., 1, 0]], axis=-1)
+    v = Td[..., :3, 3] - np.cross(w, T[:4, :, :3, 3])
+    V = np.einsum("nbik,nk->nbi", J[:4], qd)
+    assert np.max(np.abs(V - np.concatenate([w, v], axis=-1))) <= TWIST_FD_TOL
+
+
+REFERENCE_MECHS = ("four_bar", "bennett", "planar_3rrr", "delta", "rps_3", "stewart", "five_bar", "sarrus")
+
+
+@pytest.mark.parametrize("name", REFERENCE_MECHS)
+def test_reference_rank_equals_numpy(name):
+    """The compile step's reference rank (``_compile.instantaneous_mobility`` on the kernels: K and the
+    output bodies' space Jacobians) against the same computation on the numpy formulation."""
+    from robomech.multibody._compile import compile_model, instantaneous_mobility
+
+    mech = mb.gallery.load(name) if name in mb.gallery.NAMES else _get(name)
+    model = compile_model(mech)
+    got = instantaneous_mobility(mech.tree, model.tables, model.q_ref[None])
+    with numpy_reference():
+        ref = instantaneous_mobility(mech.tree, model, model.q_ref[None])
+    assert (got.rank, got.idle, got.locked.shape[1]) == (ref.rank, ref.idle, ref.locked.shape[1])
+    assert (model.dof, model.idle_dof) == (mech.nv - got.rank - got.idle, got.idle)
+    _close(got.K, ref.K, CONSTRAINT_RTOL, "scaled K")
+    _close(got.T, ref.T, POSE_RTOL, "poses")
+    _close(got.S, ref.S, POSE_RTOL, "screws")

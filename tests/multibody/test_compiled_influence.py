@@ -57,7 +57,7 @@ def _configurations(mech, n, seed=0, spread=0.08):
     tree = mech.tree
     if mech.constraints.m == 0:
         dv = spread * rng.uniform(-1, 1, (n, tree.nv))
-        from robomech.multibody._tree import integrate
+        from ._reference import integrate
 
         return integrate(tree, np.repeat(tree.q0[None], n, axis=0), dv)
     scale = np.where(tree.dof_translational[tree.act_dof], mech.length, 1.0)

@@ -180,7 +180,8 @@ def test_com_inverse_dynamics_matches_spatial_form():
     r = mb.inverse_dynamics(RRR, q, qd, qdd)
     # kinetic energy from the com kernel equals the actuator-space quadratic form
     from robomech.multibody import _dynamics as D
-    from robomech.multibody._tree import kinematics
+
+    from ._reference import kinematics
 
     st = kinematics(RRR.tree, q)
     bd = D._bodies(RRR)
@@ -195,7 +196,7 @@ def test_com_inverse_dynamics_matches_spatial_form():
 def test_kdot_qd_equals_constraint_jacobian_rate(name):
     """The reference's direct velocity-product closure accelerations against the multibody layer's dK/dt
     (the kernels' are checked against the reference: test_compiled_influence.py)."""
-    from robomech.multibody._tree import kinematics
+    from ._reference import kinematics
 
     mech = mb.gallery.load(name)
     q, qd_a, _ = _motion(mech, n=3, seed=6, amp=0.02)
@@ -208,7 +209,7 @@ def test_kdot_qd_equals_constraint_jacobian_rate(name):
 
 @pytest.mark.parametrize("name", ["four_bar", "bennett", "delta", "stewart"])
 def test_constraint_matrix_equals_multibody_layer(name):
-    from robomech.multibody._tree import kinematics
+    from ._reference import kinematics
 
     mech = mb.gallery.load(name)
     q, _, _ = _motion(mech, n=3, seed=7, amp=0.02)
@@ -217,7 +218,7 @@ def test_constraint_matrix_equals_multibody_layer(name):
 
 
 def test_screw_rates_flat_equal_screw_rates():
-    from robomech.multibody._tree import kinematics
+    from ._reference import kinematics
 
     mech = mb.gallery.load("stewart")
     q, _, _ = _motion(mech, n=3, seed=8, amp=0.02)

@@ -61,7 +61,8 @@ def test_pinocchio_model_agrees_with_the_engine(name):
         # every body's frame where the engine puts it
         pin.framesForwardKinematics(model, data, qp)
         from robomech.multibody._compile import compile_model
-        from robomech.multibody._tree import kinematics
+
+        from ._reference import kinematics
 
         Tw = kinematics(compile_model(mech).tree, q[None]).T[0]
         for b, fid in P.body_frames.items():

@@ -25,8 +25,8 @@ from numpy.typing import ArrayLike, NDArray
 from robomech._validation import as_array, check_int, check_positive, check_real
 
 from ._assembly import check_mechanism, check_q
+from ._compile import compile_model
 from ._model import Mechanism
-from ._tree import body_poses
 
 __all__ = ["animate", "frame_ms"]
 
@@ -87,7 +87,9 @@ def _drawing(mech: Mechanism, q: NDArray[np.float64]) -> _Drawing:
     is drawn at its actual length from its base (not as a rod of constant length sliding past it).
     """
     tree = mech.tree
-    T = body_poses(tree, q)  # (nt, nb, 4, 4)
+    from ._compiled import compiled_body_poses  # numba loads on the first kernel call, not at import
+
+    T = compiled_body_poses(compile_model(mech), q)  # (nt, nb, 4, 4)
     nt = q.shape[0]
 
     def world(b: int, x: ArrayLike) -> NDArray[np.float64]:

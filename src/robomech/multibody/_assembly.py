@@ -18,10 +18,10 @@ from numpy.typing import ArrayLike
 
 from robomech._validation import MAX_MAGNITUDE, as_array, broadcast_batch, check_int
 
-from ._constraints import jacobian
+from ._compile import compile_model
 from ._model import Mechanism
 from ._options import CONVERGED_RTOL
-from ._tree import kinematics, normalize_quaternions
+from ._tree import normalize_quaternions
 
 __all__ = [
     "CONVERGED_RTOL",
@@ -71,9 +71,11 @@ MAX_STEPS = 10_000
 
 
 def _passive_block(mech: Mechanism, q: np.ndarray) -> np.ndarray:
-    tree = mech.tree
-    K = jacobian(mech.constraints, tree, kinematics(tree, q), q)
-    return K[..., np.setdiff1d(np.arange(tree.nv), tree.act_dof)]
+    """The passive columns ``K_p (N, m, nv - na)`` of the velocity constraint matrix at ``q (N, nq)``."""
+    from ._compiled import compiled_resjac  # numba loads on the first kernel call, not at import
+
+    model = compile_model(mech)
+    return compiled_resjac(model, q, True)[1][..., model.pas]
 
 
 def assembly_mode_sign(mech: Mechanism, q_start: np.ndarray, q_end: np.ndarray) -> np.ndarray:

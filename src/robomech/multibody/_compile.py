@@ -10,10 +10,17 @@ Nothing is written into the description: the compiled model is kept in a module-
 the description's identity (released with it), and :attr:`Model.cache` holds what other modules
 derive from it.
 
+The step runs in this order: the tree (its characteristic length, when the description gives none,
+from the body poses at ``qpos0``), the closure rows, the packed :class:`Tables`, then the reference
+assembly and the reference rank, both on the compiled kernels of ``_compiled`` run on those tables (the
+model does not exist yet): the tree kinematics, closure residual and ``K`` have one implementation, the
+kernels'.
+
 Import order inside the layer (no circle): ``_options`` and ``_model`` (the description) ->
-``_tree``, ``_constraints`` (numpy tree and closure functions) -> ``_compile`` -> ``_compiled``
-(kernels) -> ``_designs`` (design-batched drivers), ``_assembly``, ``_influence`` -> analysis and
-dynamics modules.
+``_tree``, ``_constraints`` (the tree and closure rows compiled to arrays) -> ``_compile`` ->
+``_compiled`` (kernels) -> ``_designs`` (design-batched drivers), ``_assembly``, ``_influence`` ->
+analysis and dynamics modules.  ``_compile`` calls ``_compiled`` and ``_reference`` inside its
+functions only (they import ``_compile`` at module level).
 """
 
 from __future__ import annotations
@@ -27,13 +34,21 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import _options as opt
-from ._constraints import Constraints, compile_constraints, jacobian
-from ._tree import Tree, compile_tree, kinematics, quat_to_matrix, space_jacobian
+from ._constraints import Constraints, compile_constraints
+from ._tree import Tree, compile_tree, quat_to_matrix
 
 if TYPE_CHECKING:  # the description; imported for the annotations only
     from ._model import Mechanism
 
-__all__ = ["DynTables", "Model", "RneaTables", "Tables", "compile_model", "instantaneous_mobility"]
+__all__ = [
+    "DynTables",
+    "Model",
+    "RneaTables",
+    "Tables",
+    "build_tree",
+    "compile_model",
+    "instantaneous_mobility",
+]
 
 
 class Tables(NamedTuple):
@@ -172,28 +187,31 @@ class Instantaneous:
     N: np.ndarray  # (nv, total_dof) orthonormal basis of the admissible motions (scaled coordinates)
     locked: np.ndarray  # admissible motions with every actuated joint locked
     idle: int  # locked motions that move no output body
-    state: Any  # the tree state at q (TreeState, batch 1)
+    T: np.ndarray  # (nb, 4, 4) the bodies' world poses at q
+    S: np.ndarray  # (nv, 6) the coordinates' space screws at q
 
 
-def instantaneous_mobility(tree: Tree, cs: Constraints, q: np.ndarray) -> Instantaneous:
-    """Rank of the unit-scaled ``K`` at ``q (1, nq)``, admissible and locked motions, idle count."""
-    st = kinematics(tree, q)
+def instantaneous_mobility(tree: Tree, tables: Tables | Model, q: np.ndarray) -> Instantaneous:
+    """Rank of the unit-scaled ``K`` at ``q (1, nq)``, admissible and locked motions, idle count
+    (poses, screws and ``K`` from the compiled kernels on ``tables``, or on a compiled model's)."""
+    from ._compiled import compiled_kinematics, compiled_resjac, space_jacobians
+
+    T, S = compiled_kinematics(tables, q)
     col = np.where(tree.dof_translational, tree.length, 1.0)
-    K = jacobian(cs, tree, st, q)[0] * col
+    K = compiled_resjac(tables, q, True)[1][0] * col
     nv = K.shape[1]
     kmax = float(np.max(np.linalg.svd(K, compute_uv=False))) if K.size else 1.0
     rank = _rank(K, kmax)
     N = _null(K, nv)
     na = len(tree.act_dof)
     locked = N @ _null(N[tree.act_dof], N.shape[1]) if na else N
-    outs = []
-    for b in _output_bodies(tree):
-        Jb = space_jacobian(tree, st, b)[0] / col  # twist per scaled coordinate
-        outs.append(Jb * np.array([tree.length] * 3 + [1.0] * 3)[:, None])
-    Jout = np.concatenate(outs) if outs else np.zeros((0, nv))
-    # Jout has unit screws times L: rows of order L, so a motion that moves an output has |Jout v| ~ L|v|
+    outs = _output_bodies(tree)
+    # twists per scaled coordinate, angular rows times L: rows of order L, so a motion that moves an
+    # output has |Jout v| ~ L|v|
+    J = space_jacobians(tree.A, S, outs)[0] / col * np.array([tree.length] * 3 + [1.0] * 3)[:, None]
+    Jout = J.reshape(-1, nv)
     idle = locked.shape[1] - _rank(Jout @ locked, tree.length) if locked.shape[1] else 0
-    return Instantaneous(K=K, kmax=kmax, rank=rank, N=N, locked=locked, idle=int(idle), state=st)
+    return Instantaneous(K=K, kmax=kmax, rank=rank, N=N, locked=locked, idle=int(idle), T=T[0], S=S[0])
 
 
 # ----------------------------------------------------------------------------- packing
@@ -266,17 +284,47 @@ def _tables(tree: Tree, cs: Constraints) -> Tables:
     )
 
 
+_NO_ROWS = Constraints(blocks=(), m=0, row_owner=(), row_kind=())
+
+
+def _default_length(tree: Tree) -> float:
+    """RMS distance of the body origins, joint anchors and sites from their centroid at q0 (m).
+
+    This is the length that makes a rotation (rad) and a translation (m) commensurate in residuals
+    and conditioning; 1 m if the mechanism has no extent (a single point).
+    """
+    from ._compiled import compiled_body_poses  # lazily: _compiled -> _compile
+
+    T = compiled_body_poses(_tables(tree, _NO_ROWS), tree.q0[None])[0]
+    pts = [T[1:, :3, 3]]
+    for k in range(len(tree.jnt_names)):
+        Tb = T[tree.jnt_body[k]]
+        pts.append((Tb[:3, :3] @ tree.jnt_pos[k] + Tb[:3, 3])[None])
+    for s in range(len(tree.site_names)):
+        pts.append((T[tree.site_body[s]] @ tree.T_site[s])[None, :3, 3])
+    P = np.concatenate(pts)
+    L = float(np.sqrt(np.mean(np.sum((P - P.mean(axis=0)) ** 2, axis=1)))) if len(P) > 1 else 0.0
+    return L if L > 1e-9 else 1.0
+
+
+def build_tree(mech: Mechanism) -> Tree:
+    """The compiled tree of ``mech``, its characteristic length the description's or, when it gives
+    none, :func:`_default_length`."""
+    return compile_tree(mech, _default_length)
+
+
 def _compile(mech: Mechanism, tree: Tree | None = None) -> Model:
-    tree = compile_tree(mech) if tree is None else tree
+    tree = build_tree(mech) if tree is None else tree
     cs = compile_constraints(mech, tree)
+    tables = _tables(tree, cs)  # first: the reference assembly and rank below run on the kernels
     act = tree.act_dof.astype(np.int64)
     pas = np.setdiff1d(np.arange(tree.nv), act).astype(np.int64)
     from ._reference import assembled_reference  # lazily: _reference -> _assembly -> _compile
 
     # the reference configuration: qpos0, or the assembly nearest to it for a description typed
     # unassembled (a ValueError with the residual if none); the reference rank is taken there
-    q_ref = assembled_reference(mech, tree, cs)
-    inst = instantaneous_mobility(tree, cs, q_ref[None])
+    q_ref = assembled_reference(mech, tree, cs, tables)
+    inst = instantaneous_mobility(tree, tables, q_ref[None])
     total = tree.nv - inst.rank
     dof = total - inst.idle
     # the passive block has full column rank but for the idle motions (computed at the reference, not
@@ -303,7 +351,6 @@ def _compile(mech: Mechanism, tree: Tree | None = None) -> Model:
         admissible_rtol=float(opt.ADMISSIBLE_RTOL),
         rate_floor=float(opt.RATE_FLOOR),
     )
-    tables = _tables(tree, cs)
     rnea = RneaTables(
         parent=tables.parent,
         T_off=tables.T_off,
@@ -353,7 +400,7 @@ def _drop(key: int) -> None:
 
 def compile_model(mech: Mechanism, *, _tree: Tree | None = None) -> Model:
     """The compiled model of ``mech`` (built on first use, then returned from the table).  ``_tree``:
-    its already compiled tree (``compile_tree`` of a description with the same bodies, sites, actuation
+    its already compiled tree (:func:`build_tree` of a description with the same bodies, sites, actuation
     and characteristic length: the tree depends on nothing else), which the first use then reuses."""
     hit = _MODELS.get(id(mech))
     if hit is not None and hit[0]() is mech:

@@ -2,9 +2,12 @@
 Hessians, inverse dynamics.
 
 The one implementation of each of these algorithms, for every batch size (batch 1 included): tree
-kinematics, closure residual and velocity constraint matrix (the formulas of ``_tree`` and
+kinematics (every body's pose and every coordinate's space screw, :func:`compiled_kinematics`, for the
+compile step's reference rank, ``mobility``, drawing and export), integration ``q ⊕ dv``
+(:func:`compiled_integrate`), closure residual and velocity constraint matrix (the rows of
 ``_constraints``, written per sample; :func:`resjac_block` for ``constraint_residual``,
-``constraint_jacobian`` and ``singularities``, :func:`kdot_block` for ``dK/dt``), the
+``constraint_jacobian``, ``singularities``, ``mobility`` and the compile step's reference assembly and
+rank, :func:`kdot_block` for ``dK/dt``), the
 Levenberg–Marquardt assembly (damping, step cap and stopping rules of ``_options``),
 ``G = [I; -K_p^+ K_a]`` by the SVD pseudo-inverse (:func:`influence_G`) with the site's ``[ω; ṗ]``
 Jacobian, the second-order coefficients ``∂G/∂q_act`` and site Hessians
@@ -19,24 +22,30 @@ tests as the reference (tests/multibody/_reference.py).
 
 from __future__ import annotations
 
+from typing import Literal, overload
+
 import numpy as np
 
 from robomech._numba import import_numba
 from robomech._validation import MAX_MAGNITUDE
 
 from . import _options as opt
-from ._compile import compile_model
+from ._compile import Tables, compile_model
 
 __all__ = [
+    "compiled_body_poses",
     "compiled_energy",
     "compiled_fk",
     "compiled_influence",
+    "compiled_integrate",
     "compiled_jacobian_rate",
+    "compiled_kinematics",
     "compiled_project",
     "compiled_resjac",
     "compiled_site_jacobian",
     "compiled_site_pose",
     "inv_dyn",
+    "space_jacobians",
 ]
 
 numba = import_numba()
@@ -63,7 +72,8 @@ def quat_mat(w, x, y, z, R):  # pragma: no cover - compiled
 
 @_nj
 def kin(q, t, T, S):  # pragma: no cover
-    """Body poses ``T (nb, 4, 4)`` and coordinate space screws ``S (nv, 6)`` at ``q`` (``_tree._kin``)."""
+    """Body poses ``T (nb, 4, 4)`` and coordinate space screws ``S (nv, 6)`` at ``q``: body b's space twist
+    is ``V_b = sum_k A[b, k] S_k qd_k`` (``[ω; v]``, v of the point at the world origin)."""
     kin_into(q, t, T, S, np.empty((3, 3)), np.empty((3, 3)), np.empty(3))
 
 
@@ -1639,17 +1649,29 @@ def compiled_influence(model, q: np.ndarray, second: bool, site: int = -1) -> tu
     return G, (dG if second else None), (H if second and site >= 0 else None), rank, cons, smin, cond
 
 
-def compiled_resjac(model, q: np.ndarray, with_jac: bool) -> tuple[np.ndarray, np.ndarray | None]:
+@overload
+def compiled_resjac(
+    model_or_tables, q: np.ndarray, with_jac: Literal[True]
+) -> tuple[np.ndarray, np.ndarray]: ...
+@overload
+def compiled_resjac(
+    model_or_tables, q: np.ndarray, with_jac: bool
+) -> tuple[np.ndarray, np.ndarray | None]: ...
+def compiled_resjac(model_or_tables, q: np.ndarray, with_jac: bool) -> tuple[np.ndarray, np.ndarray | None]:
     """The closure residual ``(N, m)`` and, with ``with_jac``, the velocity constraint matrix
-    ``K (N, m, nv)`` (else None) at ``q (N, nq)`` (:func:`resjac_block`)."""
+    ``K (N, m, nv)`` (else None) at ``q (N, nq)`` (:func:`resjac_block`).  ``model_or_tables``: a
+    compiled model or its :class:`Tables` (:func:`compiled_kinematics`)."""
+    t, model = _tables_of(model_or_tables)
     Q = writable(q)
-    N, m, nv = Q.shape[0], model.tables.m, model.tree.nv
+    N, m, nv = Q.shape[0], t.m, t.A.shape[1]
     R = np.empty((N, m))
     K = np.empty((N if with_jac else 0, m, nv))
-    if N <= BLOCK:
-        entry(model, resjac_block, "resjac_block", (Q, 0, N, model.tables, bool(with_jac), R, K))
+    if N > BLOCK:
+        resjac_par(Q, t, bool(with_jac), R, K)
+    elif model is None:
+        resjac_block(Q, 0, N, t, bool(with_jac), R, K)
     else:
-        resjac_par(Q, model.tables, bool(with_jac), R, K)
+        entry(model, resjac_block, "resjac_block", (Q, 0, N, t, bool(with_jac), R, K))
     return R, (K if with_jac else None)
 
 
@@ -1887,6 +1909,96 @@ def compiled_rnea(model, Q: np.ndarray, QD: np.ndarray, QDD: np.ndarray, gv: np.
     return tau
 
 
+# ----------------------------------------------------------------------------- body poses and integration
+@_nj
+def kin_block(Q, lo, hi, t, T_o, S_o):  # pragma: no cover - compiled
+    """World pose of every body ``T_o (N, nb, 4, 4)`` (body 0 the world) and every velocity coordinate's
+    space screw ``S_o (N, nv, 6)`` (:func:`kin`) for samples ``lo:hi``; an ``S_o`` of no rows
+    (``(0, nv, 6)``): poses only."""
+    nv = t.A.shape[1]
+    screws = S_o.shape[0] > 0
+    S = np.empty((nv, 6))
+    Rj, Rn, anchor = np.empty((3, 3)), np.empty((3, 3)), np.empty(3)
+    for n in range(lo, hi):
+        kin_into(Q[n], t, T_o[n], S_o[n] if screws else S, Rj, Rn, anchor)
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def kin_par(Q, t, T_o, S_o):  # pragma: no cover - compiled
+    """:func:`kin_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        kin_block(Q, k * BLOCK, min(N, (k + 1) * BLOCK), t, T_o, S_o)
+
+
+@_nj
+def integrate_block(Q, DV, t, Q_o):  # pragma: no cover - compiled
+    """``Q_o = Q ⊕ DV`` (:func:`integrate`) for every sample."""
+    for n in range(Q.shape[0]):
+        integrate(Q[n], DV[n], t.jtype, t.jqadr, t.jdadr, Q_o[n])
+
+
+def _tables_of(model_or_tables):
+    """The packed tables and the model (None when given the tables alone: the compile step, before
+    the model exists, calls the kernels through numba's dispatcher)."""
+    if isinstance(model_or_tables, Tables):
+        return model_or_tables, None
+    return model_or_tables.tables, model_or_tables
+
+
+@overload
+def compiled_kinematics(
+    model_or_tables, q: np.ndarray, screws: Literal[True] = True
+) -> tuple[np.ndarray, np.ndarray]: ...
+@overload
+def compiled_kinematics(
+    model_or_tables, q: np.ndarray, screws: bool
+) -> tuple[np.ndarray, np.ndarray | None]: ...
+def compiled_kinematics(
+    model_or_tables, q: np.ndarray, screws: bool = True
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """Every body's world pose ``(N, nb, 4, 4)`` and, with ``screws``, every velocity coordinate's
+    space screw ``S (N, nv, 6)`` (else None) at normalised ``q (N, nq)`` (:func:`kin_block`).
+
+    Body b's space Jacobian is ``S[:, k]`` over the coordinates ``k`` with ``A[b, k]``: its twist is
+    ``V_b = sum_k A[b, k] S_k qd_k``.  ``model_or_tables``: a compiled model or its :class:`Tables`."""
+    t, model = _tables_of(model_or_tables)
+    Q = writable(q)
+    N, nb, nv = Q.shape[0], t.parent.shape[0], t.A.shape[1]
+    T = np.empty((N, nb, 4, 4))
+    S = np.empty((N if screws else 0, nv, 6))
+    if N > BLOCK:
+        kin_par(Q, t, T, S)
+    elif model is None:
+        kin_block(Q, 0, N, t, T, S)
+    else:
+        entry(model, kin_block, "kin_block", (Q, 0, N, t, T, S))
+    return T, (S if screws else None)
+
+
+def compiled_body_poses(model_or_tables, q: np.ndarray) -> np.ndarray:
+    """Every body's world pose ``(N, nb, 4, 4)`` (body 0 the world) at normalised ``q (N, nq)``."""
+    return compiled_kinematics(model_or_tables, q, screws=False)[0]
+
+
+def space_jacobians(A: np.ndarray, S: np.ndarray, bodies) -> np.ndarray:
+    """Space-twist Jacobians ``(N, len(bodies), 6, nv)`` of ``bodies`` from the screws ``S (N, nv, 6)``
+    of :func:`compiled_kinematics` and the tree's incidence ``A (nb, nv)``: ``V_b = J_b qd`` (``[ω; v]``,
+    v of the point at the world origin)."""
+    Ab = A[np.asarray(bodies, dtype=np.int64)]  # (nb', nv)
+    return (S[:, None] * Ab[None, :, :, None]).swapaxes(-1, -2)
+
+
+def compiled_integrate(model_or_tables, q: np.ndarray, dv: np.ndarray) -> np.ndarray:
+    """``q ⊕ dv (N, nq)``: hinge/slide add, ball/free rotate by ``exp`` of the *local* angular increment
+    and renormalise (MuJoCo's ``mj_integratePos``), for ``q (N, nq)``, ``dv (N, nv)``."""
+    t, _ = _tables_of(model_or_tables)
+    Q, DV = writable(q), writable(dv)
+    out = np.empty_like(Q)
+    integrate_block(Q, DV, t, out)
+    return out
+
+
 # ----------------------------------------------------------------------------- site pose and energy
 @_nj
 def site_pose_block(Q, lo, hi, t, sb, Tsite, T_o):  # pragma: no cover - compiled
@@ -2055,6 +2167,8 @@ def warm(part: int | None = None) -> None:
     name = mech.sites[0].name
     for n in (1, 2 * BLOCK + 1):  # closure rows, site poses, energies, singularities, rank measures
         q = np.tile(mech.q0, (n, 1))
+        compiled_kinematics(model, q)  # body poses and screws (drawing, export, the compile step)
+        compiled_integrate(model.tables, q, np.zeros((n, mech.nv)))
         zv, za = np.zeros((n, mech.nv)), np.zeros((n, len(model.act)))
         constraint_residual(mech, q)
         constraint_jacobian(mech, q)

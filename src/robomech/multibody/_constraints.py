@@ -1,4 +1,9 @@
-"""Closure equations ``phi(q) = 0``, their velocity matrix ``K`` and its time derivative (internal).
+"""Closure equations ``phi(q) = 0`` compiled to rows (internal); the compiled kernels evaluate them.
+
+:func:`compile_constraints` turns a description's closures and couplings into the row blocks below,
+which the compile step packs into ``_compile.Tables``; the residual, ``K`` and ``dK/dt`` are evaluated
+by the kernels (``_compiled.resjac``, ``kdot_block``), their numpy formulation being the tests'
+reference (tests/multibody/_reference.py).
 
 Rows, in the order of ``mech.closures`` then ``mech.couplings`` (all in length units, so that a
 rotation error counts as the arc it sweeps at the characteristic length ``L``):
@@ -21,9 +26,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._tree import Tree, TreeState, frame_jacobian, quat_to_matrix
+from ._tree import Tree, quat_to_matrix
 
-__all__ = ["Constraints", "compile_constraints", "jacobian", "residual"]
+__all__ = ["Constraints", "compile_constraints"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -85,62 +90,3 @@ def compile_constraints(mech, tree: Tree) -> Constraints:
         )
         add("coupling", data, c.name, 1)
     return Constraints(blocks=tuple(blocks), m=len(owner), row_owner=tuple(owner), row_kind=tuple(kind))
-
-
-def _poly(c: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    f = c[0] + x * (c[1] + x * (c[2] + x * (c[3] + x * c[4])))
-    d1 = c[1] + x * (2 * c[2] + x * (3 * c[3] + x * 4 * c[4]))
-    d2 = 2 * c[2] + x * (6 * c[3] + x * 12 * c[4])
-    return f, d1, d2
-
-
-def _points(
-    state: TreeState, b1: int, x1: np.ndarray, b2: int, x2: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    return (state.T[:, b1] @ x1)[:, :3], (state.T[:, b2] @ x2)[:, :3]
-
-
-def residual(cs: Constraints, tree: Tree, state: TreeState, q: np.ndarray) -> np.ndarray:
-    """Closure residual ``(N, m)`` in length units."""
-    out = []
-    L = tree.length
-    for k, d in cs.blocks:
-        if k == "point":
-            p1, p2 = _points(state, *d)
-            out.append(p1 - p2)
-        elif k == "rot":
-            b1, Rrel, b2 = d
-            Rt = state.T[:, b1, :3, :3] @ Rrel
-            R2 = state.T[:, b2, :3, :3]
-            out.append(0.5 * L * np.sum(np.cross(Rt, R2, axis=-2), axis=-1))
-        else:
-            _d1, q1, ref1, _, q2, ref2, c, s = d
-            x = q[:, q2] - ref2 if q2 >= 0 else np.zeros(q.shape[0])
-            out.append((s * ((q[:, q1] - ref1) - _poly(c, x)[0]))[:, None])
-    return np.concatenate(out, axis=-1) if out else np.zeros((q.shape[0], 0))
-
-
-def jacobian(cs: Constraints, tree: Tree, state: TreeState, q: np.ndarray) -> np.ndarray:
-    """Velocity constraint matrix ``K (N, m, nv)``."""
-    N = state.T.shape[0]
-    L = tree.length
-    out = []
-    for k, d in cs.blocks:
-        if k == "point":
-            b1, _x1, b2, _x2 = d
-            p1, p2 = _points(state, *d)
-            out.append(
-                frame_jacobian(tree, state, b1, p1)[:, 3:] - frame_jacobian(tree, state, b2, p2)[:, 3:]
-            )
-        elif k == "rot":
-            b1, _, b2 = d
-            w = state.S[..., :3].swapaxes(-1, -2)
-            out.append(L * w * (tree.A[b2] - tree.A[b1]))
-        else:
-            d1, _, _, d2, q2, ref2, c, s = d
-            row = np.zeros((N, 1, tree.nv))
-            row[:, 0, d1] = s
-            if d2 >= 0:
-                row[:, 0, d2] -= s * _poly(c, q[:, q2] - ref2)[1]
-            out.append(row)
-    return np.concatenate(out, axis=-2) if out else np.zeros((N, 0, tree.nv))

@@ -12,8 +12,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._assembly import check_mechanism, check_q
+from ._compile import compile_model
 from ._model import Mechanism
-from ._tree import body_poses
 
 __all__ = ["body_segments", "draw", "view"]
 
@@ -46,7 +46,9 @@ def body_segments(mech: Mechanism, q: ArrayLike) -> dict[str, np.ndarray]:
     if q.ndim != 1:
         raise ValueError(f"Expected q to have shape ({mech.nq},) (one configuration), got {q.shape}.")
     tree = mech.tree
-    T = body_poses(tree, q[None])[0]
+    from ._compiled import compiled_body_poses  # numba loads on the first kernel call, not at import
+
+    T = compiled_body_poses(compile_model(mech), q[None])[0]
 
     def world(b: int, x) -> np.ndarray:
         return T[b, :3, :3] @ np.asarray(x, float) + T[b, :3, 3]
@@ -110,7 +112,9 @@ def draw(
         raise ValueError(f"Expected title to be None or a string, got {title!r}.")
     qn = check_q(mech, q)
     tree = mech.tree
-    T = body_poses(tree, qn[None])[0]
+    from ._compiled import compiled_body_poses  # numba loads on the first kernel call, not at import
+
+    T = compiled_body_poses(compile_model(mech), qn[None])[0]
     if ax is None:
         fig = plt.figure(figsize=(5, 5))
         ax = fig.add_subplot(projection="3d")

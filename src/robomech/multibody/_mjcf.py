@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._compile import compile_model
 from ._model import (
     ASSEMBLED_RTOL,
     Body,
@@ -29,7 +30,7 @@ from ._model import (
     Site,
     _quat_from_matrix,
 )
-from ._tree import body_poses, quat_to_matrix
+from ._tree import quat_to_matrix
 
 __all__ = ["AUX_SITE_PREFIX", "from_mjcf", "to_mjcf"]
 
@@ -364,7 +365,9 @@ def to_mjcf(mech: Mechanism, *, comment: str | None = None) -> str:
     tree = mech.tree
     L = tree.length
     radius = 0.02 * L
-    T0 = body_poses(tree, tree.q0[None])[0]
+    from ._compiled import compiled_body_poses  # numba loads on the first kernel call, not at import
+
+    T0 = compiled_body_poses(compile_model(mech), tree.q0[None])[0]
     root = ET.Element("mujoco", model=mech.name)
     if comment:
         root.append(ET.Comment(" " + comment.replace("--", "- -").strip() + " "))

@@ -32,11 +32,9 @@ from numpy.typing import ArrayLike
 from robomech.analysis import mobility as screw_mobility
 
 from ._assembly import check_mechanism, check_q
-from ._compile import _rank, instantaneous_mobility
-from ._constraints import jacobian
+from ._compile import _rank, compile_model, instantaneous_mobility
 from ._model import Mechanism
 from ._options import MOBILITY_RTOL, NEIGHBOUR_STEP
-from ._tree import TreeState, kinematics, space_jacobian
 
 # The rank is checked at neighbours along at most this many admissible directions (both signs): a
 # rank that is not locally constant drops on a set of measure zero, so generic (random orthonormal)
@@ -126,20 +124,22 @@ class MobilityReport:
         return s
 
 
-def _scaled_K(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, TreeState]:
+def _scaled_K(mech: Mechanism, q: np.ndarray) -> np.ndarray:
+    """``K (N, m, nv)`` at ``q (N, nq)`` (the compiled kernel), translational columns times L."""
+    from ._compiled import compiled_resjac  # numba loads on the first kernel call, not at import
+
     tree = mech.tree
-    st = kinematics(tree, q)
-    K = jacobian(mech.constraints, tree, st, q)
+    K = compiled_resjac(compile_model(mech), q, True)[1]
     col = np.where(tree.dof_translational, tree.length, 1.0)
-    return K * col, st
+    return K * col
 
 
-def _serial_legs(mech: Mechanism, st, platform: int) -> list[np.ndarray] | None:
-    """Joint screws (world, at q) of each serial leg to ``platform``; None if not of that form."""
+def _serial_legs(mech: Mechanism, T: np.ndarray, S: np.ndarray, platform: int) -> list[np.ndarray] | None:
+    """Joint screws (world, at q: body poses ``T (nb, 4, 4)``, coordinate screws ``S (nv, 6)``) of each
+    serial leg to ``platform``; None if not of that form."""
     tree = mech.tree
     if mech.couplings:
         return None
-    S = st.S[0]
     chains = [S[tree.A[platform] > 0]]
     used = tree.A[platform].copy()
     for c in mech.closures:
@@ -152,13 +152,13 @@ def _serial_legs(mech: Mechanism, st, platform: int) -> list[np.ndarray] | None:
         ).any():  # shares joints with another leg: not serial legs (e.g. a parallelogram)
             return None
         used = np.maximum(used, tree.A[other])
-        T = st.T[0, other]
-        p = T[:3, :3] @ np.asarray(anchor) + T[:3, 3]
+        Tb = T[other]
+        p = Tb[:3, :3] @ np.asarray(anchor) + Tb[:3, 3]
         leg = list(S[tree.A[other] > 0])
         if c.kind == "point":
             leg += [np.concatenate([e, np.cross(p, e)]) for e in np.eye(3)]
         elif c.kind == "revolute":
-            a = T[:3, :3] @ np.asarray(c.axis2 if b1 == platform else c.axis)
+            a = Tb[:3, :3] @ np.asarray(c.axis2 if b1 == platform else c.axis)
             leg.append(np.concatenate([a, np.cross(p, a)]))
         if not leg:
             return None
@@ -223,8 +223,9 @@ def mobility(mech: Mechanism, q: ArrayLike | None = None, *, platform: str | Non
     if q.ndim != 1:
         raise ValueError(f"Expected q to have shape ({mech.nq},) (one configuration), got {q.shape}.")
     q = q[None]
-    inst = instantaneous_mobility(tree, mech.constraints, q)
-    K, st, kmax, rank, N = inst.K, inst.state, inst.kmax, inst.rank, inst.N
+    model = compile_model(mech)
+    inst = instantaneous_mobility(tree, model, q)
+    K, kmax, rank, N = inst.K, inst.kmax, inst.rank, inst.N
     locked, idle = inst.locked, inst.idle
     nv = K.shape[1]
     total = nv - rank
@@ -241,13 +242,11 @@ def mobility(mech: Mechanism, q: ArrayLike | None = None, *, platform: str | Non
             rng = np.random.default_rng(0)  # fixed: the report is deterministic
             D = N @ np.linalg.qr(rng.standard_normal((N.shape[1], NEIGHBOUR_DIRECTIONS)))[0]
         steps = np.concatenate([D.T, -D.T]) * NEIGHBOUR_STEP / col  # back to unscaled coordinates
-        from ._tree import integrate
+        from ._compiled import compiled_fk, compiled_integrate  # numba loads on the first kernel call
 
-        qn = integrate(tree, np.repeat(q, steps.shape[0], axis=0), steps)
-        from ._compiled import compiled_fk  # numba loads on the first kernel call, not at import
-
+        qn = compiled_integrate(model, np.repeat(q, steps.shape[0], axis=0), steps)
         qn, _rc, _, _ = compiled_fk(mech, qn, np.arange(nv))
-        Kn = _scaled_K(mech, qn)[0]  # one batched evaluation for every neighbour
+        Kn = _scaled_K(mech, qn)  # one batched evaluation for every neighbour
         nearby = [_rank(Kn[k], kmax) for k in range(Kn.shape[0])]
     singular = any(r != rank for r in nearby)
     if platform is None and len(tree.site_names):
@@ -255,14 +254,16 @@ def mobility(mech: Mechanism, q: ArrayLike | None = None, *, platform: str | Non
     p_dof = p_rot = p_tw = sm = None
     if platform is not None:
         pb = tree.body_index(platform)
-        Jp = space_jacobian(tree, st, pb)[0] / col
+        from ._compiled import space_jacobians
+
+        Jp = space_jacobians(tree.A, inst.S[None], [pb])[0, 0] / col
         Tw = Jp @ N
         Tw[3:] /= tree.length
         U, s, _ = np.linalg.svd(Tw) if Tw.size else (np.zeros((6, 0)), np.zeros(0), None)
         p_dof = int(np.sum(s > MOBILITY_RTOL))  # N orthonormal, Tw entries O(1)
         p_tw = U[:, :p_dof].T
         p_rot = _rank(p_tw[:, :3], 1.0) if p_dof else 0
-        legs = _serial_legs(mech, st, pb)
+        legs = _serial_legs(mech, inst.T, inst.S, pb)
         if legs is not None and all(len(c) for c in legs):  # a platform welded to the world has no legs
             # analysis.mobility divides moments by length_scale and wants unit screws after that:
             # prismatic screws [0; d] are passed as [0; L d]

@@ -757,13 +757,16 @@ class Builder:
         )
         # Its tree and assembled reference only (the compile step's q_ref), not its whole compiled model:
         # the mechanism is compiled once, below.
+        from ._compile import _tables, build_tree
+        from ._compiled import compiled_body_poses
         from ._constraints import compile_constraints
         from ._reference import assembled_reference
-        from ._tree import body_poses, compile_tree
 
-        tree0 = compile_tree(tree_only)
-        q_ref0 = assembled_reference(tree_only, tree0, compile_constraints(tree_only, tree0))
-        T0 = body_poses(tree0, q_ref0[None])[0]
+        tree0 = build_tree(tree_only)
+        cs0 = compile_constraints(tree_only, tree0)
+        tables0 = _tables(tree0, cs0)
+        q_ref0 = assembled_reference(tree_only, tree0, cs0, tables0)
+        T0 = compiled_body_poses(tables0, q_ref0[None])[0]
 
         def pose(body: str) -> np.ndarray:
             return T0[tree0.body_index(body)]

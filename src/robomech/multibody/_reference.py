@@ -19,8 +19,6 @@ from typing import Any
 import numpy as np
 
 from ._assembly import CONVERGED_RTOL, floating_base_dofs
-from ._constraints import residual
-from ._tree import integrate, kinematics
 
 __all__ = ["ASSEMBLY_MAX_ITER", "PERTURBATION", "START_PERTURBATIONS", "assembled_reference"]
 
@@ -34,16 +32,19 @@ START_PERTURBATIONS = 8
 PERTURBATION = 0.2
 
 
-def assembled_reference(mech, tree, cs) -> np.ndarray:
+def assembled_reference(mech, tree, cs, tables) -> np.ndarray:
     """``qpos0`` if it satisfies the closures to ``CONVERGED_RTOL * L``, else the assembly nearest to it.
 
-    Called by the compile step (``_compile``) with the description's just-built tree and closure rows,
-    before the reference rank is taken there (so the rank is that of the assembled reference)."""
+    Called by the compile step (``_compile``) with the description's just-built tree, closure rows and
+    their packed tables, before the reference rank is taken there (so the rank is that of the assembled
+    reference); the residual and the assembly run on the compiled kernels."""
+    from ._compiled import closure_solve, compiled_integrate, compiled_resjac  # numba loads on first call
+
     q0 = np.array(tree.q0, dtype=float)
     if cs.m == 0:
         return q0
     tol = CONVERGED_RTOL * tree.length
-    r0 = float(np.max(np.abs(residual(cs, tree, kinematics(tree, q0[None]), q0[None]))))
+    r0 = float(np.max(np.abs(compiled_resjac(tables, q0[None], False)[0])))
     if r0 <= tol:
         return q0
     # the compiled model is being built: the assembly kernel runs on the tables of the tree and rows
@@ -56,22 +57,13 @@ def assembled_reference(mech, tree, cs) -> np.ndarray:
     dv = np.zeros((1 + START_PERTURBATIONS, tree.nv))
     w = np.where(tree.dof_translational, tree.length, 1.0)[free]
     dv[1:, free] = PERTURBATION * w * rng.uniform(-1.0, 1.0, (START_PERTURBATIONS, len(free)))
-    starts = integrate(tree, np.repeat(q0[None], 1 + START_PERTURBATIONS, axis=0), dv)
-    from ._compile import _tables
-    from ._compiled import closure_solve  # numba loads on the first kernel call, not at import
-
+    starts = compiled_integrate(tables, np.repeat(q0[None], 1 + START_PERTURBATIONS, axis=0), dv)
     wstep = np.where(tree.dof_translational, 1.0 / tree.length, 1.0)[free]
-    q, rc, _, _ = closure_solve(_tables(tree, cs), starts, free, wstep, ASSEMBLY_MAX_ITER)
+    q, rc, _, _ = closure_solve(tables, starts, free, wstep, ASSEMBLY_MAX_ITER)
     ok = rc <= tol
     if not ok.any():
         best = int(np.argmin(rc))
-        worst = cs.row_owner[
-            int(
-                np.argmax(
-                    np.abs(residual(cs, tree, kinematics(tree, q[best : best + 1]), q[best : best + 1])[0])
-                )
-            )
-        ]
+        worst = cs.row_owner[int(np.argmax(np.abs(compiled_resjac(tables, q[best : best + 1], False)[0][0])))]
         raise ValueError(
             f"Expected the description {mech.name!r} to assemble (closures closed to "
             f"{CONVERGED_RTOL:g} L = {tol:.3g} m): from its reference pose (residual {r0:.3g} m) the "

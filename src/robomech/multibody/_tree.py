@@ -1,19 +1,15 @@
-"""Batched tree kinematics of a described mechanism (internal; kernels trust their inputs).
+"""The compiled tree of a described mechanism (internal): the arrays the kernels run on.
 
-Everything here works on flat batches ``q (N, nq)`` / ``qd (N, ..., nv)`` and returns world-frame
-quantities:
-
-* :func:`kinematics` -> :class:`TreeState`: every body's pose ``T (N, nb, 4, 4)`` (index 0 is the
-  world), every velocity coordinate's space screw ``S (N, nv, 6)`` (``[ω; v]``, v of the point at the
-  world origin), so that body b's space twist is ``V_b = sum_k A[b, k] S_k qd_k``;
-* :func:`frame_jacobian` -> the ``[ω; ṗ]`` Jacobian ``(N, 6, nv)`` of a point fixed in a body
-  (MuJoCo's ``mj_jacSite`` quantities);
-* :func:`integrate` -> ``q ⊕ δ``: hinge/slide add, ball/free rotate by ``exp`` of the *local*
-  angular increment (MuJoCo's ``mj_integratePos``).
+:func:`compile_tree` builds the :class:`Tree` (bodies indexed from 1, world at 0; joints, their
+coordinates and axes; the incidence ``A (nb, nv)`` of the coordinates that move each body; sites and
+actuators) once per description.  The tree kinematics, Jacobians and integration run on these arrays
+in the compiled kernels (``_compiled.kin``, ``compiled_kinematics``, ``compiled_integrate``); the
+numpy formulation of the same algorithms is the tests' reference (tests/multibody/_reference.py).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,16 +18,10 @@ from ._options import QUAT_MIN_NORM as _QUAT_MIN_NORM
 
 __all__ = [
     "Tree",
-    "TreeState",
-    "body_poses",
-    "body_twists",
     "compile_tree",
-    "frame_jacobian",
-    "integrate",
-    "kinematics",
     "normalize_quaternions",
+    "quat_mul",
     "quat_to_matrix",
-    "space_jacobian",
 ]
 
 _TYPES = {"hinge": 0, "slide": 1, "ball": 2, "free": 3}
@@ -66,23 +56,6 @@ def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
         ],
         axis=-1,
     )
-
-
-def quat_exp(w: np.ndarray) -> np.ndarray:
-    """Unit quaternion of the rotation vector ``w`` (..., 3)."""
-    th = np.linalg.norm(w, axis=-1)
-    half = 0.5 * th
-    # sin(th/2)/th, with its series below 1e-4 rad (error < th^4/3840 ~ 1e-19)
-    small = th < 1e-4
-    k = np.where(small, 0.5 - th * th / 48.0, np.sin(half) / np.where(small, 1.0, th))
-    return np.concatenate([np.cos(half)[..., None], k[..., None] * w], axis=-1)
-
-
-def axis_angle_matrix(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """Rotation (..., 3, 3) by ``angle (...)`` about the unit ``axis (3,)`` (Rodrigues)."""
-    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    s, c = np.sin(angle)[..., None, None], np.cos(angle)[..., None, None]
-    return np.eye(3) + s * K + (1 - c) * (K @ K)
 
 
 def normalize_quaternions(tree: Tree, q: np.ndarray) -> np.ndarray:
@@ -158,7 +131,9 @@ def _pose(pos, quat) -> np.ndarray:
     return T
 
 
-def compile_tree(mech) -> Tree:
+def compile_tree(mech, default_length: Callable[[Tree], float]) -> Tree:
+    """The :class:`Tree` of ``mech``; its characteristic length the description's, else
+    ``default_length(tree)`` (the compile step passes one from the body poses at q0)."""
     names = ["world", *(b.name for b in mech.bodies)]
     nb = len(names)
     parent = np.zeros(nb, dtype=int)
@@ -263,143 +238,6 @@ def compile_tree(mech) -> Tree:
     )
     L = mech.characteristic_length
     if L is None:
-        L = _default_length(mech, tree)
+        L = default_length(tree)
     object.__setattr__(tree, "length", float(L))
     return tree
-
-
-def _default_length(mech, tree: Tree) -> float:
-    """RMS distance of the body origins, joint anchors and sites from their centroid at q0 (m).
-
-    This is the length that makes a rotation (rad) and a translation (m) commensurate in residuals
-    and conditioning; 1 m if the mechanism has no extent (a single point).
-    """
-    T = body_poses(tree, tree.q0[None])[0]
-    pts = [T[1:, :3, 3]]
-    for k in range(len(tree.jnt_names)):
-        Tb = T[tree.jnt_body[k]]
-        pts.append((Tb[:3, :3] @ tree.jnt_pos[k] + Tb[:3, 3])[None])
-    for s in range(len(tree.site_names)):
-        pts.append((T[tree.site_body[s]] @ tree.T_site[s])[None, :3, 3])
-    P = np.concatenate(pts)
-    L = float(np.sqrt(np.mean(np.sum((P - P.mean(axis=0)) ** 2, axis=1)))) if len(P) > 1 else 0.0
-    return L if L > 1e-9 else 1.0
-
-
-# ------------------------------------------------------------------ kinematics
-@dataclass(frozen=True, eq=False)
-class TreeState:
-    """World poses ``T (N, nb, 4, 4)`` of all bodies and space screws ``S (N, nv, 6)`` of all coordinates."""
-
-    T: np.ndarray
-    S: np.ndarray
-
-
-def _cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``np.cross`` of ``(N, 3)`` arrays, the same products and differences in the same order (so the
-    same bits) without its axis handling, which dominated the kinematics of a single configuration."""
-    out = np.empty(a.shape)
-    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
-    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
-    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    return out
-
-
-def _kin(tree: Tree, q: np.ndarray, screws: bool) -> TreeState:
-    N = q.shape[0]
-    nb = len(tree.body_names)
-    T = np.empty((N, nb, 4, 4))
-    T[:, 0] = np.eye(4)
-    # Without screws S is an empty (N, 0, 6) placeholder that is never written (only poses wanted).
-    S = np.zeros((N, tree.nv if screws else 0, 6))
-    for b in range(1, nb):
-        Tb = T[:, tree.parent[b]] @ tree.T_off[b]
-        for k in tree.body_jnts[b]:
-            typ, qa, da = tree.jnt_type[k], tree.jnt_qadr[k], tree.jnt_dadr[k]
-            pos, axis = tree.jnt_pos[k], tree.jnt_axis[k]
-            R, p = Tb[:, :3, :3], Tb[:, :3, 3]
-            if typ == 0 or typ == 2:
-                anchor = p + R @ pos
-                Rj = (
-                    axis_angle_matrix(axis, q[:, qa] - tree.jnt_ref[k])
-                    if typ == 0
-                    else quat_to_matrix(q[:, qa : qa + 4])
-                )
-                Rn = R @ Rj
-                Tb = Tb.copy()
-                Tb[:, :3, :3] = Rn
-                Tb[:, :3, 3] = anchor - Rn @ pos
-                if screws:
-                    if typ == 0:
-                        w = R @ axis
-                        S[:, da, :3] = w
-                        S[:, da, 3:] = _cross3(anchor, w)
-                    else:
-                        for c in range(3):
-                            w = Rn[:, :, c]
-                            S[:, da + c, :3] = w
-                            S[:, da + c, 3:] = _cross3(anchor, w)
-            elif typ == 1:
-                w = R @ axis
-                Tb = Tb.copy()
-                Tb[:, :3, 3] = p + w * (q[:, qa] - tree.jnt_ref[k])[:, None]
-                if screws:
-                    S[:, da, 3:] = w
-            else:
-                Tb = np.tile(np.eye(4), (N, 1, 1))
-                Rn = quat_to_matrix(q[:, qa + 3 : qa + 7])
-                Tb[:, :3, :3] = Rn
-                Tb[:, :3, 3] = q[:, qa : qa + 3]
-                if screws:
-                    for c in range(3):
-                        S[:, da + c, 3 + c] = 1.0
-                        w = Rn[:, :, c]
-                        S[:, da + 3 + c, :3] = w
-                        S[:, da + 3 + c, 3:] = _cross3(q[:, qa : qa + 3], w)
-        T[:, b] = Tb
-    return TreeState(T=T, S=S)
-
-
-def body_poses(tree: Tree, q: np.ndarray) -> np.ndarray:
-    """World pose of every body, ``(N, nb, 4, 4)`` (body 0 is the world).  ``q`` normalised quaternions."""
-    return _kin(tree, q, screws=False).T
-
-
-def kinematics(tree: Tree, q: np.ndarray) -> TreeState:
-    """Body poses and coordinate space screws at ``q (N, nq)`` (quaternions already normalised)."""
-    return _kin(tree, q, screws=True)
-
-
-def integrate(tree: Tree, q: np.ndarray, dv: np.ndarray) -> np.ndarray:
-    """``q ⊕ dv``: the configuration reached from ``q`` by the velocity increment ``dv (N, nv)``."""
-    out = np.array(q, copy=True)
-    for k in range(len(tree.jnt_names)):
-        typ, qa, da = tree.jnt_type[k], tree.jnt_qadr[k], tree.jnt_dadr[k]
-        if typ <= 1:
-            out[:, qa] += dv[:, da]
-        elif typ == 2:
-            out[:, qa : qa + 4] = quat_mul(q[:, qa : qa + 4], quat_exp(dv[:, da : da + 3]))
-        else:
-            out[:, qa : qa + 3] += dv[:, da : da + 3]
-            out[:, qa + 3 : qa + 7] = quat_mul(q[:, qa + 3 : qa + 7], quat_exp(dv[:, da + 3 : da + 6]))
-    return normalize_quaternions(tree, out) if tree.quat_adr else out
-
-
-def space_jacobian(tree: Tree, state: TreeState, body: int) -> np.ndarray:
-    """Space-twist Jacobian of ``body`` (N, 6, nv): ``V_b = J qd`` (``[ω; v]``, v at the world origin)."""
-    return (state.S * tree.A[body][:, None]).swapaxes(-1, -2)
-
-
-def body_twists(tree: Tree, state: TreeState, qd: np.ndarray) -> np.ndarray:
-    """Space twists of all bodies (N, ..., nb, 6) for ``qd (N, ..., nv)``."""
-    S = state.S.reshape(state.S.shape[0], *(1,) * (qd.ndim - 2), *state.S.shape[1:])
-    return np.einsum("bk,...kx,...k->...bx", tree.A, S, qd)
-
-
-def frame_jacobian(tree: Tree, state: TreeState, body: int, point: np.ndarray) -> np.ndarray:
-    """``[ω; ṗ] = J qd`` for the point ``point (N, 3)`` (world) fixed in ``body``: (N, 6, nv)."""
-    S = state.S
-    mask = tree.A[body][None, :, None]
-    w = S[..., :3] * mask
-    v = (S[..., 3:] + np.cross(S[..., :3], point[:, None, :])) * mask
-    return np.concatenate([w, v], axis=-1).swapaxes(-1, -2)

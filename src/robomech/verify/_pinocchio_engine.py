@@ -29,7 +29,7 @@ def check_mechanism_pinocchio(mech, name: str | None = None) -> list[Check]:
 
     from robomech import multibody as mb
     from robomech.multibody._compile import compile_model
-    from robomech.multibody._tree import kinematics
+    from robomech.multibody._compiled import compiled_body_poses
 
     name = f"{name or mech.name} (pinocchio)"
     mech, virtual = g._virtually_actuated(mech)
@@ -57,7 +57,7 @@ def check_mechanism_pinocchio(mech, name: str | None = None) -> list[Check]:
     L = tree.length
     closure = adm = frames = 0.0
     tau_err = tau_scale = m_err = m_scale = vscale = 0.0
-    Tw = kinematics(tree, q).T
+    Tw = compiled_body_poses(compile_model(mech), q)
     for i in range(len(q)):
         qp, vp, ap = P.state(q[i], inv.qd[i], inv.qdd[i])
         T = P.velocity_map(q[i])

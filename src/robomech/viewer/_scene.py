@@ -25,8 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from robomech.multibody._compile import compile_model
 from robomech.multibody._model import Mechanism
-from robomech.multibody._tree import body_poses
 
 # A link shorter than this fraction of the characteristic length has coincident ends: it is drawn
 # between its joints' axes instead (a spherical linkage), or not at all when neither end has an axis.
@@ -205,7 +205,9 @@ def _spherical_centres(mech: Mechanism) -> list[NDArray[np.float64]]:
 
 def poses(mech: Mechanism, q: NDArray[np.float64]) -> NDArray[np.float64]:
     """World pose ``(nb, 4, 4)`` of every tree body (index 0 the world) at one configuration."""
-    return np.asarray(body_poses(mech.tree, np.asarray(q, float)[None])[0])
+    from robomech.multibody._compiled import compiled_body_poses  # numba loads at the first kernel call
+
+    return np.asarray(compiled_body_poses(compile_model(mech), np.asarray(q, float)[None])[0])
 
 
 def cylinder_pose(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[np.ndarray, np.ndarray, float]:

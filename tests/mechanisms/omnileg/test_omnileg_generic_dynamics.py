@@ -21,7 +21,8 @@ from robomech import multibody as mb
 from robomech.mechanisms import omnileg as ol
 from robomech.mechanisms.omnileg._dynamics import _body_list
 from robomech.mechanisms.omnileg._multibody import _frame
-from robomech.multibody import _tree
+from robomech.multibody._compile import compile_model
+from robomech.multibody._compiled import compiled_body_poses
 
 # Both sides are exact rigid-body models of the same bodies (issue 13's bar: 1e-8 relative; measured
 # ~2e-14).
@@ -94,7 +95,7 @@ def test_body_frames_and_mass_centres_are_the_analytic_ones():
     )
     fk = mb.forward_kinematics(MECH, q, steps=4)
     assert fk.converged.all()
-    T = _tree.body_poses(MECH.tree, fk.q)
+    T = compiled_body_poses(compile_model(MECH), fk.q)
     R_an, p_an = ol.body_poses(LEG, q)
     bodies = {b.name: b for b in MECH.bodies}
     for i, (name, kind) in enumerate(_body_list()):

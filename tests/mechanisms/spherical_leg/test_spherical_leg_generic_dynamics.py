@@ -21,10 +21,10 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from tests.multibody._reference import body_twists, kinematics
 
 from robomech import multibody as mb
 from robomech.mechanisms import spherical_leg as sl
-from robomech.multibody._tree import body_twists, kinematics
 
 # Both models are exact rigid-body dynamics; agreement to rounding (measured ~1e-14 relative).
 AGREE_RTOL = 1e-10
