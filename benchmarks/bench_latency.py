@@ -24,6 +24,11 @@
   ``site_pose`` and ``energy`` at batch 1 and 10^4 samples (run on two source trees in turn for a
   before / after comparison).
 
+* ``--compile`` (:func:`compile_rows`): the compile step (``_compile._compile``: tree, closure rows,
+  tables, reference assembly and reference rank) and ``mb.mobility`` of the Delta and the 6-DOF arm,
+  and the first load or build of each (its compile step included) in a fresh process (warm kernel
+  cache).
+
 The compared measurements are taken in interleaved rounds (:func:`_interleaved`: in each round
 robomech and every alternative in turn) and reported as the minimum and the median over the rounds,
 so that the shared machine's background load hits both sides alike; the load average is printed.
@@ -375,11 +380,59 @@ def moved_rows() -> list[str]:
     return rows
 
 
+def _fresh_compile(name: str) -> float:
+    """Seconds of the first ``gallery.load("delta")`` or ``arm6()`` (``name``: ``delta`` or ``arm6``) in a
+    fresh process: reading or building the description and its compile step (both compile it)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = (
+        "import time, sys; sys.path.insert(0, sys.argv[1]); import bench_latency as b\n"
+        "from robomech import multibody as mb\n"
+        "import mujoco\n"  # the MJCF reader's import, outside the timing
+        "t0 = time.perf_counter()\n"
+        "m = mb.gallery.load('delta') if sys.argv[2] == 'delta' else b.arm6()\n"
+        "print(time.perf_counter() - t0)\n"
+    )
+    here = str(Path(__file__).resolve().parent)
+    out = subprocess.run([sys.executable, "-c", code, here, name], capture_output=True, text=True, check=True)
+    return float(out.stdout.split()[-1])
+
+
+def compile_rows() -> list[str]:
+    """The compile step and ``mobility`` of the Delta and the 6-DOF arm, per call (min / median over
+    interleaved rounds), and the first compile in a fresh process (3 processes: min / median)."""
+    from robomech.multibody import _compile
+
+    mechs = {"Delta": mb.gallery.load("delta"), "6-DOF arm": arm6()}
+    fns = {}
+    for name, mech in mechs.items():
+        mb.mobility(mech)  # load every kernel outside the timing
+        fns[name + " compile"] = lambda mech=mech: _per(lambda i: _compile._compile(mech), 20)
+        fns[name + " mobility"] = lambda mech=mech: _per(lambda i: mb.mobility(mech), 20)
+    res = _interleaved(fns, rounds=5)
+    rows = [
+        "| | compile step (per call, min / median) | mobility (per call) | first load, fresh process |",
+        "|---|---|---|---|",
+    ]
+    for name, key in (("Delta", "delta"), ("6-DOF arm", "arm6")):
+        first = [_fresh_compile(key) for _ in range(3)]
+        rows.append(
+            f"| {name} | {_mm(res[name + ' compile'])} | {_mm(res[name + ' mobility'])} | "
+            f"{min(first) * 1e3:.0f} / {np.median(first) * 1e3:.0f} ms |"
+        )
+    return rows
+
+
 if __name__ == "__main__":
     import sys
 
     if sys.argv[1:] == ["--moved"]:
         for row in moved_rows():
+            print(row)
+    elif sys.argv[1:] == ["--compile"]:
+        for row in compile_rows():
             print(row)
     else:
         main()
