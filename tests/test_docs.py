@@ -76,7 +76,7 @@ def test_every_public_name_is_on_its_module_page():
 def test_the_api_pages_document_no_private_internals():
     for module_name in _conf().API_MODULES:
         doc = importlib.import_module(module_name).__doc__ or ""
-        # a private module's attribute (``_tree.kinematics``); a file name (``_householder.py``) is fine
+        # a private module's attribute (``_tree.compile_tree``); a file name (``_householder.py``) is fine
         private = re.findall(r"(?<![\w./])_[a-z]\w*\.(?!py\b)[A-Za-z_]\w*", doc)
         assert not private, f"{module_name}'s docstring documents private internals: {private}"
 
