@@ -112,6 +112,66 @@ def test_singularities_equal_numpy_at_every_batch_size(name):
             _close(np.nan_to_num(a), np.nan_to_num(getattr(s, f)[:n]), BATCH_RTOL, f"{f} at batch {n}")
 
 
+# dK/dt applied to v against the per-product kernel (dK/dt along u) v: the same products and sums per
+# entry, identical bits measured; a few ulps of the largest entry allowed.
+PRODUCT_RTOL = 1e-14
+# Central differences of K along qd (step H_FD): truncation h^2 |d3K/dt3| ~ 1e-12 plus rounding
+# eps |K| / h ~ 1e-10 (K's entries are O(1) m).
+H_FD = 1e-6
+FD_RTOL = 1e-8
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_rate_columns_equal_the_per_product_kernel(name):
+    """Every column of dK/dt in one pass (``_compiled.kdot_columns``) against ``kdot_uv``, the kernel that
+    forms ``(dK/dt along u) v`` for one ``v`` (inverse dynamics, second-order influence coefficients),
+    with random ``v``, on assembled and unassembled samples, at every batch size."""
+    from robomech.multibody import _compiled as C
+    from robomech.multibody._compile import compile_model
+    from robomech.multibody._tree import integrate
+
+    mech = _get(name)
+    t = compile_model(mech).tables
+    rng = np.random.default_rng(6)
+    q = _configurations(mech, N, seed=6)
+    q = np.concatenate([q, integrate(mech.tree, q, 0.05 * rng.uniform(-1, 1, (N, mech.nv)))])
+    qd, v = rng.normal(size=(2, 2 * N, mech.nv))
+    nb, nv, m = t.parent.shape[0], mech.nv, t.m
+    T, S, Sd = np.empty((nb, 4, 4)), np.zeros((nv, 6)), np.empty((nv, 6))
+    Vu, Vv, Vd, kd = np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nb, 6)), np.empty(m)
+    picks = np.arange(0, 2 * N, 23)  # a spread of samples, assembled and not
+    ref = np.empty((len(picks), m))
+    for i, n in enumerate(picks):
+        C.kin(q[n], t, T, S)
+        C.screw_rates_into(t, S, qd[n], Sd)
+        C.kdot_uv(q[n], t, T, S, Sd, qd[n], v[n], Vu, Vv, Vd, kd)
+        ref[i] = kd
+    for n in (*SIZES, 2 * N):
+        sel = picks[picks < n]
+        Kd = mb.constraint_jacobian_rate(mech, q[:n], qd[:n])
+        _close(np.einsum("nij,nj->ni", Kd[sel], v[sel]), ref[: len(sel)], PRODUCT_RTOL, f"batch {n}")
+
+
+@pytest.mark.parametrize("name", ("delta", "tsai", "sarrus", "five_bar", "bennett"))
+def test_rate_equals_finite_differences_of_k(name):
+    """dK/dt against central differences of K along qd, at assembled and unassembled configurations:
+    the rate of every closure row (points, rotations) from an independent formula."""
+    from robomech.multibody._tree import integrate
+
+    mech = _get(name)
+    rng = np.random.default_rng(7)
+    q = _configurations(mech, 8, seed=7)
+    q = np.concatenate([q, integrate(mech.tree, q, 0.05 * rng.uniform(-1, 1, (len(q), mech.nv)))])
+    qd = rng.normal(size=(len(q), mech.nv))
+    fd = (
+        mb.constraint_jacobian(mech, integrate(mech.tree, q, H_FD * qd))
+        - mb.constraint_jacobian(mech, integrate(mech.tree, q, -H_FD * qd))
+    ) / (2 * H_FD)
+    Kd = mb.constraint_jacobian_rate(mech, q, qd)
+    assert np.max(np.abs(Kd)) > 0.1  # a rate that is not zero
+    assert np.max(np.abs(Kd - fd)) <= FD_RTOL * max(1.0, float(np.max(np.abs(Kd))))
+
+
 def test_coupling_rate_equals_finite_differences():
     """dK/dt of the cubic coupling row (the only row here whose K depends on q) against central
     differences of K along qd: an independent check of the kernel's second derivative of the polynomial."""

@@ -725,27 +725,19 @@ def resjac_par(Q, t, with_jac, R_o, K_o):  # pragma: no cover - compiled
 
 @_nj
 def kdot_block(Q, QD, lo, hi, t, KD_o):  # pragma: no cover - compiled
-    """``dK/dt`` along ``QD (N, nv)`` into ``KD_o (N, m, nv)`` for samples ``lo:hi``: column ``k`` is
-    :func:`kdot_uv` with ``u = qd`` and ``v`` the ``k``-th unit vector."""
+    """``dK/dt`` along ``QD (N, nv)`` into ``KD_o (N, m, nv)`` for samples ``lo:hi``, every column in
+    one pass per sample (:func:`kdot_columns`)."""
     nb = t.parent.shape[0]
     nv = t.A.shape[1]
-    m = t.m
     T = np.empty((nb, 4, 4))
     S = np.zeros((nv, 6))
     Sd = np.empty((nv, 6))
-    e = np.zeros(nv)
-    Vu, Vv, Vd = np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nb, 6))
-    kd = np.empty(m)
+    Vu = np.empty((nb, 6))
     for n in range(lo, hi):
         q, qd = Q[n], QD[n]
         kin(q, t, T, S)
         screw_rates_into(t, S, qd, Sd)
-        for k in range(nv):
-            e[k] = 1.0
-            kdot_uv(q, t, T, S, Sd, qd, e, Vu, Vv, Vd, kd)
-            e[k] = 0.0
-            for i in range(m):
-                KD_o[n, i, k] = kd[i]
+        kdot_columns(q, t, T, S, Sd, qd, Vu, KD_o[n])
 
 
 @numba.njit(cache=True, error_model="numpy", parallel=True)
@@ -754,6 +746,64 @@ def kdot_par(Q, QD, t, KD_o):  # pragma: no cover - compiled
     N = Q.shape[0]
     for k in numba.prange((N + BLOCK - 1) // BLOCK):
         kdot_block(Q, QD, k * BLOCK, min(N, (k + 1) * BLOCK), t, KD_o)
+
+
+# ----------------------------------------------------------------------------- dK/dt, every column
+@_nj
+def kdot_columns(q, t, T, S, Sd, u, Vu, KD):  # pragma: no cover - compiled
+    """``KD = dK/dt (m, nv)`` along ``u (nv,)`` in one pass, ``Sd`` the screw rates along ``u``
+    (:func:`screw_rates_into`); column ``k`` is :func:`kdot_uv` with ``v`` the ``k``-th unit vector.
+
+    A point row's column ``k`` is, per anchor ``p`` on body ``b`` (sign + for the first, - for the
+    second), the rate of ``A_bk (v_k + w_k x p)``: ``A_bk (dv_k + dw_k x p + w_k x pdot)`` with ``pdot =
+    v_b + w_b x p`` the anchor's velocity along ``u``; a rotation row's is ``L (A_b2k - A_b1k) dw_k``; a
+    coupling row's is ``-s poly''(x) u_2`` in the column of its second coordinate (its first column is
+    constant).  Also fills the body twists ``Vu = A S u (nb, 6)``."""
+    A, L = t.A, t.L
+    nb, nv = A.shape
+    for b in range(nb):
+        for i in range(6):
+            acc = 0.0
+            for k in range(nv):
+                if A[b, k] != 0.0:
+                    acc += A[b, k] * S[k, i] * u[k]
+            Vu[b, i] = acc
+    KD[:, :] = 0.0
+    for i in range(t.pp.shape[0]):
+        row = t.pp[i, 2]
+        for side in range(2):
+            b = t.pp[i, side]
+            x = t.px[i, side]
+            sign = 1.0 if side == 0 else -1.0
+            p0 = T[b, 0, 3] + T[b, 0, 0] * x[0] + T[b, 0, 1] * x[1] + T[b, 0, 2] * x[2]
+            p1 = T[b, 1, 3] + T[b, 1, 0] * x[0] + T[b, 1, 1] * x[1] + T[b, 1, 2] * x[2]
+            p2 = T[b, 2, 3] + T[b, 2, 0] * x[0] + T[b, 2, 1] * x[1] + T[b, 2, 2] * x[2]
+            w0, w1, w2 = Vu[b, 0], Vu[b, 1], Vu[b, 2]
+            pd0 = Vu[b, 3] + w1 * p2 - w2 * p1
+            pd1 = Vu[b, 4] + w2 * p0 - w0 * p2
+            pd2 = Vu[b, 5] + w0 * p1 - w1 * p0
+            for k in range(nv):
+                a = A[b, k]
+                if a == 0.0:
+                    continue
+                e0, e1, e2 = a * Sd[k, 0], a * Sd[k, 1], a * Sd[k, 2]
+                x0, x1, x2 = a * S[k, 0], a * S[k, 1], a * S[k, 2]
+                KD[row, k] += sign * (a * Sd[k, 3] + (e1 * p2 - e2 * p1) + (x1 * pd2 - x2 * pd1))
+                KD[row + 1, k] += sign * (a * Sd[k, 4] + (e2 * p0 - e0 * p2) + (x2 * pd0 - x0 * pd2))
+                KD[row + 2, k] += sign * (a * Sd[k, 5] + (e0 * p1 - e1 * p0) + (x0 * pd1 - x1 * pd0))
+    for i in range(t.rr.shape[0]):
+        b1, b2, row = t.rr[i, 0], t.rr[i, 1], t.rr[i, 2]
+        for k in range(nv):
+            a1, a2 = A[b1, k], A[b2, k]
+            if a1 != 0.0 or a2 != 0.0:
+                for c in range(3):
+                    KD[row + c, k] = L * (a2 * Sd[k, c] - a1 * Sd[k, c])
+    for i in range(t.cc.shape[0]):
+        d2, q2, row = t.cc[i, 2], t.cc[i, 3], t.cc[i, 4]
+        if d2 >= 0:
+            x = q[q2] - t.cf[i, 1]
+            dd = 2 * t.cf[i, 4] + x * (6 * t.cf[i, 5] + x * 12 * t.cf[i, 6])
+            KD[row, d2] = -t.cf[i, 7] * dd * u[d2]
 
 
 # ----------------------------------------------------------------------------- inverse dynamics
