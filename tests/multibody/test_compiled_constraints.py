@@ -105,6 +105,12 @@ def test_singularities_equal_numpy_at_every_batch_size(name):
         assert np.array_equal(np.isfinite(a), np.isfinite(b)), f
         fin = np.isfinite(b)
         assert np.all(np.abs(a[fin] - b[fin]) <= SINGULAR_RTOL * np.maximum(1.0, np.abs(b[fin]))), f
+    for output in ("position", (0, 4)):  # a part of the site's rows: the kernel's row selection
+        a = mb.singularities(mech, q, site, output=output)
+        with numpy_reference():
+            b = mb.singularities(mech, q, site, output=output)
+        assert np.array_equal(a.type_I, b.type_I), output
+        _close(np.nan_to_num(a.sigma_I), np.nan_to_num(b.sigma_I), SINGULAR_RTOL, f"sigma_I {output}")
     for n in SIZES[:-1]:
         part = mb.singularities(mech, q[:n] if n > 1 else q[0], site)
         for f in ("sigma_I", "sigma_II", "sigma_C", "closure"):

@@ -19,6 +19,8 @@ tests as the reference (tests/multibody/_reference.py).
 
 from __future__ import annotations
 
+import importlib
+
 import numpy as np
 
 from robomech._numba import import_numba
@@ -34,6 +36,7 @@ __all__ = [
     "compiled_jacobian_rate",
     "compiled_project",
     "compiled_resjac",
+    "compiled_singular_values",
     "compiled_site_jacobian",
     "compiled_site_pose",
     "inv_dyn",
@@ -748,7 +751,13 @@ def kdot_par(Q, QD, t, KD_o):  # pragma: no cover - compiled
         kdot_block(Q, QD, k * BLOCK, min(N, (k + 1) * BLOCK), t, KD_o)
 
 
-# ----------------------------------------------------------------------------- dK/dt, every column
+# ----------------------------------------------------------------------------- dK/dt and singular values
+# LAPACK's gesdd without singular vectors (jobz 'N', the routine of numpy's ``svd(compute_uv=False)``,
+# half the cost of numba's ``np.linalg.svd``, which always forms U and V): numba has it only as the
+# helper of its ``np.linalg.norm`` / ``cond`` / ``matrix_rank``, so the kernels call that helper.
+_singular_values = importlib.import_module("numba.np.linalg")._compute_singular_values
+
+
 @_nj
 def kdot_columns(q, t, T, S, Sd, u, Vu, KD):  # pragma: no cover - compiled
     """``KD = dK/dt (m, nv)`` along ``u (nv,)`` in one pass, ``Sd`` the screw rates along ``u``
@@ -804,6 +813,122 @@ def kdot_columns(q, t, T, S, Sd, u, Vu, KD):  # pragma: no cover - compiled
             x = q[q2] - t.cf[i, 1]
             dd = 2 * t.cf[i, 4] + x * (6 * t.cf[i, 5] + x * 12 * t.cf[i, 6])
             KD[row, d2] = -t.cf[i, 7] * dd * u[d2]
+
+
+@_nj
+def singular_values_into(X, s):  # pragma: no cover - compiled
+    """The singular values of ``X (m, n)``, largest first, into ``s (min(m, n),)``: LAPACK's gesdd
+    without singular vectors, as ``np.linalg.svd(X, compute_uv=False)``; NaN where ``X`` is not finite
+    or LAPACK does not converge, nothing for an empty ``X``."""
+    if X.shape[0] == 0 or X.shape[1] == 0:
+        return
+    if not _all_finite(X):
+        s[:] = np.nan
+        return
+    try:
+        s[:] = _singular_values(X)
+    except Exception:  # no convergence (LAPACK)
+        s[:] = np.nan
+
+
+@_nj
+def singular_block(
+    Q, lo, hi, act, pas, sb, Tsite, t, rtol, L, rows, C_o, sK_o, sP_o, sJ_o
+):  # pragma: no cover - compiled
+    """The singularity measures' matrices of samples ``lo:hi`` in one pass per sample (``_singularity``'s
+    module docstring): the largest closure row ``C_o (N,)`` and the singular values, largest first, of
+    the scaled ``K`` (``sK_o (N, min(m, nv))``), of its passive columns (``sP_o (N, min(m, npas))``) and of
+    the scaled site Jacobian's ``rows`` (``sJ_o (N, min(len(rows), na))``).  Hinge columns are multiplied
+    by the length ``L`` (slides by 1), the Jacobian's rotation rows by ``L`` and its columns divided by
+    their input's; ``J = J_f G`` by :func:`site_jac_one` (``G`` with the passive-rank ``rtol``)."""
+    nb = t.parent.shape[0]
+    m = t.m
+    nv = t.A.shape[1]
+    na, npas, nr = act.shape[0], pas.shape[0], rows.shape[0]
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    r = np.empty(m)
+    K = np.empty((m, nv))
+    G = np.zeros((nv, na))
+    Kp = np.empty((m, npas))
+    P = np.empty((npas, m))
+    J = np.empty((6, na))
+    col = np.empty(nv)
+    for k in range(nv):
+        col[k] = 1.0 if t.dof_tr[k] else L
+    Ks = np.empty((m, nv))
+    Ksp = np.empty((m, npas))
+    Js = np.empty((nr, na))
+    for n in range(lo, hi):
+        site_jac_one(Q[n], act, pas, sb, Tsite, t, rtol, T, S, r, K, G, Kp, P, J)
+        C_o[n] = _amax_abs(r)
+        for i in range(m):
+            for k in range(nv):
+                Ks[i, k] = K[i, k] * col[k]
+            for j in range(npas):
+                Ksp[i, j] = Ks[i, pas[j]]
+        for i in range(nr):
+            f = L if rows[i] < 3 else 1.0
+            for j in range(na):
+                Js[i, j] = f * J[rows[i], j] / col[act[j]]
+        singular_values_into(Ks, sK_o[n])
+        singular_values_into(Ksp, sP_o[n])
+        singular_values_into(Js, sJ_o[n])
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def singular_par(Q, act, pas, sb, Tsite, t, rtol, L, rows, C_o, sK_o, sP_o, sJ_o):  # pragma: no cover
+    """:func:`singular_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        singular_block(
+            Q,
+            k * BLOCK,
+            min(N, (k + 1) * BLOCK),
+            act,
+            pas,
+            sb,
+            Tsite,
+            t,
+            rtol,
+            L,
+            rows,
+            C_o,
+            sK_o,
+            sP_o,
+            sJ_o,
+        )
+
+
+def compiled_singular_values(model, q: np.ndarray, site: int, L: float, rows: tuple[int, ...]) -> tuple:
+    """``(closure (N,), sK, sP, sJ)`` at ``q (N, nq)`` for site index ``site``, length ``L`` and the
+    Jacobian's ``rows`` (:func:`singular_block`): the largest closure row and the singular values of the
+    scaled ``K (N, min(m, nv))``, ``K_p (N, min(m, npas))`` and site Jacobian ``(N, min(len(rows), na))``."""
+    tree, m = model.tree, model.tables.m
+    Q = writable(q)
+    N, nv, na, npas = Q.shape[0], tree.nv, len(model.act), len(model.pas)
+    out = (
+        np.empty(N),
+        np.empty((N, min(m, nv))),
+        np.empty((N, min(m, npas))),
+        np.empty((N, min(len(rows), na))),
+    )
+    args = (
+        model.act,
+        model.pas,
+        int(tree.site_body[site]),
+        np.ascontiguousarray(tree.T_site[site], dtype=float),
+        model.tables,
+        opt.PASSIVE_RANK_RTOL,
+        float(L),
+        np.array(rows, dtype=np.int64),
+        *out,
+    )
+    if N <= BLOCK:
+        entry(model, singular_block, "singular_block", (Q, 0, N, *args))
+    else:
+        singular_par(Q, *args)
+    return out
 
 
 # ----------------------------------------------------------------------------- inverse dynamics
