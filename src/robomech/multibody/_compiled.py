@@ -2174,6 +2174,7 @@ def warm(part: int | None = None) -> None:
     import logging
 
     from . import _dynamics
+    from ._singularity import singularities
     from .gallery import load
 
     if not logging.getLogger("robomech").handlers and not logging.getLogger().handlers:
@@ -2189,6 +2190,7 @@ def warm(part: int | None = None) -> None:
         qf, _, _, _ = compiled_fk(mech, q, model.pas)
         compiled_site_jacobian(mech, qf, site)
         compiled_influence(model, qf, True, site)  # influence coefficients and site Hessians
+        singularities(mech, qf, mech.sites[0].name)  # singular values of the scaled K, K_p and J
         zv = np.zeros((n, mech.nv))
         _dynamics.inverse_dynamics(mech, qf, qd=zv, qdd=zv)  # the full-rate inverse dynamics kernel
         if n == 1:
@@ -2225,10 +2227,9 @@ def warm(part: int | None = None) -> None:
     from ._designs import closure_designs, inverse_dynamics_designs
     from ._influence import constraint_jacobian, constraint_jacobian_rate, constraint_residual, site_pose
     from ._rnea_kernels import passive_rank_measures
-    from ._singularity import singularities
 
     name = mech.sites[0].name
-    for n in (1, 2 * BLOCK + 1):  # closure rows, site poses, energies, singularities, rank measures
+    for n in (1, 2 * BLOCK + 1):  # closure rows, dK/dt, site poses, energies, rank measures
         q = np.tile(mech.q0, (n, 1))
         zv, za = np.zeros((n, mech.nv)), np.zeros((n, len(model.act)))
         constraint_residual(mech, q)
@@ -2236,7 +2237,6 @@ def warm(part: int | None = None) -> None:
         constraint_jacobian_rate(mech, q, zv)
         site_pose(mech, q, name)
         _dynamics.energy(mech, q, zv)
-        singularities(mech, q, name)
         passive_rank_measures(model, q)
         di = np.arange(n) % 2  # the design-batched inverse dynamics and closure solve
         inverse_dynamics_designs(batch, di, q, za, za)
