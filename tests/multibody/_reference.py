@@ -575,9 +575,9 @@ _SWAPS_DYNAMICS = {
 
 @contextlib.contextmanager
 def numpy_reference():
-    """Inside the block, FK, the closure residual, K and dK/dt, site poses, energies, site Jacobians,
-    influence coefficients, site Hessians, the closure terms, the velocity projection, inverse and
-    forward dynamics run the numpy formulation."""
+    """Inside the block, FK, the closure residual, K and dK/dt, the singularity measures' singular values,
+    site poses, energies, site Jacobians, influence coefficients, site Hessians, the closure terms, the
+    velocity projection, inverse and forward dynamics run the numpy formulation."""
     saved = {k: getattr(_compiled, k) for k in _SWAPS}
     saved_rank = _rnea_kernels.passive_rank_measures
     _rnea_kernels.passive_rank_measures = numpy_passive_rank_measures

@@ -118,6 +118,28 @@ def test_singularities_equal_numpy_at_every_batch_size(name):
             _close(np.nan_to_num(a), np.nan_to_num(getattr(s, f)[:n]), BATCH_RTOL, f"{f} at batch {n}")
 
 
+def test_singular_values_kernel_against_numpy_and_on_bad_matrices():
+    """``_compiled.singular_values_into`` (LAPACK gesdd without vectors): numpy's values on wide, tall and
+    rank-deficient matrices; NaN for a non-finite matrix (where numpy's batched SVD raises and would end
+    the batch), nothing written for an empty one."""
+    from robomech.multibody._compiled import singular_values_into
+
+    rng = np.random.default_rng(8)
+    low = rng.normal(size=(6, 2)) @ rng.normal(size=(2, 5))  # rank 2
+    for X in (rng.normal(size=(4, 7)), rng.normal(size=(7, 4)), low):
+        s = np.empty(min(X.shape))
+        singular_values_into(X, s)
+        _close(s, np.linalg.svd(X, compute_uv=False), BATCH_RTOL, f"shape {X.shape}")
+    X = rng.normal(size=(3, 4))
+    X[1, 2] = np.nan
+    s = np.zeros(3)
+    singular_values_into(X, s)
+    assert np.isnan(s).all()
+    s = np.zeros(0)
+    singular_values_into(np.zeros((0, 3)), s)  # an open chain's empty K
+    assert s.shape == (0,)
+
+
 # dK/dt applied to v against the per-product kernel (dK/dt along u) v: the same products and sums per
 # entry, identical bits measured; a few ulps of the largest entry allowed.
 PRODUCT_RTOL = 1e-14

@@ -3,8 +3,9 @@ Hessians, inverse dynamics.
 
 The one implementation of each of these algorithms, for every batch size (batch 1 included): tree
 kinematics, closure residual and velocity constraint matrix (the formulas of ``_tree`` and
-``_constraints``, written per sample; :func:`resjac_block` for ``constraint_residual``,
-``constraint_jacobian`` and ``singularities``, :func:`kdot_block` for ``dK/dt``), the
+``_constraints``, written per sample; :func:`resjac_block` for ``constraint_residual`` and
+``constraint_jacobian``, :func:`kdot_block` for ``dK/dt``, every column in one pass), the singular
+values of ``singularities``' scaled ``K``, ``K_p`` and site Jacobian (:func:`singular_block`), the
 Levenberg–Marquardt assembly (damping, step cap and stopping rules of ``_options``),
 ``G = [I; -K_p^+ K_a]`` by the SVD pseudo-inverse (:func:`influence_G`) with the site's ``[ω; ṗ]``
 Jacobian, the second-order coefficients ``∂G/∂q_act`` and site Hessians
