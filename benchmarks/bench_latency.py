@@ -425,6 +425,59 @@ def compile_rows() -> list[str]:
     return rows
 
 
+KERNEL_MECHS = ("delta", "stewart")  # a 3-DOF and a 6-DOF parallel mechanism of the gallery
+KERNEL_SIZES = (1, 1_000, 10_000)  # batch sizes of :func:`kernel_rows`
+
+
+def kernel_rows() -> list[str]:
+    """``singularities`` (site Jacobian, scaled K, K_p and J and their singular values) and
+    ``constraint_jacobian_rate`` of the Delta and the Stewart platform at batch sizes ``KERNEL_SIZES``:
+    per call at batch 1, per sample above (the largest batch on every numba thread and on one), min /
+    median over interleaved rounds (run on two source trees in turn for a before / after comparison)."""
+    import os
+
+    import numba
+
+    threads = numba.get_num_threads()
+    fns = {}
+    for name in KERNEL_MECHS:
+        mech = mb.gallery.load(name)
+        q, qd_act, qdd_act = _states(mech, max(KERNEL_SIZES))
+        qd = mb.inverse_dynamics(mech, q, qd_act, qdd_act).qd  # the full admissible rates
+        site = mech.sites[0].name
+        calls = {
+            "singularities": lambda s, mech=mech, q=q, site=site: mb.singularities(mech, q[s], site),
+            "constraint_jacobian_rate": lambda s, mech=mech, q=q, qd=qd: mb.constraint_jacobian_rate(
+                mech, q[s], qd[s]
+            ),
+        }
+        for fn in calls.values():  # compile / load every kernel outside the timing
+            fn(0), fn(slice(0, 100))
+        for call, fn in calls.items():
+            for n in KERNEL_SIZES:
+                fns[(name, call, n)] = (
+                    (lambda fn=fn: _per(fn, 200))
+                    if n == 1
+                    else _large(lambda fn=fn, n=n: fn(slice(0, n)), n, threads)
+                )
+            n = KERNEL_SIZES[-1]  # the largest batch on one thread too: the work, not the cores
+            fns[(name, call, "1 thread")] = _large(lambda fn=fn, n=n: fn(slice(0, n)), n, 1)
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
+    res = _interleaved(fns, rounds=3)
+    numba.set_num_threads(threads)
+    rows = [
+        f"load average (1, 5, 15 min) before the run: {load}",
+        "| mechanism | function | batch 1 (per call) | 10^3 (per sample) | "
+        f"10^4 (per sample, {threads} threads) | 10^4 (per sample, 1 thread) |",
+        "|---|---|---|---|---|---|",
+    ]
+    for name in KERNEL_MECHS:
+        for call in ("singularities", "constraint_jacobian_rate"):
+            cells = " | ".join(_mm(res[(name, call, n)]) for n in (*KERNEL_SIZES, "1 thread"))
+            rows.append(f"| {name} | {call} | {cells} |")
+    return rows
+
+
 if __name__ == "__main__":
     import sys
 
@@ -433,6 +486,9 @@ if __name__ == "__main__":
             print(row)
     elif sys.argv[1:] == ["--compile"]:
         for row in compile_rows():
+            print(row)
+    elif sys.argv[1:] == ["--kernels"]:
+        for row in kernel_rows():
             print(row)
     else:
         main()

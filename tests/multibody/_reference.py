@@ -695,6 +695,23 @@ def numpy_jacobian_rate(model, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
     return jacobian_rate(model.constraints, model.tree, st, screw_rates(model.tree, st, qd), q, qd)
 
 
+def numpy_singular_values(model, q: np.ndarray, site: int, L: float, rows: tuple[int, ...]) -> tuple:
+    """The numpy formulation of ``_compiled.compiled_singular_values``: the largest closure row and the
+    singular values of the scaled K, K_p and site Jacobian rows (hinge columns and rotation rows times L)."""
+    tree = model.tree
+    r, K = numpy_resjac(model, q, True)
+    col = np.where(tree.dof_translational, 1.0, L)
+    scale = np.array([L, L, L, 1.0, 1.0, 1.0])
+    J = (scale[:, None] * numpy_site_jacobian(model, q, site) / col[model.act])[:, list(rows)]
+    Ks = K * col
+
+    def sv(X: np.ndarray) -> np.ndarray:
+        return np.linalg.svd(X, compute_uv=False) if X.shape[1] and X.shape[2] else np.zeros((len(q), 0))
+
+    closure = np.max(np.abs(r), axis=-1, initial=0.0)
+    return closure, sv(Ks), sv(Ks[..., model.pas]), sv(J)
+
+
 # ----------------------------------------------------------------------------- site pose and energy
 # The numpy formulation of _compiled.site_pose_block and energy_block.
 def _com_jacobians(tree, state, bd, qd: np.ndarray | None, Sd: np.ndarray | None):
@@ -760,6 +777,7 @@ _SWAPS = {
     "compiled_project": numpy_project,
     "compiled_resjac": numpy_resjac,
     "compiled_jacobian_rate": numpy_jacobian_rate,
+    "compiled_singular_values": numpy_singular_values,
     "compiled_site_pose": numpy_site_pose,
     "compiled_energy": numpy_energy,
     "compiled_kinematics": numpy_kinematics,
@@ -776,9 +794,9 @@ _SWAPS_DYNAMICS = {
 @contextlib.contextmanager
 def numpy_reference():
     """Inside the block, tree kinematics (body poses and screws), integration, FK, the closure
-    residual, K and dK/dt, site poses, energies, site Jacobians,
-    influence coefficients, site Hessians, the closure terms, the velocity projection, inverse and
-    forward dynamics run the numpy formulation."""
+    residual, K and dK/dt, the singularity measures' singular values, site poses, energies, site
+    Jacobians, influence coefficients, site Hessians, the closure terms, the velocity projection,
+    inverse and forward dynamics run the numpy formulation."""
     saved = {k: getattr(_compiled, k) for k in _SWAPS}
     saved_rank = _rnea_kernels.passive_rank_measures
     _rnea_kernels.passive_rank_measures = numpy_passive_rank_measures

@@ -105,11 +105,99 @@ def test_singularities_equal_numpy_at_every_batch_size(name):
         assert np.array_equal(np.isfinite(a), np.isfinite(b)), f
         fin = np.isfinite(b)
         assert np.all(np.abs(a[fin] - b[fin]) <= SINGULAR_RTOL * np.maximum(1.0, np.abs(b[fin]))), f
+    for output in ("position", (0, 4)):  # a part of the site's rows: the kernel's row selection
+        a = mb.singularities(mech, q, site, output=output)
+        with numpy_reference():
+            b = mb.singularities(mech, q, site, output=output)
+        assert np.array_equal(a.type_I, b.type_I), output
+        _close(np.nan_to_num(a.sigma_I), np.nan_to_num(b.sigma_I), SINGULAR_RTOL, f"sigma_I {output}")
     for n in SIZES[:-1]:
         part = mb.singularities(mech, q[:n] if n > 1 else q[0], site)
         for f in ("sigma_I", "sigma_II", "sigma_C", "closure"):
             a = np.atleast_1d(getattr(part, f))
             _close(np.nan_to_num(a), np.nan_to_num(getattr(s, f)[:n]), BATCH_RTOL, f"{f} at batch {n}")
+
+
+def test_singular_values_kernel_against_numpy_and_on_bad_matrices():
+    """``_compiled.singular_values_into`` (LAPACK gesdd without vectors): numpy's values on wide, tall and
+    rank-deficient matrices; NaN for a non-finite matrix (where numpy's batched SVD raises and would end
+    the batch), nothing written for an empty one."""
+    from robomech.multibody._compiled import singular_values_into
+
+    rng = np.random.default_rng(8)
+    low = rng.normal(size=(6, 2)) @ rng.normal(size=(2, 5))  # rank 2
+    for X in (rng.normal(size=(4, 7)), rng.normal(size=(7, 4)), low):
+        s = np.empty(min(X.shape))
+        singular_values_into(X, s)
+        _close(s, np.linalg.svd(X, compute_uv=False), BATCH_RTOL, f"shape {X.shape}")
+    X = rng.normal(size=(3, 4))
+    X[1, 2] = np.nan
+    s = np.zeros(3)
+    singular_values_into(X, s)
+    assert np.isnan(s).all()
+    s = np.zeros(0)
+    singular_values_into(np.zeros((0, 3)), s)  # an open chain's empty K
+    assert s.shape == (0,)
+
+
+# dK/dt applied to v against the per-product kernel (dK/dt along u) v: the same products and sums per
+# entry, identical bits measured; a few ulps of the largest entry allowed.
+PRODUCT_RTOL = 1e-14
+# Central differences of K along qd (step H_FD): truncation h^2 |d3K/dt3| ~ 1e-12 plus rounding
+# eps |K| / h ~ 1e-10 (K's entries are O(1) m).
+H_FD = 1e-6
+FD_RTOL = 1e-8
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_rate_columns_equal_the_per_product_kernel(name):
+    """Every column of dK/dt in one pass (``_compiled.kdot_columns``) against ``kdot_uv``, the kernel that
+    forms ``(dK/dt along u) v`` for one ``v`` (inverse dynamics, second-order influence coefficients),
+    with random ``v``, on assembled and unassembled samples, at every batch size."""
+    from robomech.multibody import _compiled as C
+    from robomech.multibody._compile import compile_model
+    from robomech.multibody._tree import integrate
+
+    mech = _get(name)
+    t = compile_model(mech).tables
+    rng = np.random.default_rng(6)
+    q = _configurations(mech, N, seed=6)
+    q = np.concatenate([q, integrate(mech.tree, q, 0.05 * rng.uniform(-1, 1, (N, mech.nv)))])
+    qd, v = rng.normal(size=(2, 2 * N, mech.nv))
+    nb, nv, m = t.parent.shape[0], mech.nv, t.m
+    T, S, Sd = np.empty((nb, 4, 4)), np.zeros((nv, 6)), np.empty((nv, 6))
+    Vu, Vv, Vd, kd = np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nb, 6)), np.empty(m)
+    picks = np.arange(0, 2 * N, 23)  # a spread of samples, assembled and not
+    ref = np.empty((len(picks), m))
+    for i, n in enumerate(picks):
+        C.kin(q[n], t, T, S)
+        C.screw_rates_into(t, S, qd[n], Sd)
+        C.kdot_uv(q[n], t, T, S, Sd, qd[n], v[n], Vu, Vv, Vd, kd)
+        ref[i] = kd
+    for n in (*SIZES, 2 * N):
+        sel = picks[picks < n]
+        Kd = mb.constraint_jacobian_rate(mech, q[:n], qd[:n])
+        _close(np.einsum("nij,nj->ni", Kd[sel], v[sel]), ref[: len(sel)], PRODUCT_RTOL, f"batch {n}")
+
+
+@pytest.mark.parametrize("name", ("delta", "tsai", "sarrus", "five_bar", "bennett"))
+def test_rate_equals_finite_differences_of_k(name):
+    """dK/dt against central differences of K along qd, at assembled and unassembled configurations:
+    the rate of every closure row (points, rotations) from an independent formula."""
+    from robomech.multibody._tree import integrate
+
+    mech = _get(name)
+    rng = np.random.default_rng(7)
+    q = _configurations(mech, 8, seed=7)
+    q = np.concatenate([q, integrate(mech.tree, q, 0.05 * rng.uniform(-1, 1, (len(q), mech.nv)))])
+    qd = rng.normal(size=(len(q), mech.nv))
+    fd = (
+        mb.constraint_jacobian(mech, integrate(mech.tree, q, H_FD * qd))
+        - mb.constraint_jacobian(mech, integrate(mech.tree, q, -H_FD * qd))
+    ) / (2 * H_FD)
+    Kd = mb.constraint_jacobian_rate(mech, q, qd)
+    assert np.max(np.abs(Kd)) > 0.1  # a rate that is not zero
+    assert np.max(np.abs(Kd - fd)) <= FD_RTOL * max(1.0, float(np.max(np.abs(Kd))))
 
 
 def test_coupling_rate_equals_finite_differences():

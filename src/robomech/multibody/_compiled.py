@@ -7,7 +7,8 @@ compile step's reference rank, ``mobility``, drawing and export), integration ``
 (:func:`compiled_integrate`), closure residual and velocity constraint matrix (the rows of
 ``_constraints``, written per sample; :func:`resjac_block` for ``constraint_residual``,
 ``constraint_jacobian``, ``singularities``, ``mobility`` and the compile step's reference assembly and
-rank, :func:`kdot_block` for ``dK/dt``), the
+rank, :func:`kdot_block` for ``dK/dt``, every column in one pass), the singular values of
+``singularities``' scaled ``K``, ``K_p`` and site Jacobian (:func:`singular_block`), the
 Levenberg–Marquardt assembly (damping, step cap and stopping rules of ``_options``),
 ``G = [I; -K_p^+ K_a]`` by the SVD pseudo-inverse (:func:`influence_G`) with the site's ``[ω; ṗ]``
 Jacobian, the second-order coefficients ``∂G/∂q_act`` and site Hessians
@@ -22,6 +23,7 @@ tests as the reference (tests/multibody/_reference.py).
 
 from __future__ import annotations
 
+import importlib
 from typing import Literal, overload
 
 import numpy as np
@@ -42,6 +44,7 @@ __all__ = [
     "compiled_kinematics",
     "compiled_project",
     "compiled_resjac",
+    "compiled_singular_values",
     "compiled_site_jacobian",
     "compiled_site_pose",
     "inv_dyn",
@@ -735,27 +738,19 @@ def resjac_par(Q, t, with_jac, R_o, K_o):  # pragma: no cover - compiled
 
 @_nj
 def kdot_block(Q, QD, lo, hi, t, KD_o):  # pragma: no cover - compiled
-    """``dK/dt`` along ``QD (N, nv)`` into ``KD_o (N, m, nv)`` for samples ``lo:hi``: column ``k`` is
-    :func:`kdot_uv` with ``u = qd`` and ``v`` the ``k``-th unit vector."""
+    """``dK/dt`` along ``QD (N, nv)`` into ``KD_o (N, m, nv)`` for samples ``lo:hi``, every column in
+    one pass per sample (:func:`kdot_columns`)."""
     nb = t.parent.shape[0]
     nv = t.A.shape[1]
-    m = t.m
     T = np.empty((nb, 4, 4))
     S = np.zeros((nv, 6))
     Sd = np.empty((nv, 6))
-    e = np.zeros(nv)
-    Vu, Vv, Vd = np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nb, 6))
-    kd = np.empty(m)
+    Vu = np.empty((nb, 6))
     for n in range(lo, hi):
         q, qd = Q[n], QD[n]
         kin(q, t, T, S)
         screw_rates_into(t, S, qd, Sd)
-        for k in range(nv):
-            e[k] = 1.0
-            kdot_uv(q, t, T, S, Sd, qd, e, Vu, Vv, Vd, kd)
-            e[k] = 0.0
-            for i in range(m):
-                KD_o[n, i, k] = kd[i]
+        kdot_columns(q, t, T, S, Sd, qd, Vu, KD_o[n])
 
 
 @numba.njit(cache=True, error_model="numpy", parallel=True)
@@ -764,6 +759,186 @@ def kdot_par(Q, QD, t, KD_o):  # pragma: no cover - compiled
     N = Q.shape[0]
     for k in numba.prange((N + BLOCK - 1) // BLOCK):
         kdot_block(Q, QD, k * BLOCK, min(N, (k + 1) * BLOCK), t, KD_o)
+
+
+# ----------------------------------------------------------------------------- dK/dt and singular values
+# LAPACK's gesdd without singular vectors (jobz 'N', the routine of numpy's ``svd(compute_uv=False)``,
+# half the cost of numba's ``np.linalg.svd``, which always forms U and V): numba has it only as the
+# helper of its ``np.linalg.norm`` / ``cond`` / ``matrix_rank``, so the kernels call that helper.
+_singular_values = importlib.import_module("numba.np.linalg")._compute_singular_values
+
+
+@_nj
+def kdot_columns(q, t, T, S, Sd, u, Vu, KD):  # pragma: no cover - compiled
+    """``KD = dK/dt (m, nv)`` along ``u (nv,)`` in one pass, ``Sd`` the screw rates along ``u``
+    (:func:`screw_rates_into`); column ``k`` is :func:`kdot_uv` with ``v`` the ``k``-th unit vector.
+
+    A point row's column ``k`` is, per anchor ``p`` on body ``b`` (sign + for the first, - for the
+    second), the rate of ``A_bk (v_k + w_k x p)``: ``A_bk (dv_k + dw_k x p + w_k x pdot)`` with ``pdot =
+    v_b + w_b x p`` the anchor's velocity along ``u``; a rotation row's is ``L (A_b2k - A_b1k) dw_k``; a
+    coupling row's is ``-s poly''(x) u_2`` in the column of its second coordinate (its first column is
+    constant).  Also fills the body twists ``Vu = A S u (nb, 6)``."""
+    A, L = t.A, t.L
+    nb, nv = A.shape
+    for b in range(nb):
+        for i in range(6):
+            acc = 0.0
+            for k in range(nv):
+                if A[b, k] != 0.0:
+                    acc += A[b, k] * S[k, i] * u[k]
+            Vu[b, i] = acc
+    KD[:, :] = 0.0
+    for i in range(t.pp.shape[0]):
+        row = t.pp[i, 2]
+        for side in range(2):
+            b = t.pp[i, side]
+            x = t.px[i, side]
+            sign = 1.0 if side == 0 else -1.0
+            p0 = T[b, 0, 3] + T[b, 0, 0] * x[0] + T[b, 0, 1] * x[1] + T[b, 0, 2] * x[2]
+            p1 = T[b, 1, 3] + T[b, 1, 0] * x[0] + T[b, 1, 1] * x[1] + T[b, 1, 2] * x[2]
+            p2 = T[b, 2, 3] + T[b, 2, 0] * x[0] + T[b, 2, 1] * x[1] + T[b, 2, 2] * x[2]
+            w0, w1, w2 = Vu[b, 0], Vu[b, 1], Vu[b, 2]
+            pd0 = Vu[b, 3] + w1 * p2 - w2 * p1
+            pd1 = Vu[b, 4] + w2 * p0 - w0 * p2
+            pd2 = Vu[b, 5] + w0 * p1 - w1 * p0
+            for k in range(nv):
+                a = A[b, k]
+                if a == 0.0:
+                    continue
+                e0, e1, e2 = a * Sd[k, 0], a * Sd[k, 1], a * Sd[k, 2]
+                x0, x1, x2 = a * S[k, 0], a * S[k, 1], a * S[k, 2]
+                KD[row, k] += sign * (a * Sd[k, 3] + (e1 * p2 - e2 * p1) + (x1 * pd2 - x2 * pd1))
+                KD[row + 1, k] += sign * (a * Sd[k, 4] + (e2 * p0 - e0 * p2) + (x2 * pd0 - x0 * pd2))
+                KD[row + 2, k] += sign * (a * Sd[k, 5] + (e0 * p1 - e1 * p0) + (x0 * pd1 - x1 * pd0))
+    for i in range(t.rr.shape[0]):
+        b1, b2, row = t.rr[i, 0], t.rr[i, 1], t.rr[i, 2]
+        for k in range(nv):
+            a1, a2 = A[b1, k], A[b2, k]
+            if a1 != 0.0 or a2 != 0.0:
+                for c in range(3):
+                    KD[row + c, k] = L * (a2 * Sd[k, c] - a1 * Sd[k, c])
+    for i in range(t.cc.shape[0]):
+        d2, q2, row = t.cc[i, 2], t.cc[i, 3], t.cc[i, 4]
+        if d2 >= 0:
+            x = q[q2] - t.cf[i, 1]
+            dd = 2 * t.cf[i, 4] + x * (6 * t.cf[i, 5] + x * 12 * t.cf[i, 6])
+            KD[row, d2] = -t.cf[i, 7] * dd * u[d2]
+
+
+@_nj
+def singular_values_into(X, s):  # pragma: no cover - compiled
+    """The singular values of ``X (m, n)``, largest first, into ``s (min(m, n),)``: LAPACK's gesdd
+    without singular vectors, as ``np.linalg.svd(X, compute_uv=False)``; NaN where ``X`` is not finite
+    or LAPACK does not converge, nothing for an empty ``X``."""
+    if X.shape[0] == 0 or X.shape[1] == 0:
+        return
+    if not _all_finite(X):
+        s[:] = np.nan
+        return
+    try:
+        s[:] = _singular_values(X)
+    except Exception:  # no convergence (LAPACK)
+        s[:] = np.nan
+
+
+@_nj
+def singular_block(
+    Q, lo, hi, act, pas, sb, Tsite, t, rtol, L, rows, C_o, sK_o, sP_o, sJ_o
+):  # pragma: no cover - compiled
+    """The singularity measures' matrices of samples ``lo:hi`` in one pass per sample (``_singularity``'s
+    module docstring): the largest closure row ``C_o (N,)`` and the singular values, largest first, of
+    the scaled ``K`` (``sK_o (N, min(m, nv))``), of its passive columns (``sP_o (N, min(m, npas))``) and of
+    the scaled site Jacobian's ``rows`` (``sJ_o (N, min(len(rows), na))``).  Hinge columns are multiplied
+    by the length ``L`` (slides by 1), the Jacobian's rotation rows by ``L`` and its columns divided by
+    their input's; ``J = J_f G`` by :func:`site_jac_one` (``G`` with the passive-rank ``rtol``)."""
+    nb = t.parent.shape[0]
+    m = t.m
+    nv = t.A.shape[1]
+    na, npas, nr = act.shape[0], pas.shape[0], rows.shape[0]
+    T = np.empty((nb, 4, 4))
+    S = np.zeros((nv, 6))
+    r = np.empty(m)
+    K = np.empty((m, nv))
+    G = np.zeros((nv, na))
+    Kp = np.empty((m, npas))
+    P = np.empty((npas, m))
+    J = np.empty((6, na))
+    col = np.empty(nv)
+    for k in range(nv):
+        col[k] = 1.0 if t.dof_tr[k] else L
+    Ks = np.empty((m, nv))
+    Ksp = np.empty((m, npas))
+    Js = np.empty((nr, na))
+    for n in range(lo, hi):
+        site_jac_one(Q[n], act, pas, sb, Tsite, t, rtol, T, S, r, K, G, Kp, P, J)
+        C_o[n] = _amax_abs(r)
+        for i in range(m):
+            for k in range(nv):
+                Ks[i, k] = K[i, k] * col[k]
+            for j in range(npas):
+                Ksp[i, j] = Ks[i, pas[j]]
+        for i in range(nr):
+            f = L if rows[i] < 3 else 1.0
+            for j in range(na):
+                Js[i, j] = f * J[rows[i], j] / col[act[j]]
+        singular_values_into(Ks, sK_o[n])
+        singular_values_into(Ksp, sP_o[n])
+        singular_values_into(Js, sJ_o[n])
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def singular_par(Q, act, pas, sb, Tsite, t, rtol, L, rows, C_o, sK_o, sP_o, sJ_o):  # pragma: no cover
+    """:func:`singular_block` over ``Q`` in blocks of ``BLOCK`` samples, in parallel."""
+    N = Q.shape[0]
+    for k in numba.prange((N + BLOCK - 1) // BLOCK):
+        singular_block(
+            Q,
+            k * BLOCK,
+            min(N, (k + 1) * BLOCK),
+            act,
+            pas,
+            sb,
+            Tsite,
+            t,
+            rtol,
+            L,
+            rows,
+            C_o,
+            sK_o,
+            sP_o,
+            sJ_o,
+        )
+
+
+def compiled_singular_values(model, q: np.ndarray, site: int, L: float, rows: tuple[int, ...]) -> tuple:
+    """``(closure (N,), sK, sP, sJ)`` at ``q (N, nq)`` for site index ``site``, length ``L`` and the
+    Jacobian's ``rows`` (:func:`singular_block`): the largest closure row and the singular values of the
+    scaled ``K (N, min(m, nv))``, ``K_p (N, min(m, npas))`` and site Jacobian ``(N, min(len(rows), na))``."""
+    tree, m = model.tree, model.tables.m
+    Q = writable(q)
+    N, nv, na, npas = Q.shape[0], tree.nv, len(model.act), len(model.pas)
+    out = (
+        np.empty(N),
+        np.empty((N, min(m, nv))),
+        np.empty((N, min(m, npas))),
+        np.empty((N, min(len(rows), na))),
+    )
+    args = (
+        model.act,
+        model.pas,
+        int(tree.site_body[site]),
+        np.ascontiguousarray(tree.T_site[site], dtype=float),
+        model.tables,
+        opt.PASSIVE_RANK_RTOL,
+        float(L),
+        np.array(rows, dtype=np.int64),
+        *out,
+    )
+    if N <= BLOCK:
+        entry(model, singular_block, "singular_block", (Q, 0, N, *args))
+    else:
+        singular_par(Q, *args)
+    return out
 
 
 # ----------------------------------------------------------------------------- inverse dynamics
@@ -2111,6 +2286,7 @@ def warm(part: int | None = None) -> None:
     import logging
 
     from . import _dynamics
+    from ._singularity import singularities
     from .gallery import load
 
     if not logging.getLogger("robomech").handlers and not logging.getLogger().handlers:
@@ -2126,6 +2302,7 @@ def warm(part: int | None = None) -> None:
         qf, _, _, _ = compiled_fk(mech, q, model.pas)
         compiled_site_jacobian(mech, qf, site)
         compiled_influence(model, qf, True, site)  # influence coefficients and site Hessians
+        singularities(mech, qf, mech.sites[0].name)  # singular values of the scaled K, K_p and J
         zv = np.zeros((n, mech.nv))
         _dynamics.inverse_dynamics(mech, qf, qd=zv, qdd=zv)  # the full-rate inverse dynamics kernel
         if n == 1:
@@ -2162,10 +2339,9 @@ def warm(part: int | None = None) -> None:
     from ._designs import closure_designs, inverse_dynamics_designs
     from ._influence import constraint_jacobian, constraint_jacobian_rate, constraint_residual, site_pose
     from ._rnea_kernels import passive_rank_measures
-    from ._singularity import singularities
 
     name = mech.sites[0].name
-    for n in (1, 2 * BLOCK + 1):  # closure rows, site poses, energies, singularities, rank measures
+    for n in (1, 2 * BLOCK + 1):  # closure rows, dK/dt, site poses, energies, rank measures
         q = np.tile(mech.q0, (n, 1))
         compiled_kinematics(model, q)  # body poses and screws (drawing, export, the compile step)
         compiled_integrate(model.tables, q, np.zeros((n, mech.nv)))
@@ -2175,7 +2351,6 @@ def warm(part: int | None = None) -> None:
         constraint_jacobian_rate(mech, q, zv)
         site_pose(mech, q, name)
         _dynamics.energy(mech, q, zv)
-        singularities(mech, q, name)
         passive_rank_measures(model, q)
         di = np.arange(n) % 2  # the design-batched inverse dynamics and closure solve
         inverse_dynamics_designs(batch, di, q, za, za)

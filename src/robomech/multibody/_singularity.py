@@ -132,16 +132,12 @@ def _rows(output: object) -> tuple[int, ...]:
     return rows
 
 
-def _scaled_output_jacobian(mech: Mechanism, qf: np.ndarray, si: int, L: float, rows: tuple[int, ...]):
-    """(closure residual (N, m), K (N, m, nv), column scales (nv,), the scaled site Jacobian's ``rows``)."""
-    from ._compiled import compiled_resjac, compiled_site_jacobian  # numba loads on the first kernel call
+def _singular_values(mech: Mechanism, qf: np.ndarray, si: int, L: float, rows: tuple[int, ...]) -> tuple:
+    """(largest closure row (N,), singular values of the scaled K, K_p and site Jacobian's ``rows``),
+    each largest first (``_compiled.singular_block``)."""
+    from ._compiled import compiled_singular_values  # numba loads on the first kernel call
 
-    tree = mech.tree
-    r, K = compiled_resjac(compile_model(mech), qf, True)
-    col = np.where(tree.dof_translational, 1.0, L)
-    scale = np.array([L, L, L, 1.0, 1.0, 1.0])
-    J = (scale[:, None] * compiled_site_jacobian(mech, qf, si) / col[tree.act_dof])[:, list(rows)]
-    return r, K, col, J
+    return compiled_singular_values(compile_model(mech), qf, si, L, rows)
 
 
 def _reference_mobility(mech: Mechanism, ref_q: np.ndarray | None):
@@ -173,10 +169,9 @@ def _generic_output_rank(
         fk = forward_kinematics(mech, qa, q_ref)
         if np.any(fk.converged):
             qs.append(fk.q[fk.converged])
-    J = _scaled_output_jacobian(mech, np.concatenate(qs), si, L, rows)[3]
+    s = _singular_values(mech, np.concatenate(qs), si, L, rows)[3]
     r = 0
-    if J.shape[-1] and J.shape[-2]:
-        s = np.linalg.svd(J, compute_uv=False)
+    if s.shape[-1]:
         r = int(np.max(np.sum(s > rtol * np.maximum(s[:, :1], L), axis=-1)))
     cache[key] = r
     return r
@@ -246,24 +241,15 @@ def singularities(
     batch = q.shape[:-1]
 
     def run(qf: np.ndarray) -> tuple:
-        # input-output Jacobian per scaled input rate: G maps unscaled rates; hinge inputs are per rad
-        res, K, col, J = _scaled_output_jacobian(mech, qf, si, L, out_rows)
-        act = tree.act_dof
-        pas = np.setdiff1d(np.arange(tree.nv), act)
-        Ks = K * col  # K rows are already lengths
-        sK = np.linalg.svd(Ks, compute_uv=False) if Ks.shape[1] and Ks.shape[2] else np.zeros((len(qf), 0))
-        sP = (
-            np.linalg.svd(Ks[..., pas], compute_uv=False)
-            if Ks.shape[1] and len(pas)
-            else np.zeros((len(qf), 0))
-        )
-        sJ = np.linalg.svd(J, compute_uv=False) if len(act) else np.zeros((len(qf), 0))
+        # K rows are already lengths; the input-output Jacobian is per scaled input rate
+        closure, sK, sP, sJ = _singular_values(mech, qf, si, L, out_rows)
+        n_pas = tree.nv - len(tree.act_dof)
         idle_locked = ref.locked_dof  # motions of a generic configuration with every input locked
         # the output can lose no more directions than it has at a generic configuration (a floating robot's
         # trunk site does not move with the legs; a point output has at most 3)
         k_out = min(ref.dof, _generic_output_rank(mech, si, L, out_rows, reference, rtol))
         sigma_I = _kth(sJ, k_out)
-        sigma_II = _kth(sP, len(pas) - idle_locked)
+        sigma_II = _kth(sP, n_pas - idle_locked)
         sigma_C = _kth(sK, ref.rank)
 
         def cond(sig: np.ndarray | None, smax: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -277,7 +263,6 @@ def singularities(
         sigma_I, cI = cond(sigma_I, sJ[:, 0] if sJ.shape[1] else np.ones(len(qf)))
         sigma_II, cII = cond(sigma_II, sP[:, 0] if sP.shape[1] else np.ones(len(qf)))
         sigma_C, cC = cond(sigma_C, sK[:, 0] if sK.shape[1] else np.ones(len(qf)))
-        closure = np.max(np.abs(res), axis=-1, initial=0.0)  # the largest closure row (m); 0 for a tree
         return sigma_I, sigma_II, sigma_C, cI, cII, cC, closure
 
     from ._dynamics import CLOSURE_RTOL
