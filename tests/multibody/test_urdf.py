@@ -179,6 +179,21 @@ def test_actuated_and_closures_arguments():
         _load(GRIPPER, closures=[1])
 
 
+@pytest.mark.parametrize("bad", [3, 2.5, object()])
+def test_closures_and_actuated_that_are_no_sequence_name_the_argument(bad):
+    with pytest.raises(ValueError, match="Expected closures"):
+        _load(GRIPPER, closures=bad)
+    with pytest.raises(ValueError, match="Expected actuated"):
+        _load(GRIPPER, actuated=bad)
+
+
+def test_a_closure_snippet_that_does_not_compile_names_closures():
+    """MuJoCo's error on the snippet is reported against ``closures``, not the internal MJCF document."""
+    snippet = '<equality><weld name="w" body1="palm" body2="no_such_link"/></equality>'
+    with pytest.raises(ValueError, match=r"Expected closures.*no_such_link|Expected closures.*MuJoCo"):
+        _load(GRIPPER, actuated=[], closures=snippet)
+
+
 def test_from_mjcf_refuses_urdf():
     with pytest.raises(ValueError, match="from_urdf"):
         mb.from_mjcf(GRIPPER)

@@ -118,6 +118,46 @@ def test_passive_and_underactuated_descriptions_are_verified(case):
     assert "virtual actuators on " + ", ".join(added) in checks[0].detail
 
 
+# Three links hanging straight down (the reference): there the tip's velocity along the chain and the
+# motion that keeps the tip still to first order leave one locked motion that moves no site, so the
+# reference mobility of the passive description counts 2 DOF + 1 idle, while with two joints actuated
+# the third moves the tip and the DOF is 3.
+TRIPLE_PENDULUM = """<mujoco model="triple_pendulum"><worldbody>
+  <body name="l1" pos="0 0 2"><joint name="a1" axis="0 1 0"/>
+    <inertial pos="0 0 -0.22" mass="1.3" diaginertia="0.031 0.03 0.002"/>
+    <body name="l2" pos="0 0 -0.5"><joint name="a2" axis="0 1 0"/>
+      <inertial pos="0 0 -0.18" mass="0.9" diaginertia="0.016 0.015 0.001"/>
+      <body name="l3" pos="0 0 -0.4"><joint name="a3" axis="0 1 0"/>
+        <inertial pos="0 0 -0.16" mass="0.6" diaginertia="0.0061 0.006 0.0005"/>
+        <site name="tip" pos="0 0 -0.3"/></body></body></body>
+</worldbody></mujoco>"""
+
+
+def test_a_passive_chain_straight_at_its_reference_gets_enough_virtual_actuators():
+    """The virtual actuators are added until they determine the motion of the mechanism they drive, not
+    only until their number reaches the passive description's reference DOF (2 here, one short)."""
+    mech = mb.from_mjcf(TRIPLE_PENDULUM)
+    _, added = g._virtually_actuated(mech)
+    assert added == ("a1", "a2", "a3")
+    checks = g.check_mechanism(mech, "triple pendulum", simulate=False)
+    assert all(c.passed for c in checks), [(c.quantity, c.max_error) for c in checks if not c.passed]
+
+
+def test_a_failing_simulation_is_explained_once(monkeypatch):
+    """When both the simulation and its energy drift fail, the explanation (which re-simulates the motion
+    around each approach to a singularity: minutes near one) is computed once and given to both."""
+    mech = mb.from_mjcf(PENDULUM)
+    monkeypatch.setattr(g, "TOL_SIM", Tolerance(1e-300, "impossible: forces a failure", relative=True))
+    monkeypatch.setattr(g, "TOL_DRIFT", Tolerance(1e-300, "impossible: forces a failure", relative=True))
+    calls = []
+    real = g._why
+    monkeypatch.setattr(g, "_why", lambda *a, **k: calls.append(1) or real(*a, **k))
+    driven, _ = g._virtually_actuated(mech)  # as check_mechanism calls it
+    checks = g._simulation_checks(driven, "pendulum", mech.q0, qd0=np.array([0.5, -0.3]))
+    assert [c.passed for c in checks] == [False, False]
+    assert len(calls) == 1
+
+
 def test_passive_verification_has_teeth():
     """The same passive pendulum with a 1 % heavier link on the engine side fails the dynamics checks."""
     mech = mb.from_mjcf(PENDULUM)
