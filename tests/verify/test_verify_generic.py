@@ -84,6 +84,23 @@ def test_cli_verifies_a_users_file(capsys, monkeypatch):
     assert main(["verify", "missing.xml"]) == 2
 
 
+def test_an_error_in_one_of_several_files_names_that_file(tmp_path, capsys, monkeypatch):
+    """``robomech verify a.xml b.xml``: an input error found while checking one file says which."""
+    a, b = tmp_path / "first.xml", tmp_path / "second.xml"
+    a.write_text(mb.gallery.path("four_bar").read_text())
+    b.write_text(mb.gallery.path("four_bar").read_text())
+    real = g.check_mechanism
+
+    def check(mech, label, **kw):
+        if label == "second":
+            raise ValueError("Expected something else, got this.")
+        return real(mech, label, **kw)
+
+    monkeypatch.setattr(g, "check_mechanism", check)
+    assert main(["verify", str(a), str(b), "--quiet"]) == 2
+    assert "second.xml: Expected something else" in capsys.readouterr().err
+
+
 PENDULUM = """<mujoco model="double_pendulum"><worldbody>
   <body name="l1" pos="0 0 1"><joint name="j1" axis="0 1 0"/>
     <geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.02" mass="1"/>

@@ -759,7 +759,10 @@ def run_generic(targets, **options) -> list[Check]:
         except OSError as exc:
             raise ValueError(f"cannot read {t!r}: {exc}") from exc
         label = Path(t).stem if t.endswith((".xml", ".urdf")) else f"{t} (generic)"
-        checks.extend(check_mechanism(mech, label, **options))
+        try:
+            checks.extend(check_mechanism(mech, label, **options))
+        except ValueError as exc:  # of several targets, say which one
+            raise ValueError(f"{t}: {exc}") from exc
     return checks
 
 
