@@ -12,6 +12,9 @@ import pytest
 
 from robomech import multibody as mb
 
+from ._helpers import axis_angle as _axis_angle
+from ._helpers import urdf_rpy as _rpy
+
 DATA = Path(__file__).parent / "data"
 ARM = DATA / "ur5_like.urdf"
 GRIPPER = DATA / "gripper_mimic.urdf"
@@ -28,20 +31,6 @@ def _load(path, **kw):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # the arm's missing meshes (tested separately)
         return mb.from_urdf(path, **kw)
-
-
-def _rpy(r, p, y):
-    cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
-    Rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
-    Ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
-    Rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
-    return Rz @ Ry @ Rx  # URDF: fixed-axis roll, pitch, yaw
-
-
-def _axis_angle(a, t):
-    a = np.asarray(a, float) / np.linalg.norm(a)
-    K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
-    return np.eye(3) + np.sin(t) * K + (1 - np.cos(t)) * K @ K
 
 
 def _urdf_chain(path, q_by_joint, link):
