@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -139,15 +140,7 @@ def test_passive_and_underactuated_descriptions_are_verified(case):
 # motion that keeps the tip still to first order leave one locked motion that moves no site, so the
 # reference mobility of the passive description counts 2 DOF + 1 idle, while with two joints actuated
 # the third moves the tip and the DOF is 3.
-TRIPLE_PENDULUM = """<mujoco model="triple_pendulum"><worldbody>
-  <body name="l1" pos="0 0 2"><joint name="a1" axis="0 1 0"/>
-    <inertial pos="0 0 -0.22" mass="1.3" diaginertia="0.031 0.03 0.002"/>
-    <body name="l2" pos="0 0 -0.5"><joint name="a2" axis="0 1 0"/>
-      <inertial pos="0 0 -0.18" mass="0.9" diaginertia="0.016 0.015 0.001"/>
-      <body name="l3" pos="0 0 -0.4"><joint name="a3" axis="0 1 0"/>
-        <inertial pos="0 0 -0.16" mass="0.6" diaginertia="0.0061 0.006 0.0005"/>
-        <site name="tip" pos="0 0 -0.3"/></body></body></body>
-</worldbody></mujoco>"""
+TRIPLE_PENDULUM = (Path(__file__).parents[1] / "multibody" / "data" / "triple_pendulum.xml").read_text()
 
 
 def test_a_passive_chain_straight_at_its_reference_gets_enough_virtual_actuators():
