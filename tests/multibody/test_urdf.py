@@ -183,6 +183,29 @@ def test_a_closure_snippet_that_does_not_compile_names_closures():
         _load(GRIPPER, actuated=[], closures=snippet)
 
 
+FLOATING = """<robot name="floating_slide">
+  <link name="world"/>
+  <link name="base"><inertial><origin xyz="0.01 0 0.02" rpy="0.1 0 0"/><mass value="5"/>
+    <inertia ixx="0.1" iyy="0.12" izz="0.08" ixy="0.01" ixz="0" iyz="0.002"/></inertial></link>
+  <link name="slider"><inertial><origin xyz="0 0.02 0"/><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="float" type="floating"><parent link="world"/><child link="base"/><origin xyz="0 0 1"/></joint>
+  <joint name="s" type="prismatic"><parent link="base"/><child link="slider"/>
+    <origin xyz="0.1 0 0" rpy="0 0.3 0"/><axis xyz="1 0 0"/>
+    <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+</robot>"""
+
+
+def test_a_floating_joint_is_a_free_base_not_an_actuator():
+    """``actuated=None`` actuates the revolute, continuous and prismatic joints only; naming the floating
+    joint is refused with its type."""
+    mech = _load(FLOATING)
+    assert mech.actuated == ("s",)
+    assert [j.type for b in mech.bodies for j in b.joints] == ["free", "slide"]
+    with pytest.raises(ValueError, match="floating"):
+        _load(FLOATING, actuated=["float"])
+
+
 def test_from_mjcf_refuses_urdf():
     with pytest.raises(ValueError, match="from_urdf"):
         mb.from_mjcf(GRIPPER)

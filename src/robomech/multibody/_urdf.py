@@ -204,6 +204,7 @@ def from_urdf(
             )
     moving = [j.get("name", "") for j in joints if j.get("type") in _MOVING]
     fixed = {j.get("name", "") for j in joints if j.get("type") not in _MOVING}
+    floating = {j.get("name", "") for j in joints if j.get("type") == "floating"}  # a free base
     couplings = []
     for j in joints:
         mimic = j.find("mimic")
@@ -220,12 +221,17 @@ def from_urdf(
             )
     followers = {c.joint1 for c in couplings}
     if actuated is None:
-        act = tuple(n for n in moving if n not in followers)
+        act = tuple(n for n in moving if n not in followers and n not in floating)
     else:
         act = tuple(actuated)
         for a in act:
             if a in fixed:
                 raise ValueError(f"Expected actuated to name non-fixed joints, got the fixed joint {a!r}.")
+            if a in floating:
+                raise ValueError(
+                    f"Expected actuated to name revolute, continuous or prismatic joints, got the floating "
+                    f"joint {a!r} (a free base)."
+                )
             if a not in moving:
                 raise ValueError(f"Expected actuated to name joints of the URDF (among {moving}), got {a!r}.")
     link_names = [lk.get("name", "") for lk in root.findall("link")]
