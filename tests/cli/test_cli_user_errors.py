@@ -164,3 +164,5 @@ def test_control_help_still_prints_the_usage(capsys):
 def test_start_rates_without_a_start_configuration_are_named_by_their_options(capsys):
     err = _one_line_usage_error(capsys, ["verify", "four_bar", "--qd0", "1"])
     assert "--qd0 needs --q0" in err and "qd_act0" not in err
+    err = _one_line_usage_error(capsys, ["verify", "four_bar", "--qvel0", "1", "0", "0"])
+    assert "--qvel0 needs --q0" in err and "qd0" not in err.replace("--qvel0", "")

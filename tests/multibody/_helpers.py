@@ -47,3 +47,19 @@ def mujoco_closure(mech_or_xml, qs):
         eq = d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY
         out.append(np.max(np.abs(d.efc_pos[eq])) if np.any(eq) else 0.0)
     return np.array(out)
+
+
+def urdf_rpy(r, p, y):
+    """URDF ``rpy``: fixed-axis roll, pitch, yaw, ``R = Rz(y) Ry(p) Rx(r)``."""
+    cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
+    Rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    Ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+    Rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
+    return Rz @ Ry @ Rx
+
+
+def axis_angle(a, t):
+    """Rotation by ``t`` about the axis ``a`` (Rodrigues; ``a`` need not be a unit vector)."""
+    a = np.asarray(a, float) / np.linalg.norm(a)
+    K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    return np.eye(3) + np.sin(t) * K + (1 - np.cos(t)) * K @ K

@@ -12,6 +12,9 @@ import pytest
 
 from robomech import multibody as mb
 
+from ._helpers import axis_angle as _axis_angle
+from ._helpers import urdf_rpy as _rpy
+
 DATA = Path(__file__).parent / "data"
 ARM = DATA / "ur5_like.urdf"
 GRIPPER = DATA / "gripper_mimic.urdf"
@@ -28,20 +31,6 @@ def _load(path, **kw):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # the arm's missing meshes (tested separately)
         return mb.from_urdf(path, **kw)
-
-
-def _rpy(r, p, y):
-    cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
-    Rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
-    Ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
-    Rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
-    return Rz @ Ry @ Rx  # URDF: fixed-axis roll, pitch, yaw
-
-
-def _axis_angle(a, t):
-    a = np.asarray(a, float) / np.linalg.norm(a)
-    K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
-    return np.eye(3) + np.sin(t) * K + (1 - np.cos(t)) * K @ K
 
 
 def _urdf_chain(path, q_by_joint, link):
@@ -177,6 +166,44 @@ def test_actuated_and_closures_arguments():
     assert b.closures == a.closures
     with pytest.raises(ValueError, match="closures"):
         _load(GRIPPER, closures=[1])
+
+
+@pytest.mark.parametrize("bad", [3, 2.5, object()])
+def test_closures_and_actuated_that_are_no_sequence_name_the_argument(bad):
+    with pytest.raises(ValueError, match="Expected closures"):
+        _load(GRIPPER, closures=bad)
+    with pytest.raises(ValueError, match="Expected actuated"):
+        _load(GRIPPER, actuated=bad)
+
+
+def test_a_closure_snippet_that_does_not_compile_names_closures():
+    """MuJoCo's error on the snippet is reported against ``closures``, not the internal MJCF document."""
+    snippet = '<equality><weld name="w" body1="palm" body2="no_such_link"/></equality>'
+    with pytest.raises(ValueError, match=r"Expected closures.*no_such_link|Expected closures.*MuJoCo"):
+        _load(GRIPPER, actuated=[], closures=snippet)
+
+
+FLOATING = """<robot name="floating_slide">
+  <link name="world"/>
+  <link name="base"><inertial><origin xyz="0.01 0 0.02" rpy="0.1 0 0"/><mass value="5"/>
+    <inertia ixx="0.1" iyy="0.12" izz="0.08" ixy="0.01" ixz="0" iyz="0.002"/></inertial></link>
+  <link name="slider"><inertial><origin xyz="0 0.02 0"/><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="float" type="floating"><parent link="world"/><child link="base"/><origin xyz="0 0 1"/></joint>
+  <joint name="s" type="prismatic"><parent link="base"/><child link="slider"/>
+    <origin xyz="0.1 0 0" rpy="0 0.3 0"/><axis xyz="1 0 0"/>
+    <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+</robot>"""
+
+
+def test_a_floating_joint_is_a_free_base_not_an_actuator():
+    """``actuated=None`` actuates the revolute, continuous and prismatic joints only; naming the floating
+    joint is refused with its type."""
+    mech = _load(FLOATING)
+    assert mech.actuated == ("s",)
+    assert [j.type for b in mech.bodies for j in b.joints] == ["free", "slide"]
+    with pytest.raises(ValueError, match="floating"):
+        _load(FLOATING, actuated=["float"])
 
 
 def test_from_mjcf_refuses_urdf():

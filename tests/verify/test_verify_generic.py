@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -84,6 +85,23 @@ def test_cli_verifies_a_users_file(capsys, monkeypatch):
     assert main(["verify", "missing.xml"]) == 2
 
 
+def test_an_error_in_one_of_several_files_names_that_file(tmp_path, capsys, monkeypatch):
+    """``robomech verify a.xml b.xml``: an input error found while checking one file says which."""
+    a, b = tmp_path / "first.xml", tmp_path / "second.xml"
+    a.write_text(mb.gallery.path("four_bar").read_text())
+    b.write_text(mb.gallery.path("four_bar").read_text())
+    real = g.check_mechanism
+
+    def check(mech, label, **kw):
+        if label == "second":
+            raise ValueError("Expected something else, got this.")
+        return real(mech, label, **kw)
+
+    monkeypatch.setattr(g, "check_mechanism", check)
+    assert main(["verify", str(a), str(b), "--quiet"]) == 2
+    assert "second.xml: Expected something else" in capsys.readouterr().err
+
+
 PENDULUM = """<mujoco model="double_pendulum"><worldbody>
   <body name="l1" pos="0 0 1"><joint name="j1" axis="0 1 0"/>
     <geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.02" mass="1"/>
@@ -116,6 +134,38 @@ def test_passive_and_underactuated_descriptions_are_verified(case):
     checks = g.check_mechanism(mech, case, simulate=case != "underactuated stewart")
     assert all(c.passed for c in checks), [(c.quantity, c.max_error) for c in checks if not c.passed]
     assert "virtual actuators on " + ", ".join(added) in checks[0].detail
+
+
+# Three links hanging straight down (the reference): there the tip's velocity along the chain and the
+# motion that keeps the tip still to first order leave one locked motion that moves no site, so the
+# reference mobility of the passive description counts 2 DOF + 1 idle, while with two joints actuated
+# the third moves the tip and the DOF is 3.
+TRIPLE_PENDULUM = (Path(__file__).parents[1] / "multibody" / "data" / "triple_pendulum.xml").read_text()
+
+
+def test_a_passive_chain_straight_at_its_reference_gets_enough_virtual_actuators():
+    """The virtual actuators are added until they determine the motion of the mechanism they drive, not
+    only until their number reaches the passive description's reference DOF (2 here, one short)."""
+    mech = mb.from_mjcf(TRIPLE_PENDULUM)
+    _, added = g._virtually_actuated(mech)
+    assert added == ("a1", "a2", "a3")
+    checks = g.check_mechanism(mech, "triple pendulum", simulate=False)
+    assert all(c.passed for c in checks), [(c.quantity, c.max_error) for c in checks if not c.passed]
+
+
+def test_a_failing_simulation_is_explained_once(monkeypatch):
+    """When both the simulation and its energy drift fail, the explanation (which re-simulates the motion
+    around each approach to a singularity: minutes near one) is computed once and given to both."""
+    mech = mb.from_mjcf(PENDULUM)
+    monkeypatch.setattr(g, "TOL_SIM", Tolerance(1e-300, "impossible: forces a failure", relative=True))
+    monkeypatch.setattr(g, "TOL_DRIFT", Tolerance(1e-300, "impossible: forces a failure", relative=True))
+    calls = []
+    real = g._why
+    monkeypatch.setattr(g, "_why", lambda *a, **k: calls.append(1) or real(*a, **k))
+    driven, _ = g._virtually_actuated(mech)  # as check_mechanism calls it
+    checks = g._simulation_checks(driven, "pendulum", mech.q0, qd0=np.array([0.5, -0.3]))
+    assert [c.passed for c in checks] == [False, False]
+    assert len(calls) == 1
 
 
 def test_passive_verification_has_teeth():

@@ -151,8 +151,9 @@ def _run(args: argparse.Namespace) -> int:
         for k, v in (("duration", args.duration), ("q0", args.q0), ("qd_act0", args.qd0), ("qd0", args.qvel0))
         if v is not None
     }
-    if args.qd0 is not None and args.q0 is None:
-        raise CliError("--qd0 needs --q0 (the start configuration the rates belong to)")
+    for flag, rates in (("--qd0", args.qd0), ("--qvel0", args.qvel0)):
+        if rates is not None and args.q0 is None:
+            raise CliError(f"{flag} needs --q0 (the start configuration the rates belong to)")
     if sim and not generic:
         flag = {"qd_act0": "qd0", "qd0": "qvel0"}.get(next(iter(sim)), next(iter(sim)))
         raise CliError(f"--{flag} applies to MJCF files and gallery mechanisms only")

@@ -116,7 +116,21 @@ def _closures_from_snippet(mech: Mechanism, snippet: str) -> Mechanism:
             eq.append(child)
     # <equality> goes before <actuator> (MJCF section order does not matter to MuJoCo, but keep it tidy)
     root.append(eq)
-    return from_mjcf(ET.tostring(root, encoding="unicode"))
+    try:
+        return from_mjcf(ET.tostring(root, encoding="unicode"))
+    except ValueError as exc:  # an error in the snippet, not in the document it was merged into
+        raise ValueError(
+            f"Expected closures to be an <equality> snippet naming the URDF's links and joints; "
+            f"loading it with the URDF failed: {exc}"
+        ) from exc
+
+
+def _iterable(x: object) -> bool:
+    try:
+        iter(x)  # type: ignore[call-overload]
+    except TypeError:
+        return False
+    return True
 
 
 def from_urdf(
@@ -171,10 +185,12 @@ def from_urdf(
     root, folder = _read(path_or_text)
     if root.tag != "robot":
         raise ValueError(f"Expected path_or_text to be URDF (root <robot>), got root <{root.tag}>.")
-    if actuated is not None and (isinstance(actuated, str) or not all(isinstance(a, str) for a in actuated)):
+    if actuated is not None and (
+        isinstance(actuated, str) or not _iterable(actuated) or not all(isinstance(a, str) for a in actuated)
+    ):
         raise ValueError(f"Expected actuated to be None or a sequence of joint names, got {actuated!r}.")
     if closures is not None and not isinstance(closures, str):
-        if not all(isinstance(c, Closure) for c in closures):
+        if not _iterable(closures) or not all(isinstance(c, Closure) for c in closures):
             raise ValueError(
                 "Expected closures to be None, an MJCF <equality> snippet or a sequence of Closure, "
                 f"got {closures!r}."
@@ -188,6 +204,7 @@ def from_urdf(
             )
     moving = [j.get("name", "") for j in joints if j.get("type") in _MOVING]
     fixed = {j.get("name", "") for j in joints if j.get("type") not in _MOVING}
+    floating = {j.get("name", "") for j in joints if j.get("type") == "floating"}  # a free base
     couplings = []
     for j in joints:
         mimic = j.find("mimic")
@@ -204,12 +221,17 @@ def from_urdf(
             )
     followers = {c.joint1 for c in couplings}
     if actuated is None:
-        act = tuple(n for n in moving if n not in followers)
+        act = tuple(n for n in moving if n not in followers and n not in floating)
     else:
         act = tuple(actuated)
         for a in act:
             if a in fixed:
                 raise ValueError(f"Expected actuated to name non-fixed joints, got the fixed joint {a!r}.")
+            if a in floating:
+                raise ValueError(
+                    f"Expected actuated to name revolute, continuous or prismatic joints, got the floating "
+                    f"joint {a!r} (a free base)."
+                )
             if a not in moving:
                 raise ValueError(f"Expected actuated to name joints of the URDF (among {moving}), got {a!r}.")
     link_names = [lk.get("name", "") for lk in root.findall("link")]

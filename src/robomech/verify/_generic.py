@@ -532,9 +532,10 @@ def _flight_checks(mech, name, q0, qd0, duration: float, eng) -> list[Check]:
 def _virtually_actuated(mech):
     """``(mech, ())`` where the actuated rates determine the state; otherwise the same mechanism with
     actuators added on hinge/slide joints, in file order, each one that the actuators so far leave free
-    (it lowers the passive rates' nullity at the reference), until none is left free: ``(mech', added
-    names)``.  The added actuators only give the checks a motion to follow and forces to compare (the
-    passive simulation applies none), so a passive or underactuated description is verified as it is.
+    (it lowers the passive rates' nullity at the reference), until the actuators determine the driven
+    mechanism's motion (as many as its own DOF): ``(mech', added names)``.  The added actuators only
+    give the checks a motion to follow and forces to compare (the passive simulation applies none), so
+    a passive or underactuated description is verified as it is.
     ``(mech, None)`` where no such set exists (a floating base)."""
     from robomech import multibody as mb
 
@@ -556,8 +557,10 @@ def _virtually_actuated(mech):
             if n < free:
                 added.append(j.name)
                 free = n
-            if len(mech.actuated) + len(added) == dof:
-                return dataclasses.replace(mech, actuated=(*mech.actuated, *added)), tuple(added)
+                # determined as the dynamics judge it: the driven mechanism's own DOF (a chain straight
+                # at its reference counts a locked motion as idle until enough joints are actuated)
+                if len(trial.actuated) >= mb.mobility(trial).dof:
+                    return trial, tuple(added)
     return mech, None
 
 
@@ -703,11 +706,18 @@ def _simulation_checks(mech, name, q0, qd_act0=None, duration: float = T_SIM, *,
     rel = _rel(err, max(moved, 1e-3))
     detail = f"max |q_act - engine| {err:.2e} (rad, slides / L) for a motion of {moved:.3g}"
     off = dev > TOL_SIM.value * max(moved, 1e-3)  # where the motion left the engine's
+    explained: list[str] = []  # computed once for both checks (it re-simulates around close approaches)
+
+    def explain() -> str:
+        if not explained:
+            explained.append(_why(mech, t, sim.q, off, sim.qd))
+        return explained[0]
+
     if not rel <= TOL_SIM.value:
-        detail += "; " + _why(mech, t, sim.q, off, sim.qd)
+        detail += "; " + explain()
     drift = f"{float(sim.energy_drift):.2e} J"
     if not float(sim.energy_drift_rel) <= TOL_DRIFT.value:
-        drift += "; " + _why(mech, t, sim.q, off, sim.qd)
+        drift += "; " + explain()
     return [
         Check(name, f"forward simulation vs engine ({duration:g} s, passive)", rel, TOL_SIM, detail),
         Check(name, "energy drift of the simulation", float(sim.energy_drift_rel), TOL_DRIFT, drift),
@@ -749,7 +759,10 @@ def run_generic(targets, **options) -> list[Check]:
         except OSError as exc:
             raise ValueError(f"cannot read {t!r}: {exc}") from exc
         label = Path(t).stem if t.endswith((".xml", ".urdf")) else f"{t} (generic)"
-        checks.extend(check_mechanism(mech, label, **options))
+        try:
+            checks.extend(check_mechanism(mech, label, **options))
+        except ValueError as exc:  # of several targets, say which one
+            raise ValueError(f"{t}: {exc}") from exc
     return checks
 
 
