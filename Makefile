@@ -13,17 +13,25 @@ MINIMAL := .venv-minimal
 
 .PHONY: install install-browser run test test-slow test-all bench verify lint typecheck docs check-minimal clean
 
-install: $(STAMP)
+# The modules that define numba kernels (robomech._numba.KERNEL_SOURCES): an edit of any of them (a
+# pull, a checkout) names a new kernel cache folder (their fingerprint), which the warm-up fills again.
+KERNEL_FILES := $(shell grep -rlE '_nj\b|njit' src/robomech --include='*.py')
+WARM_STAMP := $(VENV)/.warmed
+
+install: $(STAMP) $(WARM_STAMP)
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e ".[verify,explore,test]"
-	# compile the multibody kernels into the on-disk cache now, not at the user's first call: two halves
-	# in two processes at once (numba compiles on one thread)
+	touch $(STAMP)
+
+# compile the multibody kernels into the on-disk cache now, not at the user's first call: two halves
+# in two processes at once (numba compiles on one thread); seconds when the cache is already filled
+$(WARM_STAMP): $(STAMP) $(KERNEL_FILES)
 	$(BIN)/python -c "from robomech.multibody._compiled import warm; warm(0)" & pid=$$!; \
 	  $(BIN)/python -c "from robomech.multibody._compiled import warm; warm(1)" && wait $$pid
-	touch $(STAMP)
+	touch $(WARM_STAMP)
 
 $(DOCS_STAMP): $(STAMP)
 	$(BIN)/python -m pip install --quiet -e ".[verify,explore,test,docs]"

@@ -14,8 +14,9 @@ cache is opened).
 
 Every compilation (a kernel's first use with empty caches) is announced on the ``robomech`` logger
 (``logging.getLogger("robomech")``) at INFO: ``compiling kernel X (first use; cached in DIR)``, then
-the time it took, so that a first call is never minutes of silence.  A kernel loaded from the cache
-is not compiled and says nothing.
+the time it took.  The first compilation of a process is also a WARNING, which Python prints even
+where logging is not configured (its last-resort handler), so that a plain script's first call is
+never minutes of silence.  A kernel loaded from the cache is not compiled and says nothing.
 """
 
 from __future__ import annotations
@@ -72,7 +73,7 @@ def _listen(numba: ModuleType) -> None:
         return
     from numba.core import event
 
-    state: dict[str, Any] = {"depth": 0, "t0": 0.0, "name": ""}
+    state: dict[str, Any] = {"depth": 0, "t0": 0.0, "name": "", "warned": False}
 
     class _Listener(event.Listener):
         def on_start(self, ev: Any) -> None:
@@ -83,6 +84,14 @@ def _listen(numba: ModuleType) -> None:
                 mod = getattr(getattr(disp, "py_func", None), "__module__", "")
                 state["t0"], state["name"] = time.perf_counter(), f"{mod}.{name}" if mod else name
                 where = getattr(numba.config, "CACHE_DIR", "")
+                if not state["warned"]:
+                    state["warned"] = True
+                    _LOG.warning(
+                        "compiling robomech's kernels, which are not in the cache %s (a new install or "
+                        "version, or a cleared cache): each compiles once, in seconds, and is then "
+                        "cached; logging at INFO on the 'robomech' logger names each one",
+                        where,
+                    )
                 _LOG.info("compiling kernel %s (first use; cached in %s)", state["name"], where)
 
         def on_end(self, ev: Any) -> None:

@@ -107,3 +107,23 @@ def test_kernels_cache_outside_the_package_and_say_when_they_compile(tmp_path):
     assert "robomech compiled kernel" in out.stderr
     assert _nb_files() == before, sorted(map(str, _nb_files() - before))
     assert any(p.suffix == ".nbi" for p in (tmp_path / "robomech" / "numba").rglob("*"))
+
+
+@pytest.mark.slow
+def test_a_plain_script_is_told_once_that_kernels_compile(tmp_path):
+    """Without any logging configuration (a plain script), the first compilation of a process is a
+    warning Python prints on its own, once; the kernels' own lines stay at INFO."""
+    code = (
+        "import numpy as np\n"
+        "from robomech.analysis import lstsq\n"
+        "lstsq.solve(np.eye(3)[None], np.ones((1, 3)))\n"
+    )
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path), "PYTHONPATH": str(SRC)}
+    env.pop("NUMBA_CACHE_DIR", None)
+    run = [sys.executable, "-c", code]
+    out = subprocess.run(run, env=env, capture_output=True, text=True, timeout=SUBPROCESS_TIMEOUT)
+    assert out.returncode == 0, out.stderr
+    assert out.stderr.count("compiling robomech's kernels") == 1, out.stderr
+    assert "compiling kernel" not in out.stderr  # the per-kernel lines are INFO
+    again = subprocess.run(run, env=env, capture_output=True, text=True, timeout=SUBPROCESS_TIMEOUT)
+    assert again.returncode == 0 and "compiling" not in again.stderr, again.stderr  # cached: silent
