@@ -219,6 +219,24 @@ def test_inverse_then_forward_dynamics_recover_the_accelerations(name):
     np.testing.assert_allclose(fwd.qdd_act, qdd, atol=ROUND_TRIP_TOL)
 
 
+def test_an_unassembled_description_exports_its_assembled_reference_as_a_keyframe():
+    """The five-bar typed open: MuJoCo's qpos0 of the exported file leaves the closure open (as typed),
+    its keyframe ``assembled`` starts MuJoCo closed; a description closed at qpos0 gets no keyframe."""
+    mujoco = pytest.importorskip("mujoco")
+    m = mujoco.MjModel.from_xml_string(mb.to_mjcf(FIVE_BAR))
+    d = mujoco.MjData(m)
+
+    def closure_error() -> float:
+        mujoco.mj_forward(m, d)
+        return float(np.max(np.abs(d.efc_pos[d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY])))
+
+    assert closure_error() > 1e3 * CLOSED_FORM_TOL  # control: typed open at qpos0
+    mujoco.mj_resetDataKeyframe(m, d, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "assembled"))
+    np.testing.assert_array_equal(d.qpos, FIVE_BAR.q0)
+    assert closure_error() < CLOSED_FORM_TOL
+    assert mujoco.MjModel.from_xml_string(mb.to_mjcf(mb.gallery.load("four_bar"))).nkey == 0
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["five_bar", "agile_eye", "tsai_3upu"])
 def test_verify_of_the_exported_mjcf_passes(name, tmp_path):

@@ -34,6 +34,8 @@ from ._tree import quat_to_matrix
 
 __all__ = ["AUX_SITE_PREFIX", "from_mjcf", "to_mjcf"]
 
+# The keyframe to_mjcf writes with the assembled reference of a description typed unassembled
+ASSEMBLED_KEY = "assembled"
 # Sites written by to_mjcf to express a point closure whose anchors do not coincide at qpos0
 # (MuJoCo's site form of <connect>); from_mjcf does not list them as the mechanism's sites.
 AUX_SITE_PREFIX = "_closure_"
@@ -334,7 +336,9 @@ def to_mjcf(mech: Mechanism, *, comment: str | None = None) -> str:
     MuJoCo's viewer.  Bodies without an :class:`Inertial` get MuJoCo's inertia from these geoms.
     A ``revolute`` closure is written as two ``connect`` elements ``name`` and ``name/axis`` one
     characteristic length apart along the axis (MJCF has no hinge equality).  ``comment`` is written
-    as an XML comment at the top of the model.
+    as an XML comment at the top of the model.  A description whose closures are not closed at
+    ``qpos0`` (assembled at load, :attr:`Mechanism.q0`) also gets a keyframe ``assembled`` holding the
+    assembled reference, from which MuJoCo starts closed (``mj_resetDataKeyframe``).
 
     Parameters
     ----------
@@ -468,6 +472,10 @@ def to_mjcf(mech: Mechanism, *, comment: str | None = None) -> str:
         act = ET.SubElement(root, "actuator")
         for a in mech.actuated:
             ET.SubElement(act, "general", name=f"act_{a}", joint=a)
+    q_ref = np.asarray(mech.q0, dtype=float)
+    if not np.array_equal(q_ref, tree.q0):  # typed unassembled: MuJoCo's qpos0 leaves the closures open
+        key = ET.SubElement(root, "keyframe")
+        ET.SubElement(key, "key", name=ASSEMBLED_KEY, qpos=_f(q_ref))
     ET.indent(root)
     xml = ET.tostring(root, encoding="unicode")
     _check_mujoco_accepts(mech, xml)
