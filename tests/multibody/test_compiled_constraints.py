@@ -140,6 +140,15 @@ def test_singular_values_kernel_against_numpy_and_on_bad_matrices():
     assert s.shape == (0,)
 
 
+def test_the_full_svd_fallback_gives_the_same_singular_values():
+    """``singular_values_full``: what the kernels call where numba has no vector-free SVD helper."""
+    from robomech.multibody._compiled import singular_values_full
+
+    rng = np.random.default_rng(9)
+    for X in (rng.normal(size=(4, 7)), rng.normal(size=(7, 4))):
+        _close(singular_values_full(X), np.linalg.svd(X, compute_uv=False), BATCH_RTOL, f"shape {X.shape}")
+
+
 # dK/dt applied to v against the per-product kernel (dK/dt along u) v: the same products and sums per
 # entry, identical bits measured; a few ulps of the largest entry allowed.
 PRODUCT_RTOL = 1e-14

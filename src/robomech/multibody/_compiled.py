@@ -764,8 +764,17 @@ def kdot_par(Q, QD, t, KD_o):  # pragma: no cover - compiled
 # ----------------------------------------------------------------------------- dK/dt and singular values
 # LAPACK's gesdd without singular vectors (jobz 'N', the routine of numpy's ``svd(compute_uv=False)``,
 # half the cost of numba's ``np.linalg.svd``, which always forms U and V): numba has it only as the
-# helper of its ``np.linalg.norm`` / ``cond`` / ``matrix_rank``, so the kernels call that helper.
-_singular_values = importlib.import_module("numba.np.linalg")._compute_singular_values
+# helper of its ``np.linalg.norm`` / ``cond`` / ``matrix_rank``, so the kernels call that helper, and a
+# numba without it the full SVD (the same values, at twice the cost) rather than failing at import.
+@_nj
+def singular_values_full(a):  # pragma: no cover - compiled
+    """Singular values of ``a`` through numba's ``np.linalg.svd`` (which also forms U and V)."""
+    return np.linalg.svd(a, full_matrices=False)[1]
+
+
+_singular_values = getattr(
+    importlib.import_module("numba.np.linalg"), "_compute_singular_values", singular_values_full
+)
 
 
 @_nj
