@@ -165,7 +165,7 @@ def test_rate_columns_equal_the_per_product_kernel(name):
     with random ``v``, on assembled and unassembled samples, at every batch size."""
     from robomech.multibody import _compiled as C
     from robomech.multibody._compile import compile_model
-    from robomech.multibody._tree import integrate
+    from ._reference import integrate
 
     mech = _get(name)
     t = compile_model(mech).tables
@@ -193,7 +193,7 @@ def test_rate_columns_equal_the_per_product_kernel(name):
 def test_rate_equals_finite_differences_of_k(name):
     """dK/dt against central differences of K along qd, at assembled and unassembled configurations:
     the rate of every closure row (points, rotations) from an independent formula."""
-    from robomech.multibody._tree import integrate
+    from ._reference import integrate
 
     mech = _get(name)
     rng = np.random.default_rng(7)
