@@ -177,6 +177,42 @@ def _output_bodies(tree: Tree) -> list[int]:
     return list(range(1, len(tree.body_names)))
 
 
+def _watched_points(
+    tree: Tree, tables: Tables, bodies: Bodies, T: np.ndarray
+) -> tuple[list[int], np.ndarray]:
+    """The points an idle motion must leave still, at body poses ``T (nb, 4, 4)``: each as (body it moves
+    with, world position ``(n, 3)``).
+
+    Every tree joint's anchor, as a point of the joint's body and of its parent (where the body attaches;
+    they differ for slides), both anchors of every point closure (``connect``; a revolute closure's two
+    point pairs, a weld's anchor), and the centre of mass of every body with mass.  The sites move with
+    the output bodies, whose whole twists are watched (:func:`_output_bodies`).
+    """
+    on: list[int] = []
+    pts: list[np.ndarray] = []
+
+    def add(b: int, x: np.ndarray) -> None:
+        if b > 0:  # a point of the world never moves
+            on.append(int(b))
+            pts.append(T[b, :3, :3] @ x + T[b, :3, 3])
+
+    for k in range(len(tree.jnt_names)):
+        b = int(tree.jnt_body[k])
+        add(b, tree.jnt_pos[k])
+        p = T[b, :3, :3] @ tree.jnt_pos[k] + T[b, :3, 3]
+        pb = int(tree.parent[b])
+        if pb > 0:
+            on.append(pb)
+            pts.append(p)
+    for (b1, b2, _row), (x1, x2) in zip(tables.pp, tables.px, strict=True):
+        add(int(b1), x1)
+        add(int(b2), x2)
+    for b, m, c in zip(bodies.idx, bodies.mass, bodies.com, strict=True):
+        if m > 0:
+            add(int(b), c)
+    return on, np.array(pts, dtype=float).reshape(-1, 3)
+
+
 @dataclass(frozen=True, eq=False)
 class Instantaneous:
     """The instantaneous mobility at one configuration (unit-scaled constraint Jacobian)."""
@@ -186,16 +222,26 @@ class Instantaneous:
     rank: int
     N: np.ndarray  # (nv, total_dof) orthonormal basis of the admissible motions (scaled coordinates)
     locked: np.ndarray  # admissible motions with every actuated joint locked
-    idle: int  # locked motions that move no output body
+    idle: int  # locked motions that move no output body and none of the watched points
     T: np.ndarray  # (nb, 4, 4) the bodies' world poses at q
     S: np.ndarray  # (nv, 6) the coordinates' space screws at q
 
 
-def instantaneous_mobility(tree: Tree, tables: Tables | Model, q: np.ndarray) -> Instantaneous:
+def instantaneous_mobility(
+    tree: Tree, tables: Tables | Model, q: np.ndarray, bodies: Bodies
+) -> Instantaneous:
     """Rank of the unit-scaled ``K`` at ``q (1, nq)``, admissible and locked motions, idle count
-    (poses, screws and ``K`` from the compiled kernels on ``tables``, or on a compiled model's)."""
+    (poses, screws and ``K`` from the compiled kernels on ``tables``, or on a compiled model's).
+
+    A locked motion (every actuated joint still) is idle when it moves no output body
+    (:func:`_output_bodies`: the twists of the bodies that carry sites, every body without sites),
+    rotates no body held in orientation by a closure (a weld's two bodies), and moves none of the points
+    of :func:`_watched_points` (joint anchors, closure points, centres of mass of bodies with mass): an
+    S-S rod spinning about the line through its two ball centres, with its centre of mass on that line.
+    ``bodies``: the mass tables (:class:`Bodies`) of the description."""
     from ._compiled import compiled_kinematics, compiled_resjac, space_jacobians
 
+    tb = tables.tables if isinstance(tables, Model) else tables
     T, S = compiled_kinematics(tables, q)
     col = np.where(tree.dof_translational, tree.length, 1.0)
     K = compiled_resjac(tables, q, True)[1][0] * col
@@ -205,12 +251,19 @@ def instantaneous_mobility(tree: Tree, tables: Tables | Model, q: np.ndarray) ->
     N = _null(K, nv)
     na = len(tree.act_dof)
     locked = N @ _null(N[tree.act_dof], N.shape[1]) if na else N
-    outs = _output_bodies(tree)
-    # twists per scaled coordinate, angular rows times L: rows of order L, so a motion that moves an
-    # output has |Jout v| ~ L|v|
-    J = space_jacobians(tree.A, S, outs)[0] / col * np.array([tree.length] * 3 + [1.0] * 3)[:, None]
-    Jout = J.reshape(-1, nv)
-    idle = locked.shape[1] - _rank(Jout @ locked, tree.length) if locked.shape[1] else 0
+    if not locked.shape[1]:
+        return Instantaneous(K=K, kmax=kmax, rank=rank, N=N, locked=locked, idle=0, T=T[0], S=S[0])
+    # every body's twist per scaled coordinate (nb, 6, nv), [ω; v] with v at the world origin
+    J = space_jacobians(tree.A, S, range(len(tree.body_names)))[0] / col
+    # whole twists of the output bodies and of the welded ones, angular rows times L: rows of order L,
+    # so a motion that moves one has |J v| ~ L|v|
+    whole = sorted(set(_output_bodies(tree)) | {int(b) for r in tb.rr for b in r[:2] if b > 0})
+    Jw = J[whole] * np.array([tree.length] * 3 + [1.0] * 3)[:, None]
+    # the watched points' velocities v + ω × p (m per scaled coordinate, of order L as well)
+    on, P = _watched_points(tree, tb, bodies, T[0])
+    Jp = J[on, 3:] - np.cross(P[:, :, None], J[on, :3], axis=1)
+    moved = np.concatenate([Jw.reshape(-1, nv), Jp.reshape(-1, nv)])
+    idle = locked.shape[1] - _rank(moved @ locked, tree.length)
     return Instantaneous(K=K, kmax=kmax, rank=rank, N=N, locked=locked, idle=int(idle), T=T[0], S=S[0])
 
 
@@ -324,7 +377,8 @@ def _compile(mech: Mechanism, tree: Tree | None = None) -> Model:
     # the reference configuration: qpos0, or the assembly nearest to it for a description typed
     # unassembled (a ValueError with the residual if none); the reference rank is taken there
     q_ref = assembled_reference(mech, tree, cs, tables)
-    inst = instantaneous_mobility(tree, tables, q_ref[None])
+    bodies = _bodies(mech)
+    inst = instantaneous_mobility(tree, tables, q_ref[None], bodies)
     total = tree.nv - inst.rank
     dof = total - inst.idle
     # the passive block has full column rank but for the idle motions (computed at the reference, not
@@ -332,7 +386,6 @@ def _compile(mech: Mechanism, tree: Tree | None = None) -> Model:
     # and the idle motions free
     rank0 = len(pas) - inst.idle
     rank_K = tree.nv - dof - inst.idle
-    bodies = _bodies(mech)
     dyn = DynTables(
         bidx=bodies.idx.astype(np.int64),
         mass=np.ascontiguousarray(bodies.mass, dtype=float),
