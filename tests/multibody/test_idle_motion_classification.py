@@ -1,10 +1,11 @@
 """Idle motions: motions with every actuated joint locked that move no output body (the bodies that
-carry sites, every body if there is none), turn no welded body, and move none of the points that
-connect or carry mass (every tree joint's anchor, the closure points, the centres of mass of the bodies
-with mass) -- a Delta forearm or an RSSR coupler spinning about its own axis.  Two descriptions a user
-writes where watching the output bodies alone would count real degrees of freedom as idle (a passive
-chain straight at its reference, a cart-pole whose only site is on the cart), and the rule itself on an
-RSSR linkage whose coupler's spin is idle or not by where its mass is."""
+carry sites, every body if there is none), turn no welded body, and move none of the points that connect
+or carry mass (every tree joint's anchor, the closure points, the centres of mass of the bodies with
+mass) -- a Delta forearm or an RSSR coupler spinning about its own axis. Two descriptions a user writes
+where watching the output bodies alone would count real degrees of freedom as idle (a passive chain
+straight at its reference, a cart-pole whose only site is on the cart), and the rule itself: an RSSR
+linkage whose coupler's spin is idle or not by where its mass is, and a pendulum whose massless links
+carry only joint anchors."""
 
 from __future__ import annotations
 
@@ -154,3 +155,31 @@ def test_an_rssr_coupler_spin_is_idle_exactly_when_its_mass_is_on_its_axis(name)
         assert abs(dU) > 1e-3  # 0.4 kg, 4 cm off the axis: ~0.1 J over 0.7 rad
         with pytest.raises(ValueError, match="do not determine"):
             mb.inverse_dynamics(mech, q[None], np.array([[0.5]]), np.array([[1.0]]))
+
+
+def _pendulum_with_massless_upper_links() -> mb.Mechanism:
+    """The triple pendulum's geometry with its first two links massless: only the joint anchors they
+    carry (a2 on l1, a3 on l2) tie their motion to anything watched."""
+    b = mb.Builder("massless_upper_links")
+    b.body("l1", pos=(0, 0, 2), joints=[b.hinge("a1", axis=(0, 1, 0))])
+    b.body("l2", "l1", pos=(0, 0, -0.5), joints=[b.hinge("a2", axis=(0, 1, 0))])
+    b.body(
+        "l3",
+        "l2",
+        pos=(0, 0, -0.4),
+        joints=[b.hinge("a3", axis=(0, 1, 0))],
+        inertial=mb.Inertial(0.6, pos=(0, 0, -0.16), diaginertia=(0.0061, 0.006, 0.0005)),
+    )
+    b.site("tip", "l3", pos=(0, 0, -0.3))
+    return b.build()
+
+
+def test_the_joint_anchors_keep_massless_links_from_counting_idle():
+    """Straight, l3 (the output) stays still to first order when a1 turns at w, a2 at -9w/4 (a3's anchor
+    stays put: 0.9 w - 0.4 (9w/4) = 0) and a3 at 5w/4 (l3 keeps its orientation): only the anchor a2 that
+    the massless l1 carries moves.  Watched, it makes the three swings degrees of freedom, straight as
+    bent."""
+    mech = _pendulum_with_massless_upper_links()
+    for q in (np.zeros(3), np.array([0.3, -0.5, 0.8])):
+        m = mb.mobility(mech, q)
+        assert (m.total_dof, m.dof, m.idle_dof) == (3, 3, 0)

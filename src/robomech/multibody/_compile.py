@@ -179,38 +179,24 @@ def _output_bodies(tree: Tree) -> list[int]:
 
 def _watched_points(
     tree: Tree, tables: Tables, bodies: Bodies, T: np.ndarray
-) -> tuple[list[int], np.ndarray]:
-    """The points an idle motion must leave still, at body poses ``T (nb, 4, 4)``: each as (body it moves
-    with, world position ``(n, 3)``).
+) -> tuple[np.ndarray, np.ndarray]:
+    """The points an idle motion must leave still, at body poses ``T (nb, 4, 4)``: the body each moves
+    with ``(n,)`` and its world position ``(n, 3)``.
 
     Every tree joint's anchor, as a point of the joint's body and of its parent (where the body attaches;
     they differ for slides), both anchors of every point closure (``connect``; a revolute closure's two
     point pairs, a weld's anchor), and the centre of mass of every body with mass.  The sites move with
     the output bodies, whose whole twists are watched (:func:`_output_bodies`).
     """
-    on: list[int] = []
-    pts: list[np.ndarray] = []
-
-    def add(b: int, x: np.ndarray) -> None:
-        if b > 0:  # a point of the world never moves
-            on.append(int(b))
-            pts.append(T[b, :3, :3] @ x + T[b, :3, 3])
-
-    for k in range(len(tree.jnt_names)):
-        b = int(tree.jnt_body[k])
-        add(b, tree.jnt_pos[k])
-        p = T[b, :3, :3] @ tree.jnt_pos[k] + T[b, :3, 3]
-        pb = int(tree.parent[b])
-        if pb > 0:
-            on.append(pb)
-            pts.append(p)
-    for (b1, b2, _row), (x1, x2) in zip(tables.pp, tables.px, strict=True):
-        add(int(b1), x1)
-        add(int(b2), x2)
-    for b, m, c in zip(bodies.idx, bodies.mass, bodies.com, strict=True):
-        if m > 0:
-            add(int(b), c)
-    return on, np.array(pts, dtype=float).reshape(-1, 3)
+    jb = tree.jnt_body.astype(np.int64)
+    heavy = bodies.mass > 0
+    # (body the point moves with, body whose frame gives it, its position in that frame)
+    on = np.concatenate([jb, tree.parent[jb], tables.pp[:, 0], tables.pp[:, 1], bodies.idx[heavy]])
+    frame = np.concatenate([jb, jb, tables.pp[:, 0], tables.pp[:, 1], bodies.idx[heavy]])
+    x = np.concatenate([tree.jnt_pos, tree.jnt_pos, tables.px[:, 0], tables.px[:, 1], bodies.com[heavy]])
+    keep = on > 0  # a point of the world never moves
+    on, frame, x = on[keep].astype(np.int64), frame[keep], x[keep]
+    return on, np.einsum("nij,nj->ni", T[frame, :3, :3], x) + T[frame, :3, 3]
 
 
 @dataclass(frozen=True, eq=False)
@@ -259,9 +245,11 @@ def instantaneous_mobility(
     # so a motion that moves one has |J v| ~ L|v|
     whole = sorted(set(_output_bodies(tree)) | {int(b) for r in tb.rr for b in r[:2] if b > 0})
     Jw = J[whole] * np.array([tree.length] * 3 + [1.0] * 3)[:, None]
-    # the watched points' velocities v + ω × p (m per scaled coordinate, of order L as well)
+    # the watched points' velocities v + ω × p = v - [p]× ω (m per scaled coordinate, of order L as well)
     on, P = _watched_points(tree, tb, bodies, T[0])
-    Jp = J[on, 3:] - np.cross(P[:, :, None], J[on, :3], axis=1)
+    z = np.zeros(len(on))
+    Px = np.stack([z, -P[:, 2], P[:, 1], P[:, 2], z, -P[:, 0], -P[:, 1], P[:, 0], z], -1).reshape(-1, 3, 3)
+    Jp = J[on, 3:] - Px @ J[on, :3]
     moved = np.concatenate([Jw.reshape(-1, nv), Jp.reshape(-1, nv)])
     idle = locked.shape[1] - _rank(moved @ locked, tree.length)
     return Instantaneous(K=K, kmax=kmax, rank=rank, N=N, locked=locked, idle=int(idle), T=T[0], S=S[0])
