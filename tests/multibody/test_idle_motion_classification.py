@@ -1,11 +1,11 @@
 """Idle motions: motions with every actuated joint locked that move no output body (the bodies that
 carry sites, every body if there is none), turn no welded body, and move none of the points that connect
 or carry mass (every tree joint's anchor, the closure points, the centres of mass of the bodies with
-mass) -- a Delta forearm or an RSSR coupler spinning about its own axis. Two descriptions a user writes
-where watching the output bodies alone would count real degrees of freedom as idle (a passive chain
-straight at its reference, a cart-pole whose only site is on the cart), and the rule itself: an RSSR
-linkage whose coupler's spin is idle or not by where its mass is, and a pendulum whose massless links
-carry only joint anchors."""
+mass) -- a Delta forearm or an RSSR coupler spinning about its own axis. Three descriptions a user
+writes where watching the output bodies alone would count real degrees of freedom as idle (a passive
+chain straight at its reference, a cart-pole whose only site is on the cart, a chain of more links than
+its tip has twist directions), and the rule itself: an RSSR linkage whose coupler's spin is idle or not
+by where its mass is, and a pendulum whose massless links carry only joint anchors."""
 
 from __future__ import annotations
 
@@ -183,3 +183,24 @@ def test_the_joint_anchors_keep_massless_links_from_counting_idle():
     for q in (np.zeros(3), np.array([0.3, -0.5, 0.8])):
         m = mb.mobility(mech, q)
         assert (m.total_dof, m.dof, m.idle_dof) == (3, 3, 0)
+
+
+def test_a_chain_of_more_links_than_its_tip_has_twist_directions_has_a_dof_per_link():
+    """Ten massive links (hinges alternately about y and z, links along x), actuated at the first, a site
+    at the tip: the tip's twist spans 4 directions over the 9 locked swings (it never turns about x), so
+    the output body alone would leave 5 of them idle at any pose; every swing moves a centre of mass, so
+    each is a degree of freedom."""
+    b = mb.Builder("chain")
+    parent = "world"
+    for i in range(10):
+        parent = b.body(
+            f"b{i}",
+            parent=parent,
+            pos=(0.1, 0, 0) if i else (0, 0, 0),
+            joints=[b.hinge(f"j{i}", (0, 0, 1) if i % 2 else (0, 1, 0))],
+            inertial=mb.Inertial(1.0, pos=(0.05, 0, 0), diaginertia=(0.01, 0.01, 0.01)),
+        )
+    b.site("tip", parent, pos=(0.1, 0, 0))
+    b.actuate("j0")
+    m = mb.mobility(b.build())
+    assert (m.total_dof, m.dof, m.idle_dof, m.locked_dof) == (10, 10, 0, 9)

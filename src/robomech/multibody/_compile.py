@@ -33,6 +33,8 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from robomech.spatial import hat
+
 from . import _options as opt
 from ._constraints import Constraints, compile_constraints
 from ._tree import Tree, compile_tree, quat_to_matrix
@@ -245,11 +247,11 @@ def instantaneous_mobility(
     # so a motion that moves one has |J v| ~ L|v|
     whole = sorted(set(_output_bodies(tree)) | {int(b) for r in tb.rr for b in r[:2] if b > 0})
     Jw = J[whole] * np.array([tree.length] * 3 + [1.0] * 3)[:, None]
-    # the watched points' velocities v + ω × p = v - [p]× ω (m per scaled coordinate, of order L as well)
+    # the watched points of the other bodies (m per scaled coordinate, of order L as well)
     on, P = _watched_points(tree, tb, bodies, T[0])
-    z = np.zeros(len(on))
-    Px = np.stack([z, -P[:, 2], P[:, 1], P[:, 2], z, -P[:, 0], -P[:, 1], P[:, 0], z], -1).reshape(-1, 3, 3)
-    Jp = J[on, 3:] - Px @ J[on, :3]
+    free = ~np.isin(on, whole)  # a point of a body whose whole twist is watched adds nothing
+    on, P = on[free], P[free]
+    Jp = J[on, 3:] - hat(P) @ J[on, :3]  # v + ω × p = v - [p]× ω
     moved = np.concatenate([Jw.reshape(-1, nv), Jp.reshape(-1, nv)])
     idle = locked.shape[1] - _rank(moved @ locked, tree.length)
     return Instantaneous(K=K, kmax=kmax, rank=rank, N=N, locked=locked, idle=int(idle), T=T[0], S=S[0])
