@@ -11,7 +11,8 @@ length ``L`` (so that ranks are unit-consistent):
   as a point of its body and of its parent; both anchors of every point closure; the centre of mass of
   every body with mass) — e.g. a massless S–S link, or one with its centre of mass on its axis,
   spinning about the line through its two ball centres.  Those points are fixed in their bodies, so
-  the count does not change where an output loses rank (a passive chain hanging straight);
+  the count does not hinge on the outputs' twists: a passive chain hanging straight, where its tip
+  loses a rank, or a chain of more links than its tip has twist directions, counts a DOF per link;
 * ``dof = total_dof - idle_dof``: the mechanism's degrees of freedom (the Delta's 3, Bennett's 1);
 * ``gruebler_kutzbach = nv - sum c_i`` (the spatial count ``6(n - 1) - sum (6 - f)`` for the tree plus
   a cut joint of ``c`` equations per closure: 3 point, 5 revolute (or two point closures between the
