@@ -312,14 +312,14 @@ REFERENCE_MECHS = ("four_bar", "bennett", "planar_3rrr", "delta", "rps_3", "stew
 @pytest.mark.parametrize("name", REFERENCE_MECHS)
 def test_reference_rank_equals_numpy(name):
     """The compile step's reference rank (``_compile.instantaneous_mobility`` on the kernels: K and the
-    output bodies' space Jacobians) against the same computation on the numpy formulation."""
+    bodies' space Jacobians) against the same computation on the numpy formulation."""
     from robomech.multibody._compile import compile_model, instantaneous_mobility
 
     mech = mb.gallery.load(name) if name in mb.gallery.NAMES else _get(name)
     model = compile_model(mech)
-    got = instantaneous_mobility(mech.tree, model.tables, model.q_ref[None])
+    got = instantaneous_mobility(mech.tree, model.tables, model.q_ref[None], model.bodies)
     with numpy_reference():
-        ref = instantaneous_mobility(mech.tree, model, model.q_ref[None])
+        ref = instantaneous_mobility(mech.tree, model, model.q_ref[None], model.bodies)
     assert (got.rank, got.idle, got.locked.shape[1]) == (ref.rank, ref.idle, ref.locked.shape[1])
     assert (model.dof, model.idle_dof) == (mech.nv - got.rank - got.idle, got.idle)
     _close(got.K, ref.K, CONSTRAINT_RTOL, "scaled K")

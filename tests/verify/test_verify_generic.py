@@ -136,16 +136,15 @@ def test_passive_and_underactuated_descriptions_are_verified(case):
     assert "virtual actuators on " + ", ".join(added) in checks[0].detail
 
 
-# Three links hanging straight down (the reference): there the tip's velocity along the chain and the
-# motion that keeps the tip still to first order leave one locked motion that moves no site, so the
-# reference mobility of the passive description counts 2 DOF + 1 idle, while with two joints actuated
-# the third moves the tip and the DOF is 3.
+# Three links hanging straight down (the reference): there the tip's twist has rank 2 over the three
+# swings, so a rule watching the tip alone would count 2 DOF + 1 idle; each swing moves a joint anchor or
+# a centre of mass, so the passive description counts 3 DOF and all three joints need an actuator.
 TRIPLE_PENDULUM = (Path(__file__).parents[1] / "multibody" / "data" / "triple_pendulum.xml").read_text()
 
 
 def test_a_passive_chain_straight_at_its_reference_gets_enough_virtual_actuators():
     """The virtual actuators are added until they determine the motion of the mechanism they drive, not
-    only until their number reaches the passive description's reference DOF (2 here, one short)."""
+    only until their number reaches a reference DOF (straight, the tip alone loses a rank)."""
     mech = mb.from_mjcf(TRIPLE_PENDULUM)
     _, added = g._virtually_actuated(mech)
     assert added == ("a1", "a2", "a3")

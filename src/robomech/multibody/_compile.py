@@ -33,6 +33,8 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from robomech.spatial import hat
+
 from . import _options as opt
 from ._constraints import Constraints, compile_constraints
 from ._tree import Tree, compile_tree, quat_to_matrix
@@ -177,6 +179,28 @@ def _output_bodies(tree: Tree) -> list[int]:
     return list(range(1, len(tree.body_names)))
 
 
+def _watched_points(
+    tree: Tree, tables: Tables, bodies: Bodies, T: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The points an idle motion must leave still, at body poses ``T (nb, 4, 4)``: the body each moves
+    with ``(n,)`` and its world position ``(n, 3)``.
+
+    Every tree joint's anchor, as a point of the joint's body and of its parent (where the body attaches;
+    they differ for slides), both anchors of every point closure (``connect``; a revolute closure's two
+    point pairs, a weld's anchor), and the centre of mass of every body with mass.  The sites move with
+    the output bodies, whose whole twists are watched (:func:`_output_bodies`).
+    """
+    jb = tree.jnt_body.astype(np.int64)
+    heavy = bodies.mass > 0
+    # (body the point moves with, body whose frame gives it, its position in that frame)
+    on = np.concatenate([jb, tree.parent[jb], tables.pp[:, 0], tables.pp[:, 1], bodies.idx[heavy]])
+    frame = np.concatenate([jb, jb, tables.pp[:, 0], tables.pp[:, 1], bodies.idx[heavy]])
+    x = np.concatenate([tree.jnt_pos, tree.jnt_pos, tables.px[:, 0], tables.px[:, 1], bodies.com[heavy]])
+    keep = on > 0  # a point of the world never moves
+    on, frame, x = on[keep].astype(np.int64), frame[keep], x[keep]
+    return on, np.einsum("nij,nj->ni", T[frame, :3, :3], x) + T[frame, :3, 3]
+
+
 @dataclass(frozen=True, eq=False)
 class Instantaneous:
     """The instantaneous mobility at one configuration (unit-scaled constraint Jacobian)."""
@@ -186,16 +210,26 @@ class Instantaneous:
     rank: int
     N: np.ndarray  # (nv, total_dof) orthonormal basis of the admissible motions (scaled coordinates)
     locked: np.ndarray  # admissible motions with every actuated joint locked
-    idle: int  # locked motions that move no output body
+    idle: int  # locked motions that move no output body and none of the watched points
     T: np.ndarray  # (nb, 4, 4) the bodies' world poses at q
     S: np.ndarray  # (nv, 6) the coordinates' space screws at q
 
 
-def instantaneous_mobility(tree: Tree, tables: Tables | Model, q: np.ndarray) -> Instantaneous:
+def instantaneous_mobility(
+    tree: Tree, tables: Tables | Model, q: np.ndarray, bodies: Bodies
+) -> Instantaneous:
     """Rank of the unit-scaled ``K`` at ``q (1, nq)``, admissible and locked motions, idle count
-    (poses, screws and ``K`` from the compiled kernels on ``tables``, or on a compiled model's)."""
+    (poses, screws and ``K`` from the compiled kernels on ``tables``, or on a compiled model's).
+
+    A locked motion (every actuated joint still) is idle when it moves no output body
+    (:func:`_output_bodies`: the twists of the bodies that carry sites, every body without sites),
+    rotates no body held in orientation by a closure (a weld's two bodies), and moves none of the points
+    of :func:`_watched_points` (joint anchors, closure points, centres of mass of bodies with mass): an
+    S-S rod spinning about the line through its two ball centres, with its centre of mass on that line.
+    ``bodies``: the mass tables (:class:`Bodies`) of the description."""
     from ._compiled import compiled_kinematics, compiled_resjac, space_jacobians
 
+    tb = tables.tables if isinstance(tables, Model) else tables
     T, S = compiled_kinematics(tables, q)
     col = np.where(tree.dof_translational, tree.length, 1.0)
     K = compiled_resjac(tables, q, True)[1][0] * col
@@ -205,12 +239,21 @@ def instantaneous_mobility(tree: Tree, tables: Tables | Model, q: np.ndarray) ->
     N = _null(K, nv)
     na = len(tree.act_dof)
     locked = N @ _null(N[tree.act_dof], N.shape[1]) if na else N
-    outs = _output_bodies(tree)
-    # twists per scaled coordinate, angular rows times L: rows of order L, so a motion that moves an
-    # output has |Jout v| ~ L|v|
-    J = space_jacobians(tree.A, S, outs)[0] / col * np.array([tree.length] * 3 + [1.0] * 3)[:, None]
-    Jout = J.reshape(-1, nv)
-    idle = locked.shape[1] - _rank(Jout @ locked, tree.length) if locked.shape[1] else 0
+    if not locked.shape[1]:
+        return Instantaneous(K=K, kmax=kmax, rank=rank, N=N, locked=locked, idle=0, T=T[0], S=S[0])
+    # every body's twist per scaled coordinate (nb, 6, nv), [ω; v] with v at the world origin
+    J = space_jacobians(tree.A, S, range(len(tree.body_names)))[0] / col
+    # whole twists of the output bodies and of the welded ones, angular rows times L: rows of order L,
+    # so a motion that moves one has |J v| ~ L|v|
+    whole = sorted(set(_output_bodies(tree)) | {int(b) for r in tb.rr for b in r[:2] if b > 0})
+    Jw = J[whole] * np.array([tree.length] * 3 + [1.0] * 3)[:, None]
+    # the watched points of the other bodies (m per scaled coordinate, of order L as well)
+    on, P = _watched_points(tree, tb, bodies, T[0])
+    free = ~np.isin(on, whole)  # a point of a body whose whole twist is watched adds nothing
+    on, P = on[free], P[free]
+    Jp = J[on, 3:] - hat(P) @ J[on, :3]  # v + ω × p = v - [p]× ω
+    moved = np.concatenate([Jw.reshape(-1, nv), Jp.reshape(-1, nv)])
+    idle = locked.shape[1] - _rank(moved @ locked, tree.length)
     return Instantaneous(K=K, kmax=kmax, rank=rank, N=N, locked=locked, idle=int(idle), T=T[0], S=S[0])
 
 
@@ -324,7 +367,8 @@ def _compile(mech: Mechanism, tree: Tree | None = None) -> Model:
     # the reference configuration: qpos0, or the assembly nearest to it for a description typed
     # unassembled (a ValueError with the residual if none); the reference rank is taken there
     q_ref = assembled_reference(mech, tree, cs, tables)
-    inst = instantaneous_mobility(tree, tables, q_ref[None])
+    bodies = _bodies(mech)
+    inst = instantaneous_mobility(tree, tables, q_ref[None], bodies)
     total = tree.nv - inst.rank
     dof = total - inst.idle
     # the passive block has full column rank but for the idle motions (computed at the reference, not
@@ -332,7 +376,6 @@ def _compile(mech: Mechanism, tree: Tree | None = None) -> Model:
     # and the idle motions free
     rank0 = len(pas) - inst.idle
     rank_K = tree.nv - dof - inst.idle
-    bodies = _bodies(mech)
     dyn = DynTables(
         bidx=bodies.idx.astype(np.int64),
         mass=np.ascontiguousarray(bodies.mass, dtype=float),

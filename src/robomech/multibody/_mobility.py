@@ -5,8 +5,14 @@ matrix).  With all rotation rows and translational columns scaled to metres by t
 length ``L`` (so that ranks are unit-consistent):
 
 * ``total_dof = nv - rank K``: every instantaneous motion, idle ones included;
-* ``idle_dof``: motions with every actuated joint locked that move no output body (the bodies that
-  carry sites; all bodies if there is none) — e.g. an S–S link spinning about its own axis;
+* ``idle_dof``: motions with every actuated joint locked that move nothing that matters: no output
+  body (the whole twists of the bodies that carry sites; all bodies if there is none), no body a weld
+  holds in orientation, and none of the points that connect or carry mass (every tree joint's anchor,
+  as a point of its body and of its parent; both anchors of every point closure; the centre of mass of
+  every body with mass) — e.g. a massless S–S link, or one with its centre of mass on its axis,
+  spinning about the line through its two ball centres.  Those points are fixed in their bodies, so
+  the count does not hinge on the outputs' twists: a passive chain hanging straight, where its tip
+  loses a rank, or a chain of more links than its tip has twist directions, counts a DOF per link;
 * ``dof = total_dof - idle_dof``: the mechanism's degrees of freedom (the Delta's 3, Bennett's 1);
 * ``gruebler_kutzbach = nv - sum c_i`` (the spatial count ``6(n - 1) - sum (6 - f)`` for the tree plus
   a cut joint of ``c`` equations per closure: 3 point, 5 revolute (or two point closures between the
@@ -54,12 +60,12 @@ class MobilityReport:
     Attributes
     ----------
     dof : int
-        Degrees of freedom: admissible motions that move an output (a site's body, or any body
-        without sites), idle motions excluded.
+        Degrees of freedom: ``total_dof - idle_dof``, the admissible motions without the idle ones.
     total_dof : int
         ``nv - rank``: every instantaneous admissible motion, idle motions included.
     idle_dof : int
-        Motions that move no output with every actuated joint locked (a leg spinning about its axis).
+        Motions with every actuated joint locked that move no output, turn no welded body and move no
+        joint anchor, closure point or centre of mass (an S–S leg spinning about its axis).
     locked_dof : int
         Motions left with every actuated joint locked (idle plus uncontrolled).
     redundant_constraints : int
@@ -224,7 +230,7 @@ def mobility(mech: Mechanism, q: ArrayLike | None = None, *, platform: str | Non
         raise ValueError(f"Expected q to have shape ({mech.nq},) (one configuration), got {q.shape}.")
     q = q[None]
     model = compile_model(mech)
-    inst = instantaneous_mobility(tree, model, q)
+    inst = instantaneous_mobility(tree, model, q, model.bodies)
     K, kmax, rank, N = inst.K, inst.kmax, inst.rank, inst.N
     locked, idle = inst.locked, inst.idle
     nv = K.shape[1]
