@@ -206,6 +206,14 @@ def test_a_floating_joint_is_a_free_base_not_an_actuator():
         _load(FLOATING, actuated=["float"])
 
 
+def test_a_root_link_named_world_is_no_platform():
+    """The URDF's root link ``world`` is a site on the world body; the default platform of ``mobility`` is
+    the first site's body that moves (here ``base``), not the world (which moves with no DOF)."""
+    m = mb.mobility(_load(FLOATING))
+    assert _load(FLOATING).sites[0].body == "world"  # control: the first site is the world's
+    assert m.platform == "base" and m.platform_dof == 6
+
+
 def test_from_mjcf_refuses_urdf():
     with pytest.raises(ValueError, match="from_urdf"):
         mb.from_mjcf(GRIPPER)

@@ -192,9 +192,9 @@ def _cut_constraints(mech: Mechanism) -> int:
 def mobility(mech: Mechanism, q: ArrayLike | None = None, *, platform: str | None = None) -> MobilityReport:
     """Mobility at one assembled configuration ``q (nq,)`` (default the reference configuration).
 
-    ``platform`` (a body name; default the body of the first site, if any) adds the platform's twist
-    system, and the screw-theory analysis of :mod:`robomech.analysis.mobility` when the platform is
-    carried by serial legs.
+    ``platform`` (a body name; default the body of the first site not on the world, if any) adds the
+    platform's twist system, and the screw-theory analysis of :mod:`robomech.analysis.mobility` when the
+    platform is carried by serial legs.
 
     Parameters
     ----------
@@ -255,8 +255,9 @@ def mobility(mech: Mechanism, q: ArrayLike | None = None, *, platform: str | Non
         Kn = _scaled_K(mech, qn)  # one batched evaluation for every neighbour
         nearby = [_rank(Kn[k], kmax) for k in range(Kn.shape[0])]
     singular = any(r != rank for r in nearby)
-    if platform is None and len(tree.site_names):
-        platform = tree.body_names[tree.site_body[0]]
+    moving_sites = [int(b) for b in tree.site_body if b != 0]  # a site on the world is no platform
+    if platform is None and moving_sites:
+        platform = tree.body_names[moving_sites[0]]
     p_dof = p_rot = p_tw = sm = None
     if platform is not None:
         pb = tree.body_index(platform)
