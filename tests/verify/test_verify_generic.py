@@ -12,7 +12,7 @@ import pytest
 from robomech import multibody as mb
 from robomech.cli import main
 from robomech.verify import _generic as g
-from robomech.verify._core import Check, Tolerance, VerificationReport
+from robomech.verify._core import Check, Tolerance, VerificationReport, dumps_json
 from robomech.verify._mujoco import assemble_along
 
 FAST = ["four_bar", "bennett", "planar_3rrr", "rps_3"]
@@ -289,20 +289,25 @@ def test_a_wrong_description_still_fails_before_the_crossing(wrong, monkeypatch)
     assert drift.passed  # the wrong description's own energy is conserved: only the comparison sees it
 
 
-def test_a_crossing_too_early_is_inconclusive():
-    """Started 5 ms before the crossing, 0.3 s asked: 3 ms are left to compare, less than
-    MIN_COMPARED_FRACTION of the duration: both rows inconclusive (neither passed nor failed), the
-    report passes and says so."""
+@pytest.mark.parametrize("before", [5.2e-3, 1e-3])
+def test_a_crossing_too_early_is_inconclusive(before):
+    """Started 5.2 ms (or 1 ms) before the crossing, 0.3 s asked: 3.2 ms (or nothing, the margin being
+    2 ms) are left to compare, less than MIN_COMPARED_FRACTION of the duration: both rows inconclusive
+    (neither passed nor failed; no error where nothing was compared), the report passes and says so."""
     mech = mb.from_mjcf(AGILE_EYE)
     _, mo = g.driven_motion(mech, "agile eye")
     fall = g._fall(mech, mo.q[0], g._sample_times(0.3), qd_act0=mo.qda[0])
     k = int(np.searchsorted(fall.t, 0.28))
-    checks = g._simulation_checks(mech, "agile eye", fall.q[k], qd0=fall.qd[k])
+    start = mb.simulate(mech, fall.q[k], t=[0.28, fall.crossing - before], qd0=fall.qd[k])
+    checks = g._simulation_checks(mech, "agile eye", start.q[-1], qd0=start.qd[-1])
     assert [c.status for c in checks] == ["inconclusive", "inconclusive"]
     assert not any(c.passed or c.failed for c in checks)
-    assert "type II singularity at t = 0.005" in checks[0].note and "inconclusive" in checks[0].note
+    assert f"type II singularity at t = {before:.2g}" in checks[0].note, checks[0].note
+    assert "inconclusive" in checks[0].note
+    assert np.isfinite(checks[0].max_error) == (before > g.CROSSING_MARGIN)
     report = VerificationReport(checks)
     assert report.passed and report.table().endswith("0 passed, 0 failed, 2 inconclusive")
+    assert [c["status"] for c in json.loads(dumps_json(report.as_dict()))["checks"]] == ["inconclusive"] * 2
 
 
 def test_closure_rows_of_an_open_chain_are_not_applicable(tmp_path, capsys):

@@ -780,9 +780,10 @@ def _simulation_checks(mech, name, q0, qd_act0=None, duration: float = T_SIM, *,
     note, verdict = "", ""
     if fall.crossing is not None:
         t_end = np.floor((fall.crossing - CROSSING_MARGIN) / SIM_TIMESTEP) * SIM_TIMESTEP
+        where = f"[0, {t_end:.4g}] s" if t_end > t[0] else "nothing"
         note = (
             f"the motion reaches a type II singularity at t = {fall.crossing:.4g} s, where it is not "
-            f"determined: compared on [0, {max(t_end, 0.0):.4g}] s, {CROSSING_MARGIN * 1e3:g} ms before it"
+            f"determined: compared on {where}, {CROSSING_MARGIN * 1e3:g} ms before it"
         )
         if t_end < MIN_COMPARED_FRACTION * duration:
             verdict = "inconclusive"
