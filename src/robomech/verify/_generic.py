@@ -17,9 +17,9 @@ multibody layer with the engine's *own* computations along a smooth trajectory o
   ``mj_energyVel``), differentiated along the trajectory by a five-point stencil;
 * forward simulation: :func:`~robomech.multibody.simulate` from the trajectory's first state, passive
   (gravity only), against MuJoCo's RK4 integration with stiff equality constraints; and the energy
-  drift of the multibody simulation.  A fall that reaches a type II singularity (where the motion is
-  not determined) stops there and both are judged up to CROSSING_MARGIN before it, the crossing named
-  in their note (:func:`_fall`).
+  drift of the multibody simulation.  A fall that reaches a constraint singularity (where the
+  motion is not determined) stops there and both are judged up to CROSSING_MARGIN before it, the
+  crossing named in their note (:func:`_fall`).
 
 An open chain's closure and admissible-velocity rows are 0 by construction: they are reported
 ``n/a`` (:attr:`Check.verdict <robomech.verify.Check.verdict>`), neither passed nor failed.
@@ -84,18 +84,21 @@ T_SIM = 0.3
 MAX_SIM_DURATION = 10.0
 # Samples compared along the simulation.
 SIM_SAMPLES = 31
-# A passive block whose smallest singular value is below this fraction of L is at a type II singularity.
+# A constraint Jacobian whose rank-th singular value (m, _closure_sigma) is below this fraction of L is
+# at a constraint singularity.
 SINGULAR_SIGMA_RTOL = 1e-6
-# A passive motion that reaches a type II singularity is not determined there (both codes' motions
-# diverge after it): the fall is walked sample by sample with the passive block's sigma_min at each
-# state, and while sigma_min falls each step covers at most APPROACH_FRACTION of the time it takes, at
-# its current rate, to reach 0 (the steps shrink geometrically: ~25 reach SINGULAR_SIGMA_RTOL L from a
-# sample 10 ms away, each a short integration, so the motion stops at the crossing instead of being
-# integrated slowly through it).  MAX_APPROACH_STEPS bounds the extra steps of one fall.
+# A passive motion that reaches a constraint singularity (K loses rank: a change point, where branches
+# meet) is not determined there (both codes' motions diverge after it; a type II singularity alone,
+# where only the passive block of K loses rank, leaves a passive fall determined): the fall is walked
+# sample by sample with K's sigma at each state, and while sigma falls each step covers at most
+# APPROACH_FRACTION of the time it takes, at its current rate, to reach 0 (the steps shrink
+# geometrically: ~25 reach SINGULAR_SIGMA_RTOL L from a sample 10 ms away, each a short integration,
+# so the motion stops at the crossing instead of being integrated slowly through it).
+# MAX_APPROACH_STEPS bounds the extra steps of one fall.
 APPROACH_FRACTION = 0.5
 MAX_APPROACH_STEPS = 200
 # The comparison with the engine ends CROSSING_MARGIN before a crossing: four time constants of the
-# engine's soft equality constraints (SIM_SOLREF, 0.5 ms), whose lag grows as sigma_min falls.  On the
+# engine's soft equality constraints (SIM_SOLREF, 0.5 ms), whose lag grows as sigma falls.  On the
 # Agile-Eye-type wrist (crossing at 0.2852 s) the engine agrees to 3.8e-7 relative 2 ms before it,
 # 5e-6 at 0.2 ms.
 CROSSING_MARGIN = 2e-3
@@ -622,20 +625,26 @@ def _power_check(mech, name, eng, at, t, q, tau, qd_act) -> Check:
     return Check(name, "power balance tau.qd = dE/dt (engine energy)", _rel(err, scale), TOL_POWER, "")
 
 
-def _smallest_sigma(mech, q: np.ndarray, full_rank: int) -> np.ndarray:
-    """Smallest singular value of the passive block of K (m) at each ``q``; 0 where its rank drops."""
+def _closure_sigma(mech, q: np.ndarray, rank: int) -> np.ndarray:
+    """The ``rank``-th singular value (m) of the constraint Jacobian K at each ``q (n, nq)`` (slide
+    columns times L, so that every entry is a length), ``rank`` its rank at a regular configuration:
+    0 at a constraint singularity, where K loses rank and a passive motion (no actuator holding any
+    joint) is not determined.  (A type II singularity alone, the passive block of K losing rank with K
+    keeping its own, leaves a passive fall determined: MuJoCo and robomech follow it through.)"""
     from robomech import multibody as mb
 
-    inf = mb.influence(mech, q, second_order=False)
-    return np.where(inf.passive_rank < full_rank, 0.0, inf.sigma_min)
+    tree = mech.tree
+    K = mb.constraint_jacobian(mech, q) * np.where(tree.dof_translational, tree.length, 1.0)
+    return np.linalg.svd(K, compute_uv=False)[..., rank - 1]
 
 
 @dataclasses.dataclass(frozen=True)
 class _Fall:
     """A passive fall walked by :func:`_fall`: the states ``q, qd`` and energies ``kinetic, potential``
     at the output times ``t`` reached; every state visited (output times and the steps approaching a
-    singularity) as ``seen_t`` with the passive block's ``seen_sigma`` (m; empty without passive
-    coordinates); ``crossing`` the time a type II singularity was reached (None: none) and ``success``
+    singularity) as ``seen_t`` with the constraint Jacobian's ``seen_sigma`` (m, :func:`_closure_sigma`;
+    empty without constraints); ``crossing`` the time a constraint singularity was reached (None:
+    none) and ``success``
     False where the integration failed after the last time in ``t``."""
 
     t: np.ndarray
@@ -660,28 +669,27 @@ class _Fall:
 def _fall(mech, q0, t: np.ndarray, qd_act0=None, qd0=None) -> _Fall:
     """The passive motion from ``q0`` with the actuated rates ``qd_act0`` or every rate ``qd0`` to the
     output times ``t``, walked one sample interval at a time (:func:`multibody.simulate` from the state
-    reached, which it projects onto the manifold at each output time anyway), with the passive block's
-    sigma_min at every state (the first step is one engine step long, for sigma_min's first rate).
-    While sigma_min falls, a step covers at most APPROACH_FRACTION of the time it takes to reach 0 at
-    its current rate; the walk stops at a type II singularity (sigma_min below SINGULAR_SIGMA_RTOL L),
-    where the motion is not determined."""
+    reached, which it projects onto the manifold at each output time anyway), with the constraint
+    Jacobian's sigma (:func:`_closure_sigma`) at every state (the first step is one engine step long,
+    for sigma's first rate).  While sigma falls, a step covers at most APPROACH_FRACTION of the time it
+    takes to reach 0 at its current rate; the walk stops at a constraint singularity (sigma below
+    SINGULAR_SIGMA_RTOL L), where the passive motion is not determined."""
     from robomech import multibody as mb
 
-    inf = mb.influence(mech, np.asarray(q0, float), second_order=False)
-    watch = bool(inf.n_passive)
-    full = int(inf.passive_rank) if watch else 0
+    full = int(mb.mobility(mech, np.asarray(q0, float)).rank)  # K's rank at the (regular) start
+    watch = full > 0
     floor = SINGULAR_SIGMA_RTOL * mech.tree.length
     kw = {"qd0": qd0} if qd_act0 is None else {"qd_act0": qd_act0}
     out: list[tuple[np.ndarray, ...]] = []  # (q, qd, T, U) at each output time reached
     seen_t: list[float] = []
     seen_s: list[float] = []
     q, now, k, extra, crossing, ok = np.asarray(q0, float), float(t[0]), 1, 0, None, True
-    if watch and float(_smallest_sigma(mech, q[None], full)[0]) < floor:  # starts at the singularity
+    if watch and float(_closure_sigma(mech, q[None], full)[0]) < floor:  # starts at the singularity
         nan = np.full(1, np.nan)
         return _Fall(t[:1], q[None], np.zeros((1, mech.nv)), nan, nan, t[:1], np.zeros(1), float(t[0]), True)
     while k < len(t):
         end = float(t[k])
-        if watch and len(seen_s) < 2:  # a first step of one engine step gives sigma_min's first rate
+        if watch and len(seen_s) < 2:  # a first step of one engine step gives sigma's first rate
             end = min(end, now + SIM_TIMESTEP)
         elif watch and seen_s[-1] < seen_s[-2] and extra < MAX_APPROACH_STEPS:
             rate = (seen_s[-1] - seen_s[-2]) / (seen_t[-1] - seen_t[-2])
@@ -694,7 +702,7 @@ def _fall(mech, q0, t: np.ndarray, qd_act0=None, qd0=None) -> _Fall:
             out.append((sim.q[0], sim.qd[0], sim.kinetic[0], sim.potential[0]))
             if watch:
                 seen_t.append(now)
-                seen_s.append(float(_smallest_sigma(mech, sim.q[:1], full)[0]))
+                seen_s.append(float(_closure_sigma(mech, sim.q[:1], full)[0]))
         if not bool(sim.success):
             ok = False
             break
@@ -706,7 +714,7 @@ def _fall(mech, q0, t: np.ndarray, qd_act0=None, qd0=None) -> _Fall:
             extra += 1
         if watch:
             seen_t.append(now)
-            seen_s.append(float(_smallest_sigma(mech, sim.q[-1:], full)[0]))
+            seen_s.append(float(_closure_sigma(mech, sim.q[-1:], full)[0]))
             if seen_s[-1] < floor:
                 crossing = now
                 break
@@ -734,10 +742,10 @@ def _cut(mech, fall: _Fall, t_end: float, kw: dict) -> _Fall:
 
 
 def _why(mech, t: np.ndarray, q: np.ndarray, off: np.ndarray, seen=None) -> str:
-    """Why a simulation disagrees: when it first left the engine, and the type II singularity it crossed
-    or came closest to before (smallest singular value of the passive block of K, in m, from
-    :func:`multibody.influence`) among the states the simulation visited: ``seen = (times, sigma)``
-    (the walk of :func:`_fall`, nothing simulated again), or the samples ``t, q`` themselves."""
+    """Why a simulation disagrees: when it first left the engine, and the constraint singularity it
+    crossed or came closest to before (:func:`_closure_sigma`, m) among the states the simulation
+    visited: ``seen = (times, sigma)`` (the walk of :func:`_fall`, nothing simulated again), or the
+    samples ``t, q`` themselves."""
     from robomech import multibody as mb
 
     words = []
@@ -746,11 +754,10 @@ def _why(mech, t: np.ndarray, q: np.ndarray, off: np.ndarray, seen=None) -> str:
         end = float(t[int(np.argmax(off))])
         words.append(f"diverged from the engine after t = {end:.3g} s")
     if seen is None:
-        inf = mb.influence(mech, q, second_order=False)
-        if not inf.n_passive:
+        rank = int(mb.mobility(mech, q[0]).rank)
+        if not rank:
             return "; ".join(words)
-        full = int(inf.passive_rank.max(initial=0))
-        seen = (np.asarray(t), np.where(inf.passive_rank < full, 0.0, inf.sigma_min))
+        seen = (np.asarray(t), _closure_sigma(mech, q, rank))
     times, sigma = (np.asarray(a, float) for a in seen)
     before = times <= end + 0.5 * SIM_TIMESTEP
     if not before.any():
@@ -758,18 +765,18 @@ def _why(mech, t: np.ndarray, q: np.ndarray, off: np.ndarray, seen=None) -> str:
     times, sigma = times[before], sigma[before]
     j = int(np.argmin(sigma))
     kind = (
-        "crossed a type II singularity near"
+        "crossed a constraint singularity near"
         if sigma[j] < SINGULAR_SIGMA_RTOL * mech.tree.length
-        else ("closest to a type II singularity at")
+        else ("closest to a constraint singularity at")
     )
-    words.append(f"{kind} t = {times[j]:.4g} s (sigma_min {sigma[j]:.1e} m)")
+    words.append(f"{kind} t = {times[j]:.4g} s (sigma {sigma[j]:.1e} m)")
     return "; ".join(words)
 
 
 def _simulation_checks(mech, name, q0, qd_act0=None, duration: float = T_SIM, *, qd0=None) -> list[Check]:
     """The passive simulation from ``q0`` with the actuated rates ``qd_act0`` or every rate ``qd0``
     against the engine's, and the energy drift of the multibody simulation; where the motion reaches a
-    type II singularity (:func:`_fall`), both on the interval ending CROSSING_MARGIN before it, the
+    constraint singularity (:func:`_fall`), both on the interval ending CROSSING_MARGIN before it, the
     crossing named in the checks' note (inconclusive when that interval is shorter than
     MIN_COMPARED_FRACTION of ``duration``)."""
     from robomech import multibody as mb
@@ -782,8 +789,9 @@ def _simulation_checks(mech, name, q0, qd_act0=None, duration: float = T_SIM, *,
         t_end = np.floor((fall.crossing - CROSSING_MARGIN) / SIM_TIMESTEP) * SIM_TIMESTEP
         where = f"[0, {t_end:.4g}] s" if t_end > t[0] else "nothing"
         note = (
-            f"the motion reaches a type II singularity at t = {fall.crossing:.4g} s, where it is not "
-            f"determined: compared on {where}, {CROSSING_MARGIN * 1e3:g} ms before it"
+            f"the motion reaches a constraint singularity (its closure's Jacobian loses rank) at t = "
+            f"{fall.crossing:.4g} s, where it is not determined: compared on {where}, "
+            f"{CROSSING_MARGIN * 1e3:g} ms before it"
         )
         if t_end < MIN_COMPARED_FRACTION * duration:
             verdict = "inconclusive"
