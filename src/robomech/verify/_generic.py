@@ -22,7 +22,7 @@ multibody layer with the engine's *own* computations along a smooth trajectory o
   crossing named in their note (:func:`_fall`).
 
 An open chain's closure and admissible-velocity rows are 0 by construction: they are reported
-``n/a`` (:attr:`Check.verdict <robomech.verify.Check.verdict>`), neither passed nor failed.
+``n/a`` (``Check.verdict``), neither passed nor failed.
 
 A floating base (no hinge/slide joints determine its state) gets, at random states, its generalized
 forces (``mj_rne``), mass matrix (``mj_fullM``) and, for a tree, forward dynamics under actuator forces
