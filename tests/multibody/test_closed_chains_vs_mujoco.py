@@ -11,6 +11,8 @@ Batches of 1 and 300, and the batch of 300 equal to its samples one at a time.""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -47,32 +49,7 @@ FIVE_BAR = f"""<mujoco model="five_bar_typed_along_x">
 </mujoco>"""
 
 # Agile-Eye type: every axis through the origin; leg i: base axis e_i, elbow e_(i+1), platform e_(i+2)
-AGILE_EYE = """<mujoco model="agile_eye">
-  <option gravity="0.5 -1.0 -9.81"/>
-  <worldbody>
-    <body name="prox1"><joint name="a1" axis="1 0 0"/>
-      <inertial pos="0.05 0.05 0" mass="0.3" diaginertia="0.001 0.0012 0.0011"/>
-      <body name="dist1"><joint name="b1" axis="0 1 0"/>
-        <inertial pos="0 0.05 0.05" mass="0.2" diaginertia="0.0008 0.0007 0.0009"/>
-        <body name="platform"><joint name="c1" axis="0 0 1"/>
-          <inertial pos="0.03 0.03 0.06" mass="0.5" fullinertia="0.002 0.0022 0.0018 0.0001 0 0.0002"/>
-          <site name="camera" pos="0.04 0.04 0.08"/>
-          <site name="v2" pos="0.1 0 0"/><site name="v3" pos="0 0.1 0"/>
-        </body></body></body>
-    <body name="prox2"><joint name="a2" axis="0 1 0"/>
-      <inertial pos="0 0.05 0.05" mass="0.3" diaginertia="0.001 0.0012 0.0011"/>
-      <body name="dist2"><joint name="b2" axis="0 0 1"/>
-        <inertial pos="0.05 0 0.05" mass="0.2" diaginertia="0.0008 0.0007 0.0009"/>
-        <site name="w2" pos="0.1 0 0"/></body></body>
-    <body name="prox3"><joint name="a3" axis="0 0 1"/>
-      <inertial pos="0.05 0 0.05" mass="0.3" diaginertia="0.001 0.0012 0.0011"/>
-      <body name="dist3"><joint name="b3" axis="1 0 0"/>
-        <inertial pos="0.05 0.05 0" mass="0.2" diaginertia="0.0008 0.0007 0.0009"/>
-        <site name="w3" pos="0 0.1 0"/></body></body>
-  </worldbody>
-  <equality><connect site1="w2" site2="v2"/><connect site1="w3" site2="v3"/></equality>
-  <actuator><motor joint="a1"/><motor joint="a2"/><motor joint="a3"/></actuator>
-</mujoco>"""
+AGILE_EYE = (Path(__file__).parent / "data" / "agile_eye.xml").read_text()  # robomech verify reads it too
 
 
 def _sarrus(a: float = 0.3, b: float = 0.25, alpha: float = np.deg2rad(40)) -> str:

@@ -134,11 +134,15 @@ def test_index_is_rebuilt_from_every_results_json_and_shows_verification(tmp_pat
     assert "[other](other/report.md)" in index and "[demo](demo/report.md)" in index
     assert "spherical-leg" in index and "not reproduced yet" in index
 
-    v = Verification("demo", "D", "none", run=lambda: [Check("demo", "x", 0.0, Tolerance(1e-3, "t"))])
+    rows = [
+        Check("demo", "x", 0.0, Tolerance(1e-3, "t")),
+        Check("demo", "y", 0.0, Tolerance(1e-3, "t"), verdict="n/a"),
+    ]
+    v = Verification("demo", "D", "none", run=lambda: rows)
     monkeypatch.setattr(verify, "available_verifications", lambda: {"demo": v})
     assert main(["verify", "--out", str(tmp_path), "--quiet"]) == 0
     assert (tmp_path / "verification.json").exists()
     row = next(line for line in (tmp_path / "index.md").read_text().splitlines() if "[demo]" in line)
-    assert "pass (1 checks)" in row
+    assert "pass (2 checks, 1 n/a)" in row  # an n/a row is counted, not failed
     html = (tmp_path / "index.html").read_text()
     assert 'href="demo/report.html"' in html and "<table>" in html

@@ -87,9 +87,26 @@ def test_checks_round_trip_through_columns():
     checks = [
         Check("m", "q (rel)", 1.2345678901234567e-15, Tolerance(1e-9, "rounding", relative=True), "n = 3"),
         Check("m", "p", float("inf"), Tolerance(2.0, "why")),
+        Check("m", "closure", 0.0, Tolerance(1e-9, "why"), "", "n/a", "0 by construction"),
+        Check("m", "fall", 1e-7, Tolerance(1e-3, "why"), "d", "inconclusive", "crossed early"),
     ]
     assert checks_from_arrays(checks_to_arrays(checks)) == checks
     assert checks_from_arrays(checks_to_arrays([])) == []
+    older = {k: v for k, v in checks_to_arrays(checks[:2]).items() if k not in ("verdict", "note")}
+    assert checks_from_arrays(older) == checks[:2]  # a store written before verdicts reads as judged
+
+
+def test_a_check_states_its_verdict():
+    """n/a and inconclusive are neither passed nor failed; anything else is refused."""
+    tol = Tolerance(1e-9, "why")
+    assert [Check("m", "q", 0.0, tol, verdict=v).status for v in ("", "n/a", "inconclusive")] == [
+        "pass",
+        "n/a",
+        "inconclusive",
+    ]
+    assert Check("m", "q", 1.0, tol).failed and not Check("m", "q", 1.0, tol, verdict="n/a").failed
+    with pytest.raises(ValueError, match="verdict"):
+        Check("m", "q", 0.0, tol, verdict="skipped")
 
 
 def test_bad_input_is_refused():

@@ -12,7 +12,7 @@ import pytest
 from robomech import multibody as mb
 from robomech.cli import main
 from robomech.verify import _generic as g
-from robomech.verify._core import Tolerance
+from robomech.verify._core import Check, Tolerance, VerificationReport, dumps_json
 from robomech.verify._mujoco import assemble_along
 
 FAST = ["four_bar", "bennett", "planar_3rrr", "rps_3"]
@@ -132,7 +132,7 @@ def test_passive_and_underactuated_descriptions_are_verified(case):
     if expect is not None:
         assert added == expect
     checks = g.check_mechanism(mech, case, simulate=case != "underactuated stewart")
-    assert all(c.passed for c in checks), [(c.quantity, c.max_error) for c in checks if not c.passed]
+    assert not any(c.failed for c in checks), [(c.quantity, c.max_error) for c in checks if c.failed]
     assert "virtual actuators on " + ", ".join(added) in checks[0].detail
 
 
@@ -149,18 +149,28 @@ def test_a_passive_chain_straight_at_its_reference_gets_enough_virtual_actuators
     _, added = g._virtually_actuated(mech)
     assert added == ("a1", "a2", "a3")
     checks = g.check_mechanism(mech, "triple pendulum", simulate=False)
-    assert all(c.passed for c in checks), [(c.quantity, c.max_error) for c in checks if not c.passed]
+    assert not any(c.failed for c in checks), [(c.quantity, c.max_error) for c in checks if c.failed]
 
 
 def test_a_failing_simulation_is_explained_once(monkeypatch):
-    """When both the simulation and its energy drift fail, the explanation (which re-simulates the motion
-    around each approach to a singularity: minutes near one) is computed once and given to both."""
+    """When both the simulation and its energy drift fail, the explanation is computed once and given to
+    both, from the states the simulation visited (nothing is simulated again)."""
     mech = mb.from_mjcf(PENDULUM)
     monkeypatch.setattr(g, "TOL_SIM", Tolerance(1e-300, "impossible: forces a failure", relative=True))
     monkeypatch.setattr(g, "TOL_DRIFT", Tolerance(1e-300, "impossible: forces a failure", relative=True))
     calls = []
     real = g._why
-    monkeypatch.setattr(g, "_why", lambda *a, **k: calls.append(1) or real(*a, **k))
+    simulate = mb.simulate
+
+    def why(*a, **k):
+        calls.append(1)
+        monkeypatch.setattr(mb, "simulate", None)  # the explanation must not simulate
+        try:
+            return real(*a, **k)
+        finally:
+            monkeypatch.setattr(mb, "simulate", simulate)
+
+    monkeypatch.setattr(g, "_why", why)
     driven, _ = g._virtually_actuated(mech)  # as check_mechanism calls it
     checks = g._simulation_checks(driven, "pendulum", mech.q0, qd0=np.array([0.5, -0.3]))
     assert [c.passed for c in checks] == [False, False]
@@ -198,21 +208,146 @@ PARALLELOGRAM = """<mujoco model="parallelogram"><compiler angle="radian"/><opti
 <equality><connect body1="coupler" body2="rocker" anchor="1 0 0"/></equality></mujoco>"""
 
 
-@pytest.mark.slow
-def test_a_passive_fall_through_a_singular_pose_says_where_it_crossed():
-    """The fall leaves the engine after the second change point (crank at 3 pi / 2, t ~ 0.694 s, between
-    two samples 33 ms apart); the failed check names the crossing, resolved between the samples."""
+def test_a_passive_fall_through_a_change_point_is_compared_up_to_it():
+    """The parallelogram reaches its first change point (crank horizontal, every link collinear: the
+    anti-parallelogram branch meets this one and K loses rank) at t ~ 0.243 s; past
+    it the motion may follow either branch (the multibody fall switches at the second pass, 0.694 s).
+    The simulation rows are compared up to it, pass, and name it; the walk stops where the geometry
+    says (crank angle pi / 2 to 1e-6 rad: sigma falls linearly to below SINGULAR_SIGMA_RTOL L)."""
     mech = mb.from_mjcf(PARALLELOGRAM)
     checks = g.check_mechanism(mech, "parallelogram", duration=1.0, q0=[1.0, -1.0, 1.0])
-    sim = next(c for c in checks if c.quantity.startswith("forward simulation"))
-    assert not sim.passed
-    assert "crossed a type II singularity near t = 0.69" in sim.detail, sim.detail
-    sigma = float(sim.detail.rsplit("sigma_min ", 1)[1].split()[0])
-    assert sigma < g.SINGULAR_SIGMA_RTOL * mech.tree.length
-    # The rest of the description is right.  The energy drift of a fall through a type II singularity sits
-    # at the integrator's tolerance (2e-7 relative against 1e-7 with the compiled forward dynamics, 9e-8
-    # with the former numpy path, whose accelerations agree to 1e-13): where it fails, it must name the same
-    # crossing.
-    drift = next(c for c in checks if c.quantity.startswith("energy drift"))
-    assert drift.passed or "crossed a type II singularity near t = 0.69" in drift.detail, drift.detail
-    assert all(c.passed for c in checks if c is not sim and c is not drift)
+    assert all(c.passed for c in checks), [
+        (c.quantity, c.max_error, c.detail) for c in checks if not c.passed
+    ]
+    for c in _sim_rows(checks):
+        assert "constraint singularity (its closure's Jacobian loses rank) at t = 0.24" in c.note, c.note
+    driven, _ = g._virtually_actuated(mech)
+    fall = g._fall(driven, np.array([1.0, -1.0, 1.0]), g._sample_times(1.0), qd0=np.zeros(3))
+    assert fall.crossing is not None and 0.24 < fall.crossing < 0.25
+    crank = driven.tree.jnt_qadr[driven.tree.joint_index("crank")]
+    at = mb.simulate(driven, fall.q[-1], t=[fall.t[-1], fall.crossing], qd0=fall.qd[-1]).q[-1]
+    assert abs(abs(at[crank]) - np.pi / 2) < 1e-6, at[crank]
+
+
+# An Agile-Eye-type 3-RRR spherical wrist (every axis through the origin), falling passively from the
+# test trajectory's first state: it reaches a type II singularity that is also a constraint singularity
+# (the passive block of K and K itself lose rank)
+# at t = 0.2852 s, where robomech's and MuJoCo's motions both diverge (the motion is not determined).
+AGILE_EYE = (Path(__file__).parents[1] / "multibody" / "data" / "agile_eye.xml").read_text()
+
+
+def _sim_rows(checks):
+    return [c for c in checks if c.quantity.startswith(("forward simulation", "energy drift"))]
+
+
+def test_a_fall_through_a_constraint_singularity_is_compared_up_to_it():
+    """The wrist's checks pass; the simulation rows are compared on [0, crossing - CROSSING_MARGIN] and
+    say so (the crossing resolved by the walk to below SINGULAR_SIGMA_RTOL L, not by re-simulating)."""
+    mech = mb.from_mjcf(AGILE_EYE)
+    checks = g.check_mechanism(mech, "agile eye")
+    assert all(c.passed for c in checks), [
+        (c.quantity, c.max_error, c.detail) for c in checks if not c.passed
+    ]
+    for c in _sim_rows(checks):
+        assert "constraint singularity (its closure's Jacobian loses rank) at t = 0.2852 s" in c.note
+        assert "compared on [0, 0.2832] s" in c.note, c.note
+    report = VerificationReport(checks)
+    assert report.table().count("note: the motion reaches a constraint singularity") == 2
+
+
+def _wrist_fall(**change):
+    """The wrist (driven through its own actuators) with the test start, the robomech description
+    changed by ``change`` (dataclasses.replace) while the engine keeps the file's."""
+    mech = mb.from_mjcf(AGILE_EYE)
+    _, mo = g.driven_motion(mech, "agile eye")
+    wrong = dataclasses.replace(mech, **change)
+    return mech, wrong, mo.q[0], mo.qda[0]
+
+
+@pytest.mark.parametrize("wrong", ["platform 5 % heavier", "gravity along -z only"])
+def test_a_wrong_description_still_fails_before_the_crossing(wrong, monkeypatch):
+    """Control: the same fall with the robomech description wrong (one body's mass, or the gravity) and
+    the engine built from the right one fails the comparison before the crossing."""
+    mech = mb.from_mjcf(AGILE_EYE)
+    if wrong.startswith("platform"):
+        bodies = list(mech.bodies)
+        k = next(i for i, b in enumerate(bodies) if b.name == "platform")
+        b = bodies[k]
+        bodies[k] = dataclasses.replace(
+            b, inertial=dataclasses.replace(b.inertial, mass=1.05 * b.inertial.mass)
+        )
+        change = {"bodies": tuple(bodies)}
+    else:
+        change = {"gravity": (0.0, 0.0, -9.81)}
+    right, bad, q0, qda0 = _wrist_fall(**change)
+    real = g.engine_model
+    monkeypatch.setattr(g, "engine_model", lambda m, **kw: real(right, **kw))
+    sim, drift = g._simulation_checks(bad, "agile eye", q0, qda0)
+    assert sim.failed, (sim.max_error, sim.note)
+    t_off = float(sim.detail.split("diverged from the engine after t = ")[1].split(" s")[0])
+    assert t_off < 0.2852 - g.CROSSING_MARGIN  # before the right description's crossing
+    assert drift.passed  # the wrong description's own energy is conserved: only the comparison sees it
+
+
+@pytest.mark.parametrize("before", [5.2e-3, 1e-3])
+def test_a_crossing_too_early_is_inconclusive(before):
+    """Started 5.2 ms (or 1 ms) before the crossing, 0.3 s asked: 3.2 ms (or nothing, the margin being
+    2 ms) are left to compare, less than MIN_COMPARED_FRACTION of the duration: both rows inconclusive
+    (neither passed nor failed; no error where nothing was compared), the report passes and says so."""
+    mech = mb.from_mjcf(AGILE_EYE)
+    _, mo = g.driven_motion(mech, "agile eye")
+    fall = g._fall(mech, mo.q[0], g._sample_times(0.3), qd_act0=mo.qda[0])
+    k = int(np.searchsorted(fall.t, 0.28))
+    start = mb.simulate(mech, fall.q[k], t=[0.28, fall.crossing - before], qd0=fall.qd[k])
+    checks = g._simulation_checks(mech, "agile eye", start.q[-1], qd0=start.qd[-1])
+    assert [c.status for c in checks] == ["inconclusive", "inconclusive"]
+    assert not any(c.passed or c.failed for c in checks)
+    assert f"loses rank) at t = {before:.2g}" in checks[0].note, checks[0].note
+    assert "inconclusive" in checks[0].note
+    assert np.isfinite(checks[0].max_error) == (before > g.CROSSING_MARGIN)
+    report = VerificationReport(checks)
+    assert report.passed and report.table().endswith("0 passed, 0 failed, 2 inconclusive")
+    assert [c["status"] for c in json.loads(dumps_json(report.as_dict()))["checks"]] == ["inconclusive"] * 2
+
+
+def test_closure_rows_of_an_open_chain_are_not_applicable(tmp_path, capsys):
+    """An open chain's closure and admissible-velocity rows are 0 by construction: reported n/a (not
+    pass, not fail) in the table, the JSON and the exit status; a closed chain's are judged (control)."""
+    rows = ("closure (engine efc_pos)", "admissible velocity (engine efc_J qd)")
+    open_chain = g.check_mechanism(mb.from_mjcf(PENDULUM), "pendulum", simulate=False)
+    closed = g.check_mechanism(mb.gallery.load("four_bar"), "four_bar", simulate=False)
+    assert {c.quantity: c.status for c in open_chain if c.quantity in rows} == dict.fromkeys(rows, "n/a")
+    assert {c.quantity: c.status for c in closed if c.quantity in rows} == dict.fromkeys(rows, "pass")
+    assert all(c.passed for c in open_chain if c.quantity not in rows)
+    report = VerificationReport(open_chain)
+    assert report.passed and report.table().endswith(f"{len(open_chain) - 2} passed, 0 failed, 2 n/a")
+    data = report.as_dict()
+    na = [c for c in data["checks"] if c["quantity"] in rows]
+    assert all(c["status"] == "n/a" and c["passed"] is False and "by construction" in c["note"] for c in na)
+    failing = VerificationReport([*open_chain, Check("pendulum", "control", 1.0, Tolerance(1e-3, "control"))])
+    assert not failing.passed  # n/a rows never hide a failure
+    path = tmp_path / "pendulum.xml"
+    path.write_text(PENDULUM)
+    assert main(["verify", str(path), "--quiet", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["passed"] and [c["status"] for c in out["checks"] if c["quantity"] in rows] == ["n/a", "n/a"]
+
+
+def test_a_type_ii_singularity_alone_does_not_stop_a_passive_fall():
+    """Control: the 3-RPS test fall crosses type II singularities from t ~ 0.257 s (its square passive block
+    of K changes the sign of its determinant between two samples) while K keeps its rank: with no actuator
+    holding a joint the motion is determined there, both codes follow it (1e-8), and the comparison runs
+    over the whole 0.3 s without a note."""
+    mech = mb.gallery.load("rps_3")
+    checks = g.check_mechanism(mech, "rps_3")
+    sims = _sim_rows(checks)
+    assert all(c.passed and not c.note for c in sims), [(c.max_error, c.note) for c in sims]
+    _, mo = g.driven_motion(mech, "rps_3")
+    fall = g._fall(mech, mo.q[0], g._sample_times(0.3), qd_act0=mo.qda[0])
+    assert fall.crossing is None and len(fall.t) == g.SIM_SAMPLES
+    passive = np.setdiff1d(np.arange(mech.nv), mech.tree.act_dof)
+    Kp = mb.constraint_jacobian(mech, fall.q)[:, :, passive]
+    assert Kp.shape[1] == Kp.shape[2]
+    sign = np.sign(np.linalg.det(Kp))
+    flips = fall.t[1:][sign[1:] != sign[:-1]]
+    assert len(flips) >= 1 and 0.25 < flips[0] <= 0.26, flips  # (and again at 0.28 and 0.3 s)

@@ -42,3 +42,24 @@ def test_pinocchio_checks_have_teeth(monkeypatch):
 
 def test_a_mechanism_without_description_is_a_usage_error(capsys):
     assert main(["verify", "--engine", "pinocchio", "continuum"]) == 2
+
+
+def test_an_open_chains_closure_rows_are_not_applicable_against_pinocchio(tmp_path, capsys):
+    """A double pendulum has no constraint rows: its closure and admissible-velocity rows are n/a (0 by
+    construction), the rest pass and the exit status is 0; the four-bar's are judged (the gallery test)."""
+    path = tmp_path / "pendulum.xml"
+    path.write_text(
+        '<mujoco><worldbody><body name="l1"><joint name="j1" axis="0 1 0"/>'
+        '<geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.02" mass="1"/>'
+        '<body name="l2" pos="0.5 0 0"><joint name="j2" axis="0 1 0"/>'
+        '<geom type="capsule" fromto="0 0 0 0.4 0 0" size="0.02" mass="0.7"/></body></body>'
+        "</worldbody></mujoco>"
+    )
+    assert main(["verify", "--engine", "pinocchio", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "4 passed, 0 failed, 2 n/a" in out
+    na = [line for line in out.splitlines() if line.rstrip().endswith("n/a") and "passed" not in line]
+    assert [("closure" in line, "admissible velocity" in line) for line in na] == [
+        (True, False),
+        (False, True),
+    ]

@@ -408,13 +408,15 @@ def _verification_status(out_root: Path) -> tuple[dict[str, str], str | None]:
         data = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return {}, None
-    status: dict[str, list[bool]] = {}
-    for c in data.get("checks", []):
-        status.setdefault(str(c.get("mechanism")), []).append(bool(c.get("passed")))
-    out = {
-        m: (f"pass ({len(v)} checks)" if all(v) else f"FAIL ({v.count(False)} of {len(v)} checks)")
-        for m, v in status.items()
-    }
+    status: dict[str, list[str]] = {}
+    for c in data.get("checks", []):  # "status": pass, FAIL, n/a or inconclusive (older files: "passed")
+        s = c.get("status") or ("pass" if c.get("passed") else "FAIL")
+        status.setdefault(str(c.get("mechanism")), []).append(str(s))
+    out = {}
+    for m, v in status.items():
+        rest = "".join(f", {v.count(s)} {s}" for s in sorted(set(v) - {"pass", "FAIL"}))
+        fails = v.count("FAIL")
+        out[m] = f"FAIL ({fails} of {len(v)} checks{rest})" if fails else f"pass ({len(v)} checks{rest})"
     for s in data.get("skipped", []):
         out[str(s.get("mechanism"))] = f"skipped: {s.get('reason')}"
     return out, (data.get("provenance") or {}).get("date_utc")

@@ -211,6 +211,10 @@ class Tolerance:
         object.__setattr__(self, "relative", check_bool(self.relative, "relative"))
 
 
+# What a check that is neither passed nor failed says instead (Check.verdict).
+NOT_JUDGED = ("n/a", "inconclusive")
+
+
 @dataclass(frozen=True)
 class Check:
     """One comparison of a model quantity against an independent engine or model.
@@ -228,13 +232,27 @@ class Check:
         The bound and its reason.
     detail : str, optional
         Free text (sample counts, where the maximum occurred).
+    verdict : str, optional
+        ``""`` (default): judged by the tolerance, pass or FAIL.  ``"n/a"``: the quantity does not
+        apply to this mechanism (it would be 0 by construction, e.g. the closure of an open chain);
+        ``"inconclusive"``: too little could be compared.  Either is neither passed nor failed.
+    note : str, optional
+        A remark the report prints under the check whatever its result (a comparison cut short, why a
+        check does not apply).
+
+    Raises
+    ------
+    ValueError
+        If ``verdict`` is not one of ``""``, ``"n/a"``, ``"inconclusive"``.
 
     Examples
     --------
     >>> from robomech.verify import Check, Tolerance
     >>> c = Check("demo", "tip position (m)", 2e-9, Tolerance(1e-6, "engine constraint stiffness"))
-    >>> c.passed, c.as_dict()["tolerance"]
-    (True, 1e-06)
+    >>> c.passed, c.status, c.as_dict()["tolerance"]
+    (True, 'pass', 1e-06)
+    >>> Check("demo", "closure", 0.0, Tolerance(1e-9, "rounding"), verdict="n/a").status
+    'n/a'
     """
 
     mechanism: str
@@ -242,11 +260,27 @@ class Check:
     max_error: float
     tolerance: Tolerance
     detail: str = ""
+    verdict: str = ""
+    note: str = ""
+
+    def __post_init__(self) -> None:
+        if self.verdict not in (*NOT_JUDGED, ""):
+            raise ValueError(f"Expected verdict to be one of '', {NOT_JUDGED}, got {self.verdict!r}.")
 
     @property
     def passed(self) -> bool:
-        """``max_error`` is finite and at most ``tolerance.value``."""
-        return math.isfinite(self.max_error) and self.max_error <= self.tolerance.value
+        """Judged (no ``verdict``), ``max_error`` finite and at most ``tolerance.value``."""
+        return not self.verdict and math.isfinite(self.max_error) and self.max_error <= self.tolerance.value
+
+    @property
+    def failed(self) -> bool:
+        """Judged (no ``verdict``) and not passed: an n/a or inconclusive check has not failed."""
+        return not self.verdict and not self.passed
+
+    @property
+    def status(self) -> str:
+        """``"pass"``, ``"FAIL"``, or the ``verdict`` (``"n/a"``, ``"inconclusive"``)."""
+        return self.verdict or ("pass" if self.passed else "FAIL")
 
     def as_dict(self) -> dict[str, Any]:
         """Plain Python types only (numpy scalars converted; a non-finite error becomes None)."""
@@ -259,7 +293,9 @@ class Check:
             "relative": bool(self.tolerance.relative),
             "reason": str(self.tolerance.reason),
             "passed": bool(self.passed),
+            "status": self.status,
             "detail": str(self.detail),
+            "note": str(self.note),
         }
 
 
@@ -316,8 +352,9 @@ class VerificationReport:
 
     @property
     def passed(self) -> bool:
-        """Every check that ran passed (skipped verifications are listed, not failed)."""
-        return all(c.passed for c in self.checks)
+        """No check that ran failed (skipped verifications are listed, n/a and inconclusive checks
+        counted, not failed)."""
+        return not any(c.failed for c in self.checks)
 
     def as_dict(self) -> dict[str, Any]:
         """``passed``, every check's :meth:`Check.as_dict` and the skipped ones, as plain data."""
@@ -328,8 +365,8 @@ class VerificationReport:
         }
 
     def table(self) -> str:
-        """A plain-text table: one line per check (error, tolerance, pass/FAIL; a failure's detail on
-        the next line), skips and counts."""
+        """A plain-text table: one line per check (error, tolerance, pass/FAIL/n/a/inconclusive; a
+        failure's detail and any check's note on the next lines), skips and counts."""
         wq = max([len("quantity"), *(len(c.quantity) for c in self.checks)])
         wm = max([len("mechanism"), *(len(c.mechanism) for c in self.checks)])
         header = f"{'mechanism':<{wm}} {'quantity':<{wq}} {'max error':>11} {'tolerance':>11}      result"
@@ -338,12 +375,17 @@ class VerificationReport:
             kind = " rel" if c.tolerance.relative else ""
             lines.append(
                 f"{c.mechanism:<{wm}} {c.quantity:<{wq}} {c.max_error:>11.3e} "
-                f"{c.tolerance.value:>11.1e}{kind:4}  {'pass' if c.passed else 'FAIL'}"
+                f"{c.tolerance.value:>11.1e}{kind:4}  {c.status}"
             )
-            if not c.passed and c.detail:  # a failure says why under its line
+            if c.failed and c.detail:  # a failure says why under its line
                 lines.append(f"{'':<{wm}}   why: {c.detail}")
-        n_fail = sum(not c.passed for c in self.checks)
+            if c.note:
+                lines.append(f"{'':<{wm}}  note: {c.note}")
+        n_pass = sum(c.passed for c in self.checks)
+        n_fail = sum(c.failed for c in self.checks)
         lines += [f"skipped: {n} — {r}" for n, r in self.skipped]
-        tail = f", {len(self.skipped)} skipped" if self.skipped else ""
-        lines.append(f"{len(self.checks) - n_fail} passed, {n_fail} failed{tail}")
+        tail = "".join(
+            f", {n} {v}" for v in NOT_JUDGED if (n := sum(c.verdict == v for c in self.checks))
+        ) + (f", {len(self.skipped)} skipped" if self.skipped else "")
+        lines.append(f"{n_pass} passed, {n_fail} failed{tail}")
         return "\n".join(lines)

@@ -97,9 +97,11 @@ def check_mechanism_pinocchio(mech, name: str | None = None) -> list[Check]:
         tau = np.linalg.lstsq(Nn.T @ (T.T @ E), Nn.T @ f, rcond=None)[0]
         tau_err = max(tau_err, float(np.abs(tau - inv.tau[i]).max()))
         tau_scale = max(tau_scale, float(np.abs(inv.tau[i]).max()))
+    na, why_na = g._open_chain(len(pairs) + len(mech.couplings))
     checks += [
-        Check(name, "closure (constraint-model frames)", closure, g.TOL_CLOSURE, ""),
-        Check(name, "admissible velocity (frame Jacobians . v)", g._rel(adm, vscale * L), g.TOL_VELOCITY, ""),
+        Check(name, "closure (constraint-model frames)", closure, g.TOL_CLOSURE, "", na, why_na),
+        Check(name, "admissible velocity (frame Jacobians . v)", g._rel(adm, vscale * L), g.TOL_VELOCITY, "",
+              na, why_na),
         Check(name, "body frames (framesForwardKinematics)", frames, g.TOL_CLOSURE, ""),
         Check(name, "mass matrix (crba)", g._rel(m_err, m_scale), g.TOL_TORQUE, ""),
         Check(name, "inverse dynamics (rnea through the constraint Jacobian)", g._rel(tau_err, tau_scale),

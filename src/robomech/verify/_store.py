@@ -219,6 +219,8 @@ def computed_once(name: str, params: object, compute: Callable[[], Mapping[str, 
 
 
 _CHECK_FIELDS = ("mechanism", "quantity", "max_error", "tolerance", "reason", "relative", "detail")
+# Columns a store written before them lacks: read as their default ("").
+_OPTIONAL_FIELDS = ("verdict", "note")
 
 
 def checks_to_arrays(checks: list[Check]) -> dict[str, np.ndarray]:
@@ -231,6 +233,7 @@ def checks_to_arrays(checks: list[Check]) -> dict[str, np.ndarray]:
         "reason": np.array([c.tolerance.reason for c in checks], dtype=str),
         "relative": np.array([c.tolerance.relative for c in checks], dtype=bool),
         "detail": np.array([c.detail for c in checks], dtype=str),
+        **{f: np.array([getattr(c, f) for c in checks], dtype=str) for f in _OPTIONAL_FIELDS},
     }
 
 
@@ -238,6 +241,9 @@ def checks_from_arrays(columns: Mapping[str, Any]) -> list[Check]:
     """The checks of :func:`checks_to_arrays`' columns."""
     n = len(columns["quantity"])
     col = {k: np.asarray(columns[k]).reshape(n) for k in _CHECK_FIELDS}
+    extra = {
+        k: np.asarray(columns[k]).reshape(n) if k in columns else np.full(n, "") for k in _OPTIONAL_FIELDS
+    }
     return [
         Check(
             str(col["mechanism"][i]),
@@ -245,6 +251,7 @@ def checks_from_arrays(columns: Mapping[str, Any]) -> list[Check]:
             float(col["max_error"][i]),
             Tolerance(float(col["tolerance"][i]), str(col["reason"][i]), bool(col["relative"][i])),
             str(col["detail"][i]),
+            **{k: str(extra[k][i]) for k in _OPTIONAL_FIELDS},
         )
         for i in range(n)
     ]
