@@ -165,6 +165,7 @@ def test_rate_columns_equal_the_per_product_kernel(name):
     with random ``v``, on assembled and unassembled samples, at every batch size."""
     from robomech.multibody import _compiled as C
     from robomech.multibody._compile import compile_model
+
     from ._reference import integrate
 
     mech = _get(name)
