@@ -342,13 +342,6 @@ def _run_chunked(fn, n: int, arrays: list[np.ndarray], **kw) -> dict[str, np.nda
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
 
 
-def _finite_rows(*xs: np.ndarray) -> np.ndarray:
-    ok = np.ones(xs[0].shape[0], dtype=bool)
-    for x in xs:
-        ok &= np.all(np.isfinite(x.reshape(x.shape[0], int(np.prod(x.shape[1:])))), axis=-1)
-    return ok
-
-
 def _broadcast(mech, q, others: list[tuple[object, str, int]], qname: str = "q"):
     """Validate ``q`` (non-finite allowed: masked) and the others (..., n); broadcast, flatten."""
     qv = as_array(q, qname, (mech.nq,), finite=False)
@@ -380,9 +373,10 @@ def _site_inputs(mech, q, arrays, wrenches):
 
 def _sanitize(mech, flat: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray]]:
     # a sample with an entry beyond MAX_MAGNITUDE (1e300, say) would overflow in products: masked like NaN
-    ok = _finite_rows(*flat)
+    # (|x| <= MAX_MAGNITUDE is False for NaN and inf too: one pass tests finiteness and magnitude)
+    ok = np.ones(flat[0].shape[0], dtype=bool)
     for a in flat:
-        ok &= np.all(np.abs(np.where(np.isfinite(a), a, 0.0)) <= MAX_MAGNITUDE, axis=-1)
+        ok &= np.all(np.abs(a) <= MAX_MAGNITUDE, axis=-1)
     out = []
     for i, a in enumerate(flat):
         a = np.array(a, dtype=float)
@@ -410,14 +404,17 @@ def _shape(d: dict, batch, ok: np.ndarray, nan_keys) -> dict:
         v = np.asarray(d[k])
         keep &= np.all(np.isfinite(v.reshape(v.shape[0], int(np.prod(v.shape[1:])))), axis=-1)
     res = {}
-    for k, v in d.items():
-        v = np.array(v)
+    all_ok, all_kept = bool(ok.all()), bool(keep.all())
+    for k, v in d.items():  # every branch returns a new array (no result aliases an input or a cache)
+        v = np.asarray(v)
         if k == "valid":
             v = v & fin
-        elif k in nan_keys:
+        elif k in nan_keys and not all_kept:
             v = np.where(keep.reshape(-1, *(1,) * (v.ndim - 1)), v, np.nan)
-        elif v.dtype.kind == "f":
+        elif v.dtype.kind == "f" and k not in nan_keys and not all_ok:
             v = np.where(ok.reshape(-1, *(1,) * (v.ndim - 1)), v, np.nan)
+        else:  # nothing to mask (np.where would only copy, at twice the cost)
+            v = v.copy()
         res[k] = np.reshape(v, (*batch, *v.shape[1:]))
     return res
 

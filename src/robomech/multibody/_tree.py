@@ -63,7 +63,7 @@ def normalize_quaternions(tree: Tree, q: np.ndarray) -> np.ndarray:
     q = np.array(q, dtype=float, copy=True)
     for a in tree.quat_adr:
         qt = q[..., a : a + 4]
-        n = np.linalg.norm(qt, axis=-1, keepdims=True)
+        n = np.sqrt(np.einsum("...i,...i->...", qt, qt))[..., None]
         q[..., a : a + 4] = np.where(
             n > _QUAT_MIN_NORM, qt / np.where(n > _QUAT_MIN_NORM, n, 1.0), [1, 0, 0, 0]
         )
