@@ -952,13 +952,6 @@ def compiled_singular_values(model, q: np.ndarray, site: int, L: float, rows: tu
 
 # ----------------------------------------------------------------------------- inverse dynamics
 @_nj
-def _cross_into(a0, a1, a2, b0, b1, b2, out, o):  # pragma: no cover - compiled
-    out[o] = a1 * b2 - a2 * b1
-    out[o + 1] = a2 * b0 - a0 * b2
-    out[o + 2] = a0 * b1 - a1 * b0
-
-
-@_nj
 def _all_finite(x):  # pragma: no cover - compiled
     for v in x.ravel():
         if not np.isfinite(v):

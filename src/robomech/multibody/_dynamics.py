@@ -42,7 +42,6 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import TypeVar
 
 import numpy as np
 
@@ -83,21 +82,10 @@ __all__ = [
 CHUNK = 2048
 
 
-# ----------------------------------------------------------------------------- cached mechanism data
-_T = TypeVar("_T")
-
-
+# ----------------------------------------------------------------------------- helpers
 def _mv(A: np.ndarray, x: np.ndarray) -> np.ndarray:
     """Batched matrix-vector product ``A (N, i, j) x (N, j) -> (N, i)`` (matmul, BLAS)."""
     return (A @ x[..., None])[..., 0]
-
-
-def _cache(mech: Mechanism, key: str, make: Callable[[], _T]) -> _T:
-    d = compile_model(mech).cache  # the compiled model's, never the frozen description
-    if key not in d:
-        d[key] = make()
-    out: _T = d[key]
-    return out
 
 
 def _bodies(mech: Mechanism) -> Bodies:
